@@ -1,0 +1,28 @@
+// eikon — eikonal rendering of refractive, dispersive and birefringent objects.
+#include <cstdio>
+#include <exception>
+
+#include "apps/commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"eikon: eikonal rendering of gems, prisms and crystals (see README.md)", "eikon"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "eikon 0.1.0");
+  eikon::cli::addRenderCommand(app);
+  eikon::cli::addTraceCommand(app);
+  eikon::cli::addInfoCommand(app);
+  eikon::cli::addFitCommand(app);
+  eikon::cli::addBenchCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const eikon::cli::CliError& e) {
+    std::fprintf(stderr, "eikon: error: %s\n", e.what());
+    return e.exit_code;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "eikon: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
