@@ -1,0 +1,2 @@
+// module placeholder (filled in by its issue)
+namespace eikon { [[maybe_unused]] static int placeholder_scene = 0; }
