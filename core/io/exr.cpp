@@ -1,0 +1,164 @@
+#include "core/io/exr.h"
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfTestFile.h>
+#include <ImfCheckFile.h>
+#include <png.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <stdexcept>
+
+namespace eikon {
+namespace {
+
+std::filesystem::path tempPathFor(const std::filesystem::path& path) {
+  std::random_device rd;
+  char suffix[32];
+  std::snprintf(suffix, sizeof suffix, ".tmp-%08x", rd());
+  return std::filesystem::path(path.string() + suffix);
+}
+
+/// Run `write(tmp)` then rename tmp over path; remove tmp on any failure.
+template <typename F>
+void atomicWrite(const std::filesystem::path& path, F&& write) {
+  checkWritable(path);
+  auto tmp = tempPathFor(path);
+  try {
+    write(tmp);
+    std::filesystem::rename(tmp, path);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
+}
+
+}  // namespace
+
+void checkWritable(const std::filesystem::path& path) {
+  auto dir = path.parent_path();
+  if (dir.empty()) dir = ".";
+  if (!std::filesystem::is_directory(dir))
+    throw std::runtime_error("cannot write '" + path.string() + "': directory '" + dir.string() + "' does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw std::runtime_error("cannot write '" + path.string() + "': directory '" + dir.string() + "' is not writable");
+  if (std::filesystem::is_directory(path))
+    throw std::runtime_error("cannot write '" + path.string() + "': it is a directory");
+}
+
+RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_height) {
+  const std::string p = path.string();
+  if (!std::filesystem::is_regular_file(path)) throw std::runtime_error("'" + p + "': no such file");
+  bool tiled = false, deep = false, multipart = false;
+  if (!Imf::isOpenExrFile(p.c_str(), tiled, deep, multipart)) throw std::runtime_error("'" + p + "' is not an OpenEXR file");
+  if (deep) throw std::runtime_error("'" + p + "' is a deep EXR image; deep images are not supported");
+  // checkOpenEXRFile returns true when it found a problem.
+  if (Imf::checkOpenEXRFile(p.c_str(), /*reduceMemory=*/true, /*reduceTime=*/true))
+    throw std::runtime_error("'" + p + "' failed the OpenEXR integrity check (corrupt or unsafe file)");
+  try {
+    Imf::InputFile file(p.c_str());
+    const auto dw = file.header().dataWindow();
+    long w = long(dw.max.x) - dw.min.x + 1, h = long(dw.max.y) - dw.min.y + 1;
+    if (w <= 0 || h <= 0 || w > max_width || h > max_height)
+      throw std::runtime_error("'" + p + "': image size " + std::to_string(w) + "x" + std::to_string(h) +
+                               " outside the accepted 1.." + std::to_string(max_width) + " x 1.." + std::to_string(max_height));
+    const auto& ch = file.header().channels();
+    if (!ch.findChannel("R") || !ch.findChannel("G") || !ch.findChannel("B"))
+      throw std::runtime_error("'" + p + "': expected R, G and B channels");
+    RgbaImage img;
+    img.width = int(w);
+    img.height = int(h);
+    img.rgba.assign(size_t(w * h * 4), 1.0f);
+    Imf::FrameBuffer fb;
+    char* base = reinterpret_cast<char*>(img.rgba.data()) - (long(dw.min.x) + long(dw.min.y) * w) * 4 * long(sizeof(float));
+    const char* names[4] = {"R", "G", "B", "A"};
+    for (int c = 0; c < 4; ++c)
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 4 * sizeof(float), size_t(4 * w) * sizeof(float), 1, 1, c == 3 ? 1.0 : 0.0));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    for (float v : img.rgba)
+      if (!std::isfinite(v)) throw std::runtime_error("'" + p + "' contains NaN or infinite pixels");
+    return img;
+  } catch (const std::runtime_error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw std::runtime_error("'" + p + "': " + e.what());
+  }
+}
+
+void writeExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels) {
+  atomicWrite(path, [&](const std::filesystem::path& tmp) {
+    Imf::Header header(width, height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    for (const auto& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+    Imf::FrameBuffer fb;
+    for (const auto& c : channels)
+      fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data, sizeof(float), size_t(width) * sizeof(float)));
+    Imf::OutputFile file(tmp.c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(height);
+  });
+}
+
+void writeExrRgb(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb) {
+  size_t n = size_t(width) * size_t(height);
+  if (rgb.size() != 3 * n) throw std::invalid_argument("writeExrRgb: pixel count mismatch");
+  std::vector<float> r(n), g(n), b(n);
+  for (size_t i = 0; i < n; ++i) {
+    r[i] = rgb[3 * i];
+    g[i] = rgb[3 * i + 1];
+    b[i] = rgb[3 * i + 2];
+  }
+  writeExr(path, width, height, {{"R", r.data()}, {"G", g.data()}, {"B", b.data()}});
+}
+
+void writePngPreview(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb,
+                     double exposure) {
+  size_t n = size_t(width) * size_t(height);
+  if (rgb.size() != 3 * n) throw std::invalid_argument("writePngPreview: pixel count mismatch");
+  std::vector<unsigned char> px(3 * n);
+  const double scale = std::pow(2.0, exposure);
+  auto encode = [](double v) {
+    v = std::clamp(v, 0.0, 1.0);
+    double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+    return (unsigned char)std::lround(s * 255.0);
+  };
+  for (size_t i = 0; i < n; ++i) {
+    double r = rgb[3 * i] * scale, g = rgb[3 * i + 1] * scale, b = rgb[3 * i + 2] * scale;
+    double lum = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+    double k = lum > 0 ? (lum / (1.0 + lum / 4.0)) / lum : 1.0;  // soft shoulder above ~1
+    px[3 * i] = encode(r * k);
+    px[3 * i + 1] = encode(g * k);
+    px[3 * i + 2] = encode(b * k);
+  }
+  atomicWrite(path, [&](const std::filesystem::path& tmp) {
+    FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw std::runtime_error("cannot open '" + tmp.string() + "' for writing");
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png ? png_create_info_struct(png) : nullptr;
+    if (!png || !info || setjmp(png_jmpbuf(png))) {
+      png_destroy_write_struct(&png, &info);
+      std::fclose(f);
+      throw std::runtime_error("libpng failed writing '" + path.string() + "'");
+    }
+    png_init_io(png, f);
+    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    for (int y = 0; y < height; ++y) png_write_row(png, &px[size_t(y) * size_t(width) * 3]);
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    if (std::fclose(f) != 0) throw std::runtime_error("error closing '" + tmp.string() + "'");
+  });
+}
+
+}  // namespace eikon

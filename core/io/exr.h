@@ -1,0 +1,45 @@
+// Image files: OpenEXR (linear HDR, float) in and out, PNG previews, and atomic writes.
+//
+// Every writer writes to "<path>.tmp-XXXX" in the same directory and renames it into place, so a
+// failed or interrupted run leaves no partial file. Readers validate before decoding: Debian's
+// OpenEXR 3.1.5 has a known flaw with deep images, so EXR input is accepted only after
+// Imf::checkOpenEXRFile passes, deep files are rejected, and sizes are capped.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace eikon {
+
+struct RgbaImage {
+  int width = 0, height = 0;
+  std::vector<float> rgba;  ///< rows from the top, 4 floats per pixel
+};
+
+/// Read an RGB(A) EXR. Throws std::runtime_error for unreadable, corrupt, deep, tiled-deep or
+/// oversized files (width > max_width or height > max_height).
+RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_height);
+
+/// One named float channel of an EXR file ("R", "G", "B", or e.g. "S0.550,000000nm").
+struct ExrChannel {
+  std::string name;
+  const float* data;  ///< width*height floats, rows from the top
+};
+
+/// Write float channels to an EXR (ZIP compression) atomically.
+void writeExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels);
+
+/// Write linear RGB floats (3 per pixel) as an EXR with R, G, B channels, atomically.
+void writeExrRgb(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb);
+
+/// Write an 8-bit sRGB PNG preview of linear RGB (3 floats per pixel): multiply by 2^exposure,
+/// Reinhard-style tone map x/(1+x) on luminance-preserving ratio, sRGB transfer. Atomic.
+void writePngPreview(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb,
+                     double exposure = 0.0);
+
+/// Check that `path` can be created (directory exists and is writable); throws with a clear
+/// message otherwise. Call before long work so that it fails early.
+void checkWritable(const std::filesystem::path& path);
+
+}  // namespace eikon

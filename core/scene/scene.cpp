@@ -1,0 +1,571 @@
+#include "core/scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/io/exr.h"
+
+namespace eikon {
+namespace {
+
+using json = nlohmann::json;
+constexpr double kPi = 3.14159265358979323846;
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+/// A JSON value with its location, for error messages that name file and path.
+class Node {
+ public:
+  Node(const json& j, std::string path, const std::string& file) : j_(j), path_(std::move(path)), file_(file) {}
+
+  [[noreturn]] void fail(const std::string& msg) const {
+    throw SceneError(file_ + ": " + (path_.empty() ? "/" : path_) + ": " + msg);
+  }
+  const json& raw() const { return j_; }
+  const std::string& path() const { return path_; }
+  bool isObject() const { return j_.is_object(); }
+  bool isNumber() const { return j_.is_number(); }
+  bool isArray() const { return j_.is_array(); }
+  bool isString() const { return j_.is_string(); }
+
+  void requireObject() const {
+    if (!j_.is_object()) fail("expected an object");
+  }
+  void allowKeys(std::initializer_list<const char*> keys) const {
+    requireObject();
+    std::set<std::string> allowed(keys.begin(), keys.end());
+    for (auto it = j_.begin(); it != j_.end(); ++it)
+      if (!allowed.count(it.key())) {
+        std::string list;
+        for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
+        throw SceneError(file_ + ": " + path_ + "/" + it.key() + ": unknown key (allowed here: " + list + ")");
+      }
+  }
+  bool has(const std::string& key) const { return j_.is_object() && j_.contains(key); }
+  Node at(const std::string& key) const {
+    requireObject();
+    if (!j_.contains(key)) fail("missing required key '" + key + "'");
+    return Node(j_.at(key), path_ + "/" + key, file_);
+  }
+  std::optional<Node> get(const std::string& key) const {
+    if (!has(key)) return std::nullopt;
+    return Node(j_.at(key), path_ + "/" + key, file_);
+  }
+  Node index(size_t i) const { return Node(j_.at(i), path_ + "/" + std::to_string(i), file_); }
+  size_t size() const { return j_.size(); }
+
+  double number() const {
+    if (!j_.is_number()) fail("expected a number, got " + std::string(j_.type_name()));
+    double v = j_.get<double>();
+    if (!std::isfinite(v)) fail("must be finite");
+    return v;
+  }
+  double number(double lo, double hi, bool lo_open = false) const {
+    double v = number();
+    if (v < lo || (lo_open && v == lo) || v > hi)
+      fail("must be in " + std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + "], got " + fmt(v));
+    return v;
+  }
+  double positive() const {
+    double v = number();
+    if (!(v > 0)) fail("must be > 0, got " + fmt(v));
+    return v;
+  }
+  int integer(int lo, int hi) const {
+    if (!j_.is_number_integer()) fail("expected an integer");
+    long long v = j_.get<long long>();
+    if (v < lo || v > hi) fail("must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + std::to_string(v));
+    return int(v);
+  }
+  std::string string() const {
+    if (!j_.is_string()) fail("expected a string");
+    return j_.get<std::string>();
+  }
+  std::vector<double> numbers() const {
+    if (!j_.is_array()) fail("expected an array of numbers");
+    std::vector<double> v;
+    for (size_t i = 0; i < j_.size(); ++i) v.push_back(index(i).number());
+    return v;
+  }
+  glm::dvec3 vec3() const {
+    if (!j_.is_array() || j_.size() != 3) fail("expected an array of 3 numbers");
+    return {index(0).number(), index(1).number(), index(2).number()};
+  }
+  glm::dvec3 color() const {  // a number (grey) or [r, g, b], all ≥ 0
+    glm::dvec3 c = j_.is_number() ? glm::dvec3(number()) : vec3();
+    if (c.x < 0 || c.y < 0 || c.z < 0) fail("must be non-negative");
+    return c;
+  }
+  glm::dvec3 unitVector() const {
+    glm::dvec3 v = vec3();
+    double len = glm::length(v);
+    if (!(len > 1e-12) || !std::isfinite(len)) fail("must be a non-zero vector");
+    return v / len;
+  }
+
+ private:
+  const json& j_;
+  std::string path_;
+  const std::string& file_;
+};
+
+// ------------------------------------------------------------------ materials
+void checkIndexAtLeastOne(const Node& at, const Dispersion& d) {
+  // An index below 1 (or a Sellmeier pole) anywhere in the visible window is an error (never clamped).
+  for (double l = 380.0; l <= 780.0; l += 1.0) {
+    double n = d.index(l);
+    if (!(n >= 1.0)) at.fail("refractive index " + (std::isfinite(n) ? fmt(n) : std::string("undefined")) +
+                             " at " + fmt(l) + " nm is below 1");
+  }
+}
+
+Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
+  if (n.isNumber()) {
+    double v = n.number();
+    if (v < 1.0) n.fail("refractive index must be >= 1, got " + fmt(v));
+    return Dispersion::constant(v);
+  }
+  if (!n.isObject()) n.fail("expected a number or an object {\"cauchy\": [...]} / {\"sellmeier\": [...]}");
+  n.allowKeys({"cauchy", "sellmeier", "range_nm", "sigma", "linear", "luneburg", "maxwell_fisheye"});
+  int kinds = int(n.has("cauchy")) + int(n.has("sellmeier")) + int(n.has("linear")) + int(n.has("luneburg")) +
+              int(n.has("maxwell_fisheye"));
+  if (kinds != 1) n.fail("give exactly one of cauchy, sellmeier, linear, luneburg, maxwell_fisheye");
+  if (n.has("linear") || n.has("luneburg") || n.has("maxwell_fisheye")) {
+    if (!grin) n.fail("gradient-index profiles are allowed only for isotropic materials (key \"n\")");
+    if (auto l = n.get("linear")) {
+      l->allowKeys({"n0", "gradient_per_mm", "origin"});
+      grin->type = GrinProfile::Type::Linear;
+      grin->n0 = l->at("n0").number(1.0, 10.0);
+      grin->gradient = l->at("gradient_per_mm").vec3();
+      grin->origin = l->get("origin") ? l->at("origin").vec3() : glm::dvec3(0.0);
+    } else if (auto lu = n.get("luneburg")) {
+      lu->allowKeys({"center", "radius"});
+      grin->type = GrinProfile::Type::Luneburg;
+      grin->origin = lu->at("center").vec3();
+      grin->radius = lu->at("radius").positive();
+    } else {
+      auto f = n.at("maxwell_fisheye");
+      f.allowKeys({"center", "radius", "n0"});
+      grin->type = GrinProfile::Type::MaxwellFisheye;
+      grin->origin = f.at("center").vec3();
+      grin->radius = f.at("radius").positive();
+      grin->n0 = f.at("n0").number(1.0, 10.0);
+    }
+    return Dispersion::constant(grin->type == GrinProfile::Type::Linear ? grin->n0 : 1.0);
+  }
+  Dispersion d;
+  try {
+    if (auto c = n.get("cauchy")) {
+      auto v = c->numbers();
+      if (v.empty() || v.size() > 6) c->fail("cauchy needs 1 to 6 coefficients [A, B, C, ...] (λ in µm), got " + std::to_string(v.size()));
+      d = Dispersion::cauchy(v);
+    } else {
+      auto s = n.at("sellmeier");
+      auto v = s.numbers();
+      if (v.empty() || v.size() % 2 || v.size() > 12)
+        s.fail("sellmeier needs [B1..Bk, C1..Ck] (k = 1..6, C in µm²), got " + std::to_string(v.size()) + " numbers");
+      size_t k = v.size() / 2;
+      d = Dispersion::sellmeier({v.begin(), v.begin() + long(k)}, {v.begin() + long(k), v.end()});
+    }
+    if (auto r = n.get("range_nm")) {
+      auto v = r->numbers();
+      if (v.size() != 2 || !(v[0] > 0 && v[1] > v[0])) r->fail("range_nm must be [lo, hi] with 0 < lo < hi");
+      d.withRange(v[0], v[1]);
+    }
+  } catch (const std::invalid_argument& e) {
+    n.fail(e.what());
+  }
+  checkIndexAtLeastOne(n, d);
+  return d;
+}
+
+Attenuation parseAttenuation(const Node& n) {
+  Attenuation a;
+  if (n.isObject()) {
+    n.allowKeys({"wavelength_nm", "per_mm"});
+    a.wavelengths_nm = n.at("wavelength_nm").numbers();
+    a.values = n.at("per_mm").numbers();
+    if (a.wavelengths_nm.size() != a.values.size() || a.values.empty())
+      n.fail("wavelength_nm and per_mm must have the same non-zero length");
+    for (size_t i = 0; i < a.values.size(); ++i) {
+      if (a.values[i] < 0) n.fail("attenuation must be >= 0");
+      if (i && !(a.wavelengths_nm[i] > a.wavelengths_nm[i - 1])) n.fail("wavelength_nm must be strictly increasing");
+    }
+    return a;
+  }
+  a.rgb = n.color();
+  return a;
+}
+
+Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
+  if (is_file)
+    m.allowKeys({"name", "source", "notes", "fit", "n", "n_o", "n_e", "optic_axis", "attenuation_per_mm",
+                 "attenuation_o_per_mm", "attenuation_e_per_mm", "emission", "opacity"});
+  else
+    m.allowKeys({"n", "n_o", "n_e", "optic_axis", "attenuation_per_mm", "attenuation_o_per_mm",
+                 "attenuation_e_per_mm", "emission", "opacity", "source", "notes"});
+  Material mat;
+  mat.name = name;
+  if (auto s = m.get("source")) mat.source = s->string();
+  bool iso = m.has("n"), crystal = m.has("n_o") || m.has("n_e");
+  if (iso && crystal) m.fail("give either \"n\" (isotropic) or \"n_o\" and \"n_e\" (uniaxial), not both");
+  if (!iso && !crystal) m.fail("missing \"n\" (isotropic) or \"n_o\"/\"n_e\" (uniaxial)");
+  if (iso) {
+    mat.n_o = parseDispersion(m.at("n"), &mat.grin);
+    mat.n_e = mat.n_o;
+    if (m.has("optic_axis")) m.fail("optic_axis given for an isotropic material (use n_o and n_e)");
+    if (m.has("attenuation_o_per_mm") || m.has("attenuation_e_per_mm"))
+      m.fail("attenuation_o_per_mm/attenuation_e_per_mm are for uniaxial materials; use attenuation_per_mm");
+    if (auto a = m.get("attenuation_per_mm")) mat.attenuation_o = mat.attenuation_e = parseAttenuation(*a);
+  } else {
+    if (!m.has("n_o")) m.fail("uniaxial material is missing n_o");
+    if (!m.has("n_e")) m.fail("uniaxial material is missing n_e (extraordinary index)");
+    mat.uniaxial = true;
+    mat.n_o = parseDispersion(m.at("n_o"), nullptr);
+    mat.n_e = parseDispersion(m.at("n_e"), nullptr);
+    if (auto a = m.get("optic_axis")) mat.optic_axis = a->unitVector();
+    if (m.has("attenuation_per_mm")) m.fail("uniaxial materials take attenuation_o_per_mm and attenuation_e_per_mm");
+    if (auto a = m.get("attenuation_o_per_mm")) mat.attenuation_o = parseAttenuation(*a);
+    if (auto a = m.get("attenuation_e_per_mm")) mat.attenuation_e = parseAttenuation(*a);
+  }
+  if (auto e = m.get("emission")) mat.emission = e->color();
+  if (auto o = m.get("opacity")) mat.opacity = o->number(0.0, 1.0);
+  return mat;
+}
+
+// ------------------------------------------------------------------ objects
+SceneObject parseObject(const Node& o) {
+  o.requireObject();
+  std::string shape = o.at("shape").string();
+  glm::dvec3 center = o.get("center") ? o.at("center").vec3() : glm::dvec3(0.0);
+  glm::dvec3 rot = o.get("rotation_deg") ? o.at("rotation_deg").vec3() : glm::dvec3(0.0);
+  SceneObject obj;
+  ShapeGeometry g;
+  auto common = {"shape", "center", "rotation_deg", "material", "optic_axis"};
+  auto allow = [&](std::initializer_list<const char*> extra) {
+    std::vector<const char*> keys(common);
+    keys.insert(keys.end(), extra.begin(), extra.end());
+    std::set<std::string> allowed(keys.begin(), keys.end());
+    for (auto it = o.raw().begin(); it != o.raw().end(); ++it)
+      if (!allowed.count(it.key())) {
+        std::string list;
+        for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
+        o.fail("unknown key '" + it.key() + "' for shape '" + shape + "' (allowed: " + list + ")");
+      }
+  };
+  try {
+    if (shape == "sphere") {
+      allow({"radius"});
+      g = SphereShape{o.at("radius").positive()};
+    } else if (shape == "box") {
+      allow({"size"});
+      auto s = o.at("size").vec3();
+      if (!(s.x > 0 && s.y > 0 && s.z > 0)) o.at("size").fail("all sizes must be > 0");
+      g = BoxShape{s};
+    } else if (shape == "rounded_box") {
+      allow({"size", "radius"});
+      auto s = o.at("size").vec3();
+      if (!(s.x > 0 && s.y > 0 && s.z > 0)) o.at("size").fail("all sizes must be > 0");
+      double r = o.at("radius").positive();
+      if (2 * r > std::min(s.x, std::min(s.y, s.z))) o.at("radius").fail("corner radius exceeds half the smallest side");
+      g = RoundedBoxShape{s, r};
+    } else if (shape == "prism") {
+      allow({"apex_deg", "side", "height"});
+      g = makePrism(o.at("apex_deg").number(0.0, 180.0, true), o.at("side").positive(), o.at("height").positive());
+    } else if (shape == "brilliant") {
+      allow({"diameter", "table", "crown_deg", "pavilion_deg", "girdle", "facets"});
+      g = makeBrilliant(o.at("diameter").positive(), o.get("table") ? o.at("table").number(0.0, 1.0, true) : 0.57,
+                        o.get("crown_deg") ? o.at("crown_deg").number() : 34.5,
+                        o.get("pavilion_deg") ? o.at("pavilion_deg").number() : 40.75,
+                        o.get("girdle") ? o.at("girdle").number(0.0, 0.5) : 0.02,
+                        o.get("facets") ? o.at("facets").integer(3, 64) : 16);
+    } else if (shape == "planes") {
+      allow({"planes"});
+      auto p = o.at("planes");
+      if (!p.isArray()) p.fail("expected an array of [nx, ny, nz, d]");
+      ConvexShape c;
+      for (size_t i = 0; i < p.size(); ++i) {
+        auto v = p.index(i).numbers();
+        if (v.size() != 4) p.index(i).fail("expected [nx, ny, nz, d]");
+        glm::dvec3 n(v[0], v[1], v[2]);
+        double len = glm::length(n);
+        if (!(len > 1e-12)) p.index(i).fail("plane normal must be non-zero");
+        c.planes.push_back({n / len, v[3] / len});
+      }
+      finishConvex(c);
+      g = c;
+    } else if (shape == "mesh") {
+      o.at("shape").fail("shape 'mesh' is not supported yet (use planes for convex solids)");
+    } else {
+      o.at("shape").fail("unknown shape '" + shape + "' (sphere, box, rounded_box, prism, brilliant, planes)");
+    }
+  } catch (const std::invalid_argument& e) {
+    o.fail(e.what());
+  }
+  obj.shape = Shape(shape, g, center, rot);
+  obj.material = o.at("material").string();
+  if (auto a = o.get("optic_axis")) obj.optic_axis = a->unitVector();
+  return obj;
+}
+
+json readJsonFile(const std::filesystem::path& path, const char* what) {
+  std::ifstream in(path);
+  if (!in) throw SceneError(path.string() + ": cannot open " + what);
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw SceneError(path.string() + ": malformed JSON: " + e.what());
+  }
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ small physics helpers
+double GrinProfile::index(const glm::dvec3& x) const {
+  switch (type) {
+    case Type::None: return n0;
+    case Type::Linear: return n0 + glm::dot(gradient, x - origin);
+    case Type::Luneburg: {
+      double r2 = glm::dot(x - origin, x - origin) / (radius * radius);
+      return std::sqrt(std::max(2.0 - r2, 1.0));
+    }
+    case Type::MaxwellFisheye: {
+      double r2 = glm::dot(x - origin, x - origin) / (radius * radius);
+      return std::max(n0 / (1.0 + r2), 1.0);
+    }
+  }
+  return n0;
+}
+
+double Attenuation::at(double lambda_nm) const {
+  if (!wavelengths_nm.empty()) {
+    if (lambda_nm <= wavelengths_nm.front()) return values.front();
+    if (lambda_nm >= wavelengths_nm.back()) return values.back();
+    auto it = std::upper_bound(wavelengths_nm.begin(), wavelengths_nm.end(), lambda_nm);
+    size_t i = size_t(it - wavelengths_nm.begin());
+    double t = (lambda_nm - wavelengths_nm[i - 1]) / (wavelengths_nm[i] - wavelengths_nm[i - 1]);
+    return values[i - 1] + t * (values[i] - values[i - 1]);
+  }
+  // RGB bands at 612 (r), 549 (g), 465 (b) nm.
+  if (lambda_nm <= 465.0) return rgb.b;
+  if (lambda_nm >= 612.0) return rgb.r;
+  if (lambda_nm <= 549.0) return rgb.b + (rgb.g - rgb.b) * (lambda_nm - 465.0) / (549.0 - 465.0);
+  return rgb.g + (rgb.r - rgb.g) * (lambda_nm - 549.0) / (612.0 - 549.0);
+}
+
+bool Attenuation::isZero() const {
+  if (!values.empty()) return std::all_of(values.begin(), values.end(), [](double v) { return v == 0.0; });
+  return rgb == glm::dvec3(0.0);
+}
+
+glm::dvec3 Environment::lookup(const glm::dvec3& d) const {
+  // Latitude-longitude parameterisation: y is up; u = atan2(x, -z)/(2π) + 0.5, v = acos(y)/π.
+  double u = std::atan2(d.x, -d.z) / (2.0 * kPi) + 0.5;
+  double v = std::acos(std::clamp(d.y, -1.0, 1.0)) / kPi;
+  switch (type) {
+    case Type::Constant: return radiance * intensity;
+    case Type::Checker: {
+      long iu = long(std::floor(u * 2.0 * squares)), iv = long(std::floor(v * squares));
+      return ((iu + iv) & 1 ? color_b : color_a) * intensity;
+    }
+    case Type::LatLong: {
+      // Bilinear, wrapping in u, clamped in v; texel centres at (i + 0.5)/w.
+      double fx = u * image_width - 0.5, fy = v * image_height - 0.5;
+      long x0 = long(std::floor(fx)), y0 = long(std::floor(fy));
+      double tx = fx - double(x0), ty = fy - double(y0);
+      auto texel = [&](long x, long y) {
+        x = ((x % image_width) + image_width) % image_width;
+        y = std::clamp<long>(y, 0, image_height - 1);
+        const float* p = &image_rgba[size_t(4 * (y * image_width + x))];
+        return glm::dvec3(p[0], p[1], p[2]);
+      };
+      glm::dvec3 c = (1 - ty) * ((1 - tx) * texel(x0, y0) + tx * texel(x0 + 1, y0)) +
+                     ty * ((1 - tx) * texel(x0, y0 + 1) + tx * texel(x0 + 1, y0 + 1));
+      return c * intensity;
+    }
+  }
+  return glm::dvec3(0.0);
+}
+
+bool Scene::anyUniaxial() const {
+  return std::any_of(materials.begin(), materials.end(), [](const auto& m) { return m.second.uniaxial; });
+}
+
+bool Scene::anyDispersive() const {
+  return std::any_of(materials.begin(), materials.end(), [](const auto& m) {
+    return !m.second.n_o.isDispersionless() || !m.second.n_e.isDispersionless();
+  });
+}
+
+std::vector<std::filesystem::path> materialSearchPath() {
+  std::vector<std::filesystem::path> dirs;
+  if (const char* env = std::getenv("EIKON_MATERIALS_PATH")) {
+    std::stringstream ss(env);
+    std::string item;
+    while (std::getline(ss, item, ':'))
+      if (!item.empty()) dirs.emplace_back(item);
+  }
+  dirs.emplace_back(EIKON_MATERIALS_DIR);
+  return dirs;
+}
+
+Material loadMaterialFile(const std::filesystem::path& path) {
+  json j = readJsonFile(path, "material file");
+  const std::string file = path.string();
+  Node root(j, "", file);
+  std::string name = root.get("name") ? root.at("name").string() : path.stem().string();
+  return parseMaterial(root, name, true);
+}
+
+Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
+  json j;
+  const std::string file = origin.string();
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw SceneError(file + ": malformed JSON: " + e.what());
+  }
+  Scene scene;
+  scene.file = origin;
+  Node root(j, "", file);
+  root.allowKeys({"camera", "environment", "volume", "materials", "objects", "lights", "ambient_index", "description"});
+
+  if (auto c = root.get("camera")) {
+    c->allowKeys({"position", "look_at", "up", "fov_deg", "width", "height"});
+    auto& cam = scene.camera;
+    if (auto v = c->get("position")) cam.position = v->vec3();
+    if (auto v = c->get("look_at")) cam.look_at = v->vec3();
+    if (auto v = c->get("up")) cam.up = v->unitVector();
+    if (auto v = c->get("fov_deg")) cam.fov_deg = v->number(0.0, 179.0, true);
+    if (auto v = c->get("width")) cam.width = v->integer(1, 16384);
+    if (auto v = c->get("height")) cam.height = v->integer(1, 16384);
+    glm::dvec3 fwd = cam.look_at - cam.position;
+    if (glm::length(fwd) < 1e-9) c->fail("position and look_at coincide");
+    if (glm::length(glm::cross(glm::normalize(fwd), cam.up)) < 1e-6) c->fail("up is parallel to the viewing direction");
+  }
+
+  if (auto e = root.get("environment")) {
+    auto& env = scene.environment;
+    std::string type = e->at("type").string();
+    if (type == "checker") {
+      e->allowKeys({"type", "squares", "color_a", "color_b", "intensity"});
+      env.type = Environment::Type::Checker;
+      if (auto v = e->get("squares")) env.squares = v->integer(1, 4096);
+      if (auto v = e->get("color_a")) env.color_a = v->color();
+      if (auto v = e->get("color_b")) env.color_b = v->color();
+    } else if (type == "constant") {
+      e->allowKeys({"type", "radiance", "intensity"});
+      env.type = Environment::Type::Constant;
+      if (auto v = e->get("radiance")) env.radiance = v->color();
+    } else if (type == "latlong") {
+      e->allowKeys({"type", "file", "intensity"});
+      env.type = Environment::Type::LatLong;
+      std::filesystem::path p = e->at("file").string();
+      if (p.is_relative()) p = origin.parent_path() / p;
+      env.image_path = p;
+      try {
+        auto img = readExrRgba(p, 16384, 8192);
+        env.image_width = img.width;
+        env.image_height = img.height;
+        env.image_rgba = std::move(img.rgba);
+      } catch (const std::exception& ex) {
+        e->at("file").fail(ex.what());
+      }
+    } else {
+      e->at("type").fail("unknown environment type '" + type + "' (checker, constant, latlong)");
+    }
+    if (auto v = e->get("intensity")) env.intensity = v->number(0.0, 1e9);
+  }
+
+  if (auto v = root.get("volume")) {
+    v->allowKeys({"bounds_min", "bounds_max", "resolution", "smoothing_voxels"});
+    auto& vol = scene.volume;
+    if (auto b = v->get("bounds_min")) vol.bounds_min = b->vec3();
+    if (auto b = v->get("bounds_max")) vol.bounds_max = b->vec3();
+    glm::dvec3 ext = vol.bounds_max - vol.bounds_min;
+    if (!(ext.x > 0 && ext.y > 0 && ext.z > 0)) v->fail("bounds_max must exceed bounds_min on every axis");
+    if (auto r = v->get("resolution")) vol.resolution = r->integer(4, 1 << 20);  // device limit checked at upload
+    if (auto s = v->get("smoothing_voxels")) vol.smoothing_voxels = s->number(0.0, 8.0);
+  }
+  if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
+
+  if (auto ms = root.get("materials")) {
+    ms->requireObject();
+    for (auto it = ms->raw().begin(); it != ms->raw().end(); ++it)
+      scene.materials[it.key()] = parseMaterial(Node(it.value(), ms->path() + "/" + it.key(), file), it.key(), false);
+  }
+
+  auto objs = root.at("objects");
+  if (!objs.isArray()) objs.fail("expected an array of objects");
+  for (size_t i = 0; i < objs.size(); ++i) {
+    Node o = objs.index(i);
+    SceneObject obj = parseObject(o);
+    if (!scene.materials.count(obj.material)) {
+      bool found = false;
+      for (const auto& dir : materialSearchPath()) {
+        auto p = dir / (obj.material + ".json");
+        if (std::filesystem::exists(p)) {
+          scene.materials[obj.material] = loadMaterialFile(p);
+          found = true;
+          break;
+        }
+      }
+      if (!found)
+        o.at("material").fail("unknown material '" + obj.material +
+                              "' (not defined under /materials and not in the material library)");
+    }
+    const Material& mat = scene.materials[obj.material];
+    if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis)
+      o.fail("uniaxial material '" + obj.material + "' needs an optic_axis (on the object or the material)");
+    if (!mat.uniaxial && obj.optic_axis) o.at("optic_axis").fail("optic_axis given for an isotropic material");
+    auto [lo, hi] = obj.shape.bounds();
+    (void)lo;
+    (void)hi;
+    scene.objects.push_back(std::move(obj));
+  }
+
+  if (auto ls = root.get("lights")) {
+    if (!ls->isArray()) ls->fail("expected an array of lights");
+    for (size_t i = 0; i < ls->size(); ++i) {
+      Node l = ls->index(i);
+      Light light;
+      std::string type = l.at("type").string();
+      if (type == "directional") {
+        l.allowKeys({"type", "direction", "irradiance"});
+        light.type = Light::Type::Directional;
+        light.direction = l.at("direction").unitVector();
+        if (auto v = l.get("irradiance")) light.irradiance = v->number(0.0, 1e12);
+      } else if (type == "point") {
+        l.allowKeys({"type", "position", "intensity"});
+        light.type = Light::Type::Point;
+        light.position = l.at("position").vec3();
+        if (auto v = l.get("intensity")) light.irradiance = v->number(0.0, 1e12);
+      } else {
+        l.at("type").fail("unknown light type '" + type + "' (directional, point)");
+      }
+      scene.lights.push_back(light);
+    }
+  }
+  return scene;
+}
+
+Scene loadScene(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw SceneError(path.string() + ": cannot open scene file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parseScene(ss.str(), path);
+}
+
+}  // namespace eikon

@@ -1,0 +1,128 @@
+// A scene as read from scene.json (format: docs/scene-format.md; DESIGN §3).
+//
+//   eikon::Scene scene = eikon::loadScene("scenes/glass_sphere.json");   // throws SceneError
+//   scene.camera.width = 400;                                           // override before use
+//
+// Every user error is an eikon::SceneError whose message names the file and the JSON path
+// ("scenes/x.json: /objects/1/radius: must be > 0, got -3"). Unknown keys are errors; nothing is
+// clamped. Lengths are millimetres, wavelengths nanometres, attenuation per millimetre.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "anisotropic/dispersion.h"
+#include "core/scene/shapes.h"
+
+namespace eikon {
+
+struct SceneError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// A gradient-index profile that replaces a constant index inside an object (world coordinates).
+struct GrinProfile {
+  enum class Type { None, Linear, Luneburg, MaxwellFisheye } type = Type::None;
+  double n0 = 1.0;             ///< Linear: index at `origin`; Fisheye: n₀ of n₀/(1 + r²/R²)
+  glm::dvec3 gradient{0.0};    ///< Linear: ∇n per mm
+  glm::dvec3 origin{0.0};      ///< Linear origin / Luneburg and fisheye centre
+  double radius = 1.0;         ///< Luneburg: n = √(2 − r²/R²); fisheye R
+  /// Index at a world point (valid inside the object only).
+  double index(const glm::dvec3& x) const;
+};
+
+/// Wavelength-dependent attenuation σ(λ) per mm, given as RGB band values (placed at 612, 549 and
+/// 465 nm, linear in between, constant beyond) or as explicit spectral samples.
+struct Attenuation {
+  glm::dvec3 rgb{0.0};
+  std::vector<double> wavelengths_nm, values;  ///< spectral form (sorted), overrides rgb if set
+  double at(double lambda_nm) const;
+  bool isZero() const;
+};
+
+struct Material {
+  std::string name;
+  std::string source;             ///< where the data came from (library files)
+  bool uniaxial = false;
+  Dispersion n_o;                 ///< the index of an isotropic material, or the ordinary index
+  Dispersion n_e;                 ///< extraordinary index (uniaxial only)
+  GrinProfile grin;               ///< isotropic gradient-index profile (replaces n_o if set)
+  std::optional<glm::dvec3> optic_axis;  ///< unit vector, world space
+  Attenuation attenuation_o, attenuation_e;
+  glm::dvec3 emission{0.0};       ///< radiance per mm (translucent) or surface radiance (opaque)
+  double opacity = 0.0;           ///< 1 = opaque: rays stop at the surface
+};
+
+struct Camera {
+  glm::dvec3 position{0, 0, -60}, look_at{0.0}, up{0, 1, 0};
+  double fov_deg = 30.0;  ///< vertical field of view
+  int width = 800, height = 600;
+};
+
+struct Environment {
+  enum class Type { Checker, Constant, LatLong } type = Type::Checker;
+  int squares = 16;                           ///< checker squares per 180° of latitude
+  glm::dvec3 color_a{1.0}, color_b{0.05};     ///< checker colours (linear sRGB radiance)
+  glm::dvec3 radiance{1.0};                   ///< constant
+  double intensity = 1.0;                     ///< scale applied to every type
+  std::filesystem::path image_path;           ///< latlong EXR
+  int image_width = 0, image_height = 0;
+  std::vector<float> image_rgba;              ///< latlong texels, rows from the top (north)
+  /// Radiance seen in a world direction (unit vector), linear sRGB. Same formula as the shader.
+  glm::dvec3 lookup(const glm::dvec3& dir) const;
+};
+
+struct VolumeSpec {
+  glm::dvec3 bounds_min{-12.0}, bounds_max{12.0};
+  int resolution = 128;            ///< voxels along the longest side; voxels are cubes
+  double smoothing_voxels = 0.75;  ///< Gaussian σ of the pre-smoothing, in voxels (0 = none)
+};
+
+struct SceneObject {
+  Shape shape;
+  std::string material;              ///< key into Scene::materials
+  std::optional<glm::dvec3> optic_axis;  ///< per-object override (unit, world space)
+};
+
+struct Light {
+  enum class Type { Directional, Point } type = Type::Directional;
+  glm::dvec3 direction{0, -1, 0};  ///< directional: unit propagation direction
+  glm::dvec3 position{0.0};        ///< point
+  double irradiance = 1.0;         ///< directional: W/mm² (relative); point: intensity W/sr
+};
+
+struct Scene {
+  std::filesystem::path file;
+  Camera camera;
+  Environment environment;
+  VolumeSpec volume;
+  std::map<std::string, Material> materials;
+  std::vector<SceneObject> objects;
+  std::vector<Light> lights;
+  double ambient_index = 1.0;  ///< index of the medium around the objects (air)
+  /// Messages for the user that are not errors (e.g. a wavelength outside a material's range).
+  std::vector<std::string> warnings;
+
+  bool anyUniaxial() const;
+  bool anyDispersive() const;
+};
+
+/// Parse a scene file. Material names not defined in the file are looked up in the material
+/// library (materials/<name>.json in the source tree, or directories in EIKON_MATERIALS_PATH).
+Scene loadScene(const std::filesystem::path& path);
+/// Parse a scene from JSON text; `origin` names the source in error messages and resolves
+/// relative paths (latlong images).
+Scene parseScene(const std::string& json_text, const std::filesystem::path& origin);
+
+/// Load a material file (format: docs/scene-format.md, "Material files").
+Material loadMaterialFile(const std::filesystem::path& path);
+/// Directories searched for library materials, in order.
+std::vector<std::filesystem::path> materialSearchPath();
+
+}  // namespace eikon

@@ -1,0 +1,73 @@
+// Shapes of scene objects, as point-inclusion tests plus a conservative distance bound used by the
+// voxeliser (a voxel whose centre is farther than half its diagonal from the surface is wholly
+// inside or outside and needs no supersampling).
+//
+// Conventions: lengths in mm, world space; `rotation_deg` = [rx, ry, rz] applied as Rz·Ry·Rx to the
+// object's local frame (x first), about the object's centre. Planes are [nx, ny, nz, d] with the
+// inside where n·x ≤ d, n the outward normal of any non-zero length (DESIGN §3).
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace eikon {
+
+struct Plane {
+  glm::dvec3 normal;  ///< unit outward normal
+  double d;           ///< inside where dot(normal, x) <= d
+};
+
+struct SphereShape { double radius; };
+struct BoxShape { glm::dvec3 size; };
+struct RoundedBoxShape { glm::dvec3 size; double radius; };
+/// Convex polyhedron given by planes in the object's local frame (prism, brilliant, planes).
+struct ConvexShape {
+  std::vector<Plane> planes;
+  /// Radius of a sphere about the local origin that holds the polyhedron (from its vertices).
+  double bounding_radius = 0.0;
+};
+
+/// Compute the vertices of a convex polyhedron and fill `bounding_radius`; throws
+/// std::invalid_argument if the planes do not enclose a bounded, non-empty solid.
+void finishConvex(ConvexShape& shape);
+
+using ShapeGeometry = std::variant<SphereShape, BoxShape, RoundedBoxShape, ConvexShape>;
+
+class Shape {
+ public:
+  Shape() = default;
+  Shape(std::string kind, ShapeGeometry geometry, glm::dvec3 center, glm::dvec3 rotation_deg);
+
+  const std::string& kind() const { return kind_; }
+  glm::dvec3 center() const { return center_; }
+  /// Signed distance (negative inside). Exact for sphere, box and rounded box; for convex
+  /// polyhedra the max over planes, exact inside and a lower bound of the distance outside.
+  double signedDistance(const glm::dvec3& world) const;
+  bool contains(const glm::dvec3& world) const { return signedDistance(world) <= 0.0; }
+  /// World-space axis-aligned bounding box {min, max} (conservative).
+  std::pair<glm::dvec3, glm::dvec3> bounds() const;
+  /// World-space outward normals of a convex shape's faces (empty for curved shapes).
+  std::vector<Plane> worldPlanes() const;
+
+ private:
+  glm::dvec3 toLocal(const glm::dvec3& world) const;
+  std::string kind_;
+  ShapeGeometry geometry_;
+  glm::dvec3 center_{0.0};
+  glm::dmat3 rotation_{1.0};  ///< local -> world
+};
+
+/// Convex polyhedron of a triangular prism: apex angle (deg) between the two refracting faces,
+/// side = length of the faces' edges in the triangle, height along the prism's local z axis.
+/// Local frame: the apex points to +y, the base is parallel to x, the centroid of the triangle at 0.
+ConvexShape makePrism(double apex_deg, double side, double height);
+
+/// Standard round brilliant approximated by facets (Tolkowsky-like proportions, all relative to
+/// the girdle diameter): table, crown angle, pavilion angle, girdle thickness. Table up (+y).
+ConvexShape makeBrilliant(double diameter, double table_frac, double crown_deg, double pavilion_deg,
+                          double girdle_frac, int facets);
+
+}  // namespace eikon

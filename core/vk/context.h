@@ -1,0 +1,94 @@
+// Headless Vulkan compute context: instance, one physical device, one logical device with a
+// compute queue, a command pool, and (optionally) the Khronos validation layer whose messages are
+// collected so that tests can fail on any of them.
+//
+//   eikon::vk::ContextOptions opt;          // validation follows EIKON_VALIDATION=1 by default
+//   auto ctx = eikon::vk::Context::create(opt);
+//   ctx->submitAndWait([&](VkCommandBuffer cmd) { vkCmdDispatch(cmd, 8, 8, 1); });
+//   if (ctx->validationMessageCount()) ...  // every warning/error the layer printed
+//
+// Device choice: a discrete GPU if there is one, else integrated, else CPU (Mesa lavapipe).
+// EIKON_DEVICE=<index or case-insensitive name substring> overrides. Knows nothing about scenes.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace eikon::vk {
+
+struct ContextOptions {
+  /// Enable VK_LAYER_KHRONOS_validation. Default: on iff the environment has EIKON_VALIDATION=1.
+  bool validation = false;
+  bool validation_from_env = true;
+  /// Device selector (index or name substring); empty = use EIKON_DEVICE or the default choice.
+  std::string device;
+  /// Print validation messages to stderr as they arrive.
+  bool echo_messages = true;
+};
+
+/// Device facts that callers check before allocating (they refuse clearly, never clamp).
+struct DeviceLimits {
+  uint32_t max_image_dimension_3d = 0;
+  uint64_t max_storage_buffer_range = 0;
+  uint64_t heap_size = 0;  ///< largest device-local heap (bytes)
+  uint32_t max_compute_workgroup_invocations = 0;
+  bool shader_float64 = false;
+};
+
+class Context {
+ public:
+  static std::unique_ptr<Context> create(const ContextOptions& options = {});
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkInstance instance() const { return instance_; }
+  VkPhysicalDevice physicalDevice() const { return physical_; }
+  VkDevice device() const { return device_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queueFamily() const { return queue_family_; }
+  const VkPhysicalDeviceProperties& properties() const { return props_; }
+  const DeviceLimits& limits() const { return limits_; }
+  std::string deviceName() const { return props_.deviceName; }
+  std::string deviceTypeName() const;
+  std::string apiVersionString() const;
+  bool validationEnabled() const { return validation_; }
+
+  /// Index of a memory type with all `required` flags among `type_bits`; throws if none.
+  uint32_t findMemoryType(uint32_t type_bits, VkMemoryPropertyFlags required) const;
+
+  /// Record commands into a fresh primary command buffer, submit, and wait (fence).
+  void submitAndWait(const std::function<void(VkCommandBuffer)>& record) const;
+
+  /// Validation-layer messages (warnings and errors) received so far.
+  size_t validationMessageCount() const;
+  std::vector<std::string> validationMessages() const;
+  void clearValidationMessages();
+
+  /// Called by the debug messenger; public only for the C callback.
+  void onMessage(const std::string& msg);
+
+ private:
+  Context() = default;
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queue_family_ = 0;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceProperties props_{};
+  DeviceLimits limits_{};
+  bool validation_ = false;
+  bool echo_ = true;
+  mutable std::mutex mutex_;
+  std::vector<std::string> messages_;
+};
+
+}  // namespace eikon::vk

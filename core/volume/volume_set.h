@@ -1,0 +1,76 @@
+// VolumeSet: the scene voxelised into the fields both twins (GPU and CPU reference) march through.
+//
+// Pipeline (DESIGN §1): for each object, anti-aliased coverage (4³ supersampling in voxels the
+// surface crosses) → composite material properties in object order → separable Gaussian
+// pre-smoothing with σ = smoothing_voxels → central-difference gradients. Dispersion is carried
+// by Cauchy coefficient fields, n(λ, x) = A(x) + B(x)/λ² + C(x)/λ⁴ (λ in µm), so one set of
+// volumes serves every wavelength: ∇n(λ) = ∇A + ∇B/λ² + ∇C/λ⁴.
+//
+// Grid conventions: voxel (i, j, k) has its centre at bounds_min + (i + ½, j + ½, k + ½)·h, h the
+// voxel edge in mm; arrays are x-fastest. Samples between centres are trilinear; outside the
+// grid the nearest voxel is used (clamp to edge).
+//
+// Layout of each texel (4 floats, vec4-only so that GLSL and C++ agree without padding rules):
+//   index[m][c]   : (c-th Cauchy coefficient, ∂/∂x, ∂/∂y, ∂/∂z) for mode m ∈ {o, e}, c ∈ {A, B, C}
+//   medium[m]     : (σ_r, σ_g, σ_b, opacity) attenuation per mm for mode m (band values)
+//   emission      : (e_r, e_g, e_b, skip) emission and the empty-space skip distance in voxels
+//   axis          : (a_x, a_y, a_z, 0) optic axis (uniaxial scenes only)
+// The skip distance D is the Chebyshev distance (in voxels, capped) from the voxel to the nearest
+// voxel whose fields differ from a neighbour's: within (D − 1) voxels every field is constant,
+// so a ray may cross that distance in one straight step (DESIGN's "distance volume").
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/scene/scene.h"
+
+namespace eikon {
+
+struct Grid {
+  std::array<int, 3> dims{};  ///< voxels per axis
+  glm::dvec3 origin{0.0};     ///< bounds_min (mm)
+  glm::dvec3 extent{0.0};     ///< dims · h (mm); may exceed the requested bounds by < 1 voxel
+  double h = 1.0;             ///< voxel edge (mm)
+  size_t count() const { return size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]); }
+  size_t index(int i, int j, int k) const { return (size_t(k) * size_t(dims[1]) + size_t(j)) * size_t(dims[0]) + size_t(i); }
+  glm::dvec3 center(int i, int j, int k) const { return origin + (glm::dvec3(i, j, k) + 0.5) * h; }
+  glm::dvec3 boundsMax() const { return origin + extent; }
+};
+
+struct VolumeSet {
+  Grid grid;
+  bool uniaxial = false;     ///< e-mode fields differ from o-mode fields
+  bool dispersive = false;   ///< some B or C coefficient is non-zero
+  double ambient_index = 1.0;
+  std::array<std::array<std::vector<glm::vec4>, 3>, 2> index;  ///< [mode][A,B,C]; e empty if !uniaxial
+  std::array<std::vector<glm::vec4>, 2> medium;                ///< [mode]; e empty if !uniaxial
+  std::vector<glm::vec4> emission;
+  std::vector<glm::vec4> axis;  ///< empty unless uniaxial
+  int skip_cap = 32;            ///< largest stored skip distance (voxels)
+
+  /// Bytes the GPU copy needs (to refuse clearly before allocating).
+  size_t deviceBytes() const;
+};
+
+struct VoxelizeOptions {
+  /// Called with (fraction done, stage name) now and then; may be empty.
+  std::function<void(double, const char*)> progress;
+  int threads = 0;  ///< 0 = hardware concurrency
+};
+
+/// Grid for a volume spec: h = longest side / resolution, dims = ceil(side / h).
+Grid makeGrid(const VolumeSpec& spec);
+
+/// Voxelise a scene. Throws SceneError for inconsistent input (e.g. more than 2^31 voxels).
+VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& options = {});
+
+/// Smooth a scalar field in place with a separable Gaussian of σ voxels (truncated at 3σ,
+/// renormalised, clamp-to-edge). Exposed for tests.
+void gaussianSmooth(std::vector<float>& field, const std::array<int, 3>& dims, double sigma, int threads = 0);
+
+}  // namespace eikon
