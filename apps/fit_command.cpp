@@ -1,8 +1,305 @@
-// Placeholder until the subcommand lands; replaced in the same session.
+// `eikon fit DATA [E_DATA] [--model M] [--loss huber:δ] [--json] [--export-yaml FILE] [--strict]
+//             [--range-nm LO,HI] [--samples N] [--name NAME] -o MATERIAL.json`
+//
+// Fits a dispersion model to refractive-index data (CSV or refractiveindex.info YAML; see
+// anisotropic/index_data.h) and writes the material file the renderer loads. A CSV with n_o,n_e
+// columns, or two single-index files (ordinary first, then extraordinary), makes a uniaxial
+// crystal, fitted per mode. Prints a table (or, with --json, one JSON object) on stdout;
+// warnings go to stderr as "eikon: warning: ..." (errors with --strict). Output files are
+// written to a temporary file beside the target and renamed, so a failed run leaves nothing.
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <yaml-cpp/yaml.h>
+
+#include "anisotropic/fitting.h"
+#include "anisotropic/index_data.h"
 #include "apps/commands.h"
+
 namespace eikon::cli {
-void addFitCommand(CLI::App& app) {
-  auto* sub = app.add_subcommand("fit", "(not built yet)");
-  sub->callback([] { throw CliError("'fit' is not built yet"); });
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct FitArgs {
+  std::vector<std::string> data;
+  std::string model = "cauchy3";
+  std::string loss;
+  bool json_out = false;
+  std::string export_yaml;
+  bool strict = false;
+  std::string output;
+  std::vector<double> range_nm;
+  int samples = 201;
+  std::string name;
+};
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
 }
+
+json nullable(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
+
+std::string lossName(const FitResult& r) { return r.huber_delta ? "huber:" + fmt("%g", *r.huber_delta) : "none"; }
+
+json fitStats(const FitResult& r) {
+  return {{"chi2_reduced", nullable(r.chi2_reduced)},
+          {"rms", r.rms},
+          {"max_residual", r.max_residual},
+          {"residual_std", r.residual_std},
+          {"n_F", r.n_F},
+          {"n_d", r.n_d},
+          {"n_C", r.n_C},
+          {"abbe", r.abbe},
+          {"points", r.points},
+          {"weighted", r.weighted},
+          {"model", modelName(r.model)},
+          {"loss", lossName(r)}};
+}
+
+// {"cauchy": [...], "range_nm": [...], "sigma": [...]} (or "sellmeier": all B then all C).
+json materialIndex(const FitResult& r) {
+  const bool cauchy = r.model == DispersionModel::Cauchy2 || r.model == DispersionModel::Cauchy3;
+  return {{cauchy ? "cauchy" : "sellmeier", r.coeffs}, {"range_nm", r.range_nm}, {"sigma", r.sigma}};
+}
+
+json reportMode(const FitResult& r) {
+  json coeffs = json::object(), sig = json::object();
+  const auto names = parameterNames(r.model);
+  for (size_t k = 0; k < names.size(); ++k) coeffs[names[k]] = r.coeffs[k], sig[names[k]] = r.sigma[k];
+  json j = fitStats(r);
+  j["coefficients"] = coeffs;
+  j["sigma"] = sig;
+  j["covariance"] = r.covariance;
+  j["range_nm"] = r.range_nm;
+  j["iterations"] = r.iterations;
+  return j;
+}
+
+void printTable(std::ostream& os, const IndexData& data, const std::vector<FitResult>& fits) {
+  const FitResult& f0 = fits.front();
+  os << "eikon fit: " << data.source << ", model " << modelName(f0.model) << ", loss " << lossName(f0) << "\n";
+  for (const FitResult& r : fits) {
+    os << "\n" << r.label << ": " << r.points << " points, " << fmt("%g", r.range_nm[0]) << "-"
+       << fmt("%g", r.range_nm[1]) << " nm, "
+       << (r.weighted ? "weighted by sigma" : "unweighted (sigma of n estimated from the scatter)") << "\n";
+    const auto names = parameterNames(r.model);
+    for (size_t k = 0; k < names.size(); ++k)
+      os << "  " << names[k] << std::string(4 - std::min<size_t>(4, names[k].size()), ' ') << "= "
+         << fmt("%15.8e", r.coeffs[k]) << "  +/- " << fmt("%.2e", r.sigma[k]) << "\n";
+    os << "  residual rms " << fmt("%.3e", r.rms) << ", max " << fmt("%.3e", r.max_residual) << ", chi2_red "
+       << (r.chi2_reduced ? fmt("%.3f", *r.chi2_reduced) : std::string("- (no sigma column)")) << "\n";
+    os << "  n_F " << fmt("%.6f", r.n_F) << "  n_d " << fmt("%.6f", r.n_d) << "  n_C " << fmt("%.6f", r.n_C)
+       << "  V_d " << fmt("%.2f", r.abbe) << "\n";
+  }
+}
+
+// refractiveindex.info entry for one fitted mode: formula 5 (Cauchy / Conrady) or 2 (Sellmeier).
+std::string yamlEntry(const FitResult& r, const std::string& source) {
+  std::ostringstream coeffs;
+  coeffs.precision(12);
+  int formula = 5;
+  switch (r.model) {
+    case DispersionModel::Cauchy2:
+    case DispersionModel::Cauchy3:
+      for (size_t k = 0; k < r.coeffs.size(); ++k)
+        coeffs << (k ? " " : "") << r.coeffs[k] << (k ? " " + std::to_string(-2 * int(k)) : "");
+      break;
+    case DispersionModel::Conrady:
+      coeffs << r.coeffs[0] << " " << r.coeffs[1] << " -1 " << r.coeffs[2] << " -3.5";
+      break;
+    default: {
+      formula = 2;
+      const size_t K = r.coeffs.size() / 2;
+      coeffs << 0;
+      for (size_t i = 0; i < K; ++i) coeffs << " " << r.coeffs[i] << " " << r.coeffs[K + i];
+    }
+  }
+  std::ostringstream comment;
+  comment << "1-sigma: ";
+  const auto names = parameterNames(r.model);
+  for (size_t k = 0; k < names.size(); ++k) comment << (k ? ", " : "") << names[k] << " " << fmt("%.3e", r.sigma[k]);
+  comment << "; residual rms " << fmt("%.3e", r.rms) << ", max " << fmt("%.3e", r.max_residual);
+  YAML::Emitter e;
+  e << YAML::BeginMap;
+  e << YAML::Key << "REFERENCES" << YAML::Value
+    << ("eikon fit of " + source + ", model " + modelName(r.model) + " (" + r.label + ")");
+  e << YAML::Key << "COMMENTS" << YAML::Value << comment.str();
+  e << YAML::Key << "DATA" << YAML::Value << YAML::BeginSeq << YAML::BeginMap;
+  e << YAML::Key << "type" << YAML::Value << ("formula " + std::to_string(formula));
+  e << YAML::Key << "wavelength_range" << YAML::Value
+    << (fmt("%.10g", r.range_nm[0] * 1e-3) + " " + fmt("%.10g", r.range_nm[1] * 1e-3));
+  e << YAML::Key << "coefficients" << YAML::Value << coeffs.str();
+  e << YAML::EndMap << YAML::EndSeq << YAML::EndMap;
+  return std::string(e.c_str()) + "\n";
+}
+
+// "calcite.yml" + "o" → "calcite-o.yml".
+std::string withSuffix(const std::string& path, const std::string& suffix) {
+  fs::path p(path);
+  return (p.parent_path() / (p.stem().string() + "-" + suffix + p.extension().string())).string();
+}
+
+// Writes every file to a temporary sibling first and renames only when all were written.
+void writeAllAtomically(const std::vector<std::pair<std::string, std::string>>& files) {
+  std::vector<std::pair<std::string, std::string>> temps;  // temp, final
+  auto cleanup = [&] {
+    for (auto& t : temps) ::unlink(t.first.c_str());
+  };
+  for (const auto& [path, content] : files) {
+    fs::path target(path);
+    fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    std::string tmpl = (dir / ("." + target.filename().string() + ".tmpXXXXXX")).string();
+    int fd = ::mkstemp(tmpl.data());
+    if (fd < 0) {
+      cleanup();
+      throw CliError("cannot write " + path + ": " + std::strerror(errno));
+    }
+    temps.emplace_back(tmpl, path);
+    size_t done = 0;
+    while (done < content.size()) {
+      ssize_t w = ::write(fd, content.data() + done, content.size() - done);
+      if (w <= 0) {
+        ::close(fd);
+        cleanup();
+        throw CliError("cannot write " + path + ": " + std::strerror(errno));
+      }
+      done += size_t(w);
+    }
+    ::fchmod(fd, 0644);
+    if (::close(fd) != 0) {
+      cleanup();
+      throw CliError("cannot write " + path + ": " + std::strerror(errno));
+    }
+  }
+  for (auto& [tmp, final_path] : temps)
+    if (std::rename(tmp.c_str(), final_path.c_str()) != 0) {
+      cleanup();
+      throw CliError("cannot rename temporary file to " + final_path + ": " + std::strerror(errno));
+    }
+}
+
+std::optional<double> parseLoss(const std::string& s) {
+  if (s.empty() || s == "none") return std::nullopt;
+  const std::string prefix = "huber:";
+  if (s.rfind(prefix, 0) != 0) throw CliError("--loss must be 'huber:DELTA' or 'none', got '" + s + "'");
+  const std::string v = s.substr(prefix.size());
+  double d = 0.0;
+  auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), d);
+  if (ec != std::errc() || ptr != v.data() + v.size() || !(std::isfinite(d) && d > 0))
+    throw CliError("--loss huber:DELTA needs a number DELTA > 0, got '" + v + "'");
+  return d;
+}
+
+void run(const FitArgs& a) {
+  FitOptions fo;
+  fo.model = parseDispersionModel(a.model);
+  fo.huber_delta = parseLoss(a.loss);
+  IndexReadOptions ro;
+  ro.formula_samples = a.samples;
+  if (!a.range_nm.empty()) {
+    if (a.range_nm.size() != 2) throw CliError("--range-nm takes LO,HI in nm");
+    ro.window_nm = std::array<double, 2>{a.range_nm[0], a.range_nm[1]};
+  }
+  if (fo.model == DispersionModel::Conrady && (!a.output.empty()))
+    throw CliError("the conrady model cannot be written as a renderer material (cauchy or sellmeier only); "
+                   "drop -o or choose another --model");
+
+  IndexData data = readIndexData(a.data[0], ro);
+  if (a.data.size() == 2) {
+    data = combineOrdinaryExtraordinary(std::move(data), readIndexData(a.data[1], ro));
+  }
+  for (const std::string& w : data.warnings) {
+    if (a.strict) throw CliError(w + " (--strict)");
+    std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+  }
+
+  std::vector<FitResult> fits;
+  for (const IndexSeries& s : data.modes) fits.push_back(fitDispersion(s, fo));
+
+  const std::string name =
+      !a.name.empty() ? a.name : fs::path(a.data[0]).stem().string();
+  const std::string source = "eikon fit of " + data.source + ", model " + modelName(fo.model);
+  std::vector<std::pair<std::string, std::string>> files;
+  if (!a.output.empty()) {
+    json m = {{"name", name}, {"source", source}};
+    if (!data.uniaxial()) {
+      m["n"] = materialIndex(fits[0]);
+      m["fit"] = fitStats(fits[0]);
+    } else {
+      m["n_o"] = materialIndex(fits[0]);
+      m["n_e"] = materialIndex(fits[1]);
+      m["fit"] = {{"model", modelName(fo.model)}, {"loss", lossName(fits[0])},
+                  {"n_o", fitStats(fits[0])}, {"n_e", fitStats(fits[1])}};
+    }
+    files.emplace_back(a.output, m.dump(2) + "\n");
+  }
+  if (!a.export_yaml.empty()) {
+    if (!data.uniaxial()) {
+      files.emplace_back(a.export_yaml, yamlEntry(fits[0], data.source));
+    } else {
+      files.emplace_back(withSuffix(a.export_yaml, "o"), yamlEntry(fits[0], data.source));
+      files.emplace_back(withSuffix(a.export_yaml, "e"), yamlEntry(fits[1], data.source));
+    }
+  }
+  writeAllAtomically(files);
+
+  if (a.json_out) {
+    json modes = json::object();
+    for (const FitResult& r : fits) modes[r.label] = reportMode(r);
+    json out = {{"source", data.source}, {"model", modelName(fo.model)}, {"loss", lossName(fits[0])},
+                {"modes", modes}, {"warnings", data.warnings}};
+    json written = json::array();
+    for (auto& f : files) written.push_back(f.first);
+    out["written"] = written;
+    std::cout << out.dump(2) << "\n";
+  } else {
+    printTable(std::cout, data, fits);
+    for (auto& f : files) std::cout << "wrote " << f.first << "\n";
+  }
+}
+
+}  // namespace
+
+void addFitCommand(CLI::App& app) {
+  auto args = std::make_shared<FitArgs>();
+  auto* sub = app.add_subcommand("fit", "Fit a dispersion model to refractive-index data (CSV or refractiveindex.info YAML)");
+  sub->add_option("data", args->data,
+                  "DATA file (.csv or .yml); give two single-index files (ordinary, extraordinary) for a crystal")
+      ->required()
+      ->expected(1, 2);
+  sub->add_option("--model", args->model, "cauchy2 | cauchy3 | sellmeier1 | sellmeier2 | sellmeier3 | conrady")
+      ->capture_default_str();
+  sub->add_option("--loss", args->loss, "robust loss 'huber:DELTA' (DELTA in sigma units with a sigma column, else in index units)");
+  sub->add_flag("--json", args->json_out, "print the fit as one JSON object instead of a table");
+  sub->add_option("--export-yaml", args->export_yaml, "also write a refractiveindex.info formula entry (crystals: FILE-o/-e)");
+  sub->add_flag("--strict", args->strict, "treat warnings (e.g. unsorted rows) as errors");
+  sub->add_option("-o,--output", args->output, "material JSON file for the renderer");
+  sub->add_option("--range-nm", args->range_nm, "fit only LO,HI nm (formulas are sampled inside it)")->delimiter(',');
+  sub->add_option("--samples", args->samples, "samples per refractiveindex.info formula block")->capture_default_str();
+  sub->add_option("--name", args->name, "material name (default: the DATA file's stem)");
+  sub->callback([args] {
+    try {
+      run(*args);
+    } catch (const CliError&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw CliError(e.what());
+    }
+  });
+}
+
 }  // namespace eikon::cli

@@ -1,0 +1,340 @@
+#include "anisotropic/index_data.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+#include "anisotropic/refractiveindex_formula.h"
+
+namespace eikon {
+namespace {
+
+std::string trim(std::string_view s) {
+  size_t b = 0, e = s.size();
+  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
+  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
+  return std::string(s.substr(b, e - b));
+}
+
+std::vector<std::string> splitCommas(const std::string& line) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  for (;;) {
+    size_t comma = line.find(',', start);
+    out.push_back(trim(std::string_view(line).substr(start, comma == std::string::npos ? std::string::npos
+                                                                                        : comma - start)));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+// Parses the whole field as a double or returns nullopt (no partial parses, no locale).
+std::optional<double> parseNumber(const std::string& s) {
+  if (s.empty()) return std::nullopt;
+  const char* b = s.data();
+  if (*b == '+') ++b;  // from_chars rejects a leading '+'
+  double v = 0.0;
+  auto [ptr, ec] = std::from_chars(b, s.data() + s.size(), v);
+  if (ec != std::errc() || ptr != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// A series under construction: values plus where each point came from, for messages.
+struct Pending {
+  IndexSeries series;
+  std::vector<std::string> where;
+
+  void add(double lambda_nm, double n, std::optional<double> sigma, const std::string& at) {
+    if (!std::isfinite(lambda_nm)) throw std::invalid_argument(at + ": wavelength is not a finite number");
+    if (!std::isfinite(n)) throw std::invalid_argument(at + ": " + series.label + " is not a finite number");
+    if (lambda_nm <= 0.0) throw std::invalid_argument(at + ": wavelength must be > 0, got " + fmt(lambda_nm));
+    if (n < 1.0) throw std::invalid_argument(at + ": " + series.label + " must be >= 1, got " + fmt(n));
+    if (sigma) {
+      if (!std::isfinite(*sigma) || *sigma <= 0.0)
+        throw std::invalid_argument(at + ": sigma of " + series.label + " must be a finite number > 0");
+      series.sigma.push_back(*sigma);
+    }
+    series.lambda_nm.push_back(lambda_nm);
+    series.n.push_back(n);
+    where.push_back(at);
+  }
+};
+
+// Window filter, sort (with a warning), duplicate check, minimum size.
+IndexSeries finish(Pending p, const std::string& name, const IndexReadOptions& opt,
+                   std::vector<std::string>& warnings) {
+  IndexSeries& s = p.series;
+  if (opt.window_nm) {
+    const double lo = (*opt.window_nm)[0], hi = (*opt.window_nm)[1];
+    Pending kept;
+    kept.series.label = s.label;
+    for (size_t i = 0; i < s.size(); ++i)
+      if (s.lambda_nm[i] >= lo && s.lambda_nm[i] <= hi)
+        kept.add(s.lambda_nm[i], s.n[i], s.weighted() ? std::optional(s.sigma[i]) : std::nullopt, p.where[i]);
+    p = std::move(kept);
+  }
+  if (s.size() == 0)
+    throw std::invalid_argument(name + ": no data points" + (opt.window_nm ? " inside the wavelength window" : ""));
+  if (s.size() < 2)
+    throw std::invalid_argument(name + ": only one data point (" + p.where[0] + "); a dispersion fit needs at least 2");
+  std::vector<size_t> order(s.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  const bool sorted = std::is_sorted(s.lambda_nm.begin(), s.lambda_nm.end());
+  if (!sorted) {
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return s.lambda_nm[a] < s.lambda_nm[b]; });
+  }
+  for (size_t k = 1; k < order.size(); ++k) {
+    if (s.lambda_nm[order[k]] == s.lambda_nm[order[k - 1]])
+      throw std::invalid_argument(p.where[order[k]] + ": duplicate wavelength " + fmt(s.lambda_nm[order[k]]) +
+                                  " nm (also at " + p.where[order[k - 1]] + ")");
+  }
+  if (!sorted) {
+    IndexSeries out;
+    out.label = s.label;
+    for (size_t i : order) {
+      out.lambda_nm.push_back(s.lambda_nm[i]);
+      out.n.push_back(s.n[i]);
+      if (s.weighted()) out.sigma.push_back(s.sigma[i]);
+    }
+    warnings.push_back(name + ": " + out.label + " rows are not in ascending wavelength order; sorted them");
+    return out;
+  }
+  return s;
+}
+
+void checkOptions(const IndexReadOptions& opt) {
+  if (opt.window_nm && !((*opt.window_nm)[0] > 0 && (*opt.window_nm)[1] > (*opt.window_nm)[0]))
+    throw std::invalid_argument("wavelength window must satisfy 0 < lo < hi (nm)");
+  if (opt.formula_samples < 2) throw std::invalid_argument("formula_samples must be >= 2");
+}
+
+}  // namespace
+
+IndexData parseIndexCsv(const std::string& text, const std::string& name, const IndexReadOptions& opt) {
+  checkOptions(opt);
+  IndexData data;
+  data.source = name;
+  std::istringstream in(text);
+  std::string raw;
+  int line_no = 0;
+  std::vector<std::string> header;
+  int header_line = 0;
+  double unit_to_nm = 0.0;
+  bool crystal = false, has_sigma = false;
+  Pending a, b;
+  while (std::getline(in, raw)) {
+    ++line_no;
+    const std::string line = trim(raw);
+    if (line.empty() || line[0] == '#') continue;
+    const std::string at = name + ":" + std::to_string(line_no);
+    auto fields = splitCommas(line);
+    if (header.empty()) {
+      header = fields;
+      header_line = line_no;
+      if (header[0] == "wavelength_nm") unit_to_nm = 1.0;
+      else if (header[0] == "wavelength_um") unit_to_nm = 1000.0;
+      else if (parseNumber(header[0]))
+        throw std::invalid_argument(at + ": missing header; the first line must be "
+                                    "'wavelength_nm,n[,sigma]' or 'wavelength_nm,n_o,n_e[,sigma_o,sigma_e]' "
+                                    "(or wavelength_um)");
+      else
+        throw std::invalid_argument(at + ": first column must be 'wavelength_nm' or 'wavelength_um' (the unit "
+                                    "is never guessed), got '" + header[0] + "'");
+      std::vector<std::string> rest(header.begin() + 1, header.end());
+      using V = std::vector<std::string>;
+      if (rest == V{"n"}) {
+      } else if (rest == V{"n", "sigma"}) {
+        has_sigma = true;
+      } else if (rest == V{"n_o", "n_e"}) {
+        crystal = true;
+      } else if (rest == V{"n_o", "n_e", "sigma_o", "sigma_e"}) {
+        crystal = has_sigma = true;
+      } else {
+        throw std::invalid_argument(at + ": unrecognised header '" + line +
+                                    "'; expected wavelength_nm,n[,sigma] or "
+                                    "wavelength_nm,n_o,n_e[,sigma_o,sigma_e]");
+      }
+      a.series.label = crystal ? "n_o" : "n";
+      b.series.label = "n_e";
+      continue;
+    }
+    if (fields.size() != header.size())
+      throw std::invalid_argument(at + ": expected " + std::to_string(header.size()) + " fields (as in the header on line " +
+                                  std::to_string(header_line) + "), got " + std::to_string(fields.size()));
+    std::vector<double> v(fields.size());
+    for (size_t i = 0; i < fields.size(); ++i) {
+      auto x = parseNumber(fields[i]);
+      if (!x) throw std::invalid_argument(at + ": " + header[i] + " '" + fields[i] + "' is not a number");
+      v[i] = *x;
+    }
+    const double lnm = v[0] * unit_to_nm;
+    if (!crystal) {
+      a.add(lnm, v[1], has_sigma ? std::optional(v[2]) : std::nullopt, at);
+    } else {
+      a.add(lnm, v[1], has_sigma ? std::optional(v[3]) : std::nullopt, at);
+      b.add(lnm, v[2], has_sigma ? std::optional(v[4]) : std::nullopt, at);
+    }
+  }
+  if (header.empty()) throw std::invalid_argument(name + ": empty file (no header, no data)");
+  data.modes.push_back(finish(std::move(a), name, opt, data.warnings));
+  if (crystal) {
+    data.modes.push_back(finish(std::move(b), name, opt, data.warnings));
+    // Sorting o and e from the same rows warns twice; once is enough.
+    if (data.warnings.size() == 2) data.warnings.pop_back();
+  }
+  return data;
+}
+
+IndexData readIndexCsv(const std::string& path, const IndexReadOptions& opt) {
+  return parseIndexCsv(readFile(path), path, opt);
+}
+
+IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& name, const IndexReadOptions& opt) {
+  checkOptions(opt);
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(name + ":" + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);
+  }
+  if (!root || root.IsNull()) throw std::invalid_argument(name + ": empty file");
+  if (!root.IsMap()) throw std::invalid_argument(name + ": expected a refractiveindex.info file (a map with DATA)");
+  const YAML::Node blocks = root["DATA"];
+  if (!blocks) throw std::invalid_argument(name + ": no DATA key (not a refractiveindex.info file?)");
+  if (!blocks.IsSequence() || blocks.size() == 0)
+    throw std::invalid_argument(name + ": DATA must be a non-empty list of blocks");
+
+  IndexData data;
+  data.source = name;
+  Pending p;
+  p.series.label = "n";
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    const std::string path = name + ": DATA[" + std::to_string(i) + "]";
+    const YAML::Node blk = blocks[i];
+    auto scalar = [&](const char* key) -> std::string {
+      const YAML::Node v = blk[key];
+      if (!v || !v.IsScalar()) throw std::invalid_argument(path + "." + key + ": missing or not a scalar");
+      return v.as<std::string>();
+    };
+    auto numbers = [&](const std::string& s, const std::string& where) {
+      std::vector<double> out;
+      std::istringstream ss(s);
+      std::string tok;
+      while (ss >> tok) {
+        auto x = parseNumber(tok);
+        if (!x) throw std::invalid_argument(where + ": '" + tok + "' is not a number");
+        out.push_back(*x);
+      }
+      return out;
+    };
+    if (!blk.IsMap()) throw std::invalid_argument(path + ": expected a map with 'type'");
+    const std::string type = trim(scalar("type"));
+    if (type == "tabulated n" || type == "tabulated nk") {
+      const size_t cols = type == "tabulated n" ? 2 : 3;
+      std::istringstream rows(scalar("data"));
+      std::string row;
+      int r = 0;
+      while (std::getline(rows, row)) {
+        if (trim(row).empty()) continue;
+        const std::string at = path + ".data row " + std::to_string(++r);
+        auto v = numbers(row, at);
+        if (v.size() != cols)
+          throw std::invalid_argument(at + ": expected " + std::to_string(cols) + " numbers (" + type + "), got " +
+                                      std::to_string(v.size()));
+        p.add(v[0] * 1000.0, v[1], std::nullopt, at);  // database λ is in µm
+      }
+      if (r == 0) throw std::invalid_argument(path + ".data: no rows");
+    } else if (type == "tabulated k") {
+      continue;  // extinction only: nothing to fit n to
+    } else if (type.rfind("formula ", 0) == 0) {
+      int k = 0;
+      const std::string num = trim(type.substr(8));
+      auto [ptr, ec] = std::from_chars(num.data(), num.data() + num.size(), k);
+      if (ec != std::errc() || ptr != num.data() + num.size() || k < 1 || k > 9)
+        throw std::invalid_argument(path + ".type: unknown formula '" + type + "' (expected formula 1 to 9)");
+      const char* range_key = blk["wavelength_range"] ? "wavelength_range" : blk["range"] ? "range" : nullptr;
+      if (!range_key) throw std::invalid_argument(path + ": formula without 'wavelength_range' (or 'range')");
+      auto range = numbers(scalar(range_key), path + "." + range_key);
+      if (range.size() != 2 || !(range[0] > 0 && range[1] > range[0]))
+        throw std::invalid_argument(path + "." + range_key + ": expected two wavelengths 0 < lo < hi (µm)");
+      std::vector<double> coeffs = numbers(scalar("coefficients"), path + ".coefficients");
+      std::optional<RefractiveIndexFormula> f;
+      try {
+        f.emplace(k, coeffs);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(path + ".coefficients: " + e.what());
+      }
+      double lo = range[0] * 1000.0, hi = range[1] * 1000.0;
+      if (opt.window_nm) {
+        lo = std::max(lo, (*opt.window_nm)[0]);
+        hi = std::min(hi, (*opt.window_nm)[1]);
+        if (!(hi > lo)) continue;  // block entirely outside the window
+      }
+      const int m = opt.formula_samples;
+      for (int j = 0; j < m; ++j) {
+        const double lnm = lo + (hi - lo) * j / double(m - 1);
+        p.add(lnm, f->index(lnm * 1e-3), std::nullopt, path + " (" + type + " at " + fmt(lnm) + " nm)");
+      }
+    } else {
+      throw std::invalid_argument(path + ".type: unsupported type '" + type +
+                                  "' (expected tabulated n, tabulated nk, tabulated k, formula 1..9)");
+    }
+  }
+  data.modes.push_back(finish(std::move(p), name, opt, data.warnings));
+  return data;
+}
+
+IndexData readRefractiveIndexYaml(const std::string& path, const IndexReadOptions& opt) {
+  return parseRefractiveIndexYaml(readFile(path), path, opt);
+}
+
+IndexData readIndexData(const std::string& path, const IndexReadOptions& opt) {
+  auto ends = [&](const char* ext) {
+    std::string e(ext);
+    if (path.size() < e.size()) return false;
+    std::string tail = path.substr(path.size() - e.size());
+    std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+    return tail == e;
+  };
+  if (ends(".csv")) return readIndexCsv(path, opt);
+  if (ends(".yml") || ends(".yaml")) return readRefractiveIndexYaml(path, opt);
+  throw std::invalid_argument(path + ": unknown data format (expected a .csv or a refractiveindex.info .yml file)");
+}
+
+IndexData combineOrdinaryExtraordinary(IndexData o, IndexData e) {
+  if (o.modes.size() != 1 || e.modes.size() != 1)
+    throw std::invalid_argument("ordinary and extraordinary data must each be a single isotropic series (" +
+                                o.source + ", " + e.source + ")");
+  IndexData out;
+  out.source = o.source + " + " + e.source;
+  out.modes = {std::move(o.modes[0]), std::move(e.modes[0])};
+  out.modes[0].label = "n_o";
+  out.modes[1].label = "n_e";
+  out.warnings = std::move(o.warnings);
+  out.warnings.insert(out.warnings.end(), e.warnings.begin(), e.warnings.end());
+  return out;
+}
+
+}  // namespace eikon

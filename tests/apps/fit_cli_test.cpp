@@ -1,0 +1,199 @@
+// `eikon fit` as a user runs it: the real binary (EIKON_BINARY), exit codes, the one-line error on
+// stderr, the material file's keys, atomic output (nothing written on error).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "anisotropic/dispersion.h"
+#include "anisotropic/index_data.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct Outcome {
+  int code;
+  std::string out, err;
+};
+
+class FitCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "eikon_fit_cli_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
+    dir_ = tmpl;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name)) << text;
+    return path(name);
+  }
+  static std::string slurp(const std::string& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  Outcome run(const std::string& args) const {
+    const std::string cmd = std::string(EIKON_BINARY) + " fit " + args + " >" + path("stdout") + " 2>" + path("stderr");
+    const int st = std::system(cmd.c_str());
+    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(path("stdout")), slurp(path("stderr"))};
+  }
+  // N-BK7 (SCHOTT) sampled every `step` nm from lo to hi.
+  std::string bk7Csv(double lo = 400, double hi = 700, double step = 5) const {
+    const auto bk7 = eikon::Dispersion::sellmeier({1.03961212, 0.231792344, 1.01046945},
+                                                  {0.00600069867, 0.0200179144, 103.560653});
+    std::ostringstream s;
+    s.precision(10);
+    s << "wavelength_nm,n\n";
+    for (double l = lo; l <= hi + 1e-9; l += step) s << l << "," << bk7.index(l) << "\n";
+    return write("bk7.csv", s.str());
+  }
+  // A failed run: exit 1, exactly one line "eikon: error: ..." on stderr, no output file.
+  void expectCleanFailure(const Outcome& r, const std::string& must_contain) const {
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(r.err.rfind("eikon: error: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(must_contain), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("out.json")));
+    for (auto& e : fs::directory_iterator(dir_))
+      EXPECT_EQ(e.path().filename().string().find(".out.json.tmp"), std::string::npos) << "temporary file left";
+  }
+  fs::path dir_;
+};
+
+// The material file has exactly the contract's keys and the physics of §6 (n_d of N-BK7 within
+// 1e-4 of the catalogue 1.516800 through a cauchy3 fit over 400–700 nm).
+TEST_F(FitCli, IsotropicMaterialFile) {
+  const std::string csv = bk7Csv();
+  const Outcome r = run(csv + " -o " + path("out.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_NE(r.out.find("n_d 1.5167"), std::string::npos) << r.out;
+  const json m = json::parse(slurp(path("out.json")));
+  for (auto& [k, v] : m.items())
+    EXPECT_TRUE(k == "name" || k == "source" || k == "notes" || k == "fit" || k == "n") << k;
+  EXPECT_EQ(m["name"], "bk7");
+  EXPECT_EQ(m["source"], "eikon fit of " + csv + ", model cauchy3");
+  ASSERT_EQ(m["n"]["cauchy"].size(), 3u);
+  EXPECT_EQ(m["n"]["range_nm"], json::array({400.0, 700.0}));
+  EXPECT_EQ(m["n"]["sigma"].size(), 3u);
+  const double A = m["n"]["cauchy"][0], B = m["n"]["cauchy"][1], C = m["n"]["cauchy"][2];
+  const double l2 = std::pow(eikon::fraunhofer::d * 1e-3, 2);
+  EXPECT_NEAR(A + B / l2 + C / (l2 * l2), 1.516800, 1e-4);
+  EXPECT_LT(m["fit"]["rms"].get<double>(), 3e-5);
+  EXPECT_EQ(m["fit"]["model"], "cauchy3");
+  EXPECT_TRUE(m["fit"]["chi2_reduced"].is_null());
+}
+
+TEST_F(FitCli, JsonReportAndSellmeierMaterial) {
+  const std::string csv = bk7Csv(300, 2500, 20);
+  const Outcome r = run(csv + " --model sellmeier3 --json -o " + path("out.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["model"], "sellmeier3");
+  EXPECT_LT(j["modes"]["n"]["rms"].get<double>(), 1e-7);
+  EXPECT_EQ(j["modes"]["n"]["coefficients"].size(), 6u);
+  const json m = json::parse(slurp(path("out.json")));
+  ASSERT_EQ(m["n"]["sellmeier"].size(), 6u);
+  const auto p = m["n"]["sellmeier"].get<std::vector<double>>();
+  const auto fitted = eikon::Dispersion::sellmeier({p[0], p[1], p[2]}, {p[3], p[4], p[5]});
+  EXPECT_NEAR(fitted.index(eikon::fraunhofer::d), 1.516800, 1e-6);
+}
+
+// Crystal CSV → n_o and n_e blocks (calcite values near the Ghosh formula), no optic axis.
+TEST_F(FitCli, CrystalMaterialFileAndYamlExport) {
+  std::ostringstream s;
+  s << "wavelength_nm,n_o,n_e\n";
+  // Ghosh formula 2 has C1 ≠ 0: n² = 1 + C1 + …; fold C1 in as a term with a pole at 0.
+  const auto o_full = eikon::Dispersion::sellmeier({0.73358749, 0.96464345, 1.82831454}, {0.0, 0.0194325203, 120});
+  const auto e_full = eikon::Dispersion::sellmeier({0.35859695, 0.8242783, 0.14429128}, {0.0, 0.0106689543, 120});
+  s.precision(10);
+  for (double l = 400; l <= 700; l += 10) s << l << "," << o_full.index(l) << "," << e_full.index(l) << "\n";
+  const std::string csv = write("calcite.csv", s.str());
+  const Outcome r = run(csv + " -o " + path("out.json") + " --export-yaml " + path("calcite.yml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json m = json::parse(slurp(path("out.json")));
+  EXPECT_FALSE(m.contains("n"));
+  EXPECT_FALSE(m.contains("optic_axis"));
+  ASSERT_TRUE(m.contains("n_o") && m.contains("n_e"));
+  const double l2 = std::pow(eikon::fraunhofer::d * 1e-3, 2);
+  auto nd = [&](const json& c) { return c[0].get<double>() + c[1].get<double>() / l2 + c[2].get<double>() / (l2 * l2); };
+  EXPECT_NEAR(nd(m["n_o"]["cauchy"]), 1.658461, 1e-4);  // materials.json calcite o, d line
+  EXPECT_NEAR(nd(m["n_e"]["cauchy"]), 1.486185, 1e-4);
+  // The exported formula entries read back (our own reader) to the same curve.
+  for (auto [suffix, key] : {std::pair{"o", "n_o"}, std::pair{"e", "n_e"}}) {
+    const std::string y = path(std::string("calcite-") + suffix + ".yml");
+    ASSERT_TRUE(fs::exists(y)) << y;
+    eikon::IndexReadOptions ro;
+    ro.formula_samples = 4;
+    const auto d = eikon::readRefractiveIndexYaml(y, ro);
+    EXPECT_DOUBLE_EQ(d.modes[0].lambda_nm.front(), 400.0);
+    const auto& c = m[key]["cauchy"];
+    const double lu2 = std::pow(d.modes[0].lambda_nm[1] * 1e-3, 2);
+    EXPECT_NEAR(d.modes[0].n[1], c[0].get<double>() + c[1].get<double>() / lu2 + c[2].get<double>() / (lu2 * lu2), 1e-10);
+  }
+}
+
+TEST_F(FitCli, UnsortedWarnsButStrictFails) {
+  write("u.csv", "wavelength_nm,n\n600,1.5163\n500,1.5214\n550,1.5185\n650,1.5145\n700,1.5131\n");
+  Outcome r = run(path("u.csv") + " -o " + path("out.json"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.rfind("eikon: warning: ", 0), 0u) << r.err;
+  EXPECT_TRUE(fs::exists(path("out.json")));
+  fs::remove(path("out.json"));
+  expectCleanFailure(run(path("u.csv") + " --strict -o " + path("out.json")), "sorted");
+}
+
+TEST_F(FitCli, BadInputFailsWithOneLineAndNoFile) {
+  const std::string out = " -o " + path("out.json");
+  auto bad = [&](const std::string& name, const std::string& text, const std::string& msg) {
+    SCOPED_TRACE(name);
+    expectCleanFailure(run(write(name, text) + out), msg);
+  };
+  bad("empty.csv", "", "empty");
+  bad("one.csv", "wavelength_nm,n\n500,1.52\n", "one data point");
+  bad("few.csv", "wavelength_nm,n\n500,1.52\n600,1.51\n", "fewer than the 3 coefficients");
+  bad("nan.csv", "wavelength_nm,n\n500,1.52\n600,nan\n700,1.50\n800,1.49\n", "nan.csv:3");
+  bad("neg.csv", "wavelength_nm,n\n-500,1.52\n600,1.51\n700,1.50\n800,1.49\n", "wavelength must be > 0");
+  bad("dup.csv", "wavelength_nm,n\n500,1.52\n600,1.51\n600,1.51\n800,1.49\n", "duplicate wavelength");
+  bad("low.csv", "wavelength_nm,n\n500,1.52\n600,0.5\n700,1.50\n800,1.49\n", "must be >= 1");
+  bad("unit.csv", "wavelength,n\n500,1.52\n600,1.51\n700,1.50\n800,1.49\n", "wavelength_nm");
+  bad("bad.yml", "DATA: [\n  - type: formula 2\n", "malformed YAML");
+  write("rank.csv", [] {
+    std::ostringstream s;
+    s << "wavelength_nm,n\n";
+    s.precision(12);
+    const auto one = eikon::Dispersion::sellmeier({1.2}, {0.01});
+    for (double l = 400; l <= 1000; l += 10) s << l << "," << one.index(l) << "\n";
+    return s.str();
+  }());
+  expectCleanFailure(run(path("rank.csv") + " --model sellmeier2" + out), "rank-deficient");
+  expectCleanFailure(run(path("missing.csv") + out), "cannot open");
+  expectCleanFailure(run(bk7Csv() + " --model cauchy9" + out), "unknown model");
+  expectCleanFailure(run(bk7Csv() + " --loss huber:-1" + out), "huber");
+  expectCleanFailure(run(bk7Csv() + " --model conrady" + out), "conrady");
+  // An unwritable output directory: error, nothing left behind.
+  expectCleanFailure(run(bk7Csv() + " -o " + path("no/such/dir/out.json")), "cannot write");
+}
+
+TEST_F(FitCli, ConradyReportWithoutMaterialAndHuberLoss) {
+  const Outcome r = run(bk7Csv() + " --model conrady");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("n0"), std::string::npos);
+  const Outcome h = run(bk7Csv() + " --loss huber:1e-4 --json");
+  ASSERT_EQ(h.code, 0) << h.err;
+  EXPECT_EQ(json::parse(h.out)["loss"], "huber:0.0001");
+}
+
+}  // namespace
