@@ -50,6 +50,37 @@ class PointResidual final : public ceres::CostFunction {
   double lambda_nm_, n_, w_;
 };
 
+// All N residuals in one block, for fits without a robust loss (a loss applies per block, so
+// Huber needs one block per point; without it one block is several times faster to set up).
+class AllResiduals final : public ceres::CostFunction {
+ public:
+  AllResiduals(DispersionModel m, const std::vector<double>& scale, const IndexSeries& d, const std::vector<double>& w)
+      : m_(m), scale_(scale), d_(d), w_(w) {
+    set_num_residuals(int(d.size()));
+    mutable_parameter_block_sizes()->push_back(int(scale.size()));
+  }
+  bool Evaluate(double const* const* q, double* residual, double** jacobians) const override {
+    const size_t P = scale_.size();
+    double p[6], g[6];
+    for (size_t k = 0; k < P; ++k) p[k] = scale_[k] * q[0][k];
+    const bool want_j = jacobians != nullptr && jacobians[0] != nullptr;
+    for (size_t i = 0; i < d_.size(); ++i) {
+      const double nm = modelIndex(m_, p, d_.lambda_nm[i], want_j ? g : nullptr);
+      if (!std::isfinite(nm)) return false;
+      residual[i] = (nm - d_.n[i]) * w_[i];
+      if (want_j)
+        for (size_t k = 0; k < P; ++k) jacobians[0][i * P + k] = g[k] * scale_[k] * w_[i];
+    }
+    return true;
+  }
+
+ private:
+  DispersionModel m_;
+  const std::vector<double>& scale_;
+  const IndexSeries& d_;
+  const std::vector<double>& w_;
+};
+
 // Weighted linear least squares min ‖W (X b − y)‖ by column-pivoted QR; NaN-free or throws.
 Eigen::VectorXd linearSolve(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(X);
@@ -271,9 +302,13 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
   ceres::Problem problem(po);
   std::unique_ptr<ceres::LossFunction> loss;
   if (opt.huber_delta) loss = std::make_unique<ceres::HuberLoss>(*opt.huber_delta);
-  for (int i = 0; i < N; ++i)
-    problem.AddResidualBlock(new PointResidual(opt.model, scale, d.lambda_nm[size_t(i)], d.n[size_t(i)], w[size_t(i)]),
-                             loss.get(), q.data());
+  if (loss) {
+    for (int i = 0; i < N; ++i)
+      problem.AddResidualBlock(new PointResidual(opt.model, scale, d.lambda_nm[size_t(i)], d.n[size_t(i)], w[size_t(i)]),
+                               loss.get(), q.data());
+  } else {
+    problem.AddResidualBlock(new AllResiduals(opt.model, scale, d, w), nullptr, q.data());
+  }
 
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
@@ -285,8 +320,8 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
   so.num_threads = 1;
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
-  if (!summary.IsSolutionUsable() || summary.termination_type == ceres::NO_CONVERGENCE)
-    throw std::runtime_error(who + ": " + modelName(opt.model) + " fit did not converge (" + summary.message + ")");
+  if (!summary.IsSolutionUsable())
+    throw std::runtime_error(who + ": " + modelName(opt.model) + " fit failed (" + summary.message + ")");
 
   ceres::Covariance::Options co;
   co.algorithm_type = ceres::DENSE_SVD;
@@ -304,6 +339,11 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
     throw std::runtime_error(who + ": rank-deficient " + modelName(opt.model) +
                              " fit: the data cannot determine all coefficients (covariance is singular); "
                              "use a model with fewer terms or data over a wider range");
+  // Checked after the covariance: a fit that wanders along a flat valley until the iteration
+  // limit is usually rank-deficient, and that is the more useful message.
+  if (summary.termination_type == ceres::NO_CONVERGENCE)
+    throw std::runtime_error(who + ": " + modelName(opt.model) + " fit did not converge in " +
+                             std::to_string(opt.max_iterations) + " iterations (" + summary.message + ")");
   std::vector<double> cq(size_t(P * P));
   cov.GetCovarianceBlock(q.data(), q.data(), cq.data());
 
@@ -335,6 +375,17 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
       r.covariance[size_t(a * P + b)] = factor * scale[size_t(a)] * scale[size_t(b)] * cq[size_t(a * P + b)];
   for (int k = 0; k < P; ++k) r.sigma.push_back(std::sqrt(std::max(0.0, r.covariance[size_t(k * P + k)])));
 
+  // Goodness of fit (weighted data): with the Wilson–Hilferty cube-root normal approximation of
+  // χ²_ν, z = ((χ²/ν)^{1/3} − (1 − 2/(9ν))) / sqrt(2/(9ν)); z > 3.09 means p < 1e-3.
+  if (r.chi2_reduced) {
+    const double nu = N - P, h = 2.0 / (9.0 * nu);
+    const double z = (std::cbrt(*r.chi2_reduced) - (1.0 - h)) / std::sqrt(h);
+    if (z > 3.09)
+      r.warnings.push_back(who + ": chi2_red = " + std::to_string(*r.chi2_reduced).substr(0, 6) + " for " +
+                           std::to_string(N - P) + " degrees of freedom (p < 1e-3): " + modelName(opt.model) +
+                           " does not describe the data within their sigma, so its error bars are too small; "
+                           "try a model with more terms");
+  }
   auto n_at = [&](double lnm) { return modelIndex(opt.model, r.coeffs.data(), lnm); };
   if (opt.model != DispersionModel::Conrady) {
     const Dispersion disp = r.dispersion();

@@ -87,6 +87,8 @@ struct FitResult {
   double abbe = 0.0;                   ///< V_d = (n_d − 1)/(n_F − n_C)
   int iterations = 0;
   std::optional<double> huber_delta;
+  /// Recoverable problems, e.g. χ²_red too large for the σ given (p < 1e-3).
+  std::vector<std::string> warnings;
 
   /// The fitted curve as a renderer model (Cauchy or Sellmeier, with range); throws
   /// std::invalid_argument for Conrady, which the renderer does not carry.

@@ -229,6 +229,11 @@ void run(const FitArgs& a) {
 
   std::vector<FitResult> fits;
   for (const IndexSeries& s : data.modes) fits.push_back(fitDispersion(s, fo));
+  for (const FitResult& r : fits)
+    for (const std::string& w : r.warnings) {
+      if (a.strict) throw CliError(w + " (--strict)");
+      std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+    }
 
   const std::string name =
       !a.name.empty() ? a.name : fs::path(a.data[0]).stem().string();
@@ -259,9 +264,12 @@ void run(const FitArgs& a) {
 
   if (a.json_out) {
     json modes = json::object();
+    json warnings = data.warnings;
+    for (const FitResult& r : fits)
+      for (const std::string& w : r.warnings) warnings.push_back(w);
     for (const FitResult& r : fits) modes[r.label] = reportMode(r);
     json out = {{"source", data.source}, {"model", modelName(fo.model)}, {"loss", lossName(fits[0])},
-                {"modes", modes}, {"warnings", data.warnings}};
+                {"modes", modes}, {"warnings", warnings}};
     json written = json::array();
     for (auto& f : files) written.push_back(f.first);
     out["written"] = written;

@@ -191,6 +191,8 @@ TEST(DispersionFit, HuberLossResistsAnOutlier) {
   EXPECT_GT(std::abs(plain.n_d - n_true(fraunhofer::d)), 5e-5);
   EXPECT_LT(std::abs(robust.n_d - n_true(fraunhofer::d)), 1e-5);
   EXPECT_GT(*plain.chi2_reduced, 100.0);  // the outlier is 500 σ away
+  ASSERT_EQ(plain.warnings.size(), 1u);  // χ² test: the model does not fit within σ
+  EXPECT_NE(plain.warnings[0].find("chi2_red"), std::string::npos);
 }
 
 // Two Sellmeier terms for data made by one resonance: the second term is redundant, JᵀJ is

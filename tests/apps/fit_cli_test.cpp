@@ -187,6 +187,22 @@ TEST_F(FitCli, BadInputFailsWithOneLineAndNoFile) {
   expectCleanFailure(run(bk7Csv() + " -o " + path("no/such/dir/out.json")), "cannot write");
 }
 
+// tests/data/fit/calcite_ghosh.csv: Ghosh's calcite formula + Gaussian noise σ = 2e-5, 20 points
+// over 405–690 nm. cauchy3 cannot follow n_o to 2e-5 there (its χ²_red ≈ 6 has p ≪ 1e-3), so the
+// fit must say so (warning; error with --strict); n_e is fine. Conrady describes both modes.
+TEST_F(FitCli, ChiSquareWarningOnInadequateModel) {
+  const std::string csv = std::string(EIKON_SOURCE_DIR) + "/tests/data/fit/calcite_ghosh.csv";
+  Outcome r = run(csv + " -o " + path("out.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.rfind("eikon: warning: n_o: chi2_red", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  fs::remove(path("out.json"));
+  expectCleanFailure(run(csv + " --strict -o " + path("out.json")), "chi2_red");
+  r = run(csv + " --model conrady");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
 TEST_F(FitCli, ConradyReportWithoutMaterialAndHuberLoss) {
   const Outcome r = run(bk7Csv() + " --model conrady");
   ASSERT_EQ(r.code, 0) << r.err;
