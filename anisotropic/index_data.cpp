@@ -62,14 +62,18 @@ std::string fmt(double v) {
 }
 
 // A series under construction: values plus where each point came from, for messages.
+// Points outside the caller's window are dropped before the physical checks (a database file's
+// EUV rows with n < 1 must not stop a visible-range fit), but never before the finiteness checks.
 struct Pending {
   IndexSeries series;
   std::vector<std::string> where;
+  std::optional<std::array<double, 2>> window_nm;
 
   void add(double lambda_nm, double n, std::optional<double> sigma, const std::string& at) {
     if (!std::isfinite(lambda_nm)) throw std::invalid_argument(at + ": wavelength is not a finite number");
     if (!std::isfinite(n)) throw std::invalid_argument(at + ": " + series.label + " is not a finite number");
     if (lambda_nm <= 0.0) throw std::invalid_argument(at + ": wavelength must be > 0, got " + fmt(lambda_nm));
+    if (window_nm && (lambda_nm < (*window_nm)[0] || lambda_nm > (*window_nm)[1])) return;
     if (n < 1.0) throw std::invalid_argument(at + ": " + series.label + " must be >= 1, got " + fmt(n));
     if (sigma) {
       if (!std::isfinite(*sigma) || *sigma <= 0.0)
@@ -85,16 +89,7 @@ struct Pending {
 // Window filter, sort (with a warning), duplicate check, minimum size.
 IndexSeries finish(Pending p, const std::string& name, const IndexReadOptions& opt,
                    std::vector<std::string>& warnings) {
-  IndexSeries& s = p.series;
-  if (opt.window_nm) {
-    const double lo = (*opt.window_nm)[0], hi = (*opt.window_nm)[1];
-    Pending kept;
-    kept.series.label = s.label;
-    for (size_t i = 0; i < s.size(); ++i)
-      if (s.lambda_nm[i] >= lo && s.lambda_nm[i] <= hi)
-        kept.add(s.lambda_nm[i], s.n[i], s.weighted() ? std::optional(s.sigma[i]) : std::nullopt, p.where[i]);
-    p = std::move(kept);
-  }
+  const IndexSeries& s = p.series;
   if (s.size() == 0)
     throw std::invalid_argument(name + ": no data points" + (opt.window_nm ? " inside the wavelength window" : ""));
   if (s.size() < 2)
@@ -144,6 +139,7 @@ IndexData parseIndexCsv(const std::string& text, const std::string& name, const 
   double unit_to_nm = 0.0;
   bool crystal = false, has_sigma = false;
   Pending a, b;
+  a.window_nm = b.window_nm = opt.window_nm;
   while (std::getline(in, raw)) {
     ++line_no;
     const std::string line = trim(raw);
@@ -230,6 +226,7 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
   data.source = name;
   Pending p;
   p.series.label = "n";
+  p.window_nm = opt.window_nm;
   for (size_t i = 0; i < blocks.size(); ++i) {
     const std::string path = name + ": DATA[" + std::to_string(i) + "]";
     const YAML::Node blk = blocks[i];

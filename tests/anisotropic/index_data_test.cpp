@@ -211,6 +211,17 @@ SPECS:
   EXPECT_EQ(d.warnings.size(), 1u);  // blocks out of order → sorted
 }
 
+// Database nk files often start in the EUV where n < 1: an error on its own, skipped when the
+// caller's window excludes it.
+TEST(RefractiveIndexYaml, WindowSkipsRowsOutsideBeforeChecks) {
+  const char* text = "DATA:\n  - type: tabulated nk\n    data: |\n        0.03 0.93 0.08\n"
+                     "        0.45 1.47 0\n        0.55 1.46 0\n        0.65 1.456 0\n";
+  EXPECT_THROW(parseRefractiveIndexYaml(text, "euv.yml"), std::invalid_argument);
+  IndexReadOptions o;
+  o.window_nm = std::array<double, 2>{400.0, 700.0};
+  EXPECT_EQ(parseRefractiveIndexYaml(text, "euv.yml", o).modes[0].size(), 3u);
+}
+
 TEST(RefractiveIndexYaml, BadInputIsOneClearError) {
   auto yml = [](const std::string& text) { return [text] { parseRefractiveIndexYaml(text, "bad.yml"); }; };
   expectError(yml(""), {"bad.yml", "empty"});
