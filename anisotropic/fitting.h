@@ -15,8 +15,10 @@
 //
 // Start values: Cauchy and Conrady are linear in p, so the start is the exact weighted linear
 // least-squares solution (Ceres then only adds the robust loss). Sellmeier is linear in B for fixed
-// poles C, so the start scans a grid of poles (UV poles below the shortest λ², one IR pole above
-// the longest for K = 3) and solves for B at each; the best start is refined by Ceres.
+// poles C, so the start scans a grid of poles (UV poles below the shortest λ²; for K = 3, and as
+// an alternative second pole for K = 2, an IR pole above the longest) and solves for B at each;
+// the best start is refined by Ceres. Parameters are scaled by the inverse Jacobian column norms
+// at the start, so the optimiser and the rank test below compare like with like.
 //
 // Uncertainties: covariance of p from ceres::Covariance (dense SVD) at the optimum, i.e.
 // (JᵀJ)⁻¹ with J the Jacobian of the weighted residuals. With a σ column the σᵢ are taken as
@@ -25,7 +27,8 @@
 // residual variance (the usual "σ from the scatter" estimate). If JᵀJ is numerically singular
 // (reciprocal condition < 1e-14: e.g. two Sellmeier terms describing one resonance) the fit
 // throws std::runtime_error("... rank-deficient ..."): a coefficient that the data cannot pin
-// down has no error bar worth reporting.
+// down has no error bar worth reporting. With a σ column, a χ² that is improbably large
+// (p < 1e-3) adds a warning to FitResult::warnings: the error bars assume a model that fits.
 //
 // Example:
 //   eikon::IndexData data = eikon::readIndexData("bk7.csv");
