@@ -20,6 +20,5 @@ void addRenderCommand(CLI::App& app);
 void addTraceCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addFitCommand(CLI::App& app);
-void addBenchCommand(CLI::App& app);
 
 }  // namespace eikon::cli

@@ -12,7 +12,6 @@ int main(int argc, char** argv) {
   eikon::cli::addTraceCommand(app);
   eikon::cli::addInfoCommand(app);
   eikon::cli::addFitCommand(app);
-  eikon::cli::addBenchCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
