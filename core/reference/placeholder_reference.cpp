@@ -1,2 +1,0 @@
-// module placeholder (filled in by its issue)
-namespace eikon { [[maybe_unused]] static int placeholder_reference = 0; }

@@ -1,0 +1,254 @@
+#include "core/render/view_renderer.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "core/spectrum/cie1931.h"
+#include "core/spectrum/color.h"
+#include "core/spectrum/rgb_to_spectrum.h"
+#include "shaders/eikon_shared.h"
+#include "shaders/trace.spv.h"
+#include "shaders/view.spv.h"
+
+namespace eikon {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void validate(const MarchSettings& m) {
+  if (!(m.step_voxels > 0 && m.step_voxels <= 4)) throw std::invalid_argument("march step must be in (0, 4] voxels");
+  if (m.max_steps < 1) throw std::invalid_argument("max_steps must be >= 1");
+  if (!(m.interface_threshold > 0)) throw std::invalid_argument("interface threshold must be > 0");
+}
+
+}  // namespace
+
+void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scene) {
+  const auto& lim = ctx.limits();
+  for (int a = 0; a < 3; ++a)
+    if (uint32_t(grid.dims[size_t(a)]) > lim.max_image_dimension_3d)
+      throw std::runtime_error(scene.file.string() + ": /volume/resolution: the volume needs " +
+                               std::to_string(grid.dims[0]) + "x" + std::to_string(grid.dims[1]) + "x" +
+                               std::to_string(grid.dims[2]) + " voxels but the device '" + ctx.deviceName() +
+                               "' allows at most " + std::to_string(lim.max_image_dimension_3d) + " per side");
+  // Images: 3 index fields + medium + emission (+ 3 e-index, medium e, axis when uniaxial).
+  size_t images = scene.anyUniaxial() ? 10 : 5;
+  double bytes = double(grid.count()) * 16.0 * double(images);
+  if (bytes > 0.9 * double(lim.heap_size))
+    throw std::runtime_error(scene.file.string() + ": /volume/resolution: the volume needs " +
+                             std::to_string(int64_t(bytes / (1 << 20))) + " MiB of device memory but the device heap has " +
+                             std::to_string(lim.heap_size >> 20) + " MiB; lower the resolution");
+}
+
+struct ViewRenderer::Impl {
+  vk::Context& ctx;
+  const Scene& scene;
+  Grid grid;
+  bool uniaxial = false, dispersive = false;
+  std::vector<vk::Image3D> images;  // [oA, oB, oC, eA, eB, eC, medO, medE, emission, axis]
+  vk::Buffer params, env, tables;
+  vk::ComputePipeline view, tracer;
+  int skip_cap = 32;
+  double ambient = 1.0;
+
+  Impl(vk::Context& context, const Scene& s, const VolumeSet& v) : ctx(context), scene(s), grid(v.grid) {
+    checkVolumeFits(ctx, grid, scene);
+    uniaxial = v.uniaxial;
+    dispersive = v.dispersive;
+    skip_cap = v.skip_cap;
+    ambient = v.ambient_index;
+    std::array<uint32_t, 3> ext{uint32_t(grid.dims[0]), uint32_t(grid.dims[1]), uint32_t(grid.dims[2])};
+    auto upload = [&](const std::vector<glm::vec4>& data, const char* name) {
+      vk::Image3D img(ctx, ext, VK_FORMAT_R32G32B32A32_SFLOAT, name);
+      img.upload(ctx, data.data(), data.size() * sizeof(glm::vec4));
+      images.push_back(std::move(img));
+    };
+    const char* names[3] = {"index A", "index B", "index C"};
+    for (int c = 0; c < 3; ++c) upload(v.index[0][size_t(c)], names[c]);
+    if (uniaxial)
+      for (int c = 0; c < 3; ++c) upload(v.index[1][size_t(c)], names[c]);
+    upload(v.medium[0], "medium o");
+    if (uniaxial) upload(v.medium[1], "medium e");
+    upload(v.emission, "emission");
+    if (uniaxial) upload(v.axis, "optic axis");
+
+    params = vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
+    const auto& e = scene.environment;
+    if (e.type == Environment::Type::LatLong) {
+      env = vk::Buffer(ctx, e.image_rgba.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "environment");
+      env.write(e.image_rgba.data(), e.image_rgba.size() * sizeof(float));
+    } else {
+      env = vk::Buffer(ctx, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "environment (unused)");
+      float zero[4] = {0, 0, 0, 0};
+      env.write(zero, 16);
+    }
+    std::vector<glm::vec4> tab(EIKON_TABLE_COUNT, glm::vec4(0.0f));
+    for (int i = 0; i < EIKON_CMF_COUNT; ++i) tab[size_t(EIKON_CMF_OFFSET + i)] = glm::vec4(glm::vec3(spectrum::cmfTableRow(i)), 0.0f);
+    const auto& basis = spectrum::basisTable();
+    for (int i = 0; i < EIKON_BASIS_COUNT; ++i)
+      tab[size_t(EIKON_BASIS_OFFSET + i)] = glm::vec4(basis[size_t(3 * i)], basis[size_t(3 * i + 1)], basis[size_t(3 * i + 2)], 0.0f);
+    glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
+    for (int r = 0; r < 3; ++r) tab[size_t(EIKON_MATRIX_OFFSET + r)] = glm::vec4(float(M[0][r]), float(M[1][r]), float(M[2][r]), 0.0f);
+    tables = vk::Buffer(ctx, tab.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "spectral tables");
+    tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
+
+    std::vector<vk::BindingSpec> common;
+    for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b) common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE), uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    view = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4), common, 0, "view");
+    auto traceBindings = common;
+    traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    tracer = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4), traceBindings, 0, "trace");
+    for (auto* p : {&view, &tracer}) bindCommon(*p);
+  }
+
+  void bindCommon(vk::ComputePipeline& p) {
+    size_t oA = 0, eA = uniaxial ? 3 : 0;
+    size_t medO = uniaxial ? 6 : 3, medE = uniaxial ? 7 : 3, emi = uniaxial ? 8 : 4, axis = uniaxial ? 9 : 4;
+    p.bindImage(EIKON_B_INDEX_O_A, images[oA]);
+    p.bindImage(EIKON_B_INDEX_O_B, images[oA + 1]);
+    p.bindImage(EIKON_B_INDEX_O_C, images[oA + 2]);
+    p.bindImage(EIKON_B_INDEX_E_A, images[eA]);
+    p.bindImage(EIKON_B_INDEX_E_B, images[eA + 1]);
+    p.bindImage(EIKON_B_INDEX_E_C, images[eA + 2]);
+    p.bindImage(EIKON_B_MEDIUM_O, images[medO]);
+    p.bindImage(EIKON_B_MEDIUM_E, images[medE]);
+    p.bindImage(EIKON_B_EMISSION, images[emi]);
+    p.bindImage(EIKON_B_AXIS, images[axis]);
+    p.bindBuffer(EIKON_B_PARAMS, params);
+    p.bindBuffer(EIKON_B_ENV_IMAGE, env);
+    p.bindBuffer(EIKON_B_TABLES, tables);
+  }
+
+  gpu::ViewParams baseParams(const MarchSettings& m, int flags_extra) const {
+    gpu::ViewParams p{};
+    const Camera& cam = scene.camera;
+    glm::dvec3 fwd = glm::normalize(cam.look_at - cam.position);
+    glm::dvec3 right = glm::normalize(glm::cross(fwd, cam.up));
+    glm::dvec3 up = glm::cross(right, fwd);
+    p.cam_pos = glm::vec4(glm::vec3(cam.position), float(std::tan(0.5 * cam.fov_deg * kPi / 180.0)));
+    p.cam_forward = glm::vec4(glm::vec3(fwd), float(double(cam.width) / cam.height));
+    p.cam_right = glm::vec4(glm::vec3(right), 0.0f);
+    p.cam_up = glm::vec4(glm::vec3(up), 0.0f);
+    p.grid_origin = glm::vec4(glm::vec3(grid.origin), float(grid.h));
+    p.grid_extent = glm::vec4(glm::vec3(grid.extent), float(1.0 / grid.h));
+    int flags = flags_extra;
+    if (dispersive) flags |= EIKON_F_DISPERSIVE;
+    if (uniaxial) flags |= EIKON_F_UNIAXIAL;
+    if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
+    if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
+    p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
+    p.march = glm::vec4(float(m.step_voxels), float(m.interface_threshold), float(ambient), float(int(m.integrator)));
+    p.limits = glm::ivec4(m.max_steps, 1, 1, skip_cap);
+    const auto& e = scene.environment;
+    int type = e.type == Environment::Type::Checker ? EIKON_ENV_CHECKER
+               : e.type == Environment::Type::Constant ? EIKON_ENV_CONSTANT : EIKON_ENV_LATLONG;
+    p.env = glm::vec4(float(type), float(e.squares), float(e.intensity), 0.0f);
+    p.env_a = glm::vec4(glm::vec3(e.type == Environment::Type::Constant ? e.radiance : e.color_a), 0.0f);
+    p.env_b = glm::vec4(glm::vec3(e.color_b), 0.0f);
+    p.env_size = glm::ivec4(e.image_width, e.image_height, 0, 0);
+    return p;
+  }
+};
+
+ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume)
+    : impl_(std::make_unique<Impl>(ctx, scene, volume)) {}
+ViewRenderer::~ViewRenderer() = default;
+
+RenderImage ViewRenderer::render(const RenderSettings& s) {
+  validate(s.march);
+  Impl& I = *impl_;
+  RenderImage img;
+  img.width = s.width > 0 ? s.width : I.scene.camera.width;
+  img.height = s.height > 0 ? s.height : I.scene.camera.height;
+  if (img.width > 16384 || img.height > 16384) throw std::invalid_argument("image larger than 16384 pixels per side");
+  if (s.spp < 1 || s.spp > 4096) throw std::invalid_argument("spp must be in [1, 4096]");
+  if (s.wavelengths < 0 || s.wavelengths > 256) throw std::invalid_argument("wavelengths must be in [0, 256]");
+  gpu::ViewParams p = I.baseParams(s.march, s.wavelengths > 0 ? EIKON_F_SPECTRAL : 0);
+  // Keep the camera's aspect from the requested image size.
+  p.cam_forward.w = float(double(img.width) / img.height);
+  p.limits.y = s.spp;
+  p.limits.z = std::max(1, s.wavelengths);
+  double l = s.wavelength_nm * 1e-3;
+  p.wavelength = glm::vec4(float(l), float(1.0 / (l * l)), float(1.0 / (l * l * l * l)), 0.0f);
+
+  // Bands of rows so that progress can be reported and no single dispatch runs for long.
+  const double work = double(img.width) * img.height * s.spp * std::max(1, s.wavelengths);
+  int rows = std::clamp(int(std::ceil(double(img.height) * 2.0e5 / std::max(work, 1.0))), EIKON_WG_Y, img.height);
+  rows = (rows + EIKON_WG_Y - 1) / EIKON_WG_Y * EIKON_WG_Y;
+  vk::Buffer out(I.ctx, size_t(img.width) * size_t(rows) * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
+  I.view.bindBuffer(EIKON_B_OUTPUT, out);
+  img.rgb.resize(size_t(img.width) * size_t(img.height) * 3);
+  std::vector<glm::vec4> band(size_t(img.width) * size_t(rows));
+  double steps = 0.0;
+  auto t0 = std::chrono::steady_clock::now();
+  for (int y0 = 0; y0 < img.height; y0 += rows) {
+    int n = std::min(rows, img.height - y0);
+    p.image = glm::ivec4(img.width, img.height, y0, n);
+    I.params.write(&p, sizeof p);
+    I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
+      I.view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X), uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
+    });
+    out.read(band.data(), size_t(img.width) * size_t(n) * sizeof(glm::vec4));
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        const glm::vec4& v = band[size_t(y) * size_t(img.width) + size_t(x)];
+        size_t o = (size_t(y0 + y) * size_t(img.width) + size_t(x)) * 3;
+        img.rgb[o] = v.x;
+        img.rgb[o + 1] = v.y;
+        img.rgb[o + 2] = v.z;
+        steps += v.w;
+      }
+    if (s.progress) s.progress(double(y0 + n) / img.height);
+  }
+  img.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  img.mean_steps = steps / (double(img.width) * img.height);
+  return img;
+}
+
+std::vector<TraceOutcome> ViewRenderer::trace(const std::vector<TraceRequest>& rays, const MarchSettings& m) {
+  validate(m);
+  Impl& I = *impl_;
+  if (rays.empty()) return {};
+  std::vector<gpu::TraceRay> in(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) {
+    double len = glm::length(rays[i].direction);
+    if (!(len > 0) || !std::isfinite(len)) throw std::invalid_argument("trace direction must be a non-zero finite vector");
+    if (!(rays[i].wavelength_nm > 0)) throw std::invalid_argument("trace wavelength must be > 0 nm");
+    in[i].origin = glm::vec4(glm::vec3(rays[i].origin), float(rays[i].wavelength_nm * 1e-3));
+    in[i].direction = glm::vec4(glm::vec3(rays[i].direction / len), 0.0f);
+  }
+  gpu::ViewParams p = I.baseParams(m, 0);
+  p.image = glm::ivec4(int(rays.size()), 1, 0, 1);
+  I.params.write(&p, sizeof p);
+  vk::Buffer rb(I.ctx, in.size() * sizeof(gpu::TraceRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "trace rays");
+  rb.write(in.data(), in.size() * sizeof(gpu::TraceRay));
+  vk::Buffer ob(I.ctx, in.size() * sizeof(gpu::TraceResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "trace results");
+  I.tracer.bindBuffer(EIKON_B_RAYS, rb);
+  I.tracer.bindBuffer(EIKON_B_OUTPUT, ob);
+  I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
+    I.tracer.dispatch(cmd, uint32_t((in.size() + EIKON_TRACE_WG - 1) / EIKON_TRACE_WG), 1, 1, nullptr);
+  });
+  std::vector<gpu::TraceResult> res(in.size());
+  ob.read(res.data(), res.size() * sizeof(gpu::TraceResult));
+  std::vector<TraceOutcome> out(in.size());
+  for (size_t i = 0; i < in.size(); ++i) {
+    const auto& r = res[i];
+    TraceOutcome& o = out[i];
+    o.exit_point = glm::dvec3(r.exit_point);
+    o.left_volume = r.exit_point.w > 0.5f;
+    o.exit_direction = glm::normalize(glm::dvec3(r.exit_direction));
+    o.optical_path_mm = r.exit_direction.w;
+    o.wave_normal = glm::normalize(glm::dvec3(r.wave_normal));
+    o.transmittance = r.wave_normal.w;
+    o.steps = int(r.stats.x);
+    o.invariant_drift = r.stats.y;
+    o.interfaces = int(r.stats.z);
+    o.total_internal_reflections = int(r.stats.w);
+  }
+  return out;
+}
+
+}  // namespace eikon

@@ -1,0 +1,48 @@
+// The GPU view renderer: uploads a VolumeSet into 3D images and marches viewing rays through it
+// with the ray equation (shaders/march.glsl). Its double-precision twin is
+// core/reference/reference_marcher.h; tests hold the two to each other.
+//
+//   auto ctx = eikon::vk::Context::create();
+//   eikon::Scene scene = eikon::loadScene("scenes/glass_sphere.json");
+//   eikon::checkVolumeFits(*ctx, eikon::makeGrid(scene.volume), scene);   // refuse before voxelising
+//   eikon::VolumeSet vol = eikon::voxelize(scene);
+//   eikon::ViewRenderer renderer(*ctx, scene, vol);
+//   eikon::RenderImage img = renderer.render({});
+//
+// Common mistakes: voxelising before checkVolumeFits (a 4096³ request would exhaust host memory
+// before the device refuses it); comparing timings across runs (lavapipe varies ±20%).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/scene/scene.h"
+#include "core/vk/context.h"
+#include "core/vk/resources.h"
+#include "core/volume/march_types.h"
+#include "core/volume/volume_set.h"
+
+namespace eikon {
+
+/// Throw a one-line std::runtime_error if the scene's volume cannot live on this device
+/// (3D image side limit, heap size). Call before voxelising.
+void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scene);
+
+class ViewRenderer {
+ public:
+  ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume);
+  ~ViewRenderer();
+  ViewRenderer(const ViewRenderer&) = delete;
+  ViewRenderer& operator=(const ViewRenderer&) = delete;
+
+  /// Render the scene's camera view. Throws std::invalid_argument for bad settings.
+  RenderImage render(const RenderSettings& settings);
+  /// Trace individual rays (o-mode) at their wavelengths.
+  std::vector<TraceOutcome> trace(const std::vector<TraceRequest>& rays, const MarchSettings& settings);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace eikon

@@ -1,0 +1,100 @@
+// Shared between C++ and GLSL (vk_mini_path_tracer style): binding numbers, workgroup sizes and
+// the parameter/record structs of the view and trace kernels, declared once. vec4/ivec4 members
+// only, so std430 (GLSL) and C++ agree without padding rules; the C++ side static_asserts sizes.
+#ifndef EIKON_SHARED_H
+#define EIKON_SHARED_H
+
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+#include <cstdint>
+namespace eikon::gpu {
+using vec4 = glm::vec4;
+using ivec4 = glm::ivec4;
+#endif
+
+#define EIKON_WG_X 8
+#define EIKON_WG_Y 8
+#define EIKON_TRACE_WG 64
+
+// Descriptor bindings (set 0).
+#define EIKON_B_PARAMS 0
+#define EIKON_B_INDEX_O_A 1
+#define EIKON_B_INDEX_O_B 2
+#define EIKON_B_INDEX_O_C 3
+#define EIKON_B_INDEX_E_A 4
+#define EIKON_B_INDEX_E_B 5
+#define EIKON_B_INDEX_E_C 6
+#define EIKON_B_MEDIUM_O 7
+#define EIKON_B_MEDIUM_E 8
+#define EIKON_B_EMISSION 9
+#define EIKON_B_AXIS 10
+#define EIKON_B_ENV_IMAGE 11
+#define EIKON_B_TABLES 12
+#define EIKON_B_OUTPUT 13
+#define EIKON_B_RAYS 14
+
+// ViewParams.flags bits.
+#define EIKON_F_DISPERSIVE 1
+#define EIKON_F_UNIAXIAL 2
+#define EIKON_F_SPECTRAL 4
+#define EIKON_F_NO_SKIP 8
+#define EIKON_F_NO_FRESNEL 16
+
+// Integrators (ViewParams.march.w).
+#define EIKON_INT_EULER 0
+#define EIKON_INT_MIDPOINT 1
+#define EIKON_INT_RK4 2
+
+// Environment types.
+#define EIKON_ENV_CHECKER 0
+#define EIKON_ENV_CONSTANT 1
+#define EIKON_ENV_LATLONG 2
+
+// Table layout in the EIKON_B_TABLES buffer (vec4 entries): CIE 1931 x̄ȳz̄ at 1 nm from 360 nm,
+// then the RGB→spectrum basis at 5 nm from 380 nm, then the 3 rows of the spectral→sRGB matrix.
+#define EIKON_CMF_OFFSET 0
+#define EIKON_CMF_COUNT 471
+#define EIKON_BASIS_OFFSET 471
+#define EIKON_BASIS_COUNT 81
+#define EIKON_MATRIX_OFFSET 552
+#define EIKON_TABLE_COUNT 555
+
+struct ViewParams {
+  vec4 cam_pos;      // xyz: eye (mm); w: tan(fov_y / 2)
+  vec4 cam_forward;  // xyz: unit forward; w: aspect (width / height)
+  vec4 cam_right;    // xyz: unit right
+  vec4 cam_up;       // xyz: unit up
+  vec4 grid_origin;  // xyz: bounds_min (mm); w: voxel edge h (mm)
+  vec4 grid_extent;  // xyz: dims·h (mm); w: 1/h
+  ivec4 grid_dims;   // xyz: voxels per axis; w: flags (EIKON_F_*)
+  vec4 march;        // x: step (voxels); y: interface threshold |∇n|·h; z: ambient index; w: integrator
+  ivec4 limits;      // x: max steps per ray; y: spp; z: wavelengths per sample (spectral); w: skip cap
+  vec4 env;          // x: type; y: checker squares; z: intensity; w: unused
+  vec4 env_a;        // checker colour a / constant radiance (linear sRGB)
+  vec4 env_b;        // checker colour b
+  ivec4 env_size;    // latlong width, height
+  ivec4 image;       // x: width; y: height; z: first row of this dispatch; w: rows in this dispatch
+  vec4 wavelength;   // x: λ (µm) of the non-spectral mode; y: 1/λ²; z: 1/λ⁴
+};
+
+// One ray for the trace kernel: origin and unit direction in world space, λ in µm.
+struct TraceRay {
+  vec4 origin;     // xyz, w: λ (µm)
+  vec4 direction;  // xyz unit
+};
+
+// What the trace kernel reports for one ray (one mode).
+struct TraceResult {
+  vec4 exit_point;      // xyz (mm); w: 1 if the ray left the volume, 0 if stopped (opaque/steps)
+  vec4 exit_direction;  // xyz unit ray direction; w: optical path length (mm)
+  vec4 wave_normal;     // xyz unit wave normal; w: transmittance
+  vec4 stats;           // x: steps; y: max | |w| − n | (invariant drift); z: interfaces; w: TIR count
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(ViewParams) == 15 * 16, "ViewParams must be vec4-packed");
+static_assert(sizeof(TraceRay) == 32 && sizeof(TraceResult) == 64, "trace records must be vec4-packed");
+}  // namespace eikon::gpu
+#endif
+
+#endif  // EIKON_SHARED_H

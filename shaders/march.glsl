@@ -1,0 +1,336 @@
+// The eikonal march shared by view.comp and trace.comp (GPU twin of core/reference/marcher.cpp).
+//
+// Ray equation with the spatial arc parameter s (DESIGN §2; Ihrke et al. 2007 eq. 3):
+//   dx/ds = w / n(x),   dw/ds = ∇n(x),   w = n·dx/ds, invariant |w| = n.
+// Integrated with a fixed step ds = march.x · h by Euler, midpoint (RK2) or classical RK4; inside
+// homogeneous regions (skip distance D ≥ 2 voxels) the ray crosses (D − 1.5)·h in one straight
+// step, exact because every field is constant there. Interfaces are the layers where |∇n|·h
+// rises above 1e-6: on leaving a layer whose peak exceeded march.y, the ray either crossed it
+// (Fresnel: transmitted fraction 1 − R with the full unpolarised equations, and an external
+// reflection that samples the environment) or was turned back by total internal reflection, which
+// the ODE produces by itself (no Fresnel loss).
+#ifndef EIKON_MARCH_GLSL
+#define EIKON_MARCH_GLSL
+
+layout(std430, binding = EIKON_B_PARAMS) readonly buffer ParamsBuf { ViewParams P; };
+layout(binding = EIKON_B_INDEX_O_A, rgba32f) readonly uniform image3D idxOA;
+layout(binding = EIKON_B_INDEX_O_B, rgba32f) readonly uniform image3D idxOB;
+layout(binding = EIKON_B_INDEX_O_C, rgba32f) readonly uniform image3D idxOC;
+layout(binding = EIKON_B_INDEX_E_A, rgba32f) readonly uniform image3D idxEA;
+layout(binding = EIKON_B_INDEX_E_B, rgba32f) readonly uniform image3D idxEB;
+layout(binding = EIKON_B_INDEX_E_C, rgba32f) readonly uniform image3D idxEC;
+layout(binding = EIKON_B_MEDIUM_O, rgba32f) readonly uniform image3D mediumO;
+layout(binding = EIKON_B_MEDIUM_E, rgba32f) readonly uniform image3D mediumE;
+layout(binding = EIKON_B_EMISSION, rgba32f) readonly uniform image3D emissionImg;
+layout(binding = EIKON_B_AXIS, rgba32f) readonly uniform image3D axisImg;
+layout(std430, binding = EIKON_B_ENV_IMAGE) readonly buffer EnvBuf { vec4 envTexels[]; };
+layout(std430, binding = EIKON_B_TABLES) readonly buffer TableBuf { vec4 tables[]; };
+
+const float kPi = 3.14159265358979323846;
+
+// Per-wavelength state set before a march.
+float gLambdaUm = 0.5876;
+float gIl2 = 1.0 / (0.5876 * 0.5876);
+float gIl4 = gIl2 * gIl2;
+bool gScalar = false;  // spectral/trace: radiance and attenuation at gLambdaUm, carried in .x (broadcast)
+
+void setWavelength(float lambda_um, bool scalar) {
+  gLambdaUm = lambda_um;
+  gIl2 = 1.0 / (lambda_um * lambda_um);
+  gIl4 = gIl2 * gIl2;
+  gScalar = scalar;
+}
+
+bool hasFlag(int f) { return (P.grid_dims.w & f) != 0; }
+
+struct Stencil {
+  ivec3 i0;
+  ivec3 i1;
+  vec3 f;
+};
+
+Stencil stencilAt(vec3 x) {
+  vec3 g = (x - P.grid_origin.xyz) * P.grid_extent.w - 0.5;
+  vec3 fl = floor(g);
+  Stencil s;
+  s.f = g - fl;
+  ivec3 i = ivec3(fl);
+  ivec3 dmax = P.grid_dims.xyz - 1;
+  s.i0 = clamp(i, ivec3(0), dmax);
+  s.i1 = clamp(i + 1, ivec3(0), dmax);
+  return s;
+}
+
+#define TRI(img, s)                                                                              \
+  mix(mix(mix(imageLoad(img, s.i0), imageLoad(img, ivec3(s.i1.x, s.i0.y, s.i0.z)), s.f.x),      \
+          mix(imageLoad(img, ivec3(s.i0.x, s.i1.y, s.i0.z)), imageLoad(img, ivec3(s.i1.x, s.i1.y, s.i0.z)), s.f.x), \
+          s.f.y),                                                                                \
+      mix(mix(imageLoad(img, ivec3(s.i0.x, s.i0.y, s.i1.z)), imageLoad(img, ivec3(s.i1.x, s.i0.y, s.i1.z)), s.f.x), \
+          mix(imageLoad(img, ivec3(s.i0.x, s.i1.y, s.i1.z)), imageLoad(img, s.i1), s.f.x), s.f.y), \
+      s.f.z)
+
+// (n, ∂n/∂x, ∂n/∂y, ∂n/∂z) at x for the current wavelength; mode 0 = o, 1 = e.
+vec4 sampleIndex(vec3 x, int mode) {
+  Stencil s = stencilAt(x);
+  vec4 a;
+  if (mode == 0) {
+    a = TRI(idxOA, s);
+    if (hasFlag(EIKON_F_DISPERSIVE)) a += TRI(idxOB, s) * gIl2 + TRI(idxOC, s) * gIl4;
+  } else {
+    a = TRI(idxEA, s);
+    if (hasFlag(EIKON_F_DISPERSIVE)) a += TRI(idxEB, s) * gIl2 + TRI(idxEC, s) * gIl4;
+  }
+  return a;
+}
+
+vec4 sampleMedium(vec3 x, int mode) {
+  Stencil s = stencilAt(x);
+  return mode == 0 ? TRI(mediumO, s) : TRI(mediumE, s);
+}
+
+vec3 sampleEmission(vec3 x) {
+  Stencil s = stencilAt(x);
+  return TRI(emissionImg, s).xyz;
+}
+
+// Band values (σ at 612, 549, 465 nm) → value at gLambdaUm, linear between, constant beyond.
+float bandAt(vec3 rgb) {
+  float l = gLambdaUm * 1000.0;
+  if (l <= 465.0) return rgb.b;
+  if (l >= 612.0) return rgb.r;
+  if (l <= 549.0) return rgb.b + (rgb.g - rgb.b) * (l - 465.0) / (549.0 - 465.0);
+  return rgb.g + (rgb.r - rgb.g) * (l - 549.0) / (612.0 - 549.0);
+}
+
+// Linear sRGB colour → smooth spectrum value at gLambdaUm (core/spectrum/rgb_to_spectrum.h).
+float rgbToSpectrum(vec3 rgb) {
+  float t = clamp((gLambdaUm * 1000.0 - 380.0) / 5.0, 0.0, 80.0);
+  int i = min(int(floor(t)), 79);
+  float f = t - float(i);
+  vec3 b = mix(tables[EIKON_BASIS_OFFSET + i].xyz, tables[EIKON_BASIS_OFFSET + i + 1].xyz, f);
+  return max(rgb.g + (rgb.r - rgb.g) * b.x + (rgb.b - rgb.g) * b.z, 0.0);
+}
+
+// Attenuation and colours in the current mode: RGB triplets, or the value at λ broadcast.
+vec3 sigmaOf(vec3 bands) { return gScalar ? vec3(bandAt(bands)) : bands; }
+vec3 colourOf(vec3 rgb) { return gScalar ? vec3(rgbToSpectrum(rgb)) : rgb; }
+
+// Environment radiance in direction d (unit). Same formulas as Environment::lookup (scene.cpp).
+vec3 environment(vec3 d) {
+  float u = atan(d.x, -d.z) / (2.0 * kPi) + 0.5;
+  float v = acos(clamp(d.y, -1.0, 1.0)) / kPi;
+  int type = int(P.env.x);
+  vec3 c;
+  if (type == EIKON_ENV_CONSTANT) {
+    c = P.env_a.xyz;
+  } else if (type == EIKON_ENV_CHECKER) {
+    float sq = P.env.y;
+    int iu = int(floor(u * 2.0 * sq)), iv = int(floor(v * sq));
+    c = ((iu + iv) & 1) != 0 ? P.env_b.xyz : P.env_a.xyz;
+  } else {
+    int W = P.env_size.x, H = P.env_size.y;
+    float fx = u * float(W) - 0.5, fy = v * float(H) - 0.5;
+    int x0 = int(floor(fx)), y0 = int(floor(fy));
+    float tx = fx - float(x0), ty = fy - float(y0);
+    int xa = ((x0 % W) + W) % W, xb = (((x0 + 1) % W) + W) % W;
+    int ya = clamp(y0, 0, H - 1), yb = clamp(y0 + 1, 0, H - 1);
+    c = mix(mix(envTexels[ya * W + xa].xyz, envTexels[ya * W + xb].xyz, tx),
+            mix(envTexels[yb * W + xa].xyz, envTexels[yb * W + xb].xyz, tx), ty);
+  }
+  return colourOf(c * P.env.z);
+}
+
+// Unpolarised Fresnel reflectance for a wave going from index n1 into n2 with cos θ_i = ci ≥ 0
+// (Born & Wolf §1.5.2): R = (Rs + Rp)/2; 1 beyond the critical angle.
+float fresnelR(float ci, float n1, float n2) {
+  float eta = n1 / n2;
+  float st2 = eta * eta * max(0.0, 1.0 - ci * ci);
+  if (st2 >= 1.0) return 1.0;
+  float ct = sqrt(1.0 - st2);
+  float rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
+  float rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
+// Ray–box slab test; returns false if the line misses. t0 ≤ t1.
+bool boxHit(vec3 o, vec3 d, vec3 bmin, vec3 bmax, out float t0, out float t1) {
+  vec3 inv = 1.0 / mix(d, vec3(1e-30), equal(d, vec3(0.0)));
+  vec3 ta = (bmin - o) * inv, tb = (bmax - o) * inv;
+  vec3 lo = min(ta, tb), hi = max(ta, tb);
+  t0 = max(max(lo.x, lo.y), lo.z);
+  t1 = min(min(hi.x, hi.y), hi.z);
+  return t1 >= max(t0, 0.0);
+}
+
+struct MarchResult {
+  vec3 radiance;
+  vec3 exit_point;
+  vec3 exit_dir;
+  vec3 throughput;
+  float opl;
+  bool left;
+  int steps;
+  float drift;
+  int interfaces;
+  int tir;
+};
+
+// One RK stage's derivative of (x, w).
+void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
+  vec4 nn = sampleIndex(x, mode);
+  dx = w / nn.x;
+  dw = nn.yzw;
+}
+
+MarchResult march(vec3 o, vec3 d, int mode) {
+  MarchResult R;
+  R.radiance = vec3(0.0);
+  R.throughput = vec3(1.0);
+  R.opl = 0.0;
+  R.left = true;
+  R.steps = 0;
+  R.drift = 0.0;
+  R.interfaces = 0;
+  R.tir = 0;
+  const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
+  const float h = P.grid_origin.w;
+  const float ambient = P.march.z;
+  float t0, t1;
+  if (!boxHit(o, d, bmin, bmax, t0, t1)) {
+    R.radiance = environment(d);
+    R.exit_point = o;
+    R.exit_dir = d;
+    return R;
+  }
+  t0 = max(t0, 0.0);
+  vec3 x = o + d * t0;
+  R.opl = ambient * t0;
+  vec4 nn = sampleIndex(x, mode);
+  vec3 w = nn.x * d;
+  const float ds = P.march.x * h;
+  const int integrator = int(P.march.w);
+  const float thrLow = 1e-6, thrIface = P.march.y;
+  bool inLayer = false;
+  float nBefore = nn.x, peak = 0.0;
+  vec3 dBefore = d, gAcc = vec3(0.0);
+  vec3 T = vec3(1.0), L = vec3(0.0);
+  bool stopped = false;
+  const int maxSteps = P.limits.x;
+  int steps = 0;
+  for (; steps < maxSteps; ++steps) {
+    vec3 dir = normalize(w);
+    float tb0, tb1;
+    boxHit(x, dir, bmin, bmax, tb0, tb1);
+    float tExit = max(tb1, 0.0);
+    // Homogeneous region: one straight, exact step.
+    ivec3 vi = clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_extent.w)), ivec3(0), P.grid_dims.xyz - 1);
+    vec4 em = imageLoad(emissionImg, vi);
+    if (!inLayer && em.w >= 2.0 && !hasFlag(EIKON_F_NO_SKIP)) {
+      float len = (em.w - 1.5) * h;
+      bool leaving = len >= tExit;
+      len = min(len, tExit);
+      vec4 med = sampleMedium(x, mode);
+      if (med.w >= 0.5) { L += T * colourOf(em.xyz); stopped = true; break; }
+      vec3 sig = sigmaOf(med.xyz);
+      vec3 e = colourOf(em.xyz);
+      vec3 att = exp(-sig * len);
+      // ∫₀^len T e^{−σs} e ds = T e (1 − e^{−σ len})/σ  (→ T e len as σ → 0)
+      L += T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
+      T *= att;
+      float n = length(w);
+      R.opl += n * len;
+      x += dir * len;
+      if (leaving) break;
+      continue;
+    }
+    // One integration step of the ray equation.
+    vec3 x0 = x, w0 = w;
+    float n0 = length(w0);
+    vec3 k1x, k1w, k2x, k2w, k3x, k3w, k4x, k4w;
+    deriv(x, w, mode, k1x, k1w);
+    if (integrator == EIKON_INT_EULER) {
+      x += ds * k1x;
+      w += ds * k1w;
+    } else if (integrator == EIKON_INT_MIDPOINT) {
+      deriv(x + 0.5 * ds * k1x, w + 0.5 * ds * k1w, mode, k2x, k2w);
+      x += ds * k2x;
+      w += ds * k2w;
+    } else {
+      deriv(x + 0.5 * ds * k1x, w + 0.5 * ds * k1w, mode, k2x, k2w);
+      deriv(x + 0.5 * ds * k2x, w + 0.5 * ds * k2w, mode, k3x, k3w);
+      deriv(x + ds * k3x, w + ds * k3w, mode, k4x, k4w);
+      x += ds / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+      w += ds / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+    }
+    nn = sampleIndex(x, mode);
+    R.drift = max(R.drift, abs(length(w) - nn.x));
+    R.opl += 0.5 * (n0 + nn.x) * ds;
+    // Medium at the step midpoint.
+    vec3 xm = 0.5 * (x0 + x);
+    vec4 med = sampleMedium(xm, mode);
+    vec3 sig = sigmaOf(med.xyz);
+    L += T * colourOf(sampleEmission(xm)) * ds;
+    T *= exp(-sig * ds);
+    if (sampleMedium(x, mode).w >= 0.5) { L += T * colourOf(sampleEmission(x)); stopped = true; break; }
+    // Interface bookkeeping.
+    float g = length(nn.yzw) * h;
+    if (!inLayer && g > thrLow) {
+      inLayer = true;
+      nBefore = n0;
+      dBefore = normalize(w0);
+      gAcc = vec3(0.0);
+      peak = 0.0;
+    }
+    if (inLayer) {
+      gAcc += nn.yzw * ds;
+      peak = max(peak, g);
+      if (g <= thrLow) {
+        inLayer = false;
+        if (dot(gAcc, gAcc) > 0.0) {
+          // Back on the constraint surface |w| = n(x) (H = 0) along the layer normal: the
+          // tangential part of w is what the interface conserves (Snell); the stored central-
+          // difference gradient is not exactly the derivative of the trilinear n, which makes |w|
+          // drift by ~1e-4 across a sharp layer. Skipped if the normal part would vanish.
+          vec3 N = normalize(gAcc);
+          float wn = dot(w, N);
+          vec3 wt = w - wn * N;
+          float rem = nn.x * nn.x - dot(wt, wt);
+          if (rem > 0.25 * wn * wn) w = wt + sign(wn) * sqrt(rem) * N;
+        }
+        if (peak > thrIface && !hasFlag(EIKON_F_NO_FRESNEL) && dot(gAcc, gAcc) > 0.0) {
+          vec3 N = normalize(gAcc);
+          vec3 dAfter = normalize(w);
+          float ci = dot(dBefore, N), co = dot(dAfter, N);
+          if (ci * co > 0.0) {
+            float Rf = fresnelR(abs(ci), nBefore, nn.x);
+            if (nn.x > nBefore) L += T * Rf * environment(reflect(dBefore, N));
+            T *= 1.0 - Rf;
+            R.interfaces++;
+          } else {
+            R.tir++;
+          }
+        }
+      }
+    }
+    // Left the volume? The ray is straight outside (fields clamp to the uniform edge voxels).
+    if (any(lessThan(x, bmin)) || any(greaterThan(x, bmax))) {
+      vec3 dd = normalize(w);
+      float a0, a1;
+      boxHit(x0, dd, bmin, bmax, a0, a1);
+      float back = length(x - x0) - max(a1, 0.0);
+      x = x0 + dd * max(a1, 0.0);
+      R.opl -= max(back, 0.0) * nn.x;
+      break;
+    }
+  }
+  R.steps = steps;
+  R.exit_point = x;
+  R.exit_dir = normalize(w);
+  R.left = !stopped && steps < maxSteps;
+  if (R.left) L += T * environment(R.exit_dir);
+  R.radiance = L;
+  R.throughput = T;
+  return R;
+}
+
+#endif

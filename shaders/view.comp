@@ -1,0 +1,69 @@
+#version 450
+// View renderer: one thread per pixel; spp jittered sub-pixel samples; RGB mode (one march at a
+// fixed wavelength, RGB attenuation) or spectral mode (N stratified wavelengths per sample,
+// CIE 1931 → linear sRGB). Output: linear sRGB radiance per pixel, w = mean steps.
+#extension GL_GOOGLE_include_directive : require
+#include "eikon_shared.h"
+
+layout(local_size_x = EIKON_WG_X, local_size_y = EIKON_WG_Y) in;
+
+#include "march.glsl"
+
+layout(std430, binding = EIKON_B_OUTPUT) writeonly buffer OutBuf { vec4 pixels[]; };
+
+uint pcg_hash(uint v) {
+  uint state = v * 747796405u + 2891336453u;
+  uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+
+vec3 cmf(float lambda_nm) {
+  float t = lambda_nm - 360.0;
+  if (t < 0.0 || t > 470.0) return vec3(0.0);
+  int i = min(int(floor(t)), 469);
+  float f = t - float(i);
+  return mix(tables[EIKON_CMF_OFFSET + i].xyz, tables[EIKON_CMF_OFFSET + i + 1].xyz, f);
+}
+
+void main() {
+  uvec2 gid = gl_GlobalInvocationID.xy;
+  int W = P.image.x, H = P.image.y;
+  int px = int(gid.x), py = P.image.z + int(gid.y);
+  if (px >= W || int(gid.y) >= P.image.w || py >= H) return;
+  uint pixelIndex = uint(py * W + px);
+  int spp = P.limits.y;
+  vec3 sum = vec3(0.0);
+  float steps = 0.0;
+  for (int s = 0; s < spp; ++s) {
+    vec2 jitter = vec2(0.5);
+    if (spp > 1) {
+      uint hs = pcg_hash(pixelIndex * 9781u + uint(s) * 6271u + 17u);
+      jitter = vec2(float(hs & 0xffffu), float(hs >> 16u)) / 65536.0;
+    }
+    float u = ((float(px) + jitter.x) / float(W) * 2.0 - 1.0) * P.cam_pos.w * P.cam_forward.w;
+    float v = (1.0 - (float(py) + jitter.y) / float(H) * 2.0) * P.cam_pos.w;
+    vec3 d = normalize(P.cam_forward.xyz + u * P.cam_right.xyz + v * P.cam_up.xyz);
+    if (hasFlag(EIKON_F_SPECTRAL)) {
+      int N = P.limits.z;
+      uint seed = pcg_hash(pixelIndex + pcg_hash(uint(s)));
+      vec3 xyz = vec3(0.0);
+      for (int k = 0; k < N; ++k) {
+        float uk = float(pcg_hash(seed + uint(k)) >> 8u) * (1.0 / 16777216.0);
+        float lambda = 380.0 + (float(k) + uk) * (400.0 / float(N));
+        setWavelength(lambda * 1e-3, true);
+        MarchResult r = march(P.cam_pos.xyz, d, 0);
+        xyz += r.radiance.x * cmf(lambda) * (400.0 / float(N));
+        steps += float(r.steps) / float(N);
+      }
+      mat3 M = mat3(tables[EIKON_MATRIX_OFFSET].xyz, tables[EIKON_MATRIX_OFFSET + 1].xyz,
+                    tables[EIKON_MATRIX_OFFSET + 2].xyz);
+      sum += xyz * M;  // rows stored: rgb_i = dot(row_i, xyz)
+    } else {
+      setWavelength(P.wavelength.x, false);
+      MarchResult r = march(P.cam_pos.xyz, d, 0);
+      sum += r.radiance;
+      steps += float(r.steps);
+    }
+  }
+  pixels[int(gid.y) * W + px] = vec4(sum / float(spp), steps / float(spp));
+}
