@@ -212,7 +212,7 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   const float thrLow = 1e-6, thrIface = P.march.y;
   bool inLayer = false;
   float nBefore = nn.x, peak = 0.0;
-  vec3 dBefore = d, gAcc = vec3(0.0);
+  vec3 dBefore = d, gAcc = vec3(0.0), xOpen = x;
   vec3 T = vec3(1.0), L = vec3(0.0);
   bool stopped = false;
   const int maxSteps = P.limits.x;
@@ -280,17 +280,19 @@ MarchResult march(vec3 o, vec3 d, int mode) {
       dBefore = normalize(w0);
       gAcc = vec3(0.0);
       peak = 0.0;
+      xOpen = x0;
     }
     if (inLayer) {
       gAcc += nn.yzw * ds;
       peak = max(peak, g);
       if (g <= thrLow) {
         inLayer = false;
-        if (dot(gAcc, gAcc) > 0.0) {
+        if (dot(gAcc, gAcc) > 0.0 && abs(dot(x - xOpen, normalize(gAcc))) <= 12.0 * h) {
           // Back on the constraint surface |w| = n(x) (H = 0) along the layer normal: the
           // tangential part of w is what the interface conserves (Snell); the stored central-
           // difference gradient is not exactly the derivative of the trilinear n, which makes |w|
-          // drift by ~1e-4 across a sharp layer. Skipped if the normal part would vanish.
+          // drift by ~1e-4 across a sharp layer. Only for thin layers (interfaces no thicker than 12
+          // voxels along their normal), never across gradient-index bodies; skipped if the normal part would vanish.
           vec3 N = normalize(gAcc);
           float wn = dot(w, N);
           vec3 wt = w - wn * N;
@@ -317,9 +319,12 @@ MarchResult march(vec3 o, vec3 d, int mode) {
       vec3 dd = normalize(w);
       float a0, a1;
       boxHit(x0, dd, bmin, bmax, a0, a1);
-      float back = length(x - x0) - max(a1, 0.0);
+      float stepLen = length(x - x0);
+      float back = stepLen - max(a1, 0.0);
       x = x0 + dd * max(a1, 0.0);
       R.opl -= max(back, 0.0) * nn.x;
+      // w at the boundary, not at the overshoot (linear within the step).
+      if (stepLen > 0.0) w = mix(w0, w, clamp(max(a1, 0.0) / stepLen, 0.0, 1.0));
       break;
     }
   }

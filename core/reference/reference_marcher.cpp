@@ -129,7 +129,7 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
   const double thrLow = 1e-6, thrIface = m.interface_threshold;
   bool inLayer = false, stopped = false;
   double nBefore = n, peak = 0.0;
-  glm::dvec3 dBefore = d, gAcc(0.0), T(1.0), L(0.0);
+  glm::dvec3 dBefore = d, gAcc(0.0), T(1.0), L(0.0), xOpen = x;
   auto deriv = [&](const glm::dvec3& xx, const glm::dvec3& ww, glm::dvec3& dx, glm::dvec3& dw) {
     double nn;
     glm::dvec3 gg;
@@ -203,13 +203,14 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
       dBefore = glm::normalize(w0);
       gAcc = glm::dvec3(0.0);
       peak = 0.0;
+      xOpen = x0;
     }
     if (inLayer) {
       gAcc += grad * ds;
       peak = std::max(peak, g);
       if (g <= thrLow) {
         inLayer = false;
-        if (glm::dot(gAcc, gAcc) > 0.0) {
+        if (glm::dot(gAcc, gAcc) > 0.0 && std::abs(glm::dot(x - xOpen, glm::normalize(gAcc))) <= 12.0 * h) {
           // Project back onto |w| = n along the layer normal (see shaders/march.glsl).
           glm::dvec3 N = glm::normalize(gAcc);
           double wn = glm::dot(w, N);
@@ -237,9 +238,11 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
       glm::dvec3 dd = glm::normalize(w);
       double a0, a1;
       boxHit(x0, dd, bmin, bmax, a0, a1);
-      double back = glm::length(x - x0) - std::max(a1, 0.0);
+      double stepLen = glm::length(x - x0);
+      double back = stepLen - std::max(a1, 0.0);
       x = x0 + dd * std::max(a1, 0.0);
       R.opl -= std::max(back, 0.0) * n;
+      if (stepLen > 0.0) w = glm::mix(w0, w, std::clamp(std::max(a1, 0.0) / stepLen, 0.0, 1.0));
       break;
     }
   }

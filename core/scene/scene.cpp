@@ -433,7 +433,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   const std::string file = origin.string();
   try {
     j = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse errors and number overflow (1e999)
     throw SceneError(file + ": malformed JSON: " + e.what());
   }
   Scene scene;
@@ -529,9 +529,28 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis)
       o.fail("uniaxial material '" + obj.material + "' needs an optic_axis (on the object or the material)");
     if (!mat.uniaxial && obj.optic_axis) o.at("optic_axis").fail("optic_axis given for an isotropic material");
-    auto [lo, hi] = obj.shape.bounds();
-    (void)lo;
-    (void)hi;
+    if (mat.grin.type != GrinProfile::Type::None) {
+      // The profile must give n ≥ 1 wherever the object is inside the volume (sampled on a 17³
+      // lattice of the overlap of its box with the volume).
+      auto [lo, hi] = obj.shape.bounds();
+      lo = glm::max(lo, scene.volume.bounds_min);
+      hi = glm::min(hi, scene.volume.bounds_max);
+      for (int k = 0; k <= 16; ++k)
+        for (int jj = 0; jj <= 16; ++jj)
+          for (int ii = 0; ii <= 16; ++ii) {
+            glm::dvec3 p = lo + (hi - lo) * glm::dvec3(ii, jj, k) / 16.0;
+            if (!obj.shape.contains(p)) continue;
+            double n = mat.grin.type == GrinProfile::Type::Linear ? mat.grin.n0 + glm::dot(mat.grin.gradient, p - mat.grin.origin)
+                                                                  : mat.grin.index(p);
+            if (mat.grin.type == GrinProfile::Type::Luneburg) {
+              double r2 = glm::dot(p - mat.grin.origin, p - mat.grin.origin) / (mat.grin.radius * mat.grin.radius);
+              n = r2 <= 2.0 ? std::sqrt(2.0 - r2) : std::nan("");
+            }
+            if (!(n >= 1.0))
+              o.at("material").fail("gradient-index material '" + obj.material + "' gives n = " + fmt(n) +
+                                    ", below 1, inside this object at (" + fmt(p.x) + ", " + fmt(p.y) + ", " + fmt(p.z) + ")");
+          }
+    }
     scene.objects.push_back(std::move(obj));
   }
 
