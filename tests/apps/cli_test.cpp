@@ -1,0 +1,403 @@
+// The `eikon` binary (render, trace, info) run as a user runs it: help texts, a tiny render that
+// writes OUT.exr and OUT.png, the JSON of `trace`, GPU vs CPU reference agreement, and bad input
+// — one stderr line "eikon: error: ...", non-zero exit, no output file and no leftover temporary.
+// GPU runs have EIKON_VALIDATION=1 and must print no "[vulkan validation]" line.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "core/io/exr.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct Outcome {
+  int code;
+  std::string out, err;
+};
+
+// A small glass sphere (n = 1.5, r = 3 mm) in a 10 mm volume of 32³ voxels, a 32x24 camera.
+std::string tinyScene(const std::string& volume_extra = "", const std::string& material = R"({"n": 1.5})",
+                      const std::string& object_extra = "") {
+  return R"({
+  "camera": {"position": [0, 0, -30], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 20, "width": 32, "height": 24},
+  "environment": {"type": "checker", "squares": 8},
+  "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "smoothing_voxels": 0.75)" +
+         (volume_extra.empty() ? std::string(R"(, "resolution": 32)") : ", " + volume_extra) + R"(},
+  "materials": {"glass": )" + material + R"(},
+  "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "glass")" + object_extra + R"(}]
+})";
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "eikon_cli_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
+    dir_ = tmpl;
+    io_ = dir_ / "io";  // captured stdout/stderr live apart from the output directory
+    out_ = dir_ / "out";
+    fs::create_directories(io_);
+    fs::create_directories(out_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    for (auto& p : chmodded_) fs::permissions(p, fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(dir_, ec);
+  }
+
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name) << text;
+    return (dir_ / name).string();
+  }
+  static std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  /// Run `eikon ARGS` with validation layers on; stdout/stderr captured.
+  Outcome run(const std::string& args) const {
+    const std::string cmd = "EIKON_VALIDATION=1 " + std::string(EIKON_BINARY) + " " + args + " >" +
+                            (io_ / "stdout").string() + " 2>" + (io_ / "stderr").string() + " </dev/null";
+    const int st = std::system(cmd.c_str());
+    Outcome o{WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(io_ / "stdout"), slurp(io_ / "stderr")};
+    EXPECT_EQ(o.err.find("[vulkan validation]"), std::string::npos) << "validation messages:\n" << o.err;
+    return o;
+  }
+  std::string outPath(const std::string& name = "render.exr") const { return (out_ / name).string(); }
+
+  /// Exactly one stderr line "eikon: error: ..." containing `phrase`, non-zero exit, nothing left in
+  /// `dir` (the output directory) but what was there before.
+  void expectCleanFailure(const Outcome& r, const std::string& phrase, const fs::path& dir) const {
+    EXPECT_NE(r.code, 0);
+    EXPECT_EQ(r.err.rfind("eikon: error: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(phrase), std::string::npos) << "stderr lacks '" << phrase << "': " << r.err;
+    std::error_code ec;
+    if (fs::is_directory(dir, ec))
+      for (auto& e : fs::directory_iterator(dir, ec)) {
+        const std::string n = e.path().filename().string();
+        EXPECT_EQ(n.find(".tmp-"), std::string::npos) << "temporary file left: " << n;
+        EXPECT_NE(e.path().extension(), ".exr") << "output left: " << n;
+        EXPECT_NE(e.path().extension(), ".png") << "output left: " << n;
+      }
+  }
+  void expectCleanFailure(const Outcome& r, const std::string& phrase) const { expectCleanFailure(r, phrase, out_); }
+
+  Outcome render(const std::string& scene_text, const std::string& extra = "") {
+    const std::string scene = write("scene.json", scene_text);
+    return run("render " + quote(scene) + " -o " + quote(outPath()) + " " + extra);
+  }
+
+  fs::path dir_, io_, out_;
+  std::vector<fs::path> chmodded_;
+};
+
+// ------------------------------------------------------------------ help and info
+
+TEST_F(Cli, TopLevelHelp) {
+  const Outcome r = run("--help");
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"render", "trace", "info", "fit"}) EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+}
+
+TEST_F(Cli, RenderHelp) {
+  const Outcome r = run("render --help");
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"--output", "--width", "--height", "--spp", "--wavelengths", "--reference"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+}
+
+TEST_F(Cli, TraceHelp) {
+  const Outcome r = run("trace --help");
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"--origin", "--dir", "--wavelength", "--json", "--reference"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+}
+
+TEST_F(Cli, Info) {
+  const Outcome r = run("info");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("max 3D image side"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("device:"), std::string::npos) << r.out;
+}
+
+// ------------------------------------------------------------------ render
+
+TEST_F(Cli, RenderTinyScene) {
+  const Outcome r = render(tinyScene());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(outPath("render.exr")));
+  EXPECT_TRUE(fs::is_regular_file(outPath("render.png")));
+  EXPECT_NE(r.out.find("eikon: rendered"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("32x24"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(outPath("render.png")), std::string::npos) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << "one summary line:\n" << r.out;
+  for (auto& e : fs::directory_iterator(out_))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+  // The EXR reads back at the camera's size with finite, non-negative radiance, and the image is
+  // not blank: the checker environment has radiance ≥ its dark colour everywhere.
+  const eikon::RgbaImage img = eikon::readExrRgba(outPath("render.exr"), 64, 64);
+  EXPECT_EQ(img.width, 32);
+  EXPECT_EQ(img.height, 24);
+  double mx = 0;
+  for (size_t i = 0; i < img.rgba.size(); ++i) {
+    EXPECT_TRUE(std::isfinite(img.rgba[i]) && img.rgba[i] >= 0.0f) << i;
+    mx = std::max(mx, double(img.rgba[i]));
+  }
+  EXPECT_GT(mx, 0.1);
+  const std::string png = slurp(outPath("render.png"));
+  ASSERT_GE(png.size(), 8u);
+  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+}
+
+// ------------------------------------------------------------------ render: bad input
+
+TEST_F(Cli, RenderMalformedJson) {
+  expectCleanFailure(render(R"({"objects": [ {"shape": )"), "malformed JSON");
+}
+
+TEST_F(Cli, RenderUnknownKeyNamesThePath) {
+  const Outcome r = render(tinyScene(R"("resolution": 32, "smoothing": 1)"));
+  expectCleanFailure(r, "/volume/smoothing");
+  EXPECT_NE(r.err.find("unknown key"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("scene.json"), std::string::npos) << "the message names the file: " << r.err;
+}
+
+TEST_F(Cli, RenderIndexBelowOne) {
+  const Outcome r = render(tinyScene("", R"({"n": 0.9})"));
+  expectCleanFailure(r, "/materials/glass/n");
+  EXPECT_NE(r.err.find(">= 1"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, RenderZeroSize) {
+  std::string s = tinyScene();
+  const std::string sphere = R"({"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "glass"})";
+  s.replace(s.find(sphere), sphere.size(), R"({"shape": "box", "size": [2, 0, 2], "material": "glass"})");
+  expectCleanFailure(render(s), "/objects/0/size");
+}
+
+// A volume beyond the device's 3D image side limit is refused before voxelising, naming the limit.
+TEST_F(Cli, RenderResolutionBeyondTheDeviceLimit) {
+  const Outcome info = run("info");
+  ASSERT_EQ(info.code, 0) << info.err;
+  const auto at = info.out.find("max 3D image side:");
+  ASSERT_NE(at, std::string::npos) << info.out;
+  const long limit = std::stol(info.out.substr(at + std::string("max 3D image side:").size()));
+  ASSERT_GT(limit, 0);
+  const long res = std::max(5000L, limit + 1);
+  const Outcome r = render(tinyScene(R"("resolution": )" + std::to_string(res)));
+  expectCleanFailure(r, "/volume/resolution");
+  EXPECT_NE(r.err.find(std::to_string(limit)), std::string::npos) << "message should state the limit " << limit << ": " << r.err;
+}
+
+TEST_F(Cli, RenderOutputDirectoryMissing) {
+  const std::string scene = write("scene.json", tinyScene());
+  const fs::path missing = dir_ / "no_such_dir";
+  expectCleanFailure(run("render " + quote(scene) + " -o " + quote((missing / "x.exr").string())), "does not exist");
+  EXPECT_FALSE(fs::exists(missing));
+}
+
+// An unwritable output directory. As root, permissions do not apply (access(W_OK) succeeds on a
+// 0555 directory), so there the test writes under /proc, which refuses new files even for root.
+TEST_F(Cli, RenderOutputDirectoryReadOnly) {
+  const std::string scene = write("scene.json", tinyScene());
+  const fs::path ro = dir_ / "readonly";
+  fs::create_directories(ro);
+  fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read | fs::perms::group_exec |
+                          fs::perms::others_read | fs::perms::others_exec);
+  chmodded_.push_back(ro);
+  if (::access(ro.c_str(), W_OK) != 0) {
+    expectCleanFailure(run("render " + quote(scene) + " -o " + quote((ro / "x.exr").string())), "not writable", ro);
+    EXPECT_TRUE(fs::is_empty(ro));
+  } else {
+    const Outcome r = run("render " + quote(scene) + " -o /proc/eikon_cli_test.exr");
+    expectCleanFailure(r, "/proc/eikon_cli_test", "/proc");
+    EXPECT_FALSE(fs::exists("/proc/eikon_cli_test.exr"));
+    EXPECT_FALSE(fs::exists("/proc/eikon_cli_test.png"));
+  }
+}
+
+TEST_F(Cli, RenderOutputMustEndInExr) {
+  const std::string scene = write("scene.json", tinyScene());
+  expectCleanFailure(run("render " + quote(scene) + " -o " + quote(outPath("render.png"))), ".exr");
+}
+
+TEST_F(Cli, RenderSppZero) { expectCleanFailure(render(tinyScene(), "--spp 0"), "--spp"); }
+
+TEST_F(Cli, RenderSceneFileMissing) {
+  expectCleanFailure(run("render " + quote((dir_ / "nope.json").string()) + " -o " + quote(outPath())), "nope.json");
+}
+
+// CLI-syntax errors (a missing required option, an unknown flag) are bad input too: DESIGN §4 /
+// the CLI contract say one "eikon: error:" line and a non-zero exit, like every other error.
+TEST_F(Cli, RenderMissingOutputOptionIsOneErrorLine) {
+  const std::string scene = write("scene.json", tinyScene());
+  expectCleanFailure(run("render " + quote(scene)), "--output");
+}
+
+TEST_F(Cli, UnknownOptionIsOneErrorLine) {
+  const std::string scene = write("scene.json", tinyScene());
+  expectCleanFailure(run("render " + quote(scene) + " -o " + quote(outPath()) + " --bogus"), "--bogus");
+}
+
+// ------------------------------------------------------------------ trace
+
+TEST_F(Cli, TraceZeroDirection) {
+  const std::string scene = write("scene.json", tinyScene());
+  expectCleanFailure(run("trace " + quote(scene) + " --origin 0,0,-4 --dir 0,0,0"), "--dir");
+}
+
+TEST_F(Cli, TraceOriginWithTwoNumbers) {
+  const std::string scene = write("scene.json", tinyScene());
+  expectCleanFailure(run("trace " + quote(scene) + " --origin 1,2 --dir 0,0,1"), "--origin");
+}
+
+TEST_F(Cli, TraceNegativeWavelength) {
+  const std::string scene = write("scene.json", tinyScene());
+  expectCleanFailure(run("trace " + quote(scene) + " --origin 0,0,-4 --dir 0,0,1 --wavelength -5"), "--wavelength");
+}
+
+TEST_F(Cli, TraceNonFiniteOrigin) {
+  const std::string scene = write("scene.json", tinyScene());
+  expectCleanFailure(run("trace " + quote(scene) + " --origin 0,nan,-4 --dir 0,0,1"), "--origin");
+}
+
+// A ray parallel to the axis at height y0 = 1.5 mm through a glass sphere (n = 1.5, r = 3 mm)
+// starting inside the volume at z = −4.9, wavelength 550 nm.
+struct TraceCase {
+  std::string args = "--origin 0,1.5,-4.9 --dir 0,0,1 --wavelength 550 --json";
+};
+
+json parseTrace(const Outcome& r) {
+  json j;
+  try {
+    j = json::parse(r.out);
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "trace --json did not print JSON (" << e.what() << "):\n" << r.out;
+  }
+  return j;
+}
+
+TEST_F(Cli, TraceJsonIsotropic) {
+  const std::string scene = write("scene.json", tinyScene());
+  const Outcome r = run("trace " + quote(scene) + " " + TraceCase{}.args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = parseTrace(r);
+  ASSERT_TRUE(j.is_object());
+  EXPECT_DOUBLE_EQ(j.at("wavelength_nm").get<double>(), 550.0);
+  ASSERT_TRUE(j.at("modes").is_array());
+  ASSERT_EQ(j.at("modes").size(), 2u);
+  EXPECT_EQ(j["modes"][0].at("mode"), "o");
+  EXPECT_EQ(j["modes"][1].at("mode"), "e");
+  for (const auto& m : j["modes"]) {
+    for (const char* k : {"exit_point", "exit_direction", "wave_normal"}) {
+      ASSERT_TRUE(m.at(k).is_array()) << k;
+      ASSERT_EQ(m.at(k).size(), 3u) << k;
+    }
+    ASSERT_TRUE(m.at("optical_path_mm").is_number());
+    ASSERT_TRUE(m.at("transmittance").is_number());
+    const auto d = m["exit_direction"].get<std::vector<double>>();
+    const auto w = m["wave_normal"].get<std::vector<double>>();
+    // Unit vectors: the tracer normalises in double (or float: 1 ulp ≈ 6e-8) ⇒ 1e-6.
+    EXPECT_NEAR(std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), 1.0, 1e-6);
+    EXPECT_NEAR(std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), 1.0, 1e-6);
+    // Isotropic: wave normal = ray direction.
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(d[size_t(i)], w[size_t(i)], 1e-6);
+    // A sphere is a converging lens: a ray entering at y = +1.5 leaves heading down (−y) and
+    // still forward (+z), out of the volume (|coordinate| = 5 on some face).
+    EXPECT_LT(d[1], -0.05);
+    EXPECT_GT(d[2], 0.5);
+    const auto p = m["exit_point"].get<std::vector<double>>();
+    const double face = std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])});
+    EXPECT_NEAR(face, 5.0, 0.01) << "exit point should lie on the volume boundary";
+    // Fresnel losses at two air-glass faces (normal incidence R = 4% each): 0.85 < T < 1.
+    const double T = m["transmittance"];
+    EXPECT_GT(T, 0.85);
+    EXPECT_LE(T, 1.0);
+    // Optical path ≥ geometric path from origin to exit (n ≥ 1 everywhere) and ≥ the straight
+    // distance, which is ≥ 9.9 − a little.
+    EXPECT_GT(m["optical_path_mm"].get<double>(), 9.0);
+  }
+  EXPECT_EQ(j["modes"][0]["exit_point"], j["modes"][1]["exit_point"]);
+}
+
+// The axial ray from the volume face z = −5 through the sphere's centre, both twins.
+//  * Symmetry: the grid is symmetric about the axis, so the ray stays on it: exit (0, 0, 5),
+//    direction (0, 0, 1) up to float32 rounding (GPU) ⇒ 1e-5.
+//  * Optical path: 4 mm of air + 2r = 6 mm of n = 1.5 ⇒ 13 mm. The voxelised surface is placed
+//    within ±h/2 (h = 0.3125 mm) at each crossing ⇒ ±(n − 1)·h = ±0.16 mm, and smoothing with
+//    σ = 0.75 h shortens the central chord by 2σ²/r ⇒ −0.018 mm ⇒ tolerance 0.2 mm.
+//  * Transmittance: Fresnel at normal incidence, R = ((n − 1)/(n + 1))² = 0.04 per surface,
+//    T = 0.96² = 0.9216; ±2e-3 ⇔ R within ±1e-3 per surface ⇔ the index contrast within ±1%.
+TEST_F(Cli, TraceAxialRayPhysics) {
+  const std::string scene = write("scene.json", tinyScene());
+  for (const char* twin : {"", " --reference"}) {
+    const Outcome r = run("trace " + quote(scene) + " --origin 0,0,-5 --dir 0,0,1 --json" + twin);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json j = parseTrace(r);
+    ASSERT_TRUE(j.is_object());
+    const json& m = j["modes"][0];
+    const auto p = m["exit_point"].get<std::vector<double>>();
+    const auto d = m["exit_direction"].get<std::vector<double>>();
+    EXPECT_NEAR(p[0], 0.0, 1e-5) << twin;
+    EXPECT_NEAR(p[1], 0.0, 1e-5) << twin;
+    EXPECT_NEAR(p[2], 5.0, 1e-5) << twin;
+    EXPECT_NEAR(d[2], 1.0, 1e-5) << twin;
+    const double opl = m["optical_path_mm"], T = m["transmittance"];
+    std::printf("[ measured ]%s axial OPL %.6f mm (expected 13), T %.6f (expected 0.9216)\n", twin, opl, T);
+    EXPECT_NEAR(opl, 13.0, 0.2) << twin;
+    EXPECT_NEAR(T, 0.9216, 2e-3) << twin;
+  }
+}
+
+// GPU (float32) vs CPU reference (double) on the same voxel field and the same step size.
+// Tolerance 1e-4 mm on the exit point: the two differ by float32 rounding only. Positions of
+// |x| ≤ 5 mm carry 3e-7 mm per step; ≈ 200 steps add up to ≤ 6e-5 mm if every rounding had the
+// same sign, and the refraction at the sphere turns a direction error δ (≈ 1e-6 rad) into
+// ≤ 1e-5 mm over the 10 mm path ⇒ 1e-4 mm. The directions are compared to 1e-4 likewise.
+TEST_F(Cli, TraceGpuAgreesWithReference) {
+  const std::string scene = write("scene.json", tinyScene());
+  const Outcome gpu = run("trace " + quote(scene) + " " + TraceCase{}.args);
+  ASSERT_EQ(gpu.code, 0) << gpu.err;
+  const Outcome cpu = run("trace " + quote(scene) + " " + TraceCase{}.args + " --reference");
+  ASSERT_EQ(cpu.code, 0) << cpu.err;
+  const json g = parseTrace(gpu), c = parseTrace(cpu);
+  ASSERT_TRUE(g.is_object() && c.is_object());
+  const auto pg = g["modes"][0]["exit_point"].get<std::vector<double>>();
+  const auto pc = c["modes"][0]["exit_point"].get<std::vector<double>>();
+  const auto dg = g["modes"][0]["exit_direction"].get<std::vector<double>>();
+  const auto dc = c["modes"][0]["exit_direction"].get<std::vector<double>>();
+  double dp = 0, dd = 0;
+  for (size_t i = 0; i < 3; ++i) {
+    dp = std::max(dp, std::abs(pg[i] - pc[i]));
+    dd = std::max(dd, std::abs(dg[i] - dc[i]));
+  }
+  std::printf("[ measured ] GPU vs reference: exit point %.2e mm, direction %.2e; OPL %.9f vs %.9f\n", dp, dd,
+              g["modes"][0]["optical_path_mm"].get<double>(), c["modes"][0]["optical_path_mm"].get<double>());
+  EXPECT_LT(dp, 1e-4);
+  EXPECT_LT(dd, 1e-4);
+  // The ray was actually bent (the comparison is not trivially between two straight lines).
+  EXPECT_GT(std::abs(pc[1] - 1.5), 0.1);
+}
+
+}  // namespace
