@@ -15,7 +15,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::fprintf(stderr, "eikon: error: %s (run with --help)\n", e.what());
+    return 2;
   } catch (const eikon::cli::CliError& e) {
     std::fprintf(stderr, "eikon: error: %s\n", e.what());
     return e.exit_code;

@@ -1,7 +1,9 @@
 // eikon trace SCENE.json --origin x,y,z --dir x,y,z --wavelength NM [--json] [--reference]
 // Traces one ray through the voxelised scene and prints, per mode, exit point, exit direction,
 // wave normal, optical path and transmittance (DESIGN §3). Isotropic scenes print both modes,
-// identical.
+// identical. Transmittance is the mode's own (Fresnel for its polarisation × attenuation);
+// unpolarised light gives each mode half of the incident power.
+#include <array>
 #include <cstdio>
 #include <sstream>
 
@@ -55,27 +57,26 @@ void addTraceCommand(CLI::App& app) {
   sub->callback([a] {
     glm::dvec3 o = parseVec(a->origin, "--origin"), d = parseVec(a->dir, "--dir");
     if (glm::length(d) < 1e-12) throw CliError("--dir must be a non-zero vector");
-    if (!(a->wavelength > 0 && a->wavelength < 1e5)) throw CliError("--wavelength must be a positive number of nm");
+    if (!(a->wavelength >= 100 && a->wavelength <= 10000)) throw CliError("--wavelength must be in [100, 10000] nm");
     if (!(a->step > 0 && a->step <= 4)) throw CliError("--step must be in (0, 4] voxels");
     Scene scene = loadScene(a->scene);
-    if (scene.anyUniaxial())
-      throw CliError("uniaxial materials: the e-ray march is not available in this build; trace isotropic scenes");
     MarchSettings ms;
     ms.step_voxels = a->step;
     TraceRequest req{o, glm::normalize(d), a->wavelength};
-    TraceOutcome t;
+    std::array<TraceOutcome, 2> modes;
     std::string device;
     if (a->reference) {
       VolumeSet volume = voxelize(scene);
       VolumeField field(volume);
-      t = ReferenceMarcher(field, scene.environment).trace(req, ms);
+      ReferenceMarcher ref(field, scene.environment);
+      modes = {ref.trace(req, ms, 0), ref.trace(req, ms, 1)};
       device = "CPU reference (double)";
     } else {
       auto ctx = vk::Context::create();
       checkVolumeFits(*ctx, makeGrid(scene.volume), scene);
       VolumeSet volume = voxelize(scene);
       ViewRenderer r(*ctx, scene, volume);
-      t = r.trace({req}, ms).front();
+      modes = r.traceModes({req}, ms).front();
       device = ctx->deviceName();
     }
     auto vec = [](const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
@@ -83,8 +84,9 @@ void addTraceCommand(CLI::App& app) {
       nlohmann::json j;
       j["wavelength_nm"] = a->wavelength;
       j["modes"] = nlohmann::json::array();
-      for (const char* mode : {"o", "e"}) {
-        j["modes"].push_back({{"mode", mode},
+      for (int mi = 0; mi < 2; ++mi) {
+        const TraceOutcome& t = modes[size_t(mi)];
+        j["modes"].push_back({{"mode", mi == 0 ? "o" : "e"},
                               {"exit_point", vec(t.exit_point)},
                               {"exit_direction", vec(t.exit_direction)},
                               {"wave_normal", vec(t.wave_normal)},
@@ -100,11 +102,13 @@ void addTraceCommand(CLI::App& app) {
       return;
     }
     std::printf("wavelength %.4f nm on %s\n", a->wavelength, device.c_str());
-    for (const char* mode : {"o", "e"})
+    for (int mi = 0; mi < 2; ++mi) {
+      const TraceOutcome& t = modes[size_t(mi)];
       std::printf("  %s: exit (%.6f, %.6f, %.6f) dir (%.6f, %.6f, %.6f) wave normal (%.6f, %.6f, %.6f) OPL %.6f mm T %.6f%s\n",
-                  mode, t.exit_point.x, t.exit_point.y, t.exit_point.z, t.exit_direction.x, t.exit_direction.y,
+                  mi == 0 ? "o" : "e", t.exit_point.x, t.exit_point.y, t.exit_point.z, t.exit_direction.x, t.exit_direction.y,
                   t.exit_direction.z, t.wave_normal.x, t.wave_normal.y, t.wave_normal.z, t.optical_path_mm,
                   t.transmittance, t.left_volume ? "" : " (stopped inside)");
+    }
   });
 }
 

@@ -39,6 +39,9 @@ using ivec4 = glm::ivec4;
 #define EIKON_F_SPECTRAL 4
 #define EIKON_F_NO_SKIP 8
 #define EIKON_F_NO_FRESNEL 16
+#define EIKON_F_ATTENUATION 32  // some σ ≠ 0: sample the medium images
+#define EIKON_F_EMISSION 64     // some emission ≠ 0
+#define EIKON_F_OPACITY 128     // some opaque object
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0

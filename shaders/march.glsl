@@ -140,16 +140,16 @@ vec3 environment(vec3 d) {
   return colourOf(c * P.env.z);
 }
 
-// Unpolarised Fresnel reflectance for a wave going from index n1 into n2 with cos θ_i = ci ≥ 0
-// (Born & Wolf §1.5.2): R = (Rs + Rp)/2; 1 beyond the critical angle.
-float fresnelR(float ci, float n1, float n2) {
+// Fresnel amplitude reflectances squared (Rs, Rp) for a wave going from index n1 into n2 with
+// cos θ_i = ci ≥ 0 (Born & Wolf §1.5.2); (1, 1) beyond the critical angle.
+vec2 fresnelRsRp(float ci, float n1, float n2) {
   float eta = n1 / n2;
   float st2 = eta * eta * max(0.0, 1.0 - ci * ci);
-  if (st2 >= 1.0) return 1.0;
+  if (st2 >= 1.0) return vec2(1.0);
   float ct = sqrt(1.0 - st2);
   float rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
   float rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
-  return 0.5 * (rs * rs + rp * rp);
+  return vec2(rs * rs, rp * rp);
 }
 
 // Ray–box slab test; returns false if the line misses. t0 ≤ t1.
@@ -165,7 +165,8 @@ bool boxHit(vec3 o, vec3 d, vec3 bmin, vec3 bmax, out float t0, out float t1) {
 struct MarchResult {
   vec3 radiance;
   vec3 exit_point;
-  vec3 exit_dir;
+  vec3 exit_dir;     // ray (energy) direction
+  vec3 wave_normal;
   vec3 throughput;
   float opl;
   bool left;
@@ -175,11 +176,84 @@ struct MarchResult {
   int tir;
 };
 
-// One RK stage's derivative of (x, w).
+// Optic axis at x (nearest voxel; zero where there is no crystal).
+vec3 axisAt(vec3 x) {
+  if (!hasFlag(EIKON_F_UNIAXIAL)) return vec3(0.0);
+  ivec3 vi = clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_extent.w)), ivec3(0), P.grid_dims.xyz - 1);
+  return imageLoad(axisImg, vi).xyz;
+}
+
+// The e-mode's inverse dielectric-like matrix M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e² applied to p.
+vec3 applyM(vec3 p, vec3 a, float no, float ne) {
+  float pa = dot(p, a);
+  return a * pa / (no * no) + (p - a * pa) / (ne * ne);
+}
+
+// Derivatives of (x, w) with respect to ray arc length s.
+//  o-mode (DESIGN §2, isotropic form): dx/ds = w/n, dw/ds = ∇n.
+//  e-mode (Hamiltonian H = ½(pᵀM_e p − 1), w = p): dx/dτ = M p,
+//    dp/dτ = −½ pᵀ(∂M/∂x)p = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e   (a piecewise constant),
+//    divided by |M p| to step in arc length. Where there is no axis the e-mode is the o-mode.
 void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
-  vec4 nn = sampleIndex(x, mode);
-  dx = w / nn.x;
-  dw = nn.yzw;
+  vec4 o = sampleIndex(x, 0);
+  if (mode == 0) {
+    dx = w / o.x;
+    dw = o.yzw;
+    return;
+  }
+  vec3 a = axisAt(x);
+  if (dot(a, a) < 0.25) {
+    dx = w / o.x;
+    dw = o.yzw;
+    return;
+  }
+  vec4 e = sampleIndex(x, 1);
+  float pa = dot(w, a), p2 = dot(w, w);
+  vec3 Mp = applyM(w, a, o.x, e.x);
+  vec3 dp = (pa * pa / (o.x * o.x * o.x)) * o.yzw + ((p2 - pa * pa) / (e.x * e.x * e.x)) * e.yzw;
+  float L = length(Mp);
+  dx = Mp / L;
+  dw = dp / L;
+}
+
+// Ray direction of mode `mode` for wave vector w at x.
+vec3 rayDirection(vec3 x, vec3 w, int mode) {
+  if (mode == 0) return normalize(w);
+  vec3 a = axisAt(x);
+  if (dot(a, a) < 0.25) return normalize(w);
+  return normalize(applyM(w, a, sampleIndex(x, 0).x, sampleIndex(x, 1).x));
+}
+
+// Attenuation per unit ray length of `mode` at x for wave vector w (band values or the value at λ).
+// e-mode: σ(θ) = n(θ)³[σ_o cos²θ/n_o³ + σ_e sin²θ/n_e³] per unit wave-normal length (DESIGN §2,
+// first order in the extinction), times cos ρ = s·t for the length along the ray.
+vec3 attenuationAt(vec3 x, vec3 w, int mode) {
+  vec3 so = sigmaOf(sampleMedium(x, 0).xyz);
+  if (mode == 0) return so;
+  vec3 a = axisAt(x);
+  if (dot(a, a) < 0.25) return so;
+  vec3 se = sigmaOf(sampleMedium(x, 1).xyz);
+  float no = sampleIndex(x, 0).x, ne = sampleIndex(x, 1).x;
+  vec3 s = normalize(w);
+  float c = dot(s, a), c2 = c * c, s2 = 1.0 - c2;
+  float inv_n2 = c2 / (no * no) + s2 / (ne * ne);
+  float n = inversesqrt(inv_n2);
+  vec3 t = normalize(applyM(w, a, no, ne));
+  return n * n * n * (so * c2 / (no * no * no) + se * s2 / (ne * ne * ne)) * dot(s, t);
+}
+
+// Fresnel (Rs, Rp) weights of a mode at an interface: the share of its D field along the
+// s-polarisation direction (normal to the plane of incidence). Isotropic or degenerate: ½/½,
+// which makes ½(T_o + T_e) the unpolarised transmittance.
+float sWeight(vec3 s_crystal, vec3 a, vec3 N, vec3 dIn, int mode) {
+  vec3 es = cross(N, dIn);
+  if (dot(a, a) < 0.25 || dot(es, es) < 1e-12) return 0.5;
+  vec3 Do = cross(s_crystal, a);
+  if (dot(Do, Do) < 1e-12) return 0.5;  // wave normal along the axis: no split
+  Do = normalize(Do);
+  es = normalize(es);
+  float wo = dot(Do, es) * dot(Do, es);
+  return mode == 0 ? wo : 1.0 - wo;
 }
 
 MarchResult march(vec3 o, vec3 d, int mode) {
@@ -200,52 +274,57 @@ MarchResult march(vec3 o, vec3 d, int mode) {
     R.radiance = environment(d);
     R.exit_point = o;
     R.exit_dir = d;
+    R.wave_normal = d;
     return R;
   }
   t0 = max(t0, 0.0);
   vec3 x = o + d * t0;
   R.opl = ambient * t0;
-  vec4 nn = sampleIndex(x, mode);
-  vec3 w = nn.x * d;
+  vec4 nn = sampleIndex(x, 0);
+  vec3 w = nn.x * d;  // the volume's faces are isotropic (air): p = n d
   const float ds = P.march.x * h;
   const int integrator = int(P.march.w);
   const float thrLow = 1e-6, thrIface = P.march.y;
   bool inLayer = false;
-  float nBefore = nn.x, peak = 0.0;
-  vec3 dBefore = d, gAcc = vec3(0.0), xOpen = x;
+  float peak = 0.0;
+  vec3 wBefore = w, gAcc = vec3(0.0), xOpen = x;
   vec3 T = vec3(1.0), L = vec3(0.0);
   bool stopped = false;
   const int maxSteps = P.limits.x;
   int steps = 0;
   for (; steps < maxSteps; ++steps) {
-    vec3 dir = normalize(w);
-    float tb0, tb1;
-    boxHit(x, dir, bmin, bmax, tb0, tb1);
-    float tExit = max(tb1, 0.0);
-    // Homogeneous region: one straight, exact step.
+    // Homogeneous region: one straight, exact step along the ray direction.
     ivec3 vi = clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_extent.w)), ivec3(0), P.grid_dims.xyz - 1);
     vec4 em = imageLoad(emissionImg, vi);
     if (!inLayer && em.w >= 2.0 && !hasFlag(EIKON_F_NO_SKIP)) {
+      vec3 dir = rayDirection(x, w, mode);
+      float tb0, tb1;
+      boxHit(x, dir, bmin, bmax, tb0, tb1);
+      float tExit = max(tb1, 0.0);
       float len = (em.w - 1.5) * h;
       bool leaving = len >= tExit;
       len = min(len, tExit);
-      vec4 med = sampleMedium(x, mode);
-      if (med.w >= 0.5) { L += T * colourOf(em.xyz); stopped = true; break; }
-      vec3 sig = sigmaOf(med.xyz);
-      vec3 e = colourOf(em.xyz);
-      vec3 att = exp(-sig * len);
-      // ∫₀^len T e^{−σs} e ds = T e (1 − e^{−σ len})/σ  (→ T e len as σ → 0)
-      L += T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
-      T *= att;
-      float n = length(w);
-      R.opl += n * len;
+      if (hasFlag(EIKON_F_OPACITY) && sampleMedium(x, mode).w >= 0.5) {
+        L += T * colourOf(em.xyz);
+        stopped = true;
+        break;
+      }
+      if (hasFlag(EIKON_F_EMISSION) || hasFlag(EIKON_F_ATTENUATION)) {
+        vec3 sig = hasFlag(EIKON_F_ATTENUATION) ? attenuationAt(x, w, mode) : vec3(0.0);
+        vec3 e = colourOf(em.xyz);
+        vec3 att = exp(-sig * len);
+        // ∫₀^len T e^{−σs} e ds = T e (1 − e^{−σ len})/σ  (→ T e len as σ → 0)
+        L += T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
+        T *= att;
+      }
+      R.opl += dot(w, dir) * len;  // ∫ p·dx
       x += dir * len;
       if (leaving) break;
       continue;
     }
     // One integration step of the ray equation.
     vec3 x0 = x, w0 = w;
-    float n0 = length(w0);
+    float n0 = nn.x;
     vec3 k1x, k1w, k2x, k2w, k3x, k3w, k4x, k4w;
     deriv(x, w, mode, k1x, k1w);
     if (integrator == EIKON_INT_EULER) {
@@ -262,50 +341,79 @@ MarchResult march(vec3 o, vec3 d, int mode) {
       x += ds / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
       w += ds / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
     }
-    nn = sampleIndex(x, mode);
-    R.drift = max(R.drift, abs(length(w) - nn.x));
-    R.opl += 0.5 * (n0 + nn.x) * ds;
-    // Medium at the step midpoint.
+    nn = sampleIndex(x, 0);
+    vec3 gradN = nn.yzw;
+    vec3 aHere = mode == 1 ? axisAt(x) : vec3(0.0);
+    bool eHere = mode == 1 && dot(aHere, aHere) >= 0.25;
+    vec4 ne = eHere ? sampleIndex(x, 1) : nn;
+    if (mode == 0) {
+      R.drift = max(R.drift, abs(length(w) - nn.x));
+      R.opl += 0.5 * (n0 + nn.x) * ds;
+    } else {
+      R.opl += 0.5 * dot(w0 + w, x - x0);
+      if (eHere) gradN = 0.5 * (nn.yzw + ne.yzw);
+    }
+    // Medium at the step midpoint (only sampled where the scene has any).
     vec3 xm = 0.5 * (x0 + x);
-    vec4 med = sampleMedium(xm, mode);
-    vec3 sig = sigmaOf(med.xyz);
-    L += T * colourOf(sampleEmission(xm)) * ds;
-    T *= exp(-sig * ds);
-    if (sampleMedium(x, mode).w >= 0.5) { L += T * colourOf(sampleEmission(x)); stopped = true; break; }
+    if (hasFlag(EIKON_F_EMISSION)) L += T * colourOf(sampleEmission(xm)) * ds;
+    if (hasFlag(EIKON_F_ATTENUATION)) T *= exp(-attenuationAt(xm, 0.5 * (w0 + w), mode) * ds);
+    if (hasFlag(EIKON_F_OPACITY) && sampleMedium(x, mode).w >= 0.5) {
+      L += T * colourOf(sampleEmission(x));
+      stopped = true;
+      break;
+    }
     // Interface bookkeeping.
-    float g = length(nn.yzw) * h;
+    float g = max(length(nn.yzw), length(ne.yzw)) * h;
     if (!inLayer && g > thrLow) {
       inLayer = true;
-      nBefore = n0;
-      dBefore = normalize(w0);
+      wBefore = w0;
       gAcc = vec3(0.0);
       peak = 0.0;
       xOpen = x0;
     }
     if (inLayer) {
-      gAcc += nn.yzw * ds;
+      gAcc += gradN * ds;
       peak = max(peak, g);
       if (g <= thrLow) {
         inLayer = false;
-        if (dot(gAcc, gAcc) > 0.0 && abs(dot(x - xOpen, normalize(gAcc))) <= 12.0 * h) {
-          // Back on the constraint surface |w| = n(x) (H = 0) along the layer normal: the
-          // tangential part of w is what the interface conserves (Snell); the stored central-
-          // difference gradient is not exactly the derivative of the trilinear n, which makes |w|
-          // drift by ~1e-4 across a sharp layer. Only for thin layers (interfaces no thicker than 12
-          // voxels along their normal), never across gradient-index bodies; skipped if the normal part would vanish.
-          vec3 N = normalize(gAcc);
+        vec3 N = dot(gAcc, gAcc) > 0.0 ? normalize(gAcc) : vec3(0.0);
+        if (dot(N, N) > 0.0 && abs(dot(x - xOpen, N)) <= 12.0 * h) {
+          // Back on the constraint surface H = 0 (|w| = n for the o-mode, wᵀM_e w = 1 for the
+          // e-mode) along the layer normal: the tangential part of w is what the interface
+          // conserves (Snell). The stored central-difference gradient is not exactly the
+          // derivative of the trilinear n, which makes H drift by ~1e-4 across a sharp layer.
+          // Only for thin layers (interfaces no thicker than 12 voxels along their normal),
+          // never across gradient-index bodies; skipped if the normal part would change much.
           float wn = dot(w, N);
           vec3 wt = w - wn * N;
-          float rem = nn.x * nn.x - dot(wt, wt);
-          if (rem > 0.25 * wn * wn) w = wt + sign(wn) * sqrt(rem) * N;
+          if (!eHere) {
+            float rem = nn.x * nn.x - dot(wt, wt);
+            if (rem > 0.25 * wn * wn) w = wt + sign(wn) * sqrt(rem) * N;
+          } else {
+            // (wt + λN)ᵀ M (wt + λN) = 1: qa λ² + 2 qb λ + qc = 0, root nearest the current wn.
+            vec3 MN = applyM(N, aHere, nn.x, ne.x);
+            float qa = dot(N, MN), qb = dot(wt, MN), qc = dot(wt, applyM(wt, aHere, nn.x, ne.x)) - 1.0;
+            float disc = qb * qb - qa * qc;
+            if (disc > 0.0) {
+              float l1 = (-qb + sqrt(disc)) / qa, l2 = (-qb - sqrt(disc)) / qa;
+              float lam = abs(l1 - wn) < abs(l2 - wn) ? l1 : l2;
+              if (abs(lam - wn) < 0.5 * abs(wn)) w = wt + lam * N;
+            }
+          }
         }
-        if (peak > thrIface && !hasFlag(EIKON_F_NO_FRESNEL) && dot(gAcc, gAcc) > 0.0) {
-          vec3 N = normalize(gAcc);
-          vec3 dAfter = normalize(w);
-          float ci = dot(dBefore, N), co = dot(dAfter, N);
+        if (peak > thrIface && !hasFlag(EIKON_F_NO_FRESNEL) && dot(N, N) > 0.0) {
+          vec3 dIn = normalize(wBefore), dOut = normalize(w);
+          float ci = dot(dIn, N), co = dot(dOut, N);
+          float n1 = length(wBefore), n2 = length(w);
           if (ci * co > 0.0) {
-            float Rf = fresnelR(abs(ci), nBefore, nn.x);
-            if (nn.x > nBefore) L += T * Rf * environment(reflect(dBefore, N));
+            // Which side is the crystal? Its wave normal defines the mode's polarisation.
+            vec3 aOut = axisAt(x), aIn = axisAt(xOpen);
+            bool outCrystal = dot(aOut, aOut) >= 0.25;
+            vec3 a = outCrystal ? aOut : aIn;
+            float wsw = sWeight(outCrystal ? dOut : dIn, a, N, dIn, mode);
+            vec2 rsp = fresnelRsRp(abs(ci), n1, n2);
+            float Rf = hasFlag(EIKON_F_UNIAXIAL) ? wsw * rsp.x + (1.0 - wsw) * rsp.y : 0.5 * (rsp.x + rsp.y);
+            if (n2 > n1) L += T * Rf * environment(reflect(dIn, N));
             T *= 1.0 - Rf;
             R.interfaces++;
           } else {
@@ -316,21 +424,22 @@ MarchResult march(vec3 o, vec3 d, int mode) {
     }
     // Left the volume? The ray is straight outside (fields clamp to the uniform edge voxels).
     if (any(lessThan(x, bmin)) || any(greaterThan(x, bmax))) {
-      vec3 dd = normalize(w);
+      vec3 dd = normalize(x - x0);
       float a0, a1;
       boxHit(x0, dd, bmin, bmax, a0, a1);
       float stepLen = length(x - x0);
-      float back = stepLen - max(a1, 0.0);
-      x = x0 + dd * max(a1, 0.0);
-      R.opl -= max(back, 0.0) * nn.x;
+      float keep = clamp(max(a1, 0.0) / max(stepLen, 1e-30), 0.0, 1.0);
+      R.opl -= (1.0 - keep) * 0.5 * dot(w0 + w, x - x0);
+      x = x0 + (x - x0) * keep;
       // w at the boundary, not at the overshoot (linear within the step).
-      if (stepLen > 0.0) w = mix(w0, w, clamp(max(a1, 0.0) / stepLen, 0.0, 1.0));
+      w = mix(w0, w, keep);
       break;
     }
   }
   R.steps = steps;
   R.exit_point = x;
-  R.exit_dir = normalize(w);
+  R.exit_dir = rayDirection(x, w, mode);
+  R.wave_normal = normalize(w);
   R.left = !stopped && steps < maxSteps;
   if (R.left) L += T * environment(R.exit_dir);
   R.radiance = L;

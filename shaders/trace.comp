@@ -11,16 +11,23 @@ layout(local_size_x = EIKON_TRACE_WG) in;
 layout(std430, binding = EIKON_B_RAYS) readonly buffer RayBuf { TraceRay rays[]; };
 layout(std430, binding = EIKON_B_OUTPUT) writeonly buffer ResultBuf { TraceResult results[]; };
 
+TraceResult pack(MarchResult r) {
+  TraceResult o;
+  o.exit_point = vec4(r.exit_point, r.left ? 1.0 : 0.0);
+  o.exit_direction = vec4(r.exit_dir, r.opl);
+  o.wave_normal = vec4(r.wave_normal, r.throughput.x);
+  o.stats = vec4(float(r.steps), r.drift, float(r.interfaces), float(r.tir));
+  return o;
+}
+
+// results[2i] is the o-mode of ray i, results[2i + 1] its e-mode (identical where isotropic).
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= uint(P.image.x)) return;
   TraceRay ray = rays[i];
   setWavelength(ray.origin.w, true);
-  MarchResult r = march(ray.origin.xyz, normalize(ray.direction.xyz), 0);
-  TraceResult out_;
-  out_.exit_point = vec4(r.exit_point, r.left ? 1.0 : 0.0);
-  out_.exit_direction = vec4(r.exit_dir, r.opl);
-  out_.wave_normal = vec4(r.exit_dir, r.throughput.x);
-  out_.stats = vec4(float(r.steps), r.drift, float(r.interfaces), float(r.tir));
-  results[i] = out_;
+  vec3 d = normalize(ray.direction.xyz);
+  TraceResult o = pack(march(ray.origin.xyz, d, 0));
+  results[2 * i] = o;
+  results[2 * i + 1] = hasFlag(EIKON_F_UNIAXIAL) ? pack(march(ray.origin.xyz, d, 1)) : o;
 }

@@ -1,7 +1,8 @@
 #version 450
 // View renderer: one thread per pixel; spp jittered sub-pixel samples; RGB mode (one march at a
 // fixed wavelength, RGB attenuation) or spectral mode (N stratified wavelengths per sample,
-// CIE 1931 → linear sRGB). Output: linear sRGB radiance per pixel, w = mean steps.
+// CIE 1931 → linear sRGB). Uniaxial scenes march the o- and e-modes, each carrying half of the
+// unpolarised radiance. Output: linear sRGB radiance per pixel, w = mean steps.
 #extension GL_GOOGLE_include_directive : require
 #include "eikon_shared.h"
 
@@ -52,8 +53,14 @@ void main() {
         float lambda = 380.0 + (float(k) + uk) * (400.0 / float(N));
         setWavelength(lambda * 1e-3, true);
         MarchResult r = march(P.cam_pos.xyz, d, 0);
-        xyz += r.radiance.x * cmf(lambda) * (400.0 / float(N));
+        float rad = r.radiance.x;
         steps += float(r.steps) / float(N);
+        if (hasFlag(EIKON_F_UNIAXIAL)) {  // unpolarised: each mode carries half
+          MarchResult re = march(P.cam_pos.xyz, d, 1);
+          rad = 0.5 * (rad + re.radiance.x);
+          steps += float(re.steps) / float(N);
+        }
+        xyz += rad * cmf(lambda) * (400.0 / float(N));
       }
       mat3 M = mat3(tables[EIKON_MATRIX_OFFSET].xyz, tables[EIKON_MATRIX_OFFSET + 1].xyz,
                     tables[EIKON_MATRIX_OFFSET + 2].xyz);
@@ -61,8 +68,14 @@ void main() {
     } else {
       setWavelength(P.wavelength.x, false);
       MarchResult r = march(P.cam_pos.xyz, d, 0);
-      sum += r.radiance;
+      vec3 rad = r.radiance;
       steps += float(r.steps);
+      if (hasFlag(EIKON_F_UNIAXIAL)) {  // unpolarised: each mode carries half
+        MarchResult re = march(P.cam_pos.xyz, d, 1);
+        rad = 0.5 * (rad + re.radiance);
+        steps += float(re.steps);
+      }
+      sum += rad;
     }
   }
   pixels[int(gid.y) * W + px] = vec4(sum / float(spp), steps / float(spp));

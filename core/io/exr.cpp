@@ -53,6 +53,13 @@ void checkWritable(const std::filesystem::path& path) {
     throw std::runtime_error("cannot write '" + path.string() + "': directory '" + dir.string() + "' is not writable");
   if (std::filesystem::is_directory(path))
     throw std::runtime_error("cannot write '" + path.string() + "': it is a directory");
+  // access() says yes to root everywhere; creating a probe file is the real test.
+  auto probe = tempPathFor(path);
+  FILE* f = std::fopen(probe.c_str(), "wb");
+  if (!f) throw std::runtime_error("cannot write '" + path.string() + "': cannot create files in '" + dir.string() + "'");
+  std::fclose(f);
+  std::error_code ec;
+  std::filesystem::remove(probe, ec);
 }
 
 RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_height) {

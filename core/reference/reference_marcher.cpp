@@ -30,15 +30,15 @@ bool boxHit(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& bmin, co
   return t1 >= std::max(t0, 0.0);
 }
 
-/// Unpolarised Fresnel reflectance n1 → n2 at cos θ_i = ci (Born & Wolf §1.5.2); 1 for TIR.
-double fresnelR(double ci, double n1, double n2) {
+/// Fresnel (Rs, Rp) for n1 → n2 at cos θ_i = ci (Born & Wolf §1.5.2); (1, 1) for TIR.
+glm::dvec2 fresnelRsRp(double ci, double n1, double n2) {
   double eta = n1 / n2;
   double st2 = eta * eta * std::max(0.0, 1.0 - ci * ci);
-  if (st2 >= 1.0) return 1.0;
+  if (st2 >= 1.0) return glm::dvec2(1.0);
   double ct = std::sqrt(1.0 - st2);
   double rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
   double rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
-  return 0.5 * (rs * rs + rp * rp);
+  return {rs * rs, rp * rp};
 }
 
 double bandAt(const glm::dvec3& rgb, double l) {
@@ -81,7 +81,26 @@ void VolumeField::index(const glm::dvec3& x, double il2, double il4, double& n, 
   grad = glm::dvec3(a.y, a.z, a.w);
 }
 
+void VolumeField::indexE(const glm::dvec3& x, double il2, double il4, double& n, glm::dvec3& grad) const {
+  if (!v_.uniaxial) return index(x, il2, il4, n, grad);
+  glm::dvec4 a = trilinear(v_.index[1][0], x);
+  if (v_.dispersive) a += trilinear(v_.index[1][1], x) * il2 + trilinear(v_.index[1][2], x) * il4;
+  n = a.x;
+  grad = glm::dvec3(a.y, a.z, a.w);
+}
+
+glm::dvec3 VolumeField::axis(const glm::dvec3& x) const {
+  if (!v_.uniaxial) return glm::dvec3(0.0);
+  const Grid& g = v_.grid;
+  int i[3];
+  for (int a = 0; a < 3; ++a) i[a] = std::clamp(int(std::floor((x[a] - g.origin[a]) / g.h)), 0, g.dims[size_t(a)] - 1);
+  return glm::dvec3(v_.axis[g.index(i[0], i[1], i[2])]);
+}
+
 glm::dvec4 VolumeField::medium(const glm::dvec3& x) const { return trilinear(v_.medium[0], x); }
+glm::dvec4 VolumeField::mediumE(const glm::dvec3& x) const {
+  return v_.uniaxial ? trilinear(v_.medium[1], x) : trilinear(v_.medium[0], x);
+}
 glm::dvec3 VolumeField::emission(const glm::dvec3& x) const { return glm::dvec3(trilinear(v_.emission, x)); }
 
 double VolumeField::skipDistance(const glm::dvec3& x) const {
@@ -93,20 +112,85 @@ double VolumeField::skipDistance(const glm::dvec3& x) const {
 
 // ------------------------------------------------------------------ ReferenceMarcher
 struct ReferenceMarcher::Result {
-  glm::dvec3 radiance{0.0}, throughput{1.0}, exit_point{0.0}, exit_dir{0.0};
+  glm::dvec3 radiance{0.0}, throughput{1.0}, exit_point{0.0}, exit_dir{0.0}, wave_normal{0.0};
   double opl = 0.0, drift = 0.0;
   bool left = true;
   int steps = 0, interfaces = 0, tir = 0;
 };
 
 ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm,
-                                                 bool scalar, const MarchSettings& m) const {
+                                                 bool scalar, const MarchSettings& m, int mode) const {
   const double l_um = lambda_nm * 1e-3, il2 = 1.0 / (l_um * l_um), il4 = il2 * il2;
   auto colour = [&](const glm::dvec3& rgb) {
     return scalar ? glm::dvec3(spectrum::rgbToSpectrum(rgb, lambda_nm)) : rgb;
   };
   auto sigmaOf = [&](const glm::dvec3& b) { return scalar ? glm::dvec3(bandAt(b, lambda_nm)) : b; };
   auto environment = [&](const glm::dvec3& dir) { return colour(env_.lookup(dir)); };
+  auto nO = [&](const glm::dvec3& x, double& n, glm::dvec3& g) { field_.index(x, il2, il4, n, g); };
+  auto nE = [&](const glm::dvec3& x, double& n, glm::dvec3& g) { field_.indexE(x, il2, il4, n, g); };
+  auto hasAxis = [](const glm::dvec3& a) { return glm::dot(a, a) >= 0.25; };
+  // M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e² (DESIGN §2).
+  auto applyM = [](const glm::dvec3& p, const glm::dvec3& a, double no, double ne) {
+    double pa = glm::dot(p, a);
+    return a * pa / (no * no) + (p - a * pa) / (ne * ne);
+  };
+  // Derivatives with respect to ray arc length; see shaders/march.glsl deriv().
+  auto deriv = [&](const glm::dvec3& x, const glm::dvec3& w, glm::dvec3& dx, glm::dvec3& dw) {
+    double no;
+    glm::dvec3 go;
+    nO(x, no, go);
+    glm::dvec3 a = mode == 1 ? field_.axis(x) : glm::dvec3(0.0);
+    if (mode == 0 || !hasAxis(a)) {
+      dx = w / no;
+      dw = go;
+      return;
+    }
+    double ne;
+    glm::dvec3 ge;
+    nE(x, ne, ge);
+    double pa = glm::dot(w, a), p2 = glm::dot(w, w);
+    glm::dvec3 Mp = applyM(w, a, no, ne);
+    glm::dvec3 dp = (pa * pa / (no * no * no)) * go + ((p2 - pa * pa) / (ne * ne * ne)) * ge;
+    double L = glm::length(Mp);
+    dx = Mp / L;
+    dw = dp / L;
+  };
+  auto rayDirection = [&](const glm::dvec3& x, const glm::dvec3& w) {
+    glm::dvec3 a = mode == 1 ? field_.axis(x) : glm::dvec3(0.0);
+    if (mode == 0 || !hasAxis(a)) return glm::normalize(w);
+    double no, ne;
+    glm::dvec3 g;
+    nO(x, no, g);
+    nE(x, ne, g);
+    return glm::normalize(applyM(w, a, no, ne));
+  };
+  // Attenuation per unit ray length (e-mode: pleochroic σ(θ)·cos ρ, DESIGN §2).
+  auto attenuationAt = [&](const glm::dvec3& x, const glm::dvec3& w) {
+    glm::dvec3 so = sigmaOf(glm::dvec3(field_.medium(x)));
+    glm::dvec3 a = mode == 1 ? field_.axis(x) : glm::dvec3(0.0);
+    if (mode == 0 || !hasAxis(a)) return so;
+    glm::dvec3 se = sigmaOf(glm::dvec3(field_.mediumE(x)));
+    double no, ne;
+    glm::dvec3 g;
+    nO(x, no, g);
+    nE(x, ne, g);
+    glm::dvec3 sn = glm::normalize(w);
+    double c = glm::dot(sn, a), c2 = c * c, s2 = 1.0 - c2;
+    double n = 1.0 / std::sqrt(c2 / (no * no) + s2 / (ne * ne));
+    glm::dvec3 t = glm::normalize(applyM(w, a, no, ne));
+    return n * n * n * (so * c2 / (no * no * no) + se * s2 / (ne * ne * ne)) * glm::dot(sn, t);
+  };
+  auto sWeight = [](const glm::dvec3& s_crystal, const glm::dvec3& a, const glm::dvec3& N, const glm::dvec3& dIn,
+                    int md) {
+    glm::dvec3 es = glm::cross(N, dIn);
+    if (glm::dot(a, a) < 0.25 || glm::dot(es, es) < 1e-12) return 0.5;
+    glm::dvec3 Do = glm::cross(s_crystal, a);
+    if (glm::dot(Do, Do) < 1e-12) return 0.5;
+    Do = glm::normalize(Do);
+    es = glm::normalize(es);
+    double wo = glm::dot(Do, es) * glm::dot(Do, es);
+    return md == 0 ? wo : 1.0 - wo;
+  };
 
   Result R;
   const glm::dvec3 bmin = field_.boundsMin(), bmax = field_.boundsMax();
@@ -116,6 +200,7 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
     R.radiance = environment(d);
     R.exit_point = o;
     R.exit_dir = d;
+    R.wave_normal = d;
     return R;
   }
   t0 = std::max(t0, 0.0);
@@ -123,28 +208,21 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
   R.opl = field_.ambientIndex() * t0;
   double n;
   glm::dvec3 grad;
-  field_.index(x, il2, il4, n, grad);
+  nO(x, n, grad);
   glm::dvec3 w = n * d;
   const double ds = m.step_voxels * h;
   const double thrLow = 1e-6, thrIface = m.interface_threshold;
   bool inLayer = false, stopped = false;
-  double nBefore = n, peak = 0.0;
-  glm::dvec3 dBefore = d, gAcc(0.0), T(1.0), L(0.0), xOpen = x;
-  auto deriv = [&](const glm::dvec3& xx, const glm::dvec3& ww, glm::dvec3& dx, glm::dvec3& dw) {
-    double nn;
-    glm::dvec3 gg;
-    field_.index(xx, il2, il4, nn, gg);
-    dx = ww / nn;
-    dw = gg;
-  };
+  double peak = 0.0;
+  glm::dvec3 wBefore = w, gAcc(0.0), T(1.0), L(0.0), xOpen = x;
   int steps = 0;
   for (; steps < m.max_steps; ++steps) {
-    glm::dvec3 dir = glm::normalize(w);
-    double tb0, tb1;
-    boxHit(x, dir, bmin, bmax, tb0, tb1);
-    double tExit = std::max(tb1, 0.0);
     double D = field_.skipDistance(x);
     if (!inLayer && D >= 2.0 && m.skip_empty) {
+      glm::dvec3 dir = rayDirection(x, w);
+      double tb0, tb1;
+      boxHit(x, dir, bmin, bmax, tb0, tb1);
+      double tExit = std::max(tb1, 0.0);
       double len = (D - 1.5) * h;
       bool leaving = len >= tExit;
       len = std::min(len, tExit);
@@ -155,19 +233,19 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
         stopped = true;
         break;
       }
-      glm::dvec3 sig = sigmaOf(glm::dvec3(med));
+      glm::dvec3 sig = attenuationAt(x, w);
       for (int c = 0; c < 3; ++c) {
         double a = std::exp(-sig[c] * len);
         L[c] += T[c] * (sig[c] > 1e-6 ? e[c] * (1.0 - a) / sig[c] : e[c] * len);
         T[c] *= a;
       }
-      R.opl += glm::length(w) * len;
+      R.opl += glm::dot(w, dir) * len;
       x += dir * len;
       if (leaving) break;
       continue;
     }
     glm::dvec3 x0 = x, w0 = w;
-    double n0 = glm::length(w0);
+    double n0 = n;
     glm::dvec3 k1x, k1w, k2x, k2w, k3x, k3w, k4x, k4w;
     deriv(x, w, k1x, k1w);
     if (m.integrator == Integrator::Euler) {
@@ -184,46 +262,72 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
       x += ds / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
       w += ds / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
     }
-    field_.index(x, il2, il4, n, grad);
-    R.drift = std::max(R.drift, std::abs(glm::length(w) - n));
-    R.opl += 0.5 * (n0 + n) * ds;
+    nO(x, n, grad);
+    glm::dvec3 gradN = grad;
+    glm::dvec3 aHere = mode == 1 ? field_.axis(x) : glm::dvec3(0.0);
+    bool eHere = mode == 1 && hasAxis(aHere);
+    double ne = n;
+    glm::dvec3 gradE = grad;
+    if (eHere) nE(x, ne, gradE);
+    if (mode == 0) {
+      R.drift = std::max(R.drift, std::abs(glm::length(w) - n));
+      R.opl += 0.5 * (n0 + n) * ds;
+    } else {
+      R.opl += 0.5 * glm::dot(w0 + w, x - x0);
+      if (eHere) gradN = 0.5 * (grad + gradE);
+    }
     glm::dvec3 xm = 0.5 * (x0 + x);
-    glm::dvec3 sig = sigmaOf(glm::dvec3(field_.medium(xm)));
     L += T * colour(field_.emission(xm)) * ds;
-    T *= glm::exp(-sig * ds);
+    T *= glm::exp(-attenuationAt(xm, 0.5 * (w0 + w)) * ds);
     if (field_.medium(x).w >= 0.5) {
       L += T * colour(field_.emission(x));
       stopped = true;
       break;
     }
-    double g = glm::length(grad) * h;
+    double g = std::max(glm::length(grad), glm::length(gradE)) * h;
     if (!inLayer && g > thrLow) {
       inLayer = true;
-      nBefore = n0;
-      dBefore = glm::normalize(w0);
+      wBefore = w0;
       gAcc = glm::dvec3(0.0);
       peak = 0.0;
       xOpen = x0;
     }
     if (inLayer) {
-      gAcc += grad * ds;
+      gAcc += gradN * ds;
       peak = std::max(peak, g);
       if (g <= thrLow) {
         inLayer = false;
-        if (glm::dot(gAcc, gAcc) > 0.0 && std::abs(glm::dot(x - xOpen, glm::normalize(gAcc))) <= 12.0 * h) {
-          // Project back onto |w| = n along the layer normal (see shaders/march.glsl).
-          glm::dvec3 N = glm::normalize(gAcc);
+        glm::dvec3 N = glm::dot(gAcc, gAcc) > 0.0 ? glm::normalize(gAcc) : glm::dvec3(0.0);
+        if (glm::dot(N, N) > 0.0 && std::abs(glm::dot(x - xOpen, N)) <= 12.0 * h) {
+          // Back onto H = 0 along the layer normal (see shaders/march.glsl).
           double wn = glm::dot(w, N);
           glm::dvec3 wt = w - wn * N;
-          double rem = n * n - glm::dot(wt, wt);
-          if (rem > 0.25 * wn * wn) w = wt + (wn < 0 ? -1.0 : 1.0) * std::sqrt(rem) * N;
+          if (!eHere) {
+            double rem = n * n - glm::dot(wt, wt);
+            if (rem > 0.25 * wn * wn) w = wt + (wn < 0 ? -1.0 : 1.0) * std::sqrt(rem) * N;
+          } else {
+            glm::dvec3 MN = applyM(N, aHere, n, ne);
+            double qa = glm::dot(N, MN), qb = glm::dot(wt, MN), qc = glm::dot(wt, applyM(wt, aHere, n, ne)) - 1.0;
+            double disc = qb * qb - qa * qc;
+            if (disc > 0.0) {
+              double l1 = (-qb + std::sqrt(disc)) / qa, l2 = (-qb - std::sqrt(disc)) / qa;
+              double lam = std::abs(l1 - wn) < std::abs(l2 - wn) ? l1 : l2;
+              if (std::abs(lam - wn) < 0.5 * std::abs(wn)) w = wt + lam * N;
+            }
+          }
         }
-        if (peak > thrIface && m.fresnel && glm::dot(gAcc, gAcc) > 0.0) {
-          glm::dvec3 N = glm::normalize(gAcc), dAfter = glm::normalize(w);
-          double ci = glm::dot(dBefore, N), co = glm::dot(dAfter, N);
+        if (peak > thrIface && m.fresnel && glm::dot(N, N) > 0.0) {
+          glm::dvec3 dIn = glm::normalize(wBefore), dOut = glm::normalize(w);
+          double ci = glm::dot(dIn, N), co = glm::dot(dOut, N);
+          double n1 = glm::length(wBefore), n2 = glm::length(w);
           if (ci * co > 0.0) {
-            double Rf = fresnelR(std::abs(ci), nBefore, n);
-            if (n > nBefore) L += T * Rf * environment(glm::reflect(dBefore, N));
+            glm::dvec3 aOut = field_.axis(x), aIn = field_.axis(xOpen);
+            bool outCrystal = hasAxis(aOut);
+            glm::dvec3 a = outCrystal ? aOut : aIn;
+            double wsw = sWeight(outCrystal ? dOut : dIn, a, N, dIn, mode);
+            glm::dvec2 rsp = fresnelRsRp(std::abs(ci), n1, n2);
+            double Rf = field_.uniaxial() ? wsw * rsp.x + (1.0 - wsw) * rsp.y : 0.5 * (rsp.x + rsp.y);
+            if (n2 > n1) L += T * Rf * environment(glm::reflect(dIn, N));
             T *= 1.0 - Rf;
             R.interfaces++;
           } else {
@@ -235,20 +339,21 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
     bool outside = false;
     for (int a = 0; a < 3; ++a) outside = outside || x[a] < bmin[a] || x[a] > bmax[a];
     if (outside) {
-      glm::dvec3 dd = glm::normalize(w);
+      glm::dvec3 dd = glm::normalize(x - x0);
       double a0, a1;
       boxHit(x0, dd, bmin, bmax, a0, a1);
       double stepLen = glm::length(x - x0);
-      double back = stepLen - std::max(a1, 0.0);
-      x = x0 + dd * std::max(a1, 0.0);
-      R.opl -= std::max(back, 0.0) * n;
-      if (stepLen > 0.0) w = glm::mix(w0, w, std::clamp(std::max(a1, 0.0) / stepLen, 0.0, 1.0));
+      double keep = std::clamp(std::max(a1, 0.0) / std::max(stepLen, 1e-300), 0.0, 1.0);
+      R.opl -= (1.0 - keep) * 0.5 * glm::dot(w0 + w, x - x0);
+      x = x0 + (x - x0) * keep;
+      w = glm::mix(w0, w, keep);
       break;
     }
   }
   R.steps = steps;
   R.exit_point = x;
-  R.exit_dir = glm::normalize(w);
+  R.exit_dir = rayDirection(x, w);
+  R.wave_normal = glm::normalize(w);
   R.left = !stopped && steps < m.max_steps;
   if (R.left) L += T * environment(R.exit_dir);
   R.radiance = L;
@@ -256,16 +361,17 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
   return R;
 }
 
-TraceOutcome ReferenceMarcher::trace(const TraceRequest& ray, const MarchSettings& m) const {
+TraceOutcome ReferenceMarcher::trace(const TraceRequest& ray, const MarchSettings& m, int mode) const {
   validate(m);
   double len = glm::length(ray.direction);
   if (!(len > 0) || !std::isfinite(len)) throw std::invalid_argument("trace direction must be a non-zero finite vector");
   if (!(ray.wavelength_nm > 0)) throw std::invalid_argument("trace wavelength must be > 0 nm");
-  Result r = march(ray.origin, ray.direction / len, ray.wavelength_nm, true, m);
+  if (mode != 0 && mode != 1) throw std::invalid_argument("mode must be 0 (o) or 1 (e)");
+  Result r = march(ray.origin, ray.direction / len, ray.wavelength_nm, true, m, field_.uniaxial() ? mode : 0);
   TraceOutcome t;
   t.exit_point = r.exit_point;
   t.exit_direction = r.exit_dir;
-  t.wave_normal = r.exit_dir;
+  t.wave_normal = r.wave_normal;
   t.optical_path_mm = r.opl;
   t.transmittance = r.throughput.x;
   t.left_volume = r.left;
@@ -310,15 +416,27 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
             auto lambdas = spectrum::stratifiedWavelengths(pixel, uint32_t(sidx), uint32_t(s.wavelengths));
             glm::dvec3 xyz(0.0);
             for (double l : lambdas) {
-              Result r = march(cam.position, d, l, true, s.march);
-              xyz += r.radiance.x * spectrum::sampleWeightXyz(l, uint32_t(s.wavelengths));
+              Result r = march(cam.position, d, l, true, s.march, 0);
+              double rad = r.radiance.x;
               steps += double(r.steps) / s.wavelengths;
+              if (field_.uniaxial()) {  // unpolarised: each mode carries half
+                Result re = march(cam.position, d, l, true, s.march, 1);
+                rad = 0.5 * (rad + re.radiance.x);
+                steps += double(re.steps) / s.wavelengths;
+              }
+              xyz += rad * spectrum::sampleWeightXyz(l, uint32_t(s.wavelengths));
             }
             sum += M * xyz;
           } else {
-            Result r = march(cam.position, d, s.wavelength_nm, false, s.march);
-            sum += r.radiance;
+            Result r = march(cam.position, d, s.wavelength_nm, false, s.march, 0);
+            glm::dvec3 rad = r.radiance;
             steps += r.steps;
+            if (field_.uniaxial()) {
+              Result re = march(cam.position, d, s.wavelength_nm, false, s.march, 1);
+              rad = 0.5 * (rad + re.radiance);
+              steps += re.steps;
+            }
+            sum += rad;
           }
         }
         size_t o = (size_t(y) * size_t(img.width) + size_t(x)) * 3;

@@ -27,8 +27,16 @@ class Field {
   virtual ~Field() = default;
   /// n and ∇n (per mm) at x for 1/λ² and 1/λ⁴ (λ in µm).
   virtual void index(const glm::dvec3& x, double il2, double il4, double& n, glm::dvec3& grad) const = 0;
-  /// (σ_r, σ_g, σ_b band values per mm, opacity).
+  /// Extraordinary index n_e and ∇n_e (defaults to the ordinary field: isotropic media).
+  virtual void indexE(const glm::dvec3& x, double il2, double il4, double& n, glm::dvec3& grad) const {
+    index(x, il2, il4, n, grad);
+  }
+  /// Unit optic axis at x (nearest voxel), or zero where the medium is isotropic.
+  virtual glm::dvec3 axis(const glm::dvec3&) const { return glm::dvec3(0.0); }
+  /// (σ_r, σ_g, σ_b band values per mm, opacity) of the o-mode (isotropic: the medium).
   virtual glm::dvec4 medium(const glm::dvec3& x) const = 0;
+  /// The same for the e-mode (principal σ_e bands).
+  virtual glm::dvec4 mediumE(const glm::dvec3& x) const { return medium(x); }
   virtual glm::dvec3 emission(const glm::dvec3& x) const = 0;
   /// Skip distance in voxels at the voxel holding x (0 where no straight step is allowed).
   virtual double skipDistance(const glm::dvec3& x) const = 0;
@@ -37,6 +45,8 @@ class Field {
   /// Length scale of the steps (the voxel edge, mm).
   virtual double cellSize() const = 0;
   virtual double ambientIndex() const { return 1.0; }
+  /// True if some region is uniaxial (renders then average the o- and e-modes).
+  virtual bool uniaxial() const { return false; }
 };
 
 /// Trilinear sampling of a VolumeSet (same stencil and clamping as the shader).
@@ -44,13 +54,17 @@ class VolumeField : public Field {
  public:
   explicit VolumeField(const VolumeSet& v) : v_(v) {}
   void index(const glm::dvec3& x, double il2, double il4, double& n, glm::dvec3& grad) const override;
+  void indexE(const glm::dvec3& x, double il2, double il4, double& n, glm::dvec3& grad) const override;
+  glm::dvec3 axis(const glm::dvec3& x) const override;
   glm::dvec4 medium(const glm::dvec3& x) const override;
+  glm::dvec4 mediumE(const glm::dvec3& x) const override;
   glm::dvec3 emission(const glm::dvec3& x) const override;
   double skipDistance(const glm::dvec3& x) const override;
   glm::dvec3 boundsMin() const override { return v_.grid.origin; }
   glm::dvec3 boundsMax() const override { return v_.grid.boundsMax(); }
   double cellSize() const override { return v_.grid.h; }
   double ambientIndex() const override { return v_.ambient_index; }
+  bool uniaxial() const override { return v_.uniaxial; }
 
  private:
   glm::dvec4 trilinear(const std::vector<glm::vec4>& f, const glm::dvec3& x) const;
@@ -81,14 +95,15 @@ class ReferenceMarcher {
  public:
   ReferenceMarcher(const Field& field, const Environment& env) : field_(field), env_(env) {}
 
-  /// Trace one ray at its wavelength (o-mode / isotropic).
-  TraceOutcome trace(const TraceRequest& ray, const MarchSettings& settings) const;
+  /// Trace one ray at its wavelength in mode 0 (o, or the isotropic ray) or 1 (e).
+  TraceOutcome trace(const TraceRequest& ray, const MarchSettings& settings, int mode = 0) const;
   /// Render the camera view, multi-threaded (threads = 0: hardware concurrency).
   RenderImage render(const Camera& camera, const RenderSettings& settings, int threads = 0) const;
 
  private:
   struct Result;
-  Result march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar, const MarchSettings& m) const;
+  Result march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar, const MarchSettings& m,
+               int mode) const;
   const Field& field_;
   const Environment& env_;
 };

@@ -45,7 +45,7 @@ struct ViewRenderer::Impl {
   vk::Context& ctx;
   const Scene& scene;
   Grid grid;
-  bool uniaxial = false, dispersive = false;
+  bool uniaxial = false, dispersive = false, attenuating = false, emissive = false, opaque = false;
   std::vector<vk::Image3D> images;  // [oA, oB, oC, eA, eB, eC, medO, medE, emission, axis]
   vk::Buffer params, env, tables;
   vk::ComputePipeline view, tracer;
@@ -56,6 +56,9 @@ struct ViewRenderer::Impl {
     checkVolumeFits(ctx, grid, scene);
     uniaxial = v.uniaxial;
     dispersive = v.dispersive;
+    attenuating = v.attenuating;
+    emissive = v.emissive;
+    opaque = v.opaque;
     skip_cap = v.skip_cap;
     ambient = v.ambient_index;
     std::array<uint32_t, 3> ext{uint32_t(grid.dims[0]), uint32_t(grid.dims[1]), uint32_t(grid.dims[2])};
@@ -137,6 +140,9 @@ struct ViewRenderer::Impl {
     int flags = flags_extra;
     if (dispersive) flags |= EIKON_F_DISPERSIVE;
     if (uniaxial) flags |= EIKON_F_UNIAXIAL;
+    if (attenuating) flags |= EIKON_F_ATTENUATION;
+    if (emissive) flags |= EIKON_F_EMISSION;
+    if (opaque) flags |= EIKON_F_OPACITY;
     if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
     if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
@@ -209,6 +215,13 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
 }
 
 std::vector<TraceOutcome> ViewRenderer::trace(const std::vector<TraceRequest>& rays, const MarchSettings& m) {
+  std::vector<TraceOutcome> out;
+  for (const auto& pair : traceModes(rays, m)) out.push_back(pair[0]);
+  return out;
+}
+
+std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(const std::vector<TraceRequest>& rays,
+                                                                  const MarchSettings& m) {
   validate(m);
   Impl& I = *impl_;
   if (rays.empty()) return {};
@@ -225,18 +238,18 @@ std::vector<TraceOutcome> ViewRenderer::trace(const std::vector<TraceRequest>& r
   I.params.write(&p, sizeof p);
   vk::Buffer rb(I.ctx, in.size() * sizeof(gpu::TraceRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "trace rays");
   rb.write(in.data(), in.size() * sizeof(gpu::TraceRay));
-  vk::Buffer ob(I.ctx, in.size() * sizeof(gpu::TraceResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "trace results");
+  vk::Buffer ob(I.ctx, 2 * in.size() * sizeof(gpu::TraceResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "trace results");
   I.tracer.bindBuffer(EIKON_B_RAYS, rb);
   I.tracer.bindBuffer(EIKON_B_OUTPUT, ob);
   I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
     I.tracer.dispatch(cmd, uint32_t((in.size() + EIKON_TRACE_WG - 1) / EIKON_TRACE_WG), 1, 1, nullptr);
   });
-  std::vector<gpu::TraceResult> res(in.size());
+  std::vector<gpu::TraceResult> res(2 * in.size());
   ob.read(res.data(), res.size() * sizeof(gpu::TraceResult));
-  std::vector<TraceOutcome> out(in.size());
-  for (size_t i = 0; i < in.size(); ++i) {
+  std::vector<std::array<TraceOutcome, 2>> out(in.size());
+  for (size_t i = 0; i < res.size(); ++i) {
     const auto& r = res[i];
-    TraceOutcome& o = out[i];
+    TraceOutcome& o = out[i / 2][i % 2];
     o.exit_point = glm::dvec3(r.exit_point);
     o.left_volume = r.exit_point.w > 0.5f;
     o.exit_direction = glm::normalize(glm::dvec3(r.exit_direction));

@@ -13,6 +13,7 @@
 // before the device refuses it); comparing timings across runs (lavapipe varies ±20%).
 #pragma once
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -37,8 +38,11 @@ class ViewRenderer {
 
   /// Render the scene's camera view. Throws std::invalid_argument for bad settings.
   RenderImage render(const RenderSettings& settings);
-  /// Trace individual rays (o-mode) at their wavelengths.
+  /// Trace individual rays at their wavelengths: the o-mode (isotropic scenes: the ray).
   std::vector<TraceOutcome> trace(const std::vector<TraceRequest>& rays, const MarchSettings& settings);
+  /// Trace both modes of each ray: {o, e}; identical where every material is isotropic.
+  std::vector<std::array<TraceOutcome, 2>> traceModes(const std::vector<TraceRequest>& rays,
+                                                      const MarchSettings& settings);
 
  private:
   struct Impl;

@@ -84,6 +84,9 @@ class Node {
   }
   int integer(int lo, int hi) const {
     if (!j_.is_number_integer()) fail("expected an integer");
+    if (j_.is_number_unsigned() && j_.get<unsigned long long>() > (unsigned long long)hi)
+      fail("must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+           std::to_string(j_.get<unsigned long long>()));
     long long v = j_.get<long long>();
     if (v < lo || v > hi) fail("must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + std::to_string(v));
     return int(v);
@@ -348,6 +351,24 @@ double GrinProfile::index(const glm::dvec3& x) const {
   return n0;
 }
 
+glm::dvec3 GrinProfile::indexGradient(const glm::dvec3& x) const {
+  switch (type) {
+    case Type::None: return glm::dvec3(0.0);
+    case Type::Linear: return gradient;
+    case Type::Luneburg: {
+      double r2 = glm::dot(x - origin, x - origin) / (radius * radius);
+      if (2.0 - r2 <= 1.0) return glm::dvec3(0.0);
+      return -(x - origin) / (radius * radius * std::sqrt(2.0 - r2));
+    }
+    case Type::MaxwellFisheye: {
+      double r2 = glm::dot(x - origin, x - origin) / (radius * radius);
+      if (n0 / (1.0 + r2) <= 1.0) return glm::dvec3(0.0);
+      return -2.0 * n0 * (x - origin) / (radius * radius * (1.0 + r2) * (1.0 + r2));
+    }
+  }
+  return glm::dvec3(0.0);
+}
+
 double Attenuation::at(double lambda_nm) const {
   if (!wavelengths_nm.empty()) {
     if (lambda_nm <= wavelengths_nm.front()) return values.front();
@@ -489,7 +510,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   }
 
   if (auto v = root.get("volume")) {
-    v->allowKeys({"bounds_min", "bounds_max", "resolution", "smoothing_voxels"});
+    v->allowKeys({"bounds_min", "bounds_max", "resolution", "smoothing_voxels", "smoothing_method"});
     auto& vol = scene.volume;
     if (auto b = v->get("bounds_min")) vol.bounds_min = b->vec3();
     if (auto b = v->get("bounds_max")) vol.bounds_max = b->vec3();
@@ -497,6 +518,12 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     if (!(ext.x > 0 && ext.y > 0 && ext.z > 0)) v->fail("bounds_max must exceed bounds_min on every axis");
     if (auto r = v->get("resolution")) vol.resolution = r->integer(4, 1 << 20);  // device limit checked at upload
     if (auto s = v->get("smoothing_voxels")) vol.smoothing_voxels = s->number(0.0, 8.0);
+    if (auto s = v->get("smoothing_method")) {
+      std::string m = s->string();
+      if (m == "analytic") vol.smoothing = VolumeSpec::Smoothing::Analytic;
+      else if (m == "gaussian") vol.smoothing = VolumeSpec::Smoothing::Gaussian;
+      else s->fail("unknown smoothing_method '" + m + "' (analytic, gaussian)");
+    }
   }
   if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
 

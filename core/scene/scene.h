@@ -35,6 +35,8 @@ struct GrinProfile {
   double radius = 1.0;         ///< Luneburg: n = √(2 − r²/R²); fisheye R
   /// Index at a world point (valid inside the object only).
   double index(const glm::dvec3& x) const;
+  /// ∇n at a world point (per mm).
+  glm::dvec3 indexGradient(const glm::dvec3& x) const;
 };
 
 /// Wavelength-dependent attenuation σ(λ) per mm, given as RGB band values (placed at 612, 549 and
@@ -81,7 +83,11 @@ struct Environment {
 struct VolumeSpec {
   glm::dvec3 bounds_min{-12.0}, bounds_max{12.0};
   int resolution = 128;            ///< voxels along the longest side; voxels are cubes
-  double smoothing_voxels = 0.75;  ///< Gaussian σ of the pre-smoothing, in voxels (0 = none)
+  double smoothing_voxels = 0.75;  ///< σ of the pre-smoothing, in voxels (0 = none: sharp, anti-aliased)
+  /// How the σ-smoothing is done: "analytic" (default) smooths each object's indicator through its
+  /// signed distance with a compact kernel of variance σ² (exact normals for flat faces);
+  /// "gaussian" supersamples coverage and convolves with a Gaussian (the seed's method).
+  enum class Smoothing { Analytic, Gaussian } smoothing = Smoothing::Analytic;
 };
 
 struct SceneObject {

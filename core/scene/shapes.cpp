@@ -52,6 +52,48 @@ double Shape::signedDistance(const glm::dvec3& world) const {
       geometry_);
 }
 
+namespace {
+glm::dvec3 boxGradient(const glm::dvec3& p, const glm::dvec3& half) {
+  glm::dvec3 q = glm::abs(p) - half;
+  glm::dvec3 sgn(p.x < 0 ? -1.0 : 1.0, p.y < 0 ? -1.0 : 1.0, p.z < 0 ? -1.0 : 1.0);
+  glm::dvec3 outside = glm::max(q, glm::dvec3(0.0));
+  if (glm::length(outside) > 0.0) return sgn * outside / glm::length(outside);
+  int a = q.x > q.y ? (q.x > q.z ? 0 : 2) : (q.y > q.z ? 1 : 2);
+  glm::dvec3 g(0.0);
+  g[a] = sgn[a];
+  return g;
+}
+}  // namespace
+
+glm::dvec3 Shape::distanceGradient(const glm::dvec3& world) const {
+  glm::dvec3 p = toLocal(world);
+  glm::dvec3 g = std::visit(
+      [&](const auto& geo) -> glm::dvec3 {
+        using T = std::decay_t<decltype(geo)>;
+        if constexpr (std::is_same_v<T, SphereShape>) {
+          double l = glm::length(p);
+          return l > 0 ? p / l : glm::dvec3(0, 0, 1);
+        } else if constexpr (std::is_same_v<T, BoxShape>) {
+          return boxGradient(p, 0.5 * geo.size);
+        } else if constexpr (std::is_same_v<T, RoundedBoxShape>) {
+          return boxGradient(p, 0.5 * geo.size - glm::dvec3(geo.radius));
+        } else {
+          double m = -std::numeric_limits<double>::infinity();
+          glm::dvec3 n(0.0);
+          for (const auto& pl : geo.planes) {
+            double v = glm::dot(pl.normal, p) - pl.d;
+            if (v > m) {
+              m = v;
+              n = pl.normal;
+            }
+          }
+          return n;
+        }
+      },
+      geometry_);
+  return rotation_ * g;
+}
+
 std::pair<glm::dvec3, glm::dvec3> Shape::bounds() const {
   // Conservative: a bounding sphere of the local geometry around the centre.
   double r = std::visit(

@@ -47,6 +47,9 @@ class Shape {
   /// polyhedra the max over planes, exact inside and a lower bound of the distance outside.
   double signedDistance(const glm::dvec3& world) const;
   bool contains(const glm::dvec3& world) const { return signedDistance(world) <= 0.0; }
+  /// ∇ of signedDistance (unit where the distance is exact; the active face's normal for convex
+  /// polyhedra). World space.
+  glm::dvec3 distanceGradient(const glm::dvec3& world) const;
   /// World-space axis-aligned bounding box {min, max} (conservative).
   std::pair<glm::dvec3, glm::dvec3> bounds() const;
   /// World-space outward normals of a convex shape's faces (empty for curved shapes).

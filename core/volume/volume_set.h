@@ -46,6 +46,9 @@ struct VolumeSet {
   Grid grid;
   bool uniaxial = false;     ///< e-mode fields differ from o-mode fields
   bool dispersive = false;   ///< some B or C coefficient is non-zero
+  bool attenuating = false;  ///< some attenuation is non-zero
+  bool emissive = false;     ///< some emission is non-zero
+  bool opaque = false;       ///< some opacity is non-zero
   double ambient_index = 1.0;
   std::array<std::array<std::vector<glm::vec4>, 3>, 2> index;  ///< [mode][A,B,C]; e empty if !uniaxial
   std::array<std::vector<glm::vec4>, 2> medium;                ///< [mode]; e empty if !uniaxial
