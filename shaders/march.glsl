@@ -294,9 +294,10 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   int steps = 0;
   for (; steps < maxSteps; ++steps) {
     // Homogeneous region: one straight, exact step along the ray direction.
-    ivec3 vi = clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_extent.w)), ivec3(0), P.grid_dims.xyz - 1);
-    vec4 em = imageLoad(emissionImg, vi);
-    if (!inLayer && em.w >= 2.0 && !hasFlag(EIKON_F_NO_SKIP)) {
+    vec4 em = vec4(0.0);
+    if (!inLayer && !hasFlag(EIKON_F_NO_SKIP))
+      em = imageLoad(emissionImg, clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_extent.w)), ivec3(0), P.grid_dims.xyz - 1));
+    if (em.w >= 2.0) {
       vec3 dir = rayDirection(x, w, mode);
       float tb0, tb1;
       boxHit(x, dir, bmin, bmax, tb0, tb1);
