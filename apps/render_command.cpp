@@ -17,7 +17,7 @@ namespace {
 struct RenderArgs {
   std::string scene, output;
   int width = 0, height = 0, spp = 1, wavelengths = -1, threads = 0;
-  double step = 0.25, exposure = 0.0;
+  double step = 0.5, exposure = 0.0;
   std::string integrator = "rk4";
   bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
 };
@@ -40,7 +40,7 @@ void addRenderCommand(CLI::App& app) {
   sub->add_option("--spp", args->spp, "Jittered samples per pixel (default 1)");
   sub->add_option("--wavelengths", args->wavelengths,
                   "Spectral samples per pixel sample; 0 = RGB mode (default: 16 for dispersive scenes, else 0)");
-  sub->add_option("--step", args->step, "Integration step in voxels (default 0.25)");
+  sub->add_option("--step", args->step, "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", args->integrator, "euler, midpoint or rk4 (default rk4)");
   sub->add_option("--exposure", args->exposure, "PNG preview exposure in stops (default 0)");
   sub->add_option("--threads", args->threads, "CPU threads for --reference and voxelising (default: all)");
