@@ -407,10 +407,12 @@ MarchResult march(vec3 o, vec3 d, int mode) {
           float ci = dot(dIn, N), co = dot(dOut, N);
           float n1 = length(wBefore), n2 = length(w);
           if (ci * co > 0.0) {
-            // Which side is the crystal? Its wave normal defines the mode's polarisation.
-            vec3 aOut = axisAt(x), aIn = axisAt(xOpen);
-            bool outCrystal = dot(aOut, aOut) >= 0.25;
-            vec3 a = outCrystal ? aOut : aIn;
+            // Which side is the crystal? The end of the layer with the larger birefringence (the
+            // axis field itself is dilated into the air around crystals).
+            float bOut = abs(sampleIndex(x, 1).x - sampleIndex(x, 0).x);
+            float bIn = abs(sampleIndex(xOpen, 1).x - sampleIndex(xOpen, 0).x);
+            bool outCrystal = bOut >= bIn;
+            vec3 a = axisAt(outCrystal ? x : xOpen);
             float wsw = sWeight(outCrystal ? dOut : dIn, a, N, dIn, mode);
             vec2 rsp = fresnelRsRp(abs(ci), n1, n2);
             float Rf = hasFlag(EIKON_F_UNIAXIAL) ? wsw * rsp.x + (1.0 - wsw) * rsp.y : 0.5 * (rsp.x + rsp.y);

@@ -321,9 +321,16 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
           double ci = glm::dot(dIn, N), co = glm::dot(dOut, N);
           double n1 = glm::length(wBefore), n2 = glm::length(w);
           if (ci * co > 0.0) {
-            glm::dvec3 aOut = field_.axis(x), aIn = field_.axis(xOpen);
-            bool outCrystal = hasAxis(aOut);
-            glm::dvec3 a = outCrystal ? aOut : aIn;
+            // The crystal side is the layer end with the larger birefringence (the axis field is
+            // dilated into the air around crystals).
+            double noA, neA, noB, neB;
+            glm::dvec3 gtmp;
+            nO(x, noA, gtmp);
+            nE(x, neA, gtmp);
+            nO(xOpen, noB, gtmp);
+            nE(xOpen, neB, gtmp);
+            bool outCrystal = std::abs(neA - noA) >= std::abs(neB - noB);
+            glm::dvec3 a = field_.axis(outCrystal ? x : xOpen);
             double wsw = sWeight(outCrystal ? dOut : dIn, a, N, dIn, mode);
             glm::dvec2 rsp = fresnelRsRp(std::abs(ci), n1, n2);
             double Rf = field_.uniaxial() ? wsw * rsp.x + (1.0 - wsw) * rsp.y : 0.5 * (rsp.x + rsp.y);
