@@ -1,0 +1,128 @@
+// The double-precision CPU reference of the light simulator (issue 6, DESIGN §2 "Light
+// simulator", Tevs ch. 4 and 6). The GPU kernel (later) is tested against it.
+//
+// A wavefront of patches, each a quad of four corner particles, is launched from a light and
+// advanced in constant time steps (all corners of all patches share the same time, so the front
+// stays a surface of constant phase):
+//
+//     dx/dt = w / n²,   dw/dt = ∇n / n,   w = n·t̂ (|w| = n)
+//
+// t is time with c = 1 (mm): a corner moves dt/n mm per step. Each corner is integrated with RK4
+// using Field::index at the simulator's wavelength. Flux is attached to the ray tube a patch
+// spans, so it is constant along the tube except for attenuation, flux ← flux·exp(−σ Δs); the
+// patch irradiance is flux / current area (the intensity law ΔE(t) = ΔE(0)·A(0)/A(t)).
+//
+// Units: positions in mm; a light's `irradiance` is E (directional, per mm²) or I (point, per
+// sr) in the light's own radiometric unit (W in the text). A patch's flux is then in W (E·mm² or
+// I·sr). The irradiance volume (Accumulate) is in W/mm²; see WavefrontResult.
+//
+//   eikon::VolumeField field(volume);
+//   eikon::WavefrontSimulator sim(field, volume.grid, settings);
+//   eikon::WavefrontResult r = sim.run(scene.lights[0]);
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/reference/reference_marcher.h"
+#include "core/scene/scene.h"
+#include "core/volume/volume_set.h"
+
+namespace eikon {
+
+struct WavefrontSettings {
+  enum class Splat {
+    Accumulate,     ///< Σ over steps of flux·Δs / voxel volume: fluence rate (scalar irradiance), W/mm²
+    HighestEnergy,  ///< the largest patch irradiance flux/area (W/mm²) whose centre visited the voxel
+  };
+  double dt = 0.0;                    ///< time step (mm of light travel in vacuum); ≤ 0: 0.5·h of the splat grid
+  int max_steps = 20000;              ///< hard cap on the number of steps
+  /// Kill a patch whose flux falls below this fraction of its seed's flux, by attenuation or by
+  /// splitting (each split quarters it): 1e-4 allows ~6 generations of splits without absorption.
+  /// This also ends patches trapped in whispering-gallery orbits, which stretch and split forever.
+  double min_energy_fraction = 1e-4;
+  double split_span_voxels = 1.0;     ///< split a patch when an edge is longer than this (splat voxels)
+  double seed_span_voxels = 0.5;      ///< edge of the seed patches (directional: in the launch plane)
+  Splat splat = Splat::Accumulate;
+  double wavelength_nm = 587.56;      ///< index and attenuation band are evaluated here
+  int max_patches = 1 << 20;          ///< live patches never exceed this: splits beyond it are refused
+  /// Point lights: radius of the launch sphere (mm; ≤ 0: 0.5·h) and cube-sphere cells per face edge.
+  double point_radius = 0.0;
+  int point_cells_per_face = 16;
+  /// Optional probe plane {x : x[probe_axis] = probe_position} (axis −1: none). The net flux whose
+  /// patch centres cross it in the +axis direction is reported in stats.flux_probe.
+  int probe_axis = -1;
+  double probe_position = 0.0;
+};
+
+/// One wavefront element. Corners are in bilinear order (0,0), (1,0), (1,1), (0,1) of the patch's
+/// ray-label parameters. `energy` is the flux carried by the tube (W = light unit·mm² for a
+/// directional light, light unit·sr for a point light); `area0` the area (mm²) at launch.
+struct Patch {
+  std::array<glm::dvec3, 4> x{};  ///< corner positions (mm)
+  std::array<glm::dvec3, 4> w{};  ///< corner wave vectors w = n·t̂
+  double energy = 0.0;            ///< flux (W)
+  double area0 = 0.0;             ///< launch area (mm²) of the tube this patch carries
+  // Bookkeeping (not part of the physics state):
+  double transmittance = 1.0;  ///< exp(−∫σ ds) so far
+  double seed_energy = 0.0;    ///< flux of the seed patch this one descends from
+  int orientation = 1;         ///< sign of (normal · mean w) at launch; a change is a caustic
+  bool entered = false;        ///< the centre has been inside the field's bounds
+  int probe_side = 0;          ///< −1 / +1: side of the probe plane the centre is on
+};
+
+struct WavefrontStats {
+  int steps = 0;
+  size_t seeded = 0;       ///< patches launched toward the volume
+  size_t max_live = 0;     ///< most live patches at once
+  size_t splits = 0;       ///< parents split into four
+  size_t splits_refused = 0;  ///< splits not done because max_patches would be exceeded
+  size_t kills_left = 0, kills_caustic = 0, kills_energy = 0, kills_opaque = 0;
+  size_t live_at_end = 0;  ///< patches still alive when max_steps ran out (0 if the loop ended)
+  double flux_emitted = 0;  ///< Σ seed flux (only seeds whose centre ray meets the volume)
+  double flux_left = 0;     ///< carried out of the volume
+  double flux_caustic = 0;  ///< carried by patches killed at an orientation flip
+  double flux_energy = 0;   ///< carried by patches killed below the energy threshold
+  double flux_absorbed = 0; ///< removed by exp(−σΔs) along the way, plus opaque kills
+  double flux_live_at_end = 0;
+  double flux_probe = 0;    ///< net flux crossing the probe plane in the +axis direction
+  /// Flux of patches that ended (any reason, or still live at max_steps) on the upstream side of
+  /// the probe plane. Without absorption, flux_probe + flux_ended_before_probe = flux_emitted.
+  double flux_ended_before_probe = 0;
+  glm::dvec3 caustic_centroid{0.0};  ///< flux-weighted mean centre of the patches killed at caustics
+};
+
+/// Volumes on the splat grid (x-fastest, Grid::index order).
+struct WavefrontResult {
+  /// Accumulate: fluence rate (W/mm²) = Σ over steps and patches whose step midpoint lies in the
+  /// voxel of flux·Δs_path / h³ — for a single collimated beam this is the irradiance across the
+  /// beam. HighestEnergy: the highest patch irradiance flux/area (W/mm²) seen in the voxel.
+  std::vector<float> irradiance;
+  /// xyz: flux·Δs-weighted mean of the unit propagation direction (length < 1 where directions
+  /// disagree); w: the weight Σ flux·Δs / h³ (W/mm², the Accumulate value whatever the mode).
+  std::vector<glm::vec4> direction;
+  WavefrontStats stats;
+};
+
+class WavefrontSimulator {
+ public:
+  /// The field and the grid are referenced, not copied; they must outlive the simulator.
+  WavefrontSimulator(const Field& field, const Grid& splat_grid, const WavefrontSettings& settings);
+  WavefrontResult run(const Light& light) const;
+
+  /// The launch patches for a light (exposed for tests): directional — a regular grid in the
+  /// plane perpendicular to the direction through the most upstream corner of the bounds,
+  /// covering the bounds' projection; point — a cube-sphere of radius point_radius, flux I·Ω.
+  std::vector<Patch> seed(const Light& light) const;
+
+ private:
+  const Field& field_;
+  const Grid& grid_;
+  WavefrontSettings s_;
+  double il2_, il4_;
+};
+
+}  // namespace eikon

@@ -1,0 +1,235 @@
+// Light simulator, CPU reference (issue 6): energy bookkeeping, uniform beams, absorption, the
+// Luneburg focus, patch budget and termination. The GPU kernel will be tested against this.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/reference/wavefront.h"
+#include "tests/core/test_support.h"
+
+namespace eikon::test {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Grid cubeGrid(glm::dvec3 origin, int n, double h) {
+  Grid g;
+  g.dims = {n, n, n};
+  g.origin = origin;
+  g.h = h;
+  g.extent = glm::dvec3(n * h);
+  return g;
+}
+
+Light directional(glm::dvec3 d, double e) {
+  Light l;
+  l.type = Light::Type::Directional;
+  l.direction = d;
+  l.irradiance = e;
+  return l;
+}
+
+void printStats(const char* name, const WavefrontStats& s) {
+  std::printf(
+      "[ measured ] %s: steps %d, seeded %zu, max live %zu, splits %zu (refused %zu), kills left/caustic/energy "
+      "%zu/%zu/%zu\n             flux emitted %.12g, left %.12g, caustic %.12g, absorbed %.12g, probe %.12g, "
+      "ended before probe %.12g\n",
+      name, s.steps, s.seeded, s.max_live, s.splits, s.splits_refused, s.kills_left, s.kills_caustic, s.kills_energy,
+      s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_absorbed, s.flux_probe, s.flux_ended_before_probe);
+}
+
+// 1. A homogeneous medium (n = 1.5, no object), a beam along +x. Seeds are h/2 squares tiling the
+// 4 × 4 mm face; dt = 0.75 h gives Δs = dt/n = h/2, so each voxel is visited by exactly 2 × 2
+// patch columns × 2 step midpoints (midpoints sit at quarter-voxel offsets, never on a face):
+// Σ flux·Δs / h³ = 8 · E (h/2)² (h/2) / h³ = E in every voxel, exact up to the double sums and the
+// float32 store (≤ 1e-7 relative; we allow 1e-6). Nothing bends or stretches, so no patch splits
+// or dies before the far face; the flux leaving is a re-ordered sum of the same numbers (1e-12).
+TEST(Wavefront, HomogeneousBeamIsUniformAndConserved) {
+  const double h = 0.25, n = 1.5, E = 2.0;
+  const Grid grid = cubeGrid({-2, -2, -2}, 16, h);
+  AnalyticField field(
+      [&](const glm::dvec3&, double& nn, glm::dvec3& g) {
+        nn = n;
+        g = glm::dvec3(0.0);
+      },
+      grid.origin, grid.boundsMax(), h);
+  for (auto mode : {WavefrontSettings::Splat::Accumulate, WavefrontSettings::Splat::HighestEnergy}) {
+    WavefrontSettings s;
+    s.dt = 0.75 * h;
+    s.splat = mode;
+    WavefrontResult r = WavefrontSimulator(field, grid, s).run(directional({1, 0, 0}, E));
+    const WavefrontStats& st = r.stats;
+    printStats("homogeneous", st);
+    EXPECT_EQ(st.seeded, size_t(32 * 32));
+    EXPECT_NEAR(st.flux_emitted, E * 16.0, 1e-12 * E * 16.0);
+    EXPECT_EQ(st.splits, 0u);
+    EXPECT_EQ(st.kills_caustic + st.kills_energy + st.kills_opaque, 0u);
+    EXPECT_EQ(st.kills_left, st.seeded);
+    EXPECT_EQ(st.max_live, st.seeded);
+    EXPECT_EQ(st.live_at_end, 0u);
+    EXPECT_NEAR(st.flux_left, st.flux_emitted, 1e-12 * st.flux_emitted);
+    double lo = 1e9, hi = -1e9, dirErr = 0;
+    for (size_t v = 0; v < grid.count(); ++v) {
+      lo = std::min(lo, double(r.irradiance[v]));
+      hi = std::max(hi, double(r.irradiance[v]));
+      dirErr = std::max(dirErr, glm::length(glm::dvec3(r.direction[v]) - glm::dvec3(1, 0, 0)));
+    }
+    std::printf("[ measured ] %s: irradiance min %.9g max %.9g (E = %g), direction error %.2e\n",
+                mode == WavefrontSettings::Splat::Accumulate ? "accumulate" : "highest", lo, hi, E, dirErr);
+    EXPECT_NEAR(lo, E, 1e-6 * E);
+    EXPECT_NEAR(hi, E, 1e-6 * E);
+    EXPECT_LT(dirErr, 1e-6);
+  }
+}
+
+// A glass sphere (n = 1.5, R = 1 mm, smoothing 1 voxel) in a 40 × 32 × 32 grid, h = 0.1 mm; the
+// paraxial focus f = nR/(2(n − 1)) = 1.5 mm from the centre lies inside the box.
+const char* kSphereScene = R"({
+  "environment": {"type": "constant", "radiance": 1},
+  "camera": {"width": 8, "height": 8},
+  "volume": {"bounds_min": [-1.6, -1.6, -1.6], "bounds_max": [2.4, 1.6, 1.6], "resolution": 40,
+             "smoothing_voxels": 1},
+  "materials": {"glass": {"n": 1.5}},
+  "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 1.0, "material": "glass"}]
+})";
+
+// 2. No absorption: every patch ends by leaving the volume or at a caustic, and splitting hands
+// each child exactly a quarter of its parent's flux, so left + caustic = emitted by construction
+// (only summation round-off: 1e-9 relative is ~1e6 ulps of margin). The probe plane x = 1.1 mm
+// lies just behind the sphere; what we measure there is the net flux of patch centres crossing
+// it. The same bookkeeping makes probe + (flux of patches that ended upstream of the plane) =
+// emitted, and only light through the lens's aperture can end upstream (caustics inside or just
+// behind the sphere, rim rays refracted sideways out of the box, whispering-gallery patches
+// trapped in the smoothed rim and ended by the energy threshold). Smoothing (σ = 1 voxel, cut at
+// 3σ) makes the index differ from 1 out to R + 3h, so at most E·π(R + 3h)² ends upstream, and
+// rays through the centre half of the aperture reach the plane before their focus (paraxial
+// f = 1.5 mm > 1.1 mm), so at least ... nothing we can bound tightly: we assert the upper bound
+// and print the measured split.
+TEST(Wavefront, GlassSphereConservesFlux) {
+  const Scene scene = sceneFromJson(kSphereScene);
+  const VolumeSet vol = voxelize(scene);
+  VolumeField field(vol);
+  WavefrontSettings s;
+  s.probe_axis = 0;
+  s.probe_position = 1.1;
+  const double E = 1.0;
+  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directional({1, 0, 0}, E));
+  const WavefrontStats& st = r.stats;
+  printStats("glass sphere", st);
+  EXPECT_NEAR(st.flux_emitted, E * 3.2 * 3.2, 1e-9 * st.flux_emitted);
+  EXPECT_EQ(st.live_at_end, 0u);
+  EXPECT_EQ(st.flux_absorbed, 0.0);
+  EXPECT_GT(st.kills_caustic, 0u);
+  EXPECT_GT(st.splits, 0u);
+  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted, 1e-9 * st.flux_emitted);
+  EXPECT_NEAR(st.flux_probe + st.flux_ended_before_probe, st.flux_emitted, 1e-9 * st.flux_emitted);
+  const double h = vol.grid.h;
+  EXPECT_GE(st.flux_probe, st.flux_emitted - E * kPi * (1 + 3 * h) * (1 + 3 * h));
+  std::printf("[ measured ] flux ended upstream of x = 1.1 mm: %.6f = E*pi*(%.4f mm)^2\n", st.flux_ended_before_probe,
+              std::sqrt(st.flux_ended_before_probe / (E * kPi)));
+  EXPECT_LE(st.flux_probe, st.flux_emitted * (1 + 1e-9));
+}
+
+// 3. Luneburg lens n = √(2 − r²/R²), R = 1 (physics_cases §7a), exact analytic field. Every ray
+// parallel to +x reaches (R, 0, 0) after the same optical path R(1 + π/2) from x = −R, and the
+// simulator's time is optical path (c = 1), so the part of the front inside the lens collapses
+// onto the focus in the same step: patches flip there and are killed. We check (a) the
+// flux-weighted centroid of the caustic kills is within one step (dt = h/2) of (R, 0, 0); (b) the
+// accumulated irradiance peaks in the voxel whose centre is the focus (the grid is placed so that
+// (R, 0, 0) is a voxel centre), i.e. within 1 voxel; (c) before any caustic, all the flux crosses
+// the plane x = R/2 (every ray's x increases monotonically until the focus), so the probe there
+// sees the emitted flux to round-off (1e-9).
+void luneburg(const glm::dvec3& x, double& n, glm::dvec3& g) {
+  double r2 = glm::dot(x, x);
+  if (r2 >= 1.0) {
+    n = 1.0;
+    g = glm::dvec3(0.0);
+  } else {
+    n = std::sqrt(2.0 - r2);
+    g = -x / n;
+  }
+}
+
+TEST(Wavefront, LuneburgLensFocusesOnTheFarSurface) {
+  const double h = 0.05;
+  const Grid grid = cubeGrid({-1.225, -1.225, -1.225}, 49, h);
+  AnalyticField field(luneburg, grid.origin, grid.boundsMax(), h);
+  WavefrontSettings s;
+  s.probe_axis = 0;
+  s.probe_position = 0.5;
+  WavefrontResult r = WavefrontSimulator(field, grid, s).run(directional({1, 0, 0}, 1.0));
+  const WavefrontStats& st = r.stats;
+  printStats("Luneburg", st);
+  const glm::dvec3 focus(1, 0, 0);
+  std::printf("[ measured ] caustic centroid (%.5f, %.5f, %.5f), %.3e mm from the focus\n", st.caustic_centroid.x,
+              st.caustic_centroid.y, st.caustic_centroid.z, glm::length(st.caustic_centroid - focus));
+  EXPECT_LT(glm::length(st.caustic_centroid - focus), s.dt > 0 ? s.dt : 0.5 * h);
+  size_t best = 0;
+  for (size_t v = 0; v < grid.count(); ++v)
+    if (r.irradiance[v] > r.irradiance[best]) best = v;
+  const int bi = int(best % 49), bj = int((best / 49) % 49), bk = int(best / (49 * 49));
+  const glm::dvec3 c = grid.center(bi, bj, bk);
+  std::printf("[ measured ] irradiance peak %.4g (incident 1) in voxel (%d, %d, %d) centred (%.4f, %.4f, %.4f)\n",
+              double(r.irradiance[best]), bi, bj, bk, c.x, c.y, c.z);
+  EXPECT_LE(glm::length(c - focus), 1.01 * h);
+  EXPECT_NEAR(st.flux_probe, st.flux_emitted, 1e-9 * st.flux_emitted);
+  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted, 1e-9 * st.flux_emitted);
+  EXPECT_EQ(st.live_at_end, 0u);
+}
+
+// 4. The patch budget holds and the loop ends: the sphere scene with max_patches barely above the
+// seed count (4096) — splits beyond the budget are refused, never exceeded — still terminates
+// before max_steps and still conserves flux (refusing a split changes no flux). The box is 4 mm
+// long, ~90 steps of dt = h/2 for the direct light; what runs longer are patches caught in
+// whispering-gallery orbits in the smoothed rim, which end by stretching (splits quarter their
+// flux until the energy threshold) or by leaking out. With splits refused they only leak, so the
+// loop takes longer (measured 231 steps vs 148 unconstrained); max_steps = 1000 is not reached.
+TEST(Wavefront, PatchBudgetHoldsAndTheLoopEnds) {
+  const Scene scene = sceneFromJson(kSphereScene);
+  const VolumeSet vol = voxelize(scene);
+  VolumeField field(vol);
+  WavefrontSettings s;
+  s.max_patches = 5000;
+  s.max_steps = 1000;
+  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directional({1, 0, 0}, 1.0));
+  const WavefrontStats& st = r.stats;
+  printStats("budget", st);
+  EXPECT_LE(st.max_live, size_t(s.max_patches));
+  EXPECT_GT(st.splits_refused, 0u);
+  EXPECT_LT(st.steps, s.max_steps);
+  EXPECT_EQ(st.live_at_end, 0u);
+  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted, 1e-9 * st.flux_emitted);
+}
+
+// 5. Absorption: a slab of σ = 0.1 /mm (n = 1, so no refraction; the simulator has no Fresnel
+// terms, so nothing else removes flux), 5 mm thick, faces on voxel faces, no smoothing. The
+// trilinear σ along the beam is piecewise linear with kinks at voxel centres and integrates to
+// exactly 0.1 · 5 = 0.5 (the half-voxel ramps in and out cancel); dt = h/2 puts step ends on the
+// voxel centres, so the midpoint rule is exact on every step. Flux leaving = emitted · e^(−0.5)
+// up to the float32 storage of σ (1.5e-9 relative); we ask 1e-6. Absorbed + left = emitted.
+TEST(Wavefront, AbsorbingSlabTransmitsExpMinusHalf) {
+  const std::string json = R"({
+    "environment": {"type": "constant", "radiance": 1},
+    "camera": {"width": 8, "height": 8},
+    "volume": {"bounds_min": [-4, -2, -2], "bounds_max": [4, 2, 2], "resolution": 32, "smoothing_voxels": 0},
+    "materials": {"ink": {"n": 1.0, "attenuation_per_mm": [0.1, 0.1, 0.1]}},
+    "objects": [{"shape": "box", "center": [0, 0, 0], "size": [5, 40, 40], "material": "ink"}]
+  })";
+  const Scene scene = sceneFromJson(json);
+  const VolumeSet vol = voxelize(scene);
+  VolumeField field(vol);
+  WavefrontSettings s;
+  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directional({1, 0, 0}, 1.0));
+  const WavefrontStats& st = r.stats;
+  printStats("slab", st);
+  const double expected = st.flux_emitted * std::exp(-0.5);
+  std::printf("[ measured ] transmitted fraction %.12f vs exp(-0.5) = %.12f\n", st.flux_left / st.flux_emitted,
+              std::exp(-0.5));
+  EXPECT_NEAR(st.flux_left, expected, 1e-6 * expected);
+  EXPECT_NEAR(st.flux_left + st.flux_absorbed, st.flux_emitted, 1e-12 * st.flux_emitted);
+  EXPECT_EQ(st.kills_caustic + st.kills_energy, 0u);
+}
+
+}  // namespace
+}  // namespace eikon::test
