@@ -132,17 +132,22 @@ CauchyApproximation Dispersion::cauchyApproximation(double lo_nm, double hi_nm) 
     for (size_t k = 0; k < a_.size(); ++k) out.coeffs[k] = a_[k];
     return out;
   }
-  // Least squares on 1 nm samples with basis {1, λ⁻², λ⁻⁴}.
+  // Weighted least squares on 1 nm samples with basis {1, λ⁻², λ⁻⁴}. The weight
+  // w(λ) = exp(−½((λ − 560)/80)²) + 0.05 favours the bright core of the visible, where the eye and
+  // the F, d, C lines are: an unweighted fit over 380–780 nm misses N-BK7's Abbe number by −1.24%
+  // (fused silica −1.42%); weighted, −0.12% (−0.14%), while the largest |Δn| over 380–780 nm grows
+  // from 1.6e-4 to 2.6e-4 at the violet end, where the eye is least sensitive.
   std::array<std::array<double, 4>, 3> m{};
   const int samples = std::max(3, int(std::lround(hi_nm - lo_nm)) + 1);
+  auto weight = [](double lnm) { return std::exp(-0.5 * ((lnm - 560.0) / 80.0) * ((lnm - 560.0) / 80.0)) + 0.05; };
   for (int i = 0; i < samples; ++i) {
     double lnm = lo_nm + (hi_nm - lo_nm) * i / double(samples - 1);
     double l2 = (lnm * 1e-3) * (lnm * 1e-3);
     double basis[3] = {1.0, 1.0 / l2, 1.0 / (l2 * l2)};
-    double n = index(lnm);
+    double n = index(lnm), w2 = weight(lnm) * weight(lnm);
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) m[r][c] += basis[r] * basis[c];
-      m[r][3] += basis[r] * n;
+      for (int c = 0; c < 3; ++c) m[r][c] += w2 * basis[r] * basis[c];
+      m[r][3] += w2 * basis[r] * n;
     }
   }
   out.coeffs = solve3(m);

@@ -65,8 +65,9 @@ class Dispersion {
   /// dn/dλ in 1/nm (analytic).
   double derivative(double lambda_nm) const;
 
-  /// Cauchy {A,B,C} representing this model over [lo_nm, hi_nm]: exact when possible, else an
-  /// unweighted least-squares fit on 1 nm samples (DESIGN §2 "report the fit error").
+  /// Cauchy {A,B,C} representing this model over [lo_nm, hi_nm]: exact when possible, else a
+  /// least-squares fit on 1 nm samples weighted towards 560 nm (see dispersion.cpp; DESIGN §2
+  /// "report the fit error").
   CauchyApproximation cauchyApproximation(double lo_nm, double hi_nm) const;
 
   /// Abbe number V_d = (n_d − 1)/(n_F − n_C) at the Fraunhofer d, F, C lines.

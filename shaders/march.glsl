@@ -190,21 +190,20 @@ vec3 applyM(vec3 p, vec3 a, float no, float ne) {
 }
 
 // Derivatives of (x, w) with respect to ray arc length s.
-//  o-mode (DESIGN §2, isotropic form): dx/ds = w/n, dw/ds = ∇n.
+//  o-mode (DESIGN §2, isotropic form): dx/ds = w/n, dw/ds = ∇n on the shell |w| = n.
 //  e-mode (Hamiltonian H = ½(pᵀM_e p − 1), w = p): dx/dτ = M p,
 //    dp/dτ = −½ pᵀ(∂M/∂x)p = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e   (a piecewise constant),
 //    divided by |M p| to step in arc length. Where there is no axis the e-mode is the o-mode.
 void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
   vec4 o = sampleIndex(x, 0);
-  if (mode == 0) {
-    dx = w / o.x;
-    dw = o.yzw;
-    return;
-  }
-  vec3 a = axisAt(x);
+  vec3 a = mode == 1 ? axisAt(x) : vec3(0.0);
   if (dot(a, a) < 0.25) {
-    dx = w / o.x;
-    dw = o.yzw;
+    // Isotropic Hamiltonian M = I/n² in ray arc length: dx/ds = w/|w|, dw/ds = |w|∇n/n. On the
+    // shell |w| = n this is dx/ds = w/n, dw/ds = ∇n; off it the ray still moves at unit speed and
+    // |w|/n is an invariant of the flow, and it is the e-mode's equation with n_o = n_e.
+    float lw = length(w);
+    dx = w / lw;
+    dw = o.yzw * (lw / o.x);
     return;
   }
   vec4 e = sampleIndex(x, 1);

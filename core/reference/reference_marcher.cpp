@@ -140,9 +140,10 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
     glm::dvec3 go;
     nO(x, no, go);
     glm::dvec3 a = mode == 1 ? field_.axis(x) : glm::dvec3(0.0);
-    if (mode == 0 || !hasAxis(a)) {
-      dx = w / no;
-      dw = go;
+    if (mode == 0 || !hasAxis(a)) {  // M = I/n²: dx/ds = w/|w|, dw/ds = |w|∇n/n (see march.glsl)
+      double lw = glm::length(w);
+      dx = w / lw;
+      dw = go * (lw / no);
       return;
     }
     double ne;
