@@ -14,14 +14,15 @@
 //   img = r.render(width=160, height=120)                         # (H, W, 3) float32, linear sRGB
 //   res = r.trace([0, 0, -30], [0, 0, 1], wavelength_nm=587.56)   # CLI-shaped dict, per mode
 //
-// Trace results (stable across the arrival of the e-mode march). One ray gives the CLI JSON shape
+// Trace results. One ray gives the CLI JSON shape
 //   {"wavelength_nm": W, "device": "gpu"|"cpu", "modes": [{"mode": "o", "exit_point": array(3),
 //    "exit_direction", "wave_normal", "optical_path_mm", "transmittance", "left_volume", "steps",
 //    "invariant_drift", "interfaces", "total_internal_reflections"}, {"mode": "e", ...}]}
-// and trace_rays() gives the same keys with arrays of shape (N, 3) / (N,). Which modes appear:
-// "o" always; "e" for isotropic scenes (identical to o, as the CLI prints it); for uniaxial scenes
-// "e" is absent until the e-mode march lands — callers must look the mode up by name, never by
-// position. `modes_traced(scene)` tells which modes a scene will report.
+// and trace_rays() gives the same keys with arrays of shape (N, 3) / (N,). Both modes appear for
+// every scene: uniaxial scenes march each ray twice (GPU: ViewRenderer::traceModes, CPU:
+// ReferenceMarcher::trace(..., mode 0 = o, 1 = e)); isotropic scenes march once and report the
+// same outcome as "o" and "e" (as the CLI prints it). Look modes up by name, never by position;
+// `modes_traced(scene)` returns ['o', 'e'].
 //
 // Vulkan: one vk::Context is created lazily, on the first GPU call, and shared by every Renderer.
 // EIKON_VALIDATION=1 enables the Khronos validation layer (the context reads it); the messages it
@@ -32,6 +33,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -269,11 +271,38 @@ struct Prepared {
   }
 };
 
-std::vector<std::string> modesTraced(const Scene& s) {
-  // The GPU and CPU marches trace the o-mode / isotropic index today; an isotropic scene's e-mode
-  // is identical. Uniaxial e-mode: pending (lead, e-ray march).
-  if (s.anyUniaxial()) return {"o"};
+std::vector<std::string> modesTraced(const Scene&) {
+  // Both twins march the e-mode of uniaxial crystals; an isotropic scene's e-mode is its o-mode.
   return {"o", "e"};
+}
+
+// Both modes {o, e} of each ray. Isotropic scenes: one march, duplicated (the e-mode is identical
+// by definition, and ViewRenderer::traceModes would only march it again).
+std::vector<std::array<TraceOutcome, 2>> traceBoth(Prepared& p, const std::vector<TraceRequest>& req,
+                                                   const MarchSettings& ms, bool gpu) {
+  const bool uni = p.scene->anyUniaxial();
+  std::vector<std::array<TraceOutcome, 2>> out;
+  if (gpu) {
+    ViewRenderer& r = p.gpuRenderer();
+    py::gil_scoped_release release;
+    if (uni) {
+      out = r.traceModes(req, ms);
+    } else {
+      auto o = r.trace(req, ms);
+      out.reserve(o.size());
+      for (const auto& t : o) out.push_back({t, t});
+    }
+  } else {
+    ReferenceMarcher& r = p.cpuMarcher();
+    py::gil_scoped_release release;
+    out.reserve(req.size());
+    for (const auto& q : req) {
+      TraceOutcome o = r.trace(q, ms, 0);
+      out.push_back({o, uni ? r.trace(q, ms, 1) : o});
+    }
+  }
+  if (out.size() != req.size()) throw std::runtime_error("trace: outcome count differs from the ray count");
+  return out;
 }
 
 bool isGpu(const std::string& device) {
@@ -618,7 +647,7 @@ PYBIND11_MODULE(eikon, m) {
       .def("environment_lookup", [](const Scene& s, const py::handle& d) { return fromVec3(s.environment.lookup(toVec3(d))); });
   m.def("load_scene", [](const std::string& path) { return std::make_shared<Scene>(loadScene(path)); }, py::arg("path"));
   m.def("modes_traced", [](const Scene& s) { return modesTraced(s); }, py::arg("scene"),
-        "modes trace() reports for this scene: ['o', 'e'] (isotropic) or ['o'] (uniaxial, e pending)");
+        "modes trace() reports for this scene: always ['o', 'e'] (isotropic: e identical to o)");
 
   // ------------------------------------------------------------ renderer (both twins)
   py::class_<Prepared, std::shared_ptr<Prepared>>(m, "Renderer",
@@ -668,19 +697,15 @@ PYBIND11_MODULE(eikon, m) {
                             const std::string& device) {
              auto req = makeRequests(origins, directions, wavelength_nm);
              MarchSettings ms = march.value_or(MarchSettings{});
-             std::vector<TraceOutcome> out;
-             if (isGpu(device)) {
-               ViewRenderer& r = p.gpuRenderer();
-               py::gil_scoped_release release;
-               out = r.trace(req, ms);
-             } else {
-               ReferenceMarcher& r = p.cpuMarcher();
-               py::gil_scoped_release release;
-               out.reserve(req.size());
-               for (const auto& q : req) out.push_back(r.trace(q, ms));
-             }
+             auto both = traceBoth(p, req, ms, isGpu(device));
              py::dict modes;
-             for (const auto& name : modesTraced(*p.scene)) modes[py::str(name)] = outcomesArrays(out, name.c_str());
+             const char* names[2] = {"o", "e"};
+             for (int k = 0; k < 2; ++k) {
+               std::vector<TraceOutcome> col;
+               col.reserve(both.size());
+               for (const auto& b : both) col.push_back(b[size_t(k)]);
+               modes[names[k]] = outcomesArrays(col, names[k]);
+             }
              py::array_t<double> lam(py::ssize_t(req.size()));
              for (size_t i = 0; i < req.size(); ++i) lam.mutable_at(py::ssize_t(i)) = req[i].wavelength_nm;
              py::dict d;
@@ -695,18 +720,10 @@ PYBIND11_MODULE(eikon, m) {
                        std::optional<MarchSettings> march, const std::string& device) {
              TraceRequest q{toVec3(origin), toVec3(direction), wavelength_nm};
              MarchSettings ms = march.value_or(MarchSettings{});
-             TraceOutcome t;
-             if (isGpu(device)) {
-               ViewRenderer& r = p.gpuRenderer();
-               py::gil_scoped_release release;
-               t = r.trace({q}, ms).at(0);
-             } else {
-               ReferenceMarcher& r = p.cpuMarcher();
-               py::gil_scoped_release release;
-               t = r.trace(q, ms);
-             }
+             auto both = traceBoth(p, {q}, ms, isGpu(device)).at(0);
              py::list modes;
-             for (const auto& name : modesTraced(*p.scene)) modes.append(outcomeDict(t, name.c_str()));
+             modes.append(outcomeDict(both[0], "o"));
+             modes.append(outcomeDict(both[1], "e"));
              py::dict d;
              d["wavelength_nm"] = wavelength_nm;
              d["device"] = device;
