@@ -8,16 +8,17 @@
 
 #include "anisotropic/dispersion.h"
 
+#include "tests/anisotropic/crystal_fixtures.h"
+
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-double deg(double d) { return d * kPi / 180.0; }
+using eikon::test::calciteD;
+using eikon::test::deg;
+using eikon::test::kPi;
+using eikon::test::randomUnit;
+using eikon::test::toDeg;
 
-eikon::Uniaxial calciteD(glm::dvec3 axis = {0, 0, 1}) {
-  const auto o = eikon::Dispersion::sellmeier({0.73358749, 0.96464345, 1.82831454}, {0, 0.0194325203, 120});
-  const auto e = eikon::Dispersion::sellmeier({0.35859695, 0.8242783, 0.14429128}, {0, 0.0106689543, 120});
-  return eikon::Uniaxial(o.index(eikon::fraunhofer::D), e.index(eikon::fraunhofer::D), axis);
-}
+
 
 }  // namespace
 
