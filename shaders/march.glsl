@@ -176,12 +176,19 @@ struct MarchResult {
   int tir;
 };
 
-// Optic axis at x (nearest voxel; zero where there is no crystal).
-vec3 axisAt(vec3 x) {
-  if (!hasFlag(EIKON_F_UNIAXIAL)) return vec3(0.0);
+// Optic axis at x: xyz = unit axis (zero where there is no crystal), w = 1/r for a radial field
+// about a centre c (a = (x − c)/r, r = |x − c|), else 0. The texel of the nearest voxel holds either
+// the uniform axis (w = 0) or the centre (w = −1).
+vec4 axisField(vec3 x) {
+  if (!hasFlag(EIKON_F_UNIAXIAL)) return vec4(0.0);
   ivec3 vi = clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_extent.w)), ivec3(0), P.grid_dims.xyz - 1);
-  return imageLoad(axisImg, vi).xyz;
+  vec4 t = imageLoad(axisImg, vi);
+  if (t.w > -0.5) return vec4(t.xyz, 0.0);
+  vec3 d = x - t.xyz;
+  float r = length(d);
+  return r > 1e-6 ? vec4(d / r, 1.0 / r) : vec4(0.0, 0.0, 1.0, 0.0);
 }
+vec3 axisAt(vec3 x) { return axisField(x).xyz; }
 
 // The e-mode's inverse dielectric-like matrix M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e² applied to p.
 vec3 applyM(vec3 p, vec3 a, float no, float ne) {
@@ -192,11 +199,13 @@ vec3 applyM(vec3 p, vec3 a, float no, float ne) {
 // Derivatives of (x, w) with respect to ray arc length s.
 //  o-mode (DESIGN §2, isotropic form): dx/ds = w/n, dw/ds = ∇n on the shell |w| = n.
 //  e-mode (Hamiltonian H = ½(pᵀM_e p − 1), w = p): dx/dτ = M p,
-//    dp/dτ = −½ pᵀ(∂M/∂x)p = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e   (a piecewise constant),
+//    dp/dτ = −½ pᵀ(∂M/∂x)p = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e (+ the axis term of a
+//    radial field, below),
 //    divided by |M p| to step in arc length. Where there is no axis the e-mode is the o-mode.
 void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
   vec4 o = sampleIndex(x, 0);
-  vec3 a = mode == 1 ? axisAt(x) : vec3(0.0);
+  vec4 af = mode == 1 ? axisField(x) : vec4(0.0);
+  vec3 a = af.xyz;
   if (dot(a, a) < 0.25) {
     // Isotropic Hamiltonian M = I/n² in ray arc length: dx/ds = w/|w|, dw/ds = |w|∇n/n. On the
     // shell |w| = n this is dx/ds = w/n, dw/ds = ∇n; off it the ray still moves at unit speed and
@@ -210,6 +219,9 @@ void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
   float pa = dot(w, a), p2 = dot(w, w);
   vec3 Mp = applyM(w, a, o.x, e.x);
   vec3 dp = (pa * pa / (o.x * o.x * o.x)) * o.yzw + ((p2 - pa * pa) / (e.x * e.x * e.x)) * e.yzw;
+  // A varying axis adds −½ ∂(pᵀMp)/∂x from ∂a/∂x = (I − aaᵀ)/r (radial field):
+  // −(p·a)(1/n_o² − 1/n_e²)(p − (p·a)a)/r.
+  if (af.w > 0.0) dp -= pa * (1.0 / (o.x * o.x) - 1.0 / (e.x * e.x)) * (w - pa * a) * af.w;
   float L = length(Mp);
   dx = Mp / L;
   dw = dp / L;

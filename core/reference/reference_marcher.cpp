@@ -89,12 +89,16 @@ void VolumeField::indexE(const glm::dvec3& x, double il2, double il4, double& n,
   grad = glm::dvec3(a.y, a.z, a.w);
 }
 
-glm::dvec3 VolumeField::axis(const glm::dvec3& x) const {
-  if (!v_.uniaxial) return glm::dvec3(0.0);
+glm::dvec4 VolumeField::axisField(const glm::dvec3& x) const {
+  if (!v_.uniaxial) return glm::dvec4(0.0);
   const Grid& g = v_.grid;
   int i[3];
   for (int a = 0; a < 3; ++a) i[a] = std::clamp(int(std::floor((x[a] - g.origin[a]) / g.h)), 0, g.dims[size_t(a)] - 1);
-  return glm::dvec3(v_.axis[g.index(i[0], i[1], i[2])]);
+  glm::dvec4 t(v_.axis[g.index(i[0], i[1], i[2])]);
+  if (t.w > -0.5) return glm::dvec4(glm::dvec3(t), 0.0);
+  glm::dvec3 d = x - glm::dvec3(t);  // radial field about the stored centre
+  double r = glm::length(d);
+  return r > 1e-6 ? glm::dvec4(d / r, 1.0 / r) : glm::dvec4(0.0, 0.0, 1.0, 0.0);
 }
 
 glm::dvec4 VolumeField::medium(const glm::dvec3& x) const { return trilinear(v_.medium[0], x); }
@@ -139,7 +143,8 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
     double no;
     glm::dvec3 go;
     nO(x, no, go);
-    glm::dvec3 a = mode == 1 ? field_.axis(x) : glm::dvec3(0.0);
+    glm::dvec4 af = mode == 1 ? field_.axisField(x) : glm::dvec4(0.0);
+    glm::dvec3 a(af);
     if (mode == 0 || !hasAxis(a)) {  // M = I/n²: dx/ds = w/|w|, dw/ds = |w|∇n/n (see march.glsl)
       double lw = glm::length(w);
       dx = w / lw;
@@ -152,6 +157,8 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
     double pa = glm::dot(w, a), p2 = glm::dot(w, w);
     glm::dvec3 Mp = applyM(w, a, no, ne);
     glm::dvec3 dp = (pa * pa / (no * no * no)) * go + ((p2 - pa * pa) / (ne * ne * ne)) * ge;
+    // Radial axis field: −(p·a)(1/n_o² − 1/n_e²)(p − (p·a)a)/r (see march.glsl).
+    if (af.w > 0.0) dp -= pa * (1.0 / (no * no) - 1.0 / (ne * ne)) * (w - pa * a) * af.w;
     double L = glm::length(Mp);
     dx = Mp / L;
     dw = dp / L;

@@ -31,8 +31,10 @@ class Field {
   virtual void indexE(const glm::dvec3& x, double il2, double il4, double& n, glm::dvec3& grad) const {
     index(x, il2, il4, n, grad);
   }
-  /// Unit optic axis at x (nearest voxel), or zero where the medium is isotropic.
-  virtual glm::dvec3 axis(const glm::dvec3&) const { return glm::dvec3(0.0); }
+  /// Unit optic axis at x, or zero where the medium is isotropic.
+  virtual glm::dvec3 axis(const glm::dvec3& x) const { return glm::dvec3(axisField(x)); }
+  /// (axis, 1/r): 1/r ≠ 0 for a radial axis field a = (x − c)/r, whose ∂a/∂x = (I − aaᵀ)/r.
+  virtual glm::dvec4 axisField(const glm::dvec3&) const { return glm::dvec4(0.0); }
   /// (σ_r, σ_g, σ_b band values per mm, opacity) of the o-mode (isotropic: the medium).
   virtual glm::dvec4 medium(const glm::dvec3& x) const = 0;
   /// The same for the e-mode (principal σ_e bands).
@@ -55,7 +57,7 @@ class VolumeField : public Field {
   explicit VolumeField(const VolumeSet& v) : v_(v) {}
   void index(const glm::dvec3& x, double il2, double il4, double& n, glm::dvec3& grad) const override;
   void indexE(const glm::dvec3& x, double il2, double il4, double& n, glm::dvec3& grad) const override;
-  glm::dvec3 axis(const glm::dvec3& x) const override;
+  glm::dvec4 axisField(const glm::dvec3& x) const override;
   glm::dvec4 medium(const glm::dvec3& x) const override;
   glm::dvec4 mediumE(const glm::dvec3& x) const override;
   glm::dvec3 emission(const glm::dvec3& x) const override;

@@ -255,7 +255,7 @@ SceneObject parseObject(const Node& o) {
   glm::dvec3 rot = o.get("rotation_deg") ? o.at("rotation_deg").vec3() : glm::dvec3(0.0);
   SceneObject obj;
   ShapeGeometry g;
-  auto common = {"shape", "center", "rotation_deg", "material", "optic_axis"};
+  auto common = {"shape", "center", "rotation_deg", "material", "optic_axis", "optic_axis_field"};
   auto allow = [&](std::initializer_list<const char*> extra) {
     std::vector<const char*> keys(common);
     keys.insert(keys.end(), extra.begin(), extra.end());
@@ -319,6 +319,12 @@ SceneObject parseObject(const Node& o) {
   obj.shape = Shape(shape, g, center, rot);
   obj.material = o.at("material").string();
   if (auto a = o.get("optic_axis")) obj.optic_axis = a->unitVector();
+  if (auto f = o.get("optic_axis_field")) {
+    std::string kind = f->string();
+    if (kind == "radial") obj.radial_axis = true;
+    else if (kind != "uniform") f->fail("unknown optic_axis_field '" + kind + "' (uniform, radial)");
+    if (obj.radial_axis && obj.optic_axis) f->fail("give either optic_axis or optic_axis_field \"radial\", not both");
+  }
   return obj;
 }
 
@@ -553,7 +559,8 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
                               "' (not defined under /materials and not in the material library)");
     }
     const Material& mat = scene.materials[obj.material];
-    if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis)
+    if (obj.radial_axis && !mat.uniaxial) o.at("optic_axis_field").fail("optic_axis_field given for an isotropic material");
+    if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis && !obj.radial_axis)
       o.fail("uniaxial material '" + obj.material + "' needs an optic_axis (on the object or the material)");
     if (!mat.uniaxial && obj.optic_axis) o.at("optic_axis").fail("optic_axis given for an isotropic material");
     if (mat.grin.type != GrinProfile::Type::None) {

@@ -94,6 +94,9 @@ struct SceneObject {
   Shape shape;
   std::string material;              ///< key into Scene::materials
   std::optional<glm::dvec3> optic_axis;  ///< per-object override (unit, world space)
+  /// "optic_axis_field": "radial" — the axis points away from the object's centre everywhere
+  /// (a spherulite); the e-ray equation then includes the axis' derivative.
+  bool radial_axis = false;
 };
 
 struct Light {

@@ -176,8 +176,11 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
     const SceneObject& obj = scene.objects[oi];
     const Material& mat = scene.materials.at(obj.material);
     const MaterialValues& mv = values.at(obj.material);
-    glm::vec3 ax(0.0f);
-    if (mat.uniaxial) ax = glm::vec3(obj.optic_axis ? *obj.optic_axis : *mat.optic_axis);
+    // Axis texel: (a, 0) for a uniform axis; (centre, −1) for a radial field, evaluated exactly
+    // by the marchers as a(x) = (x − centre)/|x − centre| (so dilation copies stay exact).
+    glm::vec4 ax(0.0f);
+    if (mat.uniaxial && obj.radial_axis) ax = glm::vec4(glm::vec3(obj.shape.center()), -1.0f);
+    else if (mat.uniaxial) ax = glm::vec4(glm::vec3(obj.optic_axis ? *obj.optic_axis : *mat.optic_axis), 0.0f);
     auto [bmin, bmax] = obj.shape.bounds();
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
@@ -227,7 +230,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
               gradients[size_t(f)][idx] = glm::vec3(gv);
             }
           for (int f = 0; f < kFieldCount; ++f) fields[size_t(f)][idx] = fields[size_t(f)][idx] * (1 - fc) + prop[f] * fc;
-          if (vs.uniaxial && mat.uniaxial) axis[idx] = glm::vec4(ax, 0.0f);
+          if (vs.uniaxial && mat.uniaxial) axis[idx] = ax;
         }
     });
     progress(0.4 * double(oi + 1) / double(scene.objects.size()), "voxelising");
@@ -338,6 +341,8 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
                   break;
                 }
             }
+        // A radial axis field varies everywhere inside its crystal: never straight-step there.
+        if (!vs.axis.empty() && vs.axis[idx].w < -0.5f) active = true;
         if (active) dist[idx] = 0;
       }
   });

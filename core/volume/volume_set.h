@@ -14,7 +14,8 @@
 //   index[m][c]   : (c-th Cauchy coefficient, ∂/∂x, ∂/∂y, ∂/∂z) for mode m ∈ {o, e}, c ∈ {A, B, C}
 //   medium[m]     : (σ_r, σ_g, σ_b, opacity) attenuation per mm for mode m (band values)
 //   emission      : (e_r, e_g, e_b, skip) emission and the empty-space skip distance in voxels
-//   axis          : (a_x, a_y, a_z, 0) optic axis (uniaxial scenes only)
+//   axis          : (a_x, a_y, a_z, 0) uniform optic axis, or (c_x, c_y, c_z, −1) for a radial axis
+//                   field about c (uniaxial scenes only; zero where isotropic)
 // The skip distance D is the Chebyshev distance (in voxels, capped) from the voxel to the nearest
 // voxel whose fields differ from a neighbour's: within (D − 1) voxels every field is constant,
 // so a ray may cross that distance in one straight step (DESIGN's "distance volume").
