@@ -70,15 +70,34 @@ Stencil stencilAt(vec3 x) {
       s.f.z)
 
 // (n, ∂n/∂x, ∂n/∂y, ∂n/∂z) at x for the current wavelength; mode 0 = o, 1 = e.
+// Wavelength sharing (view.comp, spectral mode): while marching the first wavelength of a pixel
+// sample, note whether any sample saw dispersion (B or C ≠ 0) and record every environment lookup
+// as (direction, weight). If none did, and nothing else depends on λ (no attenuation, emission,
+// opacity or crystal), the path and every weight are the same at all wavelengths: the others are
+// Σ weight·S_env(λ, direction), without marching.
+bool gDispersiveHit = false;
+bool gRecord = false;
+bool gRecordOverflow = false;
+int gNumRecorded = 0;
+vec4 gRecorded[6];
+
 vec4 sampleIndex(vec3 x, int mode) {
   Stencil s = stencilAt(x);
   vec4 a;
   if (mode == 0) {
     a = TRI(idxOA, s);
-    if (hasFlag(EIKON_F_DISPERSIVE)) a += TRI(idxOB, s) * gIl2 + TRI(idxOC, s) * gIl4;
+    if (hasFlag(EIKON_F_DISPERSIVE)) {
+      vec4 b = TRI(idxOB, s), c = TRI(idxOC, s);
+      if (any(notEqual(b, vec4(0.0))) || any(notEqual(c, vec4(0.0)))) gDispersiveHit = true;
+      a += b * gIl2 + c * gIl4;
+    }
   } else {
     a = TRI(idxEA, s);
-    if (hasFlag(EIKON_F_DISPERSIVE)) a += TRI(idxEB, s) * gIl2 + TRI(idxEC, s) * gIl4;
+    if (hasFlag(EIKON_F_DISPERSIVE)) {
+      vec4 b = TRI(idxEB, s), c = TRI(idxEC, s);
+      if (any(notEqual(b, vec4(0.0))) || any(notEqual(c, vec4(0.0)))) gDispersiveHit = true;
+      a += b * gIl2 + c * gIl4;
+    }
   }
   return a;
 }
@@ -116,6 +135,17 @@ vec3 sigmaOf(vec3 bands) { return gScalar ? vec3(bandAt(bands)) : bands; }
 vec3 colourOf(vec3 rgb) { return gScalar ? vec3(rgbToSpectrum(rgb)) : rgb; }
 
 // Environment radiance in direction d (unit). Same formulas as Environment::lookup (scene.cpp).
+vec3 environment(vec3 d);
+
+// Environment radiance times a throughput weight, recorded for wavelength sharing.
+vec3 environmentWeighted(vec3 weight, vec3 d) {
+  if (gRecord) {
+    if (gNumRecorded < 6) gRecorded[gNumRecorded++] = vec4(d, weight.x);
+    else gRecordOverflow = true;
+  }
+  return weight * environment(d);
+}
+
 vec3 environment(vec3 d) {
   float u = atan(d.x, -d.z) / (2.0 * kPi) + 0.5;
   float v = acos(clamp(d.y, -1.0, 1.0)) / kPi;
@@ -282,7 +312,7 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   const float ambient = P.march.z;
   float t0, t1;
   if (!boxHit(o, d, bmin, bmax, t0, t1)) {
-    R.radiance = environment(d);
+    R.radiance = environmentWeighted(vec3(1.0), d);
     R.exit_point = o;
     R.exit_dir = d;
     R.wave_normal = d;
@@ -427,7 +457,7 @@ MarchResult march(vec3 o, vec3 d, int mode) {
             float wsw = sWeight(outCrystal ? dOut : dIn, a, N, dIn, mode);
             vec2 rsp = fresnelRsRp(abs(ci), n1, n2);
             float Rf = hasFlag(EIKON_F_UNIAXIAL) ? wsw * rsp.x + (1.0 - wsw) * rsp.y : 0.5 * (rsp.x + rsp.y);
-            if (n2 > n1) L += T * Rf * environment(reflect(dIn, N));
+            if (n2 > n1) L += environmentWeighted(T * Rf, reflect(dIn, N));
             T *= 1.0 - Rf;
             R.interfaces++;
           } else {
@@ -455,7 +485,7 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   R.exit_dir = rayDirection(x, w, mode);
   R.wave_normal = normalize(w);
   R.left = !stopped && steps < maxSteps;
-  if (R.left) L += T * environment(R.exit_dir);
+  if (R.left) L += environmentWeighted(T, R.exit_dir);
   R.radiance = L;
   R.throughput = T;
   return R;

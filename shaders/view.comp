@@ -48,11 +48,27 @@ void main() {
       int N = P.limits.z;
       uint seed = pcg_hash(pixelIndex + pcg_hash(uint(s)));
       vec3 xyz = vec3(0.0);
+      // Wavelength sharing (march.glsl): only where nothing but the index can depend on λ.
+      const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
+      bool share = (P.grid_dims.w & lambdaDependent) == 0;
+      bool reuse = false;
       for (int k = 0; k < N; ++k) {
         float uk = float(pcg_hash(seed + uint(k)) >> 8u) * (1.0 / 16777216.0);
         float lambda = 380.0 + (float(k) + uk) * (400.0 / float(N));
         setWavelength(lambda * 1e-3, true);
+        if (reuse) {
+          float rad = 0.0;
+          for (int j = 0; j < gNumRecorded; ++j) rad += gRecorded[j].w * environment(gRecorded[j].xyz).x;
+          xyz += rad * cmf(lambda) * (400.0 / float(N));
+          continue;
+        }
+        gRecord = share && k == 0;
+        gNumRecorded = 0;
+        gRecordOverflow = false;
+        gDispersiveHit = false;
         MarchResult r = march(P.cam_pos.xyz, d, 0);
+        reuse = gRecord && !gDispersiveHit && !gRecordOverflow;
+        gRecord = false;
         float rad = r.radiance.x;
         steps += float(r.steps) / float(N);
         if (hasFlag(EIKON_F_UNIAXIAL)) {  // unpolarised: each mode carries half
