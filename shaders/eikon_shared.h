@@ -94,9 +94,50 @@ struct TraceResult {
   vec4 stats;           // x: steps; y: max | |w| − n | (invariant drift); z: interfaces; w: TIR count
 };
 
+
+// ---- Light simulator (wavefront.comp; CPU twin core/reference/wavefront.h) ----
+#define EIKON_WAVE_WG 64
+// Descriptor bindings of the wavefront pipeline (its own set 0).
+#define EIKON_WB_PARAMS 0
+#define EIKON_WB_INDEX_A 1
+#define EIKON_WB_INDEX_B 2
+#define EIKON_WB_INDEX_C 3
+#define EIKON_WB_MEDIUM 4
+#define EIKON_WB_PATCHES 5
+#define EIKON_WB_SPLAT 6
+// WavePatch.state.x: what the kernel decided for the patch.
+#define EIKON_PATCH_ALIVE 0     // still propagating (or out of steps: state.w == max_steps)
+#define EIKON_PATCH_SPLIT 1     // alive, stopped because an edge exceeds the split span
+#define EIKON_PATCH_LEFT 2      // killed: centre left the bounds (or its ray misses them)
+#define EIKON_PATCH_CAUSTIC 3   // killed: orientation flip (fold caustic)
+#define EIKON_PATCH_ENERGY 4    // killed: flux below min_energy_fraction of its seed's
+#define EIKON_PATCH_OPAQUE 5    // killed: centre in an opaque voxel (flux counted as absorbed)
+// Splat buffer: per voxel 4 signed 64-bit fixed-point sums as (lo, hi) uint pairs, in the order
+// weight, dir.x, dir.y, dir.z (EIKON_SPLAT_ACC_WORDS words per voxel), then one uint per voxel
+// holding the float bits of the highest patch irradiance (atomicMax on non-negative floats).
+#define EIKON_SPLAT_ACC_WORDS 8
+
+struct WaveParams {
+  vec4 grid_origin;  // xyz: bounds_min (mm); w: voxel edge h (mm)
+  vec4 grid_max;     // xyz: bounds_max (mm); w: 1/h
+  ivec4 grid_dims;   // xyz: voxels per axis; w: flags (EIKON_F_DISPERSIVE | _ATTENUATION | _OPACITY)
+  vec4 step;         // x: dt (mm); y: split edge (mm); z: min energy fraction; w: 1/h³
+  vec4 wavelength;   // x: λ (µm); y: 1/λ²; z: 1/λ⁴; w: splat scale (fixed-point units per W/mm²)
+  ivec4 control;     // x: patches in the buffer; y: steps per dispatch; z: max_steps; w: unused
+};
+
+// One patch: four corners in bilinear order (0,0), (1,0), (1,1), (0,1).
+struct WavePatch {
+  vec4 x[4];    // xyz: corner position (mm)
+  vec4 w[4];    // xyz: corner wave vector w = n·t̂
+  vec4 flux;    // x: flux (W); y: area0 (mm²); z: seed flux (W); w: flux absorbed in this dispatch
+  ivec4 state;  // x: EIKON_PATCH_*; y: launch orientation (±1, 0); z: entered (0/1); w: steps done
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(ViewParams) == 15 * 16, "ViewParams must be vec4-packed");
 static_assert(sizeof(TraceRay) == 32 && sizeof(TraceResult) == 64, "trace records must be vec4-packed");
+static_assert(sizeof(WaveParams) == 6 * 16 && sizeof(WavePatch) == 10 * 16, "wavefront records must be vec4-packed");
 }  // namespace eikon::gpu
 #endif
 

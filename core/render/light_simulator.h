@@ -1,0 +1,47 @@
+// The GPU light simulator (issue 6, DESIGN §2): the wavefront of patches of
+// core/reference/wavefront.h propagated by a Vulkan compute kernel (shaders/wavefront.comp), one
+// thread per patch, RK4 in constant time on the four corners, attenuation, fixed-point atomic
+// splat into the irradiance/direction volumes. Same settings, seeds, kill rules, split rule and
+// result types as the CPU reference, which it is tested against (tests/core/wavefront_gpu_test.cpp).
+//
+//   eikon::VolumeSet vol = eikon::voxelize(scene);
+//   eikon::GpuWavefront gpu(ctx, vol, settings);
+//   eikon::WavefrontResult r = gpu.run(scene.lights[0]);   // r.irradiance in W/mm², r.stats
+//
+// What differs from the reference: the kernel runs in float32; the splits and the compaction of
+// the patch list are done on the host between dispatches (each dispatch advances every live patch
+// by up to `steps_per_dispatch` steps; a patch that needs a split stops and waits for the host);
+// the probe plane (stats.flux_probe, flux_ended_before_probe) is not computed; stats.max_live is
+// the largest live count seen at the host's sync points (the reference counts within a step).
+// Common mistakes: expecting bit-identical stats — float32 may move a borderline kill or split by
+// a step; expecting identical stats when splits are refused (the patch budget is checked at sync
+// points, so which splits are refused depends on steps_per_dispatch).
+#pragma once
+
+#include <memory>
+
+#include "core/reference/wavefront.h"
+#include "core/vk/context.h"
+#include "core/volume/volume_set.h"
+
+namespace eikon {
+
+class GpuWavefront {
+ public:
+  /// The volume is uploaded (o-mode index A/B/C and medium); it is referenced for seeding and
+  /// splitting and must outlive this object. Throws std::invalid_argument for bad settings,
+  /// std::runtime_error if the splat buffer exceeds the device's storage-buffer range.
+  GpuWavefront(vk::Context& ctx, const VolumeSet& volume, WavefrontSettings settings, int steps_per_dispatch = 16);
+  ~GpuWavefront();
+  GpuWavefront(const GpuWavefront&) = delete;
+  GpuWavefront& operator=(const GpuWavefront&) = delete;
+
+  /// Propagate a light's wavefront through the volume; the result is on the volume's grid.
+  WavefrontResult run(const Light& light);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace eikon

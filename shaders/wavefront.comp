@@ -1,0 +1,215 @@
+#version 450
+// Light simulator kernel (GPU twin of core/reference/wavefront.cpp; see docs/light-simulator.md).
+// One thread per patch; each dispatch advances a patch by up to control.y constant-time steps
+//
+//     dx/dt = w / n²,   dw/dt = ∇n / n     (c = 1, t = optical path, |w| = n)
+//
+// with classical RK4 on each of the four corners, the index sampled trilinearly from the A (and,
+// when dispersive, B, C) field exactly as march.glsl / VolumeField do. Per step, in the order of
+// the reference: flux ← flux·exp(−σΔs) (σ at the step midpoint of the centre path), splat of
+// flux_mid·Δs/h³ into the voxel holding the midpoint, then the kills (opaque, left, caustic,
+// energy) and the split test. A patch that needs a split stops there with state EIKON_PATCH_SPLIT;
+// the host splits it and launches the children in the next dispatch (so a patch never runs ahead
+// of a split it needs; patches are independent, so they need not share the same clock between
+// dispatches — each carries its own step count in state.w).
+//
+// Splat: GLSL float atomics (GL_EXT_shader_atomic_float) are not available everywhere (lavapipe),
+// so the Accumulate sums are signed 64-bit fixed point held as (lo, hi) uint pairs: lo by
+// atomicAdd, hi by the carry and the sign extension (exact, order independent). One splat is
+// rounded to the nearest 1/scale (W/mm²); the host picks scale so that the largest possible single
+// splat is ≤ 2^29 units (see light_simulator.cpp). HighestEnergy uses atomicMax on the float bits
+// (non-negative floats order as uints).
+#extension GL_GOOGLE_include_directive : require
+#include "eikon_shared.h"
+
+layout(local_size_x = EIKON_WAVE_WG) in;
+
+layout(std430, binding = EIKON_WB_PARAMS) readonly buffer ParamsBuf { WaveParams P; };
+layout(binding = EIKON_WB_INDEX_A, rgba32f) readonly uniform image3D idxA;
+layout(binding = EIKON_WB_INDEX_B, rgba32f) readonly uniform image3D idxB;
+layout(binding = EIKON_WB_INDEX_C, rgba32f) readonly uniform image3D idxC;
+layout(binding = EIKON_WB_MEDIUM, rgba32f) readonly uniform image3D medium;
+layout(std430, binding = EIKON_WB_PATCHES) buffer PatchBuf { WavePatch patches[]; };
+layout(std430, binding = EIKON_WB_SPLAT) buffer SplatBuf { uint splat[]; };
+
+bool hasFlag(int f) { return (P.grid_dims.w & f) != 0; }
+
+// Trilinear stencil, cell-centred samples, clamp to edge (march.glsl stencilAt / VolumeField).
+struct Stencil {
+  ivec3 i0;
+  ivec3 i1;
+  vec3 f;
+};
+
+Stencil stencilAt(vec3 x) {
+  vec3 g = (x - P.grid_origin.xyz) * P.grid_max.w - 0.5;
+  vec3 fl = floor(g);
+  Stencil s;
+  s.f = g - fl;
+  ivec3 i = ivec3(fl);
+  ivec3 dmax = P.grid_dims.xyz - 1;
+  s.i0 = clamp(i, ivec3(0), dmax);
+  s.i1 = clamp(i + 1, ivec3(0), dmax);
+  return s;
+}
+
+#define TRI(img, s)                                                                              \
+  mix(mix(mix(imageLoad(img, s.i0), imageLoad(img, ivec3(s.i1.x, s.i0.y, s.i0.z)), s.f.x),      \
+          mix(imageLoad(img, ivec3(s.i0.x, s.i1.y, s.i0.z)), imageLoad(img, ivec3(s.i1.x, s.i1.y, s.i0.z)), s.f.x), \
+          s.f.y),                                                                                \
+      mix(mix(imageLoad(img, ivec3(s.i0.x, s.i0.y, s.i1.z)), imageLoad(img, ivec3(s.i1.x, s.i0.y, s.i1.z)), s.f.x), \
+          mix(imageLoad(img, ivec3(s.i0.x, s.i1.y, s.i1.z)), imageLoad(img, s.i1), s.f.x), s.f.y), \
+      s.f.z)
+
+// (n, ∇n) at the simulator's wavelength.
+vec4 sampleIndex(vec3 x) {
+  Stencil s = stencilAt(x);
+  vec4 a = TRI(idxA, s);
+  if (hasFlag(EIKON_F_DISPERSIVE)) a += TRI(idxB, s) * P.wavelength.y + TRI(idxC, s) * P.wavelength.z;
+  return a;
+}
+
+// (σ at 612, 549, 465 nm, opacity); zero when the volume has neither.
+vec4 sampleMedium(vec3 x) {
+  if (!hasFlag(EIKON_F_ATTENUATION) && !hasFlag(EIKON_F_OPACITY)) return vec4(0.0);
+  Stencil s = stencilAt(x);
+  return TRI(medium, s);
+}
+
+// Band values → σ at λ (same rule as sigmaAt in wavefront.cpp and bandAt in march.glsl).
+float sigmaAt(vec3 rgb) {
+  float l = P.wavelength.x * 1000.0;
+  if (l <= 465.0) return rgb.b;
+  if (l >= 612.0) return rgb.r;
+  if (l <= 549.0) return rgb.b + (rgb.g - rgb.b) * (l - 465.0) / (549.0 - 465.0);
+  return rgb.g + (rgb.r - rgb.g) * (l - 549.0) / (612.0 - 549.0);
+}
+
+void deriv(vec3 x, vec3 w, out vec3 dx, out vec3 dw) {
+  vec4 a = sampleIndex(x);
+  dx = w / (a.x * a.x);
+  dw = a.yzw / a.x;
+}
+
+void rk4(inout vec3 x, inout vec3 w, float dt) {
+  vec3 k1x, k1w, k2x, k2w, k3x, k3w, k4x, k4w;
+  deriv(x, w, k1x, k1w);
+  deriv(x + 0.5 * dt * k1x, w + 0.5 * dt * k1w, k2x, k2w);
+  deriv(x + 0.5 * dt * k2x, w + 0.5 * dt * k2w, k3x, k3w);
+  deriv(x + dt * k3x, w + dt * k3w, k4x, k4w);
+  x += dt / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+  w += dt / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+}
+
+bool insideBounds(vec3 x) { return all(greaterThanEqual(x, P.grid_origin.xyz)) && all(lessThanEqual(x, P.grid_max.xyz)); }
+
+// Does the ray o + s·d (s ≥ 0) meet the bounds? (rayHitsBox in wavefront.cpp)
+bool rayHitsBox(vec3 o, vec3 d) {
+  float t0 = 0.0, t1 = 1e30;
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] == 0.0) {
+      if (o[a] < P.grid_origin[a] || o[a] > P.grid_max[a]) return false;
+      continue;
+    }
+    float ta = (P.grid_origin[a] - o[a]) / d[a], tb = (P.grid_max[a] - o[a]) / d[a];
+    if (ta > tb) {
+      float t = ta;
+      ta = tb;
+      tb = t;
+    }
+    t0 = max(t0, ta);
+    t1 = min(t1, tb);
+  }
+  return t0 <= t1;
+}
+
+// Add v (already in fixed-point units) to the signed 64-bit sum at words (base, base + 1).
+void addFixed(uint base, int v) {
+  if (v == 0) return;
+  uint u = uint(v);
+  uint old = atomicAdd(splat[base], u);
+  uint hiAdd = ((old + u) < old ? 1u : 0u) + (v < 0 ? 0xFFFFFFFFu : 0u);
+  if (hiAdd != 0u) atomicAdd(splat[base + 1u], hiAdd);
+}
+
+int toFixed(float value) { return int(clamp(round(value * P.wavelength.w), -2147483520.0, 2147483520.0)); }
+
+void splatAt(vec3 m, float value, float irr, vec3 dir) {
+  vec3 g = floor((m - P.grid_origin.xyz) * P.grid_max.w);
+  if (any(lessThan(g, vec3(0.0))) || any(greaterThanEqual(g, vec3(P.grid_dims.xyz)))) return;
+  ivec3 i = ivec3(g);
+  uint v = uint((i.z * P.grid_dims.y + i.y) * P.grid_dims.x + i.x);
+  uint count = uint(P.grid_dims.x * P.grid_dims.y * P.grid_dims.z);
+  uint base = v * uint(EIKON_SPLAT_ACC_WORDS);
+  addFixed(base, toFixed(value));
+  addFixed(base + 2u, toFixed(value * dir.x));
+  addFixed(base + 4u, toFixed(value * dir.y));
+  addFixed(base + 6u, toFixed(value * dir.z));
+  atomicMax(splat[count * uint(EIKON_SPLAT_ACC_WORDS) + v], floatBitsToUint(max(irr, 0.0)));
+}
+
+vec3 centreOf(vec3 x[4]) { return 0.25 * (x[0] + x[1] + x[2] + x[3]); }
+
+void main() {
+  uint id = gl_GlobalInvocationID.x;
+  if (id >= uint(P.control.x)) return;
+  WavePatch p = patches[id];
+  p.flux.w = 0.0;
+  if (p.state.x != EIKON_PATCH_ALIVE) {
+    patches[id] = p;
+    return;
+  }
+  vec3 x[4], w[4];
+  for (int k = 0; k < 4; ++k) {
+    x[k] = p.x[k].xyz;
+    w[k] = p.w[k].xyz;
+  }
+  const float dt = P.step.x, maxEdge = P.step.y;
+  for (int it = 0; it < P.control.y && p.state.w < P.control.z; ++it) {
+    ++p.state.w;
+    vec3 c0 = centreOf(x);
+    for (int k = 0; k < 4; ++k) rk4(x[k], w[k], dt);
+    vec3 c1 = centreOf(x), m = 0.5 * (c0 + c1);
+    float ds = length(c1 - c0);
+    vec4 med = sampleMedium(m);
+    float sigma = sigmaAt(med.xyz);
+    float att = exp(-sigma * ds), fluxMid = p.flux.x * exp(-0.5 * sigma * ds);
+    p.flux.w += p.flux.x * (1.0 - att);
+    p.flux.x *= att;
+    vec3 va = 0.5 * cross(x[2] - x[0], x[3] - x[1]);
+    float area = length(va);
+    vec3 wm = 0.25 * (w[0] + w[1] + w[2] + w[3]);
+    float wl = length(wm);
+    splatAt(m, fluxMid * ds * P.step.w, area > 0.0 ? fluxMid / area : 0.0, wl > 0.0 ? wm / wl : vec3(0.0));
+    if (med.w >= 0.5) {
+      p.state.x = EIKON_PATCH_OPAQUE;
+      break;
+    }
+    if (insideBounds(c1)) {
+      p.state.z = 1;
+    } else if (p.state.z != 0 || !(wl > 0.0) || !rayHitsBox(c1, wm / wl)) {
+      p.state.x = EIKON_PATCH_LEFT;
+      break;
+    }
+    float o = dot(va, wm);
+    if ((o > 0.0 && p.state.y < 0) || (o < 0.0 && p.state.y > 0)) {
+      p.state.x = EIKON_PATCH_CAUSTIC;
+      break;
+    }
+    if (p.flux.x < P.step.z * p.flux.z) {
+      p.state.x = EIKON_PATCH_ENERGY;
+      break;
+    }
+    float e = 0.0;
+    for (int k = 0; k < 4; ++k) e = max(e, length(x[(k + 1) % 4] - x[k]));
+    if (e > maxEdge) {
+      p.state.x = EIKON_PATCH_SPLIT;
+      break;
+    }
+  }
+  for (int k = 0; k < 4; ++k) {
+    p.x[k] = vec4(x[k], 0.0);
+    p.w[k] = vec4(w[k], 0.0);
+  }
+  patches[id] = p;
+}
