@@ -80,8 +80,11 @@ struct GpuWavefront::Impl {
   void ensurePatchCapacity(size_t n) {
     const VkDeviceSize bytes = std::max<size_t>(n, 64) * sizeof(gpu::WavePatch);
     if (patches.handle() != VK_NULL_HANDLE && patches.size() >= bytes) return;
-    patches = vk::Buffer(ctx, std::max<VkDeviceSize>(bytes, 2 * patches.size()), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                         "wavefront patches");
+    // Grow geometrically, but never past the storage-buffer range when the request itself fits
+    // (vk::Buffer refuses larger requests with a message: lavapipe allows 128 MiB ≈ 838k patches).
+    const VkDeviceSize range = ctx.limits().max_storage_buffer_range;
+    const VkDeviceSize grown = std::max<VkDeviceSize>(bytes, std::min<VkDeviceSize>(2 * patches.size(), range));
+    patches = vk::Buffer(ctx, grown, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront patches");
     pipe.bindBuffer(EIKON_WB_PATCHES, patches);
   }
 
