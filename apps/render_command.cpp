@@ -58,6 +58,10 @@ void addRenderCommand(CLI::App& app) {
     if (a.wavelengths < -1 || a.wavelengths > 256) throw CliError("--wavelengths must be in [0, 256]");
     if (!(a.step > 0 && a.step <= 4)) throw CliError("--step must be in (0, 4] voxels");
     Scene scene = loadScene(a.scene);
+    for (const std::string& w : scene.warnings) {
+      if (a.strict) throw CliError(w + " (--strict)");
+      std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+    }
     checkWritable(out);
     checkWritable(png);
     RenderSettings rs;

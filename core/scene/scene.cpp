@@ -588,6 +588,32 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     scene.objects.push_back(std::move(obj));
   }
 
+  // The volume's faces must lie in the ambient medium (rays leave straight from there): warn if an
+  // object comes within the smoothing reach (3σ + 1 voxel) of a face, sampled on each face.
+  {
+    const auto& v = scene.volume;
+    glm::dvec3 ext = v.bounds_max - v.bounds_min;
+    double h = std::max(ext.x, std::max(ext.y, ext.z)) / v.resolution;
+    double margin = (3.0 * v.smoothing_voxels + 1.0) * h;
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      double closest = 1e300;
+      for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side)
+          for (int a = 0; a <= 24; ++a)
+            for (int b = 0; b <= 24; ++b) {
+              glm::dvec3 q;
+              q[axis] = side ? v.bounds_max[axis] : v.bounds_min[axis];
+              q[(axis + 1) % 3] = v.bounds_min[(axis + 1) % 3] + ext[(axis + 1) % 3] * a / 24.0;
+              q[(axis + 2) % 3] = v.bounds_min[(axis + 2) % 3] + ext[(axis + 2) % 3] * b / 24.0;
+              closest = std::min(closest, scene.objects[i].shape.signedDistance(q));
+            }
+      if (closest < margin)
+        scene.warnings.push_back(file + ": /objects/" + std::to_string(i) + ": the object comes within " +
+                                 fmt(std::max(closest, 0.0)) + " mm of the volume's boundary (smoothing reach " +
+                                 fmt(margin) + " mm); rays leaving through it are not refracted there");
+    }
+  }
+
   if (auto ls = root.get("lights")) {
     if (!ls->isArray()) ls->fail("expected an array of lights");
     for (size_t i = 0; i < ls->size(); ++i) {
