@@ -10,6 +10,7 @@
 namespace eikon::gpu {
 using vec4 = glm::vec4;
 using ivec4 = glm::ivec4;
+using uvec4 = glm::uvec4;
 #endif
 
 #define EIKON_WG_X 8
@@ -105,6 +106,18 @@ struct TraceResult {
 #define EIKON_WB_MEDIUM 4
 #define EIKON_WB_PATCHES 5
 #define EIKON_WB_SPLAT 6
+#define EIKON_WB_PATCHES_B 7  // second patch list (ping-pong with EIKON_WB_PATCHES)
+#define EIKON_WB_SCAN 8       // uint per patch: output count, then its exclusive prefix sum (scan.comp)
+#define EIKON_WB_TALLY 9      // one WaveTally per workgroup of the count pass
+// wavefront.comp passes (WavePush.control.y).
+#define EIKON_WM_PROPAGATE 0     // advance ALIVE patches by up to steps_per_dispatch steps
+#define EIKON_WM_COUNT 1         // scan[i] = 0 (dead / out of steps), 1 (keep), 4 (split); tally per workgroup
+#define EIKON_WM_COUNT_SPLITS 2  // scan[i] = 1 if the patch asks for a split (its rank after the scan)
+#define EIKON_WM_COUNT_BUDGET 3  // scan[i] as COUNT, but only splits of rank < control.z are granted
+#define EIKON_WM_SCATTER 4       // write survivors and children to the other list at scan[i]
+// Scan (scan.comp): a block of EIKON_SCAN_WG threads scans 2·EIKON_SCAN_WG elements in shared memory.
+#define EIKON_SCAN_WG 256
+#define EIKON_SCAN_BLOCK 512
 // WavePatch.state.x: what the kernel decided for the patch.
 #define EIKON_PATCH_ALIVE 0     // still propagating (or out of steps: state.w == max_steps)
 #define EIKON_PATCH_SPLIT 1     // alive, stopped because an edge exceeds the split span
@@ -123,7 +136,29 @@ struct WaveParams {
   ivec4 grid_dims;   // xyz: voxels per axis; w: flags (EIKON_F_DISPERSIVE | _ATTENUATION | _OPACITY)
   vec4 step;         // x: dt (mm); y: split edge (mm); z: min energy fraction; w: 1/h³
   vec4 wavelength;   // x: λ (µm); y: 1/λ²; z: 1/λ⁴; w: splat scale (fixed-point units per W/mm²)
-  ivec4 control;     // x: patches in the buffer; y: steps per dispatch; z: max_steps; w: unused
+  ivec4 control;     // x: unused (see WavePush); y: steps per dispatch; z: max_steps; w: unused
+};
+
+// Push constants of wavefront.comp. control: x: patches in the source list; y: pass (EIKON_WM_*);
+// z: granted splits (COUNT_BUDGET) or the scan's total slot (SCATTER); w: bit 0: the source list
+// is EIKON_WB_PATCHES_B (the destination of SCATTER is the other one).
+struct WavePush {
+  uvec4 control;
+};
+
+// Push constants of scan.comp. x: first element of the level; y: elements; z: where block b's sum
+// goes (pass 0) or comes from (pass 1): element z + b; w: pass (0: scan blocks, 1: add block sums).
+struct ScanPush {
+  uvec4 control;
+};
+
+// Per-workgroup sums of the COUNT pass (the host adds them in double): what ended where.
+struct WaveTally {
+  vec4 flux_a;    // flux of patches killed: left, caustic, energy, opaque
+  vec4 flux_b;    // x: absorbed by attenuation in the last dispatch (Σ flux.w); y: flux live at max_steps
+  vec4 caustic_sum;  // xyz: Σ flux·centre of caustic kills
+  uvec4 count_a;  // kills: left, caustic, energy, opaque
+  uvec4 count_b;  // x: live at max_steps; y: patches asking for a split; z: survivors (count ≥ 1); w: max steps
 };
 
 // One patch: four corners in bilinear order (0,0), (1,0), (1,1), (0,1).
@@ -137,6 +172,8 @@ struct WavePatch {
 #ifdef __cplusplus
 static_assert(sizeof(ViewParams) == 15 * 16, "ViewParams must be vec4-packed");
 static_assert(sizeof(TraceRay) == 32 && sizeof(TraceResult) == 64, "trace records must be vec4-packed");
+static_assert(sizeof(WavePush) == 16 && sizeof(ScanPush) == 16 && sizeof(WaveTally) == 5 * 16,
+              "wavefront push/tally records must be vec4-packed");
 static_assert(sizeof(WaveParams) == 6 * 16 && sizeof(WavePatch) == 10 * 16, "wavefront records must be vec4-packed");
 }  // namespace eikon::gpu
 #endif

@@ -8,10 +8,20 @@
 // when dispersive, B, C) field exactly as march.glsl / VolumeField do. Per step, in the order of
 // the reference: flux ← flux·exp(−σΔs) (σ at the step midpoint of the centre path), splat of
 // flux_mid·Δs/h³ into the voxel holding the midpoint, then the kills (opaque, left, caustic,
-// energy) and the split test. A patch that needs a split stops there with state EIKON_PATCH_SPLIT;
-// the host splits it and launches the children in the next dispatch (so a patch never runs ahead
-// of a split it needs; patches are independent, so they need not share the same clock between
+// energy) and the split test. A patch that needs a split stops there with state EIKON_PATCH_SPLIT
+// and the list is rebuilt on the GPU before the next propagation (so a patch never runs ahead of
+// a split it needs; patches are independent, so they need not share the same clock between
 // dispatches — each carries its own step count in state.w).
+//
+// The list rebuild between propagations (see docs/light-simulator.md, "List rebuild"):
+//   COUNT (wavefront_count.comp): scan[i] = 0 (killed, or out of steps), 1 (keep) or 4 (split one
+//     level), and the workgroup's kill statistics into tally[group]; COUNT_SPLITS / COUNT_BUDGET
+//     only when the total exceeds max_patches (rank the split requests, grant the first ones);
+//   scan.comp turns scan[] into exclusive offsets and writes the total;
+//   SCATTER (this shader, push constant control.y): survivors and the four children (bilinear 3×3
+//     lattice, new w rescaled to the float n(x), ¼ flux and area0 each) go to the other list at
+//     their offset; a child whose edge still exceeds the split span is written as SPLIT and is
+//     split again by the next rebuild without propagating (the reference's recursive split).
 //
 // Splat: GLSL float atomics (GL_EXT_shader_atomic_float) are not available everywhere (lavapipe),
 // so the Accumulate sums are signed 64-bit fixed point held as (lo, hi) uint pairs: lo by
@@ -29,8 +39,30 @@ layout(binding = EIKON_WB_INDEX_A, rgba32f) readonly uniform image3D idxA;
 layout(binding = EIKON_WB_INDEX_B, rgba32f) readonly uniform image3D idxB;
 layout(binding = EIKON_WB_INDEX_C, rgba32f) readonly uniform image3D idxC;
 layout(binding = EIKON_WB_MEDIUM, rgba32f) readonly uniform image3D medium;
-layout(std430, binding = EIKON_WB_PATCHES) buffer PatchBuf { WavePatch patches[]; };
+layout(std430, binding = EIKON_WB_PATCHES) buffer PatchBuf { WavePatch patchesA[]; };
+layout(std430, binding = EIKON_WB_PATCHES_B) buffer PatchBufB { WavePatch patchesB[]; };
 layout(std430, binding = EIKON_WB_SPLAT) buffer SplatBuf { uint splat[]; };
+layout(std430, binding = EIKON_WB_SCAN) readonly buffer ScanBuf { uint scan[]; };
+layout(push_constant) uniform PushBlock { WavePush pc; };
+
+// The source list is A or B (control.w bit 0); SCATTER writes the other one.
+bool sourceIsB() { return (pc.control.w & 1u) != 0u; }
+WavePatch loadPatch(uint i) {
+  if (sourceIsB()) return patchesB[i];
+  return patchesA[i];
+}
+void storePatch(uint i, WavePatch p) {
+  if (sourceIsB())
+    patchesB[i] = p;
+  else
+    patchesA[i] = p;
+}
+void storeOther(uint i, WavePatch p) {
+  if (sourceIsB())
+    patchesA[i] = p;
+  else
+    patchesB[i] = p;
+}
 
 bool hasFlag(int f) { return (P.grid_dims.w & f) != 0; }
 
@@ -150,13 +182,18 @@ void splatAt(vec3 m, float value, float irr, vec3 dir) {
 
 vec3 centreOf(vec3 x[4]) { return 0.25 * (x[0] + x[1] + x[2] + x[3]); }
 
-void main() {
-  uint id = gl_GlobalInvocationID.x;
-  if (id >= uint(P.control.x)) return;
-  WavePatch p = patches[id];
+float maxEdgeOf(vec3 x[4]) {
+  float e = 0.0;
+  for (int k = 0; k < 4; ++k) e = max(e, length(x[(k + 1) % 4] - x[k]));
+  return e;
+}
+
+void propagate(uint id) {
+  if (id >= pc.control.x) return;
+  WavePatch p = loadPatch(id);
   p.flux.w = 0.0;
   if (p.state.x != EIKON_PATCH_ALIVE) {
-    patches[id] = p;
+    storePatch(id, p);
     return;
   }
   vec3 x[4], w[4];
@@ -200,9 +237,7 @@ void main() {
       p.state.x = EIKON_PATCH_ENERGY;
       break;
     }
-    float e = 0.0;
-    for (int k = 0; k < 4; ++k) e = max(e, length(x[(k + 1) % 4] - x[k]));
-    if (e > maxEdge) {
+    if (maxEdgeOf(x) > maxEdge) {
       p.state.x = EIKON_PATCH_SPLIT;
       break;
     }
@@ -211,5 +246,58 @@ void main() {
     p.x[k] = vec4(x[k], 0.0);
     p.w[k] = vec4(w[k], 0.0);
   }
-  patches[id] = p;
+  storePatch(id, p);
+}
+
+// ---- list rebuild (the COUNT* passes are in wavefront_count.comp, so that this shader carries no
+// barrier: llvmpipe implements barriers with coroutines) ----
+void scatter(uint id) {
+  const uint n = pc.control.x;
+  if (id >= n) return;
+  const uint o = scan[id], next = id + 1u < n ? scan[id + 1u] : scan[pc.control.z];
+  if (next == o) return;
+  WavePatch p = loadPatch(id);
+  p.flux.w = 0.0;
+  if (next - o == 1u) {  // kept (a refused split goes on unsplit, as in the reference)
+    p.state.x = EIKON_PATCH_ALIVE;
+    storeOther(o, p);
+    return;
+  }
+  // Four children on the bilinear 3×3 lattice; the parent's corners are kept exactly.
+  vec3 X[9], W[9];
+  for (int b = 0; b < 3; ++b)
+    for (int a = 0; a < 3; ++a) {
+      const float fa = 0.5 * float(a), fb = 0.5 * float(b);
+      const float w0 = (1.0 - fa) * (1.0 - fb), w1 = fa * (1.0 - fb), w2 = fa * fb, w3 = (1.0 - fa) * fb;
+      X[b * 3 + a] = w0 * p.x[0].xyz + w1 * p.x[1].xyz + w2 * p.x[2].xyz + w3 * p.x[3].xyz;
+      vec3 ww = w0 * p.w[0].xyz + w1 * p.w[1].xyz + w2 * p.w[2].xyz + w3 * p.w[3].xyz;
+      if (a == 1 || b == 1) ww = normalize(ww) * sampleIndex(X[b * 3 + a]).x;
+      W[b * 3 + a] = ww;
+    }
+  X[0] = p.x[0].xyz, X[2] = p.x[1].xyz, X[8] = p.x[2].xyz, X[6] = p.x[3].xyz;
+  W[0] = p.w[0].xyz, W[2] = p.w[1].xyz, W[8] = p.w[2].xyz, W[6] = p.w[3].xyz;
+  const float maxEdge = P.step.y;
+  for (int cb = 0; cb < 2; ++cb)
+    for (int ca = 0; ca < 2; ++ca) {
+      WavePatch c = p;
+      const int pa[4] = int[4](ca, ca + 1, ca + 1, ca), pb[4] = int[4](cb, cb, cb + 1, cb + 1);
+      vec3 cx[4];
+      for (int k = 0; k < 4; ++k) {
+        cx[k] = X[pb[k] * 3 + pa[k]];
+        c.x[k] = vec4(cx[k], 0.0);
+        c.w[k] = vec4(W[pb[k] * 3 + pa[k]], 0.0);
+      }
+      c.flux.x = 0.25 * p.flux.x;
+      c.flux.y = 0.25 * p.flux.y;
+      c.state.x = maxEdgeOf(cx) > maxEdge ? EIKON_PATCH_SPLIT : EIKON_PATCH_ALIVE;
+      storeOther(o + uint(cb * 2 + ca), c);
+    }
+}
+
+void main() {
+  const uint id = gl_GlobalInvocationID.x, mode = pc.control.y;
+  if (mode == EIKON_WM_PROPAGATE)
+    propagate(id);
+  else if (mode == EIKON_WM_SCATTER)
+    scatter(id);
 }

@@ -11,9 +11,91 @@
 #include "core/reference/reference_marcher.h"
 #include "core/vk/resources.h"
 #include "shaders/eikon_shared.h"
+#include "shaders/scan.spv.h"
 #include "shaders/wavefront.spv.h"
+#include "shaders/wavefront_count.spv.h"
 
 namespace eikon {
+
+namespace {
+
+/// Compute → compute memory dependency between two dispatches of one command buffer.
+void computeBarrier(VkCommandBuffer c) {
+  VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT,
+                     VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT};
+  vkCmdPipelineBarrier(c, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0,
+                       nullptr, 0, nullptr);
+}
+
+uint32_t blocksOf(size_t n) { return uint32_t((n + EIKON_SCAN_BLOCK - 1) / EIKON_SCAN_BLOCK); }
+
+/// The multi-level exclusive scan of shaders/scan.comp over one buffer: level 0 holds the n
+/// values at word 0, each further level the block totals of the one below, right after it; the
+/// single block of the top level writes the grand total to `total_slot`.
+struct ScanKernel {
+  vk::ComputePipeline pipe;
+  explicit ScanKernel(vk::Context& ctx)
+      : pipe(ctx, std::span<const uint32_t>(k_scan_spv, sizeof(k_scan_spv) / 4), {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
+             sizeof(gpu::ScanPush), "scan") {}
+  /// Words a buffer needs to scan up to n values: the levels plus the total slot (the last word).
+  static size_t words(size_t n) {
+    size_t w = 1;
+    for (size_t m = std::max<size_t>(n, 1);; m = blocksOf(m)) {
+      w += m;
+      if (blocksOf(m) == 1) break;
+    }
+    return w;
+  }
+  void bind(const vk::Buffer& b) { pipe.bindBuffer(0, b); }
+  /// Record the scan of the first n (≥ 1) words in place; the total goes to word total_slot.
+  void record(VkCommandBuffer c, uint32_t n, uint32_t total_slot) const {
+    struct Level {
+      uint32_t off, n;
+    };
+    std::vector<Level> lv{{0, n}};
+    while (blocksOf(lv.back().n) > 1) lv.push_back({lv.back().off + lv.back().n, blocksOf(lv.back().n)});
+    for (size_t l = 0; l < lv.size(); ++l) {
+      const uint32_t sums = l + 1 < lv.size() ? lv[l + 1].off : total_slot;
+      gpu::ScanPush push{glm::uvec4(lv[l].off, lv[l].n, sums, 0u)};
+      pipe.dispatch(c, blocksOf(lv[l].n), 1, 1, &push);
+      computeBarrier(c);
+    }
+    for (size_t l = lv.size() - 1; l-- > 0;) {
+      gpu::ScanPush push{glm::uvec4(lv[l].off, lv[l].n, lv[l + 1].off, 1u)};
+      pipe.dispatch(c, blocksOf(lv[l].n), 1, 1, &push);
+      computeBarrier(c);
+    }
+  }
+};
+
+}  // namespace
+
+struct GpuScan::Impl {
+  vk::Context& ctx;
+  ScanKernel kernel;
+  vk::Buffer buf;
+  explicit Impl(vk::Context& c) : ctx(c), kernel(c) {}
+};
+
+GpuScan::GpuScan(vk::Context& ctx) : impl_(std::make_unique<Impl>(ctx)) {}
+GpuScan::~GpuScan() = default;
+
+uint32_t GpuScan::exclusiveScan(std::vector<uint32_t>& values) {
+  if (values.empty()) return 0;
+  Impl& m = *impl_;
+  const size_t words = ScanKernel::words(values.size());
+  if (m.buf.handle() == VK_NULL_HANDLE || m.buf.size() < words * sizeof(uint32_t)) {
+    m.buf = vk::Buffer(m.ctx, words * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "scan test");
+    m.kernel.bind(m.buf);
+  }
+  m.buf.write(values.data(), values.size() * sizeof(uint32_t));
+  const uint32_t slot = uint32_t(words - 1);
+  m.ctx.submitAndWait([&](VkCommandBuffer c) { m.kernel.record(c, uint32_t(values.size()), slot); });
+  m.buf.read(values.data(), values.size() * sizeof(uint32_t));
+  uint32_t total = 0;
+  m.buf.read(&total, sizeof total, slot * sizeof(uint32_t));
+  return total;
+}
 
 struct GpuWavefront::Impl {
   vk::Context& ctx;
@@ -22,14 +104,17 @@ struct GpuWavefront::Impl {
   int steps_per_dispatch;
   VolumeField field;
   std::vector<vk::Image3D> images;  // A, B, C (B, C only when dispersive), medium
-  vk::Buffer params, splat, patches;
-  vk::ComputePipeline pipe;
+  vk::Buffer params, splat, patches[2], scan, tally;
+  vk::ComputePipeline pipe, countPipe;  // wavefront.comp (propagate, scatter), wavefront_count.comp
+  ScanKernel scanner;
+  size_t list_cap = 0;  // patches the scan and tally buffers hold
   double il2 = 0, il4 = 0, n_min = 1.0;
 
   Impl(vk::Context& c, const VolumeSet& v, WavefrontSettings settings, int k)
-      : ctx(c), vol(v), s(settings), steps_per_dispatch(k), field(v) {
+      : ctx(c), vol(v), s(settings), steps_per_dispatch(k), field(v), scanner(c) {
     const Grid& g = vol.grid;
     if (k < 1) throw std::invalid_argument("wavefront: steps_per_dispatch must be >= 1");
+    if (s.max_patches < 1) throw std::invalid_argument("wavefront: max_patches must be >= 1");
     if (!(g.h > 0) || g.count() == 0) throw std::invalid_argument("wavefront: empty volume");
     if (s.dt <= 0) s.dt = 0.5 * g.h;
     if (!(s.wavelength_nm > 0)) throw std::invalid_argument("wavefront: wavelength must be > 0");
@@ -64,10 +149,11 @@ struct GpuWavefront::Impl {
     for (uint32_t i : {uint32_t(EIKON_WB_INDEX_A), uint32_t(EIKON_WB_INDEX_B), uint32_t(EIKON_WB_INDEX_C),
                        uint32_t(EIKON_WB_MEDIUM)})
       b.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t i : {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_SPLAT)})
+    for (uint32_t i : {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_SPLAT),
+                       uint32_t(EIKON_WB_PATCHES_B), uint32_t(EIKON_WB_SCAN), uint32_t(EIKON_WB_TALLY)})
       b.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    pipe = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_wavefront_spv, sizeof(k_wavefront_spv) / 4), b, 0,
-                               "wavefront");
+    pipe = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_wavefront_spv, sizeof(k_wavefront_spv) / 4), b,
+                               sizeof(gpu::WavePush), "wavefront");
     const size_t med = vol.dispersive ? 3 : 1;
     pipe.bindImage(EIKON_WB_INDEX_A, images[0]);
     pipe.bindImage(EIKON_WB_INDEX_B, images[vol.dispersive ? 1 : 0]);
@@ -75,18 +161,48 @@ struct GpuWavefront::Impl {
     pipe.bindImage(EIKON_WB_MEDIUM, images[med]);
     pipe.bindBuffer(EIKON_WB_PARAMS, params);
     pipe.bindBuffer(EIKON_WB_SPLAT, splat);
+    std::vector<vk::BindingSpec> cb;
+    for (uint32_t i : {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_PATCHES_B),
+                       uint32_t(EIKON_WB_SCAN), uint32_t(EIKON_WB_TALLY)})
+      cb.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    countPipe = vk::ComputePipeline(
+        ctx, std::span<const uint32_t>(k_wavefront_count_spv, sizeof(k_wavefront_count_spv) / 4), cb,
+        sizeof(gpu::WavePush), "wavefront count");
+    countPipe.bindBuffer(EIKON_WB_PARAMS, params);
   }
 
-  void ensurePatchCapacity(size_t n) {
+  // Patch list `which` (0: EIKON_WB_PATCHES, 1: _B) holds at least n patches. Only called between
+  // submissions, and never for the list a pending scatter reads.
+  void ensurePatchCapacity(int which, size_t n) {
+    vk::Buffer& buf = patches[which];
     const VkDeviceSize bytes = std::max<size_t>(n, 64) * sizeof(gpu::WavePatch);
-    if (patches.handle() != VK_NULL_HANDLE && patches.size() >= bytes) return;
+    if (buf.handle() != VK_NULL_HANDLE && buf.size() >= bytes) return;
     // Grow geometrically, but never past the storage-buffer range when the request itself fits
     // (vk::Buffer refuses larger requests with a message: lavapipe allows 128 MiB ≈ 838k patches).
     const VkDeviceSize range = ctx.limits().max_storage_buffer_range;
-    const VkDeviceSize grown = std::max<VkDeviceSize>(bytes, std::min<VkDeviceSize>(2 * patches.size(), range));
-    patches = vk::Buffer(ctx, grown, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront patches");
-    pipe.bindBuffer(EIKON_WB_PATCHES, patches);
+    const VkDeviceSize grown = std::max<VkDeviceSize>(bytes, std::min<VkDeviceSize>(2 * buf.size(), range));
+    buf = vk::Buffer(ctx, grown, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, which ? "wavefront patches B" : "wavefront patches A");
+    pipe.bindBuffer(which ? EIKON_WB_PATCHES_B : EIKON_WB_PATCHES, buf);
+    countPipe.bindBuffer(which ? EIKON_WB_PATCHES_B : EIKON_WB_PATCHES, buf);
   }
+
+  // The scan and tally buffers hold any list of this run: the list never exceeds
+  // max(seeds, max_patches) patches (the budget is applied before a list is written), nor what
+  // one storage buffer can hold.
+  void ensureListCapacity(size_t n) {
+    if (n <= list_cap) return;
+    scan = vk::Buffer(ctx, ScanKernel::words(n) * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                      "wavefront scan");
+    tally = vk::Buffer(ctx, ((n + EIKON_WAVE_WG - 1) / EIKON_WAVE_WG) * sizeof(gpu::WaveTally),
+                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront tally");
+    pipe.bindBuffer(EIKON_WB_SCAN, scan);
+    pipe.bindBuffer(EIKON_WB_TALLY, tally);
+    countPipe.bindBuffer(EIKON_WB_SCAN, scan);
+    countPipe.bindBuffer(EIKON_WB_TALLY, tally);
+    scanner.bind(scan);
+    list_cap = n;
+  }
+  uint32_t totalSlot() const { return uint32_t(ScanKernel::words(list_cap) - 1); }
 
   static gpu::WavePatch toGpu(const Patch& p) {
     gpu::WavePatch g{};
@@ -99,60 +215,23 @@ struct GpuWavefront::Impl {
     return g;
   }
 
-  // Split p (stopped by the kernel with EIKON_PATCH_SPLIT) into children on the bilinear 3×3
-  // lattice, recursively until no edge exceeds the split span or the budget is spent — the same
-  // rule as WavefrontSimulator::run's emit, in double from the float state.
-  void emit(const gpu::WavePatch& p0, std::vector<gpu::WavePatch>& out, size_t& live, WavefrontStats& st) const {
-    const double maxEdge = s.split_span_voxels * vol.grid.h;
-    std::vector<gpu::WavePatch> work{p0};
-    while (!work.empty()) {
-      gpu::WavePatch p = work.back();
-      work.pop_back();
-      p.state.x = EIKON_PATCH_ALIVE;
-      glm::dvec3 x[4], w[4];
-      for (int k = 0; k < 4; ++k) x[k] = glm::dvec3(p.x[k]), w[k] = glm::dvec3(p.w[k]);
-      double e = 0;
-      for (int k = 0; k < 4; ++k) e = std::max(e, glm::length(x[(k + 1) % 4] - x[k]));
-      if (e <= maxEdge) {
-        out.push_back(p);
-        continue;
-      }
-      if (live + 3 > size_t(s.max_patches)) {
-        ++st.splits_refused;
-        out.push_back(p);
-        continue;
-      }
-      live += 3;
-      ++st.splits;
-      glm::dvec3 X[3][3], W[3][3];
-      for (int b = 0; b < 3; ++b)
-        for (int a = 0; a < 3; ++a) {
-          const double fa = 0.5 * a, fb = 0.5 * b;
-          X[b][a] = (1 - fa) * (1 - fb) * x[0] + fa * (1 - fb) * x[1] + fa * fb * x[2] + (1 - fa) * fb * x[3];
-          glm::dvec3 ww = (1 - fa) * (1 - fb) * w[0] + fa * (1 - fb) * w[1] + fa * fb * w[2] + (1 - fa) * fb * w[3];
-          if (a == 1 || b == 1) {
-            double n;
-            glm::dvec3 g;
-            field.index(X[b][a], il2, il4, n, g);
-            ww = glm::normalize(ww) * n;
-          }
-          W[b][a] = ww;
-        }
-      X[0][0] = x[0], X[0][2] = x[1], X[2][2] = x[2], X[2][0] = x[3];
-      W[0][0] = w[0], W[0][2] = w[1], W[2][2] = w[2], W[2][0] = w[3];
-      for (int cb = 0; cb < 2; ++cb)
-        for (int ca = 0; ca < 2; ++ca) {
-          gpu::WavePatch c = p;
-          const int pa[4] = {ca, ca + 1, ca + 1, ca}, pb[4] = {cb, cb, cb + 1, cb + 1};
-          for (int k = 0; k < 4; ++k) {
-            c.x[k] = glm::vec4(glm::vec3(X[pb[k]][pa[k]]), 0.0f);
-            c.w[k] = glm::vec4(glm::vec3(W[pb[k]][pa[k]]), 0.0f);
-          }
-          c.flux.x = 0.25f * p.flux.x;
-          c.flux.y = 0.25f * p.flux.y;
-          work.push_back(c);
-        }
-    }
+  static uint32_t groups(size_t n) { return uint32_t((n + EIKON_WAVE_WG - 1) / EIKON_WAVE_WG); }
+  void pass(VkCommandBuffer c, uint32_t mode, uint32_t n, int src, uint32_t z = 0) const {
+    gpu::WavePush push{glm::uvec4(n, mode, z, uint32_t(src))};
+    const bool count = mode != EIKON_WM_PROPAGATE && mode != EIKON_WM_SCATTER;
+    (count ? countPipe : pipe).dispatch(c, groups(n), 1, 1, &push);
+    computeBarrier(c);
+  }
+  // Propagate list `src` (n patches), count its outputs with the kill tallies, scan the counts.
+  void recordStep(VkCommandBuffer c, uint32_t n, int src) const {
+    pass(c, EIKON_WM_PROPAGATE, n, src);
+    pass(c, EIKON_WM_COUNT, n, src);
+    scanner.record(c, n, totalSlot());
+  }
+  uint32_t readTotal() const {
+    uint32_t t = 0;
+    scan.read(&t, sizeof t, VkDeviceSize(totalSlot()) * sizeof(uint32_t));
+    return t;
   }
 
   WavefrontResult run(const Light& light) {
@@ -195,54 +274,72 @@ struct GpuWavefront::Impl {
     P.step = glm::vec4(float(s.dt), float(s.split_span_voxels * g.h), float(s.min_energy_fraction), float(1.0 / h3));
     const double l = s.wavelength_nm * 1e-3;
     P.wavelength = glm::vec4(float(l), float(il2), float(il4), float(scale));
+    P.control = glm::ivec4(0, steps_per_dispatch, s.max_steps, 0);
+    params.write(&P, sizeof P);
     std::vector<uint32_t> zero(g.count() * (EIKON_SPLAT_ACC_WORDS + 1), 0u);
     splat.write(zero.data(), zero.size() * sizeof(uint32_t));
 
-    size_t live = cur.size();
-    std::vector<gpu::WavePatch> next;
-    while (!cur.empty()) {
-      ensurePatchCapacity(cur.size());
-      patches.write(cur.data(), cur.size() * sizeof(gpu::WavePatch));
-      P.control = glm::ivec4(int(cur.size()), steps_per_dispatch, s.max_steps, 0);
-      params.write(&P, sizeof P);
-      ctx.submitAndWait([&](VkCommandBuffer c) {
-        pipe.dispatch(c, uint32_t((cur.size() + EIKON_WAVE_WG - 1) / EIKON_WAVE_WG), 1, 1, nullptr);
-      });
-      patches.read(cur.data(), cur.size() * sizeof(gpu::WavePatch));
-      // Host compaction and splits (the GPU scan is the remaining step, see the docs).
-      next.clear();
-      for (const gpu::WavePatch& p : cur) {
-        st.steps = std::max(st.steps, p.state.w);
-        st.flux_absorbed += p.flux.w;
-        const double energy = p.flux.x;
-        const glm::dvec3 c1 = 0.25 * glm::dvec3(p.x[0] + p.x[1] + p.x[2] + p.x[3]);
-        switch (p.state.x) {
-          case EIKON_PATCH_OPAQUE:
-            ++st.kills_opaque, st.flux_absorbed += energy, --live;
-            break;
-          case EIKON_PATCH_LEFT:
-            ++st.kills_left, st.flux_left += energy, --live;
-            break;
-          case EIKON_PATCH_CAUSTIC:
-            ++st.kills_caustic, st.flux_caustic += energy, st.caustic_centroid += energy * c1, --live;
-            break;
-          case EIKON_PATCH_ENERGY:
-            ++st.kills_energy, st.flux_energy += energy, --live;
-            break;
-          case EIKON_PATCH_SPLIT:
-            emit(p, next, live, st);
-            break;
-          default:
-            if (p.state.w >= s.max_steps) {
-              ++st.live_at_end, st.flux_live_at_end += energy;  // out of steps: ends live
-              --live;
-            } else {
-              next.push_back(p);
-            }
-        }
+    // The list lives on the GPU. Per pass, one submission: scatter of the previous pass's list
+    // (survivors and children, into the other buffer), propagation, count, scan; the host reads
+    // back the scan total and one WaveTally per 64 patches. Only when the total exceeds
+    // max_patches is there a second submission (rank the split requests, grant the first ones).
+    const size_t budget = size_t(s.max_patches);
+    uint32_t n = uint32_t(cur.size());
+    int src = 0;
+    if (n > 0) {
+      // A list longer than the storage-buffer range allows cannot exist (ensurePatchCapacity throws).
+      const size_t fits = size_t(ctx.limits().max_storage_buffer_range / sizeof(gpu::WavePatch));
+      ensureListCapacity(std::max(cur.size(), std::min(budget, fits)));
+      ensurePatchCapacity(0, n);
+      ensurePatchCapacity(1, n);  // every binding must be valid from the first dispatch on
+      patches[0].write(cur.data(), cur.size() * sizeof(gpu::WavePatch));
+      ctx.submitAndWait([&](VkCommandBuffer c) { recordStep(c, n, src); });
+    }
+    std::vector<gpu::WaveTally> tallies;
+    while (n > 0) {
+      tallies.resize(groups(n));
+      tally.read(tallies.data(), tallies.size() * sizeof(gpu::WaveTally));
+      size_t survivors = 0, wantSplit = 0;
+      for (const gpu::WaveTally& t : tallies) {
+        st.flux_left += t.flux_a.x, st.flux_caustic += t.flux_a.y, st.flux_energy += t.flux_a.z;
+        st.flux_absorbed += double(t.flux_a.w) + double(t.flux_b.x);
+        st.flux_live_at_end += t.flux_b.y;
+        st.caustic_centroid += glm::dvec3(glm::vec3(t.caustic_sum));
+        st.kills_left += t.count_a.x, st.kills_caustic += t.count_a.y, st.kills_energy += t.count_a.z;
+        st.kills_opaque += t.count_a.w;
+        st.live_at_end += t.count_b.x;
+        wantSplit += t.count_b.y;
+        survivors += t.count_b.z;
+        st.steps = std::max(st.steps, int(t.count_b.w));
       }
-      st.max_live = std::max(st.max_live, live);
-      std::swap(cur, next);
+      uint32_t total = readTotal();
+      if (total > budget) {
+        // The reference refuses a split when live + 3 > max_patches, in list order. Here: grant
+        // the first `granted` requests of the list (rank by a scan of 0/1 flags), counting the
+        // survivors of this pass as live.
+        const size_t granted = survivors >= budget ? 0 : std::min(wantSplit, (budget - survivors) / 3);
+        ctx.submitAndWait([&](VkCommandBuffer c) {
+          pass(c, EIKON_WM_COUNT_SPLITS, n, src);
+          scanner.record(c, n, totalSlot());
+          pass(c, EIKON_WM_COUNT_BUDGET, n, src, uint32_t(granted));
+          scanner.record(c, n, totalSlot());
+        });
+        total = readTotal();
+        st.splits += granted;
+        st.splits_refused += wantSplit - granted;
+      } else {
+        st.splits += wantSplit;
+      }
+      st.max_live = std::max<size_t>(st.max_live, total);
+      if (total == 0) break;
+      const int dst = 1 - src;
+      ensurePatchCapacity(dst, total);
+      ctx.submitAndWait([&](VkCommandBuffer c) {
+        pass(c, EIKON_WM_SCATTER, n, src, totalSlot());
+        recordStep(c, total, dst);
+      });
+      n = total;
+      src = dst;
     }
     if (st.flux_caustic > 0) st.caustic_centroid /= st.flux_caustic;
 

@@ -8,26 +8,48 @@
 //   eikon::GpuWavefront gpu(ctx, vol, settings);
 //   eikon::WavefrontResult r = gpu.run(scene.lights[0]);   // r.irradiance in W/mm², r.stats
 //
-// What differs from the reference: the kernel runs in float32; the splits and the compaction of
-// the patch list are done on the host between dispatches (each dispatch advances every live patch
-// by up to `steps_per_dispatch` steps; a patch that needs a split stops and waits for the host);
-// the probe plane (stats.flux_probe, flux_ended_before_probe) is not computed; stats.max_live is
-// the largest live count seen at the host's sync points (the reference counts within a step).
+// What differs from the reference: the kernel runs in float32, the splits included; the patch
+// list stays on the GPU and is rebuilt between dispatches by a count / exclusive scan / scatter
+// into a second buffer (each dispatch advances every live patch by up to `steps_per_dispatch`
+// steps; a patch that needs a split stops, is split one level by the rebuild, and children still
+// too large are split again by the next rebuild before they move); the host reads back only the
+// scan total and per-workgroup kill tallies; the probe plane (stats.flux_probe,
+// flux_ended_before_probe) is not computed; stats.max_live is the largest list length after a
+// rebuild (the reference counts within a step).
 // Common mistakes: expecting bit-identical stats — float32 may move a borderline kill or split by
-// a step; expecting identical stats when splits are refused (the patch budget is checked at sync
-// points, so which splits are refused depends on steps_per_dispatch); forgetting the buffer
-// limits — live patches take 160 B each and the splat 36 B per voxel, each buffer within the
-// device's storage-buffer range (lavapipe: 128 MiB ≈ 838k live patches, 3.7M voxels; run() and
-// the constructor throw with a message beyond that, so lower max_patches or the resolution).
+// a step; expecting identical stats when splits are refused (the budget is applied per rebuild
+// against that rebuild's survivors, so which splits are refused depends on steps_per_dispatch);
+// forgetting the buffer limits — live patches take 160 B each (two lists) and the splat 36 B per
+// voxel, each buffer within the device's storage-buffer range (lavapipe: 128 MiB ≈ 838k live
+// patches, 3.7M voxels; run() and the constructor throw with a message beyond that, so lower
+// max_patches or the resolution).
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "core/reference/wavefront.h"
 #include "core/vk/context.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {
+
+/// Exclusive prefix sum of uint32 values on the GPU (shaders/scan.comp, the scan GpuWavefront
+/// uses to rebuild its patch list); exposed for tests and measurements. Sums wrap modulo 2^32.
+class GpuScan {
+ public:
+  explicit GpuScan(vk::Context& ctx);
+  ~GpuScan();
+  GpuScan(const GpuScan&) = delete;
+  GpuScan& operator=(const GpuScan&) = delete;
+  /// Replace values[i] by the sum of values[0..i); returns the sum of all of them.
+  uint32_t exclusiveScan(std::vector<uint32_t>& values);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 class GpuWavefront {
  public:

@@ -1,7 +1,8 @@
 // Light simulator, GPU kernel (shaders/wavefront.comp via GpuWavefront) against the double-precision
 // CPU reference (core/reference/wavefront.h): same seeds, same kill/split statistics, flux
 // conservation, and the splatted volumes. Both twins read the same VolumeSet (the CPU through
-// VolumeField), so every difference is float32 arithmetic and the fixed-point splat.
+// VolumeField), so every difference is float32 arithmetic (the GPU also splits in float32) and
+// the fixed-point splat. The scan of the GPU list rebuild is tested in wavefront_scan_test.cpp.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -194,10 +195,10 @@ TEST(WavefrontGpu, AbsorbingSlabMatchesReference) {
 
 
 // 4. Point light, n = 1 (the CPU test's 32³ box, h = 0.125): cube-sphere seeds, splits as the
-// front expands, everything leaves. Also the host/GPU split of the work: patches are independent
-// and the fixed-point splat is order independent, so running 1 or 16 steps per dispatch must give
-// the same kills, splits and a bit-identical volume (each patch does the same float operations;
-// only the host's sync points move). Against the CPU: 4πI leaves (float rounding of the seed
+// front expands, everything leaves. Also the dispatch/rebuild split of the work: patches are
+// independent and the fixed-point splat is order independent, so running 1 or 16 steps per
+// dispatch must give the same kills, splits and a bit-identical volume (each patch does the same
+// float operations; only the list rebuilds between dispatches move). Against the CPU: 4πI leaves (float rounding of the seed
 // flux, 1e-6), split/kill counts as in test 2 (measured: identical), volume L1 ≤ 1e-4.
 TEST(WavefrontGpu, PointLightIsIndependentOfStepsPerDispatch) {
   const double h = 0.125, I = 3.0;
@@ -238,6 +239,28 @@ TEST(WavefrontGpu, PointLightIsIndependentOfStepsPerDispatch) {
               l1 / sumC);
   EXPECT_EQ(differ, 0u);
   EXPECT_LT(l1 / sumC, 1e-4);
+  expectNoValidationMessages();
+}
+
+// 5. Patch budget on the GPU rebuild (the CPU test's max_patches = 5000 on the glass sphere): the
+// list never exceeds the budget, splits are refused, the loop ends before max_steps and flux is
+// conserved to float rounding (1e-6, as test 2). The split/refusal counts are not compared with
+// the reference: the GPU grants splits per rebuild against that rebuild's survivors, the reference
+// per patch against a running live count (docs/light-simulator.md, "List rebuild").
+TEST(WavefrontGpu, PatchBudgetHoldsOnTheGpu) {
+  const Scene scene = sceneFromJson(kSphereScene);
+  const VolumeSet vol = voxelize(scene);
+  WavefrontSettings s;
+  s.max_patches = 5000;
+  s.max_steps = 1000;
+  const WavefrontResult g = GpuWavefront(context(), vol, s).run(beam({1, 0, 0}, 1.0));
+  const WavefrontStats& st = g.stats;
+  printStats("budget gpu", st);
+  EXPECT_LE(st.max_live, size_t(s.max_patches));
+  EXPECT_GT(st.splits_refused, 0u);
+  EXPECT_LT(st.steps, s.max_steps);
+  EXPECT_EQ(st.live_at_end, 0u);
+  EXPECT_NEAR(fluxEnded(st), st.flux_emitted, 1e-6 * st.flux_emitted);
   expectNoValidationMessages();
 }
 

@@ -1,0 +1,106 @@
+#version 450
+// Count passes of the light simulator's list rebuild (see wavefront.comp and
+// docs/light-simulator.md): per patch of the source list, its number of outputs (0 dead or out of
+// steps, 1 kept, 4 split one level) into scan[i], and in the COUNT pass the workgroup's kill
+// statistics reduced in shared memory (a tree of EIKON_WAVE_WG lanes, float sums) into
+// tally[workgroup], which the host adds in double. A separate shader from wavefront.comp so that
+// the propagation shader carries no barrier (llvmpipe implements barriers with coroutines).
+#extension GL_GOOGLE_include_directive : require
+#include "eikon_shared.h"
+
+layout(local_size_x = EIKON_WAVE_WG) in;
+
+layout(std430, binding = EIKON_WB_PARAMS) readonly buffer ParamsBuf { WaveParams P; };
+layout(std430, binding = EIKON_WB_PATCHES) readonly buffer PatchBuf { WavePatch patchesA[]; };
+layout(std430, binding = EIKON_WB_PATCHES_B) readonly buffer PatchBufB { WavePatch patchesB[]; };
+layout(std430, binding = EIKON_WB_SCAN) buffer ScanBuf { uint scan[]; };
+layout(std430, binding = EIKON_WB_TALLY) writeonly buffer TallyBuf { WaveTally tally[]; };
+layout(push_constant) uniform PushBlock { WavePush pc; };
+
+WavePatch loadPatch(uint i) {
+  if ((pc.control.w & 1u) != 0u) return patchesB[i];
+  return patchesA[i];
+}
+
+shared vec4 sFluxA[EIKON_WAVE_WG], sFluxB[EIKON_WAVE_WG], sCentroid[EIKON_WAVE_WG];
+shared uvec4 sCountA[EIKON_WAVE_WG], sCountB[EIKON_WAVE_WG];
+
+void countPass(uint id, uint lid, uint mode) {
+  vec4 fa = vec4(0.0), fb = vec4(0.0), cen = vec4(0.0);
+  uvec4 ca = uvec4(0u), cb = uvec4(0u);
+  if (id < pc.control.x) {
+    WavePatch p = loadPatch(id);
+    const float e = p.flux.x;
+    uint keep = 0u;
+    bool wantSplit = false;
+    switch (p.state.x) {
+      case EIKON_PATCH_ALIVE:
+        if (p.state.w >= P.control.z) {
+          fb.y = e;  // out of steps: ends live
+          cb.x = 1u;
+        } else {
+          keep = 1u;
+        }
+        break;
+      case EIKON_PATCH_SPLIT:
+        keep = 1u;
+        wantSplit = true;
+        break;
+      case EIKON_PATCH_LEFT:
+        fa.x = e;
+        ca.x = 1u;
+        break;
+      case EIKON_PATCH_CAUSTIC:
+        fa.y = e;
+        ca.y = 1u;
+        cen.xyz = e * 0.25 * (p.x[0].xyz + p.x[1].xyz + p.x[2].xyz + p.x[3].xyz);
+        break;
+      case EIKON_PATCH_ENERGY:
+        fa.z = e;
+        ca.z = 1u;
+        break;
+      default:  // EIKON_PATCH_OPAQUE: the flux is absorbed
+        fa.w = e;
+        ca.w = 1u;
+    }
+    fb.x = p.flux.w;
+    cb.y = wantSplit ? 1u : 0u;
+    cb.z = keep;
+    cb.w = uint(max(p.state.w, 0));
+    uint c = wantSplit ? 4u : keep;
+    if (mode == EIKON_WM_COUNT_SPLITS) c = wantSplit ? 1u : 0u;
+    if (mode == EIKON_WM_COUNT_BUDGET && wantSplit) c = scan[id] < pc.control.z ? 4u : 1u;
+    scan[id] = c;
+  }
+  if (mode != EIKON_WM_COUNT) return;  // uniform: the push constant
+  sFluxA[lid] = fa;
+  sFluxB[lid] = fb;
+  sCentroid[lid] = cen;
+  sCountA[lid] = ca;
+  sCountB[lid] = cb;
+  for (uint s = EIKON_WAVE_WG / 2; s > 0u; s >>= 1) {
+    memoryBarrierShared();
+    barrier();
+    if (lid < s) {
+      sFluxA[lid] += sFluxA[lid + s];
+      sFluxB[lid] += sFluxB[lid + s];
+      sCentroid[lid] += sCentroid[lid + s];
+      sCountA[lid] += sCountA[lid + s];
+      const uvec4 o = sCountB[lid + s];
+      sCountB[lid] = uvec4(sCountB[lid].xyz + o.xyz, max(sCountB[lid].w, o.w));
+    }
+  }
+  memoryBarrierShared();
+  barrier();
+  if (lid == 0u) {
+    WaveTally t;
+    t.flux_a = sFluxA[0];
+    t.flux_b = sFluxB[0];
+    t.caustic_sum = sCentroid[0];
+    t.count_a = sCountA[0];
+    t.count_b = sCountB[0];
+    tally[gl_WorkGroupID.x] = t;
+  }
+}
+
+void main() { countPass(gl_GlobalInvocationID.x, gl_LocalInvocationID.x, pc.control.y); }
