@@ -11,18 +11,11 @@
 
 #include "core/reference/wavefront.h"
 #include "core/render/light_simulator.h"
+#include "tests/core/light_fixtures.h"
 #include "tests/core/test_support.h"
 
 namespace eikon::test {
 namespace {
-
-Light beam(glm::dvec3 d, double e) {
-  Light l;
-  l.type = Light::Type::Directional;
-  l.direction = d;
-  l.irradiance = e;
-  return l;
-}
 
 /// A uniform medium of index n on an n³ grid (no gradient, no attenuation), built by hand.
 VolumeSet uniformVolume(int dims, double h, glm::dvec3 origin, double n) {
@@ -38,14 +31,6 @@ VolumeSet uniformVolume(int dims, double h, glm::dvec3 origin, double n) {
   v.medium[0].assign(v.grid.count(), glm::vec4(0.0f));
   v.emission.assign(v.grid.count(), glm::vec4(0.0f));
   return v;
-}
-
-void printStats(const char* name, const WavefrontStats& s) {
-  std::printf(
-      "[ measured ] %s: steps %d, seeded %zu, max live %zu, splits %zu (refused %zu), kills left/caustic/energy/opaque "
-      "%zu/%zu/%zu/%zu\n             flux emitted %.9g, left %.9g, caustic %.9g, energy %.9g, absorbed %.9g\n",
-      name, s.steps, s.seeded, s.max_live, s.splits, s.splits_refused, s.kills_left, s.kills_caustic, s.kills_energy,
-      s.kills_opaque, s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_energy, s.flux_absorbed);
 }
 
 double fluxEnded(const WavefrontStats& s) {
@@ -67,9 +52,9 @@ TEST(WavefrontGpu, HomogeneousBeamMatchesReference) {
     WavefrontSettings s;
     s.dt = 0.75 * h;
     s.splat = mode;
-    const WavefrontResult c = WavefrontSimulator(field, vol.grid, s).run(beam({1, 0, 0}, E));
-    const WavefrontResult g = GpuWavefront(context(), vol, s).run(beam({1, 0, 0}, E));
-    printStats("homogeneous gpu", g.stats);
+    const WavefrontResult c = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, E));
+    const WavefrontResult g = GpuWavefront(context(), vol, s).run(directionalLight({1, 0, 0}, E));
+    printWavefrontStats("homogeneous gpu", g.stats);
     EXPECT_EQ(g.stats.seeded, c.stats.seeded);
     EXPECT_EQ(g.stats.seeded, size_t(32 * 32));
     EXPECT_EQ(g.stats.splits, 0u);
@@ -92,16 +77,6 @@ TEST(WavefrontGpu, HomogeneousBeamMatchesReference) {
   expectNoValidationMessages();
 }
 
-// The CPU test's glass sphere (n = 1.5, R = 1 mm, smoothing 1 voxel, 40 × 32 × 32, h = 0.1 mm).
-const char* kSphereScene = R"({
-  "environment": {"type": "constant", "radiance": 1},
-  "camera": {"width": 8, "height": 8},
-  "volume": {"bounds_min": [-1.6, -1.6, -1.6], "bounds_max": [2.4, 1.6, 1.6], "resolution": 40,
-             "smoothing_voxels": 1},
-  "materials": {"glass": {"n": 1.5}},
-  "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 1.0, "material": "glass"}]
-})";
-
 // 2. Glass sphere: refraction, a caustic behind the sphere, splits, whispering-gallery patches
 // killed by the energy threshold. Seeds are identical (the GPU uses WavefrontSimulator::seed), so
 // the emitted flux matches to the double sum's round-off. Conservation on the GPU: splits quarter
@@ -116,11 +91,11 @@ const char* kSphereScene = R"({
 // 1e-5 of the emitted flux by reason), and 1e-5 / 1e-4 on the volume total / L1: a borderline
 // decision that flips a large subtree in a future compiler or device is what these would catch.
 TEST(WavefrontGpu, GlassSphereAgreesWithReference) {
-  const Scene scene = sceneFromJson(kSphereScene);
+  const Scene scene = sceneFromJson(kGlassSphereLightScene);
   const VolumeSet vol = voxelize(scene);
   VolumeField field(vol);
   WavefrontSettings s;
-  const Light light = beam({1, 0, 0}, 1.0);
+  const Light light = directionalLight({1, 0, 0}, 1.0);
   GpuWavefront gpu(context(), vol, s);
   auto t0 = std::chrono::steady_clock::now();
   const WavefrontResult c = WavefrontSimulator(field, vol.grid, s).run(light);
@@ -128,8 +103,8 @@ TEST(WavefrontGpu, GlassSphereAgreesWithReference) {
   const WavefrontResult g = gpu.run(light);
   auto t2 = std::chrono::steady_clock::now();
   const double tc = std::chrono::duration<double>(t1 - t0).count(), tg = std::chrono::duration<double>(t2 - t1).count();
-  printStats("sphere cpu", c.stats);
-  printStats("sphere gpu", g.stats);
+  printWavefrontStats("sphere cpu", c.stats);
+  printWavefrontStats("sphere gpu", g.stats);
   std::printf("[ measured ] sphere: cpu %.3f s, gpu (%s) %.3f s, cpu/gpu %.2f\n", tc, context().deviceName().c_str(), tg,
               tc / tg);
   const WavefrontStats &cs = c.stats, &gs = g.stats;
@@ -176,9 +151,9 @@ TEST(WavefrontGpu, AbsorbingSlabMatchesReference) {
   const VolumeSet vol = voxelize(scene);
   VolumeField field(vol);
   WavefrontSettings s;
-  const WavefrontResult c = WavefrontSimulator(field, vol.grid, s).run(beam({1, 0, 0}, 1.0));
-  const WavefrontResult g = GpuWavefront(context(), vol, s).run(beam({1, 0, 0}, 1.0));
-  printStats("slab gpu", g.stats);
+  const WavefrontResult c = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0));
+  const WavefrontResult g = GpuWavefront(context(), vol, s).run(directionalLight({1, 0, 0}, 1.0));
+  printWavefrontStats("slab gpu", g.stats);
   std::printf("[ measured ] slab transmitted: gpu %.9f cpu %.9f exp(-0.5) %.9f\n", g.stats.flux_left / g.stats.flux_emitted,
               c.stats.flux_left / c.stats.flux_emitted, std::exp(-0.5));
   EXPECT_EQ(g.stats.seeded, c.stats.seeded);
@@ -216,8 +191,8 @@ TEST(WavefrontGpu, PointLightIsIndependentOfStepsPerDispatch) {
   auto t1 = std::chrono::steady_clock::now();
   const WavefrontResult g16 = GpuWavefront(context(), vol, s, 16).run(l);
   auto t2 = std::chrono::steady_clock::now();
-  printStats("point cpu", c.stats);
-  printStats("point gpu K=16", g16.stats);
+  printWavefrontStats("point cpu", c.stats);
+  printWavefrontStats("point gpu K=16", g16.stats);
   std::printf("[ measured ] point light: gpu K=1 %.3f s (incl. pipeline), K=16 %.3f s (incl. pipeline)\n",
               std::chrono::duration<double>(t1 - t0).count(), std::chrono::duration<double>(t2 - t1).count());
   for (const WavefrontResult* g : {&g1, &g16}) {
@@ -248,14 +223,14 @@ TEST(WavefrontGpu, PointLightIsIndependentOfStepsPerDispatch) {
 // the reference: the GPU grants splits per rebuild against that rebuild's survivors, the reference
 // per patch against a running live count (docs/light-simulator.md, "List rebuild").
 TEST(WavefrontGpu, PatchBudgetHoldsOnTheGpu) {
-  const Scene scene = sceneFromJson(kSphereScene);
+  const Scene scene = sceneFromJson(kGlassSphereLightScene);
   const VolumeSet vol = voxelize(scene);
   WavefrontSettings s;
   s.max_patches = 5000;
   s.max_steps = 1000;
-  const WavefrontResult g = GpuWavefront(context(), vol, s).run(beam({1, 0, 0}, 1.0));
+  const WavefrontResult g = GpuWavefront(context(), vol, s).run(directionalLight({1, 0, 0}, 1.0));
   const WavefrontStats& st = g.stats;
-  printStats("budget gpu", st);
+  printWavefrontStats("budget gpu", st);
   EXPECT_LE(st.max_live, size_t(s.max_patches));
   EXPECT_GT(st.splits_refused, 0u);
   EXPECT_LT(st.steps, s.max_steps);

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "core/reference/wavefront.h"
+#include "tests/core/light_fixtures.h"
 #include "tests/core/test_support.h"
 
 namespace eikon::test {
@@ -20,23 +21,6 @@ Grid cubeGrid(glm::dvec3 origin, int n, double h) {
   g.h = h;
   g.extent = glm::dvec3(n * h);
   return g;
-}
-
-Light directional(glm::dvec3 d, double e) {
-  Light l;
-  l.type = Light::Type::Directional;
-  l.direction = d;
-  l.irradiance = e;
-  return l;
-}
-
-void printStats(const char* name, const WavefrontStats& s) {
-  std::printf(
-      "[ measured ] %s: steps %d, seeded %zu, max live %zu, splits %zu (refused %zu), kills left/caustic/energy "
-      "%zu/%zu/%zu\n             flux emitted %.12g, left %.12g, caustic %.12g, absorbed %.12g, probe %.12g, "
-      "ended before probe %.12g\n",
-      name, s.steps, s.seeded, s.max_live, s.splits, s.splits_refused, s.kills_left, s.kills_caustic, s.kills_energy,
-      s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_absorbed, s.flux_probe, s.flux_ended_before_probe);
 }
 
 // 1. A homogeneous medium (n = 1.5, no object), a beam along +x. Seeds are h/2 squares tiling the
@@ -58,9 +42,9 @@ TEST(Wavefront, HomogeneousBeamIsUniformAndConserved) {
     WavefrontSettings s;
     s.dt = 0.75 * h;
     s.splat = mode;
-    WavefrontResult r = WavefrontSimulator(field, grid, s).run(directional({1, 0, 0}, E));
+    WavefrontResult r = WavefrontSimulator(field, grid, s).run(directionalLight({1, 0, 0}, E));
     const WavefrontStats& st = r.stats;
-    printStats("homogeneous", st);
+    printWavefrontStats("homogeneous", st);
     EXPECT_EQ(st.seeded, size_t(32 * 32));
     EXPECT_NEAR(st.flux_emitted, E * 16.0, 1e-12 * E * 16.0);
     EXPECT_EQ(st.splits, 0u);
@@ -83,17 +67,6 @@ TEST(Wavefront, HomogeneousBeamIsUniformAndConserved) {
   }
 }
 
-// A glass sphere (n = 1.5, R = 1 mm, smoothing 1 voxel) in a 40 × 32 × 32 grid, h = 0.1 mm; the
-// paraxial focus f = nR/(2(n − 1)) = 1.5 mm from the centre lies inside the box.
-const char* kSphereScene = R"({
-  "environment": {"type": "constant", "radiance": 1},
-  "camera": {"width": 8, "height": 8},
-  "volume": {"bounds_min": [-1.6, -1.6, -1.6], "bounds_max": [2.4, 1.6, 1.6], "resolution": 40,
-             "smoothing_voxels": 1},
-  "materials": {"glass": {"n": 1.5}},
-  "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 1.0, "material": "glass"}]
-})";
-
 // 2. No absorption: every patch ends by leaving the volume or at a caustic, and splitting hands
 // each child exactly a quarter of its parent's flux, so left + caustic = emitted by construction
 // (only summation round-off: 1e-9 relative is ~1e6 ulps of margin). The probe plane x = 1.1 mm
@@ -107,16 +80,16 @@ const char* kSphereScene = R"({
 // f = 1.5 mm > 1.1 mm), so at least ... nothing we can bound tightly: we assert the upper bound
 // and print the measured split.
 TEST(Wavefront, GlassSphereConservesFlux) {
-  const Scene scene = sceneFromJson(kSphereScene);
+  const Scene scene = sceneFromJson(kGlassSphereLightScene);
   const VolumeSet vol = voxelize(scene);
   VolumeField field(vol);
   WavefrontSettings s;
   s.probe_axis = 0;
   s.probe_position = 1.1;
   const double E = 1.0;
-  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directional({1, 0, 0}, E));
+  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, E));
   const WavefrontStats& st = r.stats;
-  printStats("glass sphere", st);
+  printWavefrontStats("glass sphere", st);
   EXPECT_NEAR(st.flux_emitted, E * 3.2 * 3.2, 1e-9 * st.flux_emitted);
   EXPECT_EQ(st.live_at_end, 0u);
   EXPECT_EQ(st.flux_absorbed, 0.0);
@@ -140,27 +113,16 @@ TEST(Wavefront, GlassSphereConservesFlux) {
 // (R, 0, 0) is a voxel centre), i.e. within 1 voxel; (c) before any caustic, all the flux crosses
 // the plane x = R/2 (every ray's x increases monotonically until the focus), so the probe there
 // sees the emitted flux to round-off (1e-9).
-void luneburg(const glm::dvec3& x, double& n, glm::dvec3& g) {
-  double r2 = glm::dot(x, x);
-  if (r2 >= 1.0) {
-    n = 1.0;
-    g = glm::dvec3(0.0);
-  } else {
-    n = std::sqrt(2.0 - r2);
-    g = -x / n;
-  }
-}
-
 TEST(Wavefront, LuneburgLensFocusesOnTheFarSurface) {
   const double h = 0.05;
   const Grid grid = cubeGrid({-1.225, -1.225, -1.225}, 49, h);
-  AnalyticField field(luneburg, grid.origin, grid.boundsMax(), h);
+  AnalyticField field(unitLuneburg, grid.origin, grid.boundsMax(), h);
   WavefrontSettings s;
   s.probe_axis = 0;
   s.probe_position = 0.5;
-  WavefrontResult r = WavefrontSimulator(field, grid, s).run(directional({1, 0, 0}, 1.0));
+  WavefrontResult r = WavefrontSimulator(field, grid, s).run(directionalLight({1, 0, 0}, 1.0));
   const WavefrontStats& st = r.stats;
-  printStats("Luneburg", st);
+  printWavefrontStats("Luneburg", st);
   const glm::dvec3 focus(1, 0, 0);
   std::printf("[ measured ] caustic centroid (%.5f, %.5f, %.5f), %.3e mm from the focus\n", st.caustic_centroid.x,
               st.caustic_centroid.y, st.caustic_centroid.z, glm::length(st.caustic_centroid - focus));
@@ -186,15 +148,15 @@ TEST(Wavefront, LuneburgLensFocusesOnTheFarSurface) {
 // flux until the energy threshold) or by leaking out. With splits refused they only leak, so the
 // loop takes longer (measured 231 steps vs 148 unconstrained); max_steps = 1000 is not reached.
 TEST(Wavefront, PatchBudgetHoldsAndTheLoopEnds) {
-  const Scene scene = sceneFromJson(kSphereScene);
+  const Scene scene = sceneFromJson(kGlassSphereLightScene);
   const VolumeSet vol = voxelize(scene);
   VolumeField field(vol);
   WavefrontSettings s;
   s.max_patches = 5000;
   s.max_steps = 1000;
-  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directional({1, 0, 0}, 1.0));
+  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0));
   const WavefrontStats& st = r.stats;
-  printStats("budget", st);
+  printWavefrontStats("budget", st);
   EXPECT_LE(st.max_live, size_t(s.max_patches));
   EXPECT_GT(st.splits_refused, 0u);
   EXPECT_LT(st.steps, s.max_steps);
@@ -220,9 +182,9 @@ TEST(Wavefront, AbsorbingSlabTransmitsExpMinusHalf) {
   const VolumeSet vol = voxelize(scene);
   VolumeField field(vol);
   WavefrontSettings s;
-  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directional({1, 0, 0}, 1.0));
+  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0));
   const WavefrontStats& st = r.stats;
-  printStats("slab", st);
+  printWavefrontStats("slab", st);
   const double expected = st.flux_emitted * std::exp(-0.5);
   std::printf("[ measured ] transmitted fraction %.12f vs exp(-0.5) = %.12f\n", st.flux_left / st.flux_emitted,
               std::exp(-0.5));
@@ -264,7 +226,7 @@ TEST(Wavefront, PointLightInverseSquare) {
   l.irradiance = I;
   WavefrontResult r = WavefrontSimulator(field, grid, s).run(l);
   const WavefrontStats& st = r.stats;
-  printStats("point light", st);
+  printWavefrontStats("point light", st);
   EXPECT_EQ(st.seeded, size_t(6 * 64));
   EXPECT_NEAR(st.flux_emitted, 4 * kPi * I, 1e-12 * 4 * kPi * I);
   EXPECT_NEAR(st.flux_left, st.flux_emitted, 1e-9 * st.flux_emitted);

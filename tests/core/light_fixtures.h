@@ -1,0 +1,54 @@
+// Fixtures shared by the light-simulator tests (CPU reference and GPU twin): lights, the glass-
+// sphere scene, the exact unit Luneburg field (physics_cases.md §7a), and a statistics printer.
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/reference/wavefront.h"
+#include "core/scene/scene.h"
+
+namespace eikon::test {
+
+inline Light directionalLight(glm::dvec3 d, double irradiance) {
+  Light l;
+  l.type = Light::Type::Directional;
+  l.direction = d;
+  l.irradiance = irradiance;
+  return l;
+}
+
+// A glass sphere (n = 1.5, R = 1 mm, smoothing 1 voxel) in a 40 × 32 × 32 grid, h = 0.1 mm; the
+// paraxial focus f = nR/(2(n − 1)) = 1.5 mm from the centre lies inside the box.
+inline const char* kGlassSphereLightScene = R"({
+  "environment": {"type": "constant", "radiance": 1},
+  "camera": {"width": 8, "height": 8},
+  "volume": {"bounds_min": [-1.6, -1.6, -1.6], "bounds_max": [2.4, 1.6, 1.6], "resolution": 40,
+             "smoothing_voxels": 1},
+  "materials": {"glass": {"n": 1.5}},
+  "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 1.0, "material": "glass"}]
+})";
+
+/// Luneburg lens of radius 1 about the origin: n = √(2 − r²) inside, 1 outside, exact ∇n.
+inline void unitLuneburg(const glm::dvec3& x, double& n, glm::dvec3& g) {
+  double r2 = glm::dot(x, x);
+  if (r2 >= 1.0) {
+    n = 1.0;
+    g = glm::dvec3(0.0);
+  } else {
+    n = std::sqrt(2.0 - r2);
+    g = -x / n;
+  }
+}
+
+inline void printWavefrontStats(const char* name, const WavefrontStats& s) {
+  std::printf(
+      "[ measured ] %s: steps %d, seeded %zu, max live %zu, splits %zu (refused %zu), kills "
+      "left/caustic/energy/opaque %zu/%zu/%zu/%zu\n             flux emitted %.12g, left %.12g, caustic %.12g, "
+      "energy %.12g, absorbed %.12g, probe %.12g, ended before probe %.12g\n",
+      name, s.steps, s.seeded, s.max_live, s.splits, s.splits_refused, s.kills_left, s.kills_caustic, s.kills_energy,
+      s.kills_opaque, s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_energy, s.flux_absorbed, s.flux_probe,
+      s.flux_ended_before_probe);
+}
+
+}  // namespace eikon::test
