@@ -17,16 +17,15 @@
 #include <string>
 
 #include "core/io/exr.h"
+#include "tests/apps/cli_support.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct Outcome {
-  int code;
-  std::string out, err;
-};
+using eikon::test::Outcome;
+using eikon::test::slurp;
 
 // A small glass sphere (n = 1.5, r = 3 mm) in a 10 mm volume of 32³ voxels, a 32x24 camera.
 std::string tinyScene(const std::string& volume_extra = "", const std::string& material = R"({"n": 1.5})",
@@ -68,18 +67,9 @@ class Cli : public ::testing::Test {
     std::ofstream(dir_ / name) << text;
     return (dir_ / name).string();
   }
-  static std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
   /// Run `eikon ARGS` with validation layers on; stdout/stderr captured.
   Outcome run(const std::string& args) const {
-    const std::string cmd = "EIKON_VALIDATION=1 " + std::string(EIKON_BINARY) + " " + args + " >" +
-                            (io_ / "stdout").string() + " 2>" + (io_ / "stderr").string() + " </dev/null";
-    const int st = std::system(cmd.c_str());
-    Outcome o{WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(io_ / "stdout"), slurp(io_ / "stderr")};
+    Outcome o = eikon::test::runEikon(args, io_, "EIKON_VALIDATION=1");
     EXPECT_EQ(o.err.find("[vulkan validation]"), std::string::npos) << "validation messages:\n" << o.err;
     return o;
   }

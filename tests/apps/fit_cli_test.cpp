@@ -13,16 +13,14 @@
 
 #include "anisotropic/dispersion.h"
 #include "anisotropic/index_data.h"
+#include "tests/apps/cli_support.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct Outcome {
-  int code;
-  std::string out, err;
-};
+using eikon::test::Outcome;
 
 class FitCli : public ::testing::Test {
  protected:
@@ -38,17 +36,8 @@ class FitCli : public ::testing::Test {
     std::ofstream(path(name)) << text;
     return path(name);
   }
-  static std::string slurp(const std::string& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
-  Outcome run(const std::string& args) const {
-    const std::string cmd = std::string(EIKON_BINARY) + " fit " + args + " >" + path("stdout") + " 2>" + path("stderr");
-    const int st = std::system(cmd.c_str());
-    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(path("stdout")), slurp(path("stderr"))};
-  }
+  static std::string slurp(const std::string& p) { return eikon::test::slurp(p); }
+  Outcome run(const std::string& args) const { return eikon::test::runEikon("fit " + args, dir_); }
   // N-BK7 (SCHOTT) sampled every `step` nm from lo to hi.
   std::string bk7Csv(double lo = 400, double hi = 700, double step = 5) const {
     const auto bk7 = eikon::Dispersion::sellmeier({1.03961212, 0.231792344, 1.01046945},
