@@ -4,6 +4,11 @@
 //
 //     dx/dt = w / n²,   dw/dt = ∇n / n     (c = 1, t = optical path, |w| = n)
 //
+// or, for the e-mode of a uniaxial volume (P.control.w = 1), where the optic axis a is non-zero,
+// the mode Hamiltonian H = ½(pᵀM_e p − 1) of DESIGN §2 in the same constant time (w = p):
+//
+//     dx/dt = M_e p,   dp/dt = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e [− radial-axis term]
+//
 // with classical RK4 on each of the four corners, the index sampled trilinearly from the A (and,
 // when dispersive, B, C) field exactly as march.glsl / VolumeField do. Per step, in the order of
 // the reference: flux ← flux·exp(−σΔs) (σ at the step midpoint of the centre path), splat of
@@ -39,6 +44,12 @@ layout(binding = EIKON_WB_INDEX_A, rgba32f) readonly uniform image3D idxA;
 layout(binding = EIKON_WB_INDEX_B, rgba32f) readonly uniform image3D idxB;
 layout(binding = EIKON_WB_INDEX_C, rgba32f) readonly uniform image3D idxC;
 layout(binding = EIKON_WB_MEDIUM, rgba32f) readonly uniform image3D medium;
+layout(binding = EIKON_WB_INDEX_E_A, rgba32f) readonly uniform image3D idxEA;
+layout(binding = EIKON_WB_INDEX_E_B, rgba32f) readonly uniform image3D idxEB;
+layout(binding = EIKON_WB_INDEX_E_C, rgba32f) readonly uniform image3D idxEC;
+layout(binding = EIKON_WB_MEDIUM_E, rgba32f) readonly uniform image3D mediumE;
+layout(binding = EIKON_WB_AXIS, rgba32f) readonly uniform image3D axisImg;
+layout(binding = EIKON_WB_SKIP, rgba32f) readonly uniform image3D skipImg;
 layout(std430, binding = EIKON_WB_PATCHES) buffer PatchBuf { WavePatch patchesA[]; };
 layout(std430, binding = EIKON_WB_PATCHES_B) buffer PatchBufB { WavePatch patchesB[]; };
 layout(std430, binding = EIKON_WB_SPLAT) buffer SplatBuf { uint splat[]; };
@@ -101,6 +112,43 @@ vec4 sampleIndex(vec3 x) {
   return a;
 }
 
+// (n_e, ∇n_e) at the simulator's wavelength (e-mode only).
+vec4 sampleIndexE(vec3 x) {
+  Stencil s = stencilAt(x);
+  vec4 a = TRI(idxEA, s);
+  if (hasFlag(EIKON_F_DISPERSIVE)) a += TRI(idxEB, s) * P.wavelength.y + TRI(idxEC, s) * P.wavelength.z;
+  return a;
+}
+
+bool eMode() { return P.control.w == 1; }
+
+// Optic axis at x (axisField in march.glsl / VolumeField): xyz unit axis (zero where isotropic),
+// w = 1/r for a radial field about the stored centre, else 0. Nearest voxel.
+vec4 axisField(vec3 x) {
+  ivec3 vi = clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_max.w)), ivec3(0), P.grid_dims.xyz - 1);
+  vec4 t = imageLoad(axisImg, vi);
+  if (t.w > -0.5) return vec4(t.xyz, 0.0);
+  vec3 d = x - t.xyz;
+  float r = length(d);
+  return r > 1e-6 ? vec4(d / r, 1.0 / r) : vec4(0.0, 0.0, 1.0, 0.0);
+}
+
+// M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e².
+vec3 applyM(vec3 p, vec3 a, float no, float ne) {
+  float pa = dot(p, a);
+  return a * (pa / (no * no)) + (p - a * pa) / (ne * ne);
+}
+
+// Wave vector along the unit direction s at x on the simulated mode's shell (onShell in wavefront.cpp).
+vec3 onShell(vec3 x, vec3 s) {
+  float n = sampleIndex(x).x;
+  if (eMode()) {
+    vec3 a = axisField(x).xyz;
+    if (dot(a, a) >= 0.25) return s * inversesqrt(dot(s, applyM(s, a, n, sampleIndexE(x).x)));
+  }
+  return s * n;
+}
+
 // (σ at 612, 549, 465 nm, opacity); zero when the volume has neither.
 vec4 sampleMedium(vec3 x) {
   if (!hasFlag(EIKON_F_ATTENUATION) && !hasFlag(EIKON_F_OPACITY)) return vec4(0.0);
@@ -119,8 +167,36 @@ float sigmaAt(vec3 rgb) {
 
 void deriv(vec3 x, vec3 w, out vec3 dx, out vec3 dw) {
   vec4 a = sampleIndex(x);
+  if (eMode()) {
+    vec4 af = axisField(x);
+    vec3 ax = af.xyz;
+    if (dot(ax, ax) >= 0.25) {
+      vec4 e = sampleIndexE(x);
+      float pa = dot(w, ax), p2 = dot(w, w);
+      dx = applyM(w, ax, a.x, e.x);
+      dw = (pa * pa / (a.x * a.x * a.x)) * a.yzw + ((p2 - pa * pa) / (e.x * e.x * e.x)) * e.yzw;
+      // Radial axis field (∂a/∂x = (I − aaᵀ)/r): −(p·a)(1/n_o² − 1/n_e²)(p − (p·a)a)/r.
+      if (af.w > 0.0) dw -= pa * (1.0 / (a.x * a.x) - 1.0 / (e.x * e.x)) * (w - pa * ax) * af.w;
+      return;
+    }
+  }
   dx = w / (a.x * a.x);
   dw = a.yzw / a.x;
+}
+
+// e-mode attenuation per unit ray length at x for wave vector w: σ(θ)·cos ρ (attenuationAt in
+// march.glsl), at the simulator's wavelength; the o-mode σ where there is no axis.
+float sigmaE(vec3 x, vec3 w) {
+  float so = sigmaAt(sampleMedium(x).xyz);
+  vec3 a = axisField(x).xyz;
+  if (dot(a, a) < 0.25 || !(dot(w, w) > 0.0)) return so;
+  float se = hasFlag(EIKON_F_ATTENUATION) ? sigmaAt(TRI(mediumE, stencilAt(x)).xyz) : 0.0;
+  float no = sampleIndex(x).x, ne = sampleIndexE(x).x;
+  vec3 sn = normalize(w);
+  float c = dot(sn, a), c2 = c * c, s2 = 1.0 - c2;
+  float n = inversesqrt(c2 / (no * no) + s2 / (ne * ne));
+  vec3 t = normalize(applyM(w, a, no, ne));
+  return n * n * n * (so * c2 / (no * no * no) + se * s2 / (ne * ne * ne)) * dot(sn, t);
 }
 
 void rk4(inout vec3 x, inout vec3 w, float dt) {
@@ -188,14 +264,155 @@ float maxEdgeOf(vec3 x[4]) {
   return e;
 }
 
+// ---- Straight steps across homogeneous regions (splatSegment / straightSteps in wavefront.cpp;
+// docs/light-simulator.md, "Straight steps") ----
+
+// Skip distance D (voxels) of the voxel holding x (VolumeField::skipDistance: nearest voxel, clamped).
+float skipAt(vec3 x) {
+  ivec3 vi = clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_max.w)), ivec3(0), P.grid_dims.xyz - 1);
+  return imageLoad(skipImg, vi).w;
+}
+
+// The centre's straight path c0 + s·u, s ∈ [0, L], deposits flux(s)·len/h³ into every voxel it
+// crosses (flux(s) = E0·exp(−σs) at the piece's midpoint, len the piece's length), and
+// HighestEnergy sees flux(s)/area(s) with area(τ) = |½ (A + τB) × (C + τD)|, τ = s/ds1 steps.
+// A voxel walk (Amanatides & Woo 1987) over the part of the segment inside the grid.
+void splatSegment(vec3 c0, vec3 u, float L, float E0, float sigma, vec3 dir, float ds1, vec3 dA, vec3 dB, vec3 dC,
+                  vec3 dD) {
+  const float h = P.grid_origin.w;
+  const vec3 g0 = P.grid_origin.xyz, g1 = P.grid_origin.xyz + vec3(P.grid_dims.xyz) * h;
+  float sA = 0.0, sB = L;
+  for (int a = 0; a < 3; ++a) {
+    if (u[a] == 0.0) {
+      if (c0[a] < g0[a] || c0[a] >= g1[a]) return;
+      continue;
+    }
+    float t0 = (g0[a] - c0[a]) / u[a], t1 = (g1[a] - c0[a]) / u[a];
+    sA = max(sA, min(t0, t1));
+    sB = min(sB, max(t0, t1));
+  }
+  if (!(sA < sB)) return;
+  ivec3 i, stepI;
+  vec3 tNext, tDelta;
+  for (int a = 0; a < 3; ++a) {
+    const float ga = (c0[a] + sA * u[a] - g0[a]) / h;
+    i[a] = clamp(int(floor(ga)), 0, P.grid_dims[a] - 1);
+    if (u[a] > 0.0) {
+      stepI[a] = 1, tDelta[a] = h / u[a];
+      tNext[a] = (g0[a] + float(i[a] + 1) * h - c0[a]) / u[a];
+    } else if (u[a] < 0.0) {
+      stepI[a] = -1, tDelta[a] = -h / u[a];
+      tNext[a] = (g0[a] + float(i[a]) * h - c0[a]) / u[a];
+    } else {
+      stepI[a] = 0, tDelta[a] = 0.0, tNext[a] = 1e30;
+    }
+  }
+  const uint count = uint(P.grid_dims.x * P.grid_dims.y * P.grid_dims.z);
+  float sCur = sA;
+  const int guard = P.grid_dims.x + P.grid_dims.y + P.grid_dims.z + 3;
+  for (int it = 0; it < guard; ++it) {
+    const int a = tNext.x <= tNext.y ? (tNext.x <= tNext.z ? 0 : 2) : (tNext.y <= tNext.z ? 1 : 2);
+    const float sEnd = min(tNext[a], sB);
+    if (sEnd > sCur) {
+      const float sm = 0.5 * (sCur + sEnd), flux = E0 * exp(-sigma * sm);
+      const float value = flux * (sEnd - sCur) * P.step.w;  // W/mm²; toFixed scales
+      const float tau = ds1 > 0.0 ? sm / ds1 : 0.0;
+      const float area = 0.5 * length(cross(dA + tau * dB, dC + tau * dD));
+      const uint v = uint((i.z * P.grid_dims.y + i.y) * P.grid_dims.x + i.x);
+      const uint base = v * uint(EIKON_SPLAT_ACC_WORDS);
+      addFixed(base, toFixed(value));
+      addFixed(base + 2u, toFixed(value * dir.x));
+      addFixed(base + 4u, toFixed(value * dir.y));
+      addFixed(base + 6u, toFixed(value * dir.z));
+      atomicMax(splat[count * uint(EIKON_SPLAT_ACC_WORDS) + v], floatBitsToUint(max(area > 0.0 ? flux / area : 0.0, 0.0)));
+      sCur = sEnd;
+    }
+    if (sCur >= sB) break;
+    i[a] += stepI[a];
+    if (i[a] < 0 || i[a] >= P.grid_dims[a]) break;
+    tNext[a] += tDelta[a];
+  }
+}
+
+// How many time steps the patch (corners x, w) may take at once along straight lines (0: take
+// an RK4 step), and the corners' constant velocities v = dx/dt; the rules of straightSteps in
+// wavefront.cpp: centre and corners in voxels of skip distance D ≥ 2, the centre's voxel not
+// opaque, no radial axis field, a centre outside the bounds headed for them; k keeps every point
+// within (D − 1.5)·h of its start, within max_steps, ends at the first step below the energy
+// threshold (σ > 0), and is cut at the first step j at which single steps would split, meet a
+// caustic or leave.
+int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, out vec3 v[4]) {
+  for (int k = 0; k < 4; ++k) v[k] = vec3(0.0);
+  if (P.options.x == 0) return 0;
+  const vec3 c0 = centreOf(x);
+  const float Dc = skipAt(c0);
+  if (Dc < 2.0) return 0;
+  float D[4];
+  for (int k = 0; k < 4; ++k) {
+    D[k] = skipAt(x[k]);
+    if (D[k] < 2.0) return 0;
+  }
+  if (sampleMedium(c0).w >= 0.5) return 0;
+  const vec3 wm = 0.25 * (w[0] + w[1] + w[2] + w[3]);
+  const float wl = length(wm);
+  if (!(wl > 0.0)) return 0;
+  const bool in0 = insideBounds(c0);
+  if (!in0 && (state.z != 0 || !rayHitsBox(c0, wm / wl))) return 0;
+  vec3 vc = vec3(0.0);
+  for (int k = 0; k < 4; ++k) {
+    if (eMode() && axisField(x[k]).w > 0.0) return 0;  // radial axis: a varies
+    vec3 dw;
+    deriv(x[k], w[k], v[k], dw);
+    vc += 0.25 * v[k];
+  }
+  const float dt = P.step.x, h = P.grid_origin.w, maxEdge = P.step.y;
+  float kmax = float(P.control.z - state.w);
+  float sp = length(vc) * dt;
+  if (sp > 0.0) kmax = min(kmax, floor((Dc - 1.5) * h / sp));
+  for (int k = 0; k < 4; ++k) {
+    sp = length(v[k]) * dt;
+    if (sp > 0.0) kmax = min(kmax, floor((D[k] - 1.5) * h / sp));
+  }
+  const float ds1 = length(vc) * dt;
+  if (ds1 > 0.0) {
+    const vec3 m = c0 + 0.5 * dt * vc;
+    const float sigma = eMode() ? sigmaE(m, wm) : sigmaAt(sampleMedium(m).xyz);
+    const float thr = P.step.z * flux.z;
+    if (sigma > 0.0 && flux.x >= thr && thr > 0.0) kmax = min(kmax, floor(log(flux.x / thr) / (sigma * ds1)) + 1.0);
+  }
+  if (kmax < 1.0) return 0;
+  const int K = int(kmax);
+  bool entered = state.z != 0 || in0;
+  for (int j = 1; j <= K; ++j) {
+    vec3 xj[4];
+    for (int k = 0; k < 4; ++k) xj[k] = x[k] + (float(j) * dt) * v[k];
+    const float o = dot(0.5 * cross(xj[2] - xj[0], xj[3] - xj[1]), wm);
+    const vec3 c = centreOf(xj);
+    bool stop = maxEdgeOf(xj) > maxEdge || (o > 0.0 && state.y < 0) || (o < 0.0 && state.y > 0);
+    if (insideBounds(c))
+      entered = true;
+    else if (entered || !rayHitsBox(c, wm / wl))
+      stop = true;
+    if (stop) return j;
+  }
+  return K;
+}
+
 void propagate(uint id) {
   if (id >= pc.control.x) return;
   WavePatch p = loadPatch(id);
   p.flux.w = 0.0;
+  for (int k = 0; k < 4; ++k) {  // the probe sums are per propagation
+    p.x[k].w = 0.0;
+    p.w[k].w = 0.0;
+  }
   if (p.state.x != EIKON_PATCH_ALIVE) {
     storePatch(id, p);
     return;
   }
+  vec4 probePos = vec4(0.0);
+  vec3 probeDir = vec3(0.0);
+  const int probeAxis = P.control.x;
   vec3 x[4], w[4];
   for (int k = 0; k < 4; ++k) {
     x[k] = p.x[k].xyz;
@@ -203,13 +420,25 @@ void propagate(uint id) {
   }
   const float dt = P.step.x, maxEdge = P.step.y;
   for (int it = 0; it < P.control.y && p.state.w < P.control.z; ++it) {
-    ++p.state.w;
-    vec3 c0 = centreOf(x);
-    for (int k = 0; k < 4; ++k) rk4(x[k], w[k], dt);
+    vec3 c0 = centreOf(x), wm0 = 0.25 * (w[0] + w[1] + w[2] + w[3]);
+    vec3 vel[4];
+    const int kStraight = straightSteps(x, w, p.flux, p.state, vel);
+    vec3 dA = vec3(0.0), dB = vec3(0.0), dC = vec3(0.0), dD = vec3(0.0);
+    if (kStraight > 0) {
+      // Straight step: k time steps along straight lines; w is unchanged (∇n = 0).
+      dA = x[2] - x[0], dB = dt * (vel[2] - vel[0]), dC = x[3] - x[1], dD = dt * (vel[3] - vel[1]);
+      const float T = float(kStraight) * dt;
+      for (int k = 0; k < 4; ++k) x[k] += T * vel[k];
+      p.state.w += kStraight;
+    } else {
+      for (int k = 0; k < 4; ++k) rk4(x[k], w[k], dt);
+      ++p.state.w;
+    }
     vec3 c1 = centreOf(x), m = 0.5 * (c0 + c1);
     float ds = length(c1 - c0);
     vec4 med = sampleMedium(m);
-    float sigma = sigmaAt(med.xyz);
+    float sigma = eMode() ? sigmaE(m, 0.5 * (wm0 + 0.25 * (w[0] + w[1] + w[2] + w[3]))) : sigmaAt(med.xyz);
+    const float E0 = p.flux.x;
     float att = exp(-sigma * ds), fluxMid = p.flux.x * exp(-0.5 * sigma * ds);
     p.flux.w += p.flux.x * (1.0 - att);
     p.flux.x *= att;
@@ -217,7 +446,28 @@ void propagate(uint id) {
     float area = length(va);
     vec3 wm = 0.25 * (w[0] + w[1] + w[2] + w[3]);
     float wl = length(wm);
-    splatAt(m, fluxMid * ds * P.step.w, area > 0.0 ? fluxMid / area : 0.0, wl > 0.0 ? wm / wl : vec3(0.0));
+    // o-mode: ŵ; e-mode: the energy direction, that of the centre's motion (as the reference).
+    vec3 dir = eMode() ? (ds > 0.0 ? (c1 - c0) / ds : vec3(0.0)) : (wl > 0.0 ? wm / wl : vec3(0.0));
+    if (kStraight > 0) {
+      if (ds > 0.0) splatSegment(c0, (c1 - c0) / ds, ds, E0, sigma, dir, ds / float(kStraight), dA, dB, dC, dD);
+    } else {
+      splatAt(m, fluxMid * ds * P.step.w, area > 0.0 ? fluxMid / area : 0.0, dir);
+    }
+    // Probe plane: the centre crossed it over this step (the side before the step is that of c0;
+    // the reference keeps the side through splits, which differs only for a child whose centre
+    // lies across the plane from its parent's).
+    if (probeAxis >= 0) {
+      const float pp = P.probe.x;
+      const bool before = c0[probeAxis] >= pp, after = c1[probeAxis] >= pp;
+      if (before != after) {
+        const float sg = after ? 1.0 : -1.0, span = c1[probeAxis] - c0[probeAxis];
+        const float f = span != 0.0 ? clamp((pp - c0[probeAxis]) / span, 0.0, 1.0) : 0.5;
+        // Flux at the crossing: mid-step (RK4 step) or at the crossing point (straight step).
+        const float fx = kStraight > 0 ? E0 * exp(-sigma * f * ds) : fluxMid;
+        probePos += sg * fx * vec4(c0 + f * (c1 - c0), 1.0);
+        if (ds > 0.0) probeDir += sg * fx * (c1 - c0) / ds;
+      }
+    }
     if (med.w >= 0.5) {
       p.state.x = EIKON_PATCH_OPAQUE;
       break;
@@ -242,10 +492,14 @@ void propagate(uint id) {
       break;
     }
   }
-  for (int k = 0; k < 4; ++k) {
-    p.x[k] = vec4(x[k], 0.0);
-    p.w[k] = vec4(w[k], 0.0);
-  }
+  p.x[0] = vec4(x[0], probePos.x);
+  p.x[1] = vec4(x[1], probePos.y);
+  p.x[2] = vec4(x[2], probePos.z);
+  p.x[3] = vec4(x[3], probePos.w);
+  p.w[0] = vec4(w[0], probeDir.x);
+  p.w[1] = vec4(w[1], probeDir.y);
+  p.w[2] = vec4(w[2], probeDir.z);
+  p.w[3] = vec4(w[3], 0.0);
   storePatch(id, p);
 }
 
@@ -258,6 +512,10 @@ void scatter(uint id) {
   if (next == o) return;
   WavePatch p = loadPatch(id);
   p.flux.w = 0.0;
+  for (int k = 0; k < 4; ++k) {  // the probe sums were counted
+    p.x[k].w = 0.0;
+    p.w[k].w = 0.0;
+  }
   if (next - o == 1u) {  // kept (a refused split goes on unsplit, as in the reference)
     p.state.x = EIKON_PATCH_ALIVE;
     storeOther(o, p);
@@ -271,7 +529,7 @@ void scatter(uint id) {
       const float w0 = (1.0 - fa) * (1.0 - fb), w1 = fa * (1.0 - fb), w2 = fa * fb, w3 = (1.0 - fa) * fb;
       X[b * 3 + a] = w0 * p.x[0].xyz + w1 * p.x[1].xyz + w2 * p.x[2].xyz + w3 * p.x[3].xyz;
       vec3 ww = w0 * p.w[0].xyz + w1 * p.w[1].xyz + w2 * p.w[2].xyz + w3 * p.w[3].xyz;
-      if (a == 1 || b == 1) ww = normalize(ww) * sampleIndex(X[b * 3 + a]).x;
+      if (a == 1 || b == 1) ww = onShell(X[b * 3 + a], normalize(ww));  // back onto the mode's shell
       W[b * 3 + a] = ww;
     }
   X[0] = p.x[0].xyz, X[2] = p.x[1].xyz, X[8] = p.x[2].xyz, X[6] = p.x[3].xyz;

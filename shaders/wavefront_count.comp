@@ -2,7 +2,7 @@
 // Count passes of the light simulator's list rebuild (see wavefront.comp and
 // docs/light-simulator.md): per patch of the source list, its number of outputs (0 dead or out of
 // steps, 1 kept, 4 split one level) into scan[i], and in the COUNT pass the workgroup's kill
-// statistics reduced in shared memory (a tree of EIKON_WAVE_WG lanes, float sums) into
+// statistics and probe-plane sums reduced in shared memory (a tree of EIKON_WAVE_WG lanes, float sums) into
 // tally[workgroup], which the host adds in double. A separate shader from wavefront.comp so that
 // the propagation shader carries no barrier (llvmpipe implements barriers with coroutines).
 #extension GL_GOOGLE_include_directive : require
@@ -23,10 +23,11 @@ WavePatch loadPatch(uint i) {
 }
 
 shared vec4 sFluxA[EIKON_WAVE_WG], sFluxB[EIKON_WAVE_WG], sCentroid[EIKON_WAVE_WG];
+shared vec4 sProbePos[EIKON_WAVE_WG], sProbeDir[EIKON_WAVE_WG];
 shared uvec4 sCountA[EIKON_WAVE_WG], sCountB[EIKON_WAVE_WG];
 
 void countPass(uint id, uint lid, uint mode) {
-  vec4 fa = vec4(0.0), fb = vec4(0.0), cen = vec4(0.0);
+  vec4 fa = vec4(0.0), fb = vec4(0.0), cen = vec4(0.0), ppos = vec4(0.0), pdir = vec4(0.0);
   uvec4 ca = uvec4(0u), cb = uvec4(0u);
   if (id < pc.control.x) {
     WavePatch p = loadPatch(id);
@@ -64,6 +65,8 @@ void countPass(uint id, uint lid, uint mode) {
         ca.w = 1u;
     }
     fb.x = p.flux.w;
+    ppos = vec4(p.x[0].w, p.x[1].w, p.x[2].w, p.x[3].w);  // probe sums of the last propagation
+    pdir = vec4(p.w[0].w, p.w[1].w, p.w[2].w, 0.0);
     cb.y = wantSplit ? 1u : 0u;
     cb.z = keep;
     cb.w = uint(max(p.state.w, 0));
@@ -76,6 +79,8 @@ void countPass(uint id, uint lid, uint mode) {
   sFluxA[lid] = fa;
   sFluxB[lid] = fb;
   sCentroid[lid] = cen;
+  sProbePos[lid] = ppos;
+  sProbeDir[lid] = pdir;
   sCountA[lid] = ca;
   sCountB[lid] = cb;
   for (uint s = EIKON_WAVE_WG / 2; s > 0u; s >>= 1) {
@@ -85,6 +90,8 @@ void countPass(uint id, uint lid, uint mode) {
       sFluxA[lid] += sFluxA[lid + s];
       sFluxB[lid] += sFluxB[lid + s];
       sCentroid[lid] += sCentroid[lid + s];
+      sProbePos[lid] += sProbePos[lid + s];
+      sProbeDir[lid] += sProbeDir[lid + s];
       sCountA[lid] += sCountA[lid + s];
       const uvec4 o = sCountB[lid + s];
       sCountB[lid] = uvec4(sCountB[lid].xyz + o.xyz, max(sCountB[lid].w, o.w));
@@ -99,6 +106,8 @@ void countPass(uint id, uint lid, uint mode) {
     t.caustic_sum = sCentroid[0];
     t.count_a = sCountA[0];
     t.count_b = sCountB[0];
+    t.probe_pos = sProbePos[0];
+    t.probe_dir = sProbeDir[0];
     tally[gl_WorkGroupID.x] = t;
   }
 }

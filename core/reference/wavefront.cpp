@@ -52,7 +52,30 @@ double triangleSolidAngle(const glm::dvec3& a, const glm::dvec3& b, const glm::d
   return 2.0 * std::atan2(num, den);
 }
 
+bool hasAxis(const glm::dvec3& a) { return glm::dot(a, a) >= 0.25; }  // as the marcher: zero outside crystals
+
+/// M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e² (DESIGN §2).
+glm::dvec3 applyM(const glm::dvec3& p, const glm::dvec3& a, double no, double ne) {
+  const double pa = glm::dot(p, a);
+  return a * (pa / (no * no)) + (p - a * pa) / (ne * ne);
+}
+
 }  // namespace
+
+glm::dvec3 WavefrontSimulator::onShell(const glm::dvec3& x, const glm::dvec3& s) const {
+  double n;
+  glm::dvec3 g;
+  field_.index(x, il2_, il4_, n, g);
+  if (s_.mode == 1) {
+    const glm::dvec3 a(field_.axisField(x));
+    if (hasAxis(a)) {
+      double ne;
+      field_.indexE(x, il2_, il4_, ne, g);
+      return s / std::sqrt(glm::dot(s, applyM(s, a, n, ne)));
+    }
+  }
+  return n * s;
+}
 
 WavefrontSimulator::WavefrontSimulator(const Field& field, const Grid& splat_grid, const WavefrontSettings& settings)
     : field_(field), grid_(splat_grid), s_(settings) {
@@ -65,6 +88,8 @@ WavefrontSimulator::WavefrontSimulator(const Field& field, const Grid& splat_gri
   if (s_.max_patches < 1) throw std::invalid_argument("wavefront: max_patches must be >= 1");
   if (s_.point_cells_per_face < 1) throw std::invalid_argument("wavefront: point_cells_per_face must be >= 1");
   if (!(s_.wavelength_nm > 0)) throw std::invalid_argument("wavefront: wavelength must be > 0");
+  if (s_.mode != 0 && s_.mode != 1) throw std::invalid_argument("wavefront: mode must be 0 (o) or 1 (e)");
+  if (s_.beam_min_cells < 1) throw std::invalid_argument("wavefront: beam_min_cells must be >= 1");
   const double l_um = s_.wavelength_nm * 1e-3;
   il2_ = 1.0 / (l_um * l_um);
   il4_ = il2_ * il2_;
@@ -73,12 +98,6 @@ WavefrontSimulator::WavefrontSimulator(const Field& field, const Grid& splat_gri
 std::vector<Patch> WavefrontSimulator::seed(const Light& light) const {
   const glm::dvec3 lo = field_.boundsMin(), hi = field_.boundsMax();
   std::vector<Patch> out;
-  auto nAt = [&](const glm::dvec3& x) {
-    double n;
-    glm::dvec3 g;
-    field_.index(x, il2_, il4_, n, g);
-    return n;
-  };
   if (light.type == Light::Type::Directional) {
     const double len = glm::length(light.direction);
     if (!(len > 0)) throw std::invalid_argument("wavefront: directional light without a direction");
@@ -97,19 +116,39 @@ std::vector<Patch> WavefrontSimulator::seed(const Light& light) const {
       umin = std::min(umin, glm::dot(p, u)), umax = std::max(umax, glm::dot(p, u));
       vmin = std::min(vmin, glm::dot(p, v)), vmax = std::max(vmax, glm::dot(p, v));
     }
-    const double edge = s_.seed_span_voxels * grid_.h;
-    const int nu = std::max(1, int(std::ceil((umax - umin) / edge - 1e-9)));
-    const int nv = std::max(1, int(std::ceil((vmax - vmin) / edge - 1e-9)));
-    const double du = (umax - umin) / nu, dv = (vmax - vmin) / nv;
+    double edge = s_.seed_span_voxels * grid_.h;
+    const double R = light.beam_radius;
+    const bool beam = R > 0;
+    int nu, nv;
+    double du, dv;
+    double pu = 0, pv = 0;  // beam axis in the launch plane
+    if (beam) {
+      // A grid of exact squares centred on the beam axis, symmetric about it in u and v, so that
+      // the launched cells (centre within R) form a disc whose flux centroid is on the axis.
+      edge = std::min(edge, R / s_.beam_min_cells);
+      pu = glm::dot(light.position, u), pv = glm::dot(light.position, v);
+      const int half = int(std::ceil(R / edge - 1e-9));
+      nu = nv = 2 * half;
+      du = dv = edge;
+      umin = pu - half * edge, vmin = pv - half * edge;
+    } else {
+      nu = std::max(1, int(std::ceil((umax - umin) / edge - 1e-9)));
+      nv = std::max(1, int(std::ceil((vmax - vmin) / edge - 1e-9)));
+      du = (umax - umin) / nu, dv = (vmax - vmin) / nv;
+    }
     const glm::dvec3 base = s0 * d;
     for (int j = 0; j < nv; ++j)
       for (int i = 0; i < nu; ++i) {
         const double uc[4] = {umin + i * du, umin + (i + 1) * du, umin + (i + 1) * du, umin + i * du};
         const double vc[4] = {vmin + j * dv, vmin + j * dv, vmin + (j + 1) * dv, vmin + (j + 1) * dv};
+        if (beam) {
+          const double cu = umin + (i + 0.5) * du - pu, cv = vmin + (j + 0.5) * dv - pv;
+          if (cu * cu + cv * cv > R * R) continue;
+        }
         Patch p;
         for (int k = 0; k < 4; ++k) {
           p.x[size_t(k)] = base + uc[k] * u + vc[k] * v;
-          p.w[size_t(k)] = nAt(p.x[size_t(k)]) * d;
+          p.w[size_t(k)] = onShell(p.x[size_t(k)], d);
         }
         if (!rayHitsBox(centre(p), d, lo, hi)) continue;
         p.area0 = du * dv;
@@ -119,27 +158,49 @@ std::vector<Patch> WavefrontSimulator::seed(const Light& light) const {
         out.push_back(p);
       }
   } else {
-    const int N = s_.point_cells_per_face;
+    const bool spot = light.type == Light::Type::Spot;
+    int N = s_.point_cells_per_face;
+    glm::dvec3 axis(0.0);
+    double cosCone = -2.0;
+    if (spot) {
+      const double len = glm::length(light.direction);
+      if (!(len > 0)) throw std::invalid_argument("wavefront: spot light without a direction");
+      if (!(light.cone_half_angle_deg > 0)) throw std::invalid_argument("wavefront: spot light cone must be > 0");
+      axis = light.direction / len;
+      const double half = light.cone_half_angle_deg * 3.14159265358979323846 / 180.0;
+      cosCone = std::cos(half);
+      // The cone meets a cube face (at distance 1) in a disc of radius ≈ tan(half); a cell edge
+      // there is 2/N, so N ≥ 2·beam_min_cells/tan(half) puts beam_min_cells cells across it.
+      if (half < 0.25 * 3.14159265358979323846)
+        N = std::max(N, std::min(4096, int(std::ceil(2.0 * s_.beam_min_cells / std::tan(half)))));
+    }
     const double eps = s_.point_radius;
     const glm::dvec3 src = light.position;
-    for (int axis = 0; axis < 3; ++axis)
+    for (int ax = 0; ax < 3; ++ax)
       for (int sg = -1; sg <= 1; sg += 2) {
-        const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
+        const int ua = (ax + 1) % 3, va = (ax + 2) % 3;
         for (int j = 0; j < N; ++j)
           for (int i = 0; i < N; ++i) {
             const double a0 = -1.0 + 2.0 * i / N, a1 = -1.0 + 2.0 * (i + 1) / N;
             const double b0 = -1.0 + 2.0 * j / N, b1 = -1.0 + 2.0 * (j + 1) / N;
+            if (spot) {
+              glm::dvec3 q(0.0);
+              q[ax] = sg;
+              q[ua] = 0.5 * (a0 + a1);
+              q[va] = 0.5 * (b0 + b1);
+              if (glm::dot(glm::normalize(q), axis) < cosCone) continue;
+            }
             const double ac[4] = {a0, a1, a1, a0}, bc[4] = {b0, b0, b1, b1};
             Patch p;
             glm::dvec3 dir[4];
             for (int k = 0; k < 4; ++k) {
               glm::dvec3 q(0.0);
-              q[axis] = sg;
+              q[ax] = sg;
               q[ua] = ac[k];
               q[va] = bc[k];
               dir[k] = glm::normalize(q);
               p.x[size_t(k)] = src + eps * dir[k];
-              p.w[size_t(k)] = nAt(p.x[size_t(k)]) * dir[k];
+              p.w[size_t(k)] = onShell(p.x[size_t(k)], dir[k]);
             }
             if (!rayHitsBox(centre(p), glm::normalize(meanW(p)), lo, hi)) continue;
             const double omega = triangleSolidAngle(dir[0], dir[1], dir[2]) + triangleSolidAngle(dir[0], dir[2], dir[3]);
@@ -174,12 +235,47 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
   size_t live = cur.size();
   st.max_live = live;
 
+  const bool eMode = s_.mode == 1;
   auto deriv = [&](const glm::dvec3& x, const glm::dvec3& w, glm::dvec3& dx, glm::dvec3& dw) {
     double n;
     glm::dvec3 g;
     field_.index(x, il2_, il4_, n, g);
+    if (eMode) {
+      // e-mode Hamiltonian H = ½(pᵀM_e p − 1) in constant time (wavefront.h): the same terms as
+      // deriv() in reference_marcher.cpp / march.glsl, not divided by |M_e p|.
+      const glm::dvec4 af = field_.axisField(x);
+      const glm::dvec3 a(af);
+      if (hasAxis(a)) {
+        double ne;
+        glm::dvec3 ge;
+        field_.indexE(x, il2_, il4_, ne, ge);
+        const double pa = glm::dot(w, a), p2 = glm::dot(w, w);
+        dx = applyM(w, a, n, ne);
+        dw = (pa * pa / (n * n * n)) * g + ((p2 - pa * pa) / (ne * ne * ne)) * ge;
+        if (af.w > 0.0) dw -= pa * (1.0 / (n * n) - 1.0 / (ne * ne)) * (w - pa * a) * af.w;
+        return;
+      }
+    }
     dx = w / (n * n);
     dw = g / n;
+  };
+  // e-mode attenuation per unit ray length at x for wave vector w: the pleochroic
+  // σ(θ) = n(θ)³[σ_o cos²θ/n_o³ + σ_e sin²θ/n_e³] times cos ρ = ŝ·t̂ (attenuationAt in march.glsl
+  // and reference_marcher.cpp), at the simulator's wavelength.
+  auto sigmaE = [&](const glm::dvec3& x, const glm::dvec3& w) {
+    const double so = sigmaAt(glm::dvec3(field_.medium(x)), s_.wavelength_nm);
+    const glm::dvec3 a = field_.axis(x);
+    if (!hasAxis(a) || !(glm::dot(w, w) > 0)) return so;
+    const double se = sigmaAt(glm::dvec3(field_.mediumE(x)), s_.wavelength_nm);
+    double no, ne;
+    glm::dvec3 g;
+    field_.index(x, il2_, il4_, no, g);
+    field_.indexE(x, il2_, il4_, ne, g);
+    const glm::dvec3 sn = glm::normalize(w);
+    const double c = glm::dot(sn, a), c2 = c * c, s2 = 1.0 - c2;
+    const double n = 1.0 / std::sqrt(c2 / (no * no) + s2 / (ne * ne));
+    const glm::dvec3 t = glm::normalize(applyM(w, a, no, ne));
+    return n * n * n * (so * c2 / (no * no * no) + se * s2 / (ne * ne * ne)) * glm::dot(sn, t);
   };
   auto rk4 = [&](glm::dvec3& x, glm::dvec3& w) {
     glm::dvec3 k1x, k1w, k2x, k2w, k3x, k3w, k4x, k4w;
@@ -201,6 +297,132 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     acc[v] += fluxDs / h3;
     dirAcc[v] += (fluxDs / h3) * dir;
     best[v] = std::max(best[v], irr);
+  };
+  // Straight-step splat: the centre's straight path c0 + s·u, s ∈ [0, L] (u unit), deposits into
+  // every voxel it crosses flux(s)·len/h³, with len the length of the piece inside the voxel and
+  // flux(s) = E0·exp(−σs) at the piece's midpoint (the sum over pieces is the single steps' sum of
+  // flux_mid·Δs up to where within a voxel it falls). HighestEnergy sees flux(s)/area(s), the
+  // patch area at that point: area(τ) = |½ (A + τB) × (C + τD)| with τ = s/ds1 time steps
+  // (A, C the diagonals at the start, B, D their change per step). A voxel walk (Amanatides & Woo
+  // 1987) over the part of the segment inside the grid; the same walk as splatSegment in
+  // wavefront.comp.
+  auto splatSegment = [&](const glm::dvec3& c0, const glm::dvec3& u, double L, double E0, double sigma,
+                          const glm::dvec3& dir, double ds1, const glm::dvec3 diag[4]) {
+    double sA = 0.0, sB = L;
+    for (int a = 0; a < 3; ++a) {
+      const double g0 = grid_.origin[a], g1 = grid_.origin[a] + grid_.dims[size_t(a)] * h;
+      if (u[a] == 0.0) {
+        if (c0[a] < g0 || c0[a] >= g1) return;
+        continue;
+      }
+      double t0 = (g0 - c0[a]) / u[a], t1 = (g1 - c0[a]) / u[a];
+      if (t0 > t1) std::swap(t0, t1);
+      sA = std::max(sA, t0);
+      sB = std::min(sB, t1);
+    }
+    if (!(sA < sB)) return;
+    int i[3], stepI[3];
+    double tNext[3], tDelta[3];
+    for (int a = 0; a < 3; ++a) {
+      const double ga = (c0[a] + sA * u[a] - grid_.origin[a]) / h;
+      i[a] = std::clamp(int(std::floor(ga)), 0, grid_.dims[size_t(a)] - 1);
+      if (u[a] > 0) {
+        stepI[a] = 1, tDelta[a] = h / u[a];
+        tNext[a] = (grid_.origin[a] + (i[a] + 1) * h - c0[a]) / u[a];
+      } else if (u[a] < 0) {
+        stepI[a] = -1, tDelta[a] = -h / u[a];
+        tNext[a] = (grid_.origin[a] + i[a] * h - c0[a]) / u[a];
+      } else {
+        stepI[a] = 0, tDelta[a] = 0, tNext[a] = 1e300;
+      }
+    }
+    double sCur = sA;
+    const int guard = grid_.dims[0] + grid_.dims[1] + grid_.dims[2] + 3;
+    for (int it = 0; it < guard; ++it) {
+      const int a = tNext[0] <= tNext[1] ? (tNext[0] <= tNext[2] ? 0 : 2) : (tNext[1] <= tNext[2] ? 1 : 2);
+      const double sEnd = std::min(tNext[a], sB);
+      if (sEnd > sCur) {
+        const double sm = 0.5 * (sCur + sEnd), flux = E0 * std::exp(-sigma * sm), val = flux * (sEnd - sCur) / h3;
+        const double tau = ds1 > 0 ? sm / ds1 : 0.0;
+        const double area = 0.5 * glm::length(glm::cross(diag[0] + tau * diag[1], diag[2] + tau * diag[3]));
+        const size_t v = grid_.index(i[0], i[1], i[2]);
+        acc[v] += val;
+        dirAcc[v] += val * dir;
+        best[v] = std::max(best[v], area > 0 ? flux / area : 0.0);
+        sCur = sEnd;
+      }
+      if (sCur >= sB) break;
+      i[a] += stepI[a];
+      if (i[a] < 0 || i[a] >= grid_.dims[size_t(a)]) break;
+      tNext[a] += tDelta[a];
+    }
+  };
+  // How many time steps p may take at once along straight lines (0: none, take an RK4 step), and
+  // the corners' constant velocities dx/dt. Conditions (docs/light-simulator.md, "Straight
+  // steps"): the centre and all corners lie in voxels of skip distance D ≥ 2, the centre's voxel is
+  // not opaque, no radial axis field (e-mode), and a centre outside the bounds is headed for them.
+  // k then keeps every point within (D − 1.5)·h of where it starts (so it, and the trilinear
+  // stencils along its path, stay inside its homogeneous region: the straight line is the exact
+  // solution there), stays within max_steps − steps and, when σ > 0, ends at the first step whose
+  // flux is below the energy threshold; finally it is cut at the first step j at which single
+  // steps would act: an edge longer than maxEdge (split), an orientation flip (caustic), the
+  // centre leaving (after having been inside, or its ray missing the bounds).
+  auto straightSteps = [&](const Patch& p, glm::dvec3 v[4]) -> int {
+    if (!s_.skip_empty) return 0;
+    const glm::dvec3 c0 = centre(p);
+    double Dmin = field_.skipDistance(c0);
+    if (Dmin < 2.0) return 0;
+    double D[4];
+    for (int k = 0; k < 4; ++k) {
+      D[k] = field_.skipDistance(p.x[size_t(k)]);
+      if (D[k] < 2.0) return 0;
+    }
+    if (field_.medium(c0).w >= 0.5) return 0;
+    const glm::dvec3 wm = meanW(p);
+    const double wl = glm::length(wm);
+    if (!(wl > 0)) return 0;
+    const bool in0 = inside(c0, lo, hi);
+    if (!in0 && (p.entered || !rayHitsBox(c0, wm / wl, lo, hi))) return 0;
+    glm::dvec3 vc(0.0);
+    for (int k = 0; k < 4; ++k) {
+      if (eMode && field_.axisField(p.x[size_t(k)]).w > 0.0) return 0;  // radial axis: a varies
+      glm::dvec3 dw;
+      deriv(p.x[size_t(k)], p.w[size_t(k)], v[k], dw);
+      vc += 0.25 * v[k];
+    }
+    double kmax = double(s_.max_steps - p.steps);
+    auto capBy = [&](double Dv, const glm::dvec3& vel) {
+      const double sp = glm::length(vel) * dt;
+      if (sp > 0) kmax = std::min(kmax, std::floor((Dv - 1.5) * h / sp));
+    };
+    capBy(Dmin, vc);
+    for (int k = 0; k < 4; ++k) capBy(D[k], v[k]);
+    const double ds1 = glm::length(vc) * dt;
+    if (ds1 > 0) {
+      const glm::dvec3 m = c0 + 0.5 * dt * vc;
+      const double sigma = eMode ? sigmaE(m, wm) : sigmaAt(glm::dvec3(field_.medium(m)), s_.wavelength_nm);
+      const double thr = s_.min_energy_fraction * p.seed_energy;
+      if (sigma > 0 && p.energy >= thr && thr > 0)
+        kmax = std::min(kmax, std::floor(std::log(p.energy / thr) / (sigma * ds1)) + 1.0);
+    }
+    if (kmax < 1.0) return 0;
+    const int K = int(kmax);
+    bool entered = p.entered || in0;
+    for (int j = 1; j <= K; ++j) {
+      glm::dvec3 x[4];
+      for (int k = 0; k < 4; ++k) x[k] = p.x[size_t(k)] + (double(j) * dt) * v[k];
+      double e = 0;
+      for (int k = 0; k < 4; ++k) e = std::max(e, glm::length(x[(k + 1) % 4] - x[k]));
+      const double o = glm::dot(0.5 * glm::cross(x[2] - x[0], x[3] - x[1]), wm);
+      const glm::dvec3 c = 0.25 * (x[0] + x[1] + x[2] + x[3]);
+      bool stop = e > maxEdge || (o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0);
+      if (inside(c, lo, hi))
+        entered = true;
+      else if (entered || !rayHitsBox(c, wm / wl, lo, hi))
+        stop = true;
+      if (stop) return j;
+    }
+    return K;
   };
   // Split p (repeatedly) until no edge exceeds maxEdge or the patch budget is spent.
   auto emit = [&](const Patch& p0) {
@@ -231,10 +453,14 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
           X[b][a] = (1 - fa) * (1 - fb) * p.x[0] + fa * (1 - fb) * p.x[1] + fa * fb * p.x[2] + (1 - fa) * fb * p.x[3];
           glm::dvec3 w = (1 - fa) * (1 - fb) * p.w[0] + fa * (1 - fb) * p.w[1] + fa * fb * p.w[2] + (1 - fa) * fb * p.w[3];
           if ((a == 1 || b == 1)) {
-            double n;
-            glm::dvec3 g;
-            field_.index(X[b][a], il2_, il4_, n, g);
-            w = glm::normalize(w) * n;
+            if (eMode) {
+              w = onShell(X[b][a], glm::normalize(w));  // back onto the mode's shell pᵀMp = 1
+            } else {
+              double n;
+              glm::dvec3 g;
+              field_.index(X[b][a], il2_, il4_, n, g);
+              w = glm::normalize(w) * n;
+            }
           }
           W[b][a] = w;
         }
@@ -261,16 +487,38 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     if (s_.probe_axis >= 0 && p.probe_side < 0) st.flux_ended_before_probe += p.energy;
   };
 
-  while (!cur.empty() && st.steps < s_.max_steps) {
-    ++st.steps;
+  // Patches that have used up max_steps stay live (and counted in `live`) but move no further.
+  std::vector<Patch> done;
+  while (!cur.empty()) {
     next.clear();
     for (Patch p : cur) {
-      const glm::dvec3 c0 = centre(p);
-      for (int k = 0; k < 4; ++k) rk4(p.x[size_t(k)], p.w[size_t(k)]);
+      if (p.steps >= s_.max_steps) {
+        done.push_back(p);
+        continue;
+      }
+      const glm::dvec3 c0 = centre(p), wm0 = eMode ? meanW(p) : glm::dvec3(0.0);
+      glm::dvec3 vel[4], diag[4];
+      const int kStraight = straightSteps(p, vel);
+      if (kStraight > 0) {
+        // Straight step: k time steps along straight lines; w is unchanged (∇n = 0). diag: the
+        // diagonals at the start and their change per time step (the area along the path).
+        diag[0] = p.x[2] - p.x[0], diag[1] = dt * (vel[2] - vel[0]);
+        diag[2] = p.x[3] - p.x[1], diag[3] = dt * (vel[3] - vel[1]);
+        const double T = double(kStraight) * dt;
+        for (int k = 0; k < 4; ++k) p.x[size_t(k)] += T * vel[k];
+        p.steps += kStraight;
+        ++st.straight_steps;
+        st.straight_time_steps += size_t(kStraight);
+      } else {
+        for (int k = 0; k < 4; ++k) rk4(p.x[size_t(k)], p.w[size_t(k)]);
+        ++p.steps;
+      }
+      st.steps = std::max(st.steps, p.steps);
       const glm::dvec3 c1 = centre(p), m = 0.5 * (c0 + c1);
       const double ds = glm::length(c1 - c0);
       const glm::dvec4 med = field_.medium(m);
-      const double sigma = sigmaAt(glm::dvec3(med), s_.wavelength_nm);
+      const double sigma = eMode ? sigmaE(m, 0.5 * (wm0 + meanW(p))) : sigmaAt(glm::dvec3(med), s_.wavelength_nm);
+      const double E0 = p.energy;
       const double att = std::exp(-sigma * ds), fluxMid = p.energy * std::exp(-0.5 * sigma * ds);
       st.flux_absorbed += p.energy * (1.0 - att);
       p.energy *= att;
@@ -279,10 +527,27 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
       const double area = glm::length(va);
       const glm::dvec3 wm = meanW(p);
       const double wl = glm::length(wm);
-      splat(m, fluxMid * ds, area > 0 ? fluxMid / area : 0.0, wl > 0 ? wm / wl : glm::dvec3(0.0));
+      // Propagation direction: ŵ for the o-mode; for the e-mode the energy direction, which is
+      // that of the centre's motion over the step (M_e p, not p, in a crystal).
+      const glm::dvec3 dir = eMode ? (ds > 0 ? (c1 - c0) / ds : glm::dvec3(0.0)) : (wl > 0 ? wm / wl : glm::dvec3(0.0));
+      if (kStraight > 0) {
+        if (ds > 0) splatSegment(c0, (c1 - c0) / ds, ds, E0, sigma, dir, ds / kStraight, diag);
+      } else {
+        splat(m, fluxMid * ds, area > 0 ? fluxMid / area : 0.0, dir);
+      }
       if (s_.probe_axis >= 0) {
         const int side = c1[s_.probe_axis] >= s_.probe_position ? 1 : -1;
-        if (side != p.probe_side) st.flux_probe += side * fluxMid;
+        if (side != p.probe_side) {
+          const int ax = s_.probe_axis;
+          const double span = c1[ax] - c0[ax];
+          const double f = span != 0 ? std::clamp((s_.probe_position - c0[ax]) / span, 0.0, 1.0) : 0.5;
+          // The flux where the centre crosses: mid-step for an RK4 step, at the crossing point
+          // for a straight step (exact along its attenuated path).
+          const double fx = kStraight > 0 ? E0 * std::exp(-sigma * f * ds) : fluxMid;
+          st.flux_probe += side * fx;
+          st.probe_centroid += side * fx * (c0 + f * (c1 - c0));
+          if (ds > 0) st.probe_direction += side * fx * (c1 - c0) / ds;
+        }
         p.probe_side = side;
       }
       // Kills, each accounted by reason.
@@ -319,7 +584,12 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     st.max_live = std::max(st.max_live, live);
     std::swap(cur, next);
   }
+  cur.swap(done);
   if (st.flux_caustic > 0) st.caustic_centroid /= st.flux_caustic;
+  if (st.flux_probe != 0) {
+    st.probe_centroid /= st.flux_probe;
+    st.probe_direction /= st.flux_probe;
+  }
   st.live_at_end = cur.size();
   for (const Patch& p : cur) {
     st.flux_live_at_end += p.energy;

@@ -1,5 +1,5 @@
 // The double-precision CPU reference of the light simulator (issue 6, DESIGN §2 "Light
-// simulator", Tevs ch. 4 and 6). The GPU kernel (later) is tested against it.
+// simulator", Tevs ch. 4 and 6). The GPU kernel (core/render/light_simulator.h) is tested against it.
 //
 // A wavefront of patches, each a quad of four corner particles, is launched from a light and
 // advanced in constant time steps (all corners of all patches share the same time, so the front
@@ -8,7 +8,15 @@
 //     dx/dt = w / n²,   dw/dt = ∇n / n,   w = n·t̂ (|w| = n)
 //
 // t is time with c = 1 (mm): a corner moves dt/n mm per step. Each corner is integrated with RK4
-// using Field::index at the simulator's wavelength. Flux is attached to the ray tube a patch
+// using Field::index at the simulator's wavelength. WavefrontSettings::mode = 1 propagates the
+// extraordinary mode of a uniaxial medium instead, with the mode Hamiltonian of DESIGN §2 in the
+// same constant time (w = p, M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e², a the unit optic axis):
+//
+//     dx/dt = M_e p,   dp/dt = −½ pᵀ(∂M_e/∂x)p = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e
+//                                                  − (p·a)(1/n_o² − 1/n_e²)(p − (p·a)a)/r
+//
+// (the last term only for a radial axis field a = (x − c)/r; shell pᵀM_e p = 1); where the axis is
+// zero (isotropic regions) the o-mode equations above are used unchanged. Flux is attached to the ray tube a patch
 // spans, so it is constant along the tube except for attenuation, flux ← flux·exp(−σ Δs); the
 // patch irradiance is flux / current area (the intensity law ΔE(t) = ΔE(0)·A(0)/A(t)).
 //
@@ -56,6 +64,24 @@ struct WavefrontSettings {
   /// patch centres cross it in the +axis direction is reported in stats.flux_probe.
   int probe_axis = -1;
   double probe_position = 0.0;
+  /// Propagated mode: 0 = ordinary (or isotropic: the index `Field::index`), 1 = extraordinary
+  /// (uniaxial media: n_o, n_e = `Field::indexE`, the axis `Field::axisField`, attenuation
+  /// σ(θ)·cos ρ from `medium`/`mediumE`). A single run carries one mode; for unpolarised light
+  /// run both and give each half of the light's power (no Fresnel, so nothing couples the modes).
+  int mode = 0;
+  /// Narrow beams and spots: at least this many seed-patch edges across the beam radius
+  /// (directional light with beam_radius > 0: seed edge = min(seed_span_voxels·h, beam_radius /
+  /// beam_min_cells)) or across the cone's radius on the unit cube (spot: cells per face edge
+  /// N ≥ max(point_cells_per_face, ⌈2·beam_min_cells / tan(half-angle)⌉), at most 4096).
+  int beam_min_cells = 8;
+  /// Straight steps across homogeneous regions: when the centre and all four corners lie in
+  /// voxels of skip distance D ≥ 2 (`Field::skipDistance`; VolumeSet: every field is constant
+  /// within D − 1 voxels), the patch advances k constant-time steps at once along straight lines
+  /// (x += k·dt·dx/dt, w unchanged), exact there. k keeps every point within (D − 1.5) voxels of
+  /// its start and stops at the first step where single steps would split, kill (caustic, left,
+  /// energy) or reach max_steps, so events fall on the same steps; the centre's path is splatted
+  /// into every voxel it crosses (flux·length/h³). See docs/light-simulator.md, "Straight steps".
+  bool skip_empty = true;
 };
 
 /// One wavefront element. Corners are in bilinear order (0,0), (1,0), (1,1), (0,1) of the patch's
@@ -72,10 +98,13 @@ struct Patch {
   int orientation = 1;         ///< sign of (normal · mean w) at launch; a change is a caustic
   bool entered = false;        ///< the centre has been inside the field's bounds
   int probe_side = 0;          ///< −1 / +1: side of the probe plane the centre is on
+  int steps = 0;               ///< time steps taken (a straight step of k counts k)
 };
 
 struct WavefrontStats {
-  int steps = 0;
+  int steps = 0;           ///< most time steps taken by one patch (a straight step of k counts k)
+  size_t straight_steps = 0;  ///< straight steps taken (each covering k ≥ 1 time steps)
+  size_t straight_time_steps = 0;  ///< time steps covered by them (Σ k)
   size_t seeded = 0;       ///< patches launched toward the volume
   size_t max_live = 0;     ///< most live patches at once
   size_t splits = 0;       ///< parents split into four
@@ -93,6 +122,12 @@ struct WavefrontStats {
   /// the probe plane. Without absorption, flux_probe + flux_ended_before_probe = flux_emitted.
   double flux_ended_before_probe = 0;
   glm::dvec3 caustic_centroid{0.0};  ///< flux-weighted mean centre of the patches killed at caustics
+  /// Probe plane: (net) flux-weighted mean of the points where patch centres cross it (mm; the
+  /// centre's path over the step, interpolated linearly to the plane), and the flux-weighted mean
+  /// unit direction of the centres' motion there (the ray, i.e. energy, direction; not
+  /// normalised: its length is < 1 where directions differ). Zero if nothing crossed.
+  glm::dvec3 probe_centroid{0.0};
+  glm::dvec3 probe_direction{0.0};
 };
 
 /// Volumes on the splat grid (x-fastest, Grid::index order).
@@ -115,10 +150,18 @@ class WavefrontSimulator {
 
   /// The launch patches for a light (exposed for tests): directional — a regular grid in the
   /// plane perpendicular to the direction through the most upstream corner of the bounds,
-  /// covering the bounds' projection; point — a cube-sphere of radius point_radius, flux I·Ω.
+  /// covering the bounds' projection (with beam_radius > 0: a grid centred on the beam axis,
+  /// only cells whose centre lies within the radius); point — a cube-sphere of radius
+  /// point_radius, flux I·Ω; spot — the cells of that cube-sphere whose centre direction lies
+  /// within the cone. Corner wave vectors point along the launch direction (the wave normal) and
+  /// lie on the mode's shell.
   std::vector<Patch> seed(const Light& light) const;
 
  private:
+  /// Wave vector along the unit direction s at x on the shell of the simulated mode: n·s for the
+  /// o-mode (and where there is no axis), s/√(sᵀM_e s) for the e-mode.
+  glm::dvec3 onShell(const glm::dvec3& x, const glm::dvec3& s) const;
+
   const Field& field_;
   const Grid& grid_;
   WavefrontSettings s_;

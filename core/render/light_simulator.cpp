@@ -103,7 +103,8 @@ struct GpuWavefront::Impl {
   WavefrontSettings s;
   int steps_per_dispatch;
   VolumeField field;
-  std::vector<vk::Image3D> images;  // A, B, C (B, C only when dispersive), medium
+  std::vector<vk::Image3D> images;  // o: A, B, C (B, C only when dispersive), medium; e: the same, axis
+  bool eMode = false;               // settings.mode == 1 and the volume is uniaxial
   vk::Buffer params, splat, patches[2], scan, tally;
   vk::ComputePipeline pipe, countPipe;  // wavefront.comp (propagate, scatter), wavefront_count.comp
   ScanKernel scanner;
@@ -118,16 +119,22 @@ struct GpuWavefront::Impl {
     if (!(g.h > 0) || g.count() == 0) throw std::invalid_argument("wavefront: empty volume");
     if (s.dt <= 0) s.dt = 0.5 * g.h;
     if (!(s.wavelength_nm > 0)) throw std::invalid_argument("wavefront: wavelength must be > 0");
+    if (s.mode != 0 && s.mode != 1) throw std::invalid_argument("wavefront: mode must be 0 (o) or 1 (e)");
+    // The e-mode of an isotropic volume is the o-mode (no axis anywhere).
+    eMode = s.mode == 1 && vol.uniaxial;
     const double l = s.wavelength_nm * 1e-3;
     il2 = 1.0 / (l * l);
     il4 = il2 * il2;
-    // Smallest index in the volume (bounds the centre's step length Δs ≤ dt/n_min for the splat scale).
+    // Smallest index in the volume (bounds the centre's step length Δs ≤ dt/n_min for the splat
+    // scale). The e-mode's ray speed |M_e p| on the shell is at most 1/min(n_o, n_e) (the ray
+    // velocity surface is an ellipsoid with semi-axes 1/n_o and 1/n_e), so both fields count.
     n_min = 1e300;
-    for (size_t i = 0; i < g.count(); ++i) {
-      double n = vol.index[0][0][i].x;
-      if (vol.dispersive) n += vol.index[0][1][i].x * il2 + vol.index[0][2][i].x * il4;
-      n_min = std::min(n_min, n);
-    }
+    for (int md = 0; md <= (eMode ? 1 : 0); ++md)
+      for (size_t i = 0; i < g.count(); ++i) {
+        double n = vol.index[size_t(md)][0][i].x;
+        if (vol.dispersive) n += vol.index[size_t(md)][1][i].x * il2 + vol.index[size_t(md)][2][i].x * il4;
+        n_min = std::min(n_min, n);
+      }
     if (!(n_min > 0)) throw std::invalid_argument("wavefront: the index volume has n <= 0");
 
     std::array<uint32_t, 3> ext{uint32_t(g.dims[0]), uint32_t(g.dims[1]), uint32_t(g.dims[2])};
@@ -142,12 +149,28 @@ struct GpuWavefront::Impl {
       upload(vol.index[0][2], "wavefront index C");
     }
     upload(vol.medium[0], "wavefront medium");
+    if (eMode) {
+      upload(vol.index[1][0], "wavefront index e A");
+      if (vol.dispersive) {
+        upload(vol.index[1][1], "wavefront index e B");
+        upload(vol.index[1][2], "wavefront index e C");
+      }
+      upload(vol.medium[1], "wavefront medium e");
+      upload(vol.axis, "wavefront axis");
+    }
+    // Skip distances for straight steps (w of the emission image; zeros where none was computed).
+    if (vol.emission.size() == g.count())
+      upload(vol.emission, "wavefront skip");
+    else
+      upload(std::vector<glm::vec4>(g.count(), glm::vec4(0.0f)), "wavefront skip");
     params = vk::Buffer(ctx, sizeof(gpu::WaveParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront params");
     splat = vk::Buffer(ctx, g.count() * (EIKON_SPLAT_ACC_WORDS + 1) * sizeof(uint32_t),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront splat");
     std::vector<vk::BindingSpec> b;
     for (uint32_t i : {uint32_t(EIKON_WB_INDEX_A), uint32_t(EIKON_WB_INDEX_B), uint32_t(EIKON_WB_INDEX_C),
-                       uint32_t(EIKON_WB_MEDIUM)})
+                       uint32_t(EIKON_WB_MEDIUM), uint32_t(EIKON_WB_INDEX_E_A), uint32_t(EIKON_WB_INDEX_E_B),
+                       uint32_t(EIKON_WB_INDEX_E_C), uint32_t(EIKON_WB_MEDIUM_E), uint32_t(EIKON_WB_AXIS),
+                       uint32_t(EIKON_WB_SKIP)})
       b.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     for (uint32_t i : {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_SPLAT),
                        uint32_t(EIKON_WB_PATCHES_B), uint32_t(EIKON_WB_SCAN), uint32_t(EIKON_WB_TALLY)})
@@ -159,6 +182,15 @@ struct GpuWavefront::Impl {
     pipe.bindImage(EIKON_WB_INDEX_B, images[vol.dispersive ? 1 : 0]);
     pipe.bindImage(EIKON_WB_INDEX_C, images[vol.dispersive ? 2 : 0]);
     pipe.bindImage(EIKON_WB_MEDIUM, images[med]);
+    // e-mode images follow the o-mode ones; an o-mode run binds the o-mode images in their place
+    // (every binding must be valid; the kernel reads them only when control.w = 1).
+    const size_t e0 = eMode ? med + 1 : 0, eMed = eMode ? e0 + (vol.dispersive ? 3 : 1) : med;
+    pipe.bindImage(EIKON_WB_INDEX_E_A, images[e0]);
+    pipe.bindImage(EIKON_WB_INDEX_E_B, images[eMode && vol.dispersive ? e0 + 1 : e0]);
+    pipe.bindImage(EIKON_WB_INDEX_E_C, images[eMode && vol.dispersive ? e0 + 2 : e0]);
+    pipe.bindImage(EIKON_WB_MEDIUM_E, images[eMed]);
+    pipe.bindImage(EIKON_WB_AXIS, images[eMode ? eMed + 1 : med]);
+    pipe.bindImage(EIKON_WB_SKIP, images.back());
     pipe.bindBuffer(EIKON_WB_PARAMS, params);
     pipe.bindBuffer(EIKON_WB_SPLAT, splat);
     std::vector<vk::BindingSpec> cb;
@@ -259,8 +291,11 @@ struct GpuWavefront::Impl {
     // is ≤ 2^28 units, far inside int32 (the factor 2 covers RK4's overshoot in steep gradients),
     // and its rounding error is ≤ 0.5/scale = 2^-29·vmax. A 64-bit voxel sum overflows only after
     // 2^35 maximal splats into one voxel, i.e. never for runs of ≤ 2^20 patches × 2^14 steps.
+    // With straight steps a splat is one voxel's piece of a straight path, at most the voxel
+    // diagonal √3·h long, so that bounds Δs too.
     const double h3 = g.h * g.h * g.h;
-    const double vmax = std::max(maxSeed, 1e-300) * s.dt / (n_min * h3);
+    const double dsMax = s.skip_empty ? std::max(s.dt / n_min, std::sqrt(3.0) * g.h) : s.dt / n_min;
+    const double vmax = std::max(maxSeed, 1e-300) * dsMax / h3;
     const double scale = std::ldexp(1.0, 29) / (2.0 * vmax);
 
     gpu::WaveParams P{};
@@ -274,7 +309,10 @@ struct GpuWavefront::Impl {
     P.step = glm::vec4(float(s.dt), float(s.split_span_voxels * g.h), float(s.min_energy_fraction), float(1.0 / h3));
     const double l = s.wavelength_nm * 1e-3;
     P.wavelength = glm::vec4(float(l), float(il2), float(il4), float(scale));
-    P.control = glm::ivec4(0, steps_per_dispatch, s.max_steps, 0);
+    P.control = glm::ivec4(s.probe_axis >= 0 && s.probe_axis < 3 ? s.probe_axis : -1, steps_per_dispatch,
+                           s.max_steps, eMode ? 1 : 0);
+    P.probe = glm::vec4(float(s.probe_position), 0.0f, 0.0f, 0.0f);
+    P.options = glm::ivec4(s.skip_empty ? 1 : 0, 0, 0, 0);
     params.write(&P, sizeof P);
     std::vector<uint32_t> zero(g.count() * (EIKON_SPLAT_ACC_WORDS + 1), 0u);
     splat.write(zero.data(), zero.size() * sizeof(uint32_t));
@@ -311,6 +349,9 @@ struct GpuWavefront::Impl {
         wantSplit += t.count_b.y;
         survivors += t.count_b.z;
         st.steps = std::max(st.steps, int(t.count_b.w));
+        st.probe_centroid += glm::dvec3(glm::vec3(t.probe_pos));
+        st.flux_probe += t.probe_pos.w;
+        st.probe_direction += glm::dvec3(glm::vec3(t.probe_dir));
       }
       uint32_t total = readTotal();
       if (total > budget) {
@@ -342,6 +383,10 @@ struct GpuWavefront::Impl {
       src = dst;
     }
     if (st.flux_caustic > 0) st.caustic_centroid /= st.flux_caustic;
+    if (st.flux_probe != 0) {
+      st.probe_centroid /= st.flux_probe;
+      st.probe_direction /= st.flux_probe;
+    }
 
     std::vector<uint32_t> words(zero.size());
     splat.read(words.data(), words.size() * sizeof(uint32_t));

@@ -13,8 +13,9 @@
 // into a second buffer (each dispatch advances every live patch by up to `steps_per_dispatch`
 // steps; a patch that needs a split stops, is split one level by the rebuild, and children still
 // too large are split again by the next rebuild before they move); the host reads back only the
-// scan total and per-workgroup kill tallies; the probe plane (stats.flux_probe,
-// flux_ended_before_probe) is not computed; stats.max_live is the largest list length after a
+// scan total and per-workgroup kill tallies; of the probe plane, flux_probe, probe_centroid and
+// probe_direction are computed (a crossing is judged from the centre's positions before and after
+// the step) but not flux_ended_before_probe; stats.max_live is the largest list length after a
 // rebuild (the reference counts within a step).
 // Common mistakes: expecting bit-identical stats — float32 may move a borderline kill or split by
 // a step; expecting identical stats when splits are refused (the budget is applied per rebuild
@@ -53,7 +54,9 @@ class GpuScan {
 
 class GpuWavefront {
  public:
-  /// The volume is uploaded (o-mode index A/B/C and medium); it is referenced for seeding and
+  /// The volume is uploaded (o-mode index A/B/C and medium; for settings.mode = 1 in a uniaxial
+  /// volume also the e-mode index A/B/C, medium and the optic axis — the e-mode of an isotropic
+  /// volume is the o-mode); it is referenced for seeding and
   /// splitting and must outlive this object. Throws std::invalid_argument for bad settings,
   /// std::runtime_error if the splat buffer exceeds the device's storage-buffer range.
   GpuWavefront(vk::Context& ctx, const VolumeSet& volume, WavefrontSettings settings, int steps_per_dispatch = 16);
