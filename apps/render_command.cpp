@@ -5,9 +5,11 @@
 #include <filesystem>
 
 #include "apps/commands.h"
+#include "apps/light_cache.h"
 #include "apps/progress.h"
 #include "core/io/exr.h"
 #include "core/reference/reference_marcher.h"
+#include "core/render/light_transport.h"
 #include "core/render/view_renderer.h"
 #include "core/vk/context.h"
 
@@ -20,6 +22,11 @@ struct RenderArgs {
   double step = 0.5, exposure = 0.0;
   std::string integrator = "rk4";
   bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
+  // Light simulator (scenes with "lights").
+  int light_bands = 0, max_patches = 1 << 20;
+  double light_step = 0.0, light_split = 1.0;
+  std::string light_splat = "accumulate", light_cache;
+  bool no_light = false, no_light_cache = false;
 };
 
 Integrator parseIntegrator(const std::string& s) {
@@ -49,6 +56,17 @@ void addRenderCommand(CLI::App& app) {
   sub->add_flag("--no-fresnel", args->no_fresnel, "Disable Fresnel reflection and transmission losses");
   sub->add_flag("--strict", args->strict, "Treat warnings (e.g. wavelengths outside a material's range) as errors");
   sub->add_flag("-q,--quiet", args->quiet, "No progress lines");
+  sub->add_option("--light-bands", args->light_bands,
+                  "Light simulator wavelength bands (default: 12 dispersive, 3 attenuating, else 1)");
+  sub->add_option("--light-splat", args->light_splat,
+                  "accumulate (fluence rate, default) or highest (the highest patch irradiance per voxel)");
+  sub->add_option("--light-step", args->light_step, "Light simulator time step in voxels (default 0.5)");
+  sub->add_option("--light-split", args->light_split, "Split wavefront patches longer than this many voxels (default 1)");
+  sub->add_option("--max-patches", args->max_patches, "Most live wavefront patches (default 1048576)");
+  sub->add_option("--light-cache", args->light_cache,
+                  "Directory of cached light volumes (default $EIKON_CACHE_DIR, $XDG_CACHE_HOME/eikon or ~/.cache/eikon)");
+  sub->add_flag("--no-light-cache", args->no_light_cache, "Simulate the light even if a cached result exists, and store none");
+  sub->add_flag("--no-light", args->no_light, "Do not simulate the scene's lights (no caustics, in-scatter or lit surfaces)");
   sub->callback([args] {
     const RenderArgs& a = *args;
     std::filesystem::path out(a.output), png = std::filesystem::path(a.output).replace_extension(".png");
@@ -57,6 +75,12 @@ void addRenderCommand(CLI::App& app) {
     if (a.width < 0 || a.height < 0 || a.width > 16384 || a.height > 16384) throw CliError("--width/--height must be in [1, 16384]");
     if (a.wavelengths < -1 || a.wavelengths > 256) throw CliError("--wavelengths must be in [0, 256]");
     if (!(a.step > 0 && a.step <= 4)) throw CliError("--step must be in (0, 4] voxels");
+    if (a.light_bands < 0 || a.light_bands > 64) throw CliError("--light-bands must be in [1, 64]");
+    if (a.light_splat != "accumulate" && a.light_splat != "highest")
+      throw CliError("--light-splat must be accumulate or highest, got '" + a.light_splat + "'");
+    if (!(a.light_step >= 0 && a.light_step <= 2)) throw CliError("--light-step must be in (0, 2] voxels");
+    if (!(a.light_split >= 0.25 && a.light_split <= 8)) throw CliError("--light-split must be in [0.25, 8] voxels");
+    if (a.max_patches < 1024 || a.max_patches > (1 << 24)) throw CliError("--max-patches must be in [1024, 16777216]");
     Scene scene = loadScene(a.scene);
     for (const std::string& w : scene.warnings) {
       if (a.strict) throw CliError(w + " (--strict)");
@@ -95,6 +119,28 @@ void addRenderCommand(CLI::App& app) {
     vo.threads = a.threads;
     vo.progress = [&](double f, const char*) { progress.update("voxelising", f); };
     VolumeSet volume = voxelize(scene, vo);
+    LightingSummary light;
+    bool light_cached = false;
+    if (!scene.lights.empty() && !a.no_light) {
+      LightingOptions lo;
+      lo.bands = a.light_bands;
+      lo.wave.splat = a.light_splat == "highest" ? WavefrontSettings::Splat::HighestEnergy : WavefrontSettings::Splat::Accumulate;
+      lo.wave.dt = a.light_step * volume.grid.h;
+      lo.wave.split_span_voxels = a.light_split;
+      lo.wave.max_patches = a.max_patches;
+      lo.progress = [&](double f, const std::string& what) { progress.update(what.c_str(), f); };
+      std::filesystem::path cache_dir = a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache);
+      uint64_t key = lightCacheKey(scene, volume, lo, a.reference);
+      if (!a.no_light_cache && loadLightCache(cache_dir, key, volume)) {
+        light_cached = true;
+      } else {
+        light = a.reference ? simulateLightingReference(scene, volume, lo) : simulateLighting(*ctx, scene, volume, lo);
+        if (!a.no_light_cache) {
+          std::string err = saveLightCache(cache_dir, key, volume);
+          if (!err.empty()) std::fprintf(stderr, "eikon: warning: light cache: %s\n", err.c_str());
+        }
+      }
+    }
     rs.progress = [&](double f) { progress.update("rendering", f); };
     RenderImage img;
     if (a.reference) {
@@ -114,6 +160,11 @@ void addRenderCommand(CLI::App& app) {
       std::filesystem::remove(out, ec);
       throw;
     }
+    if (light_cached)
+      std::printf("eikon: light volumes from the cache (%s)\n", (a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache)).c_str());
+    else if (light.runs > 0)
+      std::printf("eikon: simulated %zu light runs in %.2f s: %zu patches (%.3g patches/s), flux balance %.1e\n", light.runs,
+                  light.seconds, light.patches, double(light.patches) / std::max(light.seconds, 1e-9), light.conservationError());
     double rays = double(img.width) * img.height * a.spp * std::max(1, rs.wavelengths);
     std::printf("eikon: rendered %s (%dx%d, %s, %d spp) on %s in %.2f s: %.3g rays/s, %.1f steps/ray -> %s, %s\n",
                 a.scene.c_str(), img.width, img.height,

@@ -33,6 +33,9 @@ using uvec4 = glm::uvec4;
 #define EIKON_B_TABLES 12
 #define EIKON_B_OUTPUT 13
 #define EIKON_B_RAYS 14
+#define EIKON_B_SCATTER 15        // (albedo rgb, HG g) — VolumeSet::scatter
+#define EIKON_B_LIGHT_FLUENCE 16  // (φ_r, φ_g, φ_b, φ_Y) simulated fluence rate — VolumeSet::light_fluence
+#define EIKON_B_LIGHT_FLUX 17     // (F_x, F_y, F_z, 0) net flux vector of φ_Y — VolumeSet::light_flux
 
 // ViewParams.flags bits.
 #define EIKON_F_DISPERSIVE 1
@@ -43,6 +46,8 @@ using uvec4 = glm::uvec4;
 #define EIKON_F_ATTENUATION 32  // some σ ≠ 0: sample the medium images
 #define EIKON_F_EMISSION 64     // some emission ≠ 0
 #define EIKON_F_OPACITY 128     // some opaque object
+#define EIKON_F_SCATTER 256     // some material has an albedo (in-scatter or a diffuse surface)
+#define EIKON_F_LIT 512         // light volumes from the light simulator are bound
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0
@@ -109,6 +114,14 @@ struct TraceResult {
 #define EIKON_WB_PATCHES_B 7  // second patch list (ping-pong with EIKON_WB_PATCHES)
 #define EIKON_WB_SCAN 8       // uint per patch: output count, then its exclusive prefix sum (scan.comp)
 #define EIKON_WB_TALLY 9      // one WaveTally per workgroup of the count pass
+// e-mode (WaveParams.control.w = 1; uniaxial volumes): n_e Cauchy A/B/C, σ_e bands, optic axis.
+// Bound to the o-mode images when the volume is isotropic (never read then).
+#define EIKON_WB_INDEX_E_A 10
+#define EIKON_WB_INDEX_E_B 11
+#define EIKON_WB_INDEX_E_C 12
+#define EIKON_WB_MEDIUM_E 13
+#define EIKON_WB_AXIS 14  // (a, 0) uniform axis or (centre, −1) radial field; zero where isotropic
+#define EIKON_WB_SKIP 15  // the VolumeSet's emission image: w = skip distance D (voxels) for straight steps
 // wavefront.comp passes (WavePush.control.y).
 #define EIKON_WM_PROPAGATE 0     // advance ALIVE patches by up to steps_per_dispatch steps
 #define EIKON_WM_COUNT 1         // scan[i] = 0 (dead / out of steps), 1 (keep), 4 (split); tally per workgroup
@@ -136,7 +149,9 @@ struct WaveParams {
   ivec4 grid_dims;   // xyz: voxels per axis; w: flags (EIKON_F_DISPERSIVE | _ATTENUATION | _OPACITY)
   vec4 step;         // x: dt (mm); y: split edge (mm); z: min energy fraction; w: 1/h³
   vec4 wavelength;   // x: λ (µm); y: 1/λ²; z: 1/λ⁴; w: splat scale (fixed-point units per W/mm²)
-  ivec4 control;     // x: unused (see WavePush); y: steps per dispatch; z: max_steps; w: unused
+  ivec4 control;     // x: probe axis (−1: none); y: steps per dispatch; z: max_steps; w: mode (0 o, 1 e)
+  vec4 probe;        // x: probe plane position (mm); yzw: unused
+  ivec4 options;     // x: 1 = straight steps across homogeneous regions (WavefrontSettings::skip_empty); yzw: unused
 };
 
 // Push constants of wavefront.comp. control: x: patches in the source list; y: pass (EIKON_WM_*);
@@ -159,12 +174,16 @@ struct WaveTally {
   vec4 caustic_sum;  // xyz: Σ flux·centre of caustic kills
   uvec4 count_a;  // kills: left, caustic, energy, opaque
   uvec4 count_b;  // x: live at max_steps; y: patches asking for a split; z: survivors (count ≥ 1); w: max steps
+  vec4 probe_pos;  // probe plane crossings in the last dispatch: xyz: Σ ±flux·crossing point; w: Σ ±flux
+  vec4 probe_dir;  // xyz: Σ ±flux·unit direction of the centre's motion at the crossing
 };
 
 // One patch: four corners in bilinear order (0,0), (1,0), (1,1), (0,1).
+// x[k].w, w[k].w: the probe sums of the last propagation (x[0..2].w: Σ ±flux·crossing point,
+// x[3].w: Σ ±flux, w[0..2].w: Σ ±flux·direction; w[3].w unused), read by the COUNT pass.
 struct WavePatch {
   vec4 x[4];    // xyz: corner position (mm)
-  vec4 w[4];    // xyz: corner wave vector w = n·t̂
+  vec4 w[4];    // xyz: corner wave vector w = p (o-mode |w| = n; e-mode wᵀM_e w = 1)
   vec4 flux;    // x: flux (W); y: area0 (mm²); z: seed flux (W); w: flux absorbed in this dispatch
   ivec4 state;  // x: EIKON_PATCH_*; y: launch orientation (±1, 0); z: entered (0/1); w: steps done
 };
@@ -172,9 +191,9 @@ struct WavePatch {
 #ifdef __cplusplus
 static_assert(sizeof(ViewParams) == 15 * 16, "ViewParams must be vec4-packed");
 static_assert(sizeof(TraceRay) == 32 && sizeof(TraceResult) == 64, "trace records must be vec4-packed");
-static_assert(sizeof(WavePush) == 16 && sizeof(ScanPush) == 16 && sizeof(WaveTally) == 5 * 16,
+static_assert(sizeof(WavePush) == 16 && sizeof(ScanPush) == 16 && sizeof(WaveTally) == 7 * 16,
               "wavefront push/tally records must be vec4-packed");
-static_assert(sizeof(WaveParams) == 6 * 16 && sizeof(WavePatch) == 10 * 16, "wavefront records must be vec4-packed");
+static_assert(sizeof(WaveParams) == 8 * 16 && sizeof(WavePatch) == 10 * 16, "wavefront records must be vec4-packed");
 }  // namespace eikon::gpu
 #endif
 

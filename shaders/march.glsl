@@ -23,6 +23,9 @@ layout(binding = EIKON_B_MEDIUM_O, rgba32f) readonly uniform image3D mediumO;
 layout(binding = EIKON_B_MEDIUM_E, rgba32f) readonly uniform image3D mediumE;
 layout(binding = EIKON_B_EMISSION, rgba32f) readonly uniform image3D emissionImg;
 layout(binding = EIKON_B_AXIS, rgba32f) readonly uniform image3D axisImg;
+layout(binding = EIKON_B_SCATTER, rgba32f) readonly uniform image3D scatterImg;
+layout(binding = EIKON_B_LIGHT_FLUENCE, rgba32f) readonly uniform image3D lightFluenceImg;
+layout(binding = EIKON_B_LIGHT_FLUX, rgba32f) readonly uniform image3D lightFluxImg;
 layout(std430, binding = EIKON_B_ENV_IMAGE) readonly buffer EnvBuf { vec4 envTexels[]; };
 layout(std430, binding = EIKON_B_TABLES) readonly buffer TableBuf { vec4 tables[]; };
 
@@ -112,6 +115,13 @@ vec3 sampleEmission(vec3 x) {
   return TRI(emissionImg, s).xyz;
 }
 
+// (albedo_r, albedo_g, albedo_b, g); zero where nothing scatters.
+vec4 sampleScatter(vec3 x) {
+  if (!hasFlag(EIKON_F_SCATTER)) return vec4(0.0);
+  Stencil s = stencilAt(x);
+  return TRI(scatterImg, s);
+}
+
 // Band values (σ at 612, 549, 465 nm) → value at gLambdaUm, linear between, constant beyond.
 float bandAt(vec3 rgb) {
   float l = gLambdaUm * 1000.0;
@@ -180,6 +190,54 @@ vec2 fresnelRsRp(float ci, float n1, float n2) {
   float rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
   float rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
   return vec2(rs * rs, rp * rp);
+}
+
+// Light from the light simulator (DESIGN §2 image formation, Tevs eq. 5.10; docs/light-simulator.md).
+// φ (fluence rate, W/mm², linear sRGB) and the net flux vector F of its luminance φ_Y, trilinear.
+// Henyey–Greenstein phase function of cos θ (θ between the light's and the scattered direction).
+float phaseHG(float cosTheta, float g) {
+  float d = 1.0 + g * g - 2.0 * g * cosTheta;
+  return (1.0 - g * g) / (4.0 * kPi * d * sqrt(d));
+}
+
+// Radiance scattered towards the eye per unit length at x, for a ray travelling along d, before
+// multiplying by the path transmittance: σ_s·p·φ with σ_s = albedo·σ_t. The light in a voxel is
+// one mean direction m = F/φ_Y with |m| ≤ 1 (1 for a single collimated beam): the phase function
+// is |m|·p_HG(m̂·(−d)) + (1 − |m|)/4π, i.e. the part of the light that does not share the mean
+// direction is treated as isotropic.
+vec3 inScatter(vec3 x, vec3 d, vec3 sigmaT) {
+  vec4 sc = sampleScatter(x);
+  if (sc.x + sc.y + sc.z <= 0.0) return vec3(0.0);
+  Stencil s = stencilAt(x);
+  vec4 phi = TRI(lightFluenceImg, s);
+  if (phi.w <= 0.0) return vec3(0.0);
+  vec3 m = TRI(lightFluxImg, s).xyz / phi.w;
+  float lm = min(length(m), 1.0);
+  float p = (1.0 - lm) / (4.0 * kPi);
+  if (lm > 1e-6) p += lm * phaseHG(dot(normalize(m), -d), sc.w);
+  return sigmaOf(sc.xyz) * sigmaT * colourOf(phi.xyz) * p;
+}
+
+// Radiance of a diffuse (Lambertian) opaque surface hit at x: albedo·E/π with E = φ·max(0, −m·N),
+// the irradiance on the surface of outward normal N from the light volumes sampled 1.5 voxels
+// outside the surface (clear of the opaque voxels, where nothing is splatted). N is the
+// normalised −∇opacity by central differences of the trilinear opacity.
+vec3 diffuseSurface(vec3 x, int mode) {
+  // The albedo field is composited with the object's coverage, like the opacity: at the stop
+  // point (opacity ≥ 0.5) the surface's own albedo is their ratio.
+  vec4 sc = sampleScatter(x) / max(sampleMedium(x, mode).w, 0.5);
+  if (!hasFlag(EIKON_F_LIT) || sc.x + sc.y + sc.z <= 0.0) return vec3(0.0);
+  float h = P.grid_origin.w;
+  vec3 g = vec3(sampleMedium(x + vec3(h, 0, 0), mode).w - sampleMedium(x - vec3(h, 0, 0), mode).w,
+                sampleMedium(x + vec3(0, h, 0), mode).w - sampleMedium(x - vec3(0, h, 0), mode).w,
+                sampleMedium(x + vec3(0, 0, h), mode).w - sampleMedium(x - vec3(0, 0, h), mode).w);
+  if (dot(g, g) <= 0.0) return vec3(0.0);
+  vec3 N = -normalize(g);
+  Stencil s = stencilAt(x + 1.5 * h * N);
+  vec4 phi = TRI(lightFluenceImg, s);
+  if (phi.w <= 0.0) return vec3(0.0);
+  float cosFactor = max(0.0, -dot(TRI(lightFluxImg, s).xyz, N)) / phi.w;
+  return sigmaOf(sc.xyz) * colourOf(phi.xyz) * (cosFactor / kPi);
 }
 
 // Ray–box slab test; returns false if the line misses. t0 ≤ t1.
@@ -344,16 +402,21 @@ MarchResult march(vec3 o, vec3 d, int mode) {
       boxHit(x, dir, bmin, bmax, tb0, tb1);
       float tExit = max(tb1, 0.0);
       float len = (em.w - 1.5) * h;
+      // A lit scattering medium is homogeneous but its light is not: sample the light every voxel.
+      bool scattering = hasFlag(EIKON_F_LIT) && hasFlag(EIKON_F_SCATTER) && dot(sampleScatter(x).xyz, vec3(1.0)) > 0.0;
+      if (scattering) len = min(len, h);
       bool leaving = len >= tExit;
       len = min(len, tExit);
       if (hasFlag(EIKON_F_OPACITY) && sampleMedium(x, mode).w >= 0.5) {
-        L += T * colourOf(em.xyz);
+        L += T * (colourOf(em.xyz) / sampleMedium(x, mode).w + diffuseSurface(x, mode));
         stopped = true;
         break;
       }
       if (hasFlag(EIKON_F_EMISSION) || hasFlag(EIKON_F_ATTENUATION)) {
         vec3 sig = hasFlag(EIKON_F_ATTENUATION) ? attenuationAt(x, w, mode) : vec3(0.0);
         vec3 e = colourOf(em.xyz);
+        // In-scatter with the light at the middle of this straight step, constant over it.
+        if (scattering) e += inScatter(x + 0.5 * len * dir, dir, sig);
         vec3 att = exp(-sig * len);
         // ∫₀^len T e^{−σs} e ds = T e (1 − e^{−σ len})/σ  (→ T e len as σ → 0)
         L += T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
@@ -398,9 +461,14 @@ MarchResult march(vec3 o, vec3 d, int mode) {
     // Medium at the step midpoint (only sampled where the scene has any).
     vec3 xm = 0.5 * (x0 + x);
     if (hasFlag(EIKON_F_EMISSION)) L += T * colourOf(sampleEmission(xm)) * ds;
-    if (hasFlag(EIKON_F_ATTENUATION)) T *= exp(-attenuationAt(xm, 0.5 * (w0 + w), mode) * ds);
+    if (hasFlag(EIKON_F_ATTENUATION)) {
+      vec3 sig = attenuationAt(xm, 0.5 * (w0 + w), mode);
+      if (hasFlag(EIKON_F_LIT) && hasFlag(EIKON_F_SCATTER)) L += T * inScatter(xm, normalize(x - x0), sig) * ds;
+      T *= exp(-sig * ds);
+    }
     if (hasFlag(EIKON_F_OPACITY) && sampleMedium(x, mode).w >= 0.5) {
-      L += T * colourOf(sampleEmission(x));
+      // Surface emission: the emission field over the coverage (opacity ≥ 0.5 here), as the albedo.
+      L += T * (colourOf(sampleEmission(x)) / sampleMedium(x, mode).w + diffuseSurface(x, mode));
       stopped = true;
       break;
     }

@@ -4,6 +4,8 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <cstdio>
 #include <stdexcept>
 #include <thread>
 
@@ -106,6 +108,15 @@ glm::dvec4 VolumeField::mediumE(const glm::dvec3& x) const {
   return v_.uniaxial ? trilinear(v_.medium[1], x) : trilinear(v_.medium[0], x);
 }
 glm::dvec3 VolumeField::emission(const glm::dvec3& x) const { return glm::dvec3(trilinear(v_.emission, x)); }
+glm::dvec4 VolumeField::scatter(const glm::dvec3& x) const {
+  return v_.scatter.empty() ? glm::dvec4(0.0) : trilinear(v_.scatter, x);
+}
+glm::dvec4 VolumeField::lightFluence(const glm::dvec3& x) const {
+  return v_.light_fluence.empty() ? glm::dvec4(0.0) : trilinear(v_.light_fluence, x);
+}
+glm::dvec3 VolumeField::lightFlux(const glm::dvec3& x) const {
+  return v_.light_flux.empty() ? glm::dvec3(0.0) : glm::dvec3(trilinear(v_.light_flux, x));
+}
 
 double VolumeField::skipDistance(const glm::dvec3& x) const {
   const Grid& g = v_.grid;
@@ -188,6 +199,44 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
     glm::dvec3 t = glm::normalize(applyM(w, a, no, ne));
     return n * n * n * (so * c2 / (no * no * no) + se * s2 / (ne * ne * ne)) * glm::dot(sn, t);
   };
+  // Light from the light simulator: in-scatter σ_s·p·φ and diffuse surfaces albedo·E/π; the
+  // formulas and the mean-direction phase model are those of march.glsl inScatter/diffuseSurface.
+  const bool lit = field_.lit();
+  auto phaseHG = [](double cosTheta, double g) {
+    double dd = 1.0 + g * g - 2.0 * g * cosTheta;
+    return (1.0 - g * g) / (4.0 * kPi * dd * std::sqrt(dd));
+  };
+  auto inScatter = [&](const glm::dvec3& x, const glm::dvec3& dir, const glm::dvec3& sigmaT) {
+    glm::dvec4 sc = field_.scatter(x);
+    if (sc.x + sc.y + sc.z <= 0.0) return glm::dvec3(0.0);
+    glm::dvec4 phi = field_.lightFluence(x);
+    if (phi.w <= 0.0) return glm::dvec3(0.0);
+    glm::dvec3 mdir = field_.lightFlux(x) / phi.w;
+    double lm = std::min(glm::length(mdir), 1.0);
+    double p = (1.0 - lm) / (4.0 * kPi);
+    if (lm > 1e-6) p += lm * phaseHG(glm::dot(glm::normalize(mdir), -dir), sc.w);
+    return sigmaOf(glm::dvec3(sc)) * sigmaT * colour(glm::dvec3(phi)) * p;
+  };
+  auto diffuseSurface = [&](const glm::dvec3& x) {
+    // Albedo and opacity are both composited with the coverage: their ratio is the surface's albedo.
+    glm::dvec4 sc = field_.scatter(x) / std::max(mode == 1 ? field_.mediumE(x).w : field_.medium(x).w, 0.5);
+    if (!lit || sc.x + sc.y + sc.z <= 0.0) return glm::dvec3(0.0);
+    const double hh = field_.cellSize();
+    auto opacity = [&](const glm::dvec3& y) { return mode == 1 ? field_.mediumE(y).w : field_.medium(y).w; };
+    glm::dvec3 g;
+    for (int a = 0; a < 3; ++a) {
+      glm::dvec3 e(0.0);
+      e[a] = hh;
+      g[a] = opacity(x + e) - opacity(x - e);
+    }
+    if (glm::dot(g, g) <= 0.0) return glm::dvec3(0.0);
+    glm::dvec3 N = -glm::normalize(g);
+    glm::dvec3 xs = x + 1.5 * hh * N;
+    glm::dvec4 phi = field_.lightFluence(xs);
+    if (phi.w <= 0.0) return glm::dvec3(0.0);
+    double cosFactor = std::max(0.0, -glm::dot(field_.lightFlux(xs), N)) / phi.w;
+    return sigmaOf(glm::dvec3(sc)) * colour(glm::dvec3(phi)) * (cosFactor / kPi);
+  };
   auto sWeight = [](const glm::dvec3& s_crystal, const glm::dvec3& a, const glm::dvec3& N, const glm::dvec3& dIn,
                     int md) {
     glm::dvec3 es = glm::cross(N, dIn);
@@ -232,16 +281,21 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
       boxHit(x, dir, bmin, bmax, tb0, tb1);
       double tExit = std::max(tb1, 0.0);
       double len = (D - 1.5) * h;
+      // A lit scattering medium is homogeneous but its light is not: sample the light every voxel.
+      glm::dvec4 scHere = lit ? field_.scatter(x) : glm::dvec4(0.0);
+      bool scattering = scHere.x + scHere.y + scHere.z > 0.0;
+      if (scattering) len = std::min(len, h);
       bool leaving = len >= tExit;
       len = std::min(len, tExit);
       glm::dvec4 med = field_.medium(x);
       glm::dvec3 e = colour(field_.emission(x));
       if (med.w >= 0.5) {
-        L += T * e;
+        L += T * (e / med.w + diffuseSurface(x));
         stopped = true;
         break;
       }
       glm::dvec3 sig = attenuationAt(x, w);
+      if (scattering) e += inScatter(x + 0.5 * len * dir, dir, sig);
       for (int c = 0; c < 3; ++c) {
         double a = std::exp(-sig[c] * len);
         L[c] += T[c] * (sig[c] > 1e-6 ? e[c] * (1.0 - a) / sig[c] : e[c] * len);
@@ -286,9 +340,12 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
     }
     glm::dvec3 xm = 0.5 * (x0 + x);
     L += T * colour(field_.emission(xm)) * ds;
-    T *= glm::exp(-attenuationAt(xm, 0.5 * (w0 + w)) * ds);
+    glm::dvec3 sig = attenuationAt(xm, 0.5 * (w0 + w));
+    if (lit) L += T * inScatter(xm, glm::normalize(x - x0), sig) * ds;
+    T *= glm::exp(-sig * ds);
     if (field_.medium(x).w >= 0.5) {
-      L += T * colour(field_.emission(x));
+      // Surface emission: the emission field over the coverage (opacity ≥ 0.5 here), as the albedo.
+      L += T * (colour(field_.emission(x)) / field_.medium(x).w + diffuseSurface(x));
       stopped = true;
       break;
     }

@@ -49,6 +49,14 @@ class Field {
   virtual double ambientIndex() const { return 1.0; }
   /// True if some region is uniaxial (renders then average the o- and e-modes).
   virtual bool uniaxial() const { return false; }
+  /// (albedo_r, albedo_g, albedo_b, Henyey–Greenstein g); zero where nothing scatters.
+  virtual glm::dvec4 scatter(const glm::dvec3&) const { return glm::dvec4(0.0); }
+  /// Simulated light (VolumeSet::light_fluence, light_flux): (φ_r, φ_g, φ_b, φ_Y) in W/mm² and
+  /// the net flux vector F of φ_Y; zero where there is none.
+  virtual glm::dvec4 lightFluence(const glm::dvec3&) const { return glm::dvec4(0.0); }
+  virtual glm::dvec3 lightFlux(const glm::dvec3&) const { return glm::dvec3(0.0); }
+  /// True once light volumes are present (in-scatter and diffuse surfaces are then lit).
+  virtual bool lit() const { return false; }
 };
 
 /// Trilinear sampling of a VolumeSet (same stencil and clamping as the shader).
@@ -67,6 +75,10 @@ class VolumeField : public Field {
   double cellSize() const override { return v_.grid.h; }
   double ambientIndex() const override { return v_.ambient_index; }
   bool uniaxial() const override { return v_.uniaxial; }
+  glm::dvec4 scatter(const glm::dvec3& x) const override;
+  glm::dvec4 lightFluence(const glm::dvec3& x) const override;
+  glm::dvec3 lightFlux(const glm::dvec3& x) const override;
+  bool lit() const override { return v_.lit(); }
 
  private:
   glm::dvec4 trilinear(const std::vector<glm::vec4>& f, const glm::dvec3& x) const;

@@ -32,8 +32,13 @@ void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scen
                                std::to_string(grid.dims[0]) + "x" + std::to_string(grid.dims[1]) + "x" +
                                std::to_string(grid.dims[2]) + " voxels but the device '" + ctx.deviceName() +
                                "' allows at most " + std::to_string(lim.max_image_dimension_3d) + " per side");
-  // Images: 3 index fields + medium + emission (+ 3 e-index, medium e, axis when uniaxial).
+  // Images: 3 index fields + medium + emission (+ 3 e-index, medium e, axis when uniaxial)
+  // (+ scatter when a material has an albedo, + 2 light volumes when the scene has lights).
   size_t images = scene.anyUniaxial() ? 10 : 5;
+  bool scattering = false;
+  for (const auto& [name, m] : scene.materials) scattering = scattering || glm::length(m.albedo) > 0;
+  if (scattering) images += 1;
+  if (!scene.lights.empty()) images += 2;
   double bytes = double(grid.count()) * 16.0 * double(images);
   if (bytes > 0.9 * double(lim.heap_size))
     throw std::runtime_error(scene.file.string() + ": /volume/resolution: the volume needs " +
@@ -46,7 +51,10 @@ struct ViewRenderer::Impl {
   const Scene& scene;
   Grid grid;
   bool uniaxial = false, dispersive = false, attenuating = false, emissive = false, opaque = false;
-  std::vector<vk::Image3D> images;  // [oA, oB, oC, eA, eB, eC, medO, medE, emission, axis]
+  bool scattering = false, lit = false;
+  // [oA, oB, oC, (eA, eB, eC), medO, (medE), emission, (axis), (scatter), (fluence, flux)]
+  std::vector<vk::Image3D> images;
+  size_t scatterImage = 0, fluenceImage = 0, fluxImage = 0;  // 0: not present (index A bound instead)
   vk::Buffer params, env, tables;
   vk::ComputePipeline view, tracer;
   int skip_cap = 32;
@@ -59,6 +67,8 @@ struct ViewRenderer::Impl {
     attenuating = v.attenuating;
     emissive = v.emissive;
     opaque = v.opaque;
+    scattering = v.scattering;
+    lit = v.lit();
     skip_cap = v.skip_cap;
     ambient = v.ambient_index;
     std::array<uint32_t, 3> ext{uint32_t(grid.dims[0]), uint32_t(grid.dims[1]), uint32_t(grid.dims[2])};
@@ -75,6 +85,18 @@ struct ViewRenderer::Impl {
     if (uniaxial) upload(v.medium[1], "medium e");
     upload(v.emission, "emission");
     if (uniaxial) upload(v.axis, "optic axis");
+    if (scattering) {
+      scatterImage = images.size();
+      upload(v.scatter, "scatter");
+    }
+    if (lit) {
+      if (v.light_fluence.size() != grid.count() || v.light_flux.size() != grid.count())
+        throw std::invalid_argument("light volumes do not match the volume's grid");
+      fluenceImage = images.size();
+      upload(v.light_fluence, "light fluence");
+      fluxImage = images.size();
+      upload(v.light_flux, "light flux");
+    }
 
     params = vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
     const auto& e = scene.environment;
@@ -98,6 +120,8 @@ struct ViewRenderer::Impl {
 
     std::vector<vk::BindingSpec> common;
     for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b) common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    for (uint32_t b : {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE), uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
     view = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4), common, 0, "view");
@@ -120,6 +144,9 @@ struct ViewRenderer::Impl {
     p.bindImage(EIKON_B_MEDIUM_E, images[medE]);
     p.bindImage(EIKON_B_EMISSION, images[emi]);
     p.bindImage(EIKON_B_AXIS, images[axis]);
+    p.bindImage(EIKON_B_SCATTER, images[scatterImage]);
+    p.bindImage(EIKON_B_LIGHT_FLUENCE, images[fluenceImage]);
+    p.bindImage(EIKON_B_LIGHT_FLUX, images[fluxImage]);
     p.bindBuffer(EIKON_B_PARAMS, params);
     p.bindBuffer(EIKON_B_ENV_IMAGE, env);
     p.bindBuffer(EIKON_B_TABLES, tables);
@@ -143,6 +170,8 @@ struct ViewRenderer::Impl {
     if (attenuating) flags |= EIKON_F_ATTENUATION;
     if (emissive) flags |= EIKON_F_EMISSION;
     if (opaque) flags |= EIKON_F_OPACITY;
+    if (scattering) flags |= EIKON_F_SCATTER;
+    if (lit) flags |= EIKON_F_LIT;
     if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
     if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);

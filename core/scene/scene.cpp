@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/io/exr.h"
+#include "core/spectrum/illuminants.h"
 
 namespace eikon {
 namespace {
@@ -214,10 +215,10 @@ Attenuation parseAttenuation(const Node& n) {
 Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
   if (is_file)
     m.allowKeys({"name", "source", "notes", "fit", "n", "n_o", "n_e", "optic_axis", "attenuation_per_mm",
-                 "attenuation_o_per_mm", "attenuation_e_per_mm", "emission", "opacity"});
+                 "attenuation_o_per_mm", "attenuation_e_per_mm", "emission", "opacity", "albedo", "phase_g"});
   else
     m.allowKeys({"n", "n_o", "n_e", "optic_axis", "attenuation_per_mm", "attenuation_o_per_mm",
-                 "attenuation_e_per_mm", "emission", "opacity", "source", "notes"});
+                 "attenuation_e_per_mm", "emission", "opacity", "albedo", "phase_g", "source", "notes"});
   Material mat;
   mat.name = name;
   if (auto s = m.get("source")) mat.source = s->string();
@@ -244,6 +245,19 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
   }
   if (auto e = m.get("emission")) mat.emission = e->color();
   if (auto o = m.get("opacity")) mat.opacity = o->number(0.0, 1.0);
+  if (auto a = m.get("albedo")) {
+    mat.albedo = a->color();
+    if (mat.albedo.x > 1 || mat.albedo.y > 1 || mat.albedo.z > 1) a->fail("albedo must be in [0, 1] per band");
+    // Translucent scattering is albedo·σ_t: without attenuation there is nothing to scatter.
+    if (mat.opacity < 0.5 && glm::length(mat.albedo) > 0 && mat.attenuation_o.isZero() && mat.attenuation_e.isZero())
+      a->fail("a translucent material scatters albedo x attenuation; give attenuation_per_mm > 0 (or opacity 1 for a "
+              "diffuse surface)");
+  }
+  if (auto g = m.get("phase_g")) {
+    mat.phase_g = g->number(-1.0, 1.0);
+    if (std::abs(mat.phase_g) >= 1.0) g->fail("phase_g must be in (-1, 1), got " + fmt(mat.phase_g));
+    if (mat.opacity >= 0.5) g->fail("phase_g is the in-scatter asymmetry of a translucent material; an opaque one is diffuse");
+  }
   return mat;
 }
 
@@ -375,6 +389,15 @@ glm::dvec3 GrinProfile::indexGradient(const glm::dvec3& x) const {
   return glm::dvec3(0.0);
 }
 
+double Light::spectralPower(double lambda_nm) const {
+  if (spectrum_nm.empty()) return spectrum::d65(lambda_nm);
+  if (lambda_nm < spectrum_nm.front() || lambda_nm > spectrum_nm.back()) return 0.0;
+  size_t k = size_t(std::upper_bound(spectrum_nm.begin(), spectrum_nm.end(), lambda_nm) - spectrum_nm.begin());
+  if (k >= spectrum_nm.size()) return spectrum_power.back();
+  double t = (lambda_nm - spectrum_nm[k - 1]) / (spectrum_nm[k] - spectrum_nm[k - 1]);
+  return spectrum_power[k - 1] + t * (spectrum_power[k] - spectrum_power[k - 1]);
+}
+
 double Attenuation::at(double lambda_nm) const {
   if (!wavelengths_nm.empty()) {
     if (lambda_nm <= wavelengths_nm.front()) return values.front();
@@ -453,6 +476,62 @@ Material loadMaterialFile(const std::filesystem::path& path) {
   Node root(j, "", file);
   std::string name = root.get("name") ? root.at("name").string() : path.stem().string();
   return parseMaterial(root, name, true);
+}
+
+// ------------------------------------------------------------------ lights
+static Light parseLight(const Node& l) {
+  Light light;
+  std::string type = l.at("type").string();
+  if (type == "directional") {
+    l.allowKeys({"type", "direction", "irradiance", "beam_radius", "beam_center", "spectrum"});
+    light.type = Light::Type::Directional;
+    light.direction = l.at("direction").unitVector();
+    if (auto v = l.get("irradiance")) light.irradiance = v->number(0.0, 1e12);
+    if (auto r = l.get("beam_radius")) light.beam_radius = r->positive();
+    if (auto c = l.get("beam_center")) {
+      if (!l.has("beam_radius")) c->fail("beam_center needs beam_radius (the beam's radius in mm)");
+      light.position = c->vec3();
+    }
+  } else if (type == "point" || type == "spot") {
+    if (type == "point") l.allowKeys({"type", "position", "intensity", "spectrum"});
+    else l.allowKeys({"type", "position", "direction", "cone_half_angle_deg", "intensity", "spectrum"});
+    light.type = type == "point" ? Light::Type::Point : Light::Type::Spot;
+    light.position = l.at("position").vec3();
+    if (auto v = l.get("intensity")) light.irradiance = v->number(0.0, 1e12);
+    if (type == "spot") {
+      light.direction = l.at("direction").unitVector();
+      light.cone_half_angle_deg = l.at("cone_half_angle_deg").number(0.0, 90.0, true);
+    }
+  } else {
+    l.at("type").fail("unknown light type '" + type + "' (directional, point, spot)");
+  }
+  if (auto sp = l.get("spectrum")) {
+    if (sp->isString()) {
+      std::string name = sp->string();
+      if (name == "E") {
+        light.spectrum_nm = {380.0, 780.0};
+        light.spectrum_power = {1.0, 1.0};
+      } else if (name != "D65") {
+        sp->fail("unknown spectrum '" + name + "' (\"D65\", \"E\" or {\"wavelength_nm\": [...], \"power\": [...]})");
+      }
+    } else {
+      sp->allowKeys({"wavelength_nm", "power"});
+      light.spectrum_nm = sp->at("wavelength_nm").numbers();
+      light.spectrum_power = sp->at("power").numbers();
+      if (light.spectrum_nm.size() != light.spectrum_power.size() || light.spectrum_nm.size() < 2)
+        sp->fail("wavelength_nm and power must have the same length, at least 2");
+      double total = 0;
+      for (size_t k = 0; k < light.spectrum_nm.size(); ++k) {
+        if (light.spectrum_power[k] < 0) sp->at("power").index(k).fail("must be >= 0");
+        if (k && !(light.spectrum_nm[k] > light.spectrum_nm[k - 1]))
+          sp->at("wavelength_nm").index(k).fail("wavelength_nm must be strictly increasing");
+        total += light.spectrum_power[k];
+      }
+      if (light.spectrum_nm.front() >= 780.0 || light.spectrum_nm.back() <= 380.0 || !(total > 0))
+        sp->fail("the spectrum has no power in 380-780 nm");
+    }
+  }
+  return light;
 }
 
 Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
@@ -596,6 +675,12 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     double h = std::max(ext.x, std::max(ext.y, ext.z)) / v.resolution;
     double margin = (3.0 * v.smoothing_voxels + 1.0) * h;
     for (size_t i = 0; i < scene.objects.size(); ++i) {
+      // An object with the ambient index everywhere (a haze, an opaque floor) refracts nothing.
+      const Material& mat = scene.materials[scene.objects[i].material];
+      bool refracts = mat.uniaxial || mat.grin.type != GrinProfile::Type::None;
+      for (double l = 380.0; l <= 780.0 && !refracts; l += 40.0)
+        refracts = std::abs(mat.n_o.index(l) - scene.ambient_index) > 1e-12;
+      if (!refracts) continue;
       double closest = 1e300;
       for (int axis = 0; axis < 3; ++axis)
         for (int side = 0; side < 2; ++side)
@@ -616,25 +701,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
 
   if (auto ls = root.get("lights")) {
     if (!ls->isArray()) ls->fail("expected an array of lights");
-    for (size_t i = 0; i < ls->size(); ++i) {
-      Node l = ls->index(i);
-      Light light;
-      std::string type = l.at("type").string();
-      if (type == "directional") {
-        l.allowKeys({"type", "direction", "irradiance"});
-        light.type = Light::Type::Directional;
-        light.direction = l.at("direction").unitVector();
-        if (auto v = l.get("irradiance")) light.irradiance = v->number(0.0, 1e12);
-      } else if (type == "point") {
-        l.allowKeys({"type", "position", "intensity"});
-        light.type = Light::Type::Point;
-        light.position = l.at("position").vec3();
-        if (auto v = l.get("intensity")) light.irradiance = v->number(0.0, 1e12);
-      } else {
-        l.at("type").fail("unknown light type '" + type + "' (directional, point)");
-      }
-      scene.lights.push_back(light);
-    }
+    for (size_t i = 0; i < ls->size(); ++i) scene.lights.push_back(parseLight(ls->index(i)));
   }
   return scene;
 }

@@ -59,6 +59,11 @@ struct Material {
   Attenuation attenuation_o, attenuation_e;
   glm::dvec3 emission{0.0};       ///< radiance per mm (translucent) or surface radiance (opaque)
   double opacity = 0.0;           ///< 1 = opaque: rays stop at the surface
+  /// Translucent: single-scattering albedo σ_s/σ_t per RGB band (σ_t = the attenuation), so the
+  /// scattering coefficient is albedo·σ_t; opaque: the diffuse (Lambertian) reflectance of the
+  /// surface, which then shows the simulated irradiance as albedo·E/π. Zero: no scattering.
+  glm::dvec3 albedo{0.0};
+  double phase_g = 0.0;           ///< Henyey–Greenstein asymmetry g ∈ (−1, 1) of the in-scatter
 };
 
 struct Camera {
@@ -99,11 +104,26 @@ struct SceneObject {
   bool radial_axis = false;
 };
 
+/// A light of the light simulator (docs/light-simulator.md). Its power is `irradiance` (directional:
+/// E in W/mm² across the beam; point and spot: intensity I in W/sr), the integral over 380–780 nm
+/// of a spectral distribution of the given shape. Colours are normalised so that a light of any
+/// spectrum and power E lights a white diffuse surface at normal incidence to linear-sRGB
+/// luminance Y = E (D65: rgb ≈ (E, E, E)).
 struct Light {
-  enum class Type { Directional, Point } type = Type::Directional;
-  glm::dvec3 direction{0, -1, 0};  ///< directional: unit propagation direction
-  glm::dvec3 position{0.0};        ///< point
-  double irradiance = 1.0;         ///< directional: W/mm² (relative); point: intensity W/sr
+  enum class Type { Directional, Point, Spot } type = Type::Directional;
+  glm::dvec3 direction{0, -1, 0};  ///< directional and spot: unit propagation direction (spot: cone axis)
+  glm::dvec3 position{0.0};        ///< point and spot: the source; directional with a beam: a point on the beam axis
+  double irradiance = 1.0;         ///< directional: E (W/mm²); point, spot: intensity I (W/sr)
+  /// Directional only: radius (mm) of a collimated beam of circular cross-section about the axis
+  /// through `position` (a laser or a slit-less collimator); 0 = the whole volume is lit.
+  double beam_radius = 0.0;
+  /// Spot only: half-angle (degrees) of the cone of directions about `direction` that is lit.
+  double cone_half_angle_deg = 0.0;
+  /// Relative spectral power distribution (any scale); empty = D65 (CIE standard daylight).
+  std::vector<double> spectrum_nm, spectrum_power;
+  /// Relative spectral power at λ (nm): the tabulated shape, linear in between, 0 outside; D65
+  /// when no table is given.
+  double spectralPower(double lambda_nm) const;
 };
 
 struct Scene {

@@ -14,6 +14,7 @@ enum Field : int {
   kSor, kSog, kSob, kOpacity,        // attenuation o (band values), opacity
   kSer, kSeg, kSeb,                  // attenuation e
   kEr, kEg, kEb,                     // emission
+  kAlr, kAlg, kAlb, kPhaseG,         // scattering albedo (or diffuse reflectance), HG asymmetry
   kFieldCount
 };
 
@@ -56,7 +57,7 @@ size_t VolumeSet::deviceBytes() const {
   for (const auto& mode : index)
     for (const auto& f : mode) texels += f.size();
   for (const auto& m : medium) texels += m.size();
-  texels += emission.size() + axis.size();
+  texels += emission.size() + axis.size() + scatter.size() + light_fluence.size() + light_flux.size();
   return texels * sizeof(glm::vec4);
 }
 
@@ -126,7 +127,9 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
       mv.v[kSor + c] = float(so[c]);
       mv.v[kSer + c] = float(se[c]);
       mv.v[kEr + c] = float(m.emission[c]);
+      mv.v[kAlr + c] = float(m.albedo[c]);
     }
+    mv.v[kPhaseG] = float(m.phase_g);
     mv.v[kOpacity] = float(m.opacity);
     values[name] = mv;
     if (mv.v[kBo] != 0 || mv.v[kCo] != 0 || mv.v[kBe] != 0 || mv.v[kCe] != 0) vs.dispersive = true;
@@ -135,6 +138,8 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
     for (int f : {kEr, kEg, kEb})
       if (mv.v[f] != 0) vs.emissive = true;
     if (mv.v[kOpacity] != 0) vs.opaque = true;
+    for (int f : {kAlr, kAlg, kAlb})
+      if (mv.v[f] != 0) vs.scattering = true;
   }
 
   std::vector<std::vector<float>> fields(kFieldCount, std::vector<float>(N, 0.0f));
@@ -315,6 +320,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
     vs.axis = std::move(axis);
   }
   vs.emission = pack(kEr, kEg, kEb, -1);
+  if (vs.scattering) vs.scatter = pack(kAlr, kAlg, kAlb, kPhaseG);
 
   // Active voxels: any field differs from a 26-neighbour. Then the capped Chebyshev distance.
   std::vector<int> used;

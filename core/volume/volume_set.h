@@ -16,6 +16,13 @@
 //   emission      : (e_r, e_g, e_b, skip) emission and the empty-space skip distance in voxels
 //   axis          : (a_x, a_y, a_z, 0) uniform optic axis, or (c_x, c_y, c_z, −1) for a radial axis
 //                   field about c (uniaxial scenes only; zero where isotropic)
+//   scatter       : (albedo_r, albedo_g, albedo_b, g) single-scattering albedo and Henyey–Greenstein
+//                   g of translucent media, or the diffuse reflectance of opaque ones (only when
+//                   some material has an albedo)
+//   light_fluence : (φ_r, φ_g, φ_b, φ_Y) simulated fluence rate (W/mm², linear sRGB and luminance)
+//   light_flux    : (F_x, F_y, F_z, 0) the net flux vector of φ_Y (W/mm²): F/φ_Y is the mean
+//                   propagation direction, −F·N the irradiance on a surface of outward normal N
+//                   (both only after a light simulation: core/volume/lighting.h)
 // The skip distance D is the Chebyshev distance (in voxels, capped) from the voxel to the nearest
 // voxel whose fields differ from a neighbour's: within (D − 1) voxels every field is constant,
 // so a ray may cross that distance in one straight step (DESIGN's "distance volume").
@@ -50,12 +57,18 @@ struct VolumeSet {
   bool attenuating = false;  ///< some attenuation is non-zero
   bool emissive = false;     ///< some emission is non-zero
   bool opaque = false;       ///< some opacity is non-zero
+  bool scattering = false;   ///< some material has an albedo (translucent in-scatter or a diffuse surface)
   double ambient_index = 1.0;
   std::array<std::array<std::vector<glm::vec4>, 3>, 2> index;  ///< [mode][A,B,C]; e empty if !uniaxial
   std::array<std::vector<glm::vec4>, 2> medium;                ///< [mode]; e empty if !uniaxial
   std::vector<glm::vec4> emission;
   std::vector<glm::vec4> axis;  ///< empty unless uniaxial
+  std::vector<glm::vec4> scatter;        ///< empty unless scattering
+  std::vector<glm::vec4> light_fluence;  ///< empty until a light simulation (lighting.h) fills it
+  std::vector<glm::vec4> light_flux;     ///< same
   int skip_cap = 32;            ///< largest stored skip distance (voxels)
+
+  bool lit() const { return !light_fluence.empty(); }
 
   /// Bytes the GPU copy needs (to refuse clearly before allocating).
   size_t deviceBytes() const;

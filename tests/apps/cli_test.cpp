@@ -390,4 +390,62 @@ TEST_F(Cli, TraceGpuAgreesWithReference) {
   EXPECT_GT(std::abs(pc[1] - 1.5), 0.1);
 }
 
+// ------------------------------------------------------------------ lights (issue 6)
+
+// A lit floor under the tiny glass sphere: the light is simulated once and then read back from
+// the cache (keyed by the medium, the lights and the simulator settings, never the camera), and
+// the cached render is the same picture.
+TEST_F(Cli, RenderSimulatesLightOnceThenUsesTheCache) {
+  const std::string scene = R"({
+  "camera": {"position": [0, 20, -20], "look_at": [0, -2, 0], "up": [0, 1, 0], "fov_deg": 30, "width": 32, "height": 24},
+  "environment": {"type": "constant", "radiance": 0.1},
+  "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "resolution": 24},
+  "materials": {"glass": {"n": 1.5}, "floor": {"n": 1, "opacity": 1, "albedo": 0.8}},
+  "objects": [{"shape": "box", "center": [0, -3.5, 0], "size": [8, 1, 8], "material": "floor"},
+              {"shape": "sphere", "center": [0, 0.5, 0], "radius": 2.5, "material": "glass"}],
+  "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 2}]
+})";
+  const std::string cache = (dir_ / "cache").string();
+  const Outcome first = render(scene, "-q --light-cache " + quote(cache));
+  ASSERT_EQ(first.code, 0) << first.err;
+  EXPECT_NE(first.out.find("simulated 1 light runs"), std::string::npos) << first.out;
+  EXPECT_NE(first.out.find("flux balance"), std::string::npos) << first.out;
+  const std::vector<float> a = eikon::readExrRgba(outPath(), 64, 64).rgba;
+  // A different camera: the light is not simulated again.
+  std::string moved = scene;
+  moved.replace(moved.find("[0, 20, -20]"), 12, "[0, 21, -20]");
+  const Outcome second = render(moved, "-q --light-cache " + quote(cache));
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_NE(second.out.find("light volumes from the cache"), std::string::npos) << second.out;
+  // Same camera, cached light: the same picture as the first, simulated, render.
+  const Outcome third = render(scene, "-q --light-cache " + quote(cache));
+  ASSERT_EQ(third.code, 0) << third.err;
+  const std::vector<float> c = eikon::readExrRgba(outPath(), 64, 64).rgba;
+  ASSERT_EQ(a.size(), c.size());
+  EXPECT_EQ(a, c);
+  // A moved light is simulated anew.
+  std::string relit = scene;
+  relit.replace(relit.find("[0, -1, 0]"), 10, "[0.1, -1, 0]");
+  const Outcome fourth = render(relit, "-q --light-cache " + quote(cache));
+  ASSERT_EQ(fourth.code, 0) << fourth.err;
+  EXPECT_NE(fourth.out.find("simulated 1 light runs"), std::string::npos) << fourth.out;
+  // The lit floor is brighter than the unlit one (environment only).
+  const Outcome dark = render(scene, "-q --no-light");
+  ASSERT_EQ(dark.code, 0) << dark.err;
+  const std::vector<float> d = eikon::readExrRgba(outPath(), 64, 64).rgba;
+  double lit_sum = 0, dark_sum = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    lit_sum += a[i];
+    dark_sum += d[i];
+  }
+  EXPECT_GT(lit_sum, 1.5 * dark_sum);
+}
+
+TEST_F(Cli, BadLightOptionsFailCleanly) {
+  expectCleanFailure(render(tinyScene(), "--light-bands 100"), "--light-bands");
+  expectCleanFailure(render(tinyScene(), "--light-splat brightest"), "--light-splat must be accumulate or highest");
+  expectCleanFailure(render(tinyScene(), "--max-patches 10"), "--max-patches");
+  expectCleanFailure(render(tinyScene(), "--light-split 0.1"), "--light-split");
+}
+
 }  // namespace

@@ -439,3 +439,81 @@ TEST(SceneParse, TestDataScenesParse) {
 
 }  // namespace
 }  // namespace eikon
+
+// ------------------------------------------------------------------ lights and scattering (issue 6)
+namespace eikon {
+namespace {
+
+std::string withLight(const std::string& light) {
+  return scene(kGlass, kSphere, "\"lights\": [" + light + "]");
+}
+
+TEST(SceneParse, LightsParseBeamsSpotsAndSpectra) {
+  Scene s = parseScene(withLight(R"({"type": "directional", "direction": [0, -2, 0], "irradiance": 3,
+                                     "beam_radius": 1.5, "beam_center": [1, 2, 3], "spectrum": "E"},
+                                    {"type": "spot", "position": [0, 5, 0], "direction": [0, -1, 0],
+                                     "cone_half_angle_deg": 20, "intensity": 2,
+                                     "spectrum": {"wavelength_nm": [400, 700], "power": [1, 3]}},
+                                    {"type": "point", "position": [0, 5, 0]})"),
+                       kOrigin);
+  ASSERT_EQ(s.lights.size(), 3u);
+  EXPECT_EQ(s.lights[0].direction, glm::dvec3(0, -1, 0));
+  EXPECT_EQ(s.lights[0].beam_radius, 1.5);
+  EXPECT_EQ(s.lights[0].position, glm::dvec3(1, 2, 3));
+  EXPECT_EQ(s.lights[0].spectralPower(555.0), 1.0);  // "E": flat
+  EXPECT_EQ(s.lights[1].type, Light::Type::Spot);
+  EXPECT_EQ(s.lights[1].cone_half_angle_deg, 20.0);
+  EXPECT_DOUBLE_EQ(s.lights[1].spectralPower(550.0), 2.0);  // linear between (400, 1) and (700, 3)
+  EXPECT_EQ(s.lights[1].spectralPower(720.0), 0.0);          // nothing outside the table
+  EXPECT_DOUBLE_EQ(s.lights[2].spectralPower(560.0), 100.0);  // default D65, 100 at 560 nm
+}
+
+TEST(SceneParse, BadLights) {
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "laser", "direction": [0, -1, 0]})"), "/lights/0/type", "unknown light type");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "directional", "direction": [0, 0, 0]})"), "/lights/0/direction", "non-zero");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "directional", "direction": [0, -1, 0], "beam_radius": -1})"),
+                     "/lights/0/beam_radius", "must be > 0");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "directional", "direction": [0, -1, 0], "beam_center": [0, 0, 0]})"),
+                     "/lights/0/beam_center", "needs beam_radius");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0], "beam_radius": 1})"), "/lights/0/beam_radius",
+                     "unknown key");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "spot", "position": [0, 0, 0], "direction": [0, -1, 0], "cone_half_angle_deg": 95})"),
+                     "/lights/0/cone_half_angle_deg", "must be in");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "spot", "position": [0, 0, 0], "direction": [0, -1, 0]})"), "/lights/0",
+                     "cone_half_angle_deg");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0], "intensity": -2})"), "/lights/0/intensity",
+                     "must be in");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0], "spectrum": "tungsten"})"),
+                     "/lights/0/spectrum", "unknown spectrum");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0],
+                                   "spectrum": {"wavelength_nm": [500, 400], "power": [1, 1]}})"),
+                     "/lights/0/spectrum/wavelength_nm/1", "strictly increasing");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0],
+                                   "spectrum": {"wavelength_nm": [800, 900], "power": [1, 1]}})"),
+                     "/lights/0/spectrum", "no power in 380-780 nm");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0],
+                                   "spectrum": {"wavelength_nm": [400, 500], "power": [1, -1]}})"),
+                     "/lights/0/spectrum/power/1", ">= 0");
+}
+
+TEST(SceneParse, ScatteringMaterials) {
+  Scene s = parseScene(scene(R"("smoke": {"n": 1, "attenuation_per_mm": 0.1, "albedo": [0.9, 0.8, 0.7], "phase_g": 0.4},
+                                 "floor": {"n": 1, "opacity": 1, "albedo": 0.5})",
+                             R"({"shape": "sphere", "radius": 3, "material": "smoke"},
+                                {"shape": "sphere", "center": [5, 0, 0], "radius": 1, "material": "floor"})"),
+                       kOrigin);
+  EXPECT_EQ(s.materials.at("smoke").albedo, glm::dvec3(0.9, 0.8, 0.7));
+  EXPECT_EQ(s.materials.at("smoke").phase_g, 0.4);
+  EXPECT_EQ(s.materials.at("floor").albedo, glm::dvec3(0.5));
+  const std::string obj = R"({"shape": "sphere", "radius": 3, "material": "m"})";
+  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "attenuation_per_mm": 0.1, "albedo": 1.2})", obj), "/materials/m/albedo",
+                     "[0, 1]");
+  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "albedo": 0.5})", obj), "/materials/m/albedo", "attenuation_per_mm > 0");
+  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "attenuation_per_mm": 0.1, "albedo": 0.5, "phase_g": 1})", obj),
+                     "/materials/m/phase_g", "(-1, 1)");
+  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "opacity": 1, "albedo": 0.5, "phase_g": 0.2})", obj), "/materials/m/phase_g",
+                     "diffuse");
+}
+
+}  // namespace
+}  // namespace eikon

@@ -1,0 +1,164 @@
+#include "apps/light_cache.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <system_error>
+#include <unistd.h>
+#include <vector>
+
+namespace eikon::cli {
+namespace {
+
+constexpr uint64_t kFormat = 1;
+constexpr char kMagic[8] = {'E', 'I', 'K', 'L', 'I', 'G', 'H', 'T'};
+
+/// Word-wise 64-bit hash (FNV-1a constants, one 64-bit word per round, murmur finaliser).
+class Hasher {
+ public:
+  void bytes(const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+      uint64_t w;
+      std::memcpy(&w, p + i, 8);
+      word(w);
+    }
+    uint64_t tail = 0;
+    std::memcpy(&tail, p + i, n - i);
+    word(tail ^ (uint64_t(n) << 56));
+  }
+  template <typename T>
+  void value(const T& v) { bytes(&v, sizeof v); }
+  template <typename T>
+  void vec(const std::vector<T>& v) {
+    value(v.size());
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+  uint64_t digest() const {
+    uint64_t x = h_;
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    x *= 0xc4ceb9fe1a85ec53ULL;
+    return x ^ (x >> 33);
+  }
+
+ private:
+  void word(uint64_t w) { h_ = (h_ ^ w) * 0x100000001b3ULL + (h_ >> 29); }
+  uint64_t h_ = 0xcbf29ce484222325ULL;
+};
+
+std::filesystem::path entryPath(const std::filesystem::path& dir, uint64_t key) {
+  char name[40];
+  std::snprintf(name, sizeof name, "light-%016llx.bin", static_cast<unsigned long long>(key));
+  return dir / name;
+}
+
+}  // namespace
+
+std::filesystem::path defaultLightCacheDir() {
+  if (const char* d = std::getenv("EIKON_CACHE_DIR"); d && *d) return d;
+  if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d) return std::filesystem::path(d) / "eikon";
+  if (const char* d = std::getenv("HOME"); d && *d) return std::filesystem::path(d) / ".cache" / "eikon";
+  return {};
+}
+
+uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOptions& o, bool reference) {
+  Hasher h;
+  h.value(kFormat);
+  h.value(reference);
+  h.value(v.grid.dims);
+  h.value(v.grid.origin);
+  h.value(v.grid.h);
+  h.value(v.ambient_index);
+  for (const auto& mode : v.index)
+    for (const auto& f : mode) h.vec(f);
+  for (const auto& m : v.medium) h.vec(m);
+  h.vec(v.axis);
+  h.vec(v.scatter);
+  h.value(scene.lights.size());
+  for (const Light& l : scene.lights) {
+    h.value(l.type);
+    h.value(l.direction);
+    h.value(l.position);
+    h.value(l.irradiance);
+    h.value(l.beam_radius);
+    h.value(l.cone_half_angle_deg);
+    h.vec(l.spectrum_nm);
+    h.vec(l.spectrum_power);
+  }
+  const WavefrontSettings& s = o.wave;
+  h.value(o.bands);
+  h.value(o.smoothing_voxels);
+  h.value(s.dt);
+  h.value(s.max_steps);
+  h.value(s.min_energy_fraction);
+  h.value(s.split_span_voxels);
+  h.value(s.seed_span_voxels);
+  h.value(s.splat);
+  h.value(s.max_patches);
+  h.value(s.point_radius);
+  h.value(s.point_cells_per_face);
+  return h.digest();
+}
+
+bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& volume) {
+  if (dir.empty()) return false;
+  std::ifstream in(entryPath(dir, key), std::ios::binary);
+  if (!in) return false;
+  char magic[8];
+  uint64_t format = 0, stored_key = 0;
+  std::array<int, 3> dims{};
+  in.read(magic, 8);
+  in.read(reinterpret_cast<char*>(&format), sizeof format);
+  in.read(reinterpret_cast<char*>(&stored_key), sizeof stored_key);
+  in.read(reinterpret_cast<char*>(dims.data()), sizeof dims);
+  if (!in || std::memcmp(magic, kMagic, 8) != 0 || format != kFormat || stored_key != key || dims != volume.grid.dims)
+    return false;
+  const size_t N = volume.grid.count();
+  std::vector<glm::vec4> fluence(N), flux(N);
+  in.read(reinterpret_cast<char*>(fluence.data()), std::streamsize(N * sizeof(glm::vec4)));
+  in.read(reinterpret_cast<char*>(flux.data()), std::streamsize(N * sizeof(glm::vec4)));
+  if (!in || in.peek() != std::char_traits<char>::eof()) return false;
+  volume.light_fluence = std::move(fluence);
+  volume.light_flux = std::move(flux);
+  return true;
+}
+
+std::string saveLightCache(const std::filesystem::path& dir, uint64_t key, const VolumeSet& volume) {
+  if (dir.empty()) return "no cache directory (set EIKON_CACHE_DIR or HOME)";
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return "cannot create " + dir.string() + ": " + ec.message();
+  std::filesystem::path final_path = entryPath(dir, key);
+  std::string tmpl = final_path.string() + ".tmpXXXXXX";
+  int fd = ::mkstemp(tmpl.data());
+  if (fd < 0) return "cannot write in " + dir.string();
+  ::close(fd);
+  {
+    std::ofstream out(tmpl, std::ios::binary | std::ios::trunc);
+    uint64_t format = kFormat;
+    out.write(kMagic, 8);
+    out.write(reinterpret_cast<const char*>(&format), sizeof format);
+    out.write(reinterpret_cast<const char*>(&key), sizeof key);
+    out.write(reinterpret_cast<const char*>(volume.grid.dims.data()), sizeof volume.grid.dims);
+    out.write(reinterpret_cast<const char*>(volume.light_fluence.data()),
+              std::streamsize(volume.light_fluence.size() * sizeof(glm::vec4)));
+    out.write(reinterpret_cast<const char*>(volume.light_flux.data()),
+              std::streamsize(volume.light_flux.size() * sizeof(glm::vec4)));
+    if (!out) {
+      std::filesystem::remove(tmpl, ec);
+      return "cannot write " + final_path.string();
+    }
+  }
+  std::filesystem::rename(tmpl, final_path, ec);
+  if (ec) {
+    std::filesystem::remove(tmpl, ec);
+    return "cannot write " + final_path.string();
+  }
+  return {};
+}
+
+}  // namespace eikon::cli
