@@ -13,7 +13,10 @@
 // when dispersive, B, C) field exactly as march.glsl / VolumeField do. Per step, in the order of
 // the reference: flux ← flux·exp(−σΔs) (σ at the step midpoint of the centre path), splat of
 // flux_mid·Δs/h³ into the voxel holding the midpoint, then the kills (opaque, left, caustic,
-// energy) and the split test. A patch that needs a split stops there with state EIKON_PATCH_SPLIT
+// energy) and the split test. In homogeneous regions (WaveParams.options.x = 1, skip distance
+// D ≥ 2 at the centre and the corners) a straight step of k time steps replaces the RK4 step and
+// its centre's path is splatted into every voxel it crosses (straightSteps, splatSegment; the
+// rules of wavefront.cpp). A patch that needs a split stops there with state EIKON_PATCH_SPLIT
 // and the list is rebuilt on the GPU before the next propagation (so a patch never runs ahead of
 // a split it needs; patches are independent, so they need not share the same clock between
 // dispatches — each carries its own step count in state.w).
@@ -373,12 +376,14 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, out vec3 v[4]) {
     sp = length(v[k]) * dt;
     if (sp > 0.0) kmax = min(kmax, floor((D[k] - 1.5) * h / sp));
   }
-  const float ds1 = length(vc) * dt;
-  if (ds1 > 0.0) {
+  // Energy: below the threshold already (a split's child): one step; else the first step below it.
+  const float ds1 = length(vc) * dt, thr = P.step.z * flux.z;
+  if (flux.x < thr) {
+    kmax = min(kmax, 1.0);
+  } else if (ds1 > 0.0) {
     const vec3 m = c0 + 0.5 * dt * vc;
     const float sigma = eMode() ? sigmaE(m, wm) : sigmaAt(sampleMedium(m).xyz);
-    const float thr = P.step.z * flux.z;
-    if (sigma > 0.0 && flux.x >= thr && thr > 0.0) kmax = min(kmax, floor(log(flux.x / thr) / (sigma * ds1)) + 1.0);
+    if (sigma > 0.0 && thr > 0.0) kmax = min(kmax, floor(log(flux.x / thr) / (sigma * ds1)) + 1.0);
   }
   if (kmax < 1.0) return 0;
   const int K = int(kmax);

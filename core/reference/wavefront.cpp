@@ -397,13 +397,15 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     };
     capBy(Dmin, vc);
     for (int k = 0; k < 4; ++k) capBy(D[k], v[k]);
-    const double ds1 = glm::length(vc) * dt;
-    if (ds1 > 0) {
+    // Energy: a patch already below the threshold (a child of a split) is killed after its next
+    // step; otherwise the first step at which exp(−σ·j·ds1) takes it below.
+    const double ds1 = glm::length(vc) * dt, thr = s_.min_energy_fraction * p.seed_energy;
+    if (p.energy < thr) {
+      kmax = std::min(kmax, 1.0);
+    } else if (ds1 > 0) {
       const glm::dvec3 m = c0 + 0.5 * dt * vc;
       const double sigma = eMode ? sigmaE(m, wm) : sigmaAt(glm::dvec3(field_.medium(m)), s_.wavelength_nm);
-      const double thr = s_.min_energy_fraction * p.seed_energy;
-      if (sigma > 0 && p.energy >= thr && thr > 0)
-        kmax = std::min(kmax, std::floor(std::log(p.energy / thr) / (sigma * ds1)) + 1.0);
+      if (sigma > 0 && thr > 0) kmax = std::min(kmax, std::floor(std::log(p.energy / thr) / (sigma * ds1)) + 1.0);
     }
     if (kmax < 1.0) return 0;
     const int K = int(kmax);

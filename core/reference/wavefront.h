@@ -19,6 +19,8 @@
 // zero (isotropic regions) the o-mode equations above are used unchanged. Flux is attached to the ray tube a patch
 // spans, so it is constant along the tube except for attenuation, flux ← flux·exp(−σ Δs); the
 // patch irradiance is flux / current area (the intensity law ΔE(t) = ΔE(0)·A(0)/A(t)).
+// In homogeneous regions (skip distance ≥ 2, WavefrontSettings::skip_empty) a patch takes k steps
+// at once along straight lines, the exact solution there (docs/light-simulator.md).
 //
 // Units: positions in mm; a light's `irradiance` is E (directional, per mm²) or I (point, per
 // sr) in the light's own radiometric unit (W in the text). A patch's flux is then in W (E·mm² or

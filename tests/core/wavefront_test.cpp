@@ -104,6 +104,56 @@ TEST(Wavefront, GlassSphereConservesFlux) {
   EXPECT_LE(st.flux_probe, st.flux_emitted * (1 + 1e-9));
 }
 
+// 2b. Straight steps across homogeneous regions (WavefrontSettings::skip_empty) against single
+// RK4 steps on the same sphere. Where they are taken every field is constant, so the exact ray is
+// the straight line and RK4 reproduces it to round-off: both runs make the same decisions at the
+// same steps (straight steps stop at the first step where single steps would split or kill).
+// Only a decision within round-off of its threshold (an edge at the split span, an orientation
+// at zero) could differ; we allow 1e-3 relative on the counts and 1e-6 of the emitted flux per
+// reason (a flipped patch carries ≤ 1/4096 of it; measured: identical). The volumes differ only
+// in where deposits fall: a single step puts its whole Δs = h/2 (air) in the voxel of its
+// midpoint, the straight step splits it at the voxel face, so per face crossing at most Δs/2 of
+// a column's 2 steps per voxel moves to the neighbour (≤ 1/4 of a voxel's deposit, counted twice
+// in L1: ≤ 1/2 without any cancellation between columns; we allow 0.05, measured 1.2e-3),
+// and at the far face the last single step may deposit up to one Δs beyond the straight path
+// clipped to the grid (≤ Δs per column of ≥ 32 voxels, 1/64; measured 6.6e-5).
+TEST(Wavefront, StraightStepsMatchSingleSteps) {
+  const Scene scene = sceneFromJson(kGlassSphereLightScene);
+  const VolumeSet vol = voxelize(scene);
+  VolumeField field(vol);
+  const Light light = directionalLight({1, 0, 0}, 1.0);
+  WavefrontSettings s;
+  s.skip_empty = false;
+  const WavefrontResult a = WavefrontSimulator(field, vol.grid, s).run(light);
+  s.skip_empty = true;
+  const WavefrontResult b = WavefrontSimulator(field, vol.grid, s).run(light);
+  printWavefrontStats("single steps", a.stats);
+  printWavefrontStats("straight steps", b.stats);
+  std::printf("[ measured ] straight steps %zu covering %zu time steps\n", b.stats.straight_steps,
+              b.stats.straight_time_steps);
+  double sumA = 0, sumB = 0, l1 = 0;
+  for (size_t v = 0; v < vol.grid.count(); ++v) {
+    sumA += a.irradiance[v], sumB += b.irradiance[v], l1 += std::abs(double(b.irradiance[v]) - a.irradiance[v]);
+  }
+  std::printf("[ measured ] volume: sum straight/single - 1 = %.2e, L1 = %.2e\n", sumB / sumA - 1, l1 / sumA);
+  const WavefrontStats &sa = a.stats, &sb = b.stats;
+  EXPECT_GT(sb.straight_time_steps, sb.straight_steps);  // straight steps were taken, k > 1 on average
+  EXPECT_EQ(sa.straight_steps, 0u);
+  auto rel = [](double x, double y) { return std::abs(x - y) / std::max(1.0, std::abs(y)); };
+  EXPECT_LE(rel(double(sb.splits), double(sa.splits)), 1e-3);
+  EXPECT_LE(rel(double(sb.kills_left), double(sa.kills_left)), 1e-3);
+  EXPECT_LE(rel(double(sb.kills_caustic), double(sa.kills_caustic)), 1e-3);
+  EXPECT_LE(rel(double(sb.kills_energy), double(sa.kills_energy)), 1e-3);
+  EXPECT_EQ(sb.steps, sa.steps);
+  EXPECT_NEAR(sb.flux_left, sa.flux_left, 1e-6 * sa.flux_emitted);
+  EXPECT_NEAR(sb.flux_caustic, sa.flux_caustic, 1e-6 * sa.flux_emitted);
+  EXPECT_NEAR(sb.flux_energy, sa.flux_energy, 1e-6 * sa.flux_emitted);
+  EXPECT_NEAR(sb.flux_left + sb.flux_caustic + sb.flux_energy, sb.flux_emitted, 1e-9 * sb.flux_emitted);
+  EXPECT_LT(glm::length(sb.caustic_centroid - sa.caustic_centroid), 1e-6 * vol.grid.h);
+  EXPECT_NEAR(sumB / sumA, 1.0, 1.0 / 64);
+  EXPECT_LT(l1 / sumA, 0.05);
+}
+
 // 3. Luneburg lens n = √(2 − r²/R²), R = 1 (physics_cases §7a), exact analytic field. Every ray
 // parallel to +x reaches (R, 0, 0) after the same optical path R(1 + π/2) from x = −R, and the
 // simulator's time is optical path (c = 1), so the part of the front inside the lens collapses
