@@ -51,6 +51,8 @@
 #include "anisotropic/pleochroism.h"
 #include "anisotropic/uniaxial.h"
 #include "core/reference/reference_marcher.h"
+#include "core/reference/reference_lighting.h"
+#include "core/render/light_transport.h"
 #include "core/render/view_renderer.h"
 #include "core/scene/scene.h"
 #include "core/vk/context.h"
@@ -692,6 +694,57 @@ PYBIND11_MODULE(eikon, m) {
            py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(), py::arg("device") = "gpu",
            py::arg("threads") = 0,
            "(H, W, 3) float32 linear sRGB; wavelengths > 0 = spectral mode with that many samples")
+      .def("simulate_light", [](Prepared& p, int bands, const std::string& splat, double step_voxels,
+                                double smoothing_voxels, const std::string& device) {
+             const bool gpu = isGpu(device);
+             p.ensureVolume(gpu);
+             LightingOptions o;
+             o.bands = bands;
+             if (splat != "accumulate" && splat != "highest")
+               throw std::invalid_argument("splat must be 'accumulate' or 'highest', got '" + splat + "'");
+             o.wave.splat = splat == "highest" ? WavefrontSettings::Splat::HighestEnergy : WavefrontSettings::Splat::Accumulate;
+             o.wave.dt = step_voxels * p.volume->grid.h;
+             o.smoothing_voxels = smoothing_voxels;
+             LightingSummary sum;
+             {
+               py::gil_scoped_release release;
+               sum = gpu ? simulateLighting(*p.ctx, *p.scene, *p.volume, o) : simulateLightingReference(*p.scene, *p.volume, o);
+             }
+             // Renderers built before hold the unlit volume: rebuild them on their next use.
+             p.gpu.reset();
+             p.cpu.reset();
+             p.field.reset();
+             py::dict d;
+             d["runs"] = sum.runs;
+             d["seconds"] = sum.seconds;
+             d["patches"] = sum.patches;
+             d["flux_emitted"] = sum.flux_emitted;
+             d["flux_left"] = sum.flux_left;
+             d["flux_caustic"] = sum.flux_caustic;
+             d["flux_energy"] = sum.flux_energy;
+             d["flux_absorbed"] = sum.flux_absorbed;
+             d["conservation_error"] = sum.conservationError();
+             d["device"] = device;
+             return d; },
+           py::arg("bands") = 0, py::arg("splat") = "accumulate", py::arg("step_voxels") = 0.5,
+           py::arg("smoothing_voxels") = 1.0, py::arg("device") = "gpu",
+           "simulate the scene's lights (docs/lighting.md) into the volume that later renders read; "
+           "returns the summed run statistics")
+      .def("light_volumes", [](Prepared& p) {
+             p.ensureVolume(false);
+             if (!p.volume->lit()) throw std::runtime_error("no light volumes: call simulate_light() first");
+             const Grid& g = p.volume->grid;
+             auto arr = [&](const std::vector<glm::vec4>& v) {
+               py::array_t<float> a({py::ssize_t(g.dims[2]), py::ssize_t(g.dims[1]), py::ssize_t(g.dims[0]), py::ssize_t(4)});
+               std::copy(&v[0].x, &v[0].x + 4 * v.size(), a.mutable_data());
+               return a;
+             };
+             py::dict d;
+             d["fluence"] = arr(p.volume->light_fluence);
+             d["flux"] = arr(p.volume->light_flux);
+             return d; },
+           "{'fluence': (Z, Y, X, 4) φ_r, φ_g, φ_b, φ_Y (W/mm²), 'flux': (Z, Y, X, 4) net flux vector} "
+           "on the voxel grid (index [k, j, i] is the voxel centred at origin + (i + ½, j + ½, k + ½)·h)")
       .def("trace_rays", [](Prepared& p, const py::handle& origins, const py::handle& directions,
                             const py::handle& wavelength_nm, std::optional<MarchSettings> march,
                             const std::string& device) {
