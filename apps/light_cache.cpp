@@ -102,6 +102,7 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOpt
   h.value(s.point_radius);
   h.value(s.point_cells_per_face);
   h.value(s.skip_empty);
+  h.value(s.pass_caustics);
   h.value(s.beam_min_cells);
   return h.digest();
 }

@@ -25,7 +25,7 @@ struct RenderArgs {
   // Light simulator (scenes with "lights").
   int light_bands = 0, max_patches = 1 << 20;
   double light_step = 0.0, light_split = 1.0;
-  std::string light_splat = "accumulate", light_cache;
+  std::string light_splat = "accumulate", light_cache, caustics = "pass", light_device = "auto";
   bool no_light = false, no_light_cache = false;
 };
 
@@ -60,6 +60,11 @@ void addRenderCommand(CLI::App& app) {
                   "Light simulator wavelength bands (default: 12 dispersive, 3 attenuating, else 1)");
   sub->add_option("--light-splat", args->light_splat,
                   "accumulate (fluence rate, default) or highest (the highest patch irradiance per voxel)");
+  sub->add_option("--light-device", args->light_device,
+                  "auto (default: the CPU reference when the Vulkan device is a CPU, e.g. lavapipe, where it is "
+                  "3-4x faster; else the GPU), gpu or cpu");
+  sub->add_option("--caustics", args->caustics,
+                  "pass (light continues through a focus, default) or kill (Tevs: patches end at a fold caustic)");
   sub->add_option("--light-step", args->light_step, "Light simulator time step in voxels (default 0.5)");
   sub->add_option("--light-split", args->light_split, "Split wavefront patches longer than this many voxels (default 1)");
   sub->add_option("--max-patches", args->max_patches, "Most live wavefront patches (default 1048576)");
@@ -78,6 +83,9 @@ void addRenderCommand(CLI::App& app) {
     if (a.light_bands < 0 || a.light_bands > 64) throw CliError("--light-bands must be in [1, 64]");
     if (a.light_splat != "accumulate" && a.light_splat != "highest")
       throw CliError("--light-splat must be accumulate or highest, got '" + a.light_splat + "'");
+    if (a.light_device != "auto" && a.light_device != "gpu" && a.light_device != "cpu")
+      throw CliError("--light-device must be auto, gpu or cpu, got '" + a.light_device + "'");
+    if (a.caustics != "pass" && a.caustics != "kill") throw CliError("--caustics must be pass or kill, got '" + a.caustics + "'");
     if (!(a.light_step >= 0 && a.light_step <= 2)) throw CliError("--light-step must be in (0, 2] voxels");
     if (!(a.light_split >= 0.25 && a.light_split <= 8)) throw CliError("--light-split must be in [0.25, 8] voxels");
     if (a.max_patches < 1024 || a.max_patches > (1 << 24)) throw CliError("--max-patches must be in [1024, 16777216]");
@@ -120,7 +128,7 @@ void addRenderCommand(CLI::App& app) {
     vo.progress = [&](double f, const char*) { progress.update("voxelising", f); };
     VolumeSet volume = voxelize(scene, vo);
     LightingSummary light;
-    bool light_cached = false;
+    bool light_cached = false, light_on_cpu = false;
     if (!scene.lights.empty() && !a.no_light) {
       LightingOptions lo;
       lo.bands = a.light_bands;
@@ -128,13 +136,18 @@ void addRenderCommand(CLI::App& app) {
       lo.wave.dt = a.light_step * volume.grid.h;
       lo.wave.split_span_voxels = a.light_split;
       lo.wave.max_patches = a.max_patches;
+      lo.wave.pass_caustics = a.caustics == "pass";
       lo.progress = [&](double f, const std::string& what) { progress.update(what.c_str(), f); };
       std::filesystem::path cache_dir = a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache);
-      uint64_t key = lightCacheKey(scene, volume, lo, a.reference);
+      // Which twin simulates: --reference renders use the CPU throughout; on a CPU Vulkan device
+      // (lavapipe) the double-precision CPU twin is also the faster one (docs/light-simulator.md).
+      light_on_cpu = a.reference || a.light_device == "cpu" ||
+                     (a.light_device == "auto" && ctx && ctx->deviceTypeName() == "CPU");
+      uint64_t key = lightCacheKey(scene, volume, lo, light_on_cpu);
       if (!a.no_light_cache && loadLightCache(cache_dir, key, volume)) {
         light_cached = true;
       } else {
-        light = a.reference ? simulateLightingReference(scene, volume, lo) : simulateLighting(*ctx, scene, volume, lo);
+        light = light_on_cpu ? simulateLightingReference(scene, volume, lo) : simulateLighting(*ctx, scene, volume, lo);
         if (!a.no_light_cache) {
           std::string err = saveLightCache(cache_dir, key, volume);
           if (!err.empty()) std::fprintf(stderr, "eikon: warning: light cache: %s\n", err.c_str());
@@ -160,11 +173,13 @@ void addRenderCommand(CLI::App& app) {
       std::filesystem::remove(out, ec);
       throw;
     }
+    for (const std::string& n : light.notes) std::fprintf(stderr, "eikon: note: %s\n", n.c_str());
     if (light_cached)
       std::printf("eikon: light volumes from the cache (%s)\n", (a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache)).c_str());
     else if (light.runs > 0)
-      std::printf("eikon: simulated %zu light runs in %.2f s: %zu patches (%.3g patches/s), flux balance %.1e\n", light.runs,
-                  light.seconds, light.patches, double(light.patches) / std::max(light.seconds, 1e-9), light.conservationError());
+      std::printf("eikon: simulated %zu light runs on %s in %.2f s: %zu patches (%.3g patches/s), flux balance %.1e\n",
+                  light.runs, light_on_cpu ? "the CPU reference" : ctx->deviceName().c_str(), light.seconds, light.patches,
+                  double(light.patches) / std::max(light.seconds, 1e-9), light.conservationError());
     double rays = double(img.width) * img.height * a.spp * std::max(1, rs.wavelengths);
     std::printf("eikon: rendered %s (%dx%d, %s, %d spp) on %s in %.2f s: %.3g rays/s, %.1f steps/ray -> %s, %s\n",
                 a.scene.c_str(), img.width, img.height,

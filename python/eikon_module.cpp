@@ -695,7 +695,7 @@ PYBIND11_MODULE(eikon, m) {
            py::arg("threads") = 0,
            "(H, W, 3) float32 linear sRGB; wavelengths > 0 = spectral mode with that many samples")
       .def("simulate_light", [](Prepared& p, int bands, const std::string& splat, double step_voxels,
-                                double smoothing_voxels, const std::string& device) {
+                                double smoothing_voxels, const std::string& caustics, const std::string& device) {
              const bool gpu = isGpu(device);
              p.ensureVolume(gpu);
              LightingOptions o;
@@ -705,6 +705,9 @@ PYBIND11_MODULE(eikon, m) {
              o.wave.splat = splat == "highest" ? WavefrontSettings::Splat::HighestEnergy : WavefrontSettings::Splat::Accumulate;
              o.wave.dt = step_voxels * p.volume->grid.h;
              o.smoothing_voxels = smoothing_voxels;
+             if (caustics != "pass" && caustics != "kill")
+               throw std::invalid_argument("caustics must be 'pass' or 'kill', got '" + caustics + "'");
+             o.wave.pass_caustics = caustics == "pass";
              LightingSummary sum;
              {
                py::gil_scoped_release release;
@@ -727,7 +730,7 @@ PYBIND11_MODULE(eikon, m) {
              d["device"] = device;
              return d; },
            py::arg("bands") = 0, py::arg("splat") = "accumulate", py::arg("step_voxels") = 0.5,
-           py::arg("smoothing_voxels") = 1.0, py::arg("device") = "gpu",
+           py::arg("smoothing_voxels") = 1.0, py::arg("caustics") = "pass", py::arg("device") = "gpu",
            "simulate the scene's lights (docs/lighting.md) into the volume that later renders read; "
            "returns the summed run statistics")
       .def("light_volumes", [](Prepared& p) {

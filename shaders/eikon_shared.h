@@ -151,7 +151,7 @@ struct WaveParams {
   vec4 wavelength;   // x: λ (µm); y: 1/λ²; z: 1/λ⁴; w: splat scale (fixed-point units per W/mm²)
   ivec4 control;     // x: probe axis (−1: none); y: steps per dispatch; z: max_steps; w: mode (0 o, 1 e)
   vec4 probe;        // x: probe plane position (mm); yzw: unused
-  ivec4 options;     // x: 1 = straight steps across homogeneous regions (WavefrontSettings::skip_empty); yzw: unused
+  ivec4 options;     // x: 1 = straight steps across homogeneous regions (skip_empty); y: 1 = pass_caustics; zw: unused
 };
 
 // Push constants of wavefront.comp. control: x: patches in the source list; y: pass (EIKON_WM_*);

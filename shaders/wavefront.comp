@@ -485,8 +485,12 @@ void propagate(uint id) {
     }
     float o = dot(va, wm);
     if ((o > 0.0 && p.state.y < 0) || (o < 0.0 && p.state.y > 0)) {
-      p.state.x = EIKON_PATCH_CAUSTIC;
-      break;
+      if (P.options.y != 0) {
+        p.state.y = -p.state.y;  // pass_caustics: through the focal line, orientation reversed
+      } else {
+        p.state.x = EIKON_PATCH_CAUSTIC;
+        break;
+      }
     }
     if (p.flux.x < P.step.z * p.flux.z) {
       p.state.x = EIKON_PATCH_ENERGY;

@@ -22,21 +22,20 @@ void LightingSummary::add(const WavefrontStats& s, double weight) {
   flux_live_at_end += weight * s.flux_live_at_end;
 }
 
-LightingSummary simulateLightingReference(const Scene& scene, VolumeSet& volume, const LightingOptions& options) {
+LightingSummary simulateLightingWith(const Scene& scene, VolumeSet& volume, const LightingOptions& options,
+                                     const SimulateRun& simulate) {
   LightingSummary sum;
   if (scene.lights.empty()) return sum;
   auto runs = planLighting(scene, volume, options.bands);
   auto t0 = std::chrono::steady_clock::now();
   clearLighting(volume);
-  VolumeField field(volume);
   for (size_t i = 0; i < runs.size(); ++i) {
     const LightingRun& r = runs[i];
     if (options.progress) options.progress(double(i) / double(runs.size()), "light " + describeLighting(runs, scene));
     WavefrontSettings s = options.wave;
     s.wavelength_nm = r.wavelength_nm;
     s.mode = r.mode;
-    WavefrontSimulator sim(field, volume.grid, s);
-    WavefrontResult res = sim.run(unitPowerLight(scene.lights[r.light]));
+    WavefrontResult res = simulate(s, unitPowerLight(scene.lights[r.light]));
     addLightingRun(volume, r, res.irradiance, res.direction);
     sum.add(res.stats, r.luminance);
   }
@@ -44,6 +43,13 @@ LightingSummary simulateLightingReference(const Scene& scene, VolumeSet& volume,
   if (options.progress) options.progress(1.0, "light");
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return sum;
+}
+
+LightingSummary simulateLightingReference(const Scene& scene, VolumeSet& volume, const LightingOptions& options) {
+  VolumeField field(volume);  // reads the medium fields only: the light volumes are filled in place
+  return simulateLightingWith(scene, volume, options, [&](const WavefrontSettings& s, const Light& light) {
+    return WavefrontSimulator(field, volume.grid, s).run(light);
+  });
 }
 
 }  // namespace eikon

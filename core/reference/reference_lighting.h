@@ -10,6 +10,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "core/reference/wavefront.h"
 #include "core/volume/lighting.h"
@@ -33,9 +34,18 @@ struct LightingSummary {
   double flux_emitted = 0, flux_left = 0, flux_caustic = 0, flux_energy = 0, flux_absorbed = 0,
          flux_live_at_end = 0;
   /// |emitted − (left + caustic + energy + absorbed + live)| / emitted: the bookkeeping balance.
+  std::vector<std::string> notes;  ///< what the driver changed, for the user (e.g. a lowered patch budget)
   double conservationError() const;
   void add(const WavefrontStats& s, double weight);
 };
+
+/// One simulator run: settings (wavelength and mode set by the plan) and a unit-power light.
+using SimulateRun = std::function<WavefrontResult(const WavefrontSettings&, const Light&)>;
+
+/// The driver both twins share: plan the runs, simulate each with `simulate`, fold them into
+/// volume.light_*, smooth. A scene without lights leaves the volume unlit.
+LightingSummary simulateLightingWith(const Scene& scene, VolumeSet& volume, const LightingOptions& options,
+                                     const SimulateRun& simulate);
 
 /// Simulate every light of the scene with the CPU reference and fill volume.light_*. A scene
 /// without lights leaves the volume unlit. Throws std::invalid_argument for bad settings.

@@ -568,7 +568,10 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
         continue;
       }
       const double o = glm::dot(va, wm);
-      if ((o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0)) {
+      if (s_.pass_caustics && ((o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0))) {
+        p.orientation = -p.orientation;  // through the focal line; the next flip is the next caustic
+        ++st.caustic_crossings;
+      } else if ((o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0)) {
         ++st.kills_caustic;
         st.flux_caustic += p.energy;
         st.caustic_centroid += p.energy * c1;

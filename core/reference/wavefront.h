@@ -76,6 +76,13 @@ struct WavefrontSettings {
   /// beam_min_cells)) or across the cone's radius on the unit cube (spot: cells per face edge
   /// N ≥ max(point_cells_per_face, ⌈2·beam_min_cells / tan(half-angle)⌉), at most 4096).
   int beam_min_cells = 8;
+  /// Fold caustics: false (Tevs; the default here) ends a patch whose orientation flips, counting
+  /// its flux under `caustic`; true lets it cross with its orientation reference reversed, as
+  /// geometric optics has it (the ray tube goes through the focal line and opens again), counted
+  /// in stats.caustic_crossings (CPU only). Renders use true: otherwise the light beyond a focus,
+  /// a cone in smoke or the halo round a ball lens's spot, is missing. Accumulate splats stay
+  /// finite through a caustic (flux·Δs); HighestEnergy (flux/area) peaks there.
+  bool pass_caustics = false;
   /// Straight steps across homogeneous regions: when the centre and all four corners lie in
   /// voxels of skip distance D ≥ 2 (`Field::skipDistance`; VolumeSet: every field is constant
   /// within D − 1 voxels), the patch advances k constant-time steps at once along straight lines
@@ -123,6 +130,7 @@ struct WavefrontStats {
   /// Flux of patches that ended (any reason, or still live at max_steps) on the upstream side of
   /// the probe plane. Without absorption, flux_probe + flux_ended_before_probe = flux_emitted.
   double flux_ended_before_probe = 0;
+  size_t caustic_crossings = 0;  ///< orientation flips passed (pass_caustics; CPU reference only)
   glm::dvec3 caustic_centroid{0.0};  ///< flux-weighted mean centre of the patches killed at caustics
   /// Probe plane: (net) flux-weighted mean of the points where patch centres cross it (mm; the
   /// centre's path over the step, interpolated linearly to the plane), and the flux-weighted mean

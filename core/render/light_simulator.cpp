@@ -312,7 +312,7 @@ struct GpuWavefront::Impl {
     P.control = glm::ivec4(s.probe_axis >= 0 && s.probe_axis < 3 ? s.probe_axis : -1, steps_per_dispatch,
                            s.max_steps, eMode ? 1 : 0);
     P.probe = glm::vec4(float(s.probe_position), 0.0f, 0.0f, 0.0f);
-    P.options = glm::ivec4(s.skip_empty ? 1 : 0, 0, 0, 0);
+    P.options = glm::ivec4(s.skip_empty ? 1 : 0, s.pass_caustics ? 1 : 0, 0, 0);
     params.write(&P, sizeof P);
     std::vector<uint32_t> zero(g.count() * (EIKON_SPLAT_ACC_WORDS + 1), 0u);
     splat.write(zero.data(), zero.size() * sizeof(uint32_t));

@@ -1,35 +1,28 @@
 #include "core/render/light_transport.h"
 
-#include <chrono>
-
 #include "core/render/light_simulator.h"
+#include "shaders/eikon_shared.h"
 
 namespace eikon {
 
 LightingSummary simulateLighting(vk::Context& ctx, const Scene& scene, VolumeSet& volume, const LightingOptions& options,
                                  int steps_per_dispatch) {
-  LightingSummary sum;
-  if (scene.lights.empty()) return sum;
-  auto runs = planLighting(scene, volume, options.bands);
-  auto t0 = std::chrono::steady_clock::now();
-  // The simulator reads the volume's medium fields only, so the light volumes can be filled in place.
-  std::vector<float> irradiance;
-  std::vector<glm::vec4> direction;
-  clearLighting(volume);
-  for (size_t i = 0; i < runs.size(); ++i) {
-    const LightingRun& r = runs[i];
-    if (options.progress) options.progress(double(i) / double(runs.size()), "light " + describeLighting(runs, scene));
-    WavefrontSettings s = options.wave;
-    s.wavelength_nm = r.wavelength_nm;
-    s.mode = r.mode;
-    GpuWavefront gpu(ctx, volume, s, steps_per_dispatch);
-    WavefrontResult res = gpu.run(unitPowerLight(scene.lights[r.light]));
-    addLightingRun(volume, r, res.irradiance, res.direction);
-    sum.add(res.stats, r.luminance);
+  // The patch list is one storage buffer: the budget cannot exceed what the device holds in one
+  // (lavapipe: 128 MiB = 838,860 patches of 160 B). Lowered, and said so, rather than failing a
+  // render when the wavefront grows.
+  LightingOptions o = options;
+  std::vector<std::string> notes;
+  const size_t fits = size_t(ctx.limits().max_storage_buffer_range / sizeof(gpu::WavePatch));
+  if (size_t(o.wave.max_patches) > fits) {
+    notes.push_back("patch budget lowered from " + std::to_string(o.wave.max_patches) + " to " + std::to_string(fits) +
+                    ": the device's storage buffers hold at most that many patches");
+    o.wave.max_patches = int(fits);
   }
-  smoothLighting(volume, options.smoothing_voxels);
-  if (options.progress) options.progress(1.0, "light");
-  sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // The simulator reads the volume's medium fields only, so the light volumes are filled in place.
+  LightingSummary sum = simulateLightingWith(scene, volume, o, [&](const WavefrontSettings& s, const Light& light) {
+    return GpuWavefront(ctx, volume, s, steps_per_dispatch).run(light);
+  });
+  sum.notes.insert(sum.notes.begin(), notes.begin(), notes.end());
   return sum;
 }
 

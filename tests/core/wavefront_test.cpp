@@ -104,6 +104,36 @@ TEST(Wavefront, GlassSphereConservesFlux) {
   EXPECT_LE(st.flux_probe, st.flux_emitted * (1 + 1e-9));
 }
 
+// 2a'. The same sphere with pass_caustics: patches cross the fold caustics behind the sphere
+// with their orientation reversed instead of ending there, as rays do. Nothing absorbs, so every
+// patch ends by leaving the volume or below the energy threshold: left + energy = emitted, no
+// caustic kills, and more flux reaches the probe plane behind the focus than with kills, where
+// the caustic-killed patches stopped short of it (what still ends upstream leaves through the
+// side faces, deflected by the sphere's rim, or falls below the energy threshold).
+TEST(Wavefront, PassingCausticsKeepsTheLightBeyondTheFocus) {
+  const Scene scene = sceneFromJson(kGlassSphereLightScene);
+  const VolumeSet vol = voxelize(scene);
+  VolumeField field(vol);
+  WavefrontSettings s;
+  s.probe_axis = 0;
+  s.probe_position = 1.1;
+  s.pass_caustics = true;
+  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0));
+  s.pass_caustics = false;
+  const WavefrontStats killed = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0)).stats;
+  const WavefrontStats& st = r.stats;
+  printWavefrontStats("glass sphere, caustics passed", st);
+  std::printf("[ measured ] caustic crossings %zu\n", st.caustic_crossings);
+  EXPECT_EQ(st.kills_caustic, 0u);
+  EXPECT_EQ(st.flux_caustic, 0.0);
+  EXPECT_GT(st.caustic_crossings, 0u);
+  EXPECT_EQ(st.live_at_end, 0u);
+  EXPECT_NEAR(st.flux_left + st.flux_energy, st.flux_emitted, 1e-9 * st.flux_emitted);
+  EXPECT_NEAR(st.flux_probe + st.flux_ended_before_probe, st.flux_emitted, 1e-9 * st.flux_emitted);
+  EXPECT_GT(st.flux_probe, killed.flux_probe + 1e-3 * st.flux_emitted);
+  EXPECT_LT(st.flux_ended_before_probe, killed.flux_ended_before_probe);
+}
+
 // 2b. Straight steps across homogeneous regions (WavefrontSettings::skip_empty) against single
 // RK4 steps on the same sphere. Where they are taken every field is constant, so the exact ray is
 // the straight line and RK4 reproduces it to round-off: both runs make the same decisions at the
