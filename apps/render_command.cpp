@@ -50,7 +50,7 @@ void addRenderCommand(CLI::App& app) {
   sub->add_option("--step", args->step, "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", args->integrator, "euler, midpoint or rk4 (default rk4)");
   sub->add_option("--exposure", args->exposure, "PNG preview exposure in stops (default 0)");
-  sub->add_option("--threads", args->threads, "CPU threads for --reference and voxelising (default: all)");
+  sub->add_option("--threads", args->threads, "CPU threads for --reference, voxelising and the CPU light simulator (default: all; the simulator at most 8)");
   sub->add_flag("--reference", args->reference, "Render with the double-precision CPU reference instead of the GPU");
   sub->add_flag("--no-skip", args->no_skip, "Do not cross homogeneous regions in one step");
   sub->add_flag("--no-fresnel", args->no_fresnel, "Disable Fresnel reflection and transmission losses");
@@ -137,6 +137,7 @@ void addRenderCommand(CLI::App& app) {
       lo.wave.split_span_voxels = a.light_split;
       lo.wave.max_patches = a.max_patches;
       lo.wave.pass_caustics = a.caustics == "pass";
+      lo.wave.threads = a.threads;
       lo.progress = [&](double f, const std::string& what) { progress.update(what.c_str(), f); };
       std::filesystem::path cache_dir = a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache);
       // Which twin simulates: --reference renders use the CPU throughout; on a CPU Vulkan device

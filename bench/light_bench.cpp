@@ -9,13 +9,19 @@
 // minutes per twin on a 2-core lavapipe machine), and the speed-up of skipping at that resolution.
 // Timings are not asserted anywhere (they vary ±20% on a shared machine).
 //
+// --threads T1,T2,…: run the CPU reference once per listed thread count
+// (WavefrontSettings::threads; default 0 = hardware concurrency) and print each one's speed-up
+// over the first; --no-gpu: skip the GPU twin (and Vulkan).
+//
 //   light_bench [--resolution N] [--no-skip-resolution M] [--steps-per-dispatch K] [--no-cpu]
+//               [--no-gpu] [--threads T1,T2,…]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "core/reference/reference_marcher.h"
 #include "core/reference/wavefront.h"
@@ -41,7 +47,7 @@ struct Run {
 void print(const char* name, const Run& r) {
   const WavefrontStats& s = r.st;
   const double ended = s.flux_left + s.flux_caustic + s.flux_energy + s.flux_absorbed + s.flux_live_at_end;
-  std::printf("  %-4s %8.2f s  %10.0f patches  %9.3g patches/s  steps %5d  splits %zu (refused %zu)\n", name, r.s,
+  std::printf("  %-6s %8.2f s  %10.0f patches  %9.3g patches/s  steps %5d  splits %zu (refused %zu)\n", name, r.s,
               r.patches(), r.patches() / r.s, s.steps, s.splits, s.splits_refused);
   std::printf("       flux emitted %.9g = left %.9g + caustic %.9g + energy %.9g + absorbed %.9g + live %.9g"
               "  (balance %+.2e relative)\n",
@@ -53,13 +59,15 @@ void print(const char* name, const Run& r) {
 }
 
 struct Pair {
-  Run gpu, cpu;
-  bool haveCpu = false;
+  Run gpu;
+  std::vector<Run> cpu;  ///< one per entry of gThreads
+  bool haveGpu = false;
 };
 
 int gStepsPerDispatch = 16;
+std::vector<int> gThreads = {0};  ///< CPU reference thread counts (0: hardware concurrency)
 
-Pair simulate(vk::Context& ctx, Scene scene, int resolution, bool skip, bool cpu) {
+Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu) {
   scene.volume.resolution = resolution;
   const VolumeSet vol = voxelize(scene);
   WavefrontSettings s;
@@ -67,25 +75,34 @@ Pair simulate(vk::Context& ctx, Scene scene, int resolution, bool skip, bool cpu
   std::printf("\nvolume %dx%dx%d (h = %.4g mm), straight steps %s\n", vol.grid.dims[0], vol.grid.dims[1],
               vol.grid.dims[2], vol.grid.h, skip ? "on (skip_empty = true)" : "off (skip_empty = false)");
   Pair p;
-  {
-    GpuWavefront gpu(ctx, vol, s, gStepsPerDispatch);
+  if (ctx) {
+    GpuWavefront gpu(*ctx, vol, s, gStepsPerDispatch);
     auto t0 = std::chrono::steady_clock::now();
     WavefrontResult r = gpu.run(scene.lights[0]);
     p.gpu.s = seconds(t0);
     p.gpu.st = r.stats;
+    p.haveGpu = true;
+    print("GPU", p.gpu);
   }
-  print("GPU", p.gpu);
   if (cpu) {
     VolumeField field(vol);
-    WavefrontSimulator sim(field, vol.grid, s);
-    auto t0 = std::chrono::steady_clock::now();
-    WavefrontResult r = sim.run(scene.lights[0]);
-    p.cpu.s = seconds(t0);
-    p.cpu.st = r.stats;
-    p.haveCpu = true;
-    print("CPU", p.cpu);
-    std::printf("  GPU/CPU speed ratio (patches/s): %.2f\n",
-                (p.gpu.patches() / p.gpu.s) / (p.cpu.patches() / p.cpu.s));
+    for (int threads : gThreads) {
+      s.threads = threads;
+      WavefrontSimulator sim(field, vol.grid, s);
+      auto t0 = std::chrono::steady_clock::now();
+      WavefrontResult r = sim.run(scene.lights[0]);
+      Run run;
+      run.s = seconds(t0);
+      run.st = r.stats;
+      char name[16];
+      std::snprintf(name, sizeof name, "CPU/%d", threads);
+      print(name, run);
+      p.cpu.push_back(run);
+      if (p.cpu.size() > 1)
+        std::printf("  speed-up of %d threads over %d: %.2fx\n", threads, gThreads[0], p.cpu[0].s / run.s);
+      if (p.haveGpu)
+        std::printf("  GPU/CPU speed ratio (patches/s): %.2f\n", (p.gpu.patches() / p.gpu.s) / (run.patches() / run.s));
+    }
   }
   return p;
 }
@@ -94,13 +111,24 @@ Pair simulate(vk::Context& ctx, Scene scene, int resolution, bool skip, bool cpu
 
 int main(int argc, char** argv) {
   int resolution = 0, noSkipResolution = 64;
-  bool cpu = true;
+  bool cpu = true, gpu = true;
   std::string scene_path = std::string(EIKON_SOURCE_DIR) + "/scenes/caustic_sphere.json";
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--resolution") && i + 1 < argc) resolution = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--no-skip-resolution") && i + 1 < argc) noSkipResolution = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--steps-per-dispatch") && i + 1 < argc) gStepsPerDispatch = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--no-cpu")) cpu = false;
+    else if (!std::strcmp(argv[i], "--no-gpu")) gpu = false;
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) {
+      gThreads.clear();
+      for (const char* t = argv[++i]; *t;) {
+        char* end = nullptr;
+        gThreads.push_back(int(std::strtol(t, &end, 10)));
+        t = *end == ',' ? end + 1 : end;
+        if (end == t && *t) break;
+      }
+      if (gThreads.empty()) gThreads = {0};
+    }
     else scene_path = argv[i];
   }
   const Scene scene = loadScene(scene_path);
@@ -109,20 +137,22 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (resolution <= 0) resolution = scene.volume.resolution;
-  auto ctx = vk::Context::create();
+  std::unique_ptr<vk::Context> ctx;
+  if (gpu) ctx = vk::Context::create();
   std::printf("scene %s, light 0, WavefrontSettings defaults, GPU steps per dispatch %d, device %s\n",
-              scene_path.c_str(), gStepsPerDispatch, ctx->deviceName().c_str());
+              scene_path.c_str(), gStepsPerDispatch, ctx ? ctx->deviceName().c_str() : "(no GPU)");
 
-  const Pair full = simulate(*ctx, scene, resolution, true, cpu);
+  const Pair full = simulate(ctx.get(), scene, resolution, true, cpu);
   std::printf("\nWithout straight steps at resolution %d (lower than %d: without skipping the full resolution "
               "takes minutes per twin here):",
               noSkipResolution, resolution);
-  const Pair low = simulate(*ctx, scene, noSkipResolution, false, cpu);
+  const Pair low = simulate(ctx.get(), scene, noSkipResolution, false, cpu);
   std::printf("\nThe same resolution %d with straight steps, for the speed-up:", noSkipResolution);
-  const Pair lowSkip = simulate(*ctx, scene, noSkipResolution, true, cpu);
-  std::printf("\nspeed-up of straight steps at resolution %d (time without / with): GPU %.2fx", noSkipResolution,
-              low.gpu.s / lowSkip.gpu.s);
-  if (cpu) std::printf(", CPU %.2fx", low.cpu.s / lowSkip.cpu.s);
+  const Pair lowSkip = simulate(ctx.get(), scene, noSkipResolution, true, cpu);
+  std::printf("\nspeed-up of straight steps at resolution %d (time without / with):", noSkipResolution);
+  if (gpu) std::printf(" GPU %.2fx", low.gpu.s / lowSkip.gpu.s);
+  for (size_t i = 0; i < low.cpu.size(); ++i)
+    std::printf(" CPU/%d %.2fx", gThreads[i], low.cpu[i].s / lowSkip.cpu[i].s);
   std::printf("\n");
   (void)full;
   return 0;

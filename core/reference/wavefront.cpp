@@ -2,8 +2,15 @@
 #include "core/reference/wavefront.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
+#include <condition_variable>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
+#include <thread>
 
 namespace eikon {
 namespace {
@@ -60,6 +67,115 @@ glm::dvec3 applyM(const glm::dvec3& p, const glm::dvec3& a, double no, double ne
   return a * (pa / (no * no)) + (p - a * pa) / (ne * ne);
 }
 
+/// One chunk of a run (WavefrontSettings::threads): chunk c advances slice c of every step's
+/// list, n·c/T ≤ i < n·(c + 1)/T (n patches, T chunks), always on the same thread. It splats into
+/// its own volumes and counts into its own statistics over the whole run (reduced in chunk order
+/// at the end), and writes the step's outputs (children and survivors in list order, patches
+/// that reached max_steps); the next step's list is the chunks' outputs in chunk order, read in
+/// place (out[] alternates between steps). Chunk 0 splats into the result's volumes, so one chunk
+/// is exactly the single-threaded loop. Aligned: chunks are written concurrently, and a shared
+/// cache line would bounce between cores.
+struct alignas(64) Chunk {
+  double* acc = nullptr;         ///< Σ flux·Δs / h³ (W/mm²), per voxel
+  double* best = nullptr;        ///< highest patch irradiance (W/mm²), per voxel
+  glm::dvec3* dirAcc = nullptr;  ///< Σ (flux·Δs / h³)·direction, per voxel
+  std::vector<double> accOwn, bestOwn;  ///< storage of acc and best for chunks c ≥ 1
+  std::vector<glm::dvec3> dirOwn;       ///< storage of dirAcc for chunks c ≥ 1
+  WavefrontStats st;                    ///< this chunk's counts and flux sums over the run
+  std::vector<Patch> out[2];  ///< out[step parity]: the step's children and survivors
+  std::vector<Patch>* next = nullptr;  ///< the running step's out[]
+  std::vector<Patch> done, work;  ///< the step's patches at max_steps; emit()'s stack
+  /// Threads > 1: the step's surviving patches before emission, and the chunk's kill count when
+  /// each survived, to redo the emission serially if the patch budget binds.
+  std::vector<Patch> surv;
+  std::vector<size_t> survKills;
+  /// Live count while the step runs: absolute when emitting against the budget (one chunk, or the
+  /// serial redo), else relative to the chunk's start (−1 per kill, +3 per split).
+  long long live = 0;
+  long long maxAfterSplit = LLONG_MIN;  ///< highest `live` right after a split in this step
+  size_t kills = 0, splits = 0, refused = 0;  ///< this step's
+};
+
+/// Worker threads for one WavefrontSimulator::run, created once: go(f) calls f(c) for chunk c on
+/// worker c (c = 1 … T − 1) and f(0) on the calling thread, and returns when all have returned
+/// (rethrowing the first exception). The fixed assignment keeps each chunk's state on one core.
+class ChunkPool {
+ public:
+  explicit ChunkPool(int chunks) {
+    for (int c = 1; c < chunks; ++c) workers_.emplace_back([this, c] { work(c); });
+  }
+  ~ChunkPool() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& t : workers_) t.join();
+  }
+  ChunkPool(const ChunkPool&) = delete;
+  ChunkPool& operator=(const ChunkPool&) = delete;
+
+  void go(const std::function<void(int)>& f) {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      f_ = &f;
+      pending_ = workers_.size();
+      ++generation_;
+    }
+    wake_.notify_all();
+    std::exception_ptr mine;
+    try {
+      f(0);
+    } catch (...) {
+      mine = std::current_exception();
+    }
+    std::unique_lock<std::mutex> lock(m_);
+    done_.wait(lock, [&] { return pending_ == 0; });
+    f_ = nullptr;
+    std::exception_ptr theirs = error_;
+    error_ = nullptr;
+    if (mine) std::rethrow_exception(mine);
+    if (theirs) std::rethrow_exception(theirs);
+  }
+
+ private:
+  void work(int c) {
+    unsigned long long seen = 0;
+    for (;;) {
+      const std::function<void(int)>* f;
+      {
+        std::unique_lock<std::mutex> lock(m_);
+        wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
+        if (stop_) return;
+        seen = generation_;
+        f = f_;
+      }
+      std::exception_ptr e;
+      try {
+        (*f)(c);
+      } catch (...) {
+        e = std::current_exception();
+      }
+      std::lock_guard<std::mutex> lock(m_);
+      if (e && !error_) error_ = e;
+      if (--pending_ == 0) done_.notify_one();
+    }
+  }
+
+  std::vector<std::thread> workers_;
+  std::mutex m_;
+  std::condition_variable wake_, done_;
+  const std::function<void(int)>* f_ = nullptr;
+  size_t pending_ = 0;
+  unsigned long long generation_ = 0;
+  bool stop_ = false;
+  std::exception_ptr error_;
+};
+
+/// Steps with fewer patches than this per chunk run their chunks one after another on the calling
+/// thread (the same chunks, so the same results): waking the workers would cost more.
+constexpr size_t kMinPatchesPerChunk = 64;
+
 }  // namespace
 
 glm::dvec3 WavefrontSimulator::onShell(const glm::dvec3& x, const glm::dvec3& s) const {
@@ -90,6 +206,7 @@ WavefrontSimulator::WavefrontSimulator(const Field& field, const Grid& splat_gri
   if (!(s_.wavelength_nm > 0)) throw std::invalid_argument("wavefront: wavelength must be > 0");
   if (s_.mode != 0 && s_.mode != 1) throw std::invalid_argument("wavefront: mode must be 0 (o) or 1 (e)");
   if (s_.beam_min_cells < 1) throw std::invalid_argument("wavefront: beam_min_cells must be >= 1");
+  if (s_.threads < 0) throw std::invalid_argument("wavefront: threads must be >= 0");
   const double l_um = s_.wavelength_nm * 1e-3;
   il2_ = 1.0 / (l_um * l_um);
   il4_ = il2_ * il2_;
@@ -223,8 +340,23 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
   const double maxEdge = s_.split_span_voxels * h;
   std::vector<double> acc(grid_.count(), 0.0), best(grid_.count(), 0.0);
   std::vector<glm::dvec3> dirAcc(grid_.count(), glm::dvec3(0.0));
+  // Default: every core, at most 8 (each thread after the first keeps its own splat volumes,
+  // 40 B per voxel: 56 MB at 128×85×128).
+  const int nChunks = s_.threads > 0 ? s_.threads : int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+  std::vector<Chunk> chunks(static_cast<size_t>(nChunks));
+  for (size_t c = 0; c < chunks.size(); ++c) {
+    Chunk& ch = chunks[c];
+    if (c > 0) {
+      ch.accOwn.assign(grid_.count(), 0.0);
+      ch.bestOwn.assign(grid_.count(), 0.0);
+      ch.dirOwn.assign(grid_.count(), glm::dvec3(0.0));
+    }
+    ch.acc = c > 0 ? ch.accOwn.data() : acc.data();
+    ch.best = c > 0 ? ch.bestOwn.data() : best.data();
+    ch.dirAcc = c > 0 ? ch.dirOwn.data() : dirAcc.data();
+  }
 
-  std::vector<Patch> cur = seed(light), next, work;
+  std::vector<Patch> cur = seed(light);
   st.seeded = cur.size();
   for (Patch& p : cur) {
     st.flux_emitted += p.energy;
@@ -232,8 +364,8 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     p.entered = inside(c, lo, hi);
     if (s_.probe_axis >= 0) p.probe_side = c[s_.probe_axis] >= s_.probe_position ? 1 : -1;
   }
-  size_t live = cur.size();
-  st.max_live = live;
+  long long live = (long long)cur.size();  // patches alive (moving or at max_steps)
+  st.max_live = cur.size();
 
   const bool eMode = s_.mode == 1;
   auto deriv = [&](const glm::dvec3& x, const glm::dvec3& w, glm::dvec3& dx, glm::dvec3& dw) {
@@ -286,7 +418,7 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     x += dt / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
     w += dt / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
   };
-  auto splat = [&](const glm::dvec3& m, double fluxDs, double irr, const glm::dvec3& dir) {
+  auto splat = [&](Chunk& ch, const glm::dvec3& m, double fluxDs, double irr, const glm::dvec3& dir) {
     int idx[3];
     for (int a = 0; a < 3; ++a) {
       double f = std::floor((m[a] - grid_.origin[a]) / h);
@@ -294,9 +426,9 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
       idx[a] = int(f);
     }
     const size_t v = grid_.index(idx[0], idx[1], idx[2]);
-    acc[v] += fluxDs / h3;
-    dirAcc[v] += (fluxDs / h3) * dir;
-    best[v] = std::max(best[v], irr);
+    ch.acc[v] += fluxDs / h3;
+    ch.dirAcc[v] += (fluxDs / h3) * dir;
+    ch.best[v] = std::max(ch.best[v], irr);
   };
   // Straight-step splat: the centre's straight path c0 + s·u, s ∈ [0, L] (u unit), deposits into
   // every voxel it crosses flux(s)·len/h³, with len the length of the piece inside the voxel and
@@ -306,7 +438,7 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
   // (A, C the diagonals at the start, B, D their change per step). A voxel walk (Amanatides & Woo
   // 1987) over the part of the segment inside the grid; the same walk as splatSegment in
   // wavefront.comp.
-  auto splatSegment = [&](const glm::dvec3& c0, const glm::dvec3& u, double L, double E0, double sigma,
+  auto splatSegment = [&](Chunk& ch, const glm::dvec3& c0, const glm::dvec3& u, double L, double E0, double sigma,
                           const glm::dvec3& dir, double ds1, const glm::dvec3 diag[4]) {
     double sA = 0.0, sB = L;
     for (int a = 0; a < 3; ++a) {
@@ -346,9 +478,9 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
         const double tau = ds1 > 0 ? sm / ds1 : 0.0;
         const double area = 0.5 * glm::length(glm::cross(diag[0] + tau * diag[1], diag[2] + tau * diag[3]));
         const size_t v = grid_.index(i[0], i[1], i[2]);
-        acc[v] += val;
-        dirAcc[v] += val * dir;
-        best[v] = std::max(best[v], area > 0 ? flux / area : 0.0);
+        ch.acc[v] += val;
+        ch.dirAcc[v] += val * dir;
+        ch.best[v] = std::max(ch.best[v], area > 0 ? flux / area : 0.0);
         sCur = sEnd;
       }
       if (sCur >= sB) break;
@@ -426,8 +558,10 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     }
     return K;
   };
-  // Split p (repeatedly) until no edge exceeds maxEdge or the patch budget is spent.
-  auto emit = [&](const Patch& p0) {
+  // Split p (repeatedly) until no edge exceeds maxEdge or the patch budget is spent: a split is
+  // refused when it would take ch.live above `budget` (LLONG_MAX: never; see the step loop).
+  auto emit = [&](Chunk& ch, const Patch& p0, long long budget) {
+    std::vector<Patch>& work = ch.work;
     work.clear();
     work.push_back(p0);
     while (!work.empty()) {
@@ -436,17 +570,17 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
       double e = 0;
       for (int k = 0; k < 4; ++k) e = std::max(e, glm::length(p.x[size_t((k + 1) % 4)] - p.x[size_t(k)]));
       if (e <= maxEdge) {
-        next.push_back(p);
+        ch.next->push_back(p);
         continue;
       }
-      if (live + 3 > size_t(s_.max_patches)) {
-        ++st.splits_refused;
-        next.push_back(p);
+      if (ch.live + 3 > budget) {
+        ++ch.refused;
+        ch.next->push_back(p);
         continue;
       }
-      live += 3;
-      ++st.splits;
-      st.max_live = std::max(st.max_live, live);
+      ch.live += 3;
+      ++ch.splits;
+      ch.maxAfterSplit = std::max(ch.maxAfterSplit, ch.live);
       // 3×3 lattice of bilinear points; the parent's own corners are kept exactly.
       glm::dvec3 X[3][3], W[3][3];
       for (int b = 0; b < 3; ++b)
@@ -484,110 +618,241 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
   };
 
   // A patch ends: it leaves the live set; note its flux if it never got past the probe plane.
-  auto ended = [&](const Patch& p) {
-    --live;
-    if (s_.probe_axis >= 0 && p.probe_side < 0) st.flux_ended_before_probe += p.energy;
+  auto ended = [&](Chunk& ch, const Patch& p) {
+    ++ch.kills;
+    --ch.live;
+    if (s_.probe_axis >= 0 && p.probe_side < 0) ch.st.flux_ended_before_probe += p.energy;
+  };
+
+  // One patch's step (the single-threaded loop body): advance, splat, count, end it or emit it
+  // (split against `budget`) into *ch.next. keep: also record it in ch.surv before emission.
+  auto advance = [&](Chunk& ch, Patch p, long long budget, bool keep) {
+    if (p.steps >= s_.max_steps) {
+      ch.done.push_back(p);
+      return;
+    }
+    const glm::dvec3 c0 = centre(p), wm0 = eMode ? meanW(p) : glm::dvec3(0.0);
+    glm::dvec3 vel[4], diag[4];
+    const int kStraight = straightSteps(p, vel);
+    if (kStraight > 0) {
+      // Straight step: k time steps along straight lines; w is unchanged (∇n = 0). diag: the
+      // diagonals at the start and their change per time step (the area along the path).
+      diag[0] = p.x[2] - p.x[0], diag[1] = dt * (vel[2] - vel[0]);
+      diag[2] = p.x[3] - p.x[1], diag[3] = dt * (vel[3] - vel[1]);
+      const double T = double(kStraight) * dt;
+      for (int k = 0; k < 4; ++k) p.x[size_t(k)] += T * vel[k];
+      p.steps += kStraight;
+      ++ch.st.straight_steps;
+      ch.st.straight_time_steps += size_t(kStraight);
+    } else {
+      for (int k = 0; k < 4; ++k) rk4(p.x[size_t(k)], p.w[size_t(k)]);
+      ++p.steps;
+    }
+    ch.st.steps = std::max(ch.st.steps, p.steps);
+    const glm::dvec3 c1 = centre(p), m = 0.5 * (c0 + c1);
+    const double ds = glm::length(c1 - c0);
+    const glm::dvec4 med = field_.medium(m);
+    const double sigma = eMode ? sigmaE(m, 0.5 * (wm0 + meanW(p))) : sigmaAt(glm::dvec3(med), s_.wavelength_nm);
+    const double E0 = p.energy;
+    const double att = std::exp(-sigma * ds), fluxMid = p.energy * std::exp(-0.5 * sigma * ds);
+    ch.st.flux_absorbed += p.energy * (1.0 - att);
+    p.energy *= att;
+    p.transmittance *= att;
+    const glm::dvec3 va = vectorArea(p);
+    const double area = glm::length(va);
+    const glm::dvec3 wm = meanW(p);
+    const double wl = glm::length(wm);
+    // Propagation direction: ŵ for the o-mode; for the e-mode the energy direction, which is
+    // that of the centre's motion over the step (M_e p, not p, in a crystal).
+    const glm::dvec3 dir = eMode ? (ds > 0 ? (c1 - c0) / ds : glm::dvec3(0.0)) : (wl > 0 ? wm / wl : glm::dvec3(0.0));
+    if (kStraight > 0) {
+      if (ds > 0) splatSegment(ch, c0, (c1 - c0) / ds, ds, E0, sigma, dir, ds / kStraight, diag);
+    } else {
+      splat(ch, m, fluxMid * ds, area > 0 ? fluxMid / area : 0.0, dir);
+    }
+    if (s_.probe_axis >= 0) {
+      const int side = c1[s_.probe_axis] >= s_.probe_position ? 1 : -1;
+      if (side != p.probe_side) {
+        const int ax = s_.probe_axis;
+        const double span = c1[ax] - c0[ax];
+        const double f = span != 0 ? std::clamp((s_.probe_position - c0[ax]) / span, 0.0, 1.0) : 0.5;
+        // The flux where the centre crosses: mid-step for an RK4 step, at the crossing point
+        // for a straight step (exact along its attenuated path).
+        const double fx = kStraight > 0 ? E0 * std::exp(-sigma * f * ds) : fluxMid;
+        ch.st.flux_probe += side * fx;
+        ch.st.probe_centroid += side * fx * (c0 + f * (c1 - c0));
+        if (ds > 0) ch.st.probe_direction += side * fx * (c1 - c0) / ds;
+      }
+      p.probe_side = side;
+    }
+    // Kills, each accounted by reason.
+    if (med.w >= 0.5) {
+      ++ch.st.kills_opaque;
+      ch.st.flux_absorbed += p.energy;
+      ended(ch, p);
+      return;
+    }
+    if (inside(c1, lo, hi)) {
+      p.entered = true;
+    } else if (p.entered || !(wl > 0) || !rayHitsBox(c1, wm / wl, lo, hi)) {
+      ++ch.st.kills_left;
+      ch.st.flux_left += p.energy;
+      ended(ch, p);
+      return;
+    }
+    const double o = glm::dot(va, wm);
+    if (s_.pass_caustics && ((o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0))) {
+      p.orientation = -p.orientation;  // through the focal line; the next flip is the next caustic
+      ++ch.st.caustic_crossings;
+    } else if ((o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0)) {
+      ++ch.st.kills_caustic;
+      ch.st.flux_caustic += p.energy;
+      ch.st.caustic_centroid += p.energy * c1;
+      ended(ch, p);
+      return;
+    }
+    if (p.energy < s_.min_energy_fraction * p.seed_energy) {
+      ++ch.st.kills_energy;
+      ch.st.flux_energy += p.energy;
+      ended(ch, p);
+      return;
+    }
+    if (keep) {
+      ch.surv.push_back(p);
+      ch.survKills.push_back(ch.kills);
+    }
+    emit(ch, p, budget);
   };
 
   // Patches that have used up max_steps stay live (and counted in `live`) but move no further.
+  // Each step cuts its list into T = nChunks contiguous chunks (Chunk). With one chunk the budget is
+  // checked against the running live count, as always. With T > 1 the chunks emit without a
+  // budget, each tracking its live count relative to its start; single-threaded emission would
+  // have refused a split iff some chunk c, starting at L_c = L0 + Σ_{c' < c} (3·splits − kills),
+  // reaches L_c + maxAfterSplit > max_patches. Then the step's emission is redone serially from
+  // the recorded survivors, in list order against the running count. Either way the counts,
+  // `next` and `done` are those of the single-threaded loop.
   std::vector<Patch> done;
-  while (!cur.empty()) {
-    next.clear();
-    for (Patch p : cur) {
-      if (p.steps >= s_.max_steps) {
-        done.push_back(p);
-        continue;
-      }
-      const glm::dvec3 c0 = centre(p), wm0 = eMode ? meanW(p) : glm::dvec3(0.0);
-      glm::dvec3 vel[4], diag[4];
-      const int kStraight = straightSteps(p, vel);
-      if (kStraight > 0) {
-        // Straight step: k time steps along straight lines; w is unchanged (∇n = 0). diag: the
-        // diagonals at the start and their change per time step (the area along the path).
-        diag[0] = p.x[2] - p.x[0], diag[1] = dt * (vel[2] - vel[0]);
-        diag[2] = p.x[3] - p.x[1], diag[3] = dt * (vel[3] - vel[1]);
-        const double T = double(kStraight) * dt;
-        for (int k = 0; k < 4; ++k) p.x[size_t(k)] += T * vel[k];
-        p.steps += kStraight;
-        ++st.straight_steps;
-        st.straight_time_steps += size_t(kStraight);
-      } else {
-        for (int k = 0; k < 4; ++k) rk4(p.x[size_t(k)], p.w[size_t(k)]);
-        ++p.steps;
-      }
-      st.steps = std::max(st.steps, p.steps);
-      const glm::dvec3 c1 = centre(p), m = 0.5 * (c0 + c1);
-      const double ds = glm::length(c1 - c0);
-      const glm::dvec4 med = field_.medium(m);
-      const double sigma = eMode ? sigmaE(m, 0.5 * (wm0 + meanW(p))) : sigmaAt(glm::dvec3(med), s_.wavelength_nm);
-      const double E0 = p.energy;
-      const double att = std::exp(-sigma * ds), fluxMid = p.energy * std::exp(-0.5 * sigma * ds);
-      st.flux_absorbed += p.energy * (1.0 - att);
-      p.energy *= att;
-      p.transmittance *= att;
-      const glm::dvec3 va = vectorArea(p);
-      const double area = glm::length(va);
-      const glm::dvec3 wm = meanW(p);
-      const double wl = glm::length(wm);
-      // Propagation direction: ŵ for the o-mode; for the e-mode the energy direction, which is
-      // that of the centre's motion over the step (M_e p, not p, in a crystal).
-      const glm::dvec3 dir = eMode ? (ds > 0 ? (c1 - c0) / ds : glm::dvec3(0.0)) : (wl > 0 ? wm / wl : glm::dvec3(0.0));
-      if (kStraight > 0) {
-        if (ds > 0) splatSegment(c0, (c1 - c0) / ds, ds, E0, sigma, dir, ds / kStraight, diag);
-      } else {
-        splat(m, fluxMid * ds, area > 0 ? fluxMid / area : 0.0, dir);
-      }
-      if (s_.probe_axis >= 0) {
-        const int side = c1[s_.probe_axis] >= s_.probe_position ? 1 : -1;
-        if (side != p.probe_side) {
-          const int ax = s_.probe_axis;
-          const double span = c1[ax] - c0[ax];
-          const double f = span != 0 ? std::clamp((s_.probe_position - c0[ax]) / span, 0.0, 1.0) : 0.5;
-          // The flux where the centre crosses: mid-step for an RK4 step, at the crossing point
-          // for a straight step (exact along its attenuated path).
-          const double fx = kStraight > 0 ? E0 * std::exp(-sigma * f * ds) : fluxMid;
-          st.flux_probe += side * fx;
-          st.probe_centroid += side * fx * (c0 + f * (c1 - c0));
-          if (ds > 0) st.probe_direction += side * fx * (c1 - c0) / ds;
-        }
-        p.probe_side = side;
-      }
-      // Kills, each accounted by reason.
-      if (med.w >= 0.5) {
-        ++st.kills_opaque;
-        st.flux_absorbed += p.energy;
-        ended(p);
-        continue;
-      }
-      if (inside(c1, lo, hi)) {
-        p.entered = true;
-      } else if (p.entered || !(wl > 0) || !rayHitsBox(c1, wm / wl, lo, hi)) {
-        ++st.kills_left;
-        st.flux_left += p.energy;
-        ended(p);
-        continue;
-      }
-      const double o = glm::dot(va, wm);
-      if (s_.pass_caustics && ((o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0))) {
-        p.orientation = -p.orientation;  // through the focal line; the next flip is the next caustic
-        ++st.caustic_crossings;
-      } else if ((o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0)) {
-        ++st.kills_caustic;
-        st.flux_caustic += p.energy;
-        st.caustic_centroid += p.energy * c1;
-        ended(p);
-        continue;
-      }
-      if (p.energy < s_.min_energy_fraction * p.seed_energy) {
-        ++st.kills_energy;
-        st.flux_energy += p.energy;
-        ended(p);
-        continue;
-      }
-      emit(p);
+  std::unique_ptr<ChunkPool> pool;
+  if (nChunks > 1) pool = std::make_unique<ChunkPool>(nChunks);
+  const long long maxPatches = s_.max_patches;
+  // The step's list: the concatenation of the chunks' out[1 − ping] (the seeds: chunk 0's).
+  int ping = 0;
+  chunks[0].out[1].swap(cur);
+  std::vector<const std::vector<Patch>*> in(chunks.size());
+  for (;;) {
+    size_t n = 0;
+    for (size_t c = 0; c < chunks.size(); ++c) {
+      in[c] = &chunks[c].out[1 - ping];
+      n += in[c]->size();
     }
-    st.max_live = std::max(st.max_live, live);
-    std::swap(cur, next);
+    if (n == 0) break;
+    const long long L0 = live;
+    const std::function<void(int)> step = [&](int c) {
+      Chunk& ch = chunks[size_t(c)];
+      ch.next = &ch.out[ping];
+      ch.next->clear();
+      ch.done.clear();
+      ch.surv.clear();
+      ch.survKills.clear();
+      ch.kills = ch.splits = ch.refused = 0;
+      ch.live = nChunks == 1 ? L0 : 0;
+      ch.maxAfterSplit = LLONG_MIN;
+      const long long budget = nChunks == 1 ? maxPatches : LLONG_MAX;
+      const size_t b = n * size_t(c) / size_t(nChunks), e = n * size_t(c + 1) / size_t(nChunks);
+      size_t at = 0;  // list index of the current segment's first patch
+      for (const std::vector<Patch>* seg : in) {
+        const size_t i0 = std::max(b, at), i1 = std::min(e, at + seg->size());
+        for (size_t i = i0; i < i1; ++i) advance(ch, (*seg)[i - at], budget, nChunks > 1);
+        at += seg->size();
+        if (at >= e) break;
+      }
+    };
+    if (pool && n >= kMinPatchesPerChunk * size_t(nChunks)) {
+      pool->go(step);
+    } else {
+      for (int c = 0; c < nChunks; ++c) step(c);
+    }
+    if (nChunks == 1) {
+      live = chunks[0].live;
+      if (chunks[0].splits > 0) st.max_live = std::max(st.max_live, size_t(chunks[0].maxAfterSplit));
+    } else {
+      bool fits = true;
+      long long Lc = L0;
+      size_t peak = 0;
+      for (const Chunk& ch : chunks) {
+        if (ch.splits > 0) {
+          const long long top = Lc + ch.maxAfterSplit;
+          fits = fits && top <= maxPatches;
+          peak = std::max(peak, size_t(top));
+        }
+        Lc += 3 * (long long)ch.splits - (long long)ch.kills;
+      }
+      if (fits) {
+        live = Lc;
+        st.max_live = std::max(st.max_live, peak);
+      } else {
+        // The budget binds in this step: emit again in list order, kills interleaved as they fell.
+        live = L0;
+        for (Chunk& ch : chunks) {
+          ch.out[ping].clear();
+          ch.splits = ch.refused = 0;
+          ch.maxAfterSplit = LLONG_MIN;
+          size_t seen = 0;
+          for (size_t i = 0; i < ch.surv.size(); ++i) {
+            live -= (long long)(ch.survKills[i] - seen);
+            seen = ch.survKills[i];
+            ch.live = live;
+            emit(ch, ch.surv[i], maxPatches);
+            live = ch.live;
+          }
+          live -= (long long)(ch.kills - seen);
+          if (ch.splits > 0) st.max_live = std::max(st.max_live, size_t(ch.maxAfterSplit));
+        }
+      }
+    }
+    for (Chunk& ch : chunks) {
+      ch.st.splits += ch.splits;
+      ch.st.splits_refused += ch.refused;
+      done.insert(done.end(), ch.done.begin(), ch.done.end());
+    }
+    st.max_live = std::max(st.max_live, size_t(live));
+    ping = 1 - ping;
+  }
+  pool.reset();
+  // Reduce the chunks in chunk order (one chunk: its sums unchanged, as 0 + x = x).
+  for (const Chunk& ch : chunks) {
+    const WavefrontStats& a = ch.st;
+    st.steps = std::max(st.steps, a.steps);
+    st.straight_steps += a.straight_steps;
+    st.straight_time_steps += a.straight_time_steps;
+    st.splits += a.splits;
+    st.splits_refused += a.splits_refused;
+    st.kills_left += a.kills_left;
+    st.kills_caustic += a.kills_caustic;
+    st.kills_energy += a.kills_energy;
+    st.kills_opaque += a.kills_opaque;
+    st.flux_left += a.flux_left;
+    st.flux_caustic += a.flux_caustic;
+    st.flux_energy += a.flux_energy;
+    st.flux_absorbed += a.flux_absorbed;
+    st.flux_probe += a.flux_probe;
+    st.flux_ended_before_probe += a.flux_ended_before_probe;
+    st.caustic_crossings += a.caustic_crossings;
+    st.caustic_centroid += a.caustic_centroid;
+    st.probe_centroid += a.probe_centroid;
+    st.probe_direction += a.probe_direction;
+  }
+  for (size_t c = 1; c < chunks.size(); ++c) {
+    Chunk& ch = chunks[c];
+    for (size_t v = 0; v < grid_.count(); ++v) {
+      acc[v] += ch.acc[v];
+      best[v] = std::max(best[v], ch.best[v]);
+      dirAcc[v] += ch.dirAcc[v];
+    }
+    std::vector<double>().swap(ch.accOwn);
+    std::vector<double>().swap(ch.bestOwn);
+    std::vector<glm::dvec3>().swap(ch.dirOwn);
   }
   cur.swap(done);
   if (st.flux_caustic > 0) st.caustic_centroid /= st.flux_caustic;
