@@ -62,7 +62,7 @@ void addRenderCommand(CLI::App& app) {
                   "accumulate (fluence rate, default) or highest (the highest patch irradiance per voxel)");
   sub->add_option("--light-device", args->light_device,
                   "auto (default: the CPU reference when the Vulkan device is a CPU, e.g. lavapipe, where it is "
-                  "3-4x faster; else the GPU), gpu or cpu");
+                  "several times faster; else the GPU), gpu or cpu");
   sub->add_option("--caustics", args->caustics,
                   "pass (light continues through a focus, default) or kill (Tevs: patches end at a fold caustic)");
   sub->add_option("--light-step", args->light_step, "Light simulator time step in voxels (default 0.5)");
