@@ -100,6 +100,20 @@ glm::dvec3 centreMean(const RenderImage& img, int half) {
   return s / double(n);
 }
 
+/// The lit volume rendered by the CPU reference (unless `cpu` is false) and the GPU view renderer,
+/// at half-voxel steps.
+std::pair<RenderImage, RenderImage> renderBothTwins(const Scene& scene, const VolumeSet& v, bool cpu = true) {
+  RenderSettings rs;
+  rs.march.step_voxels = 0.5;
+  RenderImage c;
+  if (cpu) {
+    VolumeField field(v);
+    c = ReferenceMarcher(field, scene.environment).render(scene.camera, rs);
+  }
+  ViewRenderer gpu(context(), scene, v);
+  return {std::move(c), gpu.render(rs)};
+}
+
 TEST(Lighting, DiffuseFloorFollowsLambertsCosineLaw) {
   Scene scene = sceneFromJson(kFloor);
   VolumeSet v = voxelize(scene);
@@ -108,12 +122,7 @@ TEST(Lighting, DiffuseFloorFollowsLambertsCosineLaw) {
   // balances to float round-off.
   EXPECT_LT(sum.conservationError(), 1e-6);
   const double expected = 0.6 * 2.0 * std::cos(30.0 * kDeg) / kPi;
-  VolumeField field(v);
-  ReferenceMarcher cpu(field, scene.environment);
-  ViewRenderer gpu(context(), scene, v);
-  RenderSettings rs;
-  rs.march.step_voxels = 0.5;
-  RenderImage ci = cpu.render(scene.camera, rs), gi = gpu.render(rs);
+  auto [ci, gi] = renderBothTwins(scene, v);
   glm::dvec3 c = centreMean(ci, 2), g = centreMean(gi, 2);
   std::printf("floor radiance: CPU (%.6f %.6f %.6f), GPU (%.6f %.6f %.6f), Lambert %.6f\n", c.x, c.y, c.z, g.x, g.y, g.z,
               expected);
@@ -130,10 +139,7 @@ TEST(Lighting, DiffuseFloorIsLitTheSameByTheGpuSimulator) {
   VolumeSet v = voxelize(scene);
   LightingSummary sum = simulateLighting(context(), scene, v, {});
   EXPECT_LT(sum.conservationError(), 1e-5);  // float32 tallies (docs/light-simulator.md)
-  ViewRenderer gpu(context(), scene, v);
-  RenderSettings rs;
-  rs.march.step_voxels = 0.5;
-  glm::dvec3 g = centreMean(gpu.render(rs), 2);
+  glm::dvec3 g = centreMean(renderBothTwins(scene, v, false).second, 2);
   const double expected = 0.6 * 2.0 * std::cos(30.0 * kDeg) / kPi;
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(g[k], expected, 0.02 * expected);
   expectNoValidationMessages();
@@ -165,12 +171,8 @@ TEST(Lighting, InScatterMatchesSingleScatteringInASlab) {
   const double p = (1 - g * g) / (4 * kPi * std::pow(1 + g * g, 1.5));
   const double W = v.grid.extent.z;  // the grid's depth (≥ the 12 mm asked, by < 1 voxel)
   const double expected = sigma * p * 10.0 * std::exp(-sigma * 5.0) * (1 - std::exp(-sigma * W)) / sigma;
-  VolumeField field(v);
-  ReferenceMarcher cpu(field, scene.environment);
-  ViewRenderer gpu(context(), scene, v);
-  RenderSettings rs;
-  rs.march.step_voxels = 0.5;
-  glm::dvec3 c = centreMean(cpu.render(scene.camera, rs), 0), gg = centreMean(gpu.render(rs), 0);
+  auto [cImg, gImg] = renderBothTwins(scene, v);
+  glm::dvec3 c = centreMean(cImg, 0), gg = centreMean(gImg, 0);
   std::printf("in-scatter: CPU %.6f, GPU %.6f, closed form %.6f\n", luminance(c), luminance(gg), expected);
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(c[k], expected, 0.005 * expected);
@@ -195,12 +197,7 @@ TEST(Lighting, LitRenderTwinsAgree) {
     "lights": [{"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": 3}]})");
   VolumeSet v = voxelize(scene);
   simulateLightingReference(scene, v, {});
-  VolumeField field(v);
-  ReferenceMarcher cpu(field, scene.environment);
-  ViewRenderer gpu(context(), scene, v);
-  RenderSettings rs;
-  rs.march.step_voxels = 0.5;
-  RenderImage ci = cpu.render(scene.camera, rs), gi = gpu.render(rs);
+  auto [ci, gi] = renderBothTwins(scene, v);
   double diff = 0, mean = 0;
   for (size_t i = 0; i < ci.rgb.size(); ++i) {
     diff += std::abs(double(ci.rgb[i]) - gi.rgb[i]);
