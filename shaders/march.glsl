@@ -225,8 +225,9 @@ vec3 inScatter(vec3 x, vec3 d, vec3 sigmaT) {
 vec3 diffuseSurface(vec3 x, int mode) {
   // The albedo field is composited with the object's coverage, like the opacity: at the stop
   // point (opacity ≥ 0.5) the surface's own albedo is their ratio.
+  if (!hasFlag(EIKON_F_LIT)) return vec3(0.0);
   vec4 sc = sampleScatter(x) / max(sampleMedium(x, mode).w, 0.5);
-  if (!hasFlag(EIKON_F_LIT) || sc.x + sc.y + sc.z <= 0.0) return vec3(0.0);
+  if (sc.x + sc.y + sc.z <= 0.0) return vec3(0.0);
   float h = P.grid_origin.w;
   vec3 g = vec3(sampleMedium(x + vec3(h, 0, 0), mode).w - sampleMedium(x - vec3(h, 0, 0), mode).w,
                 sampleMedium(x + vec3(0, h, 0), mode).w - sampleMedium(x - vec3(0, h, 0), mode).w,

@@ -219,8 +219,9 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
   };
   auto diffuseSurface = [&](const glm::dvec3& x) {
     // Albedo and opacity are both composited with the coverage: their ratio is the surface's albedo.
+    if (!lit) return glm::dvec3(0.0);
     glm::dvec4 sc = field_.scatter(x) / std::max(mode == 1 ? field_.mediumE(x).w : field_.medium(x).w, 0.5);
-    if (!lit || sc.x + sc.y + sc.z <= 0.0) return glm::dvec3(0.0);
+    if (sc.x + sc.y + sc.z <= 0.0) return glm::dvec3(0.0);
     const double hh = field_.cellSize();
     auto opacity = [&](const glm::dvec3& y) { return mode == 1 ? field_.mediumE(y).w : field_.medium(y).w; };
     glm::dvec3 g;
