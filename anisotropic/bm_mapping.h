@@ -1,6 +1,6 @@
 // The Beyerle–McDermid space mapping: makes the extraordinary wave pseudo-isotropic.
 //
-// Essay. The e-mode's index surface pᵀ M_e p = 1 (DESIGN §2, M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e²)
+// Essay. The e-mode's index surface pᵀ M_e p = 1 (docs/design.md §2, M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e²)
 // is an ellipsoid in wave-vector space. With the symmetric positive matrix
 //     γ = O·diag(1/n_e, 1/n_e, 1/n_o)·Oᵀ = aaᵀ/n_o + (I − aaᵀ)/n_e = M_e^{1/2}
 // (O any rotation whose third column is the optic axis a) the mapped wave vector p' = γp lies on
@@ -26,7 +26,7 @@
 //   * Reflection inside the crystal (e→e): p'_r = p'_i − 2(p'_i·n')n' (ordinary mirror law).
 //
 // Worked example (calcite at D, axis ∥ x̂ along the surface, air → crystal at i = 30°,
-// physics_cases.md §3):
+// docs/reference-cases.md §3):
 //   eikon::Uniaxial calcite(1.658344, 1.486130, {1, 0, 0});
 //   eikon::BMMapping bm(calcite);
 //   glm::dvec3 n_in = {0, 0, 1};                        // interface normal into the crystal

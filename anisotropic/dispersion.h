@@ -1,6 +1,6 @@
 // Dispersion models: the refractive index n(λ) of one material (or one mode of a crystal).
 //
-// Conventions (refractiveindex.info / SCHOTT, see ../shared/reference/materials.json):
+// Conventions (refractiveindex.info / SCHOTT, see tests/data/reference/materials.json):
 //   * Every public interface takes wavelengths in **nanometres**; formulas use λ in µm inside.
 //   * Cauchy:    n(λ) = A + B/λ² + C/λ⁴ (+ D/λ⁶ …)          λ in µm, B in µm², C in µm⁴.
 //   * Sellmeier: n²(λ) = 1 + Σᵢ Bᵢ λ² / (λ² − Cᵢ)           λ in µm, Cᵢ in µm² (SCHOTT form).
@@ -8,7 +8,7 @@
 // A model may carry the wavelength range over which its coefficients were measured; evaluating
 // outside it is the caller's decision (warning or error), never silently clamped here.
 //
-// The GPU stores Cauchy coefficient *fields* A(x), B(x), C(x) (DESIGN §2, Dispersion), so every
+// The GPU stores Cauchy coefficient *fields* A(x), B(x), C(x) (docs/design.md §2, Dispersion), so every
 // model can produce the three Cauchy coefficients that represent it over a wavelength window:
 // exactly for Constant and Cauchy (≤ 3 terms), by least squares for Sellmeier, with the fit error
 // reported so that callers can show it.
@@ -66,7 +66,7 @@ class Dispersion {
   double derivative(double lambda_nm) const;
 
   /// Cauchy {A,B,C} representing this model over [lo_nm, hi_nm]: exact when possible, else a
-  /// least-squares fit on 1 nm samples weighted towards 560 nm (see dispersion.cpp; DESIGN §2
+  /// least-squares fit on 1 nm samples weighted towards 560 nm (see dispersion.cpp; docs/design.md §2
   /// "report the fit error").
   CauchyApproximation cauchyApproximation(double lo_nm, double hi_nm) const;
 
@@ -83,7 +83,7 @@ class Dispersion {
   std::optional<std::array<double, 2>> range_nm_;
 };
 
-/// Fraunhofer lines in nm (optowiki, as in ../shared/reference/materials.json).
+/// Fraunhofer lines in nm (optowiki, as in tests/data/reference/materials.json).
 namespace fraunhofer {
 inline constexpr double F = 486.1327;
 inline constexpr double d = 587.5618;

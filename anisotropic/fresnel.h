@@ -6,9 +6,9 @@
 //     Rs = ((n1 cos i − n2 cos t)/(n1 cos i + n2 cos t))²,
 //     Rp = ((n2 cos i − n1 cos t)/(n2 cos i + n1 cos t))²,   R = ½(Rs + Rp) for unpolarised light,
 // with R = 1 beyond the critical angle asin(n2/n1). Brewster: tan θ_B = n2/n1. At normal
-// incidence R₀ = ((n2 − n1)/(n2 + n1))² (physics_cases.md §5).
+// incidence R₀ = ((n2 − n1)/(n2 + n1))² (docs/reference-cases.md §5).
 //
-// At a crystal surface two refracted (or reflected) modes share the power. DESIGN §2 splits
+// At a crystal surface two refracted (or reflected) modes share the power. docs/design.md §2 splits
 // unpolarised light as "each mode carries ½ of the power times its own transmission". Two
 // implementations are provided:
 //   * EXACT (`uniaxialEntryExact`, `uniaxialExitExact`): solves Maxwell's boundary conditions —

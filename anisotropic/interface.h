@@ -5,9 +5,9 @@
 // (phase matching; Born & Wolf §1.5.1 for isotropic media, §15.3 for crystals). Write every
 // outgoing wave as p = p_t + q m, with p_t the incident wave vector's tangential part (p = n s
 // in units of k₀ = ω/c; |p| is the index the wave sees). Each mode satisfies its dispersion
-// relation pᵀ M p = 1 (DESIGN §2: M_o = I/n_o², M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e², M = I/n² in an
+// relation pᵀ M p = 1 (docs/design.md §2: M_o = I/n_o², M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e², M = I/n² in an
 // isotropic medium), which is a quadratic in q:
-//     A q² + B q + C = 0,  A = mᵀMm,  B = 2 p_tᵀMm,  C = p_tᵀMp_t − 1      (physics_cases.md §3).
+//     A q² + B q + C = 0,  A = mᵀMm,  B = 2 p_tᵀMm,  C = p_tᵀMp_t − 1      (docs/reference-cases.md §3).
 // The ray (energy) velocity is M p (∝ εs for the e-mode, §8), and its normal component
 // (Mp)·m = ±½√(B² − 4AC) for the two roots. So the root that carries energy ACROSS the interface
 // (transmission) is q = (−B + √disc)/(2A) and the reflected one is q = (−B − √disc)/(2A) — the
@@ -22,10 +22,10 @@
 //     q = p·m with m so oriented (q > 0 transmitted, q < 0 reflected).
 //   * `s_in` is the incident WAVE NORMAL (for an isotropic medium also its ray direction).
 //   * Mode conversion on reflection inside the crystal (o→e, e→o) is ignored: reflect...()
-//     returns the same-mode reflected wave only (DESIGN §2: a later refinement). Fresnel
+//     returns the same-mode reflected wave only (docs/design.md §2: a later refinement). Fresnel
 //     amplitudes are in fresnel.h.
 //
-// Worked example (physics_cases.md §3: air → calcite at D, i = 30°, axis ∥ surface, in plane):
+// Worked example (docs/reference-cases.md §3: air → calcite at D, i = 30°, axis ∥ surface, in plane):
 //   eikon::Uniaxial calcite(1.658344, 1.486130, {1, 0, 0});
 //   glm::dvec3 s_in{std::sin(pi/6), 0, std::cos(pi/6)};
 //   auto w = eikon::refractIntoUniaxial(s_in, {0, 0, 1}, 1.0, calcite);

@@ -8,7 +8,7 @@ namespace eikon {
 PleochroismWeights pleochroismWeights(double theta_rad, double n_o, double n_e, PleochroismModel model) {
   const double c = std::cos(theta_rad), s = std::sin(theta_rad);
   if (model == PleochroismModel::TevsThesis) return {c * c, (n_o / n_e) * (n_o / n_e) * s * s};
-  // First order in κ of 1/n̂² = cos²θ/n̂_o² + sin²θ/n̂_e² (physics_cases.md §9).
+  // First order in κ of 1/n̂² = cos²θ/n̂_o² + sin²θ/n̂_e² (docs/reference-cases.md §9).
   const double n = 1.0 / std::sqrt(c * c / (n_o * n_o) + s * s / (n_e * n_e));
   const double n3 = n * n * n;
   return {n3 * c * c / (n_o * n_o * n_o), n3 * s * s / (n_e * n_e * n_e)};

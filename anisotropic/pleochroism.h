@@ -4,7 +4,7 @@
 // n̂ = n(1 + iκ) (Born & Wolf §14.2 notation). The o-wave always sees σ_o. The e-wave obeys
 // 1/n̂(θ)² = cos²θ/n̂_o² + sin²θ/n̂_e², θ = angle between the WAVE NORMAL and the optic axis.
 // Expanding to first order in κ and writing the intensity attenuation coefficient α = 2k₀nκ
-// (per unit length ALONG THE WAVE NORMAL) gives (physics_cases.md §9, DESIGN §2):
+// (per unit length ALONG THE WAVE NORMAL) gives (docs/reference-cases.md §9, docs/design.md §2):
 //     σ(θ) = n(θ)³ [σ_o cos²θ/n_o³ + σ_e sin²θ/n_e³]            (PleochroismModel::FirstOrder)
 // which is exact at both ends: σ(0) = σ_o, σ(90°) = σ_e. Tevs' thesis (appendix A.3) writes
 //     σ(θ) = σ_o cos²θ + σ_e (n_o/n_e)² sin²θ                    (PleochroismModel::TevsThesis)

@@ -1,5 +1,5 @@
 // The nine dispersion formulas of the refractiveindex.info database, evaluated as the database
-// defines them ("Dispersion formulas.pdf" in database/doc, ../shared/reference/materials.json).
+// defines them ("Dispersion formulas.pdf" in database/doc, tests/data/reference/materials.json).
 //
 // A database entry `type: formula K` carries a flat coefficient list C1, C2, … and a wavelength
 // range in µm. With λ in µm (the database unit; this file is the one place in eikon whose public

@@ -55,7 +55,7 @@ glm::dmat3 Uniaxial::epsilon() const {
 glm::dvec3 Uniaxial::rayDirection(Mode mode, glm::dvec3 s) const {
   const glm::dvec3 u = glm::normalize(s);
   if (mode == Mode::Ordinary) return u;
-  // εs = n_o² s + (n_e² − n_o²)(s·a) a   (physics_cases.md §8)
+  // εs = n_o² s + (n_e² − n_o²)(s·a) a   (docs/reference-cases.md §8)
   return glm::normalize(n_o * n_o * u + (n_e * n_e - n_o * n_o) * glm::dot(u, axis) * axis);
 }
 

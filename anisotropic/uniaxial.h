@@ -6,16 +6,16 @@
 // k = k₀ n s) splits into two modes:
 //   * o (ordinary):      index n_o for every s; D ⊥ the principal plane (s, a); ray ∥ s.
 //   * e (extraordinary): index n(θ), 1/n(θ)² = cos²θ/n_o² + sin²θ/n_e²   (Born & Wolf §15.3.3,
-//                        eq. (15.3.24); physics_cases.md §1), θ = angle between the WAVE NORMAL
+//                        eq. (15.3.24); docs/reference-cases.md §1), θ = angle between the WAVE NORMAL
 //                        s and the optic axis a (NOT the ray); D in the principal plane.
 // The e-ray (Poynting vector, energy direction) is t = εs/|εs| (Beyerle & McDermid 1998,
-// Appl. Opt. 37:7947, eq. for the ray vector; Tevs 2007 appendix A.2; physics_cases.md §8).
+// Appl. Opt. 37:7947, eq. for the ray vector; Tevs 2007 appendix A.2; docs/reference-cases.md §8).
 // It differs from s by the walk-off angle ρ, tan ρ = (n_o² − n_e²) sinθ cosθ /
-// (n_e² cos²θ + n_o² sin²θ) = −(1/n) dn/dθ (physics_cases.md §2), and lies in the plane (s, a).
+// (n_e² cos²θ + n_o² sin²θ) = −(1/n) dn/dθ (docs/reference-cases.md §2), and lies in the plane (s, a).
 // In a negative crystal (calcite, n_e < n_o) the e-ray bends AWAY from the optic axis; in a
 // positive one (quartz, rutile) TOWARDS it.
 //
-// Hamiltonian form (DESIGN §2). With p = ∇S (|p| = the index the wave sees, p = n s), each
+// Hamiltonian form (docs/design.md §2). With p = ∇S (|p| = the index the wave sees, p = n s), each
 // mode satisfies H_m(p) = ½(pᵀ M_m p − 1) = 0 with
 //   M_o = I/n_o²,   M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e²  ( = ε/(n_o² n_e²) ),
 // and the ray equations dx/dτ = ∂H/∂p = M p, dp/dτ = −∂H/∂x. For the e-mode M_e p ∝ εs, so the
@@ -63,7 +63,7 @@ struct Uniaxial {
   double cosTheta(glm::dvec3 s) const;
 
   /// e-wave index for a wave normal at angle θ (radians) from the axis:
-  /// 1/n² = cos²θ/n_o² + sin²θ/n_e² (Born & Wolf eq. 15.3.24; physics_cases.md §1).
+  /// 1/n² = cos²θ/n_o² + sin²θ/n_e² (Born & Wolf eq. 15.3.24; docs/reference-cases.md §1).
   double extraordinaryIndexAt(double theta_rad) const;
   /// Same, for a wave-normal direction s (any non-zero length).
   double extraordinaryIndex(glm::dvec3 s) const;
@@ -74,20 +74,20 @@ struct Uniaxial {
   glm::dmat3 epsilon() const;
 
   /// Unit ray (Poynting) direction for wave normal s: s for the o-mode, εs/|εs| for the e-mode
-  /// (physics_cases.md §8; NOT ε⁻¹s). Points into the same half-space as s (t·s > 0).
+  /// (docs/reference-cases.md §8; NOT ε⁻¹s). Points into the same half-space as s (t·s > 0).
   glm::dvec3 rayDirection(Mode mode, glm::dvec3 s) const;
 
   /// Walk-off ρ ≥ 0 (radians) between the e-wave normal s and its ray t, ρ = acos(s·t)
-  /// (physics_cases.md §2). 0 for the o-mode, along the axis and perpendicular to it.
+  /// (docs/reference-cases.md §2). 0 for the o-mode, along the axis and perpendicular to it.
   double walkOffAngle(glm::dvec3 s) const;
   /// Signed walk-off ρ(θ) = θ_r − θ with tan θ_r = (n_o/n_e)² tan θ, θ in radians in [0, π/2].
   /// Positive: the ray lies farther from the axis than the wave normal (negative crystal).
   double walkOffAngleAt(double theta_rad) const;
   /// Largest walk-off: tan ρ_max = |n_o² − n_e²|/(2 n_o n_e), at θ = atan(n_e/n_o)
-  /// (physics_cases.md §2). Returns ρ_max (radians); `theta_at_max` receives θ if non-null.
+  /// (docs/reference-cases.md §2). Returns ρ_max (radians); `theta_at_max` receives θ if non-null.
   double maxWalkOffAngle(double* theta_at_max = nullptr) const;
 
-  /// Hamiltonian matrix M_m: M_o = I/n_o², M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e² (DESIGN §2).
+  /// Hamiltonian matrix M_m: M_o = I/n_o², M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e² (docs/design.md §2).
   glm::dmat3 hamiltonianMatrix(Mode mode) const;
   /// H_m(p) = ½(pᵀ M_m p − 1); zero on the mode's index surface (p = n s).
   double hamiltonian(Mode mode, glm::dvec3 p) const;

@@ -1,6 +1,6 @@
 // eikon trace SCENE.json --origin x,y,z --dir x,y,z --wavelength NM [--json] [--reference]
 // Traces one ray through the voxelised scene and prints, per mode, exit point, exit direction,
-// wave normal, optical path and transmittance (DESIGN §3). Isotropic scenes print both modes,
+// wave normal, optical path and transmittance (docs/design.md §3). Isotropic scenes print both modes,
 // identical. Transmittance is the mode's own (Fresnel for its polarisation × attenuation);
 // unpolarised light gives each mode half of the incident power.
 #include <array>

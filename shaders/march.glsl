@@ -1,6 +1,6 @@
 // The eikonal march shared by view.comp and trace.comp (GPU twin of core/reference/marcher.cpp).
 //
-// Ray equation with the spatial arc parameter s (DESIGN §2; Ihrke et al. 2007 eq. 3):
+// Ray equation with the spatial arc parameter s (docs/design.md §2; Ihrke et al. 2007 eq. 3):
 //   dx/ds = w / n(x),   dw/ds = ∇n(x),   w = n·dx/ds, invariant |w| = n.
 // Integrated with a fixed step ds = march.x · h by Euler, midpoint (RK2) or classical RK4; inside
 // homogeneous regions (skip distance D ≥ 2 voxels) the ray crosses (D − 1.5)·h in one straight
@@ -192,7 +192,7 @@ vec2 fresnelRsRp(float ci, float n1, float n2) {
   return vec2(rs * rs, rp * rp);
 }
 
-// Light from the light simulator (DESIGN §2 image formation, Tevs eq. 5.10; docs/light-simulator.md).
+// Light from the light simulator (docs/design.md §2 image formation, Tevs eq. 5.10; docs/light-simulator.md).
 // φ (fluence rate, W/mm², linear sRGB) and the net flux vector F of its luminance φ_Y, trilinear.
 // Henyey–Greenstein phase function of cos θ (θ between the light's and the scattered direction).
 float phaseHG(float cosTheta, float g) {
@@ -286,7 +286,7 @@ vec3 applyM(vec3 p, vec3 a, float no, float ne) {
 }
 
 // Derivatives of (x, w) with respect to ray arc length s.
-//  o-mode (DESIGN §2, isotropic form): dx/ds = w/n, dw/ds = ∇n on the shell |w| = n.
+//  o-mode (docs/design.md §2, isotropic form): dx/ds = w/n, dw/ds = ∇n on the shell |w| = n.
 //  e-mode (Hamiltonian H = ½(pᵀM_e p − 1), w = p): dx/dτ = M p,
 //    dp/dτ = −½ pᵀ(∂M/∂x)p = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e (+ the axis term of a
 //    radial field, below),
@@ -325,7 +325,7 @@ vec3 rayDirection(vec3 x, vec3 w, int mode) {
 }
 
 // Attenuation per unit ray length of `mode` at x for wave vector w (band values or the value at λ).
-// e-mode: σ(θ) = n(θ)³[σ_o cos²θ/n_o³ + σ_e sin²θ/n_e³] per unit wave-normal length (DESIGN §2,
+// e-mode: σ(θ) = n(θ)³[σ_o cos²θ/n_o³ + σ_e sin²θ/n_e³] per unit wave-normal length (docs/design.md §2,
 // first order in the extinction), times cos ρ = s·t for the length along the ray.
 vec3 attenuationAt(vec3 x, vec3 w, int mode) {
   vec3 so = sigmaOf(sampleMedium(x, 0).xyz);

@@ -5,7 +5,7 @@
 //     dx/dt = w / n²,   dw/dt = ∇n / n     (c = 1, t = optical path, |w| = n)
 //
 // or, for the e-mode of a uniaxial volume (P.control.w = 1), where the optic axis a is non-zero,
-// the mode Hamiltonian H = ½(pᵀM_e p − 1) of DESIGN §2 in the same constant time (w = p):
+// the mode Hamiltonian H = ½(pᵀM_e p − 1) of docs/design.md §2 in the same constant time (w = p):
 //
 //     dx/dt = M_e p,   dp/dt = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e [− radial-axis term]
 //

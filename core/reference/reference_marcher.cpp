@@ -144,7 +144,7 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
   auto nO = [&](const glm::dvec3& x, double& n, glm::dvec3& g) { field_.index(x, il2, il4, n, g); };
   auto nE = [&](const glm::dvec3& x, double& n, glm::dvec3& g) { field_.indexE(x, il2, il4, n, g); };
   auto hasAxis = [](const glm::dvec3& a) { return glm::dot(a, a) >= 0.25; };
-  // M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e² (DESIGN §2).
+  // M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e² (docs/design.md §2).
   auto applyM = [](const glm::dvec3& p, const glm::dvec3& a, double no, double ne) {
     double pa = glm::dot(p, a);
     return a * pa / (no * no) + (p - a * pa) / (ne * ne);
@@ -183,7 +183,7 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
     nE(x, ne, g);
     return glm::normalize(applyM(w, a, no, ne));
   };
-  // Attenuation per unit ray length (e-mode: pleochroic σ(θ)·cos ρ, DESIGN §2).
+  // Attenuation per unit ray length (e-mode: pleochroic σ(θ)·cos ρ, docs/design.md §2).
   auto attenuationAt = [&](const glm::dvec3& x, const glm::dvec3& w) {
     glm::dvec3 so = sigmaOf(glm::dvec3(field_.medium(x)));
     glm::dvec3 a = mode == 1 ? field_.axis(x) : glm::dvec3(0.0);

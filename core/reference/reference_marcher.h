@@ -1,4 +1,4 @@
-// The double-precision CPU oracle of the view renderer (DESIGN §1: "the same physics exists
+// The double-precision CPU oracle of the view renderer (docs/design.md §1: "the same physics exists
 // twice"). It integrates the same ray equation as shaders/march.glsl — dx/ds = w/n, dw/ds = ∇n
 // with Euler, midpoint or RK4, straight steps through homogeneous regions, Fresnel at interface
 // layers — in double precision, multi-threaded, sharing no code with core/render. It marches

@@ -61,7 +61,7 @@ double triangleSolidAngle(const glm::dvec3& a, const glm::dvec3& b, const glm::d
 
 bool hasAxis(const glm::dvec3& a) { return glm::dot(a, a) >= 0.25; }  // as the marcher: zero outside crystals
 
-/// M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e² (DESIGN §2).
+/// M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e² (docs/design.md §2).
 glm::dvec3 applyM(const glm::dvec3& p, const glm::dvec3& a, double no, double ne) {
   const double pa = glm::dot(p, a);
   return a * (pa / (no * no)) + (p - a * pa) / (ne * ne);

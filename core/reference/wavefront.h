@@ -1,4 +1,4 @@
-// The double-precision CPU reference of the light simulator (issue 6, DESIGN §2 "Light
+// The double-precision CPU reference of the light simulator (issue 6, docs/design.md §2 "Light
 // simulator", Tevs ch. 4 and 6). The GPU kernel (core/render/light_simulator.h) is tested against it.
 //
 // A wavefront of patches, each a quad of four corner particles, is launched from a light and
@@ -9,7 +9,7 @@
 //
 // t is time with c = 1 (mm): a corner moves dt/n mm per step. Each corner is integrated with RK4
 // using Field::index at the simulator's wavelength. WavefrontSettings::mode = 1 propagates the
-// extraordinary mode of a uniaxial medium instead, with the mode Hamiltonian of DESIGN §2 in the
+// extraordinary mode of a uniaxial medium instead, with the mode Hamiltonian of docs/design.md §2 in the
 // same constant time (w = p, M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e², a the unit optic axis):
 //
 //     dx/dt = M_e p,   dp/dt = −½ pᵀ(∂M_e/∂x)p = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e

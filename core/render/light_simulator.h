@@ -1,4 +1,4 @@
-// The GPU light simulator (issue 6, DESIGN §2): the wavefront of patches of
+// The GPU light simulator (issue 6, docs/design.md §2): the wavefront of patches of
 // core/reference/wavefront.h propagated by a Vulkan compute kernel (shaders/wavefront.comp), one
 // thread per patch, RK4 in constant time on the four corners, attenuation, fixed-point atomic
 // splat into the irradiance/direction volumes. Same settings, seeds, kill rules, split rule and

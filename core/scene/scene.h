@@ -1,4 +1,4 @@
-// A scene as read from scene.json (format: docs/scene-format.md; DESIGN §3).
+// A scene as read from scene.json (format: docs/scene-format.md; docs/design.md §3).
 //
 //   eikon::Scene scene = eikon::loadScene("scenes/glass_sphere.json");   // throws SceneError
 //   scene.camera.width = 400;                                           // override before use

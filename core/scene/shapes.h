@@ -4,7 +4,7 @@
 //
 // Conventions: lengths in mm, world space; `rotation_deg` = [rx, ry, rz] applied as Rz·Ry·Rx to the
 // object's local frame (x first), about the object's centre. Planes are [nx, ny, nz, d] with the
-// inside where n·x ≤ d, n the outward normal of any non-zero length (DESIGN §3).
+// inside where n·x ≤ d, n the outward normal of any non-zero length (docs/design.md §3).
 #pragma once
 
 #include <glm/glm.hpp>

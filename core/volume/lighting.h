@@ -1,4 +1,4 @@
-// From light-simulator runs to the light volumes the view renderer reads (DESIGN §1: LightSimulator
+// From light-simulator runs to the light volumes the view renderer reads (docs/design.md §1: LightSimulator
 // → irradiance + light-direction volumes, per wavelength band, per mode → ViewRenderer).
 //
 // The simulator (core/reference/wavefront.h, core/render/light_simulator.h) propagates one light

@@ -1,6 +1,6 @@
 // VolumeSet: the scene voxelised into the fields both twins (GPU and CPU reference) march through.
 //
-// Pipeline (DESIGN §1): for each object, anti-aliased coverage (4³ supersampling in voxels the
+// Pipeline (docs/design.md §1): for each object, anti-aliased coverage (4³ supersampling in voxels the
 // surface crosses) → composite material properties in object order → separable Gaussian
 // pre-smoothing with σ = smoothing_voxels → central-difference gradients. Dispersion is carried
 // by Cauchy coefficient fields, n(λ, x) = A(x) + B(x)/λ² + C(x)/λ⁴ (λ in µm), so one set of
@@ -25,7 +25,7 @@
 //                   (both only after a light simulation: core/volume/lighting.h)
 // The skip distance D is the Chebyshev distance (in voxels, capped) from the voxel to the nearest
 // voxel whose fields differ from a neighbour's: within (D − 1) voxels every field is constant,
-// so a ray may cross that distance in one straight step (DESIGN's "distance volume").
+// so a ray may cross that distance in one straight step (docs/design.md's "distance volume").
 #pragma once
 
 #include <glm/glm.hpp>

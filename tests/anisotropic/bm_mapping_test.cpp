@@ -83,7 +83,7 @@ TEST(BMMapping, ESurfaceMapsToUnitSphereAndRayToWaveNormal) {
 }
 
 TEST(BMMapping, Section3CaseInMappedSpace) {
-  // physics_cases.md §3: air → calcite at D, i = 30°, axis ∥ x̂ in the surface: φ_e 19.4362°,
+  // docs/reference-cases.md §3: air → calcite at D, i = 30°, axis ∥ x̂ in the surface: φ_e 19.4362°,
   // n 1.502601, ψ (ray) 15.8218°.
   const auto c = calciteD({1, 0, 0});
   const eikon::BMMapping bm(c);

@@ -1,5 +1,5 @@
 // Shared fixtures for the uniaxial-optics tests: angle helpers, calcite at the sodium D line from
-// the Ghosh (1999) Sellmeier coefficients in ../shared/reference/materials.json, random unit vectors.
+// the Ghosh (1999) Sellmeier coefficients in tests/data/reference/materials.json, random unit vectors.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -15,7 +15,7 @@ inline constexpr double kPi = 3.14159265358979323846;
 inline double deg(double d) { return d * kPi / 180.0; }
 inline double toDeg(double r) { return r * 180.0 / kPi; }
 
-/// Calcite at D (589.2938 nm): n_o = 1.658344, n_e = 1.486130 (physics_cases.md), any axis.
+/// Calcite at D (589.2938 nm): n_o = 1.658344, n_e = 1.486130 (docs/reference-cases.md), any axis.
 inline Uniaxial calciteD(glm::dvec3 axis = {0, 0, 1}) {
   const auto o = Dispersion::sellmeier({0.73358749, 0.96464345, 1.82831454}, {0, 0.0194325203, 120});
   const auto e = Dispersion::sellmeier({0.35859695, 0.8242783, 0.14429128}, {0, 0.0106689543, 120});

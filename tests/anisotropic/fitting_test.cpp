@@ -1,4 +1,4 @@
-// Dispersion fitting: reference fits (../shared/reference/physics_cases.md §6), coverage of the
+// Dispersion fitting: reference fits (docs/reference-cases.md §6), coverage of the
 // reported 1σ intervals, per-mode crystal fits, Sellmeier refit, robust loss, rank deficiency.
 #include "anisotropic/fitting.h"
 
@@ -17,7 +17,7 @@ namespace eikon {
 namespace {
 
 nlohmann::json materials() {
-  std::ifstream in(std::string(EIKON_SHARED_DIR) + "/reference/materials.json");
+  std::ifstream in(std::string(EIKON_SOURCE_DIR) + "/tests/data/reference/materials.json");
   if (!in) throw std::runtime_error("cannot open reference/materials.json");
   return nlohmann::json::parse(in);
 }

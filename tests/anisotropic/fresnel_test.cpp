@@ -1,4 +1,4 @@
-// Isotropic Fresnel (physics_cases.md §5) and the per-mode split at crystal surfaces: exact
+// Isotropic Fresnel (docs/reference-cases.md §5) and the per-mode split at crystal surfaces: exact
 // Maxwell solution (energy conserved, isotropic limit) and the D-projection approximation, whose
 // cost against the exact solution is measured here and quoted in docs/uniaxial-optics.md.
 #include "anisotropic/fresnel.h"

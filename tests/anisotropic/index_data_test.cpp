@@ -103,7 +103,7 @@ TEST(IndexCsv, WindowKeepsOnlyPointsInside) {
 // silica, diamond, sapphire; 2: glasses, calcite, quartz, water; 4: rutile) and printed to six
 // decimals, so agreement to 6e-7 (rounding) is required.
 TEST(RefractiveIndexFormula, MatchesMaterialsJsonAtFraunhoferLines) {
-  std::ifstream in(std::string(EIKON_SHARED_DIR) + "/reference/materials.json");
+  std::ifstream in(std::string(EIKON_SOURCE_DIR) + "/tests/data/reference/materials.json");
   ASSERT_TRUE(in.good());
   const auto m = nlohmann::json::parse(in);
   int checked = 0;

@@ -1,5 +1,5 @@
 // Plane-interface refraction and reflection of o- and e-waves (interface.h) against
-// physics_cases.md §3 and against invariants: tangential k conserved, both waves on their index
+// docs/reference-cases.md §3 and against invariants: tangential k conserved, both waves on their index
 // surfaces, energy on the correct side, isotropic Snell when n_o = n_e.
 #include "anisotropic/interface.h"
 

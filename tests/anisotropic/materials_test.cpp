@@ -1,4 +1,4 @@
-// The shipped material library (materials/*.json) against ../shared/reference/materials.json:
+// The shipped material library (materials/*.json) against tests/data/reference/materials.json:
 // every file parses with only the documented keys, builds an eikon::Dispersion, and reproduces
 // the reference n at F/d/C (and D) to 2e-6 and the Abbe number to 1%.
 #include <gtest/gtest.h>
@@ -69,7 +69,7 @@ const std::set<std::string> kCrystalKeys{"name",     "source",     "notes", "n_o
 }  // namespace
 
 TEST(Materials, LibraryMatchesReference) {
-  const json ref = readJson(fs::path(EIKON_SHARED_DIR) / "reference" / "materials.json");
+  const json ref = readJson(fs::path(EIKON_SOURCE_DIR) / "tests" / "data" / "reference" / "materials.json");
   const fs::path dir = fs::path(EIKON_SOURCE_DIR) / "materials";
   std::set<std::string> seen;
   int checked_against_reference = 0;

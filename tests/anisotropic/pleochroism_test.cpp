@@ -1,4 +1,4 @@
-// Pleochroic attenuation of the e-wave (physics_cases.md §9, DESIGN §2).
+// Pleochroic attenuation of the e-wave (docs/reference-cases.md §9, docs/design.md §2).
 #include "anisotropic/pleochroism.h"
 
 #include <gtest/gtest.h>

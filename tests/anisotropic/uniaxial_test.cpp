@@ -1,6 +1,6 @@
-// Uniaxial index surface, ray direction and walk-off against ../shared/reference/physics_cases.md
+// Uniaxial index surface, ray direction and walk-off against docs/reference-cases.md
 // §1, §2 and §8. Indices come from the Ghosh (1999) Sellmeier formulas through eikon::Dispersion,
-// so the tolerances are those of physics_cases (1e-6 on n, 1e-4° on angles), not the code's own.
+// so the tolerances are those of docs/reference-cases.md (1e-6 on n, 1e-4° on angles), not the code's own.
 #include "anisotropic/uniaxial.h"
 
 #include <gtest/gtest.h>
@@ -36,7 +36,7 @@ double angleBetween(glm::dvec3 a, glm::dvec3 b) {
 }  // namespace
 
 TEST(Uniaxial, GhoshCalciteAtD) {
-  // physics_cases.md header: n_o = 1.658344, n_e = 1.486130 at D; 1.658461 / 1.486185 at d.
+  // docs/reference-cases.md header: n_o = 1.658344, n_e = 1.486130 at D; 1.658461 / 1.486185 at d.
   const auto c = calciteAt(eikon::fraunhofer::D);
   EXPECT_NEAR(c.n_o, 1.658344, 1e-6);
   EXPECT_NEAR(c.n_e, 1.486130, 1e-6);

@@ -238,7 +238,7 @@ TEST_F(Cli, RenderSceneFileMissing) {
   expectCleanFailure(run("render " + quote((dir_ / "nope.json").string()) + " -o " + quote(outPath())), "nope.json");
 }
 
-// CLI-syntax errors (a missing required option, an unknown flag) are bad input too: DESIGN §4 /
+// CLI-syntax errors (a missing required option, an unknown flag) are bad input too: docs/design.md §4 /
 // the CLI contract say one "eikon: error:" line and a non-zero exit, like every other error.
 TEST_F(Cli, RenderMissingOutputOptionIsOneErrorLine) {
   const std::string scene = write("scene.json", tinyScene());

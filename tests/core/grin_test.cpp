@@ -1,4 +1,4 @@
-// Gradient-index media: the integrator against closed forms (physics_cases.md §7), first on the
+// Gradient-index media: the integrator against closed forms (docs/reference-cases.md §7), first on the
 // exact analytic field (integrator error only), then voxelised on both twins.
 #include <gtest/gtest.h>
 
@@ -77,7 +77,7 @@ TEST(Grin, LuneburgAnalyticFieldFocusesOnTheFarSide) {
   // R = 1. The exact field's gradient jumps at r = R (from −r/(nR²) to 0), which makes any
   // explicit integrator first order in the step that crosses the surface: errors ~ ds. With
   // ds = 2.5e-6 R (cell 1e-5, step 0.25) that is ~1e-6 R for the OPL and ~5e-6 in direction;
-  // physics_cases §7a asks for the focus within 1e-6 R and an OPL spread below 1e-6 R.
+  // docs/reference-cases.md §7a asks for the focus within 1e-6 R and an OPL spread below 1e-6 R.
   AnalyticField field(unitLuneburg, {-1.2, -1.2, -1.2}, {1.2, 1.2, 1.2}, 1e-5);
   Environment env;
   ReferenceMarcher m(field, env);

@@ -1,5 +1,5 @@
 // Fixtures shared by the light-simulator tests (CPU reference and GPU twin): lights, the glass-
-// sphere scene, the exact unit Luneburg field (physics_cases.md §7a), and a statistics printer.
+// sphere scene, the exact unit Luneburg field (docs/reference-cases.md §7a), and a statistics printer.
 #pragma once
 
 #include <cmath>

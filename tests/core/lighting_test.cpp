@@ -1,4 +1,4 @@
-// Simulated light in the view renderer (issue 6, DESIGN §2 image formation): the band/mode plan,
+// Simulated light in the view renderer (issue 6, docs/design.md §2 image formation): the band/mode plan,
 // a diffuse floor under a directional light (Lambert's cosine law), single scattering in a slab of
 // haze against its closed form, and the two twins rendering the same lit volume. The light
 // volumes come from the simulator (GPU or CPU reference); both view twins then read the same ones.
@@ -55,7 +55,7 @@ TEST(Lighting, PlanBandsAddUpToTheLightsLuminance) {
 }
 
 TEST(Lighting, UniaxialScenesRunBothModesAtHalfPower) {
-  // Unpolarised light: the o- and e-waves each carry half (DESIGN §2 "Splitting").
+  // Unpolarised light: the o- and e-waves each carry half (docs/design.md §2 "Splitting").
   Scene s = sceneFromJson(R"({
     "volume": {"bounds_min": [-4, -4, -4], "bounds_max": [4, 4, 4], "resolution": 16},
     "objects": [{"shape": "box", "size": [3, 3, 3], "material": "calcite", "optic_axis": [1, 0, 1]}],

@@ -1,4 +1,4 @@
-// Dispersion through an equilateral N-BK7 prism at minimum deviation (physics_cases.md §4):
+// Dispersion through an equilateral N-BK7 prism at minimum deviation (docs/reference-cases.md §4):
 // D_min = 2 asin(n sin(A/2)) − A at the F, d and C lines, traced through the voxelised prism.
 #include <gtest/gtest.h>
 
@@ -22,7 +22,7 @@ struct Line {
   const char* name;
   double nm, n, dmin_deg;
 };
-// n from the SCHOTT Sellmeier and D_min from physics_cases.md §4.
+// n from the SCHOTT Sellmeier and D_min from docs/reference-cases.md §4.
 const Line kLines[] = {{"F", 486.1327, 1.522376, 39.1381}, {"d", 587.5618, 1.516800, 38.6467},
                        {"C", 656.2725, 1.514322, 38.4291}};
 

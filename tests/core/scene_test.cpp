@@ -1,7 +1,7 @@
 // Scene JSON parser (core/scene/scene.cpp): every user error is a SceneError whose message names
 // the file and the JSON path of the offending value plus a phrase that tells the user what is
-// wrong (DESIGN §3-4: unknown keys are errors, n < 1 is an error, nothing is clamped). Positive
-// cases: the DESIGN §3 example, library materials (N-BK7, calcite) and every shipped scene.
+// wrong (docs/design.md §3-4: unknown keys are errors, n < 1 is an error, nothing is clamped). Positive
+// cases: the docs/design.md §3 example, library materials (N-BK7, calcite) and every shipped scene.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -208,7 +208,7 @@ TEST(SceneParse, MissingNe) {
 }
 
 // A linear GRIN profile is n(x) = n0 + g·(x − origin); inside a 20 mm box with g = 0.2/mm it
-// spans 1.5 ± 2 = [−0.5, 3.5]: n < 1 over much of the object. DESIGN §4: n < 1 is an error,
+// spans 1.5 ± 2 = [−0.5, 3.5]: n < 1 over much of the object. docs/design.md §4: n < 1 is an error,
 // never clamped, wherever it occurs — so the parser (or voxeliser) must refuse this scene.
 TEST(SceneParse, LinearGrinBelowOneInsideTheObject) {
   const std::string text =
@@ -331,7 +331,7 @@ TEST(SceneParse, MissingSceneFile) {
 
 // ------------------------------------------------------------------ positive cases
 
-// The DESIGN §3 example verbatim (N-BK7 comes from the material library, my-calcite is inline).
+// The docs/design.md §3 example verbatim (N-BK7 comes from the material library, my-calcite is inline).
 TEST(SceneParse, DesignExampleParses) {
   const char* text = R"({
     "camera": {"position": [0, 0, -60], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 30,

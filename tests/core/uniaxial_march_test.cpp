@@ -1,7 +1,7 @@
 // End-to-end checks of the e-ray march (issue 5): the voxelised, smoothed crystal marched by the
-// mode Hamiltonian H_e = ½(pᵀM_e p − 1) (DESIGN §2; shaders/march.glsl, core/reference) against
+// mode Hamiltonian H_e = ½(pᵀM_e p − 1) (docs/design.md §2; shaders/march.glsl, core/reference) against
 // the closed-form uniaxial library in anisotropic/ (uniaxial.h, interface.h, fresnel.h,
-// pleochroism.h), with the numbers of shared/reference/physics_cases.md §1–3, §8, §9.
+// pleochroism.h), with the numbers of docs/reference-cases.md §1–3, §8, §9.
 //
 // How the expected values are built. Every test takes the crystal's indices from the volume
 // itself (n_o, n_e sampled deep inside the crystal at the ray's wavelength): the voxeliser stores
@@ -29,7 +29,7 @@
 namespace eikon::test {
 namespace {
 
-constexpr double kD = 589.2938;  // sodium D line (physics_cases.md)
+constexpr double kD = 589.2938;  // sodium D line (docs/reference-cases.md)
 
 // --------------------------------------------------------------------------- helpers
 
@@ -139,7 +139,7 @@ std::array<TraceOutcome, 2> cpuModes(const Twins& t, const TraceRequest& r,
 // --------------------------------------------------------------------------- 1. plate walk-off
 
 TEST(UniaxialMarch, CalcitePlateDoubleImageAtNormalIncidence) {
-  // physics_cases.md §2: t = 10 mm, axis in the plane of incidence at 45° to the faces, normal
+  // docs/reference-cases.md §2: t = 10 mm, axis in the plane of incidence at 45° to the faces, normal
   // incidence, D line: the o-ray goes straight, the e-ray leaves parallel, displaced by
   // t·tan ρ = 1.092 mm towards −x (axis leaning to +x), ρ = 6.2324°.
   //
@@ -198,7 +198,7 @@ TEST(UniaxialMarch, CalcitePlateDoubleImageAtNormalIncidence) {
       EXPECT_NEAR(m[1].exit_point.y, o.y, tol);
       EXPECT_NEAR(sep, quad, tol);
       double rho = deg(std::atan((sep - layerExcess) / 10.0));
-      // physics_cases' own tolerance (1e-4 mm, 1e-4°) widened by the fit's shift, plus the rounding
+      // the reference cases' own tolerance (1e-4 mm, 1e-4°) widened by the fit's shift, plus the rounding
       // of the published 1.092 (±5e-4 mm).
       EXPECT_NEAR(sep - layerExcess, 1.092, std::abs(fitShift) + 6e-4);
       EXPECT_NEAR(
@@ -208,7 +208,7 @@ TEST(UniaxialMarch, CalcitePlateDoubleImageAtNormalIncidence) {
         std::printf(
             "plate (%s): separation %.6f mm (quadrature %.6f, error %+.2e); minus layer excess "
             "%.6f mm "
-            "(physics_cases 1.092); walk-off %.5f° (6.2324°)\n",
+            "(docs/reference-cases.md 1.092); walk-off %.5f° (6.2324°)\n",
             g ? "GPU" : "CPU", sep, quad, sep - quad, sep - layerExcess, rho);
     }
     ++idx;
@@ -219,7 +219,7 @@ TEST(UniaxialMarch, CalcitePlateDoubleImageAtNormalIncidence) {
 // --------------------------------------------------------------------------- 2. walk-off sign
 
 TEST(UniaxialMarch, WalkOffAwayFromAxisInCalciteTowardsItInQuartz) {
-  // physics_cases.md §2: negative crystal (calcite) e-ray bends away from the optic axis, positive
+  // docs/reference-cases.md §2: negative crystal (calcite) e-ray bends away from the optic axis, positive
   // (quartz) towards it. Axis in x-z at 45°, leaning to +x; normal incidence into a half space.
   // Inside, the ray t and wave normal s = ẑ: θ_r = angle(t, a) > θ = 45° for calcite, < for
   // quartz, by the library's walk-off (|Δ| < 1e-5 rad: the wave normal is exactly ẑ, t ∝ M_e ẑ).
@@ -259,7 +259,7 @@ TEST(UniaxialMarch, WalkOffAwayFromAxisInCalciteTowardsItInQuartz) {
 // --------------------------------------------------------------------------- 3. oblique incidence
 
 TEST(UniaxialMarch, ObliqueRefractionMatchesClosedForm) {
-  // physics_cases.md §3: air → calcite at D, i = 30°, axis in the plane of incidence and parallel
+  // docs/reference-cases.md §3: air → calcite at D, i = 30°, axis in the plane of incidence and parallel
   // to the surface: wave normal φ_e = 19.4362°, ray ψ = 15.8218°, o-wave 17.5481°. Plus a random
   // axis, where the e-ray leaves the plane of incidence. The ray ends inside a half-space crystal.
   // Tolerances: the face is parallel to the grid and ∇n ∥ ẑ, so the tangential p is conserved and
@@ -268,7 +268,7 @@ TEST(UniaxialMarch, ObliqueRefractionMatchesClosedForm) {
   // compared with the quadrature of the smoothed profile: inside the layer the marcher bends p by
   // the interpolated exact gradient, which is not exactly the derivative of the interpolated n
   // (H drifts by ~1e-4 there), so the ray slope differs by ~1e-4 over ±0.225 mm: 0.01 h = 1e-3 mm.
-  // Against physics_cases' angles: the Cauchy fit (|Δn| ≲ 3e-5) moves them by < 1e-3°.
+  // Against the reference cases' angles: the Cauchy fit (|Δn| ≲ 3e-5) moves them by < 1e-3°.
   MarchSettings ms;
   std::mt19937 rng(2024);
   std::normal_distribution<double> gauss(0.0, 1.0);
@@ -323,7 +323,7 @@ TEST(UniaxialMarch, ObliqueRefractionMatchesClosedForm) {
           glm::length(m[0].exit_point - expectO));
       if (cs.published) {
         // Library angles with Ghosh's indices vs the stored (fitted) ones: the fit's shift, then
-        // physics_cases' 1e-4°.
+        // the reference cases' 1e-4°.
         ModePair gh = refractIntoUniaxial(d, {0, 0, 1}, 1.0, Uniaxial(1.658344, 1.486130, cs.axis));
         double shPhi = deg(std::acos(ref.e.s.z) - std::acos(gh.e.s.z)),
                shPsi = deg(std::acos(ref.e.t.z) - std::acos(gh.e.t.z)),
@@ -350,7 +350,7 @@ TEST(UniaxialMarch, ObliqueRefractionMatchesClosedForm) {
 
 TEST(UniaxialMarch, AxisAlongRayGivesNoSplit) {
   // Optic axis along the surface normal, normal incidence: s ∥ a, n(0) = n_o and t = s for both
-  // modes, so o and e must coincide (physics_cases.md §2: no walk-off at θ = 0).
+  // modes, so o and e must coincide (docs/reference-cases.md §2: no walk-off at θ = 0).
   Twins t(plateScene("calcite", "[0, 0, 1]"));
   MarchSettings ms;
   TraceRequest req{{0.4, -0.3, -20}, {0, 0, 1}, kD};
@@ -560,7 +560,7 @@ TEST(UniaxialMarch, PleochroicTransmittanceFollowsFirstOrderModel) {
       }
     }
   }
-  // The library's end points (DESIGN §2): σ(0) = σ_o, σ(90°) = σ_e exactly.
+  // The library's end points (docs/design.md §2): σ(0) = σ_o, σ(90°) = σ_e exactly.
   EXPECT_DOUBLE_EQ(extraordinaryAttenuation(0.0, 1.658344, 1.486130, so, se), so);
   EXPECT_NEAR(extraordinaryAttenuation(90.0 * kDeg, 1.658344, 1.486130, so, se), se, 1e-15);
   expectNoValidationMessages();

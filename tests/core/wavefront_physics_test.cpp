@@ -1,5 +1,5 @@
 // Light simulator physics against published optics (docs/light-simulator.md, "Physics tests"):
-// the e-mode walk-off in a calcite plate (two spots, /work/shared/reference/physics_cases.md §2)
+// the e-mode walk-off in a calcite plate (two spots, docs/reference-cases.md §2)
 // and the spectral order of an N-BK7 prism at the minimum-deviation incidence (§4), each with a
 // narrow collimated beam (Light::beam_radius), on the CPU reference and on the GPU twin. Spots and
 // directions are measured on a probe plane behind the object (WavefrontStats::probe_centroid,
@@ -69,7 +69,7 @@ double plateSlope(double no, double ne, glm::dvec3 a) {
 struct PlateExpectation {
   double quad;          ///< displacement −x of the e-ray through the stored (smoothed) profile, mm
   double bulk;          ///< t·tan ρ from the stored bulk indices, mm
-  double published;     ///< t·tan ρ from Ghosh's n_o, n_e at D (physics_cases §2), mm
+  double published;     ///< t·tan ρ from Ghosh's n_o, n_e at D (docs/reference-cases.md §2), mm
 };
 
 /// Quadrature of the e-ray slope along the beam axis through the volume's own fields (n_o, n_e

@@ -185,7 +185,7 @@ TEST(Wavefront, StraightStepsMatchSingleSteps) {
   EXPECT_LT(l1 / sumA, 0.05);
 }
 
-// 3. Luneburg lens n = √(2 − r²/R²), R = 1 (physics_cases §7a), exact analytic field. Every ray
+// 3. Luneburg lens n = √(2 − r²/R²), R = 1 (docs/reference-cases.md §7a), exact analytic field. Every ray
 // parallel to +x reaches (R, 0, 0) after the same optical path R(1 + π/2) from x = −R, and the
 // simulator's time is optical path (c = 1), so the part of the front inside the lens collapses
 // onto the focus in the same step: patches flip there and are killed. We check (a) the

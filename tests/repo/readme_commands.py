@@ -1,0 +1,122 @@
+#!/usr/bin/python3
+"""Runs every `eikon ...` command shown in the README, as a user would copy it, so the README
+cannot rot.
+
+A command is a line `$ eikon ...` or `$ build/apps/eikon ...` inside a fenced code block; the
+lines after it, up to the next `$` line or the end of the block, are its printed output. For each
+command this checks that
+  * it exits 0, or non-zero when its shown output contains `eikon: error:`;
+  * every shown output line appears in what it printed, in order; `...` in a shown line matches
+    anything (the README elides columns that way).
+Commands run in a scratch folder holding links to the clone's scenes/, materials/, tests/ and
+docs/, so relative paths work and outputs land in the scratch folder. `render` commands get a
+small image (`--width 48 --height 36 --spp 1`) unless they set a size themselves: the README's
+pictures are made at full size by hand, this only checks that the command runs.
+
+usage: readme_commands.py EIKON_BINARY SOURCE_DIR
+Prints "readme: N passed, M failed" and exits non-zero if any failed.
+"""
+import os
+import re
+import shlex
+import subprocess
+import sys
+import tempfile
+
+SMALL_RENDER = ["--width", "48", "--height", "36", "--spp", "1"]
+
+
+def commands(readme_text):
+    """Yields (line_no, argv_after_eikon, expected_lines) for each `$ eikon` line in a code block."""
+    in_block = False
+    current = None
+    for no, line in enumerate(readme_text.splitlines(), 1):
+        if line.lstrip().startswith("```"):
+            if in_block and current:
+                yield current
+            current = None
+            in_block = not in_block
+            continue
+        if not in_block:
+            continue
+        m = re.match(r"^\$ (?:build/apps/)?eikon(\s.*)?$", line)
+        if m:
+            if current:
+                yield current
+            current = (no, shlex.split(m.group(1) or ""), [])
+        elif line.startswith("$ "):
+            if current:
+                yield current
+            current = None  # another program (./setup.sh ...): not ours to run here
+        elif current is not None and line.strip():
+            current[2].append(line.rstrip())
+    if current:
+        yield current
+
+
+def line_pattern(expected):
+    parts = [re.escape(p.strip()) for p in expected.split("...")]
+    return re.compile(r"\s*" + r".*?".join(parts) + r"\s*$")
+
+
+def check(binary, scratch, no, args, expected):
+    argv = list(args)
+    if argv and argv[0] == "render" and "--width" not in argv:
+        argv += SMALL_RENDER
+    proc = subprocess.run([binary] + argv, cwd=scratch, capture_output=True, text=True,
+                          timeout=900, env=dict(os.environ, EIKON_CACHE_DIR=os.path.join(scratch, "cache")))
+    printed = (proc.stdout + proc.stderr).splitlines()
+    problems = []
+    wants_error = any(e.lstrip().startswith("eikon: error:") for e in expected)
+    if wants_error and proc.returncode == 0:
+        problems.append("exited 0 but the README shows an error")
+    if not wants_error and proc.returncode != 0:
+        problems.append(f"exited {proc.returncode}")
+    at = 0
+    for e in expected:
+        pat = line_pattern(e)
+        for i in range(at, len(printed)):
+            if pat.match(printed[i]):
+                at = i + 1
+                break
+        else:
+            problems.append(f"README line not printed (in order): {e!r}")
+    name = f"README.md:{no}: eikon {' '.join(args)}"
+    if problems:
+        print(f"FAIL {name}")
+        for p in problems:
+            print(f"    {p}")
+        print("    printed:\n" + "\n".join("      | " + l for l in printed[-40:]))
+        return False
+    print(f"PASS {name}")
+    return True
+
+
+def main():
+    if len(sys.argv) != 3:
+        print(__doc__.strip().splitlines()[-2], file=sys.stderr)
+        return 2
+    binary, source = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    with open(os.path.join(source, "README.md"), encoding="utf-8") as f:
+        cmds = list(commands(f.read()))
+    if not cmds:
+        print("readme: no `$ eikon` commands found in README.md")
+        return 1
+    passed = failed = 0
+    with tempfile.TemporaryDirectory(prefix="eikon-readme-") as scratch:
+        for d in ("scenes", "materials", "tests", "docs"):
+            os.symlink(os.path.join(source, d), os.path.join(scratch, d))
+        os.mkdir(os.path.join(scratch, "build"))
+        os.makedirs(os.path.join(scratch, "build", "apps"))
+        os.symlink(binary, os.path.join(scratch, "build", "apps", "eikon"))
+        for no, args, expected in cmds:
+            if check(binary, scratch, no, args, expected):
+                passed += 1
+            else:
+                failed += 1
+    print(f"readme: {passed} passed, {failed} failed")
+    return 0 if failed == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
