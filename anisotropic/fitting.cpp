@@ -246,10 +246,9 @@ double modelIndex(DispersionModel m, const double* p, double lambda_nm, double* 
 
 Dispersion FitResult::dispersion() const {
   const int K = sellmeierTerms(model);
-  if (model == DispersionModel::Conrady)
-    throw std::invalid_argument("the conrady model cannot be stored as a renderer material (cauchy or sellmeier only)");
-  Dispersion d = K == 0 ? Dispersion::cauchy(coeffs)
-                        : Dispersion::sellmeier({coeffs.begin(), coeffs.begin() + K}, {coeffs.begin() + K, coeffs.end()});
+  Dispersion d = model == DispersionModel::Conrady ? Dispersion::conrady(coeffs.at(0), coeffs.at(1), coeffs.at(2))
+                 : K == 0 ? Dispersion::cauchy(coeffs)
+                          : Dispersion::sellmeier({coeffs.begin(), coeffs.begin() + K}, {coeffs.begin() + K, coeffs.end()});
   d.withRange(range_nm[0], range_nm[1]);
   return d;
 }
@@ -386,15 +385,9 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
                            " does not describe the data within their sigma, so its error bars are too small; "
                            "try a model with more terms");
   }
-  auto n_at = [&](double lnm) { return modelIndex(opt.model, r.coeffs.data(), lnm); };
-  if (opt.model != DispersionModel::Conrady) {
-    const Dispersion disp = r.dispersion();
-    r.n_F = disp.index(fraunhofer::F), r.n_d = disp.index(fraunhofer::d), r.n_C = disp.index(fraunhofer::C);
-    r.abbe = disp.abbeNumber();
-  } else {
-    r.n_F = n_at(fraunhofer::F), r.n_d = n_at(fraunhofer::d), r.n_C = n_at(fraunhofer::C);
-    r.abbe = (r.n_d - 1.0) / (r.n_F - r.n_C);
-  }
+  const Dispersion disp = r.dispersion();
+  r.n_F = disp.index(fraunhofer::F), r.n_d = disp.index(fraunhofer::d), r.n_C = disp.index(fraunhofer::C);
+  r.abbe = disp.abbeNumber();
   return r;
 }
 

@@ -55,8 +55,26 @@ json nullable(const std::optional<double>& v) { return v ? json(*v) : json(nullp
 
 std::string lossName(const FitResult& r) { return r.huber_delta ? "huber:" + fmt("%g", *r.huber_delta) : "none"; }
 
+bool isCauchy(DispersionModel m) { return m == DispersionModel::Cauchy2 || m == DispersionModel::Cauchy3; }
+
+// The renderer's GPU fields hold Cauchy {A, B, C}; every other model reaches them through
+// Dispersion::cauchyApproximation over the visible window (core/volume/volume_set.cpp), so fit
+// states what that approximation costs instead of approximating silently.
+constexpr double kRenderLoNm = 380.0, kRenderHiNm = 780.0;
+CauchyApproximation rendererApproximation(const FitResult& r) {
+  return r.dispersion().cauchyApproximation(kRenderLoNm, kRenderHiNm);
+}
+
+json approximationJson(const FitResult& r) {
+  const CauchyApproximation ap = rendererApproximation(r);
+  return {{"cauchy", ap.coeffs},
+          {"window_nm", {kRenderLoNm, kRenderHiNm}},
+          {"max_abs_dn", ap.max_error},
+          {"rms_abs_dn", ap.rms_error}};
+}
+
 json fitStats(const FitResult& r) {
-  return {{"chi2_reduced", nullable(r.chi2_reduced)},
+  json j = {{"chi2_reduced", nullable(r.chi2_reduced)},
           {"rms", r.rms},
           {"max_residual", r.max_residual},
           {"residual_std", r.residual_std},
@@ -68,12 +86,15 @@ json fitStats(const FitResult& r) {
           {"weighted", r.weighted},
           {"model", modelName(r.model)},
           {"loss", lossName(r)}};
+  if (!isCauchy(r.model)) j["renderer_cauchy"] = approximationJson(r);
+  return j;
 }
 
-// {"cauchy": [...], "range_nm": [...], "sigma": [...]} (or "sellmeier": all B then all C).
+// {"cauchy": [...], "range_nm": [...], "sigma": [...]} (or "sellmeier": all B then all C, or
+// "conrady": [n0, A, B]); the scene loader reads each of them (core/scene/scene.cpp).
 json materialIndex(const FitResult& r) {
-  const bool cauchy = r.model == DispersionModel::Cauchy2 || r.model == DispersionModel::Cauchy3;
-  return {{cauchy ? "cauchy" : "sellmeier", r.coeffs}, {"range_nm", r.range_nm}, {"sigma", r.sigma}};
+  const char* key = isCauchy(r.model) ? "cauchy" : r.model == DispersionModel::Conrady ? "conrady" : "sellmeier";
+  return {{key, r.coeffs}, {"range_nm", r.range_nm}, {"sigma", r.sigma}};
 }
 
 json reportMode(const FitResult& r) {
@@ -104,6 +125,12 @@ void printTable(std::ostream& os, const IndexData& data, const std::vector<FitRe
        << (r.chi2_reduced ? fmt("%.3f", *r.chi2_reduced) : std::string("- (no sigma column)")) << "\n";
     os << "  n_F " << fmt("%.6f", r.n_F) << "  n_d " << fmt("%.6f", r.n_d) << "  n_C " << fmt("%.6f", r.n_C)
        << "  V_d " << fmt("%.2f", r.abbe) << "\n";
+    if (!isCauchy(r.model)) {
+      const CauchyApproximation ap = rendererApproximation(r);
+      os << "  renderer: cauchy [" << fmt("%.8e", ap.coeffs[0]) << ", " << fmt("%.8e", ap.coeffs[1]) << ", "
+         << fmt("%.8e", ap.coeffs[2]) << "] over " << fmt("%g", kRenderLoNm) << "-" << fmt("%g", kRenderHiNm)
+         << " nm, |dn| max " << fmt("%.3e", ap.max_error) << ", rms " << fmt("%.3e", ap.rms_error) << "\n";
+    }
   }
 }
 
@@ -214,10 +241,6 @@ void run(const FitArgs& a) {
     if (a.range_nm.size() != 2) throw CliError("--range-nm takes LO,HI in nm");
     ro.window_nm = std::array<double, 2>{a.range_nm[0], a.range_nm[1]};
   }
-  if (fo.model == DispersionModel::Conrady && (!a.output.empty()))
-    throw CliError("the conrady model cannot be written as a renderer material (cauchy or sellmeier only); "
-                   "drop -o or choose another --model");
-
   IndexData data = readIndexData(a.data[0], ro);
   if (a.data.size() == 2) {
     data = combineOrdinaryExtraordinary(std::move(data), readIndexData(a.data[1], ro));
@@ -280,13 +303,27 @@ void run(const FitArgs& a) {
   }
 }
 
+// CLI11 2.1 shows a positional with expected(1, 2) as "data(1x)"; the fit's usage line names what
+// it takes instead: "DATA [E_DATA]".
+class FitFormatter final : public CLI::Formatter {
+ public:
+  std::string make_option_usage(const CLI::Option* opt) const override {
+    if (opt->get_name() == "DATA") return "DATA [E_DATA]";
+    return CLI::Formatter::make_option_usage(opt);
+  }
+};
+
 }  // namespace
 
 void addFitCommand(CLI::App& app) {
   auto args = std::make_shared<FitArgs>();
   auto* sub = app.add_subcommand("fit", "Fit a dispersion model to refractive-index data (CSV or refractiveindex.info YAML)");
-  sub->add_option("data", args->data,
-                  "DATA file (.csv or .yml); give two single-index files (ordinary, extraordinary) for a crystal")
+  sub->formatter(std::make_shared<FitFormatter>());
+  sub->add_option("DATA", args->data,
+                  "one or two index files (.csv, or refractiveindex.info .yml). One: n, or a CSV with n_o,n_e "
+                  "columns (a uniaxial crystal). Two single-index files: ordinary (DATA) then extraordinary "
+                  "(E_DATA)")
+      ->type_name("FILE")
       ->required()
       ->expected(1, 2);
   sub->add_option("--model", args->model, "cauchy2 | cauchy3 | sellmeier1 | sellmeier2 | sellmeier3 | conrady")

@@ -340,10 +340,18 @@ PYBIND11_MODULE(eikon, m) {
       .def_static("sellmeier", [](const py::handle& b, const py::handle& c) {
                     return Dispersion::sellmeier(toVector(b), toVector(c)); }, py::arg("B"), py::arg("C"),
                   "SCHOTT Sellmeier, C in µm²")
+      .def_static("conrady", &Dispersion::conrady, py::arg("n0"), py::arg("A"), py::arg("B"),
+                  "n = n0 + A/λ + B/λ^3.5, λ in µm")
       .def("with_range", [](Dispersion d, double lo, double hi) { d.withRange(lo, hi); return d; },
            py::arg("lo_nm"), py::arg("hi_nm"))
-      .def_property_readonly("kind", [](const Dispersion& d) {
-        return d.kind() == Dispersion::Kind::Constant ? "constant" : d.kind() == Dispersion::Kind::Cauchy ? "cauchy" : "sellmeier"; })
+      .def_property_readonly("kind", [](const Dispersion& d) -> const char* {
+        switch (d.kind()) {
+          case Dispersion::Kind::Constant: return "constant";
+          case Dispersion::Kind::Cauchy: return "cauchy";
+          case Dispersion::Kind::Sellmeier: return "sellmeier";
+          case Dispersion::Kind::Conrady: return "conrady";
+        }
+        return "unknown"; })
       .def_property_readonly("coefficients", [](const Dispersion& d) { return fromVector(d.coefficients()); })
       .def_property_readonly("sellmeier_c", [](const Dispersion& d) { return fromVector(d.sellmeierC()); })
       .def_property_readonly("range_nm", [](const Dispersion& d) -> py::object {
@@ -448,7 +456,7 @@ PYBIND11_MODULE(eikon, m) {
       .def_readonly("abbe", &FitResult::abbe)
       .def_readonly("iterations", &FitResult::iterations)
       .def_readonly("warnings", &FitResult::warnings)
-      .def("dispersion", &FitResult::dispersion, "the fitted curve as a Dispersion (not for conrady)")
+      .def("dispersion", &FitResult::dispersion, "the fitted curve as a Dispersion (cauchy, sellmeier or conrady)")
       .def("index", [](const FitResult& r, py::array_t<double> l) {
              return py::vectorize([&r](double x) { return modelIndex(r.model, r.coeffs.data(), x); })(l); },
            py::arg("lambda_nm"), "fitted n(λ)")
