@@ -180,42 +180,82 @@ std::string withSuffix(const std::string& path, const std::string& suffix) {
   return (p.parent_path() / (p.stem().string() + "-" + suffix + p.extension().string())).string();
 }
 
-// Writes every file to a temporary sibling first and renames only when all were written.
+// An output that is one of the inputs (the same file by device and inode, however it is spelt:
+// "./", symbolic or hard links) would be replaced by a fit of itself, and two outputs naming one
+// file would overwrite each other: both are refused before anything is written.
+void checkOutputs(const std::vector<std::string>& inputs, const std::vector<std::pair<std::string, std::string>>& files) {
+  for (size_t i = 0; i < files.size(); ++i) {
+    const std::string& out = files[i].first;
+    std::error_code ec;
+    for (const std::string& in : inputs)
+      if (fs::equivalent(in, out, ec))
+        throw CliError(out + ": the output is the input data file " + in + " (it would be overwritten); choose another path");
+    for (size_t j = 0; j < i; ++j) {
+      const bool same = fs::equivalent(files[j].first, out, ec) ||
+                        fs::weakly_canonical(files[j].first, ec) == fs::weakly_canonical(out, ec);
+      if (same) throw CliError(out + ": named by two outputs (-o and --export-yaml); choose different paths");
+    }
+  }
+}
+
+// Writes every file to a temporary sibling first and renames only when all were written. Missing
+// parent folders are created, and removed again (if still empty) when the write fails.
 void writeAllAtomically(const std::vector<std::pair<std::string, std::string>>& files) {
   std::vector<std::pair<std::string, std::string>> temps;  // temp, final
+  std::vector<fs::path> created;                           // folders made here, outermost first
   auto cleanup = [&] {
     for (auto& t : temps) ::unlink(t.first.c_str());
+    std::error_code ec;
+    for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ec);  // only if empty
   };
   for (const auto& [path, content] : files) {
     fs::path target(path);
     fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    std::vector<fs::path> missing;
+    std::error_code ec;
+    for (fs::path d = dir; !d.empty() && !fs::exists(d, ec); d = d.parent_path()) {
+      missing.push_back(d);
+      if (d == d.parent_path()) break;
+    }
+    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+      if (!fs::create_directory(*it, ec)) {
+        cleanup();
+        throw CliError("cannot write " + path + ": cannot create folder " + it->string() + ": " +
+                       (ec ? ec.message() : std::string("it exists")));
+      }
+      created.push_back(*it);
+    }
     std::string tmpl = (dir / ("." + target.filename().string() + ".tmpXXXXXX")).string();
     int fd = ::mkstemp(tmpl.data());
     if (fd < 0) {
+      const int err = errno;
       cleanup();
-      throw CliError("cannot write " + path + ": " + std::strerror(errno));
+      throw CliError("cannot write " + path + ": " + std::strerror(err));
     }
     temps.emplace_back(tmpl, path);
     size_t done = 0;
     while (done < content.size()) {
       ssize_t w = ::write(fd, content.data() + done, content.size() - done);
       if (w <= 0) {
+        const int err = errno;
         ::close(fd);
         cleanup();
-        throw CliError("cannot write " + path + ": " + std::strerror(errno));
+        throw CliError("cannot write " + path + ": " + std::strerror(err));
       }
       done += size_t(w);
     }
     ::fchmod(fd, 0644);
     if (::close(fd) != 0) {
+      const int err = errno;
       cleanup();
-      throw CliError("cannot write " + path + ": " + std::strerror(errno));
+      throw CliError("cannot write " + path + ": " + std::strerror(err));
     }
   }
   for (auto& [tmp, final_path] : temps)
     if (std::rename(tmp.c_str(), final_path.c_str()) != 0) {
+      const int err = errno;
       cleanup();
-      throw CliError("cannot rename temporary file to " + final_path + ": " + std::strerror(errno));
+      throw CliError("cannot rename temporary file to " + final_path + ": " + std::strerror(err));
     }
 }
 
@@ -235,7 +275,15 @@ void run(const FitArgs& a) {
   FitOptions fo;
   fo.model = parseDispersionModel(a.model);
   fo.huber_delta = parseLoss(a.loss);
+  // Refused before reading (the crystal's FILE-o/-e YAML names are checked again once known).
+  std::vector<std::pair<std::string, std::string>> named;
+  for (const std::string* o : {&a.output, &a.export_yaml})
+    if (!o->empty()) named.emplace_back(*o, "");
+  checkOutputs(a.data, named);
   IndexReadOptions ro;
+  if (a.samples < 2 || a.samples > kMaxFormulaSamples)
+    throw CliError("--samples must be in [2, " + std::to_string(kMaxFormulaSamples) +
+                   "] (samples per refractiveindex.info formula block), got " + std::to_string(a.samples));
   ro.formula_samples = a.samples;
   if (!a.range_nm.empty()) {
     if (a.range_nm.size() != 2) throw CliError("--range-nm takes LO,HI in nm");
@@ -283,6 +331,7 @@ void run(const FitArgs& a) {
       files.emplace_back(withSuffix(a.export_yaml, "e"), yamlEntry(fits[1], data.source));
     }
   }
+  checkOutputs(a.data, files);
   writeAllAtomically(files);
 
   if (a.json_out) {
@@ -334,7 +383,7 @@ void addFitCommand(CLI::App& app) {
   sub->add_flag("--strict", args->strict, "treat warnings (e.g. unsorted rows) as errors");
   sub->add_option("-o,--output", args->output, "material JSON file for the renderer");
   sub->add_option("--range-nm", args->range_nm, "fit only LO,HI nm (formulas are sampled inside it)")->delimiter(',');
-  sub->add_option("--samples", args->samples, "samples per refractiveindex.info formula block")->capture_default_str();
+  sub->add_option("--samples", args->samples, "samples per refractiveindex.info formula block (2 to 100000)")->capture_default_str();
   sub->add_option("--name", args->name, "material name (default: the DATA file's stem)");
   sub->callback([args] {
     try {

@@ -172,8 +172,10 @@ TEST_F(FitCli, BadInputFailsWithOneLineAndNoFile) {
   expectCleanFailure(run(path("missing.csv") + out), "cannot open");
   expectCleanFailure(run(bk7Csv() + " --model cauchy9" + out), "unknown model");
   expectCleanFailure(run(bk7Csv() + " --loss huber:-1" + out), "huber");
-  // An unwritable output directory: error, nothing left behind.
-  expectCleanFailure(run(bk7Csv() + " -o " + path("no/such/dir/out.json")), "cannot write");
+  // An output folder that cannot be made (a file stands where it should be): error, nothing left.
+  write("afile", "x");
+  expectCleanFailure(run(bk7Csv() + " -o " + path("afile/sub/out.json")), "cannot create folder");
+  EXPECT_EQ(slurp(path("afile")), "x");
 }
 
 // tests/data/fit/calcite_ghosh.csv: Ghosh's calcite formula + Gaussian noise σ = 2e-5, 20 points
@@ -311,6 +313,56 @@ TEST_F(FitCli, FailingCeresFitPrintsOneLine) {
   }
   const std::string csv = std::string(EIKON_SOURCE_DIR) + "/tests/data/fit/calcite_ghosh.csv";
   expectCleanFailure(run(csv + " --model sellmeier2 -o " + path("out.json")), "rank-deficient sellmeier2");
+}
+
+// Issue 11: --samples is bounded before anything is allocated (2000000000 ran 55 s into
+// std::bad_alloc); the bound itself is accepted.
+TEST_F(FitCli, SamplesAreBounded) {
+  const std::string yml = std::string(EIKON_SOURCE_DIR) + "/tests/data/fit/N-BK7.yml";
+  for (const char* n : {"2000000000", "100001", "1", "-5"}) {
+    const Outcome r = run(yml + " --samples " + n + " -o " + path("out.json"));
+    expectCleanFailure(r, "--samples must be in [2, 100000]");
+    EXPECT_NE(r.err.find(std::string("got ") + n), std::string::npos) << r.err;
+  }
+  const Outcome ok = run(yml + " --samples 100000 --json");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_EQ(json::parse(ok.out)["modes"]["n"]["points"], 100000);
+}
+
+// Issue 11: an output naming the fit's own data file (by any spelling: "./", "..", a symbolic
+// link) is refused and the data stay as they were; so are -o and --export-yaml naming one file.
+// -o into folders that do not exist yet creates them.
+TEST_F(FitCli, OutputsNeverReplaceInputsAndFoldersAreCreated) {
+  const std::string csv = bk7Csv();
+  const std::string before = slurp(csv);
+  fs::create_directory(dir_ / "sub");
+  fs::create_symlink(csv, dir_ / "link.csv");
+  for (const std::string out : {csv, path("sub/../bk7.csv"), path("./bk7.csv"), path("link.csv")}) {
+    const Outcome r = run(csv + " -o " + out);
+    EXPECT_EQ(r.code, 1) << out;
+    EXPECT_EQ(r.err, "eikon: error: " + out + ": the output is the input data file " + csv +
+                         " (it would be overwritten); choose another path\n");
+    EXPECT_EQ(slurp(csv), before) << out;
+    const Outcome y = run(csv + " --export-yaml " + out);
+    EXPECT_EQ(y.code, 1) << out;
+    EXPECT_NE(y.err.find("the output is the input data file"), std::string::npos) << y.err;
+    EXPECT_EQ(slurp(csv), before) << out;
+  }
+  // Two-file crystals: the second (extraordinary) file is an input too.
+  const std::string o = write("o.csv", before), e = write("e.csv", before);
+  Outcome r = run(o + " " + e + " -o " + e);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("the output is the input data file " + e), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(e), before);
+  r = run(csv + " -o " + path("same.out") + " --export-yaml " + path("same.out"));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("named by two outputs"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("same.out")));
+
+  r = run(csv + " -o " + path("new/deeper/bk7.json") + " --export-yaml " + path("yaml/bk7.yml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(json::parse(slurp(path("new/deeper/bk7.json"))).contains("n"));
+  EXPECT_NE(slurp(path("yaml/bk7.yml")).find("formula 5"), std::string::npos);
 }
 
 }  // namespace
