@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Configure and build eikon (Release) into ${EIKON_BUILD_DIR:-build}.
+# Configure and build eikon (Release) into ${EIKON_BUILD_DIR:-build}, then register its Python
+# module with Debian's python3 (scripts/install_python.sh: one eikon.pth file; see there).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR="${EIKON_BUILD_DIR:-build}"
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD_DIR" -j"$(nproc)"
+./scripts/install_python.sh "$BUILD_DIR"
