@@ -6,4 +6,5 @@ cd "$(dirname "$0")/.."
 BUILD_DIR="${EIKON_BUILD_DIR:-build}"
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD_DIR" -j"$(nproc)"
-./scripts/install_python.sh "$BUILD_DIR"
+# Not fatal here (a non-root build still builds); CTest's python.install_module fails instead.
+./scripts/install_python.sh "$BUILD_DIR" || echo "eikon: warning: Python module not registered (above); the build is done"
