@@ -4,8 +4,8 @@
 //   * Every public interface takes wavelengths in **nanometres**; formulas use λ in µm inside.
 //   * Cauchy:    n(λ) = A + B/λ² + C/λ⁴ (+ D/λ⁶ …)          λ in µm, B in µm², C in µm⁴.
 //   * Sellmeier: n²(λ) = 1 + Σᵢ Bᵢ λ² / (λ² − Cᵢ)           λ in µm, Cᵢ in µm² (SCHOTT form).
-//   * Conrady:   n(λ) = n₀ + A/λ + B/λ^3.5                    λ in µm (refractiveindex.info formula 5
-//                with exponents −1, −3.5; what `eikon fit --model conrady` writes).
+//   * Conrady:   n(λ) = n₀ + A/λ + B/λ^3.5                    λ in µm (refractiveindex.info
+//                formula 5 with exponents −1, −3.5; what `eikon fit --model conrady` writes).
 //   * Constant:  n(λ) = n.
 // A model may carry the wavelength range over which its coefficients were measured; evaluating
 // outside it is the caller's decision (warning or error), never silently clamped here.
@@ -57,11 +57,13 @@ class Dispersion {
   Dispersion& withRange(double lo_nm, double hi_nm);
 
   Kind kind() const { return kind_; }
-  const std::vector<double>& coefficients() const { return a_; }  ///< Cauchy terms, Sellmeier B or Conrady {n0, A, B}
+  /// Cauchy terms, Sellmeier B or Conrady {n0, A, B}.
+  const std::vector<double>& coefficients() const { return a_; }
   const std::vector<double>& sellmeierC() const { return c_; }
   const std::optional<std::array<double, 2>>& rangeNm() const { return range_nm_; }
   bool inRange(double lambda_nm) const;
-  /// True when n does not depend on λ (Constant, or Cauchy/Conrady with only the first term non-zero).
+  /// True when n does not depend on λ (Constant, or Cauchy/Conrady with only the first term
+  /// non-zero).
   bool isDispersionless() const;
 
   /// Refractive index at λ (nm). NaN if the Sellmeier form has n² ≤ 0 at λ (a pole).

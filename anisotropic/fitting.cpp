@@ -275,9 +275,11 @@ double modelIndex(DispersionModel m, const double* p, double lambda_nm, double* 
 
 Dispersion FitResult::dispersion() const {
   const int K = sellmeierTerms(model);
-  Dispersion d = model == DispersionModel::Conrady ? Dispersion::conrady(coeffs.at(0), coeffs.at(1), coeffs.at(2))
+  Dispersion d = model == DispersionModel::Conrady
+                     ? Dispersion::conrady(coeffs.at(0), coeffs.at(1), coeffs.at(2))
                  : K == 0 ? Dispersion::cauchy(coeffs)
-                          : Dispersion::sellmeier({coeffs.begin(), coeffs.begin() + K}, {coeffs.begin() + K, coeffs.end()});
+                          : Dispersion::sellmeier({coeffs.begin(), coeffs.begin() + K},
+                                                  {coeffs.begin() + K, coeffs.end()});
   d.withRange(range_nm[0], range_nm[1]);
   return d;
 }
@@ -413,7 +415,9 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
                            "try a model with more terms");
   }
   const Dispersion disp = r.dispersion();
-  r.n_F = disp.index(fraunhofer::F), r.n_d = disp.index(fraunhofer::d), r.n_C = disp.index(fraunhofer::C);
+  r.n_F = disp.index(fraunhofer::F);
+  r.n_d = disp.index(fraunhofer::d);
+  r.n_C = disp.index(fraunhofer::C);
   r.abbe = disp.abbeNumber();
   return r;
 }

@@ -55,7 +55,9 @@ json nullable(const std::optional<double>& v) { return v ? json(*v) : json(nullp
 
 std::string lossName(const FitResult& r) { return r.huber_delta ? "huber:" + fmt("%g", *r.huber_delta) : "none"; }
 
-bool isCauchy(DispersionModel m) { return m == DispersionModel::Cauchy2 || m == DispersionModel::Cauchy3; }
+bool isCauchy(DispersionModel m) {
+  return m == DispersionModel::Cauchy2 || m == DispersionModel::Cauchy3;
+}
 
 // The renderer's GPU fields hold Cauchy {A, B, C}; every other model reaches them through
 // Dispersion::cauchyApproximation over the visible window (core/volume/volume_set.cpp), so fit
@@ -75,17 +77,17 @@ json approximationJson(const FitResult& r) {
 
 json fitStats(const FitResult& r) {
   json j = {{"chi2_reduced", nullable(r.chi2_reduced)},
-          {"rms", r.rms},
-          {"max_residual", r.max_residual},
-          {"residual_std", r.residual_std},
-          {"n_F", r.n_F},
-          {"n_d", r.n_d},
-          {"n_C", r.n_C},
-          {"abbe", r.abbe},
-          {"points", r.points},
-          {"weighted", r.weighted},
-          {"model", modelName(r.model)},
-          {"loss", lossName(r)}};
+            {"rms", r.rms},
+            {"max_residual", r.max_residual},
+            {"residual_std", r.residual_std},
+            {"n_F", r.n_F},
+            {"n_d", r.n_d},
+            {"n_C", r.n_C},
+            {"abbe", r.abbe},
+            {"points", r.points},
+            {"weighted", r.weighted},
+            {"model", modelName(r.model)},
+            {"loss", lossName(r)}};
   if (!isCauchy(r.model)) j["renderer_cauchy"] = approximationJson(r);
   return j;
 }
@@ -93,7 +95,9 @@ json fitStats(const FitResult& r) {
 // {"cauchy": [...], "range_nm": [...], "sigma": [...]} (or "sellmeier": all B then all C, or
 // "conrady": [n0, A, B]); the scene loader reads each of them (core/scene/scene.cpp).
 json materialIndex(const FitResult& r) {
-  const char* key = isCauchy(r.model) ? "cauchy" : r.model == DispersionModel::Conrady ? "conrady" : "sellmeier";
+  const char* key = isCauchy(r.model)                     ? "cauchy"
+                    : r.model == DispersionModel::Conrady ? "conrady"
+                                                          : "sellmeier";
   return {{key, r.coeffs}, {"range_nm", r.range_nm}, {"sigma", r.sigma}};
 }
 
@@ -127,9 +131,10 @@ void printTable(std::ostream& os, const IndexData& data, const std::vector<FitRe
        << "  V_d " << fmt("%.2f", r.abbe) << "\n";
     if (!isCauchy(r.model)) {
       const CauchyApproximation ap = rendererApproximation(r);
-      os << "  renderer: cauchy [" << fmt("%.8e", ap.coeffs[0]) << ", " << fmt("%.8e", ap.coeffs[1]) << ", "
-         << fmt("%.8e", ap.coeffs[2]) << "] over " << fmt("%g", kRenderLoNm) << "-" << fmt("%g", kRenderHiNm)
-         << " nm, |dn| max " << fmt("%.3e", ap.max_error) << ", rms " << fmt("%.3e", ap.rms_error) << "\n";
+      os << "  renderer: cauchy [" << fmt("%.8e", ap.coeffs[0]) << ", " << fmt("%.8e", ap.coeffs[1])
+         << ", " << fmt("%.8e", ap.coeffs[2]) << "] over " << fmt("%g", kRenderLoNm) << "-"
+         << fmt("%g", kRenderHiNm) << " nm, |dn| max " << fmt("%.3e", ap.max_error) << ", rms "
+         << fmt("%.3e", ap.rms_error) << "\n";
     }
   }
 }
@@ -183,17 +188,21 @@ std::string withSuffix(const std::string& path, const std::string& suffix) {
 // An output that is one of the inputs (the same file by device and inode, however it is spelt:
 // "./", symbolic or hard links) would be replaced by a fit of itself, and two outputs naming one
 // file would overwrite each other: both are refused before anything is written.
-void checkOutputs(const std::vector<std::string>& inputs, const std::vector<std::pair<std::string, std::string>>& files) {
+void checkOutputs(const std::vector<std::string>& inputs,
+                  const std::vector<std::pair<std::string, std::string>>& files) {
   for (size_t i = 0; i < files.size(); ++i) {
     const std::string& out = files[i].first;
     std::error_code ec;
     for (const std::string& in : inputs)
       if (fs::equivalent(in, out, ec))
-        throw CliError(out + ": the output is the input data file " + in + " (it would be overwritten); choose another path");
+        throw CliError(out + ": the output is the input data file " + in +
+                       " (it would be overwritten); choose another path");
     for (size_t j = 0; j < i; ++j) {
       const bool same = fs::equivalent(files[j].first, out, ec) ||
                         fs::weakly_canonical(files[j].first, ec) == fs::weakly_canonical(out, ec);
-      if (same) throw CliError(out + ": named by two outputs (-o and --export-yaml); choose different paths");
+      if (same)
+        throw CliError(out +
+                       ": named by two outputs (-o and --export-yaml); choose different paths");
     }
   }
 }
@@ -206,7 +215,8 @@ void writeAllAtomically(const std::vector<std::pair<std::string, std::string>>& 
   auto cleanup = [&] {
     for (auto& t : temps) ::unlink(t.first.c_str());
     std::error_code ec;
-    for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ec);  // only if empty
+    for (auto it = created.rbegin(); it != created.rend(); ++it)
+      fs::remove(*it, ec);  // only if empty
   };
   for (const auto& [path, content] : files) {
     fs::path target(path);
@@ -283,7 +293,8 @@ void run(const FitArgs& a) {
   IndexReadOptions ro;
   if (a.samples < 2 || a.samples > kMaxFormulaSamples)
     throw CliError("--samples must be in [2, " + std::to_string(kMaxFormulaSamples) +
-                   "] (samples per refractiveindex.info formula block), got " + std::to_string(a.samples));
+                   "] (samples per refractiveindex.info formula block), got " +
+                   std::to_string(a.samples));
   ro.formula_samples = a.samples;
   if (!a.range_nm.empty()) {
     if (a.range_nm.size() != 2) throw CliError("--range-nm takes LO,HI in nm");
@@ -368,10 +379,12 @@ void addFitCommand(CLI::App& app) {
   auto args = std::make_shared<FitArgs>();
   auto* sub = app.add_subcommand("fit", "Fit a dispersion model to refractive-index data (CSV or refractiveindex.info YAML)");
   sub->formatter(std::make_shared<FitFormatter>());
-  sub->add_option("DATA", args->data,
-                  "one or two index files (.csv, or refractiveindex.info .yml). One: n, or a CSV with n_o,n_e "
-                  "columns (a uniaxial crystal). Two single-index files: ordinary (DATA) then extraordinary "
-                  "(E_DATA)")
+  sub->add_option(
+         "DATA", args->data,
+         "one or two index files (.csv, or refractiveindex.info .yml). One: n, or a CSV with "
+         "n_o,n_e "
+         "columns (a uniaxial crystal). Two single-index files: ordinary (DATA) then extraordinary "
+         "(E_DATA)")
       ->type_name("FILE")
       ->required()
       ->expected(1, 2);
@@ -383,7 +396,9 @@ void addFitCommand(CLI::App& app) {
   sub->add_flag("--strict", args->strict, "treat warnings (e.g. unsorted rows) as errors");
   sub->add_option("-o,--output", args->output, "material JSON file for the renderer");
   sub->add_option("--range-nm", args->range_nm, "fit only LO,HI nm (formulas are sampled inside it)")->delimiter(',');
-  sub->add_option("--samples", args->samples, "samples per refractiveindex.info formula block (2 to 100000)")->capture_default_str();
+  sub->add_option("--samples", args->samples,
+                  "samples per refractiveindex.info formula block (2 to 100000)")
+      ->capture_default_str();
   sub->add_option("--name", args->name, "material name (default: the DATA file's stem)");
   sub->callback([args] {
     try {

@@ -97,7 +97,8 @@ void addRenderCommand(CLI::App& app) {
     }
     checkWritable(out);
     checkWritable(png);
-    RenderSettings rs = defaultRenderSettings(scene);  // shared with Python (core/render/render_defaults.h)
+    // The defaults are shared with Python (core/render/render_defaults.h).
+    RenderSettings rs = defaultRenderSettings(scene);
     rs.width = a.width;
     rs.height = a.height;
     rs.spp = a.spp;

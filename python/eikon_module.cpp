@@ -5,13 +5,13 @@
 // (numpy users convert with np.radians/np.degrees), directions as length-3 sequences in world
 // space. Scalar functions of λ or θ accept numpy arrays and broadcast (py::vectorize).
 //
-//   import eikon        # after scripts/install_python.sh (setup.sh); else sys.path.insert(0, "build/python")
+//   import eikon   # after scripts/install_python.sh (setup.sh); or sys.path.insert(0, "build/python")
 //   bk7 = eikon.load_material("N-BK7").n            # Dispersion
 //   bk7.index([486.1327, 587.5618, 656.2725]);  bk7.abbe_number()
 //   fit = eikon.fit_dispersion(lam, n, sigma, model="cauchy3");  fit.index_sigma(lam)
 //   cal = eikon.Uniaxial(1.658344, 1.486130, [0, 0, 1]);  cal.walk_off_angle_at(np.radians(45))
 //   sc = eikon.Scene.load("scenes/glass_sphere.json");  r = eikon.Renderer(sc)
-//   img = r.render(width=160, height=120)    # (H, W, 3) float32, linear sRGB, `eikon render`'s defaults
+//   img = r.render(width=160, height=120)    # (H, W, 3) float32 linear sRGB; the CLI's defaults
 //   res = r.trace([0, 0, -30], [0, 0, 1], wavelength_nm=587.56)   # CLI-shaped dict, per mode
 //
 // Trace results. One ray gives the CLI JSON shape
@@ -254,7 +254,7 @@ struct Prepared {
   std::unique_ptr<ViewRenderer> gpu;
   std::unique_ptr<VolumeField> field;
   std::unique_ptr<ReferenceMarcher> cpu;
-  VolumeSpec voxelized_spec;  ///< scene->volume when `volume` was made (the module cache compares it)
+  VolumeSpec voxelized_spec;  ///< scene->volume when `volume` was made (for the module cache)
 
   explicit Prepared(std::shared_ptr<Scene> s) : scene(std::move(s)) {}
   void ensureVolume(bool for_gpu) {
@@ -297,7 +297,8 @@ struct Prepared {
           simulateLightingReference(*scene, *volume, lo);
         else
           simulateLighting(*ctx, *scene, *volume, lo);
-        if (!cache_dir.empty()) cli::saveLightCache(cache_dir, key, *volume);  // a failure only costs time
+        // A cache that cannot be written only costs time next time.
+        if (!cache_dir.empty()) cli::saveLightCache(cache_dir, key, *volume);
       }
     }
     dropRenderers();
@@ -319,8 +320,9 @@ struct Prepared {
 };
 
 bool sameSpec(const VolumeSpec& a, const VolumeSpec& b) {
-  return a.bounds_min == b.bounds_min && a.bounds_max == b.bounds_max && a.resolution == b.resolution &&
-         a.smoothing_voxels == b.smoothing_voxels && a.smoothing == b.smoothing;
+  return a.bounds_min == b.bounds_min && a.bounds_max == b.bounds_max &&
+         a.resolution == b.resolution && a.smoothing_voxels == b.smoothing_voxels &&
+         a.smoothing == b.smoothing;
 }
 
 // The module-level render()/trace() keep the last scene they prepared: a second call with the

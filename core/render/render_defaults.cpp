@@ -6,7 +6,9 @@
 
 namespace eikon {
 
-int defaultWavelengths(const Scene& scene) { return scene.anyDispersive() ? kDefaultDispersiveWavelengths : 0; }
+int defaultWavelengths(const Scene& scene) {
+  return scene.anyDispersive() ? kDefaultDispersiveWavelengths : 0;
+}
 
 RenderSettings defaultRenderSettings(const Scene& scene) {
   RenderSettings rs;

@@ -141,11 +141,15 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
     return Dispersion::constant(v);
   }
   if (!n.isObject())
-    n.fail("expected a number or an object {\"cauchy\": [...]} / {\"sellmeier\": [...]} / {\"conrady\": [...]}");
-  n.allowKeys({"cauchy", "sellmeier", "conrady", "range_nm", "sigma", "linear", "luneburg", "maxwell_fisheye"});
-  int kinds = int(n.has("cauchy")) + int(n.has("sellmeier")) + int(n.has("conrady")) + int(n.has("linear")) +
-              int(n.has("luneburg")) + int(n.has("maxwell_fisheye"));
-  if (kinds != 1) n.fail("give exactly one of cauchy, sellmeier, conrady, linear, luneburg, maxwell_fisheye");
+    n.fail(
+        "expected a number or an object {\"cauchy\": [...]} / {\"sellmeier\": [...]} / "
+        "{\"conrady\": [...]}");
+  n.allowKeys({"cauchy", "sellmeier", "conrady", "range_nm", "sigma", "linear", "luneburg",
+               "maxwell_fisheye"});
+  int kinds = int(n.has("cauchy")) + int(n.has("sellmeier")) + int(n.has("conrady")) +
+              int(n.has("linear")) + int(n.has("luneburg")) + int(n.has("maxwell_fisheye"));
+  if (kinds != 1)
+    n.fail("give exactly one of cauchy, sellmeier, conrady, linear, luneburg, maxwell_fisheye");
   if (n.has("linear") || n.has("luneburg") || n.has("maxwell_fisheye")) {
     if (!grin) n.fail("gradient-index profiles are allowed only for isotropic materials (key \"n\")");
     if (auto l = n.get("linear")) {
@@ -179,8 +183,8 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
       // n = n0 + A/λ + B/λ^3.5 (λ in µm); the renderer carries its Cauchy approximation.
       auto v = c->numbers();
       if (v.size() != 3)
-        c->fail("conrady needs [n0, A, B] (n = n0 + A/λ + B/λ^3.5, λ in µm), got " + std::to_string(v.size()) +
-                " numbers");
+        c->fail("conrady needs [n0, A, B] (n = n0 + A/λ + B/λ^3.5, λ in µm), got " +
+                std::to_string(v.size()) + " numbers");
       d = Dispersion::conrady(v[0], v[1], v[2]);
     } else {
       auto s = n.at("sellmeier");

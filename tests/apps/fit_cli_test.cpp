@@ -217,10 +217,12 @@ TEST_F(FitCli, ConradyIsWrittenAsASceneMaterialWithItsRendererError) {
   const json m = json::parse(slurp(path("calcite.json")));
   const eikon::Material file_mat = eikon::loadMaterialFile(path("calcite.json"));
   ASSERT_TRUE(file_mat.uniaxial);
-  const std::string scene_text = R"({"camera": {"position": [0, 0, -30], "look_at": [0, 0, 0], "width": 8, "height": 8},
+  const std::string scene_text =
+      R"({"camera": {"position": [0, 0, -30], "look_at": [0, 0, 0], "width": 8, "height": 8},
     "volume": {"bounds_min": [-6, -6, -6], "bounds_max": [6, 6, 6], "resolution": 16},
-    "materials": {"calcite": {"n_o": )" + m["n_o"].dump() + R"(, "n_e": )" + m["n_e"].dump() +
-                                 R"(, "optic_axis": [0, 0, 1]}},
+    "materials": {"calcite": {"n_o": )" +
+      m["n_o"].dump() + R"(, "n_e": )" + m["n_e"].dump() +
+      R"(, "optic_axis": [0, 0, 1]}},
     "objects": [{"shape": "sphere", "radius": 3, "material": "calcite"}]})";
   const eikon::Scene scene = eikon::parseScene(scene_text, path("scene.json"));
   const eikon::Material& sc_mat = scene.materials.at("calcite");
@@ -231,11 +233,14 @@ TEST_F(FitCli, ConradyIsWrittenAsASceneMaterialWithItsRendererError) {
     const auto p = m[mode]["conrady"].get<std::vector<double>>();
     ASSERT_EQ(p.size(), 3u);
     EXPECT_EQ(m[mode]["range_nm"], json::array({405.0, 690.0}));
-    const auto conrady = [&](double l) { return p[0] + p[1] / (l * 1e-3) + p[2] * std::pow(l * 1e-3, -3.5); };
+    const auto conrady = [&](double l) {
+      return p[0] + p[1] / (l * 1e-3) + p[2] * std::pow(l * 1e-3, -3.5);
+    };
     for (const eikon::Material* mat : {&file_mat, &sc_mat}) {
       const eikon::Dispersion& d = mode == "n_o" ? mat->n_o : mat->n_e;
       EXPECT_EQ(d.kind(), eikon::Dispersion::Kind::Conrady);
-      for (double l = 380.0; l <= 780.0; l += 20.0) EXPECT_NEAR(d.index(l), conrady(l), 1e-14) << mode << " " << l;
+      for (double l = 380.0; l <= 780.0; l += 20.0)
+        EXPECT_NEAR(d.index(l), conrady(l), 1e-14) << mode << " " << l;
     }
     // Calcite (Ghosh): n_o(d) = 1.658, n_e(d) = 1.486; the fit follows the data to ~1e-4.
     EXPECT_NEAR(conrady(587.5618), mode == "n_o" ? 1.6584 : 1.4862, 2e-4);
@@ -244,8 +249,9 @@ TEST_F(FitCli, ConradyIsWrittenAsASceneMaterialWithItsRendererError) {
     at = r.out.find("renderer: cauchy [", at);
     ASSERT_NE(at, std::string::npos) << r.out;
     double A = 0, B = 0, C = 0, mx = 0, rms = 0;
-    ASSERT_EQ(std::sscanf(r.out.c_str() + at, "renderer: cauchy [%lf, %lf, %lf] over 380-780 nm, |dn| max %lf, rms %lf", &A,
-                          &B, &C, &mx, &rms),
+    ASSERT_EQ(std::sscanf(r.out.c_str() + at,
+                          "renderer: cauchy [%lf, %lf, %lf] over 380-780 nm, |dn| max %lf, rms %lf",
+                          &A, &B, &C, &mx, &rms),
               5)
         << r.out.substr(at, 120);
     ++at;
@@ -262,7 +268,8 @@ TEST_F(FitCli, ConradyIsWrittenAsASceneMaterialWithItsRendererError) {
     EXPECT_GT(my_max, 0.0);
     EXPECT_LT(my_max, 1e-3);
     // The material file records the same numbers under fit.
-    EXPECT_NEAR(m["fit"][mode]["renderer_cauchy"]["max_abs_dn"].get<double>(), my_max, 1e-3 * my_max);
+    EXPECT_NEAR(m["fit"][mode]["renderer_cauchy"]["max_abs_dn"].get<double>(), my_max,
+                1e-3 * my_max);
   }
   // A conrady index needs exactly [n0, A, B]: the loader names the key.
   std::string bad = scene_text;
@@ -273,7 +280,9 @@ TEST_F(FitCli, ConradyIsWrittenAsASceneMaterialWithItsRendererError) {
     eikon::parseScene(bad, path("bad.json"));
     ADD_FAILURE() << "a 4-number conrady index loaded";
   } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find("/materials/calcite/n_o/conrady: conrady needs [n0, A, B]"), std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("/materials/calcite/n_o/conrady: conrady needs [n0, A, B]"),
+        std::string::npos)
         << e.what();
   }
 }
@@ -312,7 +321,8 @@ TEST_F(FitCli, FailingCeresFitPrintsOneLine) {
     EXPECT_EQ(r.err.find("trust_region"), std::string::npos) << r.err;
   }
   const std::string csv = std::string(EIKON_SOURCE_DIR) + "/tests/data/fit/calcite_ghosh.csv";
-  expectCleanFailure(run(csv + " --model sellmeier2 -o " + path("out.json")), "rank-deficient sellmeier2");
+  expectCleanFailure(run(csv + " --model sellmeier2 -o " + path("out.json")),
+                     "rank-deficient sellmeier2");
 }
 
 // Issue 11: --samples is bounded before anything is allocated (2000000000 ran 55 s into
