@@ -62,6 +62,15 @@ Dispersion Dispersion::sellmeier(std::vector<double> b, std::vector<double> c) {
   return d;
 }
 
+Dispersion Dispersion::conrady(double n0, double a, double b) {
+  std::vector<double> p{n0, a, b};
+  requireFinite(p, "conrady");
+  Dispersion d;
+  d.kind_ = Kind::Conrady;
+  d.a_ = std::move(p);
+  return d;
+}
+
 Dispersion& Dispersion::withRange(double lo_nm, double hi_nm) {
   if (!(std::isfinite(lo_nm) && std::isfinite(hi_nm) && lo_nm > 0 && hi_nm > lo_nm))
     throw std::invalid_argument("wavelength range must satisfy 0 < lo < hi (nm)");
@@ -75,7 +84,7 @@ bool Dispersion::inRange(double lambda_nm) const {
 
 bool Dispersion::isDispersionless() const {
   if (kind_ == Kind::Constant) return true;
-  if (kind_ == Kind::Cauchy) {
+  if (kind_ == Kind::Cauchy || kind_ == Kind::Conrady) {
     for (size_t k = 1; k < a_.size(); ++k)
       if (a_[k] != 0.0) return false;
     return true;
@@ -101,6 +110,8 @@ double Dispersion::index(double lambda_nm) const {
       for (size_t i = 0; i < a_.size(); ++i) n2 += a_[i] * l2 / (l2 - c_[i]);
       return n2 > 0.0 ? std::sqrt(n2) : std::nan("");
     }
+    case Kind::Conrady:
+      return a_[0] + a_[1] / l + a_[2] / (l2 * l * std::sqrt(l));
   }
   return std::nan("");
 }
@@ -121,6 +132,8 @@ double Dispersion::derivative(double lambda_nm) const {
       for (size_t i = 0; i < a_.size(); ++i) dn2 += -2.0 * a_[i] * c_[i] * l / ((l2 - c_[i]) * (l2 - c_[i]));
       return dn2 / (2.0 * index(lambda_nm)) * 1e-3;
     }
+    case Kind::Conrady:  // d/dλ of A λ⁻¹ + B λ^-3.5
+      return (-a_[1] / l2 - 3.5 * a_[2] / (l2 * l2 * std::sqrt(l))) * 1e-3;
   }
   return std::nan("");
 }
@@ -179,6 +192,7 @@ std::string Dispersion::describe() const {
     case Kind::Constant: s << a_[0]; break;
     case Kind::Cauchy: s << "cauchy"; list(a_); break;
     case Kind::Sellmeier: s << "sellmeier B"; list(a_); s << " C"; list(c_); break;
+    case Kind::Conrady: s << "conrady"; list(a_); break;
   }
   return s.str();
 }

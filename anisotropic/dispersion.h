@@ -4,14 +4,16 @@
 //   * Every public interface takes wavelengths in **nanometres**; formulas use λ in µm inside.
 //   * Cauchy:    n(λ) = A + B/λ² + C/λ⁴ (+ D/λ⁶ …)          λ in µm, B in µm², C in µm⁴.
 //   * Sellmeier: n²(λ) = 1 + Σᵢ Bᵢ λ² / (λ² − Cᵢ)           λ in µm, Cᵢ in µm² (SCHOTT form).
+//   * Conrady:   n(λ) = n₀ + A/λ + B/λ^3.5                    λ in µm (refractiveindex.info
+//                formula 5 with exponents −1, −3.5; what `eikon fit --model conrady` writes).
 //   * Constant:  n(λ) = n.
 // A model may carry the wavelength range over which its coefficients were measured; evaluating
 // outside it is the caller's decision (warning or error), never silently clamped here.
 //
 // The GPU stores Cauchy coefficient *fields* A(x), B(x), C(x) (docs/design.md §2, Dispersion), so every
 // model can produce the three Cauchy coefficients that represent it over a wavelength window:
-// exactly for Constant and Cauchy (≤ 3 terms), by least squares for Sellmeier, with the fit error
-// reported so that callers can show it.
+// exactly for Constant and Cauchy (≤ 3 terms), by least squares for Sellmeier and Conrady, with
+// the fit error reported so that callers can show it.
 //
 // Example:
 //   auto bk7 = eikon::Dispersion::sellmeier({1.03961212, 0.231792344, 1.01046945},
@@ -39,7 +41,7 @@ struct CauchyApproximation {
 
 class Dispersion {
  public:
-  enum class Kind { Constant, Cauchy, Sellmeier };
+  enum class Kind { Constant, Cauchy, Sellmeier, Conrady };
 
   Dispersion() = default;
   /// n(λ) = n. Throws std::invalid_argument unless n is finite.
@@ -48,16 +50,20 @@ class Dispersion {
   static Dispersion cauchy(std::vector<double> coeffs);
   /// SCHOTT Sellmeier with equal-length B and C (C in µm²); 1..6 terms. Throws on bad input.
   static Dispersion sellmeier(std::vector<double> b, std::vector<double> c);
+  /// Conrady n = n0 + A/λ + B/λ^3.5 (λ in µm). Throws unless all three are finite.
+  static Dispersion conrady(double n0, double a, double b);
 
   /// Attach the valid wavelength range [lo, hi] in nm (lo < hi, both > 0) or throw.
   Dispersion& withRange(double lo_nm, double hi_nm);
 
   Kind kind() const { return kind_; }
-  const std::vector<double>& coefficients() const { return a_; }  ///< Cauchy terms or Sellmeier B
+  /// Cauchy terms, Sellmeier B or Conrady {n0, A, B}.
+  const std::vector<double>& coefficients() const { return a_; }
   const std::vector<double>& sellmeierC() const { return c_; }
   const std::optional<std::array<double, 2>>& rangeNm() const { return range_nm_; }
   bool inRange(double lambda_nm) const;
-  /// True when n does not depend on λ (Constant, or Cauchy with only the A term non-zero).
+  /// True when n does not depend on λ (Constant, or Cauchy/Conrady with only the first term
+  /// non-zero).
   bool isDispersionless() const;
 
   /// Refractive index at λ (nm). NaN if the Sellmeier form has n² ≤ 0 at λ (a pole).
@@ -73,7 +79,7 @@ class Dispersion {
   /// Abbe number V_d = (n_d − 1)/(n_F − n_C) at the Fraunhofer d, F, C lines.
   double abbeNumber() const;
 
-  /// Human-readable one-line form, e.g. "cauchy[1.5, 0.0042, 0]".
+  /// Human-readable one-line form, e.g. "cauchy[1.5, 0.0042, 0]" or "conrady[1.6, 0.01, 1e-4]".
   std::string describe() const;
 
  private:

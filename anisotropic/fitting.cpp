@@ -7,11 +7,40 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
 namespace eikon {
 namespace {
+
+// Ceres reports through glog: LOG(ERROR) lines such as "trust_region_minimizer.cc:95] Terminating:
+// Number of consecutive invalid steps ..." even with logging_type = SILENT, preceded by "WARNING:
+// Logging before InitGoogleLogging()" in a program that never initialised glog. eikon reports
+// every failure as an exception with its own one-line message, so glog stays quiet: initialised
+// once (to stderr only, so it never writes log files, and at FATAL) unless the host program did,
+// and held at FATAL while Ceres runs (the level restored afterwards for hosts that use glog).
+class QuietGlog {
+ public:
+  QuietGlog() {
+    static std::once_flag once;
+    std::call_once(once, [] {
+      if (google::IsGoogleLoggingInitialized()) return;
+      FLAGS_logtostderr = true;
+      FLAGS_stderrthreshold = google::GLOG_FATAL;
+      FLAGS_minloglevel = google::GLOG_FATAL;
+      google::InitGoogleLogging("eikon");
+    });
+    saved_ = FLAGS_minloglevel;
+    FLAGS_minloglevel = google::GLOG_FATAL;
+  }
+  ~QuietGlog() { FLAGS_minloglevel = saved_; }
+  QuietGlog(const QuietGlog&) = delete;
+  QuietGlog& operator=(const QuietGlog&) = delete;
+
+ private:
+  int saved_ = 0;
+};
 
 int sellmeierTerms(DispersionModel m) {
   switch (m) {
@@ -246,10 +275,11 @@ double modelIndex(DispersionModel m, const double* p, double lambda_nm, double* 
 
 Dispersion FitResult::dispersion() const {
   const int K = sellmeierTerms(model);
-  if (model == DispersionModel::Conrady)
-    throw std::invalid_argument("the conrady model cannot be stored as a renderer material (cauchy or sellmeier only)");
-  Dispersion d = K == 0 ? Dispersion::cauchy(coeffs)
-                        : Dispersion::sellmeier({coeffs.begin(), coeffs.begin() + K}, {coeffs.begin() + K, coeffs.end()});
+  Dispersion d = model == DispersionModel::Conrady
+                     ? Dispersion::conrady(coeffs.at(0), coeffs.at(1), coeffs.at(2))
+                 : K == 0 ? Dispersion::cauchy(coeffs)
+                          : Dispersion::sellmeier({coeffs.begin(), coeffs.begin() + K},
+                                                  {coeffs.begin() + K, coeffs.end()});
   d.withRange(range_nm[0], range_nm[1]);
   return d;
 }
@@ -319,6 +349,7 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
   so.logging_type = ceres::SILENT;
   so.num_threads = 1;
   ceres::Solver::Summary summary;
+  std::optional<QuietGlog> quiet(std::in_place);
   ceres::Solve(so, &problem, &summary);
   if (!summary.IsSolutionUsable())
     throw std::runtime_error(who + ": " + modelName(opt.model) + " fit failed (" + summary.message + ")");
@@ -329,12 +360,9 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
   co.null_space_rank = 0;
   ceres::Covariance cov(co);
   std::vector<std::pair<const double*, const double*>> blocks{{q.data(), q.data()}};
-  // Ceres logs a rank-deficient covariance through glog on stderr; eikon reports it as an
-  // exception instead, so silence glog below FATAL for the call (and restore the level).
-  const int saved_level = FLAGS_minloglevel;
-  FLAGS_minloglevel = google::GLOG_FATAL;
+  // A rank-deficient covariance is logged by Ceres too; eikon throws instead (quiet still holds).
   const bool covariance_ok = cov.Compute(blocks, &problem);
-  FLAGS_minloglevel = saved_level;
+  quiet.reset();
   if (!covariance_ok)
     throw std::runtime_error(who + ": rank-deficient " + modelName(opt.model) +
                              " fit: the data cannot determine all coefficients (covariance is singular); "
@@ -386,15 +414,11 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
                            " does not describe the data within their sigma, so its error bars are too small; "
                            "try a model with more terms");
   }
-  auto n_at = [&](double lnm) { return modelIndex(opt.model, r.coeffs.data(), lnm); };
-  if (opt.model != DispersionModel::Conrady) {
-    const Dispersion disp = r.dispersion();
-    r.n_F = disp.index(fraunhofer::F), r.n_d = disp.index(fraunhofer::d), r.n_C = disp.index(fraunhofer::C);
-    r.abbe = disp.abbeNumber();
-  } else {
-    r.n_F = n_at(fraunhofer::F), r.n_d = n_at(fraunhofer::d), r.n_C = n_at(fraunhofer::C);
-    r.abbe = (r.n_d - 1.0) / (r.n_F - r.n_C);
-  }
+  const Dispersion disp = r.dispersion();
+  r.n_F = disp.index(fraunhofer::F);
+  r.n_d = disp.index(fraunhofer::d);
+  r.n_C = disp.index(fraunhofer::C);
+  r.abbe = disp.abbeNumber();
   return r;
 }
 

@@ -93,8 +93,7 @@ struct FitResult {
   /// Recoverable problems, e.g. χ²_red too large for the σ given (p < 1e-3).
   std::vector<std::string> warnings;
 
-  /// The fitted curve as a renderer model (Cauchy or Sellmeier, with range); throws
-  /// std::invalid_argument for Conrady, which the renderer does not carry.
+  /// The fitted curve as a renderer model (Cauchy, Sellmeier or Conrady, with the data's range).
   Dispersion dispersion() const;
 };
 

@@ -122,7 +122,10 @@ IndexSeries finish(Pending p, const std::string& name, const IndexReadOptions& o
 void checkOptions(const IndexReadOptions& opt) {
   if (opt.window_nm && !((*opt.window_nm)[0] > 0 && (*opt.window_nm)[1] > (*opt.window_nm)[0]))
     throw std::invalid_argument("wavelength window must satisfy 0 < lo < hi (nm)");
-  if (opt.formula_samples < 2) throw std::invalid_argument("formula_samples must be >= 2");
+  if (opt.formula_samples < 2 || opt.formula_samples > kMaxFormulaSamples)
+    throw std::invalid_argument("formula_samples must be in [2, " +
+                                std::to_string(kMaxFormulaSamples) + "], got " +
+                                std::to_string(opt.formula_samples));
 }
 
 }  // namespace

@@ -60,9 +60,14 @@ struct IndexData {
 struct IndexReadOptions {
   /// Keep only points with lo ≤ λ ≤ hi (nm); formulas are sampled inside it.
   std::optional<std::array<double, 2>> window_nm;
-  /// Number of uniform samples taken from each `formula` block (≥ 2).
+  /// Number of uniform samples taken from each `formula` block, 2 … kMaxFormulaSamples.
   int formula_samples = 201;
 };
+
+/// Most samples per `formula` block: far more than a smooth formula needs (201 resolve it to
+/// 1e-12), and small enough that a typo (2000000000 ran 55 s into std::bad_alloc) is refused
+/// before any allocation.
+inline constexpr int kMaxFormulaSamples = 100000;
 
 /// Strict CSV reader (format above). Throws with "path:line: message".
 IndexData readIndexCsv(const std::string& path, const IndexReadOptions& options = {});

@@ -55,25 +55,50 @@ json nullable(const std::optional<double>& v) { return v ? json(*v) : json(nullp
 
 std::string lossName(const FitResult& r) { return r.huber_delta ? "huber:" + fmt("%g", *r.huber_delta) : "none"; }
 
-json fitStats(const FitResult& r) {
-  return {{"chi2_reduced", nullable(r.chi2_reduced)},
-          {"rms", r.rms},
-          {"max_residual", r.max_residual},
-          {"residual_std", r.residual_std},
-          {"n_F", r.n_F},
-          {"n_d", r.n_d},
-          {"n_C", r.n_C},
-          {"abbe", r.abbe},
-          {"points", r.points},
-          {"weighted", r.weighted},
-          {"model", modelName(r.model)},
-          {"loss", lossName(r)}};
+bool isCauchy(DispersionModel m) {
+  return m == DispersionModel::Cauchy2 || m == DispersionModel::Cauchy3;
 }
 
-// {"cauchy": [...], "range_nm": [...], "sigma": [...]} (or "sellmeier": all B then all C).
+// The renderer's GPU fields hold Cauchy {A, B, C}; every other model reaches them through
+// Dispersion::cauchyApproximation over the visible window (core/volume/volume_set.cpp), so fit
+// states what that approximation costs instead of approximating silently.
+constexpr double kRenderLoNm = 380.0, kRenderHiNm = 780.0;
+CauchyApproximation rendererApproximation(const FitResult& r) {
+  return r.dispersion().cauchyApproximation(kRenderLoNm, kRenderHiNm);
+}
+
+json approximationJson(const FitResult& r) {
+  const CauchyApproximation ap = rendererApproximation(r);
+  return {{"cauchy", ap.coeffs},
+          {"window_nm", {kRenderLoNm, kRenderHiNm}},
+          {"max_abs_dn", ap.max_error},
+          {"rms_abs_dn", ap.rms_error}};
+}
+
+json fitStats(const FitResult& r) {
+  json j = {{"chi2_reduced", nullable(r.chi2_reduced)},
+            {"rms", r.rms},
+            {"max_residual", r.max_residual},
+            {"residual_std", r.residual_std},
+            {"n_F", r.n_F},
+            {"n_d", r.n_d},
+            {"n_C", r.n_C},
+            {"abbe", r.abbe},
+            {"points", r.points},
+            {"weighted", r.weighted},
+            {"model", modelName(r.model)},
+            {"loss", lossName(r)}};
+  if (!isCauchy(r.model)) j["renderer_cauchy"] = approximationJson(r);
+  return j;
+}
+
+// {"cauchy": [...], "range_nm": [...], "sigma": [...]} (or "sellmeier": all B then all C, or
+// "conrady": [n0, A, B]); the scene loader reads each of them (core/scene/scene.cpp).
 json materialIndex(const FitResult& r) {
-  const bool cauchy = r.model == DispersionModel::Cauchy2 || r.model == DispersionModel::Cauchy3;
-  return {{cauchy ? "cauchy" : "sellmeier", r.coeffs}, {"range_nm", r.range_nm}, {"sigma", r.sigma}};
+  const char* key = isCauchy(r.model)                     ? "cauchy"
+                    : r.model == DispersionModel::Conrady ? "conrady"
+                                                          : "sellmeier";
+  return {{key, r.coeffs}, {"range_nm", r.range_nm}, {"sigma", r.sigma}};
 }
 
 json reportMode(const FitResult& r) {
@@ -104,6 +129,13 @@ void printTable(std::ostream& os, const IndexData& data, const std::vector<FitRe
        << (r.chi2_reduced ? fmt("%.3f", *r.chi2_reduced) : std::string("- (no sigma column)")) << "\n";
     os << "  n_F " << fmt("%.6f", r.n_F) << "  n_d " << fmt("%.6f", r.n_d) << "  n_C " << fmt("%.6f", r.n_C)
        << "  V_d " << fmt("%.2f", r.abbe) << "\n";
+    if (!isCauchy(r.model)) {
+      const CauchyApproximation ap = rendererApproximation(r);
+      os << "  renderer: cauchy [" << fmt("%.8e", ap.coeffs[0]) << ", " << fmt("%.8e", ap.coeffs[1])
+         << ", " << fmt("%.8e", ap.coeffs[2]) << "] over " << fmt("%g", kRenderLoNm) << "-"
+         << fmt("%g", kRenderHiNm) << " nm, |dn| max " << fmt("%.3e", ap.max_error) << ", rms "
+         << fmt("%.3e", ap.rms_error) << "\n";
+    }
   }
 }
 
@@ -153,42 +185,87 @@ std::string withSuffix(const std::string& path, const std::string& suffix) {
   return (p.parent_path() / (p.stem().string() + "-" + suffix + p.extension().string())).string();
 }
 
-// Writes every file to a temporary sibling first and renames only when all were written.
+// An output that is one of the inputs (the same file by device and inode, however it is spelt:
+// "./", symbolic or hard links) would be replaced by a fit of itself, and two outputs naming one
+// file would overwrite each other: both are refused before anything is written.
+void checkOutputs(const std::vector<std::string>& inputs,
+                  const std::vector<std::pair<std::string, std::string>>& files) {
+  for (size_t i = 0; i < files.size(); ++i) {
+    const std::string& out = files[i].first;
+    std::error_code ec;
+    for (const std::string& in : inputs)
+      if (fs::equivalent(in, out, ec))
+        throw CliError(out + ": the output is the input data file " + in +
+                       " (it would be overwritten); choose another path");
+    for (size_t j = 0; j < i; ++j) {
+      const bool same = fs::equivalent(files[j].first, out, ec) ||
+                        fs::weakly_canonical(files[j].first, ec) == fs::weakly_canonical(out, ec);
+      if (same)
+        throw CliError(out +
+                       ": named by two outputs (-o and --export-yaml); choose different paths");
+    }
+  }
+}
+
+// Writes every file to a temporary sibling first and renames only when all were written. Missing
+// parent folders are created, and removed again (if still empty) when the write fails.
 void writeAllAtomically(const std::vector<std::pair<std::string, std::string>>& files) {
   std::vector<std::pair<std::string, std::string>> temps;  // temp, final
+  std::vector<fs::path> created;                           // folders made here, outermost first
   auto cleanup = [&] {
     for (auto& t : temps) ::unlink(t.first.c_str());
+    std::error_code ec;
+    for (auto it = created.rbegin(); it != created.rend(); ++it)
+      fs::remove(*it, ec);  // only if empty
   };
   for (const auto& [path, content] : files) {
     fs::path target(path);
     fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    std::vector<fs::path> missing;
+    std::error_code ec;
+    for (fs::path d = dir; !d.empty() && !fs::exists(d, ec); d = d.parent_path()) {
+      missing.push_back(d);
+      if (d == d.parent_path()) break;
+    }
+    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+      if (!fs::create_directory(*it, ec)) {
+        cleanup();
+        throw CliError("cannot write " + path + ": cannot create folder " + it->string() + ": " +
+                       (ec ? ec.message() : std::string("it exists")));
+      }
+      created.push_back(*it);
+    }
     std::string tmpl = (dir / ("." + target.filename().string() + ".tmpXXXXXX")).string();
     int fd = ::mkstemp(tmpl.data());
     if (fd < 0) {
+      const int err = errno;
       cleanup();
-      throw CliError("cannot write " + path + ": " + std::strerror(errno));
+      throw CliError("cannot write " + path + ": " + std::strerror(err));
     }
     temps.emplace_back(tmpl, path);
     size_t done = 0;
     while (done < content.size()) {
       ssize_t w = ::write(fd, content.data() + done, content.size() - done);
       if (w <= 0) {
+        const int err = errno;
         ::close(fd);
         cleanup();
-        throw CliError("cannot write " + path + ": " + std::strerror(errno));
+        throw CliError("cannot write " + path + ": " + std::strerror(err));
       }
       done += size_t(w);
     }
     ::fchmod(fd, 0644);
     if (::close(fd) != 0) {
+      const int err = errno;
       cleanup();
-      throw CliError("cannot write " + path + ": " + std::strerror(errno));
+      throw CliError("cannot write " + path + ": " + std::strerror(err));
     }
   }
   for (auto& [tmp, final_path] : temps)
     if (std::rename(tmp.c_str(), final_path.c_str()) != 0) {
+      const int err = errno;
       cleanup();
-      throw CliError("cannot rename temporary file to " + final_path + ": " + std::strerror(errno));
+      throw CliError("cannot rename temporary file to " + final_path + ": " + std::strerror(err));
     }
 }
 
@@ -208,16 +285,21 @@ void run(const FitArgs& a) {
   FitOptions fo;
   fo.model = parseDispersionModel(a.model);
   fo.huber_delta = parseLoss(a.loss);
+  // Refused before reading (the crystal's FILE-o/-e YAML names are checked again once known).
+  std::vector<std::pair<std::string, std::string>> named;
+  for (const std::string* o : {&a.output, &a.export_yaml})
+    if (!o->empty()) named.emplace_back(*o, "");
+  checkOutputs(a.data, named);
   IndexReadOptions ro;
+  if (a.samples < 2 || a.samples > kMaxFormulaSamples)
+    throw CliError("--samples must be in [2, " + std::to_string(kMaxFormulaSamples) +
+                   "] (samples per refractiveindex.info formula block), got " +
+                   std::to_string(a.samples));
   ro.formula_samples = a.samples;
   if (!a.range_nm.empty()) {
     if (a.range_nm.size() != 2) throw CliError("--range-nm takes LO,HI in nm");
     ro.window_nm = std::array<double, 2>{a.range_nm[0], a.range_nm[1]};
   }
-  if (fo.model == DispersionModel::Conrady && (!a.output.empty()))
-    throw CliError("the conrady model cannot be written as a renderer material (cauchy or sellmeier only); "
-                   "drop -o or choose another --model");
-
   IndexData data = readIndexData(a.data[0], ro);
   if (a.data.size() == 2) {
     data = combineOrdinaryExtraordinary(std::move(data), readIndexData(a.data[1], ro));
@@ -260,6 +342,7 @@ void run(const FitArgs& a) {
       files.emplace_back(withSuffix(a.export_yaml, "e"), yamlEntry(fits[1], data.source));
     }
   }
+  checkOutputs(a.data, files);
   writeAllAtomically(files);
 
   if (a.json_out) {
@@ -280,13 +363,29 @@ void run(const FitArgs& a) {
   }
 }
 
+// CLI11 2.1 shows a positional with expected(1, 2) as "data(1x)"; the fit's usage line names what
+// it takes instead: "DATA [E_DATA]".
+class FitFormatter final : public CLI::Formatter {
+ public:
+  std::string make_option_usage(const CLI::Option* opt) const override {
+    if (opt->get_name() == "DATA") return "DATA [E_DATA]";
+    return CLI::Formatter::make_option_usage(opt);
+  }
+};
+
 }  // namespace
 
 void addFitCommand(CLI::App& app) {
   auto args = std::make_shared<FitArgs>();
   auto* sub = app.add_subcommand("fit", "Fit a dispersion model to refractive-index data (CSV or refractiveindex.info YAML)");
-  sub->add_option("data", args->data,
-                  "DATA file (.csv or .yml); give two single-index files (ordinary, extraordinary) for a crystal")
+  sub->formatter(std::make_shared<FitFormatter>());
+  sub->add_option(
+         "DATA", args->data,
+         "one or two index files (.csv, or refractiveindex.info .yml). One: n, or a CSV with "
+         "n_o,n_e "
+         "columns (a uniaxial crystal). Two single-index files: ordinary (DATA) then extraordinary "
+         "(E_DATA)")
+      ->type_name("FILE")
       ->required()
       ->expected(1, 2);
   sub->add_option("--model", args->model, "cauchy2 | cauchy3 | sellmeier1 | sellmeier2 | sellmeier3 | conrady")
@@ -297,7 +396,9 @@ void addFitCommand(CLI::App& app) {
   sub->add_flag("--strict", args->strict, "treat warnings (e.g. unsorted rows) as errors");
   sub->add_option("-o,--output", args->output, "material JSON file for the renderer");
   sub->add_option("--range-nm", args->range_nm, "fit only LO,HI nm (formulas are sampled inside it)")->delimiter(',');
-  sub->add_option("--samples", args->samples, "samples per refractiveindex.info formula block")->capture_default_str();
+  sub->add_option("--samples", args->samples,
+                  "samples per refractiveindex.info formula block (2 to 100000)")
+      ->capture_default_str();
   sub->add_option("--name", args->name, "material name (default: the DATA file's stem)");
   sub->callback([args] {
     try {

@@ -10,6 +10,7 @@
 #include "core/io/exr.h"
 #include "core/reference/reference_marcher.h"
 #include "core/render/light_transport.h"
+#include "core/render/render_defaults.h"
 #include "core/render/view_renderer.h"
 #include "core/vk/context.h"
 
@@ -19,7 +20,7 @@ namespace {
 struct RenderArgs {
   std::string scene, output;
   int width = 0, height = 0, spp = 1, wavelengths = -1, threads = 0;
-  double step = 0.5, exposure = 0.0;
+  double step = kDefaultRenderStepVoxels, exposure = 0.0;
   std::string integrator = "rk4";
   bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
   // Light simulator (scenes with "lights").
@@ -96,11 +97,12 @@ void addRenderCommand(CLI::App& app) {
     }
     checkWritable(out);
     checkWritable(png);
-    RenderSettings rs;
+    // The defaults are shared with Python (core/render/render_defaults.h).
+    RenderSettings rs = defaultRenderSettings(scene);
     rs.width = a.width;
     rs.height = a.height;
     rs.spp = a.spp;
-    rs.wavelengths = a.wavelengths >= 0 ? a.wavelengths : (scene.anyDispersive() ? 16 : 0);
+    if (a.wavelengths >= 0) rs.wavelengths = a.wavelengths;
     rs.march.step_voxels = a.step;
     rs.march.integrator = parseIntegrator(a.integrator);
     rs.march.skip_empty = !a.no_skip;
@@ -130,7 +132,7 @@ void addRenderCommand(CLI::App& app) {
     LightingSummary light;
     bool light_cached = false, light_on_cpu = false;
     if (!scene.lights.empty() && !a.no_light) {
-      LightingOptions lo;
+      LightingOptions lo = defaultLightingOptions();
       lo.bands = a.light_bands;
       lo.wave.splat = a.light_splat == "highest" ? WavefrontSettings::Splat::HighestEnergy : WavefrontSettings::Splat::Accumulate;
       lo.wave.dt = a.light_step * volume.grid.h;
@@ -142,8 +144,7 @@ void addRenderCommand(CLI::App& app) {
       std::filesystem::path cache_dir = a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache);
       // Which twin simulates: --reference renders use the CPU throughout; on a CPU Vulkan device
       // (lavapipe) the double-precision CPU twin is also the faster one (docs/light-simulator.md).
-      light_on_cpu = a.reference || a.light_device == "cpu" ||
-                     (a.light_device == "auto" && ctx && ctx->deviceTypeName() == "CPU");
+      light_on_cpu = a.reference || lightOnCpu(a.light_device, ctx.get());
       // The key hashes every field of the volume (~0.3 s at 128³): only when the cache is used.
       const uint64_t key = a.no_light_cache ? 0 : lightCacheKey(scene, volume, lo, light_on_cpu);
       if (!a.no_light_cache && loadLightCache(cache_dir, key, volume)) {

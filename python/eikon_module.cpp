@@ -5,13 +5,13 @@
 // (numpy users convert with np.radians/np.degrees), directions as length-3 sequences in world
 // space. Scalar functions of λ or θ accept numpy arrays and broadcast (py::vectorize).
 //
-//   import sys; sys.path.insert(0, "build/python"); import eikon
+//   import eikon   # after scripts/install_python.sh (setup.sh); or sys.path.insert(0, "build/python")
 //   bk7 = eikon.load_material("N-BK7").n            # Dispersion
 //   bk7.index([486.1327, 587.5618, 656.2725]);  bk7.abbe_number()
 //   fit = eikon.fit_dispersion(lam, n, sigma, model="cauchy3");  fit.index_sigma(lam)
 //   cal = eikon.Uniaxial(1.658344, 1.486130, [0, 0, 1]);  cal.walk_off_angle_at(np.radians(45))
 //   sc = eikon.Scene.load("scenes/glass_sphere.json");  r = eikon.Renderer(sc)
-//   img = r.render(width=160, height=120)                         # (H, W, 3) float32, linear sRGB
+//   img = r.render(width=160, height=120)    # (H, W, 3) float32 linear sRGB; the CLI's defaults
 //   res = r.trace([0, 0, -30], [0, 0, 1], wavelength_nm=587.56)   # CLI-shaped dict, per mode
 //
 // Trace results. One ray gives the CLI JSON shape
@@ -34,6 +34,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -50,9 +51,12 @@
 #include "anisotropic/interface.h"
 #include "anisotropic/pleochroism.h"
 #include "anisotropic/uniaxial.h"
+#include "apps/light_cache.h"
 #include "core/reference/reference_marcher.h"
 #include "core/reference/reference_lighting.h"
+#include "core/io/exr.h"
 #include "core/render/light_transport.h"
+#include "core/render/render_defaults.h"
 #include "core/render/view_renderer.h"
 #include "core/scene/scene.h"
 #include "core/vk/context.h"
@@ -237,6 +241,10 @@ py::array_t<float> imageArray(const RenderImage& img) {
   return a;
 }
 
+// Voxelisations done by this module (eikon.voxelize_count()): lets tests see that a cached
+// prepared scene is reused instead of voxelised again.
+std::atomic<long> g_voxelizations{0};
+
 // A scene prepared for marching: the voxelised volume, plus (lazily) the GPU renderer and the
 // CPU reference. Owns everything the renderers reference, at stable addresses.
 struct Prepared {
@@ -246,6 +254,7 @@ struct Prepared {
   std::unique_ptr<ViewRenderer> gpu;
   std::unique_ptr<VolumeField> field;
   std::unique_ptr<ReferenceMarcher> cpu;
+  VolumeSpec voxelized_spec;  ///< scene->volume when `volume` was made (for the module cache)
 
   explicit Prepared(std::shared_ptr<Scene> s) : scene(std::move(s)) {}
   void ensureVolume(bool for_gpu) {
@@ -256,7 +265,44 @@ struct Prepared {
     if (!volume) {
       py::gil_scoped_release release;
       volume = std::make_unique<VolumeSet>(voxelize(*scene));
+      voxelized_spec = scene->volume;
+      ++g_voxelizations;
     }
+  }
+  void dropRenderers() {  // after the light volumes change: rebuilt on their next use
+    gpu.reset();
+    cpu.reset();
+    field.reset();
+  }
+  // As `eikon render` does by default: a scene with lights gets its light simulated before the
+  // first render (unless simulate_light() already did), by the twin lightOnCpu() picks (the CPU
+  // reference for CPU renders, as --reference), through the CLI's light cache when `cache_dir` is
+  // not empty. Returns whether the light was taken from the cache.
+  bool ensureLit(bool cpu_render, const std::string& cache_dir, int threads) {
+    if (scene->lights.empty()) return false;
+    ensureVolume(!cpu_render);
+    if (volume->lit()) return false;
+    LightingOptions lo = defaultLightingOptions();
+    lo.wave.threads = threads;
+    if (!cpu_render && !ctx) ctx = context();
+    const bool on_cpu = cpu_render || lightOnCpu("auto", ctx.get());
+    bool cached = false;
+    {
+      py::gil_scoped_release release;
+      const uint64_t key = cache_dir.empty() ? 0 : cli::lightCacheKey(*scene, *volume, lo, on_cpu);
+      if (!cache_dir.empty() && cli::loadLightCache(cache_dir, key, *volume)) {
+        cached = true;
+      } else {
+        if (on_cpu)
+          simulateLightingReference(*scene, *volume, lo);
+        else
+          simulateLighting(*ctx, *scene, *volume, lo);
+        // A cache that cannot be written only costs time next time.
+        if (!cache_dir.empty()) cli::saveLightCache(cache_dir, key, *volume);
+      }
+    }
+    dropRenderers();
+    return cached;
   }
   ViewRenderer& gpuRenderer() {
     ensureVolume(true);
@@ -272,6 +318,38 @@ struct Prepared {
     return *cpu;
   }
 };
+
+bool sameSpec(const VolumeSpec& a, const VolumeSpec& b) {
+  return a.bounds_min == b.bounds_min && a.bounds_max == b.bounds_max &&
+         a.resolution == b.resolution && a.smoothing_voxels == b.smoothing_voxels &&
+         a.smoothing == b.smoothing;
+}
+
+// The module-level render()/trace() keep the last scene they prepared: a second call with the
+// same Scene object (and the same volume settings) reuses its voxelised volume, GPU renderer and
+// light volumes instead of voxelising again. Camera edits need nothing (renders read the camera);
+// a changed `scene.volume` or another Scene object prepares afresh. Only one scene is kept (a
+// volume can take hundreds of MB); eikon.clear_cache() drops it.
+std::shared_ptr<Prepared> g_last_prepared;
+std::weak_ptr<Scene> g_last_scene;
+std::mutex g_prepared_mutex;
+
+std::shared_ptr<Prepared> cachedPrepared(const std::shared_ptr<Scene>& s) {
+  std::lock_guard<std::mutex> lock(g_prepared_mutex);
+  if (g_last_prepared && g_last_scene.lock() == s &&
+      (!g_last_prepared->volume || sameSpec(g_last_prepared->voxelized_spec, s->volume)))
+    return g_last_prepared;
+  g_last_prepared = std::make_shared<Prepared>(s);
+  g_last_scene = s;
+  return g_last_prepared;
+}
+
+std::string lightCacheDir(const py::object& light_cache) {
+  if (light_cache.is_none()) return {};
+  if (py::isinstance<py::bool_>(light_cache))
+    return light_cache.cast<bool>() ? cli::defaultLightCacheDir().string() : std::string();
+  return py::str(light_cache).cast<std::string>();
+}
 
 std::vector<std::string> modesTraced(const Scene&) {
   // Both twins march the e-mode of uniaxial crystals; an isotropic scene's e-mode is its o-mode.
@@ -340,10 +418,18 @@ PYBIND11_MODULE(eikon, m) {
       .def_static("sellmeier", [](const py::handle& b, const py::handle& c) {
                     return Dispersion::sellmeier(toVector(b), toVector(c)); }, py::arg("B"), py::arg("C"),
                   "SCHOTT Sellmeier, C in µm²")
+      .def_static("conrady", &Dispersion::conrady, py::arg("n0"), py::arg("A"), py::arg("B"),
+                  "n = n0 + A/λ + B/λ^3.5, λ in µm")
       .def("with_range", [](Dispersion d, double lo, double hi) { d.withRange(lo, hi); return d; },
            py::arg("lo_nm"), py::arg("hi_nm"))
-      .def_property_readonly("kind", [](const Dispersion& d) {
-        return d.kind() == Dispersion::Kind::Constant ? "constant" : d.kind() == Dispersion::Kind::Cauchy ? "cauchy" : "sellmeier"; })
+      .def_property_readonly("kind", [](const Dispersion& d) -> const char* {
+        switch (d.kind()) {
+          case Dispersion::Kind::Constant: return "constant";
+          case Dispersion::Kind::Cauchy: return "cauchy";
+          case Dispersion::Kind::Sellmeier: return "sellmeier";
+          case Dispersion::Kind::Conrady: return "conrady";
+        }
+        return "unknown"; })
       .def_property_readonly("coefficients", [](const Dispersion& d) { return fromVector(d.coefficients()); })
       .def_property_readonly("sellmeier_c", [](const Dispersion& d) { return fromVector(d.sellmeierC()); })
       .def_property_readonly("range_nm", [](const Dispersion& d) -> py::object {
@@ -448,7 +534,7 @@ PYBIND11_MODULE(eikon, m) {
       .def_readonly("abbe", &FitResult::abbe)
       .def_readonly("iterations", &FitResult::iterations)
       .def_readonly("warnings", &FitResult::warnings)
-      .def("dispersion", &FitResult::dispersion, "the fitted curve as a Dispersion (not for conrady)")
+      .def("dispersion", &FitResult::dispersion, "the fitted curve as a Dispersion (cauchy, sellmeier or conrady)")
       .def("index", [](const FitResult& r, py::array_t<double> l) {
              return py::vectorize([&r](double x) { return modelIndex(r.model, r.coeffs.data(), x); })(l); },
            py::arg("lambda_nm"), "fitted n(λ)")
@@ -667,17 +753,21 @@ PYBIND11_MODULE(eikon, m) {
              d["uniaxial"] = p.volume->uniaxial;
              d["dispersive"] = p.volume->dispersive;
              return d; }, "voxel grid facts (voxelises on first call)")
-      .def("render", [](Prepared& p, int width, int height, int spp, int wavelengths, double wavelength_nm,
-                        std::optional<MarchSettings> march, const std::string& device, int threads) {
-             RenderSettings s;
+      .def("render", [](Prepared& p, int width, int height, int spp, std::optional<int> wavelengths,
+                        double wavelength_nm, std::optional<MarchSettings> march, const std::string& device, int threads,
+                        bool light, const py::object& light_cache) {
+             const bool gpu = isGpu(device);
+             // The CLI's defaults (core/render/render_defaults.h), then what the caller chose.
+             RenderSettings s = defaultRenderSettings(*p.scene);
              s.width = width;
              s.height = height;
              s.spp = spp;
-             s.wavelengths = wavelengths;
+             if (wavelengths) s.wavelengths = *wavelengths;
              s.wavelength_nm = wavelength_nm;
              if (march) s.march = *march;
+             if (light) p.ensureLit(!gpu, lightCacheDir(light_cache), threads);
              RenderImage img;
-             if (isGpu(device)) {
+             if (gpu) {
                ViewRenderer& r = p.gpuRenderer();
                py::gil_scoped_release release;
                img = r.render(s);
@@ -690,10 +780,14 @@ PYBIND11_MODULE(eikon, m) {
                img = r.render(cam, s, threads);
              }
              return imageArray(img); },
-           py::arg("width") = 0, py::arg("height") = 0, py::arg("spp") = 1, py::arg("wavelengths") = 0,
+           py::arg("width") = 0, py::arg("height") = 0, py::arg("spp") = 1, py::arg("wavelengths") = py::none(),
            py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(), py::arg("device") = "gpu",
-           py::arg("threads") = 0,
-           "(H, W, 3) float32 linear sRGB; wavelengths > 0 = spectral mode with that many samples")
+           py::arg("threads") = 0, py::arg("light") = true, py::arg("light_cache") = true,
+           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: wavelengths=None is 16 for a "
+           "dispersive scene, else 0 (RGB; > 0 = spectral with that many samples); march=None is 0.5-voxel RK4 "
+           "steps; light=True simulates a lit scene's lights before its first render (unless simulate_light() "
+           "did), on the twin the CLI picks, through the CLI's light cache (light_cache=True: the default "
+           "folder, a path: that folder, False: none); light=False leaves an unsimulated scene unlit (--no-light)")
       .def("simulate_light", [](Prepared& p, int bands, const std::string& splat, double step_voxels,
                                 double smoothing_voxels, const std::string& caustics, const std::string& device) {
              const bool gpu = isGpu(device);
@@ -714,9 +808,7 @@ PYBIND11_MODULE(eikon, m) {
                sum = gpu ? simulateLighting(*p.ctx, *p.scene, *p.volume, o) : simulateLightingReference(*p.scene, *p.volume, o);
              }
              // Renderers built before hold the unlit volume: rebuild them on their next use.
-             p.gpu.reset();
-             p.cpu.reset();
-             p.field.reset();
+             p.dropRenderers();
              py::dict d;
              d["runs"] = sum.runs;
              d["seconds"] = sum.seconds;
@@ -790,13 +882,30 @@ PYBIND11_MODULE(eikon, m) {
            "one ray, the CLI JSON shape: {'wavelength_nm', 'device', 'modes': [{'mode': 'o', ...}, ...]}");
 
   m.def("render", [](std::shared_ptr<Scene> s, py::kwargs kw) {
-          auto p = py::cast(std::make_shared<Prepared>(std::move(s)));
+          auto p = py::cast(cachedPrepared(s));
           return p.attr("render")(**kw); }, py::arg("scene"),
-        "render(scene, width=, height=, spp=, wavelengths=, wavelength_nm=, march=, device='gpu'|'cpu')");
+        "render(scene, width=, height=, spp=, wavelengths=, wavelength_nm=, march=, device='gpu'|'cpu', light=, "
+        "light_cache=) — Renderer.render on the module's cached prepared scene (voxelised once per Scene object "
+        "and volume settings)");
   m.def("trace", [](std::shared_ptr<Scene> s, py::args a, py::kwargs kw) {
-          auto p = py::cast(std::make_shared<Prepared>(std::move(s)));
+          auto p = py::cast(cachedPrepared(s));
           return p.attr("trace")(*a, **kw); }, py::arg("scene"),
         "trace(scene, origin, direction, wavelength_nm=, march=, device=) — see Renderer.trace");
+  m.def("clear_cache", [] {
+          std::lock_guard<std::mutex> lock(g_prepared_mutex);
+          g_last_prepared.reset();
+          g_last_scene.reset(); },
+        "drop the scene that module-level render()/trace() keep prepared");
+  m.def("voxelize_count", [] { return g_voxelizations.load(); },
+        "how many times this module has voxelised a scene (each Renderer once, module-level calls once per scene)");
+  m.def("read_exr", [](const std::string& path) {
+          RgbaImage im = readExrRgba(path, 16384, 16384);
+          py::array_t<float> a({py::ssize_t(im.height), py::ssize_t(im.width), py::ssize_t(3)});
+          float* d = a.mutable_data();
+          for (size_t i = 0; i < size_t(im.width) * size_t(im.height); ++i)
+            for (int c = 0; c < 3; ++c) d[3 * i + size_t(c)] = im.rgba[4 * i + size_t(c)];
+          return a; }, py::arg("path"),
+        "(H, W, 3) float32 linear RGB of an EXR (e.g. what `eikon render` wrote)");
 
   // ------------------------------------------------------------ analytic fields (CPU reference)
   py::class_<AnalyticSpec, std::shared_ptr<AnalyticSpec>>(m, "AnalyticField",

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Configure and build eikon (Release) into ${EIKON_BUILD_DIR:-build}.
-# Uses ccache when it is installed (it is optional: a rebuild of an unchanged tree is then seconds).
+# Configure and build eikon (Release) into ${EIKON_BUILD_DIR:-build}, then register its Python
+# module with Debian's python3 (scripts/install_python.sh: one eikon.pth file; see there).
+# Uses ccache when it is installed (optional: a rebuild of an unchanged tree then takes seconds).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR="${EIKON_BUILD_DIR:-build}"
@@ -8,3 +9,5 @@ launcher=()
 if command -v ccache >/dev/null 2>&1; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" >/dev/null
 cmake --build "$BUILD_DIR" -j"$(nproc)"
+# Not fatal here (a non-root build still builds); CTest's python.install_module fails instead.
+./scripts/install_python.sh "$BUILD_DIR" || echo "eikon: warning: Python module not registered (above); the build is done"

@@ -140,11 +140,16 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
     if (v < 1.0) n.fail("refractive index must be >= 1, got " + fmt(v));
     return Dispersion::constant(v);
   }
-  if (!n.isObject()) n.fail("expected a number or an object {\"cauchy\": [...]} / {\"sellmeier\": [...]}");
-  n.allowKeys({"cauchy", "sellmeier", "range_nm", "sigma", "linear", "luneburg", "maxwell_fisheye"});
-  int kinds = int(n.has("cauchy")) + int(n.has("sellmeier")) + int(n.has("linear")) + int(n.has("luneburg")) +
-              int(n.has("maxwell_fisheye"));
-  if (kinds != 1) n.fail("give exactly one of cauchy, sellmeier, linear, luneburg, maxwell_fisheye");
+  if (!n.isObject())
+    n.fail(
+        "expected a number or an object {\"cauchy\": [...]} / {\"sellmeier\": [...]} / "
+        "{\"conrady\": [...]}");
+  n.allowKeys({"cauchy", "sellmeier", "conrady", "range_nm", "sigma", "linear", "luneburg",
+               "maxwell_fisheye"});
+  int kinds = int(n.has("cauchy")) + int(n.has("sellmeier")) + int(n.has("conrady")) +
+              int(n.has("linear")) + int(n.has("luneburg")) + int(n.has("maxwell_fisheye"));
+  if (kinds != 1)
+    n.fail("give exactly one of cauchy, sellmeier, conrady, linear, luneburg, maxwell_fisheye");
   if (n.has("linear") || n.has("luneburg") || n.has("maxwell_fisheye")) {
     if (!grin) n.fail("gradient-index profiles are allowed only for isotropic materials (key \"n\")");
     if (auto l = n.get("linear")) {
@@ -174,6 +179,13 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
       auto v = c->numbers();
       if (v.empty() || v.size() > 6) c->fail("cauchy needs 1 to 6 coefficients [A, B, C, ...] (λ in µm), got " + std::to_string(v.size()));
       d = Dispersion::cauchy(v);
+    } else if (auto c = n.get("conrady")) {
+      // n = n0 + A/λ + B/λ^3.5 (λ in µm); the renderer carries its Cauchy approximation.
+      auto v = c->numbers();
+      if (v.size() != 3)
+        c->fail("conrady needs [n0, A, B] (n = n0 + A/λ + B/λ^3.5, λ in µm), got " +
+                std::to_string(v.size()) + " numbers");
+      d = Dispersion::conrady(v[0], v[1], v[2]);
     } else {
       auto s = n.at("sellmeier");
       auto v = s.numbers();

@@ -242,7 +242,45 @@ TEST(DispersionFit, ConradyRecoversExactCoefficients) {
   }
   const FitResult r = fitDispersion(d, {.model = DispersionModel::Conrady});
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(r.coeffs[size_t(k)], p[k], 1e-9 * std::max(1.0, std::abs(p[k])));
-  EXPECT_THROW(r.dispersion(), std::invalid_argument);
+}
+
+// Conrady is a renderer material model (issue 11): Dispersion::conrady evaluates the closed form
+// n0 + A/λ + B/λ^3.5 exactly, its derivative −A/λ² − 3.5 B/λ^4.5 (per µm, /1000 per nm), and
+// FitResult::dispersion() returns it with the data's range. Its renderer Cauchy approximation is
+// not exact, and reports max/rms |Δn| that the test recomputes from the coefficients.
+TEST(DispersionFit, ConradyIsADispersionModel) {
+  const double n0 = 1.49, A = 0.012, B = 1.5e-4;
+  const Dispersion c = Dispersion::conrady(n0, A, B);
+  EXPECT_EQ(c.kind(), Dispersion::Kind::Conrady);
+  EXPECT_FALSE(c.isDispersionless());
+  EXPECT_TRUE(Dispersion::conrady(1.5, 0.0, 0.0).isDispersionless());
+  for (double l : {380.0, 486.1327, 587.5618, 780.0, 1500.0}) {
+    const double u = l * 1e-3;
+    EXPECT_NEAR(c.index(l), n0 + A / u + B * std::pow(u, -3.5), 1e-15);
+    EXPECT_NEAR(c.derivative(l), (-A / (u * u) - 3.5 * B * std::pow(u, -4.5)) * 1e-3, 1e-15);
+  }
+  EXPECT_THROW(Dispersion::conrady(1.5, std::nan(""), 0.0), std::invalid_argument);
+  const CauchyApproximation ap = c.cauchyApproximation(380.0, 780.0);
+  double mx = 0.0, s2 = 0.0;
+  int k = 0;
+  for (double l = 380.0; l <= 780.0; l += 1.0, ++k) {
+    const double u2 = (l * 1e-3) * (l * 1e-3);
+    const double e = c.index(l) - (ap.coeffs[0] + ap.coeffs[1] / u2 + ap.coeffs[2] / (u2 * u2));
+    mx = std::max(mx, std::abs(e)), s2 += e * e;
+  }
+  EXPECT_GT(ap.max_error, 0.0);
+  EXPECT_NEAR(ap.max_error, mx, 1e-15);
+  EXPECT_NEAR(ap.rms_error, std::sqrt(s2 / k), 1e-15);
+  EXPECT_LT(ap.max_error, 1e-3);  // three smooth terms follow a smooth curve closely
+
+  IndexSeries d;
+  d.label = "n";
+  for (double l = 400.0; l <= 700.0; l += 10.0) d.lambda_nm.push_back(l), d.n.push_back(c.index(l));
+  const Dispersion fitted = fitDispersion(d, {.model = DispersionModel::Conrady}).dispersion();
+  EXPECT_EQ(fitted.kind(), Dispersion::Kind::Conrady);
+  ASSERT_TRUE(fitted.rangeNm());
+  EXPECT_EQ(*fitted.rangeNm(), (std::array<double, 2>{400.0, 700.0}));
+  for (double l = 400.0; l <= 700.0; l += 25.0) EXPECT_NEAR(fitted.index(l), c.index(l), 1e-12);
 }
 
 // The fit's model evaluation agrees with eikon::Dispersion (what the renderer uses), and its

@@ -25,16 +25,22 @@ json readJson(const fs::path& p) {
 }
 
 // The dispersion spec of materials/*.json: a number, {"sellmeier": [B..., C...], "range_nm"},
-// or {"cauchy": [A, B, C...], "range_nm"}. Unknown keys are errors (as in the scene loader).
+// {"cauchy": [A, B, C...], "range_nm"} or {"conrady": [n0, A, B], "range_nm"}. Unknown keys are
+// errors (as in the scene loader).
 eikon::Dispersion parseSpec(const json& j, const std::string& where) {
   if (j.is_number()) return eikon::Dispersion::constant(j.get<double>());
   if (!j.is_object()) throw std::runtime_error(where + ": expected a number or an object");
   for (const auto& [k, v] : j.items())
-    if (k != "sellmeier" && k != "cauchy" && k != "range_nm") throw std::runtime_error(where + ": unknown key " + k);
+    if (k != "sellmeier" && k != "cauchy" && k != "conrady" && k != "range_nm")
+      throw std::runtime_error(where + ": unknown key " + k);
   eikon::Dispersion d;
-  if (j.contains("sellmeier") == j.contains("cauchy"))
-    throw std::runtime_error(where + ": need exactly one of sellmeier, cauchy");
-  if (j.contains("sellmeier")) {
+  if (int(j.contains("sellmeier")) + int(j.contains("cauchy")) + int(j.contains("conrady")) != 1)
+    throw std::runtime_error(where + ": need exactly one of sellmeier, cauchy, conrady");
+  if (j.contains("conrady")) {
+    const auto c = j.at("conrady").get<std::vector<double>>();
+    if (c.size() != 3) throw std::runtime_error(where + ": conrady needs [n0, A, B]");
+    d = eikon::Dispersion::conrady(c[0], c[1], c[2]);
+  } else if (j.contains("sellmeier")) {
     const auto c = j.at("sellmeier").get<std::vector<double>>();
     if (c.empty() || c.size() % 2 != 0) throw std::runtime_error(where + ": sellmeier needs 2k numbers");
     const std::ptrdiff_t k = std::ptrdiff_t(c.size() / 2);

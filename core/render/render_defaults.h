@@ -1,0 +1,47 @@
+// What a render does when the user chooses nothing, in one place for both front ends: the CLI
+// (`eikon render`, apps/render_command.cpp) and Python (`eikon.render`, `Renderer.render`,
+// python/eikon_module.cpp) call these functions, so the same scene renders the same from both by
+// default (issue 11: Python rendered dispersive scenes in RGB where the CLI took 16 wavelengths,
+// marched with 0.25-voxel steps where the CLI took 0.5, and left lit scenes unlit).
+//
+//   RenderSettings rs = eikon::defaultRenderSettings(scene);  // then apply the user's choices
+//   LightingOptions lo = eikon::defaultLightingOptions();
+//   bool cpu = eikon::lightOnCpu("auto", ctx);                // which twin simulates the light
+#pragma once
+
+#include <string>
+
+#include "core/reference/reference_lighting.h"
+#include "core/scene/scene.h"
+#include "core/volume/march_types.h"
+
+namespace eikon {
+namespace vk {
+class Context;
+}
+
+/// Spectral samples per pixel sample for a dispersive scene (0, RGB, otherwise).
+inline constexpr int kDefaultDispersiveWavelengths = 16;
+/// Integration step in voxels of a render (docs/view-renderer.md).
+inline constexpr double kDefaultRenderStepVoxels = 0.5;
+
+/// kDefaultDispersiveWavelengths when any material's index depends on λ, else 0 (RGB mode).
+int defaultWavelengths(const Scene& scene);
+
+/// The scene camera's size (0 = the camera's), 1 spp, defaultWavelengths(scene), the d line for
+/// RGB mode, and the march: kDefaultRenderStepVoxels, RK4, straight steps across homogeneous
+/// regions, Fresnel on.
+RenderSettings defaultRenderSettings(const Scene& scene);
+
+/// The light simulator as a render runs it: bands chosen per scene (0 → defaultLightBands),
+/// accumulated fluence, dt = 0.5 voxel (0 → 0.5·h), split at 1 voxel, 2^20 live patches, light
+/// passing through fold caustics (so the light beyond a focus is there), smoothing 1 voxel.
+LightingOptions defaultLightingOptions();
+
+/// Whether the light is simulated by the CPU twin: device "cpu", or "auto" when there is no GPU
+/// context or its Vulkan device is a CPU (lavapipe, where the threaded double-precision twin is
+/// several times faster; docs/light-simulator.md). "gpu" uses the GPU twin. Throws
+/// std::invalid_argument for any other device name.
+bool lightOnCpu(const std::string& device, const vk::Context* ctx);
+
+}  // namespace eikon
