@@ -39,6 +39,22 @@ struct MaterialValues {
   float v[kFieldCount];
 };
 
+// The voxel index range [lo, hi] of a world box widened by `margin` voxels, clamped to the grid.
+// The clamping is done in double before converting to int: an object far outside the volume
+// (centre 1e300, or 4294967296 mm) gives voxel coordinates beyond int's range, whose conversion
+// is undefined behaviour (UBSan: signed overflow). False if the box misses the grid (or is NaN).
+bool voxelRange(const glm::dvec3& bmin, const glm::dvec3& bmax, const Grid& g, int margin, int lo[3], int hi[3]) {
+  for (int a = 0; a < 3; ++a) {
+    const double top = double(g.dims[a] - 1);
+    double l = std::floor((bmin[a] - g.origin[a]) / g.h) - margin;
+    double h = std::ceil((bmax[a] - g.origin[a]) / g.h) + margin;
+    if (!(l <= top) || !(h >= 0.0) || !(l <= h)) return false;  // also false for NaN
+    lo[a] = int(std::max(l, 0.0));
+    hi[a] = int(std::min(h, top));
+  }
+  return true;
+}
+
 }  // namespace
 
 Grid makeGrid(const VolumeSpec& spec) {
@@ -188,9 +204,9 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
     else if (mat.uniaxial) ax = glm::vec4(glm::vec3(obj.optic_axis ? *obj.optic_axis : *mat.optic_axis), 0.0f);
     auto [bmin, bmax] = obj.shape.bounds();
     int lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::clamp(int(std::floor((bmin[a] - g.origin[a]) / g.h)) - margin, 0, g.dims[a] - 1);
-      hi[a] = std::clamp(int(std::ceil((bmax[a] - g.origin[a]) / g.h)) + margin, 0, g.dims[a] - 1);
+    if (!voxelRange(bmin, bmax, g, margin, lo, hi)) {  // wholly outside the grid: nothing to add
+      progress(0.4 * double(oi + 1) / double(scene.objects.size()), "voxelising");
+      continue;
     }
     parallelFor(hi[2] - lo[2] + 1, opt.threads, [&](int kk) {
       const int k = lo[2] + kk;
