@@ -18,11 +18,27 @@ namespace {
 using json = nlohmann::json;
 constexpr double kPi = 3.14159265358979323846;
 
+// Limits on what the scene may ask for, so that every derived quantity is representable:
+// - positions and lengths within ±1e12 mm: distances are computed in double (squares ≤ 1e24, no
+//   overflow) and a surface 1e12 mm from the origin is still placed to ~1e-4 mm;
+// - a voxel edge of at least 1e-6 mm (1 nm, far below where geometric optics holds), so that 1/h
+//   and the gradients the GPU stores are finite in float;
+// - the volume within 65536 voxels of the origin: the GPU marches in single precision, whose
+//   positions there resolve 2^-7 voxel (farther out the grid would be sampled off by whole voxels).
+constexpr double kMaxCoordinateMm = 1e12;
+constexpr double kMinVoxelMm = 1e-6;
+constexpr double kMaxOffsetVoxels = 65536.0;
+
 std::string fmt(double v) {
   std::ostringstream s;
   s.precision(10);
   s << v;
   return s.str();
+}
+
+std::string box(const VolumeSpec& v) {
+  auto p = [](const glm::dvec3& x) { return "(" + fmt(x.x) + ", " + fmt(x.y) + ", " + fmt(x.z) + ")"; };
+  return p(v.bounds_min) + " to " + p(v.bounds_max) + " mm";
 }
 
 /// A JSON value with its location, for error messages that name file and path.
@@ -111,6 +127,20 @@ class Node {
     if (c.x < 0 || c.y < 0 || c.z < 0) fail("must be non-negative");
     return c;
   }
+  /// A point (mm) within ±kMaxCoordinateMm on every axis.
+  glm::dvec3 position() const {
+    glm::dvec3 v = vec3();
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(v[a]) > kMaxCoordinateMm)
+        index(size_t(a)).fail("must be within ±" + fmt(kMaxCoordinateMm) + " mm, got " + fmt(v[a]));
+    return v;
+  }
+  /// A length (mm) in (0, kMaxCoordinateMm].
+  double length() const {
+    double v = positive();
+    if (v > kMaxCoordinateMm) fail("must be at most " + fmt(kMaxCoordinateMm) + " mm, got " + fmt(v));
+    return v;
+  }
   glm::dvec3 unitVector() const {
     glm::dvec3 v = vec3();
     double len = glm::length(v);
@@ -152,18 +182,18 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
       grin->type = GrinProfile::Type::Linear;
       grin->n0 = l->at("n0").number(1.0, 10.0);
       grin->gradient = l->at("gradient_per_mm").vec3();
-      grin->origin = l->get("origin") ? l->at("origin").vec3() : glm::dvec3(0.0);
+      grin->origin = l->get("origin") ? l->at("origin").position() : glm::dvec3(0.0);
     } else if (auto lu = n.get("luneburg")) {
       lu->allowKeys({"center", "radius"});
       grin->type = GrinProfile::Type::Luneburg;
-      grin->origin = lu->at("center").vec3();
-      grin->radius = lu->at("radius").positive();
+      grin->origin = lu->at("center").position();
+      grin->radius = lu->at("radius").length();
     } else {
       auto f = n.at("maxwell_fisheye");
       f.allowKeys({"center", "radius", "n0"});
       grin->type = GrinProfile::Type::MaxwellFisheye;
-      grin->origin = f.at("center").vec3();
-      grin->radius = f.at("radius").positive();
+      grin->origin = f.at("center").position();
+      grin->radius = f.at("radius").length();
       grin->n0 = f.at("n0").number(1.0, 10.0);
     }
     return Dispersion::constant(grin->type == GrinProfile::Type::Linear ? grin->n0 : 1.0);
@@ -265,7 +295,7 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
 SceneObject parseObject(const Node& o) {
   o.requireObject();
   std::string shape = o.at("shape").string();
-  glm::dvec3 center = o.get("center") ? o.at("center").vec3() : glm::dvec3(0.0);
+  glm::dvec3 center = o.get("center") ? o.at("center").position() : glm::dvec3(0.0);
   glm::dvec3 rot = o.get("rotation_deg") ? o.at("rotation_deg").vec3() : glm::dvec3(0.0);
   SceneObject obj;
   ShapeGeometry g;
@@ -284,25 +314,25 @@ SceneObject parseObject(const Node& o) {
   try {
     if (shape == "sphere") {
       allow({"radius"});
-      g = SphereShape{o.at("radius").positive()};
+      g = SphereShape{o.at("radius").length()};
     } else if (shape == "box") {
       allow({"size"});
-      auto s = o.at("size").vec3();
+      auto s = o.at("size").position();
       if (!(s.x > 0 && s.y > 0 && s.z > 0)) o.at("size").fail("all sizes must be > 0");
       g = BoxShape{s};
     } else if (shape == "rounded_box") {
       allow({"size", "radius"});
-      auto s = o.at("size").vec3();
+      auto s = o.at("size").position();
       if (!(s.x > 0 && s.y > 0 && s.z > 0)) o.at("size").fail("all sizes must be > 0");
-      double r = o.at("radius").positive();
+      double r = o.at("radius").length();
       if (2 * r > std::min(s.x, std::min(s.y, s.z))) o.at("radius").fail("corner radius exceeds half the smallest side");
       g = RoundedBoxShape{s, r};
     } else if (shape == "prism") {
       allow({"apex_deg", "side", "height"});
-      g = makePrism(o.at("apex_deg").number(0.0, 180.0, true), o.at("side").positive(), o.at("height").positive());
+      g = makePrism(o.at("apex_deg").number(0.0, 180.0, true), o.at("side").length(), o.at("height").length());
     } else if (shape == "brilliant") {
       allow({"diameter", "table", "crown_deg", "pavilion_deg", "girdle", "facets"});
-      g = makeBrilliant(o.at("diameter").positive(), o.get("table") ? o.at("table").number(0.0, 1.0, true) : 0.57,
+      g = makeBrilliant(o.at("diameter").length(), o.get("table") ? o.at("table").number(0.0, 1.0, true) : 0.57,
                         o.get("crown_deg") ? o.at("crown_deg").number() : 34.5,
                         o.get("pavilion_deg") ? o.at("pavilion_deg").number() : 40.75,
                         o.get("girdle") ? o.at("girdle").number(0.0, 0.5) : 0.02,
@@ -318,6 +348,9 @@ SceneObject parseObject(const Node& o) {
         glm::dvec3 n(v[0], v[1], v[2]);
         double len = glm::length(n);
         if (!(len > 1e-12)) p.index(i).fail("plane normal must be non-zero");
+        if (!(std::abs(v[3] / len) <= kMaxCoordinateMm))
+          p.index(i).fail("the plane's distance d/|n| from the centre must be within ±" + fmt(kMaxCoordinateMm) +
+                          " mm, got " + fmt(v[3] / len));
         c.planes.push_back({n / len, v[3] / len});
       }
       finishConvex(c);
@@ -487,16 +520,16 @@ static Light parseLight(const Node& l) {
     light.type = Light::Type::Directional;
     light.direction = l.at("direction").unitVector();
     if (auto v = l.get("irradiance")) light.irradiance = v->number(0.0, 1e12);
-    if (auto r = l.get("beam_radius")) light.beam_radius = r->positive();
+    if (auto r = l.get("beam_radius")) light.beam_radius = r->length();
     if (auto c = l.get("beam_center")) {
       if (!l.has("beam_radius")) c->fail("beam_center needs beam_radius (the beam's radius in mm)");
-      light.position = c->vec3();
+      light.position = c->position();
     }
   } else if (type == "point" || type == "spot") {
     if (type == "point") l.allowKeys({"type", "position", "intensity", "spectrum"});
     else l.allowKeys({"type", "position", "direction", "cone_half_angle_deg", "intensity", "spectrum"});
     light.type = type == "point" ? Light::Type::Point : Light::Type::Spot;
-    light.position = l.at("position").vec3();
+    light.position = l.at("position").position();
     if (auto v = l.get("intensity")) light.irradiance = v->number(0.0, 1e12);
     if (type == "spot") {
       light.direction = l.at("direction").unitVector();
@@ -550,8 +583,8 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto c = root.get("camera")) {
     c->allowKeys({"position", "look_at", "up", "fov_deg", "width", "height"});
     auto& cam = scene.camera;
-    if (auto v = c->get("position")) cam.position = v->vec3();
-    if (auto v = c->get("look_at")) cam.look_at = v->vec3();
+    if (auto v = c->get("position")) cam.position = v->position();
+    if (auto v = c->get("look_at")) cam.look_at = v->position();
     if (auto v = c->get("up")) cam.up = v->unitVector();
     if (auto v = c->get("fov_deg")) cam.fov_deg = v->number(0.0, 179.0, true);
     if (auto v = c->get("width")) cam.width = v->integer(1, 16384);
@@ -597,11 +630,24 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto v = root.get("volume")) {
     v->allowKeys({"bounds_min", "bounds_max", "resolution", "smoothing_voxels", "smoothing_method"});
     auto& vol = scene.volume;
-    if (auto b = v->get("bounds_min")) vol.bounds_min = b->vec3();
-    if (auto b = v->get("bounds_max")) vol.bounds_max = b->vec3();
+    if (auto b = v->get("bounds_min")) vol.bounds_min = b->position();
+    if (auto b = v->get("bounds_max")) vol.bounds_max = b->position();
     glm::dvec3 ext = vol.bounds_max - vol.bounds_min;
     if (!(ext.x > 0 && ext.y > 0 && ext.z > 0)) v->fail("bounds_max must exceed bounds_min on every axis");
     if (auto r = v->get("resolution")) vol.resolution = r->integer(4, 1 << 20);  // device limit checked at upload
+    const double h = std::max(ext.x, std::max(ext.y, ext.z)) / vol.resolution;
+    if (!(h >= kMinVoxelMm))
+      (v->has("resolution") ? v->at("resolution") : *v)
+          .fail("the voxel edge (longest side / resolution) is " + fmt(h) + " mm, below the smallest " +
+                fmt(kMinVoxelMm) + " mm; enlarge the bounds or lower the resolution");
+    const bool min_farther = glm::length(vol.bounds_min) > glm::length(vol.bounds_max);
+    const char* far_key = min_farther ? "bounds_min" : "bounds_max";
+    const double offset = glm::length(min_farther ? vol.bounds_min : vol.bounds_max) / h;
+    if (!(offset <= kMaxOffsetVoxels))
+      (v->has(far_key) ? v->at(far_key) : *v)
+          .fail("the volume reaches " + fmt(offset) + " voxels (of " + fmt(h) + " mm) from the origin; the GPU's " +
+                "single-precision positions resolve the grid only within " + fmt(kMaxOffsetVoxels) +
+                " voxels of it (move the scene towards the origin or lower the resolution)");
     if (auto s = v->get("smoothing_voxels")) vol.smoothing_voxels = s->number(0.0, 8.0);
     if (auto s = v->get("smoothing_method")) {
       std::string m = s->string();
@@ -620,6 +666,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
 
   auto objs = root.at("objects");
   if (!objs.isArray()) objs.fail("expected an array of objects");
+  std::set<size_t> covering;  // objects that cover the whole volume (warned about once)
   for (size_t i = 0; i < objs.size(); ++i) {
     Node o = objs.index(i);
     SceneObject obj = parseObject(o);
@@ -642,6 +689,30 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis && !obj.radial_axis)
       o.fail("uniaxial material '" + obj.material + "' needs an optic_axis (on the object or the material)");
     if (!mat.uniaxial && obj.optic_axis) o.at("optic_axis").fail("optic_axis given for an isotropic material");
+    {
+      // An object wholly outside the volume would vanish from the render, and one that covers it
+      // would fill it with no surface inside: neither may happen silently. The shape lies within
+      // its bounding sphere (exact for spheres), and every shape is convex, so it covers the box
+      // if it holds the box's 8 corners.
+      const auto& vol = scene.volume;
+      auto [lo, hi] = obj.shape.bounds();
+      const double r = 0.5 * (hi.x - lo.x);
+      const glm::dvec3 c = obj.shape.center();
+      if (glm::length(c - glm::clamp(c, vol.bounds_min, vol.bounds_max)) > r)
+        o.fail("the object lies entirely outside the volume " + box(vol) +
+               ", so nothing of it would be rendered; move it inside or enlarge the volume");
+      bool covers = true;
+      for (int corner = 0; corner < 8 && covers; ++corner)
+        covers = obj.shape.contains(glm::dvec3(corner & 1 ? vol.bounds_max.x : vol.bounds_min.x,
+                                               corner & 2 ? vol.bounds_max.y : vol.bounds_min.y,
+                                               corner & 4 ? vol.bounds_max.z : vol.bounds_min.z));
+      if (covers) {
+        scene.warnings.push_back(file + ": " + o.path() + ": the object covers the whole volume " + box(vol) +
+                                 ": it fills the volume and none of its surface is inside, so it bends no ray " +
+                                 "(shrink it or enlarge the volume)");
+        covering.insert(i);
+      }
+    }
     if (mat.grin.type != GrinProfile::Type::None) {
       // The profile must give n ≥ 1 wherever the object is inside the volume (sampled on a 17³
       // lattice of the overlap of its box with the volume).
@@ -680,7 +751,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
       bool refracts = mat.uniaxial || mat.grin.type != GrinProfile::Type::None;
       for (double l = 380.0; l <= 780.0 && !refracts; l += 40.0)
         refracts = std::abs(mat.n_o.index(l) - scene.ambient_index) > 1e-12;
-      if (!refracts) continue;
+      if (!refracts || covering.count(i)) continue;
       double closest = 1e300;
       for (int axis = 0; axis < 3; ++axis)
         for (int side = 0; side < 2; ++side)
