@@ -375,14 +375,57 @@ SceneObject parseObject(const Node& o) {
   return obj;
 }
 
+/// Parse JSON text, refusing a key that appears twice in one object (nlohmann keeps the last
+/// one silently): the parser callback sees every key event, and a stack of the open containers
+/// gives the JSON path of the duplicate. Syntax errors and numbers that overflow a double
+/// (1e999) are SceneErrors naming the file.
+json parseJson(const std::string& text, const std::string& file) {
+  struct Open {
+    bool array;
+    std::set<std::string> keys;
+    std::string key;  // object: the current key
+    long index = -1;  // array: the current element
+  };
+  std::vector<Open> open;
+  auto path = [&] {
+    std::string p;
+    for (const Open& f : open) p += "/" + (f.array ? std::to_string(f.index) : f.key);
+    return p;
+  };
+  auto element = [&] {
+    if (!open.empty() && open.back().array) ++open.back().index;
+  };
+  json::parser_callback_t cb = [&](int, json::parse_event_t ev, json& parsed) {
+    switch (ev) {
+      case json::parse_event_t::object_start: element(); open.push_back({false, {}, {}, -1}); break;
+      case json::parse_event_t::array_start: element(); open.push_back({true, {}, {}, -1}); break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end: open.pop_back(); break;
+      case json::parse_event_t::value: element(); break;
+      case json::parse_event_t::key: {
+        Open& f = open.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second)
+          throw SceneError(file + ": " + path() + ": duplicate key '" + f.key +
+                           "' (each key may appear once per object; which value was meant?)");
+        break;
+      }
+    }
+    return true;
+  };
+  try {
+    return json::parse(text, cb);
+  } catch (const json::exception& e) {  // parse errors and number overflow (1e999)
+    throw SceneError(file + ": malformed JSON: " + e.what());
+  }
+}
+
 json readJsonFile(const std::filesystem::path& path, const char* what) {
   std::ifstream in(path);
   if (!in) throw SceneError(path.string() + ": cannot open " + what);
-  try {
-    return json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw SceneError(path.string() + ": malformed JSON: " + e.what());
-  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parseJson(ss.str(), path.string());
 }
 
 }  // namespace
@@ -568,13 +611,8 @@ static Light parseLight(const Node& l) {
 }
 
 Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
-  json j;
   const std::string file = origin.string();
-  try {
-    j = json::parse(text);
-  } catch (const json::exception& e) {  // parse errors and number overflow (1e999)
-    throw SceneError(file + ": malformed JSON: " + e.what());
-  }
+  const json j = parseJson(text, file);
   Scene scene;
   scene.file = origin;
   Node root(j, "", file);
