@@ -709,6 +709,13 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     Node o = objs.index(i);
     SceneObject obj = parseObject(o);
     if (!scene.materials.count(obj.material)) {
+      // A library name is a file name inside a library directory, never a path: "../x" or
+      // "/abs/x" would read any JSON file on the machine.
+      const std::string& name = obj.material;
+      if (name.empty() || name == "." || name == ".." || name.find_first_of(std::string("/\\\0", 3)) != std::string::npos)
+        o.at("material").fail("material name '" + name + "' is not a plain name (no '/', '\\' or NUL, not '.' or " +
+                              "'..'): library materials are looked up inside the material library only; define " +
+                              "others under /materials");
       bool found = false;
       for (const auto& dir : materialSearchPath()) {
         auto p = dir / (obj.material + ".json");

@@ -105,5 +105,25 @@ TEST(SceneInput, DuplicateKeyInAMaterialFile) {
   EXPECT_EQ(m.rfind((lib.path() / "dup.json").string() + ": /attenuation_per_mm: duplicate key", 0), 0u) << m;
 }
 
+// ------------------------------------------------------------------ material names
+
+// "../x" from a library directory reaches a JSON file outside it: the name is refused before any
+// file is looked up (the file exists and is a valid material, so only the name check stops it).
+TEST(SceneInput, MaterialNamesAreNotPaths) {
+  TempDir root;
+  fs::create_directory(root.path() / "lib");
+  const fs::path outside = root.write("x.json", R"({"n": 1.7})");
+  ScopedEnv env("EIKON_MATERIALS_PATH", (root.path() / "lib").string());
+  const std::string abs = (root.path() / "x").string();  // + ".json" names the file above
+  for (const std::string& name : {std::string("../x"), abs, std::string("lib/../../x"), std::string(".."),
+                                   std::string("a\\\\b"), std::string("")}) {
+    EXPECT_INPUT_ERROR(R"({"objects": [{"shape": "sphere", "radius": 3, "material": ")" + name + R"("}]})",
+                       "/objects/0/material", "is not a plain name");
+  }
+  // The same material by its plain name from a library directory is found.
+  ScopedEnv env2("EIKON_MATERIALS_PATH", root.path().string());
+  EXPECT_NO_THROW(parseScene(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "x"}]})", kOrigin));
+}
+
 }  // namespace
 }  // namespace eikon
