@@ -66,7 +66,7 @@ class Node {
       if (!allowed.count(it.key())) {
         std::string list;
         for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
-        throw SceneError(file_ + ": " + path_ + "/" + it.key() + ": unknown key (allowed here: " + list + ")");
+        throw SceneError(file_ + ": " + path_ + "/" + excerpt(it.key()) + ": unknown key (allowed here: " + list + ")");
       }
   }
   bool has(const std::string& key) const { return j_.is_object() && j_.contains(key); }
@@ -233,6 +233,8 @@ Attenuation parseAttenuation(const Node& n) {
     if (a.wavelengths_nm.size() != a.values.size() || a.values.empty())
       n.fail("wavelength_nm and per_mm must have the same non-zero length");
     for (size_t i = 0; i < a.values.size(); ++i) {
+      if (!(a.wavelengths_nm[i] > 0))
+        n.at("wavelength_nm").index(i).fail("wavelengths must be > 0 nm, got " + fmt(a.wavelengths_nm[i]));
       if (a.values[i] < 0) n.fail("attenuation must be >= 0");
       if (i && !(a.wavelengths_nm[i] > a.wavelengths_nm[i - 1])) n.fail("wavelength_nm must be strictly increasing");
     }
@@ -308,7 +310,7 @@ SceneObject parseObject(const Node& o) {
       if (!allowed.count(it.key())) {
         std::string list;
         for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
-        o.fail("unknown key '" + it.key() + "' for shape '" + shape + "' (allowed: " + list + ")");
+        o.fail("unknown key '" + excerpt(it.key()) + "' for shape '" + excerpt(shape) + "' (allowed: " + list + ")");
       }
   };
   try {
@@ -358,7 +360,7 @@ SceneObject parseObject(const Node& o) {
     } else if (shape == "mesh") {
       o.at("shape").fail("shape 'mesh' is not supported yet (use planes for convex solids)");
     } else {
-      o.at("shape").fail("unknown shape '" + shape + "' (sphere, box, rounded_box, prism, brilliant, planes)");
+      o.at("shape").fail("unknown shape '" + excerpt(shape) + "' (sphere, box, rounded_box, prism, brilliant, planes)");
     }
   } catch (const std::invalid_argument& e) {
     o.fail(e.what());
@@ -369,7 +371,7 @@ SceneObject parseObject(const Node& o) {
   if (auto f = o.get("optic_axis_field")) {
     std::string kind = f->string();
     if (kind == "radial") obj.radial_axis = true;
-    else if (kind != "uniform") f->fail("unknown optic_axis_field '" + kind + "' (uniform, radial)");
+    else if (kind != "uniform") f->fail("unknown optic_axis_field '" + excerpt(kind) + "' (uniform, radial)");
     if (obj.radial_axis && obj.optic_axis) f->fail("give either optic_axis or optic_axis_field \"radial\", not both");
   }
   return obj;
@@ -389,7 +391,7 @@ json parseJson(const std::string& text, const std::string& file) {
   std::vector<Open> open;
   auto path = [&] {
     std::string p;
-    for (const Open& f : open) p += "/" + (f.array ? std::to_string(f.index) : f.key);
+    for (const Open& f : open) p += "/" + (f.array ? std::to_string(f.index) : excerpt(f.key));
     return p;
   };
   auto element = [&] {
@@ -406,7 +408,7 @@ json parseJson(const std::string& text, const std::string& file) {
         Open& f = open.back();
         f.key = parsed.get<std::string>();
         if (!f.keys.insert(f.key).second)
-          throw SceneError(file + ": " + path() + ": duplicate key '" + f.key +
+          throw SceneError(file + ": " + path() + ": duplicate key '" + excerpt(f.key) +
                            "' (each key may appear once per object; which value was meant?)");
         break;
       }
@@ -416,11 +418,19 @@ json parseJson(const std::string& text, const std::string& file) {
   try {
     return json::parse(text, cb);
   } catch (const json::exception& e) {  // parse errors and number overflow (1e999)
-    throw SceneError(file + ": malformed JSON: " + e.what());
+    throw SceneError(file + ": malformed JSON: " + printable(e.what(), 300));
   }
 }
 
+/// "FILE: is a directory, expected WHAT" when `path` is one (an ifstream opens a directory and
+/// then reads nothing, which read as an empty or malformed file).
+void refuseDirectory(const std::filesystem::path& path, const std::string& what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw SceneError(path.string() + ": is a directory, expected " + what);
+}
+
 json readJsonFile(const std::filesystem::path& path, const char* what) {
+  refuseDirectory(path, std::string("a ") + what);
   std::ifstream in(path);
   if (!in) throw SceneError(path.string() + ": cannot open " + what);
   std::stringstream ss;
@@ -579,7 +589,7 @@ static Light parseLight(const Node& l) {
       light.cone_half_angle_deg = l.at("cone_half_angle_deg").number(0.0, 90.0, true);
     }
   } else {
-    l.at("type").fail("unknown light type '" + type + "' (directional, point, spot)");
+    l.at("type").fail("unknown light type '" + excerpt(type) + "' (directional, point, spot)");
   }
   if (auto sp = l.get("spectrum")) {
     if (sp->isString()) {
@@ -588,7 +598,7 @@ static Light parseLight(const Node& l) {
         light.spectrum_nm = {380.0, 780.0};
         light.spectrum_power = {1.0, 1.0};
       } else if (name != "D65") {
-        sp->fail("unknown spectrum '" + name + "' (\"D65\", \"E\" or {\"wavelength_nm\": [...], \"power\": [...]})");
+        sp->fail("unknown spectrum '" + excerpt(name) + "' (\"D65\", \"E\" or {\"wavelength_nm\": [...], \"power\": [...]})");
       }
     } else {
       sp->allowKeys({"wavelength_nm", "power"});
@@ -598,6 +608,8 @@ static Light parseLight(const Node& l) {
         sp->fail("wavelength_nm and power must have the same length, at least 2");
       double total = 0;
       for (size_t k = 0; k < light.spectrum_nm.size(); ++k) {
+        if (!(light.spectrum_nm[k] > 0))
+          sp->at("wavelength_nm").index(k).fail("wavelengths must be > 0 nm, got " + fmt(light.spectrum_nm[k]));
         if (light.spectrum_power[k] < 0) sp->at("power").index(k).fail("must be >= 0");
         if (k && !(light.spectrum_nm[k] > light.spectrum_nm[k - 1]))
           sp->at("wavelength_nm").index(k).fail("wavelength_nm must be strictly increasing");
@@ -651,6 +663,9 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
       std::filesystem::path p = e->at("file").string();
       if (p.is_relative()) p = origin.parent_path() / p;
       env.image_path = p;
+      std::error_code ec;
+      if (std::filesystem::is_directory(p, ec))
+        e->at("file").fail(p.string() + ": is a directory, expected an EXR image");
       try {
         auto img = readExrRgba(p, 16384, 8192);
         env.image_width = img.width;
@@ -660,7 +675,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
         e->at("file").fail(ex.what());
       }
     } else {
-      e->at("type").fail("unknown environment type '" + type + "' (checker, constant, latlong)");
+      e->at("type").fail("unknown environment type '" + excerpt(type) + "' (checker, constant, latlong)");
     }
     if (auto v = e->get("intensity")) env.intensity = v->number(0.0, 1e9);
   }
@@ -691,7 +706,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
       std::string m = s->string();
       if (m == "analytic") vol.smoothing = VolumeSpec::Smoothing::Analytic;
       else if (m == "gaussian") vol.smoothing = VolumeSpec::Smoothing::Gaussian;
-      else s->fail("unknown smoothing_method '" + m + "' (analytic, gaussian)");
+      else s->fail("unknown smoothing_method '" + excerpt(m) + "' (analytic, gaussian)");
     }
   }
   if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
@@ -699,7 +714,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto ms = root.get("materials")) {
     ms->requireObject();
     for (auto it = ms->raw().begin(); it != ms->raw().end(); ++it)
-      scene.materials[it.key()] = parseMaterial(Node(it.value(), ms->path() + "/" + it.key(), file), it.key(), false);
+      scene.materials[it.key()] = parseMaterial(Node(it.value(), ms->path() + "/" + excerpt(it.key()), file), it.key(), false);
   }
 
   auto objs = root.at("objects");
@@ -713,7 +728,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
       // "/abs/x" would read any JSON file on the machine.
       const std::string& name = obj.material;
       if (name.empty() || name == "." || name == ".." || name.find_first_of(std::string("/\\\0", 3)) != std::string::npos)
-        o.at("material").fail("material name '" + name + "' is not a plain name (no '/', '\\' or NUL, not '.' or " +
+        o.at("material").fail("material name '" + excerpt(name) + "' is not a plain name (no '/', '\\' or NUL, not '.' or " +
                               "'..'): library materials are looked up inside the material library only; define " +
                               "others under /materials");
       bool found = false;
@@ -726,13 +741,13 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
         }
       }
       if (!found)
-        o.at("material").fail("unknown material '" + obj.material +
+        o.at("material").fail("unknown material '" + excerpt(obj.material) +
                               "' (not defined under /materials and not in the material library)");
     }
     const Material& mat = scene.materials[obj.material];
     if (obj.radial_axis && !mat.uniaxial) o.at("optic_axis_field").fail("optic_axis_field given for an isotropic material");
     if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis && !obj.radial_axis)
-      o.fail("uniaxial material '" + obj.material + "' needs an optic_axis (on the object or the material)");
+      o.fail("uniaxial material '" + excerpt(obj.material) + "' needs an optic_axis (on the object or the material)");
     if (!mat.uniaxial && obj.optic_axis) o.at("optic_axis").fail("optic_axis given for an isotropic material");
     {
       // An object wholly outside the volume would vanish from the render, and one that covers it
@@ -776,7 +791,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
               n = r2 <= 2.0 ? std::sqrt(2.0 - r2) : std::nan("");
             }
             if (!(n >= 1.0))
-              o.at("material").fail("gradient-index material '" + obj.material + "' gives n = " + fmt(n) +
+              o.at("material").fail("gradient-index material '" + excerpt(obj.material) + "' gives n = " + fmt(n) +
                                     ", below 1, inside this object at (" + fmt(p.x) + ", " + fmt(p.y) + ", " + fmt(p.z) + ")");
           }
     }
@@ -823,6 +838,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
 }
 
 Scene loadScene(const std::filesystem::path& path) {
+  refuseDirectory(path, "a scene file");
   std::ifstream in(path);
   if (!in) throw SceneError(path.string() + ": cannot open scene file");
   std::stringstream ss;
