@@ -5,6 +5,8 @@
 #include <cmath>
 #include <thread>
 
+#include "core/volume/host_memory.h"
+
 namespace eikon {
 namespace {
 
@@ -112,6 +114,23 @@ void gaussianSmooth(std::vector<float>& f, const std::array<int, 3>& dims, doubl
   }
 }
 
+double voxelizeHostBytes(const Scene& scene, const Grid& g) {
+  // Per voxel, everything voxelize() holds at once near its end (the smoothing's and the axis
+  // dilation's temporaries included).
+  const bool uniaxial = scene.anyUniaxial();
+  bool scattering = false;
+  for (const auto& [name, m] : scene.materials) scattering = scattering || m.albedo != glm::dvec3(0.0);
+  const bool analytic = scene.volume.smoothing_voxels > 0 && scene.volume.smoothing == VolumeSpec::Smoothing::Analytic;
+  double per_voxel = kFieldCount * sizeof(float);                              // composited fields
+  per_voxel += analytic ? 6 * sizeof(glm::vec3) : sizeof(float);              // exact gradients / smoothing
+  per_voxel += (uniaxial ? 6 : 3) * sizeof(glm::vec4);                        // index volumes
+  per_voxel += (uniaxial ? 2 : 1) * sizeof(glm::vec4);                        // medium volumes
+  per_voxel += sizeof(glm::vec4) + (scattering ? sizeof(glm::vec4) : 0);       // emission, scatter
+  per_voxel += uniaxial ? 2 * sizeof(glm::vec4) : 0;                          // axis and its dilation copy
+  per_voxel += 2 * sizeof(uint8_t);                                           // skip distances
+  return per_voxel * double(g.dims[0]) * double(g.dims[1]) * double(g.dims[2]);
+}
+
 VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
   auto progress = [&](double x, const char* stage) {
     if (opt.progress) opt.progress(x, stage);
@@ -122,6 +141,15 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
   if (double(g.dims[0]) * g.dims[1] * g.dims[2] > double(1u << 31))
     throw SceneError(scene.file.string() + ": /volume/resolution: " + std::to_string(g.dims[0]) + "x" +
                      std::to_string(g.dims[1]) + "x" + std::to_string(g.dims[2]) + " voxels is too many");
+  {
+    const double need = voxelizeHostBytes(scene, g);
+    const HostMemory mem = availableHostMemory();
+    if (need > double(mem.available))
+      throw SceneError(scene.file.string() + ": /volume/resolution: voxelising " + std::to_string(g.dims[0]) + "x" +
+                       std::to_string(g.dims[1]) + "x" + std::to_string(g.dims[2]) + " voxels needs " +
+                       formatBytes(need) + " of host memory, " + formatBytes(double(mem.available)) +
+                       " available (" + mem.limited_by + "); lower the resolution");
+  }
   const size_t N = g.count();
   vs.uniaxial = scene.anyUniaxial();
   vs.ambient_index = scene.ambient_index;

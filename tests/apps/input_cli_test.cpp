@@ -81,4 +81,18 @@ TEST_F(InputCli, DirectoryAsSceneSaysSo) {
   expectOneCleanLine(trace((dir_ / "scene.json").string()), "scene.json: is a directory, expected a scene file");
 }
 
+// ------------------------------------------------------------------ host memory
+
+// Under `prlimit --as` (1.5 GB of address space) a 256³ volume (≈ 3.9 GB for the voxeliser) is
+// refused with the numbers and the limit, not with std::bad_alloc.
+TEST_F(InputCli, HostMemoryIsCheckedBeforeVoxelising) {
+  const std::string scene = write("big.json", R"({"volume": {"bounds_min": [-12, -12, -12], "bounds_max": [12, 12, 12],
+      "resolution": 256}, "materials": {"glass": {"n": 1.5}},
+      "objects": [{"shape": "sphere", "radius": 5, "material": "glass"}]})");
+  const Outcome r = trace(scene, "prlimit --as=1500000000");
+  expectOneCleanLine(r, "/volume/resolution: voxelising 256x256x256 voxels needs ");
+  EXPECT_NE(r.err.find(" GiB of host memory, "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("available (RLIMIT_AS)"), std::string::npos) << r.err;
+}
+
 }  // namespace
