@@ -5,10 +5,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "core/io/exr.h"
 #include "tests/apps/cli_support.h"
 
 namespace {
@@ -93,6 +95,60 @@ TEST_F(InputCli, HostMemoryIsCheckedBeforeVoxelising) {
   expectOneCleanLine(r, "/volume/resolution: voxelising 256x256x256 voxels needs ");
   EXPECT_NE(r.err.find(" GiB of host memory, "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("available (RLIMIT_AS)"), std::string::npos) << r.err;
+}
+
+// ------------------------------------------------------------------ light cache
+
+// A cached light file whose payload is overwritten at the same size (NaN, huge values and random
+// bytes) fails its checksum: the light is simulated again with a one-line warning, and the
+// picture is the first one exactly (the simulation is deterministic), so finite. The rewritten
+// entry is then used.
+TEST_F(InputCli, CorruptedLightCacheIsSimulatedAgain) {
+  const std::string scene = write("lit.json", R"({
+  "camera": {"position": [0, 20, -20], "look_at": [0, -2, 0], "up": [0, 1, 0], "fov_deg": 30, "width": 24, "height": 16},
+  "environment": {"type": "constant", "radiance": 0.1},
+  "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "resolution": 24},
+  "materials": {"glass": {"n": 1.5}, "floor": {"n": 1, "opacity": 1, "albedo": 0.8}},
+  "objects": [{"shape": "box", "center": [0, -3.5, 0], "size": [8, 1, 8], "material": "floor"},
+              {"shape": "sphere", "center": [0, 0.5, 0], "radius": 2.5, "material": "glass"}],
+  "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 2}]
+})");
+  const fs::path cache = dir_ / "cache", exr = dir_ / "out.exr";
+  const std::string args = "render --reference -q --caustics kill --light-cache " + quote(cache.string()) + " " +
+                           quote(scene) + " -o " + quote(exr.string());
+  const Outcome first = run(args);
+  ASSERT_EQ(first.code, 0) << first.err;
+  ASSERT_NE(first.out.find("simulated 1 light runs"), std::string::npos) << first.out;
+  const std::vector<float> a = eikon::readExrRgba(exr, 64, 64).rgba;
+  fs::path entry;
+  for (const auto& e : fs::directory_iterator(cache)) entry = e.path();
+  ASSERT_FALSE(entry.empty());
+  const auto size = fs::file_size(entry);
+  {
+    std::fstream f(entry, std::ios::in | std::ios::out | std::ios::binary);
+    const float bad[4] = {std::nanf(""), 3e38f, -1e30f, 1e-40f};
+    f.seekp(std::streamoff(size / 2));
+    for (int k = 0; k < 64; ++k) f.write(reinterpret_cast<const char*>(bad), sizeof bad);
+    f.seekp(std::streamoff(size - 100));
+    for (int k = 0; k < 50; ++k) f.put(char(37 * k + 11));
+  }
+  ASSERT_EQ(fs::file_size(entry), size);
+  const Outcome second = run(args);
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_EQ(std::count(second.err.begin(), second.err.end(), '\n'), 1) << second.err;
+  EXPECT_NE(second.err.find("eikon: warning: light cache: "), std::string::npos) << second.err;
+  EXPECT_NE(second.err.find("is corrupted (checksum mismatch); simulating the light again"), std::string::npos)
+      << second.err;
+  EXPECT_NE(second.out.find("simulated 1 light runs"), std::string::npos) << second.out;
+  EXPECT_EQ(second.out.find("from the cache"), std::string::npos) << second.out;
+  const std::vector<float> b = eikon::readExrRgba(exr, 64, 64).rgba;
+  for (float v : b) ASSERT_TRUE(std::isfinite(v));
+  EXPECT_EQ(a, b);
+  const Outcome third = run(args);
+  ASSERT_EQ(third.code, 0) << third.err;
+  EXPECT_TRUE(third.err.empty()) << third.err;
+  EXPECT_NE(third.out.find("from the cache"), std::string::npos) << third.out;
+  EXPECT_EQ(eikon::readExrRgba(exr, 64, 64).rgba, a);
 }
 
 }  // namespace
