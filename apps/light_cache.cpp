@@ -51,7 +51,8 @@ class Hasher {
 };
 
 /// The header's checksum of the two light volumes (the hash above, over their bytes).
-uint64_t payloadChecksum(const std::vector<glm::vec4>& fluence, const std::vector<glm::vec4>& flux) {
+uint64_t payloadChecksum(const std::vector<glm::vec4>& fluence,
+                         const std::vector<glm::vec4>& flux) {
   Hasher h;
   h.vec(fluence);
   h.vec(flux);
@@ -115,7 +116,8 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOpt
   return h.digest();
 }
 
-bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& volume, std::string* notice) {
+bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& volume,
+                    std::string* notice) {
   if (dir.empty()) return false;
   const std::filesystem::path path = entryPath(dir, key);
   std::ifstream in(path, std::ios::binary);
@@ -135,7 +137,8 @@ bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& v
   in.read(reinterpret_cast<char*>(dims.data()), sizeof dims);
   in.read(reinterpret_cast<char*>(&checksum), sizeof checksum);
   if (!in) return corrupted("truncated header");
-  if (stored_key != key || dims != volume.grid.dims) return corrupted("header does not match its name");
+  if (stored_key != key || dims != volume.grid.dims)
+    return corrupted("header does not match its name");
   const size_t N = volume.grid.count();
   std::vector<glm::vec4> fluence(N), flux(N);
   in.read(reinterpret_cast<char*>(fluence.data()), std::streamsize(N * sizeof(glm::vec4)));

@@ -30,7 +30,8 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& volume, const Lighti
 /// that exists but is corrupted (bad magic, truncated, wrong size, checksum mismatch) also gives
 /// false, and a one-line `notice` for the user; a missing entry or one written by another format
 /// version gives none.
-bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& volume, std::string* notice = nullptr);
+bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& volume,
+                    std::string* notice = nullptr);
 /// Store volume.light_* (atomically: temporary file, then rename). Failures are returned as a
 /// message (empty on success), not thrown: a cache that cannot be written only costs time.
 std::string saveLightCache(const std::filesystem::path& dir, uint64_t key, const VolumeSet& volume);

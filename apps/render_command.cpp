@@ -148,7 +148,8 @@ void addRenderCommand(CLI::App& app) {
       const uint64_t key = a.no_light_cache ? 0 : lightCacheKey(scene, volume, lo, light_on_cpu);
       std::string cache_notice;
       const bool hit = !a.no_light_cache && loadLightCache(cache_dir, key, volume, &cache_notice);
-      if (!cache_notice.empty()) std::fprintf(stderr, "eikon: warning: light cache: %s\n", printable(cache_notice).c_str());
+      if (!cache_notice.empty())
+        std::fprintf(stderr, "eikon: warning: light cache: %s\n", printable(cache_notice).c_str());
       if (hit) {
         light_cached = true;
       } else {

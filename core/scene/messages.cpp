@@ -13,18 +13,23 @@ size_t printableUtf8(std::string_view s, size_t i) {
   const unsigned char c = b(i);
   size_t n;
   char32_t cp;
-  if (c >= 0xC2 && c <= 0xDF) n = 2, cp = c & 0x1F;
-  else if (c >= 0xE0 && c <= 0xEF) n = 3, cp = c & 0x0F;
-  else if (c >= 0xF0 && c <= 0xF4) n = 4, cp = c & 0x07;
-  else return 0;
+  if (c >= 0xC2 && c <= 0xDF)
+    n = 2, cp = c & 0x1F;
+  else if (c >= 0xE0 && c <= 0xEF)
+    n = 3, cp = c & 0x0F;
+  else if (c >= 0xF0 && c <= 0xF4)
+    n = 4, cp = c & 0x07;
+  else
+    return 0;
   if (i + n > s.size()) return 0;
   for (size_t k = 1; k < n; ++k) {
     if ((b(i + k) & 0xC0) != 0x80) return 0;
     cp = (cp << 6) | (b(i + k) & 0x3F);
   }
-  if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10FFFF))) return 0;  // overlong, range
-  if (cp >= 0xD800 && cp <= 0xDFFF) return 0;                                         // surrogates
-  if (cp >= 0x80 && cp <= 0x9F) return 0;                                             // C1 controls
+  // Overlong forms and code points beyond Unicode, surrogates, C1 controls.
+  if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10FFFF))) return 0;
+  if (cp >= 0xD800 && cp <= 0xDFFF) return 0;
+  if (cp >= 0x80 && cp <= 0x9F) return 0;
   return n;
 }
 
@@ -57,6 +62,8 @@ std::string printable(std::string_view text, size_t max_bytes) {
   return out;
 }
 
-std::string errorLine(std::string_view message) { return "eikon: error: " + printable(message) + "\n"; }
+std::string errorLine(std::string_view message) {
+  return "eikon: error: " + printable(message) + "\n";
+}
 
 }  // namespace eikon

@@ -37,7 +37,9 @@ std::string fmt(double v) {
 }
 
 std::string box(const VolumeSpec& v) {
-  auto p = [](const glm::dvec3& x) { return "(" + fmt(x.x) + ", " + fmt(x.y) + ", " + fmt(x.z) + ")"; };
+  auto p = [](const glm::dvec3& x) {
+    return "(" + fmt(x.x) + ", " + fmt(x.y) + ", " + fmt(x.z) + ")";
+  };
   return p(v.bounds_min) + " to " + p(v.bounds_max) + " mm";
 }
 
@@ -66,7 +68,8 @@ class Node {
       if (!allowed.count(it.key())) {
         std::string list;
         for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
-        throw SceneError(file_ + ": " + path_ + "/" + excerpt(it.key()) + ": unknown key (allowed here: " + list + ")");
+        throw SceneError(file_ + ": " + path_ + "/" + excerpt(it.key()) +
+                         ": unknown key (allowed here: " + list + ")");
       }
   }
   bool has(const std::string& key) const { return j_.is_object() && j_.contains(key); }
@@ -138,7 +141,8 @@ class Node {
   /// A length (mm) in (0, kMaxCoordinateMm].
   double length() const {
     double v = positive();
-    if (v > kMaxCoordinateMm) fail("must be at most " + fmt(kMaxCoordinateMm) + " mm, got " + fmt(v));
+    if (v > kMaxCoordinateMm)
+      fail("must be at most " + fmt(kMaxCoordinateMm) + " mm, got " + fmt(v));
     return v;
   }
   glm::dvec3 unitVector() const {
@@ -234,7 +238,9 @@ Attenuation parseAttenuation(const Node& n) {
       n.fail("wavelength_nm and per_mm must have the same non-zero length");
     for (size_t i = 0; i < a.values.size(); ++i) {
       if (!(a.wavelengths_nm[i] > 0))
-        n.at("wavelength_nm").index(i).fail("wavelengths must be > 0 nm, got " + fmt(a.wavelengths_nm[i]));
+        n.at("wavelength_nm")
+            .index(i)
+            .fail("wavelengths must be > 0 nm, got " + fmt(a.wavelengths_nm[i]));
       if (a.values[i] < 0) n.fail("attenuation must be >= 0");
       if (i && !(a.wavelengths_nm[i] > a.wavelengths_nm[i - 1])) n.fail("wavelength_nm must be strictly increasing");
     }
@@ -310,7 +316,8 @@ SceneObject parseObject(const Node& o) {
       if (!allowed.count(it.key())) {
         std::string list;
         for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
-        o.fail("unknown key '" + excerpt(it.key()) + "' for shape '" + excerpt(shape) + "' (allowed: " + list + ")");
+        o.fail("unknown key '" + excerpt(it.key()) + "' for shape '" + excerpt(shape) +
+               "' (allowed: " + list + ")");
       }
   };
   try {
@@ -331,10 +338,12 @@ SceneObject parseObject(const Node& o) {
       g = RoundedBoxShape{s, r};
     } else if (shape == "prism") {
       allow({"apex_deg", "side", "height"});
-      g = makePrism(o.at("apex_deg").number(0.0, 180.0, true), o.at("side").length(), o.at("height").length());
+      g = makePrism(o.at("apex_deg").number(0.0, 180.0, true), o.at("side").length(),
+                    o.at("height").length());
     } else if (shape == "brilliant") {
       allow({"diameter", "table", "crown_deg", "pavilion_deg", "girdle", "facets"});
-      g = makeBrilliant(o.at("diameter").length(), o.get("table") ? o.at("table").number(0.0, 1.0, true) : 0.57,
+      g = makeBrilliant(o.at("diameter").length(),
+                        o.get("table") ? o.at("table").number(0.0, 1.0, true) : 0.57,
                         o.get("crown_deg") ? o.at("crown_deg").number() : 34.5,
                         o.get("pavilion_deg") ? o.at("pavilion_deg").number() : 40.75,
                         o.get("girdle") ? o.at("girdle").number(0.0, 0.5) : 0.02,
@@ -351,8 +360,8 @@ SceneObject parseObject(const Node& o) {
         double len = glm::length(n);
         if (!(len > 1e-12)) p.index(i).fail("plane normal must be non-zero");
         if (!(std::abs(v[3] / len) <= kMaxCoordinateMm))
-          p.index(i).fail("the plane's distance d/|n| from the centre must be within ±" + fmt(kMaxCoordinateMm) +
-                          " mm, got " + fmt(v[3] / len));
+          p.index(i).fail("the plane's distance d/|n| from the centre must be within ±" +
+                          fmt(kMaxCoordinateMm) + " mm, got " + fmt(v[3] / len));
         c.planes.push_back({n / len, v[3] / len});
       }
       finishConvex(c);
@@ -360,7 +369,8 @@ SceneObject parseObject(const Node& o) {
     } else if (shape == "mesh") {
       o.at("shape").fail("shape 'mesh' is not supported yet (use planes for convex solids)");
     } else {
-      o.at("shape").fail("unknown shape '" + excerpt(shape) + "' (sphere, box, rounded_box, prism, brilliant, planes)");
+      o.at("shape").fail("unknown shape '" + excerpt(shape) +
+                         "' (sphere, box, rounded_box, prism, brilliant, planes)");
     }
   } catch (const std::invalid_argument& e) {
     o.fail(e.what());
@@ -371,7 +381,8 @@ SceneObject parseObject(const Node& o) {
   if (auto f = o.get("optic_axis_field")) {
     std::string kind = f->string();
     if (kind == "radial") obj.radial_axis = true;
-    else if (kind != "uniform") f->fail("unknown optic_axis_field '" + excerpt(kind) + "' (uniform, radial)");
+    else if (kind != "uniform")
+      f->fail("unknown optic_axis_field '" + excerpt(kind) + "' (uniform, radial)");
     if (obj.radial_axis && obj.optic_axis) f->fail("give either optic_axis or optic_axis_field \"radial\", not both");
   }
   return obj;
@@ -399,11 +410,21 @@ json parseJson(const std::string& text, const std::string& file) {
   };
   json::parser_callback_t cb = [&](int, json::parse_event_t ev, json& parsed) {
     switch (ev) {
-      case json::parse_event_t::object_start: element(); open.push_back({false, {}, {}, -1}); break;
-      case json::parse_event_t::array_start: element(); open.push_back({true, {}, {}, -1}); break;
+      case json::parse_event_t::object_start:
+        element();
+        open.push_back({false, {}, {}, -1});
+        break;
+      case json::parse_event_t::array_start:
+        element();
+        open.push_back({true, {}, {}, -1});
+        break;
       case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end: open.pop_back(); break;
-      case json::parse_event_t::value: element(); break;
+      case json::parse_event_t::array_end:
+        open.pop_back();
+        break;
+      case json::parse_event_t::value:
+        element();
+        break;
       case json::parse_event_t::key: {
         Open& f = open.back();
         f.key = parsed.get<std::string>();
@@ -426,7 +447,8 @@ json parseJson(const std::string& text, const std::string& file) {
 /// then reads nothing, which read as an empty or malformed file).
 void refuseDirectory(const std::filesystem::path& path, const std::string& what) {
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw SceneError(path.string() + ": is a directory, expected " + what);
+  if (std::filesystem::is_directory(path, ec))
+    throw SceneError(path.string() + ": is a directory, expected " + what);
 }
 
 json readJsonFile(const std::filesystem::path& path, const char* what) {
@@ -598,7 +620,8 @@ static Light parseLight(const Node& l) {
         light.spectrum_nm = {380.0, 780.0};
         light.spectrum_power = {1.0, 1.0};
       } else if (name != "D65") {
-        sp->fail("unknown spectrum '" + excerpt(name) + "' (\"D65\", \"E\" or {\"wavelength_nm\": [...], \"power\": [...]})");
+        sp->fail("unknown spectrum '" + excerpt(name) +
+                 "' (\"D65\", \"E\" or {\"wavelength_nm\": [...], \"power\": [...]})");
       }
     } else {
       sp->allowKeys({"wavelength_nm", "power"});
@@ -609,7 +632,9 @@ static Light parseLight(const Node& l) {
       double total = 0;
       for (size_t k = 0; k < light.spectrum_nm.size(); ++k) {
         if (!(light.spectrum_nm[k] > 0))
-          sp->at("wavelength_nm").index(k).fail("wavelengths must be > 0 nm, got " + fmt(light.spectrum_nm[k]));
+          sp->at("wavelength_nm")
+              .index(k)
+              .fail("wavelengths must be > 0 nm, got " + fmt(light.spectrum_nm[k]));
         if (light.spectrum_power[k] < 0) sp->at("power").index(k).fail("must be >= 0");
         if (k && !(light.spectrum_nm[k] > light.spectrum_nm[k - 1]))
           sp->at("wavelength_nm").index(k).fail("wavelength_nm must be strictly increasing");
@@ -675,7 +700,8 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
         e->at("file").fail(ex.what());
       }
     } else {
-      e->at("type").fail("unknown environment type '" + excerpt(type) + "' (checker, constant, latlong)");
+      e->at("type").fail("unknown environment type '" + excerpt(type) +
+                         "' (checker, constant, latlong)");
     }
     if (auto v = e->get("intensity")) env.intensity = v->number(0.0, 1e9);
   }
@@ -691,14 +717,16 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     const double h = std::max(ext.x, std::max(ext.y, ext.z)) / vol.resolution;
     if (!(h >= kMinVoxelMm))
       (v->has("resolution") ? v->at("resolution") : *v)
-          .fail("the voxel edge (longest side / resolution) is " + fmt(h) + " mm, below the smallest " +
-                fmt(kMinVoxelMm) + " mm; enlarge the bounds or lower the resolution");
+          .fail("the voxel edge (longest side / resolution) is " + fmt(h) +
+                " mm, below the smallest " + fmt(kMinVoxelMm) +
+                " mm; enlarge the bounds or lower the resolution");
     const bool min_farther = glm::length(vol.bounds_min) > glm::length(vol.bounds_max);
     const char* far_key = min_farther ? "bounds_min" : "bounds_max";
     const double offset = glm::length(min_farther ? vol.bounds_min : vol.bounds_max) / h;
     if (!(offset <= kMaxOffsetVoxels))
       (v->has(far_key) ? v->at(far_key) : *v)
-          .fail("the volume reaches " + fmt(offset) + " voxels (of " + fmt(h) + " mm) from the origin; the GPU's " +
+          .fail("the volume reaches " + fmt(offset) + " voxels (of " + fmt(h) +
+                " mm) from the origin; the GPU's " +
                 "single-precision positions resolve the grid only within " + fmt(kMaxOffsetVoxels) +
                 " voxels of it (move the scene towards the origin or lower the resolution)");
     if (auto s = v->get("smoothing_voxels")) vol.smoothing_voxels = s->number(0.0, 8.0);
@@ -706,7 +734,8 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
       std::string m = s->string();
       if (m == "analytic") vol.smoothing = VolumeSpec::Smoothing::Analytic;
       else if (m == "gaussian") vol.smoothing = VolumeSpec::Smoothing::Gaussian;
-      else s->fail("unknown smoothing_method '" + excerpt(m) + "' (analytic, gaussian)");
+      else
+        s->fail("unknown smoothing_method '" + excerpt(m) + "' (analytic, gaussian)");
     }
   }
   if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
@@ -714,7 +743,8 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto ms = root.get("materials")) {
     ms->requireObject();
     for (auto it = ms->raw().begin(); it != ms->raw().end(); ++it)
-      scene.materials[it.key()] = parseMaterial(Node(it.value(), ms->path() + "/" + excerpt(it.key()), file), it.key(), false);
+      scene.materials[it.key()] = parseMaterial(
+          Node(it.value(), ms->path() + "/" + excerpt(it.key()), file), it.key(), false);
   }
 
   auto objs = root.at("objects");
@@ -727,10 +757,14 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
       // A library name is a file name inside a library directory, never a path: "../x" or
       // "/abs/x" would read any JSON file on the machine.
       const std::string& name = obj.material;
-      if (name.empty() || name == "." || name == ".." || name.find_first_of(std::string("/\\\0", 3)) != std::string::npos)
-        o.at("material").fail("material name '" + excerpt(name) + "' is not a plain name (no '/', '\\' or NUL, not '.' or " +
-                              "'..'): library materials are looked up inside the material library only; define " +
-                              "others under /materials");
+      if (name.empty() || name == "." || name == ".." ||
+          name.find_first_of(std::string("/\\\0", 3)) != std::string::npos)
+        o.at("material")
+            .fail(
+                "material name '" + excerpt(name) +
+                "' is not a plain name (no '/', '\\' or NUL, not '.' or " +
+                "'..'): library materials are looked up inside the material library only; define " +
+                "others under /materials");
       bool found = false;
       for (const auto& dir : materialSearchPath()) {
         auto p = dir / (obj.material + ".json");
@@ -741,13 +775,15 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
         }
       }
       if (!found)
-        o.at("material").fail("unknown material '" + excerpt(obj.material) +
-                              "' (not defined under /materials and not in the material library)");
+        o.at("material")
+            .fail("unknown material '" + excerpt(obj.material) +
+                  "' (not defined under /materials and not in the material library)");
     }
     const Material& mat = scene.materials[obj.material];
     if (obj.radial_axis && !mat.uniaxial) o.at("optic_axis_field").fail("optic_axis_field given for an isotropic material");
     if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis && !obj.radial_axis)
-      o.fail("uniaxial material '" + excerpt(obj.material) + "' needs an optic_axis (on the object or the material)");
+      o.fail("uniaxial material '" + excerpt(obj.material) +
+             "' needs an optic_axis (on the object or the material)");
     if (!mat.uniaxial && obj.optic_axis) o.at("optic_axis").fail("optic_axis given for an isotropic material");
     {
       // An object wholly outside the volume would vanish from the render, and one that covers it
@@ -767,9 +803,10 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
                                                corner & 2 ? vol.bounds_max.y : vol.bounds_min.y,
                                                corner & 4 ? vol.bounds_max.z : vol.bounds_min.z));
       if (covers) {
-        scene.warnings.push_back(file + ": " + o.path() + ": the object covers the whole volume " + box(vol) +
-                                 ": it fills the volume and none of its surface is inside, so it bends no ray " +
-                                 "(shrink it or enlarge the volume)");
+        scene.warnings.push_back(
+            file + ": " + o.path() + ": the object covers the whole volume " + box(vol) +
+            ": it fills the volume and none of its surface is inside, so it bends no ray " +
+            "(shrink it or enlarge the volume)");
         covering.insert(i);
       }
     }
@@ -791,8 +828,10 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
               n = r2 <= 2.0 ? std::sqrt(2.0 - r2) : std::nan("");
             }
             if (!(n >= 1.0))
-              o.at("material").fail("gradient-index material '" + excerpt(obj.material) + "' gives n = " + fmt(n) +
-                                    ", below 1, inside this object at (" + fmt(p.x) + ", " + fmt(p.y) + ", " + fmt(p.z) + ")");
+              o.at("material")
+                  .fail("gradient-index material '" + excerpt(obj.material) +
+                        "' gives n = " + fmt(n) + ", below 1, inside this object at (" + fmt(p.x) +
+                        ", " + fmt(p.y) + ", " + fmt(p.z) + ")");
           }
     }
     scene.objects.push_back(std::move(obj));

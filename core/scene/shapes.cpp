@@ -131,12 +131,13 @@ void finishConvex(ConvexShape& shape) {
   // planes' distances from the centre, which is treated the same way).
   double dmax = 0.0;
   for (const auto& pl : P) dmax = std::max(dmax, std::abs(pl.d));
-  const double L = 1e6 * (1.0 + dmax);    // half-size of the starting square
+  const double L = 1e6 * (1.0 + dmax);     // half-size of the starting square
   const double tol = 1e-9 * (1.0 + dmax);  // on-plane tolerance (the old vertex test's)
   const std::string unbounded = "the planes do not enclose a bounded solid";
   struct V {
     glm::dvec2 p;
-    long line;  // the plane whose line the edge from this vertex to the next lies on; -1: the square
+    // The plane whose line the edge from this vertex to the next lies on; -1: the square's edge.
+    long line;
   };
   std::vector<V> poly, next;
   double r = 0.0, volume = 0.0;
@@ -150,7 +151,8 @@ void finishConvex(ConvexShape& shape) {
     poly = {{{-L, -L}, -1}, {{L, -L}, -1}, {{L, L}, -1}, {{-L, L}, -1}};
     // Plane j as the line a·(u, v) ≤ c of plane i's frame: n_j·(o + u e1 + v e2) ≤ d_j.
     auto line = [&](size_t j) {
-      return std::pair(glm::dvec2(glm::dot(P[j].normal, e1), glm::dot(P[j].normal, e2)), P[j].d - glm::dot(P[j].normal, o));
+      return std::pair(glm::dvec2(glm::dot(P[j].normal, e1), glm::dot(P[j].normal, e2)),
+                       P[j].d - glm::dot(P[j].normal, o));
     };
     for (size_t j = 0; j < P.size() && !poly.empty(); ++j) {
       if (j == i) continue;

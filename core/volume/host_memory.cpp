@@ -68,7 +68,8 @@ void considerCgroups(HostMemory& m) {
       const double limit = cgroupNumber(d / limit_file);
       if (limit > 0 && limit < 1e18) {  // v1 writes ~2^63 for "no limit"
         const double usage = cgroupNumber(d / usage_file);
-        consider(m, limit - std::max(usage, 0.0), std::string("cgroup ") + (d / limit_file).string());
+        consider(m, limit - std::max(usage, 0.0),
+                 std::string("cgroup ") + (d / limit_file).string());
       }
       if (dir.empty()) break;
     }
@@ -98,8 +99,10 @@ HostMemory availableHostMemory() {
 
 std::string formatBytes(double bytes) {
   char s[32];
-  if (bytes >= double(1ull << 30)) std::snprintf(s, sizeof s, "%.1f GiB", bytes / double(1ull << 30));
-  else std::snprintf(s, sizeof s, "%.0f MiB", bytes / double(1ull << 20));
+  if (bytes >= double(1ull << 30))
+    std::snprintf(s, sizeof s, "%.1f GiB", bytes / double(1ull << 30));
+  else
+    std::snprintf(s, sizeof s, "%.0f MiB", bytes / double(1ull << 20));
   return s;
 }
 

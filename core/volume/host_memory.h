@@ -10,7 +10,7 @@ namespace eikon {
 
 struct HostMemory {
   uint64_t available = UINT64_MAX;  ///< bytes; UINT64_MAX if nothing could be read
-  std::string limited_by;           ///< which limit gave `available` ("MemAvailable", "RLIMIT_AS", ...)
+  std::string limited_by;  ///< which limit gave `available` ("MemAvailable", "RLIMIT_AS", ...)
 };
 
 /// The least of: MemAvailable (/proc/meminfo); the soft RLIMIT_AS minus the address space in use

@@ -45,7 +45,8 @@ struct MaterialValues {
 // The clamping is done in double before converting to int: an object far outside the volume
 // (centre 1e300, or 4294967296 mm) gives voxel coordinates beyond int's range, whose conversion
 // is undefined behaviour (UBSan: signed overflow). False if the box misses the grid (or is NaN).
-bool voxelRange(const glm::dvec3& bmin, const glm::dvec3& bmax, const Grid& g, int margin, int lo[3], int hi[3]) {
+bool voxelRange(const glm::dvec3& bmin, const glm::dvec3& bmax, const Grid& g, int margin,
+                int lo[3], int hi[3]) {
   for (int a = 0; a < 3; ++a) {
     const double top = double(g.dims[a] - 1);
     double l = std::floor((bmin[a] - g.origin[a]) / g.h) - margin;
@@ -119,15 +120,17 @@ double voxelizeHostBytes(const Scene& scene, const Grid& g) {
   // dilation's temporaries included).
   const bool uniaxial = scene.anyUniaxial();
   bool scattering = false;
-  for (const auto& [name, m] : scene.materials) scattering = scattering || m.albedo != glm::dvec3(0.0);
-  const bool analytic = scene.volume.smoothing_voxels > 0 && scene.volume.smoothing == VolumeSpec::Smoothing::Analytic;
-  double per_voxel = kFieldCount * sizeof(float);                              // composited fields
-  per_voxel += analytic ? 6 * sizeof(glm::vec3) : sizeof(float);              // exact gradients / smoothing
-  per_voxel += (uniaxial ? 6 : 3) * sizeof(glm::vec4);                        // index volumes
-  per_voxel += (uniaxial ? 2 : 1) * sizeof(glm::vec4);                        // medium volumes
-  per_voxel += sizeof(glm::vec4) + (scattering ? sizeof(glm::vec4) : 0);       // emission, scatter
-  per_voxel += uniaxial ? 2 * sizeof(glm::vec4) : 0;                          // axis and its dilation copy
-  per_voxel += 2 * sizeof(uint8_t);                                           // skip distances
+  for (const auto& [name, m] : scene.materials)
+    scattering = scattering || m.albedo != glm::dvec3(0.0);
+  const bool analytic = scene.volume.smoothing_voxels > 0 &&
+                        scene.volume.smoothing == VolumeSpec::Smoothing::Analytic;
+  double per_voxel = kFieldCount * sizeof(float);                 // composited fields
+  per_voxel += analytic ? 6 * sizeof(glm::vec3) : sizeof(float);  // exact gradients / smoothing
+  per_voxel += (uniaxial ? 6 : 3) * sizeof(glm::vec4);            // index volumes
+  per_voxel += (uniaxial ? 2 : 1) * sizeof(glm::vec4);            // medium volumes
+  per_voxel += sizeof(glm::vec4) + (scattering ? sizeof(glm::vec4) : 0);  // emission, scatter
+  per_voxel += uniaxial ? 2 * sizeof(glm::vec4) : 0;  // axis and its dilation copy
+  per_voxel += 2 * sizeof(uint8_t);                   // skip distances
   return per_voxel * double(g.dims[0]) * double(g.dims[1]) * double(g.dims[2]);
 }
 
@@ -145,10 +148,11 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
     const double need = voxelizeHostBytes(scene, g);
     const HostMemory mem = availableHostMemory();
     if (need > double(mem.available))
-      throw SceneError(scene.file.string() + ": /volume/resolution: voxelising " + std::to_string(g.dims[0]) + "x" +
-                       std::to_string(g.dims[1]) + "x" + std::to_string(g.dims[2]) + " voxels needs " +
-                       formatBytes(need) + " of host memory, " + formatBytes(double(mem.available)) +
-                       " available (" + mem.limited_by + "); lower the resolution");
+      throw SceneError(scene.file.string() + ": /volume/resolution: voxelising " +
+                       std::to_string(g.dims[0]) + "x" + std::to_string(g.dims[1]) + "x" +
+                       std::to_string(g.dims[2]) + " voxels needs " + formatBytes(need) +
+                       " of host memory, " + formatBytes(double(mem.available)) + " available (" +
+                       mem.limited_by + "); lower the resolution");
   }
   const size_t N = g.count();
   vs.uniaxial = scene.anyUniaxial();

@@ -55,9 +55,11 @@ class InputCli : public ::testing::Test {
     EXPECT_EQ(r.err.back(), '\n');
     for (size_t i = 0; i + 1 < r.err.size(); ++i) {
       const unsigned char c = static_cast<unsigned char>(r.err[i]);
-      EXPECT_TRUE(c >= 0x20 && c != 0x7f) << "control byte " << int(c) << " at " << i << " in: " << r.err;
+      EXPECT_TRUE(c >= 0x20 && c != 0x7f)
+          << "control byte " << int(c) << " at " << i << " in: " << r.err;
     }
-    EXPECT_NE(r.err.find(phrase), std::string::npos) << "stderr lacks '" << phrase << "': " << r.err;
+    EXPECT_NE(r.err.find(phrase), std::string::npos)
+        << "stderr lacks '" << phrase << "': " << r.err;
   }
   fs::path dir_;
 };
@@ -80,7 +82,8 @@ TEST_F(InputCli, NulInAKeyDoesNotCutTheMessage) {
 
 TEST_F(InputCli, DirectoryAsSceneSaysSo) {
   fs::create_directory(dir_ / "scene.json");
-  expectOneCleanLine(trace((dir_ / "scene.json").string()), "scene.json: is a directory, expected a scene file");
+  expectOneCleanLine(trace((dir_ / "scene.json").string()),
+                     "scene.json: is a directory, expected a scene file");
 }
 
 // ------------------------------------------------------------------ host memory
@@ -88,7 +91,8 @@ TEST_F(InputCli, DirectoryAsSceneSaysSo) {
 // Under `prlimit --as` (1.5 GB of address space) a 256³ volume (≈ 3.9 GB for the voxeliser) is
 // refused with the numbers and the limit, not with std::bad_alloc.
 TEST_F(InputCli, HostMemoryIsCheckedBeforeVoxelising) {
-  const std::string scene = write("big.json", R"({"volume": {"bounds_min": [-12, -12, -12], "bounds_max": [12, 12, 12],
+  const std::string scene =
+      write("big.json", R"({"volume": {"bounds_min": [-12, -12, -12], "bounds_max": [12, 12, 12],
       "resolution": 256}, "materials": {"glass": {"n": 1.5}},
       "objects": [{"shape": "sphere", "radius": 5, "material": "glass"}]})");
   const Outcome r = trace(scene, "prlimit --as=1500000000");
@@ -114,8 +118,9 @@ TEST_F(InputCli, CorruptedLightCacheIsSimulatedAgain) {
   "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 2}]
 })");
   const fs::path cache = dir_ / "cache", exr = dir_ / "out.exr";
-  const std::string args = "render --reference -q --caustics kill --light-cache " + quote(cache.string()) + " " +
-                           quote(scene) + " -o " + quote(exr.string());
+  const std::string args = "render --reference -q --caustics kill --light-cache " +
+                           quote(cache.string()) + " " + quote(scene) + " -o " +
+                           quote(exr.string());
   const Outcome first = run(args);
   ASSERT_EQ(first.code, 0) << first.err;
   ASSERT_NE(first.out.find("simulated 1 light runs"), std::string::npos) << first.out;
@@ -137,7 +142,8 @@ TEST_F(InputCli, CorruptedLightCacheIsSimulatedAgain) {
   ASSERT_EQ(second.code, 0) << second.err;
   EXPECT_EQ(std::count(second.err.begin(), second.err.end(), '\n'), 1) << second.err;
   EXPECT_NE(second.err.find("eikon: warning: light cache: "), std::string::npos) << second.err;
-  EXPECT_NE(second.err.find("is corrupted (checksum mismatch); simulating the light again"), std::string::npos)
+  EXPECT_NE(second.err.find("is corrupted (checksum mismatch); simulating the light again"),
+            std::string::npos)
       << second.err;
   EXPECT_NE(second.out.find("simulated 1 light runs"), std::string::npos) << second.out;
   EXPECT_EQ(second.out.find("from the cache"), std::string::npos) << second.out;

@@ -57,7 +57,8 @@ TEST(Convex, RedundantPlanesDoNotChangeTheCube) {
     }
   const int extra = 994;
   for (int k = 0; k < extra; ++k) {  // Fibonacci directions
-    const double z = 1.0 - 2.0 * (k + 0.5) / extra, r = std::sqrt(1.0 - z * z), phi = k * kPi * (3.0 - std::sqrt(5.0));
+    const double z = 1.0 - 2.0 * (k + 0.5) / extra, r = std::sqrt(1.0 - z * z),
+                 phi = k * kPi * (3.0 - std::sqrt(5.0));
     c.planes.push_back({{r * std::cos(phi), r * std::sin(phi), z}, 2.0});
   }
   finishConvex(c);
@@ -71,7 +72,8 @@ TEST(Convex, ThousandTangentPlanes) {
   ConvexShape c;
   const int n = 1000;
   for (int k = 0; k < n; ++k) {
-    const double z = 1.0 - 2.0 * (k + 0.5) / n, r = std::sqrt(1.0 - z * z), phi = k * kPi * (3.0 - std::sqrt(5.0));
+    const double z = 1.0 - 2.0 * (k + 0.5) / n, r = std::sqrt(1.0 - z * z),
+                 phi = k * kPi * (3.0 - std::sqrt(5.0));
     c.planes.push_back({{r * std::cos(phi), r * std::sin(phi), z}, 5.0});
   }
   finishConvex(c);
@@ -113,12 +115,15 @@ TEST(Convex, ThousandPlanesInAScene) {
   const int m = 998;
   for (int k = 0; k < m; ++k) {
     const double phi = 2.0 * kPi * k / m;
-    planes += "[" + std::to_string(std::cos(phi)) + ", " + std::to_string(std::sin(phi)) + ", 0, 4], ";
+    planes +=
+        "[" + std::to_string(std::cos(phi)) + ", " + std::to_string(std::sin(phi)) + ", 0, 4], ";
   }
   planes += "[0, 0, 1, 2.5], [0, 0, -1, 2.5]";
-  const Scene s = parseScene(R"({"materials": {"g": {"n": 1.5}}, "objects": [{"shape": "planes", "material": "g",
-                                 "planes": [)" + planes + "]}]}",
-                             "planes.json");
+  const Scene s = parseScene(
+      R"({"materials": {"g": {"n": 1.5}}, "objects": [{"shape": "planes", "material": "g",
+                                 "planes": [)" +
+          planes + "]}]}",
+      "planes.json");
   ASSERT_EQ(s.objects.size(), 1u);
   EXPECT_TRUE(s.objects[0].shape.contains(glm::dvec3(3.9, 0.0, 2.4)));
   EXPECT_FALSE(s.objects[0].shape.contains(glm::dvec3(4.1, 0.0, 0.0)));

@@ -17,11 +17,12 @@ namespace eikon {
 namespace {
 
 Scene cubeScene(int resolution) {
-  return parseScene(R"({"volume": {"bounds_min": [-12, -12, -12], "bounds_max": [12, 12, 12], "resolution": )" +
-                        std::to_string(resolution) + R"(},
+  return parseScene(
+      R"({"volume": {"bounds_min": [-12, -12, -12], "bounds_max": [12, 12, 12], "resolution": )" +
+          std::to_string(resolution) + R"(},
                         "materials": {"glass": {"n": 1.5}},
                         "objects": [{"shape": "sphere", "radius": 5, "material": "glass"}]})",
-                    "memory.json");
+      "memory.json");
 }
 
 double memTotal() {
@@ -45,7 +46,9 @@ TEST(HostMemory, HugeVolumeIsRefusedBeforeAllocating) {
     ADD_FAILURE() << "voxelised 1200^3";
   } catch (const SceneError& e) {
     const std::string m = e.what();
-    EXPECT_EQ(m.rfind("memory.json: /volume/resolution: voxelising 1200x1200x1200 voxels needs ", 0), 0u) << m;
+    EXPECT_EQ(
+        m.rfind("memory.json: /volume/resolution: voxelising 1200x1200x1200 voxels needs ", 0), 0u)
+        << m;
     EXPECT_NE(m.find(" GiB of host memory, "), std::string::npos) << m;
     EXPECT_NE(m.find(" available ("), std::string::npos) << m;
   }
@@ -72,7 +75,10 @@ TEST(HostMemory, LoweredAddressSpaceLimitIsRespected) {
       ::_exit(13);
     } catch (const SceneError& e) {
       const std::string msg = e.what();
-      ::_exit(msg.find("of host memory") != std::string::npos && msg.find("(RLIMIT_AS)") != std::string::npos ? 0 : 14);
+      ::_exit(msg.find("of host memory") != std::string::npos &&
+                      msg.find("(RLIMIT_AS)") != std::string::npos
+                  ? 0
+                  : 14);
     } catch (const std::bad_alloc&) {
       ::_exit(15);
     }
@@ -80,8 +86,9 @@ TEST(HostMemory, LoweredAddressSpaceLimitIsRespected) {
   int status = 0;
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
   ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 0) << "10 setrlimit, 11 not limited by RLIMIT_AS, 12 more than the cap, "
-                                       "13 voxelised, 14 wrong message, 15 bad_alloc";
+  EXPECT_EQ(WEXITSTATUS(status), 0)
+      << "10 setrlimit, 11 not limited by RLIMIT_AS, 12 more than the cap, "
+         "13 voxelised, 14 wrong message, 15 bad_alloc";
 }
 
 // Without a cap, a small volume still voxelises (the check does not refuse what fits).

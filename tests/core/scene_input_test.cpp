@@ -28,12 +28,12 @@ std::string errorOf(const std::string& text, const fs::path& origin = kOrigin) {
   return {};
 }
 
-#define EXPECT_INPUT_ERROR(text, json_path, phrase)                                                    \
-  do {                                                                                                 \
-    const std::string m_ = errorOf(text);                                                              \
-    EXPECT_EQ(m_.rfind(std::string(kOrigin) + ": " + (json_path) + ": ", 0), 0u) << m_;                \
-    EXPECT_NE(m_.find(phrase), std::string::npos) << "lacks '" << (phrase) << "': " << m_;             \
-    EXPECT_EQ(m_.find('\n'), std::string::npos) << m_;                                                 \
+#define EXPECT_INPUT_ERROR(text, json_path, phrase)                                        \
+  do {                                                                                     \
+    const std::string m_ = errorOf(text);                                                  \
+    EXPECT_EQ(m_.rfind(std::string(kOrigin) + ": " + (json_path) + ": ", 0), 0u) << m_;    \
+    EXPECT_NE(m_.find(phrase), std::string::npos) << "lacks '" << (phrase) << "': " << m_; \
+    EXPECT_EQ(m_.find('\n'), std::string::npos) << m_;                                     \
   } while (0)
 
 class TempDir {
@@ -65,8 +65,10 @@ class ScopedEnv {
     ::setenv(name, value.c_str(), 1);
   }
   ~ScopedEnv() {
-    if (had_) ::setenv(name_, old_.c_str(), 1);
-    else ::unsetenv(name_);
+    if (had_)
+      ::setenv(name_, old_.c_str(), 1);
+    else
+      ::unsetenv(name_);
   }
 
  private:
@@ -81,10 +83,12 @@ const std::string kSphere = R"({"shape": "sphere", "radius": 3, "material": "gla
 // ------------------------------------------------------------------ duplicate keys
 
 TEST(SceneInput, DuplicateKeysAreErrors) {
-  EXPECT_INPUT_ERROR(R"({"materials": {)" + kGlass + R"(}, "objects": [], "objects": [)" + kSphere + "]}", "/objects",
-                     "duplicate key 'objects'");
-  EXPECT_INPUT_ERROR(R"({"materials": {"glass": {"n": 1.5, "n": 1.6}}, "objects": [)" + kSphere + "]}",
-                     "/materials/glass/n", "duplicate key 'n'");
+  EXPECT_INPUT_ERROR(
+      R"({"materials": {)" + kGlass + R"(}, "objects": [], "objects": [)" + kSphere + "]}",
+      "/objects", "duplicate key 'objects'");
+  EXPECT_INPUT_ERROR(
+      R"({"materials": {"glass": {"n": 1.5, "n": 1.6}}, "objects": [)" + kSphere + "]}",
+      "/materials/glass/n", "duplicate key 'n'");
   // In the second element of an array, after an element holding arrays (the path counts elements).
   EXPECT_INPUT_ERROR(R"({"materials": {)" + kGlass + R"(}, "objects": [
       {"shape": "planes", "planes": [[1, 0, 0, 1], [-1, 0, 0, 1], [0, 1, 0, 1], [0, -1, 0, 1], [0, 0, 1, 1], [0, 0, -1, 1]],
@@ -100,10 +104,14 @@ TEST(SceneInput, DuplicateKeysAreErrors) {
 
 TEST(SceneInput, DuplicateKeyInAMaterialFile) {
   TempDir lib;
-  lib.write("dup.json", R"({"name": "dup", "n": 1.5, "attenuation_per_mm": 0.1, "attenuation_per_mm": 0.2})");
+  lib.write("dup.json",
+            R"({"name": "dup", "n": 1.5, "attenuation_per_mm": 0.1, "attenuation_per_mm": 0.2})");
   ScopedEnv env("EIKON_MATERIALS_PATH", lib.path().string());
-  const std::string m = errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "dup"}]})");
-  EXPECT_EQ(m.rfind((lib.path() / "dup.json").string() + ": /attenuation_per_mm: duplicate key", 0), 0u) << m;
+  const std::string m =
+      errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "dup"}]})");
+  EXPECT_EQ(m.rfind((lib.path() / "dup.json").string() + ": /attenuation_per_mm: duplicate key", 0),
+            0u)
+      << m;
 }
 
 // ------------------------------------------------------------------ material names
@@ -116,26 +124,30 @@ TEST(SceneInput, MaterialNamesAreNotPaths) {
   const fs::path outside = root.write("x.json", R"({"n": 1.7})");
   ScopedEnv env("EIKON_MATERIALS_PATH", (root.path() / "lib").string());
   const std::string abs = (root.path() / "x").string();  // + ".json" names the file above
-  for (const std::string& name : {std::string("../x"), abs, std::string("lib/../../x"), std::string(".."),
-                                   std::string("a\\\\b"), std::string("")}) {
-    EXPECT_INPUT_ERROR(R"({"objects": [{"shape": "sphere", "radius": 3, "material": ")" + name + R"("}]})",
-                       "/objects/0/material", "is not a plain name");
+  for (const std::string& name : {std::string("../x"), abs, std::string("lib/../../x"),
+                                  std::string(".."), std::string("a\\\\b"), std::string("")}) {
+    EXPECT_INPUT_ERROR(
+        R"({"objects": [{"shape": "sphere", "radius": 3, "material": ")" + name + R"("}]})",
+        "/objects/0/material", "is not a plain name");
   }
   // The same material by its plain name from a library directory is found.
   ScopedEnv env2("EIKON_MATERIALS_PATH", root.path().string());
-  EXPECT_NO_THROW(parseScene(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "x"}]})", kOrigin));
+  EXPECT_NO_THROW(
+      parseScene(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "x"}]})", kOrigin));
 }
 
 // ------------------------------------------------------------------ wavelength tables
 
 TEST(SceneInput, NonPositiveWavelengthsAreErrors) {
   for (const char* w : {"-500", "0"}) {
-    EXPECT_INPUT_ERROR(R"({"materials": {"glass": {"n": 1.5, "attenuation_per_mm": {"wavelength_nm": [)" + std::string(w) +
-                           R"(, 600], "per_mm": [0.1, 0.2]}}}, "objects": [)" + kSphere + "]}",
-                       "/materials/glass/attenuation_per_mm/wavelength_nm/0", "must be > 0 nm");
+    EXPECT_INPUT_ERROR(
+        R"({"materials": {"glass": {"n": 1.5, "attenuation_per_mm": {"wavelength_nm": [)" +
+            std::string(w) + R"(, 600], "per_mm": [0.1, 0.2]}}}, "objects": [)" + kSphere + "]}",
+        "/materials/glass/attenuation_per_mm/wavelength_nm/0", "must be > 0 nm");
     EXPECT_INPUT_ERROR(R"({"materials": {)" + kGlass + R"(}, "objects": [)" + kSphere +
                            R"(], "lights": [{"type": "point", "position": [0, 8, 0],
-                           "spectrum": {"wavelength_nm": [)" + std::string(w) + R"(, 500], "power": [1, 1]}}]})",
+                           "spectrum": {"wavelength_nm": [)" +
+                           std::string(w) + R"(, 500], "power": [1, 1]}}]})",
                        "/lights/0/spectrum/wavelength_nm/0", "must be > 0 nm");
   }
 }
@@ -149,7 +161,8 @@ TEST(SceneInput, DirectoriesAreReportedAsDirectories) {
     loadScene(d.path() / "scene.json");
     ADD_FAILURE() << "a directory loaded as a scene";
   } catch (const SceneError& e) {
-    EXPECT_EQ(std::string(e.what()), (d.path() / "scene.json").string() + ": is a directory, expected a scene file");
+    EXPECT_EQ(std::string(e.what()),
+              (d.path() / "scene.json").string() + ": is a directory, expected a scene file");
   }
   fs::create_directory(d.path() / "env.exr");
   const std::string env = R"({"materials": {)" + kGlass + R"(}, "objects": [)" + kSphere +
@@ -160,8 +173,10 @@ TEST(SceneInput, DirectoriesAreReportedAsDirectories) {
   fs::create_directory(d.path() / "lib");
   fs::create_directory(d.path() / "lib" / "x.json");
   ScopedEnv lib("EIKON_MATERIALS_PATH", (d.path() / "lib").string());
-  const std::string mm = errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "x"}]})");
-  EXPECT_EQ(mm, (d.path() / "lib" / "x.json").string() + ": is a directory, expected a material file");
+  const std::string mm =
+      errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "x"}]})");
+  EXPECT_EQ(mm,
+            (d.path() / "lib" / "x.json").string() + ": is a directory, expected a material file");
 }
 
 // ------------------------------------------------------------------ bytes in messages
@@ -169,14 +184,15 @@ TEST(SceneInput, DirectoriesAreReportedAsDirectories) {
 TEST(Printable, EscapesWhatIsNotPrintableText) {
   using namespace std::string_literals;
   EXPECT_EQ(printable("plain ASCII, backslash \\ kept"), "plain ASCII, backslash \\ kept");
-  EXPECT_EQ(printable("λ = 587.6 nm, µm², ≥ 1, 🙂"), "λ = 587.6 nm, µm², ≥ 1, 🙂");  // valid UTF-8
+  EXPECT_EQ(printable("λ = 587.6 nm, µm², ≥ 1, 🙂"),
+            "λ = 587.6 nm, µm², ≥ 1, 🙂");  // valid UTF-8
   EXPECT_EQ(printable("a\0b"s), "a\\x00b");
   EXPECT_EQ(printable("line\nbreak\ttab\r\x7f"), "line\\x0abreak\\x09tab\\x0d\\x7f");
-  EXPECT_EQ(printable("\xff\xfe"), "\\xff\\xfe");            // never UTF-8
-  EXPECT_EQ(printable("\xc0\xaf"), "\\xc0\\xaf");            // overlong '/'
-  EXPECT_EQ(printable("\xed\xa0\x80"), "\\xed\\xa0\\x80");   // a surrogate
-  EXPECT_EQ(printable("\xc2\x85"), "\\xc2\\x85");            // C1 control NEL
-  EXPECT_EQ(printable("\xe2\x89"), "\\xe2\\x89");            // truncated sequence
+  EXPECT_EQ(printable("\xff\xfe"), "\\xff\\xfe");                    // never UTF-8
+  EXPECT_EQ(printable("\xc0\xaf"), "\\xc0\\xaf");                    // overlong '/'
+  EXPECT_EQ(printable("\xed\xa0\x80"), "\\xed\\xa0\\x80");           // a surrogate
+  EXPECT_EQ(printable("\xc2\x85"), "\\xc2\\x85");                    // C1 control NEL
+  EXPECT_EQ(printable("\xe2\x89"), "\\xe2\\x89");                    // truncated sequence
   EXPECT_EQ(printable("\xf4\x90\x80\x80"), "\\xf4\\x90\\x80\\x80");  // beyond U+10FFFF
 }
 
@@ -193,16 +209,19 @@ TEST(Printable, TruncatesAtACharacterBoundary) {
 TEST(SceneInput, NulInANameIsEscaped) {
   const std::string m = errorOf(R"({"objects": [], "lamps\u0000after": 1})");
   EXPECT_NE(m.find("/lamps\\x00after: unknown key"), std::string::npos) << m;
-  const std::string n = errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "x\u0000y"}]})");
+  const std::string n =
+      errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "x\u0000y"}]})");
   EXPECT_NE(n.find("material name 'x\\x00y' is not a plain name"), std::string::npos) << n;
-  const std::string k = errorOf(R"({"objects": [{"shape": "sphere\u0000", "radius": 3, "material": "g"}]})");
+  const std::string k =
+      errorOf(R"({"objects": [{"shape": "sphere\u0000", "radius": 3, "material": "g"}]})");
   EXPECT_NE(k.find("unknown shape 'sphere\\x00'"), std::string::npos) << k;
 }
 
 // Raw bytes of a binary file in the malformed-JSON message are escaped, and a long token is cut.
 TEST(SceneInput, BinaryBytesInMessagesAreEscapedAndShort) {
   using namespace std::string_literals;
-  const std::string binary = "{\"objects\": [\"\x01\x02\xff\xfe\x80\x00\x1b[31mred"s + std::string(100000, 'z');
+  const std::string binary =
+      "{\"objects\": [\"\x01\x02\xff\xfe\x80\x00\x1b[31mred"s + std::string(100000, 'z');
   const std::string m = errorOf(binary);
   EXPECT_EQ(m.rfind(std::string(kOrigin) + ": malformed JSON", 0), 0u) << m;
   EXPECT_LT(m.size(), 600u);

@@ -43,7 +43,8 @@ std::vector<float> indexA(const Scene& s) {
 TEST(VoxelizeExtremes, HugeSphereCoversEveryVoxel) {
   for (double sigma : {0.0, 0.75}) {
     const auto a = indexA(sphereScene(glm::dvec3(0.0), 1e9, sigma));
-    for (size_t i = 0; i < a.size(); ++i) ASSERT_FLOAT_EQ(a[i], 1.5f) << "voxel " << i << ", sigma " << sigma;
+    for (size_t i = 0; i < a.size(); ++i)
+      ASSERT_FLOAT_EQ(a[i], 1.5f) << "voxel " << i << ", sigma " << sigma;
   }
 }
 
@@ -51,7 +52,8 @@ TEST(VoxelizeExtremes, FarAwaySpheresLeaveTheAmbientMedium) {
   for (double x : {4294967296.0, -4294967296.0, 1e300, -1e300})
     for (double sigma : {0.0, 0.75}) {
       const auto a = indexA(sphereScene(glm::dvec3(x, 0.0, 0.0), 3.0, sigma));
-      for (size_t i = 0; i < a.size(); ++i) ASSERT_FLOAT_EQ(a[i], 1.0f) << "voxel " << i << ", centre x " << x;
+      for (size_t i = 0; i < a.size(); ++i)
+        ASSERT_FLOAT_EQ(a[i], 1.0f) << "voxel " << i << ", centre x " << x;
     }
 }
 
