@@ -803,10 +803,10 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
                                                corner & 2 ? vol.bounds_max.y : vol.bounds_min.y,
                                                corner & 4 ? vol.bounds_max.z : vol.bounds_min.z));
       if (covers) {
-        scene.warnings.push_back(
+        scene.warnings.push_back(printable(
             file + ": " + o.path() + ": the object covers the whole volume " + box(vol) +
             ": it fills the volume and none of its surface is inside, so it bends no ray " +
-            "(shrink it or enlarge the volume)");
+            "(shrink it or enlarge the volume)"));
         covering.insert(i);
       }
     }
@@ -863,9 +863,10 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
               closest = std::min(closest, scene.objects[i].shape.signedDistance(q));
             }
       if (closest < margin)
-        scene.warnings.push_back(file + ": /objects/" + std::to_string(i) + ": the object comes within " +
-                                 fmt(std::max(closest, 0.0)) + " mm of the volume's boundary (smoothing reach " +
-                                 fmt(margin) + " mm); rays leaving through it are not refracted there");
+        scene.warnings.push_back(printable(
+            file + ": /objects/" + std::to_string(i) + ": the object comes within " +
+            fmt(std::max(closest, 0.0)) + " mm of the volume's boundary (smoothing reach " +
+            fmt(margin) + " mm); rays leaving through it are not refracted there"));
     }
   }
 

@@ -86,6 +86,19 @@ TEST_F(InputCli, DirectoryAsSceneSaysSo) {
                      "scene.json: is a directory, expected a scene file");
 }
 
+// A sphere of 7e8 mm about the volume filled it silently (the traced optical path changed, no
+// message): trace now prints the scene's warning, once, and still traces.
+TEST_F(InputCli, TraceWarnsAboutAnObjectCoveringTheVolume) {
+  const Outcome r = trace(write("huge.json", R"({"materials": {"g": {"n": 1.5}},
+      "objects": [{"shape": "sphere", "radius": 7e8, "material": "g"}]})"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("eikon: warning: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("huge.json: /objects/0: the object covers the whole volume"),
+            std::string::npos)
+      << r.err;
+}
+
 // ------------------------------------------------------------------ host memory
 
 // Under `prlimit --as` (1.5 GB of address space) a 256³ volume (≈ 3.9 GB for the voxeliser) is
