@@ -28,6 +28,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kMaxCoordinateMm = 1e12;
 constexpr double kMinVoxelMm = 1e-6;
 constexpr double kMaxOffsetVoxels = 65536.0;
+constexpr size_t kMaxPlanes = 4096;  // planes of one "planes" object
 
 std::string fmt(double v) {
   std::ostringstream s;
@@ -352,6 +353,10 @@ SceneObject parseObject(const Node& o) {
       allow({"planes"});
       auto p = o.at("planes");
       if (!p.isArray()) p.fail("expected an array of [nx, ny, nz, d]");
+      // Validation is O(n²) (finishConvex): 4096 planes take ~1.5 s, and nothing may hang.
+      if (p.size() > kMaxPlanes)
+        p.fail("at most " + std::to_string(kMaxPlanes) + " planes, got " +
+               std::to_string(p.size()));
       ConvexShape c;
       for (size_t i = 0; i < p.size(); ++i) {
         auto v = p.index(i).numbers();

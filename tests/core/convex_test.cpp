@@ -134,5 +134,21 @@ TEST(Convex, ThousandPlanesInAScene) {
   EXPECT_LE(hi.x, 4.72);
 }
 
+// More than 4096 planes are refused before the O(n²) validation (4096 take ~1.5 s).
+TEST(Convex, PlaneCountIsLimited) {
+  std::string planes;
+  for (int k = 0; k < 4097; ++k) planes += std::string(k ? ", " : "") + "[1, 0, 0, 1]";
+  try {
+    parseScene(R"({"materials": {"g": {"n": 1.5}}, "objects": [{"shape": "planes", "material": "g",
+                   "planes": [)" +
+                   planes + "]}]}",
+               "planes.json");
+    ADD_FAILURE() << "4097 planes accepted";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "planes.json: /objects/0/planes: at most 4096 planes, got 4097");
+  }
+}
+
 }  // namespace
 }  // namespace eikon
