@@ -60,11 +60,11 @@ void addTraceCommand(CLI::App& app) {
     if (!(a->wavelength >= 100 && a->wavelength <= 10000)) throw CliError("--wavelength must be in [100, 10000] nm");
     if (!(a->step > 0 && a->step <= 4)) throw CliError("--step must be in (0, 4] voxels");
     Scene scene = loadScene(a->scene);
-    for (const std::string& w : scene.warnings)
-      std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
     MarchSettings ms;
     ms.step_voxels = a->step;
     TraceRequest req{o, glm::normalize(d), a->wavelength};
+    for (const std::string& w : scene.warnings)
+      std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
     std::array<TraceOutcome, 2> modes;
     std::string device;
     if (a->reference) {
