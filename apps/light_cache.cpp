@@ -11,7 +11,7 @@
 namespace eikon::cli {
 namespace {
 
-constexpr uint64_t kFormat = 1;
+constexpr uint64_t kFormat = 2;  // 2: a checksum of the payload in the header
 constexpr char kMagic[8] = {'E', 'I', 'K', 'L', 'I', 'G', 'H', 'T'};
 
 /// Word-wise 64-bit hash (FNV-1a constants, one 64-bit word per round, murmur finaliser).
@@ -49,6 +49,15 @@ class Hasher {
   void word(uint64_t w) { h_ = (h_ ^ w) * 0x100000001b3ULL + (h_ >> 29); }
   uint64_t h_ = 0xcbf29ce484222325ULL;
 };
+
+/// The header's checksum of the two light volumes (the hash above, over their bytes).
+uint64_t payloadChecksum(const std::vector<glm::vec4>& fluence,
+                         const std::vector<glm::vec4>& flux) {
+  Hasher h;
+  h.vec(fluence);
+  h.vec(flux);
+  return h.digest();
+}
 
 std::filesystem::path entryPath(const std::filesystem::path& dir, uint64_t key) {
   char name[40];
@@ -107,24 +116,35 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOpt
   return h.digest();
 }
 
-bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& volume) {
+bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& volume,
+                    std::string* notice) {
   if (dir.empty()) return false;
-  std::ifstream in(entryPath(dir, key), std::ios::binary);
+  const std::filesystem::path path = entryPath(dir, key);
+  std::ifstream in(path, std::ios::binary);
   if (!in) return false;
+  auto corrupted = [&](const std::string& why) {
+    if (notice) *notice = path.string() + " is corrupted (" + why + "); simulating the light again";
+    return false;
+  };
   char magic[8];
-  uint64_t format = 0, stored_key = 0;
+  uint64_t format = 0, stored_key = 0, checksum = 0;
   std::array<int, 3> dims{};
   in.read(magic, 8);
   in.read(reinterpret_cast<char*>(&format), sizeof format);
+  if (!in || std::memcmp(magic, kMagic, 8) != 0) return corrupted("not a light cache file");
+  if (format != kFormat) return false;  // another version of eikon wrote it: replaced quietly
   in.read(reinterpret_cast<char*>(&stored_key), sizeof stored_key);
   in.read(reinterpret_cast<char*>(dims.data()), sizeof dims);
-  if (!in || std::memcmp(magic, kMagic, 8) != 0 || format != kFormat || stored_key != key || dims != volume.grid.dims)
-    return false;
+  in.read(reinterpret_cast<char*>(&checksum), sizeof checksum);
+  if (!in) return corrupted("truncated header");
+  if (stored_key != key || dims != volume.grid.dims)
+    return corrupted("header does not match its name");
   const size_t N = volume.grid.count();
   std::vector<glm::vec4> fluence(N), flux(N);
   in.read(reinterpret_cast<char*>(fluence.data()), std::streamsize(N * sizeof(glm::vec4)));
   in.read(reinterpret_cast<char*>(flux.data()), std::streamsize(N * sizeof(glm::vec4)));
-  if (!in || in.peek() != std::char_traits<char>::eof()) return false;
+  if (!in || in.peek() != std::char_traits<char>::eof()) return corrupted("wrong size");
+  if (payloadChecksum(fluence, flux) != checksum) return corrupted("checksum mismatch");
   volume.light_fluence = std::move(fluence);
   volume.light_flux = std::move(flux);
   return true;
@@ -142,11 +162,12 @@ std::string saveLightCache(const std::filesystem::path& dir, uint64_t key, const
   ::close(fd);
   {
     std::ofstream out(tmpl, std::ios::binary | std::ios::trunc);
-    uint64_t format = kFormat;
+    uint64_t format = kFormat, checksum = payloadChecksum(volume.light_fluence, volume.light_flux);
     out.write(kMagic, 8);
     out.write(reinterpret_cast<const char*>(&format), sizeof format);
     out.write(reinterpret_cast<const char*>(&key), sizeof key);
     out.write(reinterpret_cast<const char*>(volume.grid.dims.data()), sizeof volume.grid.dims);
+    out.write(reinterpret_cast<const char*>(&checksum), sizeof checksum);
     out.write(reinterpret_cast<const char*>(volume.light_fluence.data()),
               std::streamsize(volume.light_fluence.size() * sizeof(glm::vec4)));
     out.write(reinterpret_cast<const char*>(volume.light_flux.data()),

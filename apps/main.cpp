@@ -1,8 +1,10 @@
 // eikon — eikonal rendering of refractive, dispersive and birefringent objects.
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "apps/commands.h"
+#include "core/scene/messages.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"eikon: eikonal rendering of gems, prisms and crystals (see README.md)", "eikon"};
@@ -16,13 +18,13 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    std::fprintf(stderr, "eikon: error: %s (run with --help)\n", e.what());
+    std::fputs(eikon::errorLine(std::string(e.what()) + " (run with --help)").c_str(), stderr);
     return 2;
   } catch (const eikon::cli::CliError& e) {
-    std::fprintf(stderr, "eikon: error: %s\n", e.what());
+    std::fputs(eikon::errorLine(e.what()).c_str(), stderr);
     return e.exit_code;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "eikon: error: %s\n", e.what());
+    std::fputs(eikon::errorLine(e.what()).c_str(), stderr);
     return 1;
   }
   return 0;

@@ -147,7 +147,11 @@ void addRenderCommand(CLI::App& app) {
       light_on_cpu = a.reference || lightOnCpu(a.light_device, ctx.get());
       // The key hashes every field of the volume (~0.3 s at 128³): only when the cache is used.
       const uint64_t key = a.no_light_cache ? 0 : lightCacheKey(scene, volume, lo, light_on_cpu);
-      if (!a.no_light_cache && loadLightCache(cache_dir, key, volume)) {
+      std::string cache_notice;
+      const bool hit = !a.no_light_cache && loadLightCache(cache_dir, key, volume, &cache_notice);
+      if (!cache_notice.empty())
+        std::fprintf(stderr, "eikon: warning: light cache: %s\n", printable(cache_notice).c_str());
+      if (hit) {
         light_cached = true;
       } else {
         light = light_on_cpu ? simulateLightingReference(scene, volume, lo) : simulateLighting(*ctx, scene, volume, lo);

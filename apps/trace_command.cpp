@@ -63,6 +63,8 @@ void addTraceCommand(CLI::App& app) {
     MarchSettings ms;
     ms.step_voxels = a->step;
     TraceRequest req{o, glm::normalize(d), a->wavelength};
+    for (const std::string& w : scene.warnings)
+      std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
     std::array<TraceOutcome, 2> modes;
     std::string device;
     if (a->reference) {

@@ -18,11 +18,30 @@ namespace {
 using json = nlohmann::json;
 constexpr double kPi = 3.14159265358979323846;
 
+// Limits on what the scene may ask for, so that every derived quantity is representable:
+// - positions and lengths within ±1e12 mm: distances are computed in double (squares ≤ 1e24, no
+//   overflow) and a surface 1e12 mm from the origin is still placed to ~1e-4 mm;
+// - a voxel edge of at least 1e-6 mm (1 nm, far below where geometric optics holds), so that 1/h
+//   and the gradients the GPU stores are finite in float;
+// - the volume within 65536 voxels of the origin: the GPU marches in single precision, whose
+//   positions there resolve 2^-7 voxel (farther out the grid would be sampled off by whole voxels).
+constexpr double kMaxCoordinateMm = 1e12;
+constexpr double kMinVoxelMm = 1e-6;
+constexpr double kMaxOffsetVoxels = 65536.0;
+constexpr size_t kMaxPlanes = 4096;  // planes of one "planes" object
+
 std::string fmt(double v) {
   std::ostringstream s;
   s.precision(10);
   s << v;
   return s.str();
+}
+
+std::string box(const VolumeSpec& v) {
+  auto p = [](const glm::dvec3& x) {
+    return "(" + fmt(x.x) + ", " + fmt(x.y) + ", " + fmt(x.z) + ")";
+  };
+  return p(v.bounds_min) + " to " + p(v.bounds_max) + " mm";
 }
 
 /// A JSON value with its location, for error messages that name file and path.
@@ -50,7 +69,8 @@ class Node {
       if (!allowed.count(it.key())) {
         std::string list;
         for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
-        throw SceneError(file_ + ": " + path_ + "/" + it.key() + ": unknown key (allowed here: " + list + ")");
+        throw SceneError(file_ + ": " + path_ + "/" + excerpt(it.key()) +
+                         ": unknown key (allowed here: " + list + ")");
       }
   }
   bool has(const std::string& key) const { return j_.is_object() && j_.contains(key); }
@@ -111,6 +131,21 @@ class Node {
     if (c.x < 0 || c.y < 0 || c.z < 0) fail("must be non-negative");
     return c;
   }
+  /// A point (mm) within ±kMaxCoordinateMm on every axis.
+  glm::dvec3 position() const {
+    glm::dvec3 v = vec3();
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(v[a]) > kMaxCoordinateMm)
+        index(size_t(a)).fail("must be within ±" + fmt(kMaxCoordinateMm) + " mm, got " + fmt(v[a]));
+    return v;
+  }
+  /// A length (mm) in (0, kMaxCoordinateMm].
+  double length() const {
+    double v = positive();
+    if (v > kMaxCoordinateMm)
+      fail("must be at most " + fmt(kMaxCoordinateMm) + " mm, got " + fmt(v));
+    return v;
+  }
   glm::dvec3 unitVector() const {
     glm::dvec3 v = vec3();
     double len = glm::length(v);
@@ -157,18 +192,18 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
       grin->type = GrinProfile::Type::Linear;
       grin->n0 = l->at("n0").number(1.0, 10.0);
       grin->gradient = l->at("gradient_per_mm").vec3();
-      grin->origin = l->get("origin") ? l->at("origin").vec3() : glm::dvec3(0.0);
+      grin->origin = l->get("origin") ? l->at("origin").position() : glm::dvec3(0.0);
     } else if (auto lu = n.get("luneburg")) {
       lu->allowKeys({"center", "radius"});
       grin->type = GrinProfile::Type::Luneburg;
-      grin->origin = lu->at("center").vec3();
-      grin->radius = lu->at("radius").positive();
+      grin->origin = lu->at("center").position();
+      grin->radius = lu->at("radius").length();
     } else {
       auto f = n.at("maxwell_fisheye");
       f.allowKeys({"center", "radius", "n0"});
       grin->type = GrinProfile::Type::MaxwellFisheye;
-      grin->origin = f.at("center").vec3();
-      grin->radius = f.at("radius").positive();
+      grin->origin = f.at("center").position();
+      grin->radius = f.at("radius").length();
       grin->n0 = f.at("n0").number(1.0, 10.0);
     }
     return Dispersion::constant(grin->type == GrinProfile::Type::Linear ? grin->n0 : 1.0);
@@ -215,6 +250,10 @@ Attenuation parseAttenuation(const Node& n) {
     if (a.wavelengths_nm.size() != a.values.size() || a.values.empty())
       n.fail("wavelength_nm and per_mm must have the same non-zero length");
     for (size_t i = 0; i < a.values.size(); ++i) {
+      if (!(a.wavelengths_nm[i] > 0))
+        n.at("wavelength_nm")
+            .index(i)
+            .fail("wavelengths must be > 0 nm, got " + fmt(a.wavelengths_nm[i]));
       if (a.values[i] < 0) n.fail("attenuation must be >= 0");
       if (i && !(a.wavelengths_nm[i] > a.wavelengths_nm[i - 1])) n.fail("wavelength_nm must be strictly increasing");
     }
@@ -277,7 +316,7 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
 SceneObject parseObject(const Node& o) {
   o.requireObject();
   std::string shape = o.at("shape").string();
-  glm::dvec3 center = o.get("center") ? o.at("center").vec3() : glm::dvec3(0.0);
+  glm::dvec3 center = o.get("center") ? o.at("center").position() : glm::dvec3(0.0);
   glm::dvec3 rot = o.get("rotation_deg") ? o.at("rotation_deg").vec3() : glm::dvec3(0.0);
   SceneObject obj;
   ShapeGeometry g;
@@ -290,31 +329,34 @@ SceneObject parseObject(const Node& o) {
       if (!allowed.count(it.key())) {
         std::string list;
         for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
-        o.fail("unknown key '" + it.key() + "' for shape '" + shape + "' (allowed: " + list + ")");
+        o.fail("unknown key '" + excerpt(it.key()) + "' for shape '" + excerpt(shape) +
+               "' (allowed: " + list + ")");
       }
   };
   try {
     if (shape == "sphere") {
       allow({"radius"});
-      g = SphereShape{o.at("radius").positive()};
+      g = SphereShape{o.at("radius").length()};
     } else if (shape == "box") {
       allow({"size"});
-      auto s = o.at("size").vec3();
+      auto s = o.at("size").position();
       if (!(s.x > 0 && s.y > 0 && s.z > 0)) o.at("size").fail("all sizes must be > 0");
       g = BoxShape{s};
     } else if (shape == "rounded_box") {
       allow({"size", "radius"});
-      auto s = o.at("size").vec3();
+      auto s = o.at("size").position();
       if (!(s.x > 0 && s.y > 0 && s.z > 0)) o.at("size").fail("all sizes must be > 0");
-      double r = o.at("radius").positive();
+      double r = o.at("radius").length();
       if (2 * r > std::min(s.x, std::min(s.y, s.z))) o.at("radius").fail("corner radius exceeds half the smallest side");
       g = RoundedBoxShape{s, r};
     } else if (shape == "prism") {
       allow({"apex_deg", "side", "height"});
-      g = makePrism(o.at("apex_deg").number(0.0, 180.0, true), o.at("side").positive(), o.at("height").positive());
+      g = makePrism(o.at("apex_deg").number(0.0, 180.0, true), o.at("side").length(),
+                    o.at("height").length());
     } else if (shape == "brilliant") {
       allow({"diameter", "table", "crown_deg", "pavilion_deg", "girdle", "facets"});
-      g = makeBrilliant(o.at("diameter").positive(), o.get("table") ? o.at("table").number(0.0, 1.0, true) : 0.57,
+      g = makeBrilliant(o.at("diameter").length(),
+                        o.get("table") ? o.at("table").number(0.0, 1.0, true) : 0.57,
                         o.get("crown_deg") ? o.at("crown_deg").number() : 34.5,
                         o.get("pavilion_deg") ? o.at("pavilion_deg").number() : 40.75,
                         o.get("girdle") ? o.at("girdle").number(0.0, 0.5) : 0.02,
@@ -323,6 +365,10 @@ SceneObject parseObject(const Node& o) {
       allow({"planes"});
       auto p = o.at("planes");
       if (!p.isArray()) p.fail("expected an array of [nx, ny, nz, d]");
+      // Validation is O(n²) (finishConvex): 4096 planes take ~1.5 s, and nothing may hang.
+      if (p.size() > kMaxPlanes)
+        p.fail("at most " + std::to_string(kMaxPlanes) + " planes, got " +
+               std::to_string(p.size()));
       ConvexShape c;
       for (size_t i = 0; i < p.size(); ++i) {
         auto v = p.index(i).numbers();
@@ -330,6 +376,9 @@ SceneObject parseObject(const Node& o) {
         glm::dvec3 n(v[0], v[1], v[2]);
         double len = glm::length(n);
         if (!(len > 1e-12)) p.index(i).fail("plane normal must be non-zero");
+        if (!(std::abs(v[3] / len) <= kMaxCoordinateMm))
+          p.index(i).fail("the plane's distance d/|n| from the centre must be within ±" +
+                          fmt(kMaxCoordinateMm) + " mm, got " + fmt(v[3] / len));
         c.planes.push_back({n / len, v[3] / len});
       }
       finishConvex(c);
@@ -337,7 +386,8 @@ SceneObject parseObject(const Node& o) {
     } else if (shape == "mesh") {
       o.at("shape").fail("shape 'mesh' is not supported yet (use planes for convex solids)");
     } else {
-      o.at("shape").fail("unknown shape '" + shape + "' (sphere, box, rounded_box, prism, brilliant, planes)");
+      o.at("shape").fail("unknown shape '" + excerpt(shape) +
+                         "' (sphere, box, rounded_box, prism, brilliant, planes)");
     }
   } catch (const std::invalid_argument& e) {
     o.fail(e.what());
@@ -348,20 +398,83 @@ SceneObject parseObject(const Node& o) {
   if (auto f = o.get("optic_axis_field")) {
     std::string kind = f->string();
     if (kind == "radial") obj.radial_axis = true;
-    else if (kind != "uniform") f->fail("unknown optic_axis_field '" + kind + "' (uniform, radial)");
+    else if (kind != "uniform")
+      f->fail("unknown optic_axis_field '" + excerpt(kind) + "' (uniform, radial)");
     if (obj.radial_axis && obj.optic_axis) f->fail("give either optic_axis or optic_axis_field \"radial\", not both");
   }
   return obj;
 }
 
+/// Parse JSON text, refusing a key that appears twice in one object (nlohmann keeps the last
+/// one silently): the parser callback sees every key event, and a stack of the open containers
+/// gives the JSON path of the duplicate. Syntax errors and numbers that overflow a double
+/// (1e999) are SceneErrors naming the file.
+json parseJson(const std::string& text, const std::string& file) {
+  struct Open {
+    bool array;
+    std::set<std::string> keys;
+    std::string key;  // object: the current key
+    long index = -1;  // array: the current element
+  };
+  std::vector<Open> open;
+  auto path = [&] {
+    std::string p;
+    for (const Open& f : open) p += "/" + (f.array ? std::to_string(f.index) : excerpt(f.key));
+    return p;
+  };
+  auto element = [&] {
+    if (!open.empty() && open.back().array) ++open.back().index;
+  };
+  json::parser_callback_t cb = [&](int, json::parse_event_t ev, json& parsed) {
+    switch (ev) {
+      case json::parse_event_t::object_start:
+        element();
+        open.push_back({false, {}, {}, -1});
+        break;
+      case json::parse_event_t::array_start:
+        element();
+        open.push_back({true, {}, {}, -1});
+        break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        open.pop_back();
+        break;
+      case json::parse_event_t::value:
+        element();
+        break;
+      case json::parse_event_t::key: {
+        Open& f = open.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second)
+          throw SceneError(file + ": " + path() + ": duplicate key '" + excerpt(f.key) +
+                           "' (each key may appear once per object; which value was meant?)");
+        break;
+      }
+    }
+    return true;
+  };
+  try {
+    return json::parse(text, cb);
+  } catch (const json::exception& e) {  // parse errors and number overflow (1e999)
+    throw SceneError(file + ": malformed JSON: " + printable(e.what(), 300));
+  }
+}
+
+/// "FILE: is a directory, expected WHAT" when `path` is one (an ifstream opens a directory and
+/// then reads nothing, which read as an empty or malformed file).
+void refuseDirectory(const std::filesystem::path& path, const std::string& what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw SceneError(path.string() + ": is a directory, expected " + what);
+}
+
 json readJsonFile(const std::filesystem::path& path, const char* what) {
+  refuseDirectory(path, std::string("a ") + what);
   std::ifstream in(path);
   if (!in) throw SceneError(path.string() + ": cannot open " + what);
-  try {
-    return json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw SceneError(path.string() + ": malformed JSON: " + e.what());
-  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parseJson(ss.str(), path.string());
 }
 
 }  // namespace
@@ -499,23 +612,23 @@ static Light parseLight(const Node& l) {
     light.type = Light::Type::Directional;
     light.direction = l.at("direction").unitVector();
     if (auto v = l.get("irradiance")) light.irradiance = v->number(0.0, 1e12);
-    if (auto r = l.get("beam_radius")) light.beam_radius = r->positive();
+    if (auto r = l.get("beam_radius")) light.beam_radius = r->length();
     if (auto c = l.get("beam_center")) {
       if (!l.has("beam_radius")) c->fail("beam_center needs beam_radius (the beam's radius in mm)");
-      light.position = c->vec3();
+      light.position = c->position();
     }
   } else if (type == "point" || type == "spot") {
     if (type == "point") l.allowKeys({"type", "position", "intensity", "spectrum"});
     else l.allowKeys({"type", "position", "direction", "cone_half_angle_deg", "intensity", "spectrum"});
     light.type = type == "point" ? Light::Type::Point : Light::Type::Spot;
-    light.position = l.at("position").vec3();
+    light.position = l.at("position").position();
     if (auto v = l.get("intensity")) light.irradiance = v->number(0.0, 1e12);
     if (type == "spot") {
       light.direction = l.at("direction").unitVector();
       light.cone_half_angle_deg = l.at("cone_half_angle_deg").number(0.0, 90.0, true);
     }
   } else {
-    l.at("type").fail("unknown light type '" + type + "' (directional, point, spot)");
+    l.at("type").fail("unknown light type '" + excerpt(type) + "' (directional, point, spot)");
   }
   if (auto sp = l.get("spectrum")) {
     if (sp->isString()) {
@@ -524,7 +637,8 @@ static Light parseLight(const Node& l) {
         light.spectrum_nm = {380.0, 780.0};
         light.spectrum_power = {1.0, 1.0};
       } else if (name != "D65") {
-        sp->fail("unknown spectrum '" + name + "' (\"D65\", \"E\" or {\"wavelength_nm\": [...], \"power\": [...]})");
+        sp->fail("unknown spectrum '" + excerpt(name) +
+                 "' (\"D65\", \"E\" or {\"wavelength_nm\": [...], \"power\": [...]})");
       }
     } else {
       sp->allowKeys({"wavelength_nm", "power"});
@@ -534,6 +648,10 @@ static Light parseLight(const Node& l) {
         sp->fail("wavelength_nm and power must have the same length, at least 2");
       double total = 0;
       for (size_t k = 0; k < light.spectrum_nm.size(); ++k) {
+        if (!(light.spectrum_nm[k] > 0))
+          sp->at("wavelength_nm")
+              .index(k)
+              .fail("wavelengths must be > 0 nm, got " + fmt(light.spectrum_nm[k]));
         if (light.spectrum_power[k] < 0) sp->at("power").index(k).fail("must be >= 0");
         if (k && !(light.spectrum_nm[k] > light.spectrum_nm[k - 1]))
           sp->at("wavelength_nm").index(k).fail("wavelength_nm must be strictly increasing");
@@ -547,13 +665,8 @@ static Light parseLight(const Node& l) {
 }
 
 Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
-  json j;
   const std::string file = origin.string();
-  try {
-    j = json::parse(text);
-  } catch (const json::exception& e) {  // parse errors and number overflow (1e999)
-    throw SceneError(file + ": malformed JSON: " + e.what());
-  }
+  const json j = parseJson(text, file);
   Scene scene;
   scene.file = origin;
   Node root(j, "", file);
@@ -562,8 +675,8 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto c = root.get("camera")) {
     c->allowKeys({"position", "look_at", "up", "fov_deg", "width", "height"});
     auto& cam = scene.camera;
-    if (auto v = c->get("position")) cam.position = v->vec3();
-    if (auto v = c->get("look_at")) cam.look_at = v->vec3();
+    if (auto v = c->get("position")) cam.position = v->position();
+    if (auto v = c->get("look_at")) cam.look_at = v->position();
     if (auto v = c->get("up")) cam.up = v->unitVector();
     if (auto v = c->get("fov_deg")) cam.fov_deg = v->number(0.0, 179.0, true);
     if (auto v = c->get("width")) cam.width = v->integer(1, 16384);
@@ -592,6 +705,9 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
       std::filesystem::path p = e->at("file").string();
       if (p.is_relative()) p = origin.parent_path() / p;
       env.image_path = p;
+      std::error_code ec;
+      if (std::filesystem::is_directory(p, ec))
+        e->at("file").fail(p.string() + ": is a directory, expected an EXR image");
       try {
         auto img = readExrRgba(p, 16384, 8192);
         env.image_width = img.width;
@@ -601,7 +717,8 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
         e->at("file").fail(ex.what());
       }
     } else {
-      e->at("type").fail("unknown environment type '" + type + "' (checker, constant, latlong)");
+      e->at("type").fail("unknown environment type '" + excerpt(type) +
+                         "' (checker, constant, latlong)");
     }
     if (auto v = e->get("intensity")) env.intensity = v->number(0.0, 1e9);
   }
@@ -609,17 +726,33 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto v = root.get("volume")) {
     v->allowKeys({"bounds_min", "bounds_max", "resolution", "smoothing_voxels", "smoothing_method"});
     auto& vol = scene.volume;
-    if (auto b = v->get("bounds_min")) vol.bounds_min = b->vec3();
-    if (auto b = v->get("bounds_max")) vol.bounds_max = b->vec3();
+    if (auto b = v->get("bounds_min")) vol.bounds_min = b->position();
+    if (auto b = v->get("bounds_max")) vol.bounds_max = b->position();
     glm::dvec3 ext = vol.bounds_max - vol.bounds_min;
     if (!(ext.x > 0 && ext.y > 0 && ext.z > 0)) v->fail("bounds_max must exceed bounds_min on every axis");
     if (auto r = v->get("resolution")) vol.resolution = r->integer(4, 1 << 20);  // device limit checked at upload
+    const double h = std::max(ext.x, std::max(ext.y, ext.z)) / vol.resolution;
+    if (!(h >= kMinVoxelMm))
+      (v->has("resolution") ? v->at("resolution") : *v)
+          .fail("the voxel edge (longest side / resolution) is " + fmt(h) +
+                " mm, below the smallest " + fmt(kMinVoxelMm) +
+                " mm; enlarge the bounds or lower the resolution");
+    const bool min_farther = glm::length(vol.bounds_min) > glm::length(vol.bounds_max);
+    const char* far_key = min_farther ? "bounds_min" : "bounds_max";
+    const double offset = glm::length(min_farther ? vol.bounds_min : vol.bounds_max) / h;
+    if (!(offset <= kMaxOffsetVoxels))
+      (v->has(far_key) ? v->at(far_key) : *v)
+          .fail("the volume reaches " + fmt(offset) + " voxels (of " + fmt(h) +
+                " mm) from the origin; the GPU's " +
+                "single-precision positions resolve the grid only within " + fmt(kMaxOffsetVoxels) +
+                " voxels of it (move the scene towards the origin or lower the resolution)");
     if (auto s = v->get("smoothing_voxels")) vol.smoothing_voxels = s->number(0.0, 8.0);
     if (auto s = v->get("smoothing_method")) {
       std::string m = s->string();
       if (m == "analytic") vol.smoothing = VolumeSpec::Smoothing::Analytic;
       else if (m == "gaussian") vol.smoothing = VolumeSpec::Smoothing::Gaussian;
-      else s->fail("unknown smoothing_method '" + m + "' (analytic, gaussian)");
+      else
+        s->fail("unknown smoothing_method '" + excerpt(m) + "' (analytic, gaussian)");
     }
   }
   if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
@@ -627,15 +760,28 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto ms = root.get("materials")) {
     ms->requireObject();
     for (auto it = ms->raw().begin(); it != ms->raw().end(); ++it)
-      scene.materials[it.key()] = parseMaterial(Node(it.value(), ms->path() + "/" + it.key(), file), it.key(), false);
+      scene.materials[it.key()] = parseMaterial(
+          Node(it.value(), ms->path() + "/" + excerpt(it.key()), file), it.key(), false);
   }
 
   auto objs = root.at("objects");
   if (!objs.isArray()) objs.fail("expected an array of objects");
+  std::set<size_t> covering;  // objects that cover the whole volume (warned about once)
   for (size_t i = 0; i < objs.size(); ++i) {
     Node o = objs.index(i);
     SceneObject obj = parseObject(o);
     if (!scene.materials.count(obj.material)) {
+      // A library name is a file name inside a library directory, never a path: "../x" or
+      // "/abs/x" would read any JSON file on the machine.
+      const std::string& name = obj.material;
+      if (name.empty() || name == "." || name == ".." ||
+          name.find_first_of(std::string("/\\\0", 3)) != std::string::npos)
+        o.at("material")
+            .fail(
+                "material name '" + excerpt(name) +
+                "' is not a plain name (no '/', '\\' or NUL, not '.' or " +
+                "'..'): library materials are looked up inside the material library only; define " +
+                "others under /materials");
       bool found = false;
       for (const auto& dir : materialSearchPath()) {
         auto p = dir / (obj.material + ".json");
@@ -646,14 +792,41 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
         }
       }
       if (!found)
-        o.at("material").fail("unknown material '" + obj.material +
-                              "' (not defined under /materials and not in the material library)");
+        o.at("material")
+            .fail("unknown material '" + excerpt(obj.material) +
+                  "' (not defined under /materials and not in the material library)");
     }
     const Material& mat = scene.materials[obj.material];
     if (obj.radial_axis && !mat.uniaxial) o.at("optic_axis_field").fail("optic_axis_field given for an isotropic material");
     if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis && !obj.radial_axis)
-      o.fail("uniaxial material '" + obj.material + "' needs an optic_axis (on the object or the material)");
+      o.fail("uniaxial material '" + excerpt(obj.material) +
+             "' needs an optic_axis (on the object or the material)");
     if (!mat.uniaxial && obj.optic_axis) o.at("optic_axis").fail("optic_axis given for an isotropic material");
+    {
+      // An object wholly outside the volume would vanish from the render, and one that covers it
+      // would fill it with no surface inside: neither may happen silently. The shape lies within
+      // its bounding sphere (exact for spheres), and every shape is convex, so it covers the box
+      // if it holds the box's 8 corners.
+      const auto& vol = scene.volume;
+      auto [lo, hi] = obj.shape.bounds();
+      const double r = 0.5 * (hi.x - lo.x);
+      const glm::dvec3 c = obj.shape.center();
+      if (glm::length(c - glm::clamp(c, vol.bounds_min, vol.bounds_max)) > r)
+        o.fail("the object lies entirely outside the volume " + box(vol) +
+               ", so nothing of it would be rendered; move it inside or enlarge the volume");
+      bool covers = true;
+      for (int corner = 0; corner < 8 && covers; ++corner)
+        covers = obj.shape.contains(glm::dvec3(corner & 1 ? vol.bounds_max.x : vol.bounds_min.x,
+                                               corner & 2 ? vol.bounds_max.y : vol.bounds_min.y,
+                                               corner & 4 ? vol.bounds_max.z : vol.bounds_min.z));
+      if (covers) {
+        scene.warnings.push_back(printable(
+            file + ": " + o.path() + ": the object covers the whole volume " + box(vol) +
+            ": it fills the volume and none of its surface is inside, so it bends no ray " +
+            "(shrink it or enlarge the volume)"));
+        covering.insert(i);
+      }
+    }
     if (mat.grin.type != GrinProfile::Type::None) {
       // The profile must give n ≥ 1 wherever the object is inside the volume (sampled on a 17³
       // lattice of the overlap of its box with the volume).
@@ -672,8 +845,10 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
               n = r2 <= 2.0 ? std::sqrt(2.0 - r2) : std::nan("");
             }
             if (!(n >= 1.0))
-              o.at("material").fail("gradient-index material '" + obj.material + "' gives n = " + fmt(n) +
-                                    ", below 1, inside this object at (" + fmt(p.x) + ", " + fmt(p.y) + ", " + fmt(p.z) + ")");
+              o.at("material")
+                  .fail("gradient-index material '" + excerpt(obj.material) +
+                        "' gives n = " + fmt(n) + ", below 1, inside this object at (" + fmt(p.x) +
+                        ", " + fmt(p.y) + ", " + fmt(p.z) + ")");
           }
     }
     scene.objects.push_back(std::move(obj));
@@ -692,7 +867,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
       bool refracts = mat.uniaxial || mat.grin.type != GrinProfile::Type::None;
       for (double l = 380.0; l <= 780.0 && !refracts; l += 40.0)
         refracts = std::abs(mat.n_o.index(l) - scene.ambient_index) > 1e-12;
-      if (!refracts) continue;
+      if (!refracts || covering.count(i)) continue;
       double closest = 1e300;
       for (int axis = 0; axis < 3; ++axis)
         for (int side = 0; side < 2; ++side)
@@ -705,9 +880,10 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
               closest = std::min(closest, scene.objects[i].shape.signedDistance(q));
             }
       if (closest < margin)
-        scene.warnings.push_back(file + ": /objects/" + std::to_string(i) + ": the object comes within " +
-                                 fmt(std::max(closest, 0.0)) + " mm of the volume's boundary (smoothing reach " +
-                                 fmt(margin) + " mm); rays leaving through it are not refracted there");
+        scene.warnings.push_back(printable(
+            file + ": /objects/" + std::to_string(i) + ": the object comes within " +
+            fmt(std::max(closest, 0.0)) + " mm of the volume's boundary (smoothing reach " +
+            fmt(margin) + " mm); rays leaving through it are not refracted there"));
     }
   }
 
@@ -719,6 +895,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
 }
 
 Scene loadScene(const std::filesystem::path& path) {
+  refuseDirectory(path, "a scene file");
   std::ifstream in(path);
   if (!in) throw SceneError(path.string() + ": cannot open scene file");
   std::stringstream ss;

@@ -18,12 +18,14 @@
 #include <vector>
 
 #include "anisotropic/dispersion.h"
+#include "core/scene/messages.h"
 #include "core/scene/shapes.h"
 
 namespace eikon {
 
+/// Its message is made printable (core/scene/messages.h) on construction: it quotes user input.
 struct SceneError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+  explicit SceneError(const std::string& message) : std::runtime_error(printable(message)) {}
 };
 
 /// A gradient-index profile that replaces a constant index inside an object (world coordinates).

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace eikon {
 namespace {
@@ -121,34 +123,87 @@ std::vector<Plane> Shape::worldPlanes() const {
 void finishConvex(ConvexShape& shape) {
   const auto& P = shape.planes;
   if (P.size() < 4) throw std::invalid_argument("a convex polyhedron needs at least 4 planes");
-  double r = 0.0;
-  int vertices = 0;
-  for (size_t i = 0; i < P.size(); ++i)
-    for (size_t j = i + 1; j < P.size(); ++j)
-      for (size_t k = j + 1; k < P.size(); ++k) {
-        glm::dmat3 m(P[i].normal, P[j].normal, P[k].normal);
-        double det = glm::determinant(m);
-        if (std::abs(det) < 1e-12) continue;
-        glm::dvec3 x = glm::inverse(glm::transpose(m)) * glm::dvec3(P[i].d, P[j].d, P[k].d);
-        bool inside = true;
-        for (const auto& pl : P)
-          if (glm::dot(pl.normal, x) - pl.d > 1e-9 * (1.0 + std::abs(pl.d))) { inside = false; break; }
-        if (!inside) continue;
-        ++vertices;
-        r = std::max(r, glm::length(x));
+  // Each face is the polygon {x on plane i : n_j·x ≤ d_j for all j ≠ i}: a large square about the
+  // foot of the origin on plane i, clipped by the other planes (Sutherland–Hodgman, O(n) per clip
+  // on small polygons: O(n²) in all, against the O(n⁴) of trying every triple of planes). The
+  // faces give the vertices (the bounding radius), the volume (Σ area_i·d_i/3) and boundedness: a
+  // face that still touches the square's edge runs off to infinity (or beyond ~1e6 times the
+  // planes' distances from the centre, which is treated the same way).
+  double dmax = 0.0;
+  for (const auto& pl : P) dmax = std::max(dmax, std::abs(pl.d));
+  const double L = 1e6 * (1.0 + dmax);     // half-size of the starting square
+  const double tol = 1e-9 * (1.0 + dmax);  // on-plane tolerance (the old vertex test's)
+  const std::string unbounded = "the planes do not enclose a bounded solid";
+  struct V {
+    glm::dvec2 p;
+    // The plane whose line the edge from this vertex to the next lies on; -1: the square's edge.
+    long line;
+  };
+  std::vector<V> poly, next;
+  double r = 0.0, volume = 0.0;
+  bool any_face = false;
+  for (size_t i = 0; i < P.size(); ++i) {
+    const glm::dvec3 n = P[i].normal, o = n * P[i].d;
+    // An orthonormal frame (e1, e2) of the plane.
+    const glm::dvec3 e1 = glm::normalize(std::abs(n.x) < 0.9 ? glm::cross(n, glm::dvec3(1, 0, 0))
+                                                             : glm::cross(n, glm::dvec3(0, 1, 0)));
+    const glm::dvec3 e2 = glm::cross(n, e1);
+    poly = {{{-L, -L}, -1}, {{L, -L}, -1}, {{L, L}, -1}, {{-L, L}, -1}};
+    // Plane j as the line a·(u, v) ≤ c of plane i's frame: n_j·(o + u e1 + v e2) ≤ d_j.
+    auto line = [&](size_t j) {
+      return std::pair(glm::dvec2(glm::dot(P[j].normal, e1), glm::dot(P[j].normal, e2)),
+                       P[j].d - glm::dot(P[j].normal, o));
+    };
+    for (size_t j = 0; j < P.size() && !poly.empty(); ++j) {
+      if (j == i) continue;
+      const auto [a, c] = line(j);
+      if (glm::length(a) < 1e-12) {  // parallel planes
+        // Opposite (or coincident) normals leave the face alone; the same normal with a smaller
+        // d hides it, and of two identical planes only the first keeps its face.
+        if (c < -tol || (glm::dot(P[j].normal, n) > 0 && std::abs(c) <= tol && j < i)) poly.clear();
+        continue;
       }
-  if (vertices < 4) throw std::invalid_argument("the planes do not enclose a bounded solid");
-  // Unbounded if some direction escapes every plane: test the 26 lattice directions cheaply.
-  for (int dx = -1; dx <= 1; ++dx)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dz = -1; dz <= 1; ++dz) {
-        if (!dx && !dy && !dz) continue;
-        glm::dvec3 far = glm::normalize(glm::dvec3(dx, dy, dz)) * (10.0 * r + 1.0);
-        bool inside = true;
-        for (const auto& pl : P)
-          if (glm::dot(pl.normal, far) > pl.d) { inside = false; break; }
-        if (inside) throw std::invalid_argument("the planes do not enclose a bounded solid");
+      next.clear();
+      for (size_t k = 0; k < poly.size(); ++k) {
+        const V& A = poly[k];
+        const V& B = poly[(k + 1) % poly.size()];
+        const double sa = glm::dot(a, A.p) - c, sb = glm::dot(a, B.p) - c;
+        if (sa <= tol) {
+          next.push_back(A);
+          if (sb > tol) next.push_back({A.p + (B.p - A.p) * (sa / (sa - sb)), long(j)});
+        } else if (sb <= tol) {
+          next.push_back({A.p + (B.p - A.p) * (sa / (sa - sb)), A.line});
+        }
       }
+      poly.swap(next);
+      if (poly.size() < 3) poly.clear();
+    }
+    if (poly.empty()) continue;
+    // Each vertex again as the crossing of the lines of its two edges: the clipped positions carry
+    // rounding errors of the starting square's size (~1e-10 of the shape's).
+    for (const V& A : poly)
+      if (A.line < 0) throw std::invalid_argument(unbounded);
+    next = poly;
+    for (size_t k = 0; k < poly.size(); ++k) {
+      const auto [a1, c1] = line(size_t(poly[(k + poly.size() - 1) % poly.size()].line));
+      const auto [a2, c2] = line(size_t(poly[k].line));
+      const double det = a1.x * a2.y - a1.y * a2.x;
+      if (std::abs(det) > 1e-6 * glm::length(a1) * glm::length(a2))
+        next[k].p = glm::dvec2(c1 * a2.y - c2 * a1.y, a1.x * c2 - a2.x * c1) / det;
+    }
+    poly.swap(next);
+    double area = 0.0;
+    for (size_t k = 0; k < poly.size(); ++k) {
+      const V& A = poly[k];
+      const V& B = poly[(k + 1) % poly.size()];
+      area += A.p.x * B.p.y - B.p.x * A.p.y;
+      r = std::max(r, glm::length(o + A.p.x * e1 + A.p.y * e2));
+    }
+    volume += 0.5 * area * P[i].d / 3.0;
+    any_face = true;
+  }
+  // Empty sets have no face; flat ones (two opposite planes at the same place) no volume.
+  if (!any_face || !(volume > 1e-12 * r * r * r)) throw std::invalid_argument(unbounded);
   shape.bounding_radius = r;
 }
 

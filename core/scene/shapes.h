@@ -30,8 +30,9 @@ struct ConvexShape {
   double bounding_radius = 0.0;
 };
 
-/// Compute the vertices of a convex polyhedron and fill `bounding_radius`; throws
-/// std::invalid_argument if the planes do not enclose a bounded, non-empty solid.
+/// Compute the faces and vertices of a convex polyhedron (O(n²) in the plane count) and fill
+/// `bounding_radius`; throws std::invalid_argument if the planes do not enclose a bounded solid
+/// of non-zero volume.
 void finishConvex(ConvexShape& shape);
 
 using ShapeGeometry = std::variant<SphereShape, BoxShape, RoundedBoxShape, ConvexShape>;

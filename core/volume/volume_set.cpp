@@ -5,6 +5,8 @@
 #include <cmath>
 #include <thread>
 
+#include "core/volume/host_memory.h"
+
 namespace eikon {
 namespace {
 
@@ -38,6 +40,23 @@ void parallelFor(int n, int threads, F&& body) {
 struct MaterialValues {
   float v[kFieldCount];
 };
+
+// The voxel index range [lo, hi] of a world box widened by `margin` voxels, clamped to the grid.
+// The clamping is done in double before converting to int: an object far outside the volume
+// (centre 1e300, or 4294967296 mm) gives voxel coordinates beyond int's range, whose conversion
+// is undefined behaviour (UBSan: signed overflow). False if the box misses the grid (or is NaN).
+bool voxelRange(const glm::dvec3& bmin, const glm::dvec3& bmax, const Grid& g, int margin,
+                int lo[3], int hi[3]) {
+  for (int a = 0; a < 3; ++a) {
+    const double top = double(g.dims[a] - 1);
+    double l = std::floor((bmin[a] - g.origin[a]) / g.h) - margin;
+    double h = std::ceil((bmax[a] - g.origin[a]) / g.h) + margin;
+    if (!(l <= top) || !(h >= 0.0) || !(l <= h)) return false;  // also false for NaN
+    lo[a] = int(std::max(l, 0.0));
+    hi[a] = int(std::min(h, top));
+  }
+  return true;
+}
 
 }  // namespace
 
@@ -96,6 +115,25 @@ void gaussianSmooth(std::vector<float>& f, const std::array<int, 3>& dims, doubl
   }
 }
 
+double voxelizeHostBytes(const Scene& scene, const Grid& g) {
+  // Per voxel, everything voxelize() holds at once near its end (the smoothing's and the axis
+  // dilation's temporaries included).
+  const bool uniaxial = scene.anyUniaxial();
+  bool scattering = false;
+  for (const auto& [name, m] : scene.materials)
+    scattering = scattering || m.albedo != glm::dvec3(0.0);
+  const bool analytic = scene.volume.smoothing_voxels > 0 &&
+                        scene.volume.smoothing == VolumeSpec::Smoothing::Analytic;
+  double per_voxel = kFieldCount * sizeof(float);                 // composited fields
+  per_voxel += analytic ? 6 * sizeof(glm::vec3) : sizeof(float);  // exact gradients / smoothing
+  per_voxel += (uniaxial ? 6 : 3) * sizeof(glm::vec4);            // index volumes
+  per_voxel += (uniaxial ? 2 : 1) * sizeof(glm::vec4);            // medium volumes
+  per_voxel += sizeof(glm::vec4) + (scattering ? sizeof(glm::vec4) : 0);  // emission, scatter
+  per_voxel += uniaxial ? 2 * sizeof(glm::vec4) : 0;  // axis and its dilation copy
+  per_voxel += 2 * sizeof(uint8_t);                   // skip distances
+  return per_voxel * double(g.dims[0]) * double(g.dims[1]) * double(g.dims[2]);
+}
+
 VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
   auto progress = [&](double x, const char* stage) {
     if (opt.progress) opt.progress(x, stage);
@@ -106,6 +144,16 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
   if (double(g.dims[0]) * g.dims[1] * g.dims[2] > double(1u << 31))
     throw SceneError(scene.file.string() + ": /volume/resolution: " + std::to_string(g.dims[0]) + "x" +
                      std::to_string(g.dims[1]) + "x" + std::to_string(g.dims[2]) + " voxels is too many");
+  {
+    const double need = voxelizeHostBytes(scene, g);
+    const HostMemory mem = availableHostMemory();
+    if (need > double(mem.available))
+      throw SceneError(scene.file.string() + ": /volume/resolution: voxelising " +
+                       std::to_string(g.dims[0]) + "x" + std::to_string(g.dims[1]) + "x" +
+                       std::to_string(g.dims[2]) + " voxels needs " + formatBytes(need) +
+                       " of host memory, " + formatBytes(double(mem.available)) + " available (" +
+                       mem.limited_by + "); lower the resolution");
+  }
   const size_t N = g.count();
   vs.uniaxial = scene.anyUniaxial();
   vs.ambient_index = scene.ambient_index;
@@ -188,9 +236,9 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
     else if (mat.uniaxial) ax = glm::vec4(glm::vec3(obj.optic_axis ? *obj.optic_axis : *mat.optic_axis), 0.0f);
     auto [bmin, bmax] = obj.shape.bounds();
     int lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::clamp(int(std::floor((bmin[a] - g.origin[a]) / g.h)) - margin, 0, g.dims[a] - 1);
-      hi[a] = std::clamp(int(std::ceil((bmax[a] - g.origin[a]) / g.h)) + margin, 0, g.dims[a] - 1);
+    if (!voxelRange(bmin, bmax, g, margin, lo, hi)) {  // wholly outside the grid: nothing to add
+      progress(0.4 * double(oi + 1) / double(scene.objects.size()), "voxelising");
+      continue;
     }
     parallelFor(hi[2] - lo[2] + 1, opt.threads, [&](int kk) {
       const int k = lo[2] + kk;

@@ -83,7 +83,12 @@ struct VoxelizeOptions {
 /// Grid for a volume spec: h = longest side / resolution, dims = ceil(side / h).
 Grid makeGrid(const VolumeSpec& spec);
 
-/// Voxelise a scene. Throws SceneError for inconsistent input (e.g. more than 2^31 voxels).
+/// Bytes of host memory voxelize() holds at its peak for this scene and grid: the composited
+/// fields, the exact gradients, the output volumes and the skip distances.
+double voxelizeHostBytes(const Scene& scene, const Grid& grid);
+
+/// Voxelise a scene. Throws SceneError for inconsistent input (e.g. more than 2^31 voxels) and,
+/// before allocating, when voxelizeHostBytes exceeds the host memory available to the process.
 VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& options = {});
 
 /// Smooth a scalar field in place with a separable Gaussian of σ voxels (truncated at 3σ,

@@ -1,0 +1,236 @@
+// Hostile scene and material input (issue 11): duplicate JSON keys, material names used as paths,
+// wavelength tables with non-positive wavelengths, directories given as files, and raw bytes in
+// error messages. Every case is a SceneError of one line that names the file and the JSON path.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/scene/messages.h"
+#include "core/scene/scene.h"
+
+namespace eikon {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr const char* kOrigin = "input.json";
+
+std::string errorOf(const std::string& text, const fs::path& origin = kOrigin) {
+  try {
+    parseScene(text, origin);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "the scene parsed:\n" << text;
+  return {};
+}
+
+#define EXPECT_INPUT_ERROR(text, json_path, phrase)                                        \
+  do {                                                                                     \
+    const std::string m_ = errorOf(text);                                                  \
+    EXPECT_EQ(m_.rfind(std::string(kOrigin) + ": " + (json_path) + ": ", 0), 0u) << m_;    \
+    EXPECT_NE(m_.find(phrase), std::string::npos) << "lacks '" << (phrase) << "': " << m_; \
+    EXPECT_EQ(m_.find('\n'), std::string::npos) << m_;                                     \
+  } while (0)
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (fs::temp_directory_path() / "eikon_input_test_XXXXXX").string();
+    if (::mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+    dir_ = tmpl;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  fs::path write(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name, std::ios::binary) << text;
+    return dir_ / name;
+  }
+  const fs::path& path() const { return dir_; }
+
+ private:
+  fs::path dir_;
+};
+
+/// Sets an environment variable for the lifetime of the object.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old, had_ = true;
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (had_)
+      ::setenv(name_, old_.c_str(), 1);
+    else
+      ::unsetenv(name_);
+  }
+
+ private:
+  const char* name_;
+  std::string old_;
+  bool had_ = false;
+};
+
+const std::string kGlass = R"("glass": {"n": 1.5})";
+const std::string kSphere = R"({"shape": "sphere", "radius": 3, "material": "glass"})";
+
+// ------------------------------------------------------------------ duplicate keys
+
+TEST(SceneInput, DuplicateKeysAreErrors) {
+  EXPECT_INPUT_ERROR(
+      R"({"materials": {)" + kGlass + R"(}, "objects": [], "objects": [)" + kSphere + "]}",
+      "/objects", "duplicate key 'objects'");
+  EXPECT_INPUT_ERROR(
+      R"({"materials": {"glass": {"n": 1.5, "n": 1.6}}, "objects": [)" + kSphere + "]}",
+      "/materials/glass/n", "duplicate key 'n'");
+  // In the second element of an array, after an element holding arrays (the path counts elements).
+  EXPECT_INPUT_ERROR(R"({"materials": {)" + kGlass + R"(}, "objects": [
+      {"shape": "planes", "planes": [[1, 0, 0, 1], [-1, 0, 0, 1], [0, 1, 0, 1], [0, -1, 0, 1], [0, 0, 1, 1], [0, 0, -1, 1]],
+       "material": "glass"},
+      {"shape": "sphere", "radius": 1, "center": [0, 0, 0], "radius": 2, "material": "glass"}]})",
+                     "/objects/1/radius", "duplicate key 'radius'");
+  // The same key in two different objects is fine.
+  EXPECT_NO_THROW(parseScene(R"({"materials": {"a": {"n": 1.5}, "b": {"n": 1.6}}, "objects": [
+      {"shape": "sphere", "radius": 1, "center": [-4, 0, 0], "material": "a"},
+      {"shape": "sphere", "radius": 1, "center": [4, 0, 0], "material": "b"}]})",
+                             kOrigin));
+}
+
+TEST(SceneInput, DuplicateKeyInAMaterialFile) {
+  TempDir lib;
+  lib.write("dup.json",
+            R"({"name": "dup", "n": 1.5, "attenuation_per_mm": 0.1, "attenuation_per_mm": 0.2})");
+  ScopedEnv env("EIKON_MATERIALS_PATH", lib.path().string());
+  const std::string m =
+      errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "dup"}]})");
+  EXPECT_EQ(m.rfind((lib.path() / "dup.json").string() + ": /attenuation_per_mm: duplicate key", 0),
+            0u)
+      << m;
+}
+
+// ------------------------------------------------------------------ material names
+
+// "../x" from a library directory reaches a JSON file outside it: the name is refused before any
+// file is looked up (the file exists and is a valid material, so only the name check stops it).
+TEST(SceneInput, MaterialNamesAreNotPaths) {
+  TempDir root;
+  fs::create_directory(root.path() / "lib");
+  const fs::path outside = root.write("x.json", R"({"n": 1.7})");
+  ScopedEnv env("EIKON_MATERIALS_PATH", (root.path() / "lib").string());
+  const std::string abs = (root.path() / "x").string();  // + ".json" names the file above
+  for (const std::string& name : {std::string("../x"), abs, std::string("lib/../../x"),
+                                  std::string(".."), std::string("a\\\\b"), std::string("")}) {
+    EXPECT_INPUT_ERROR(
+        R"({"objects": [{"shape": "sphere", "radius": 3, "material": ")" + name + R"("}]})",
+        "/objects/0/material", "is not a plain name");
+  }
+  // The same material by its plain name from a library directory is found.
+  ScopedEnv env2("EIKON_MATERIALS_PATH", root.path().string());
+  EXPECT_NO_THROW(
+      parseScene(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "x"}]})", kOrigin));
+}
+
+// ------------------------------------------------------------------ wavelength tables
+
+TEST(SceneInput, NonPositiveWavelengthsAreErrors) {
+  for (const char* w : {"-500", "0"}) {
+    EXPECT_INPUT_ERROR(
+        R"({"materials": {"glass": {"n": 1.5, "attenuation_per_mm": {"wavelength_nm": [)" +
+            std::string(w) + R"(, 600], "per_mm": [0.1, 0.2]}}}, "objects": [)" + kSphere + "]}",
+        "/materials/glass/attenuation_per_mm/wavelength_nm/0", "must be > 0 nm");
+    EXPECT_INPUT_ERROR(R"({"materials": {)" + kGlass + R"(}, "objects": [)" + kSphere +
+                           R"(], "lights": [{"type": "point", "position": [0, 8, 0],
+                           "spectrum": {"wavelength_nm": [)" +
+                           std::string(w) + R"(, 500], "power": [1, 1]}}]})",
+                       "/lights/0/spectrum/wavelength_nm/0", "must be > 0 nm");
+  }
+}
+
+// ------------------------------------------------------------------ directories given as files
+
+TEST(SceneInput, DirectoriesAreReportedAsDirectories) {
+  TempDir d;
+  fs::create_directory(d.path() / "scene.json");
+  try {
+    loadScene(d.path() / "scene.json");
+    ADD_FAILURE() << "a directory loaded as a scene";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              (d.path() / "scene.json").string() + ": is a directory, expected a scene file");
+  }
+  fs::create_directory(d.path() / "env.exr");
+  const std::string env = R"({"materials": {)" + kGlass + R"(}, "objects": [)" + kSphere +
+                          R"(], "environment": {"type": "latlong", "file": "env.exr"}})";
+  const std::string m = errorOf(env, d.path() / "s.json");
+  EXPECT_EQ(m.rfind((d.path() / "s.json").string() + ": /environment/file: ", 0), 0u) << m;
+  EXPECT_NE(m.find("env.exr: is a directory, expected an EXR image"), std::string::npos) << m;
+  fs::create_directory(d.path() / "lib");
+  fs::create_directory(d.path() / "lib" / "x.json");
+  ScopedEnv lib("EIKON_MATERIALS_PATH", (d.path() / "lib").string());
+  const std::string mm =
+      errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "x"}]})");
+  EXPECT_EQ(mm,
+            (d.path() / "lib" / "x.json").string() + ": is a directory, expected a material file");
+}
+
+// ------------------------------------------------------------------ bytes in messages
+
+TEST(Printable, EscapesWhatIsNotPrintableText) {
+  using namespace std::string_literals;
+  EXPECT_EQ(printable("plain ASCII, backslash \\ kept"), "plain ASCII, backslash \\ kept");
+  EXPECT_EQ(printable("λ = 587.6 nm, µm², ≥ 1, 🙂"),
+            "λ = 587.6 nm, µm², ≥ 1, 🙂");  // valid UTF-8
+  EXPECT_EQ(printable("a\0b"s), "a\\x00b");
+  EXPECT_EQ(printable("line\nbreak\ttab\r\x7f"), "line\\x0abreak\\x09tab\\x0d\\x7f");
+  EXPECT_EQ(printable("\xff\xfe"), "\\xff\\xfe");                    // never UTF-8
+  EXPECT_EQ(printable("\xc0\xaf"), "\\xc0\\xaf");                    // overlong '/'
+  EXPECT_EQ(printable("\xed\xa0\x80"), "\\xed\\xa0\\x80");           // a surrogate
+  EXPECT_EQ(printable("\xc2\x85"), "\\xc2\\x85");                    // C1 control NEL
+  EXPECT_EQ(printable("\xe2\x89"), "\\xe2\\x89");                    // truncated sequence
+  EXPECT_EQ(printable("\xf4\x90\x80\x80"), "\\xf4\\x90\\x80\\x80");  // beyond U+10FFFF
+}
+
+TEST(Printable, TruncatesAtACharacterBoundary) {
+  EXPECT_EQ(printable(std::string(1000, 'a'), 10), "aaaaaaaaaa... (1000 bytes)");
+  // "λ" is 2 bytes: 5 of them fill 10 bytes, a 6th would not fit and is not split.
+  EXPECT_EQ(printable("λλλλλλλ", 11), "λλλλλ... (14 bytes)");
+  EXPECT_EQ(printable("\x01\x01\x01", 9), "\\x01\\x01... (3 bytes)");  // escapes are not split
+  EXPECT_EQ(printable("short", 10), "short");
+}
+
+// A NUL inside a key or a name would cut the C string of the message (what(), printf): it is
+// escaped, and what follows it is still in the message.
+TEST(SceneInput, NulInANameIsEscaped) {
+  const std::string m = errorOf(R"({"objects": [], "lamps\u0000after": 1})");
+  EXPECT_NE(m.find("/lamps\\x00after: unknown key"), std::string::npos) << m;
+  const std::string n =
+      errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "x\u0000y"}]})");
+  EXPECT_NE(n.find("material name 'x\\x00y' is not a plain name"), std::string::npos) << n;
+  const std::string k =
+      errorOf(R"({"objects": [{"shape": "sphere\u0000", "radius": 3, "material": "g"}]})");
+  EXPECT_NE(k.find("unknown shape 'sphere\\x00'"), std::string::npos) << k;
+}
+
+// Raw bytes of a binary file in the malformed-JSON message are escaped, and a long token is cut.
+TEST(SceneInput, BinaryBytesInMessagesAreEscapedAndShort) {
+  using namespace std::string_literals;
+  const std::string binary =
+      "{\"objects\": [\"\x01\x02\xff\xfe\x80\x00\x1b[31mred"s + std::string(100000, 'z');
+  const std::string m = errorOf(binary);
+  EXPECT_EQ(m.rfind(std::string(kOrigin) + ": malformed JSON", 0), 0u) << m;
+  EXPECT_LT(m.size(), 600u);
+  for (unsigned char c : m) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << "byte " << int(c) << " in: " << m;
+  // An unknown key of 100000 bytes is cut to an excerpt.
+  const std::string key = errorOf(R"({"objects": [], ")" + std::string(100000, 'k') + R"(": 1})");
+  EXPECT_LT(key.size(), 600u);
+  EXPECT_NE(key.find("... (100000 bytes): unknown key"), std::string::npos) << key.substr(0, 300);
+}
+
+}  // namespace
+}  // namespace eikon
