@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <numeric>
 #include <sstream>
@@ -47,6 +48,10 @@ std::optional<double> parseNumber(const std::string& s) {
 }
 
 std::string readFile(const std::string& path) {
+  // An ifstream opens a directory on Linux and reads nothing: say what it is instead of "empty".
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw std::runtime_error(path + ": is a directory, expected a data file (CSV or YAML)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open file");
   std::ostringstream ss;

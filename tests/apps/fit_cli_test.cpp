@@ -170,6 +170,9 @@ TEST_F(FitCli, BadInputFailsWithOneLineAndNoFile) {
   }());
   expectCleanFailure(run(path("rank.csv") + " --model sellmeier2" + out), "rank-deficient");
   expectCleanFailure(run(path("missing.csv") + out), "cannot open");
+  // A folder given as data says so (it used to read as an "empty file").
+  std::filesystem::create_directories(path("adir.csv"));
+  expectCleanFailure(run(path("adir.csv") + out), "is a directory");
   expectCleanFailure(run(bk7Csv() + " --model cauchy9" + out), "unknown model");
   expectCleanFailure(run(bk7Csv() + " --loss huber:-1" + out), "huber");
   // An output folder that cannot be made (a file stands where it should be): error, nothing left.
