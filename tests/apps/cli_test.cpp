@@ -131,6 +131,29 @@ TEST_F(Cli, Info) {
   EXPECT_NE(r.out.find("device:"), std::string::npos) << r.out;
 }
 
+// Every "label: value" line of `eikon info` has its value in one column, after at least one space
+// (it printed "max storage buffer:128 MiB").
+TEST_F(Cli, InfoValuesAreAligned) {
+  const Outcome r = run("info");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  size_t column = 0;
+  int rows = 0;
+  while (std::getline(lines, line)) {
+    const size_t colon = line.find(':');
+    if (line.rfind("eikon ", 0) == 0 || colon == std::string::npos) continue;
+    ASSERT_LT(colon + 1, line.size()) << line;
+    EXPECT_EQ(line[colon + 1], ' ') << "no space after the label: " << line;
+    const size_t value = line.find_first_not_of(' ', colon + 1);
+    ASSERT_NE(value, std::string::npos) << line;
+    if (rows++ == 0) column = value;
+    EXPECT_EQ(value, column) << "value not in the column of the first row: " << line;
+  }
+  EXPECT_GE(rows, 6) << r.out;
+  EXPECT_NE(r.out.find("max storage buffer: "), std::string::npos) << r.out;
+}
+
 // ------------------------------------------------------------------ render
 
 TEST_F(Cli, RenderTinyScene) {
