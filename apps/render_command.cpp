@@ -42,11 +42,11 @@ void addRenderCommand(CLI::App& app) {
   auto* sub = app.add_subcommand("render", "Render a scene to an EXR (linear sRGB) and a PNG preview");
   sub->add_option("scene", args->scene, "Scene JSON file")->required();
   sub->add_option("-o,--output", args->output, "Output EXR path (the PNG preview is written beside it)")->required();
-  sub->add_option("--width", args->width, "Image width (default: the scene camera's)");
-  sub->add_option("--height", args->height, "Image height (default: the scene camera's)");
-  sub->add_option("--spp", args->spp, "Jittered samples per pixel (default 1)");
+  sub->add_option("--width", args->width, "Image width in [1, 16384] (default: the scene camera's)");
+  sub->add_option("--height", args->height, "Image height in [1, 16384] (default: the scene camera's)");
+  sub->add_option("--spp", args->spp, "Jittered samples per pixel in [1, 4096] (default 1)");
   sub->add_option("--wavelengths", args->wavelengths,
-                  "Spectral samples per pixel sample; 0 = RGB mode (default: 16 for dispersive scenes, else 0)");
+                  "Spectral samples per pixel sample in [1, 256], or 0 for RGB mode (default: 16 for dispersive scenes, else 0)");
   sub->add_option("--step", args->step, "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", args->integrator, "euler, midpoint or rk4 (default rk4)");
   sub->add_option("--exposure", args->exposure, "PNG preview exposure in stops (default 0)");
@@ -72,13 +72,21 @@ void addRenderCommand(CLI::App& app) {
                   "Directory of cached light volumes (default $EIKON_CACHE_DIR, $XDG_CACHE_HOME/eikon or ~/.cache/eikon)");
   sub->add_flag("--no-light-cache", args->no_light_cache, "Simulate the light even if a cached result exists, and store none");
   sub->add_flag("--no-light", args->no_light, "Do not simulate the scene's lights (no caustics, in-scatter or lit surfaces)");
-  sub->callback([args] {
+  sub->callback([args, sub] {
     const RenderArgs& a = *args;
     std::filesystem::path out(a.output), png = std::filesystem::path(a.output).replace_extension(".png");
     if (out.extension() != ".exr") throw CliError("output must end in .exr: " + a.output);
-    if (a.spp < 1 || a.spp > 4096) throw CliError("--spp must be in [1, 4096]");
-    if (a.width < 0 || a.height < 0 || a.width > 16384 || a.height > 16384) throw CliError("--width/--height must be in [1, 16384]");
-    if (a.wavelengths < -1 || a.wavelengths > 256) throw CliError("--wavelengths must be in [0, 256]");
+    // A size not given is the scene camera's; a given one must be a real size (0 used to mean
+    // "the scene's" silently, and a negative --wavelengths the default).
+    auto checkRange = [&](const char* name, int v, int lo, int hi) {
+      if (sub->count(name) && (v < lo || v > hi))
+        throw CliError(std::string(name) + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                       std::to_string(v));
+    };
+    checkRange("--width", a.width, 1, 16384);
+    checkRange("--height", a.height, 1, 16384);
+    checkRange("--spp", a.spp, 1, 4096);
+    checkRange("--wavelengths", a.wavelengths, 0, 256);
     if (!(a.step > 0 && a.step <= 4)) throw CliError("--step must be in (0, 4] voxels");
     if (a.light_bands < 0 || a.light_bands > 64) throw CliError("--light-bands must be in [1, 64]");
     if (a.light_splat != "accumulate" && a.light_splat != "highest")

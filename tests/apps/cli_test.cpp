@@ -257,6 +257,17 @@ TEST_F(Cli, RenderOutputMustEndInExr) {
 
 TEST_F(Cli, RenderSppZero) { expectCleanFailure(render(tinyScene(), "--spp 0"), "--spp"); }
 
+// A given size must be a size: --width 0 used to render at the scene's width with exit 0, and
+// --wavelengths -1 at the default. Not given still means the scene's value (RenderTinyScene).
+TEST_F(Cli, RenderZeroOrNegativeSizesAreRejected) {
+  for (const char* bad : {"--width 0", "--height 0", "--width -5", "--height -1", "--spp -2", "--wavelengths -1"}) {
+    const std::string flag = std::string(bad).substr(0, std::string(bad).find(' '));
+    const Outcome r = render(tinyScene(), bad);
+    expectCleanFailure(r, flag + " must be in [");
+    EXPECT_NE(r.err.find("got " + std::string(bad).substr(flag.size() + 1)), std::string::npos) << r.err;
+  }
+}
+
 TEST_F(Cli, RenderSceneFileMissing) {
   expectCleanFailure(run("render " + quote((dir_ / "nope.json").string()) + " -o " + quote(outPath())), "nope.json");
 }
