@@ -27,10 +27,20 @@ std::filesystem::path tempPathFor(const std::filesystem::path& path) {
   return std::filesystem::path(path.string() + suffix);
 }
 
+/// Create the missing folders above `path` (an output's folder need not exist: `-o out/x.exr`).
+void createParentFolders(const std::filesystem::path& path) {
+  const auto dir = path.parent_path();
+  if (dir.empty()) return;
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot write '" + path.string() + "': cannot create folder '" + dir.string() + "': " + ec.message());
+}
+
 /// Run `write(tmp)` then rename tmp over path; remove tmp on any failure.
 template <typename F>
 void atomicWrite(const std::filesystem::path& path, F&& write) {
   checkWritable(path);
+  createParentFolders(path);
   auto tmp = tempPathFor(path);
   try {
     write(tmp);
@@ -45,20 +55,22 @@ void atomicWrite(const std::filesystem::path& path, F&& write) {
 }  // namespace
 
 void checkWritable(const std::filesystem::path& path) {
-  auto dir = path.parent_path();
-  if (dir.empty()) dir = ".";
-  if (!std::filesystem::is_directory(dir))
-    throw std::runtime_error("cannot write '" + path.string() + "': directory '" + dir.string() + "' does not exist");
-  if (::access(dir.c_str(), W_OK) != 0)
-    throw std::runtime_error("cannot write '" + path.string() + "': directory '" + dir.string() + "' is not writable");
-  if (std::filesystem::is_directory(path))
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
     throw std::runtime_error("cannot write '" + path.string() + "': it is a directory");
+  // Missing folders are created when writing; here the nearest existing one must take new entries.
+  std::filesystem::path dir = path.parent_path();
+  while (!dir.empty() && !std::filesystem::exists(dir, ec)) dir = dir.parent_path();  // "a/b" → "a" → ""
+  if (dir.empty()) dir = ".";
+  if (!std::filesystem::is_directory(dir, ec))
+    throw std::runtime_error("cannot write '" + path.string() + "': '" + dir.string() + "' is not a folder");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw std::runtime_error("cannot write '" + path.string() + "': folder '" + dir.string() + "' is not writable");
   // access() says yes to root everywhere; creating a probe file is the real test.
-  auto probe = tempPathFor(path);
+  auto probe = tempPathFor(dir / path.filename());
   FILE* f = std::fopen(probe.c_str(), "wb");
   if (!f) throw std::runtime_error("cannot write '" + path.string() + "': cannot create files in '" + dir.string() + "'");
   std::fclose(f);
-  std::error_code ec;
   std::filesystem::remove(probe, ec);
 }
 

@@ -1,7 +1,7 @@
 // Image files: OpenEXR (linear HDR, float) in and out, PNG previews, and atomic writes.
 //
-// Every writer writes to "<path>.tmp-XXXX" in the same directory and renames it into place, so a
-// failed or interrupted run leaves no partial file. Readers validate before decoding: Debian's
+// Every writer creates the missing folders above its path, writes to "<path>.tmp-XXXX" in the
+// same folder and renames it into place, so a failed or interrupted run leaves no partial file. Readers validate before decoding: Debian's
 // OpenEXR 3.1.5 has a known flaw with deep images, so EXR input is accepted only after
 // Imf::checkOpenEXRFile passes, deep files are rejected, and sizes are capped.
 #pragma once
@@ -38,8 +38,9 @@ void writeExrRgb(const std::filesystem::path& path, int width, int height, const
 void writePngPreview(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb,
                      double exposure = 0.0);
 
-/// Check that `path` can be created (directory exists and is writable); throws with a clear
-/// message otherwise. Call before long work so that it fails early.
+/// Check that `path` can be created: it is not a folder, and its folder, or the nearest existing
+/// folder above it when folders are missing (the writers create them), takes new files. Throws
+/// with a clear message otherwise, creating nothing. Call before long work so that it fails early.
 void checkWritable(const std::filesystem::path& path);
 
 }  // namespace eikon

@@ -223,11 +223,29 @@ TEST_F(Cli, RenderResolutionBeyondTheDeviceLimit) {
   EXPECT_NE(r.err.find(std::to_string(limit)), std::string::npos) << "message should state the limit " << limit << ": " << r.err;
 }
 
-TEST_F(Cli, RenderOutputDirectoryMissing) {
+// Missing folders of -o are created (the render used to fail: "directory 'out' does not exist"),
+// also for a relative path, which is how a user types it.
+TEST_F(Cli, RenderCreatesMissingOutputFolders) {
   const std::string scene = write("scene.json", tinyScene());
-  const fs::path missing = dir_ / "no_such_dir";
-  expectCleanFailure(run("render " + quote(scene) + " -o " + quote((missing / "x.exr").string())), "does not exist");
-  EXPECT_FALSE(fs::exists(missing));
+  const fs::path missing = dir_ / "no_such_dir" / "deeper";
+  const Outcome r = run("render " + quote(scene) + " -q --reference -o " + quote((missing / "x.exr").string()));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(missing / "x.exr"));
+  EXPECT_TRUE(fs::is_regular_file(missing / "x.png"));
+  const Outcome rel = run("render " + quote(scene) + " -q --reference -o " +
+                          quote(fs::relative(dir_ / "rel" / "y.exr", fs::current_path()).string()));
+  ASSERT_EQ(rel.code, 0) << rel.err;
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "rel" / "y.exr"));
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "rel" / "y.png"));
+}
+
+// A file where a folder of -o should be: one error line before any work, nothing created.
+TEST_F(Cli, RenderOutputFolderIsAFile) {
+  const std::string scene = write("scene.json", tinyScene());
+  write("plain", "not a folder");
+  const Outcome r = run("render " + quote(scene) + " -o " + quote((dir_ / "plain" / "sub" / "x.exr").string()));
+  expectCleanFailure(r, "is not a folder", dir_);
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "plain"));
 }
 
 // An unwritable output directory. As root, permissions do not apply (access(W_OK) succeeds on a
