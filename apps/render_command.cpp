@@ -175,14 +175,11 @@ void addRenderCommand(CLI::App& app) {
       img = renderer.render(rs);
     }
     progress.finish();
-    writeExrRgb(out, img.width, img.height, img.rgb);
-    try {
-      writePngPreview(png, img.width, img.height, img.rgb, a.exposure);
-    } catch (...) {
-      std::error_code ec;
-      std::filesystem::remove(out, ec);
-      throw;
-    }
+    // The pair as a pair (core/io/atomic_write.h): both files or neither replace what is there,
+    // and a concurrent render to the same -o cannot interleave its pair with this one. The
+    // preview first: it is the smaller, so a full disk is usually met before the EXR is encoded.
+    writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)},
+                        {out, exrRgbContent(img.width, img.height, img.rgb)}});
     for (const std::string& n : light.notes) std::fprintf(stderr, "eikon: note: %s\n", n.c_str());
     if (light_cached)
       std::printf("eikon: light volumes from the cache (%s)\n", (a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache)).c_str());

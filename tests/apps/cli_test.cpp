@@ -268,6 +268,34 @@ TEST_F(Cli, RenderOutputDirectoryReadOnly) {
   }
 }
 
+// A render that fails while writing (here: files limited to 8 KiB, so the 6 KB PNG preview is
+// written and the 22 KB EXR is not, as on a full disk) leaves the previous render's EXR and PNG
+// byte for byte, and no temporary. It used to delete the previous EXR when the PNG failed.
+TEST_F(Cli, FailedWriteLeavesThePreviousOutputsIntact) {
+  const std::string scene = write("scene.json", tinyScene());
+  const std::string common = "render " + quote(scene) + " -q --reference --width 160 --height 120 -o " + quote(outPath());
+  const Outcome first = run(common);
+  ASSERT_EQ(first.code, 0) << first.err;
+  const std::string exr = slurp(outPath("render.exr")), png = slurp(outPath("render.png"));
+  // The sizes the limit is chosen between (a 160x120 render of the tiny scene: ~22 KB, ~6 KB).
+  ASSERT_GT(exr.size(), 12000u);
+  ASSERT_LT(png.size(), 8192u);
+  // A different picture (2 spp, brighter preview): had it replaced anything, the bytes would differ.
+  const Outcome r = eikon::test::runProgramWithFileLimit(EIKON_BINARY, common + " --spp 2 --exposure 1", io_, 8192);
+  EXPECT_NE(r.code, 0);
+  EXPECT_EQ(r.err.rfind("eikon: error: cannot write '" + outPath("render.exr") + "'", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(slurp(outPath("render.exr")), exr);
+  EXPECT_EQ(slurp(outPath("render.png")), png);
+  for (auto& e : fs::directory_iterator(out_))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+  // The same render without the limit does replace both (the test above is not vacuous).
+  const Outcome again = run(common + " --spp 2 --exposure 1");
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(slurp(outPath("render.exr")), exr);
+  EXPECT_NE(slurp(outPath("render.png")), png);
+}
+
 TEST_F(Cli, RenderOutputMustEndInExr) {
   const std::string scene = write("scene.json", tinyScene());
   expectCleanFailure(run("render " + quote(scene) + " -o " + quote(outPath("render.png"))), ".exr");
