@@ -76,15 +76,36 @@ void encodeExr(const std::filesystem::path& file, int width, int height, const s
   out.writePixels(height);
 }
 
+// libpng reports through callbacks; its defaults print "libpng error: ..." / "libpng warning: ..."
+// on stderr themselves. These keep the message (and errno, for I/O failures) so that eikon prints
+// its one line, and drop warnings (none can arise for the 8-bit RGB images written here).
+struct PngErrorState {
+  char message[256] = "";
+  int err = 0;
+};
+
+void pngError(png_structp png, png_const_charp msg) {
+  auto* st = static_cast<PngErrorState*>(png_get_error_ptr(png));
+  st->err = errno;
+  std::snprintf(st->message, sizeof st->message, "%s", msg ? msg : "unknown error");
+  png_longjmp(png, 1);
+}
+
+void pngWarning(png_structp, png_const_charp) {}
+
 void encodePng(const std::filesystem::path& file, int width, int height, const std::vector<unsigned char>& px) {
   FILE* f = std::fopen(file.c_str(), "wb");
   if (!f) throw std::runtime_error(std::string("cannot open a temporary file: ") + std::strerror(errno));
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  PngErrorState st;
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &st, pngError, pngWarning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
+  // Only plain C state lives between setjmp and a longjmp back here (no destructors skipped).
   if (!png || !info || setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
     std::fclose(f);
-    throw std::runtime_error("libpng failed");
+    std::string why = std::string("libpng: ") + (st.message[0] ? st.message : "cannot allocate");
+    if (st.err != 0) why += std::string(" (") + std::strerror(st.err) + ")";
+    throw std::runtime_error(why);
   }
   png_init_io(png, f);
   png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,

@@ -296,6 +296,17 @@ TEST_F(Cli, FailedWriteLeavesThePreviousOutputsIntact) {
   EXPECT_NE(slurp(outPath("render.png")), png);
 }
 
+// A PNG write error (files limited to 2 KiB: libpng's first 4 KiB write fails) is eikon's one
+// line, naming the file and libpng's reason; libpng's own "libpng error: Write Error" line used to
+// come first.
+TEST_F(Cli, PngWriteErrorIsOneEikonLine) {
+  const std::string scene = write("scene.json", tinyScene());
+  const Outcome r = eikon::test::runProgramWithFileLimit(
+      EIKON_BINARY, "render " + quote(scene) + " -q --reference --width 160 --height 120 -o " + quote(outPath()), io_, 2048);
+  expectCleanFailure(r, "cannot write '" + outPath("render.png") + "': libpng: Write Error (File too large)");
+  EXPECT_EQ(r.err.find("libpng error"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, RenderOutputMustEndInExr) {
   const std::string scene = write("scene.json", tinyScene());
   expectCleanFailure(run("render " + quote(scene) + " -o " + quote(outPath("render.png"))), ".exr");
