@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <utility>
+#include <vector>
 
 #include "apps/commands.h"
 #include "apps/light_cache.h"
@@ -28,6 +30,22 @@ struct RenderArgs {
   std::string light_splat = "accumulate", light_cache, caustics = "pass", light_device = "auto";
   bool no_light = false, no_light_cache = false;
 };
+
+/// Refuse an output that is one of the render's own inputs (the same file by device and inode:
+/// also through a symbolic or hard link): `-o scenes/diamond_lights.exr` used to replace the
+/// scene's environment map with the render and exit 0.
+void refuseOverwritingInputs(const Scene& scene, const std::filesystem::path& scene_path,
+                             const std::vector<std::pair<std::filesystem::path, const char*>>& outputs) {
+  std::vector<std::pair<std::filesystem::path, std::string>> inputs = {{scene_path, "the scene file"}};
+  if (!scene.environment.image_path.empty()) inputs.push_back({scene.environment.image_path, "the scene's environment map"});
+  for (const auto& [out, what] : outputs)
+    for (const auto& [in, role] : inputs) {
+      std::error_code ec;
+      if (std::filesystem::equivalent(out, in, ec))
+        throw CliError(std::string(what) + " '" + out.string() + "' is " + role + " '" + in.string() +
+                       "'; refusing to overwrite an input (choose another -o)");
+    }
+}
 
 Integrator parseIntegrator(const std::string& s) {
   if (s == "euler") return Integrator::Euler;
@@ -102,6 +120,7 @@ void addRenderCommand(CLI::App& app) {
       if (a.strict) throw CliError(w + " (--strict)");
       std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
     }
+    refuseOverwritingInputs(scene, a.scene, {{out, "the output"}, {png, "the PNG preview"}});
     checkWritable(out);
     checkWritable(png);
     RenderSettings rs;

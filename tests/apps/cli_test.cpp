@@ -307,6 +307,37 @@ TEST_F(Cli, PngWriteErrorIsOneEikonLine) {
   EXPECT_EQ(r.err.find("libpng error"), std::string::npos) << r.err;
 }
 
+// An output that is one of the render's inputs is refused with one line and the input is left as
+// it was: -o naming the environment map (directly or through a symbolic link), or a scene file
+// whose name is where the PNG preview would go. Both used to be overwritten with exit 0.
+TEST_F(Cli, RenderRefusesToOverwriteItsInputs) {
+  const std::vector<float> sky(8 * 4 * 3, 0.5f);
+  eikon::writeExrRgb(dir_ / "sky.exr", 8, 4, sky);
+  const std::string sky_bytes = slurp(dir_ / "sky.exr");
+  std::string text = tinyScene();
+  const std::string checker = R"({"type": "checker", "squares": 8})";
+  text.replace(text.find(checker), checker.size(), R"({"type": "latlong", "file": "sky.exr"})");
+  const std::string scene = write("scene.json", text);
+  Outcome r = run("render " + quote(scene) + " -q --reference -o " + quote((dir_ / "sky.exr").string()));
+  expectCleanFailure(r, "is the scene's environment map", fs::path());
+  EXPECT_EQ(slurp(dir_ / "sky.exr"), sky_bytes);
+  EXPECT_FALSE(fs::exists(dir_ / "sky.png"));
+  // The same file under another name.
+  fs::create_symlink(dir_ / "sky.exr", dir_ / "link.exr");
+  r = run("render " + quote(scene) + " -q --reference -o " + quote((dir_ / "link.exr").string()));
+  expectCleanFailure(r, "refusing to overwrite an input", fs::path());
+  EXPECT_TRUE(fs::is_symlink(dir_ / "link.exr"));
+  EXPECT_EQ(slurp(dir_ / "sky.exr"), sky_bytes);
+  // The PNG preview beside -o would replace the scene file.
+  const std::string odd = write("odd.png", tinyScene());
+  r = run("render " + quote(odd) + " -q --reference -o " + quote((dir_ / "odd.exr").string()));
+  expectCleanFailure(r, "is the scene file", fs::path());
+  EXPECT_EQ(slurp(dir_ / "odd.png"), tinyScene());
+  // A scene beside its outputs is fine when the names differ.
+  r = run("render " + quote(scene) + " -q --reference -o " + quote((dir_ / "scene.exr").string()));
+  EXPECT_EQ(r.code, 0) << r.err;
+}
+
 TEST_F(Cli, RenderOutputMustEndInExr) {
   const std::string scene = write("scene.json", tinyScene());
   expectCleanFailure(run("render " + quote(scene) + " -o " + quote(outPath("render.png"))), ".exr");
