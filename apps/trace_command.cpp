@@ -1,7 +1,7 @@
 // eikon trace SCENE.json --origin x,y,z --dir x,y,z --wavelength NM [--json] [--reference]
 // Traces one ray through the voxelised scene and prints, per mode, exit point, exit direction,
-// wave normal, optical path and transmittance (DESIGN §3). Isotropic scenes print both modes,
-// identical. Transmittance is the mode's own (Fresnel for its polarisation × attenuation);
+// wave normal, optical path, transmittance, interfaces crossed, total internal reflections and
+// steps (DESIGN §3). Isotropic scenes print one mode, marked "o=e" (--json gives both, identical). Transmittance is the mode's own (Fresnel for its polarisation × attenuation);
 // unpolarised light gives each mode half of the incident power.
 #include <array>
 #include <cstdio>
@@ -101,13 +101,19 @@ void addTraceCommand(CLI::App& app) {
       std::printf("%s\n", j.dump(2).c_str());
       return;
     }
-    std::printf("wavelength %.4f nm on %s\n", a->wavelength, device.c_str());
-    for (int mi = 0; mi < 2; ++mi) {
+    // The text carries what --json carries. An isotropic scene has one mode: the o and e traces
+    // coincide, so it is printed once and said so.
+    const bool isotropic = !scene.anyUniaxial();
+    std::printf("wavelength %.4f nm on %s%s\n", a->wavelength, device.c_str(),
+                isotropic ? " (isotropic scene: the o and e modes coincide)" : "");
+    for (int mi = 0; mi < (isotropic ? 1 : 2); ++mi) {
       const TraceOutcome& t = modes[size_t(mi)];
       std::printf("  %s: exit (%.6f, %.6f, %.6f) dir (%.6f, %.6f, %.6f) wave normal (%.6f, %.6f, %.6f) OPL %.6f mm T %.6f%s\n",
-                  mi == 0 ? "o" : "e", t.exit_point.x, t.exit_point.y, t.exit_point.z, t.exit_direction.x, t.exit_direction.y,
-                  t.exit_direction.z, t.wave_normal.x, t.wave_normal.y, t.wave_normal.z, t.optical_path_mm,
-                  t.transmittance, t.left_volume ? "" : " (stopped inside)");
+                  isotropic ? "o=e" : mi == 0 ? "o" : "e", t.exit_point.x, t.exit_point.y, t.exit_point.z,
+                  t.exit_direction.x, t.exit_direction.y, t.exit_direction.z, t.wave_normal.x, t.wave_normal.y,
+                  t.wave_normal.z, t.optical_path_mm, t.transmittance, t.left_volume ? "" : " (stopped inside)");
+      std::printf("  %*s  %d interfaces crossed, %d total internal reflections, %d steps\n", isotropic ? 3 : 1, "",
+                  t.interfaces, t.total_internal_reflections, t.steps);
     }
   });
 }

@@ -482,6 +482,42 @@ TEST_F(Cli, TraceAxialRayPhysics) {
   }
 }
 
+// The text output carries what --json carries: interfaces crossed, total internal reflections and
+// steps. The axial ray through the sphere crosses exactly 2 interfaces (in, out) and is never
+// totally reflected (normal incidence). An isotropic scene prints one "o=e" line and says the modes
+// coincide; a uniaxial one prints o and e.
+TEST_F(Cli, TraceTextShowsCountsAndIsotropicModes) {
+  const std::string iso = write("scene.json", tinyScene());
+  for (const char* twin : {"", " --reference"}) {
+    const Outcome r = run("trace " + quote(iso) + " --origin 0,0,-5 --dir 0,0,1" + twin);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("isotropic scene: the o and e modes coincide"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("  o=e: exit ("), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("  o: "), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("  e: "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(" 2 interfaces crossed, 0 total internal reflections, "), std::string::npos) << r.out;
+    // Steps: homogeneous runs are crossed in long straight steps, so only a lower bound is sure:
+    // the 6 mm inside the sphere's smoothed surface region alone takes well over 10 steps of 0.25 h.
+    const auto at = r.out.find(" total internal reflections, ");
+    ASSERT_NE(at, std::string::npos);
+    const int steps = std::stoi(r.out.substr(at + std::string(" total internal reflections, ").size()));
+    EXPECT_GT(steps, 10) << r.out;
+    EXPECT_NE(r.out.find(std::to_string(steps) + " steps\n"), std::string::npos) << r.out;
+  }
+  // Uniaxial (calcite-like, optic axis across the ray): two mode lines, each with its counts.
+  const std::string uni = write("uni.json", tinyScene("", R"({"n_o": 1.658, "n_e": 1.486, "optic_axis": [0, 1, 0]})"));
+  const Outcome r = run("trace " + quote(uni) + " --origin 0,0,-5 --dir 0,0,1 --reference");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.find("coincide"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  o: exit ("), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  e: exit ("), std::string::npos) << r.out;
+  size_t count = 0;
+  for (size_t p = r.out.find(" 2 interfaces crossed, 0 total internal reflections, "); p != std::string::npos;
+       p = r.out.find(" 2 interfaces crossed, 0 total internal reflections, ", p + 1))
+    ++count;
+  EXPECT_EQ(count, 2u) << r.out;
+}
+
 // GPU (float32) vs CPU reference (double) on the same voxel field and the same step size.
 // Tolerance 1e-4 mm on the exit point: the two differ by float32 rounding only. Positions of
 // |x| ≤ 5 mm carry 3e-7 mm per step; ≈ 200 steps add up to ≤ 6e-5 mm if every rounding had the
