@@ -22,7 +22,7 @@ struct RenderArgs {
   std::string scene, output;
   int width = 0, height = 0, spp = 1, wavelengths = -1, threads = 0;
   double step = 0.5, exposure = 0.0;
-  std::string integrator = "rk4";
+  std::string integrator = "rk4", progress = "auto";
   bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
   // Light simulator (scenes with "lights").
   int light_bands = 0, max_patches = 1 << 20;
@@ -73,7 +73,9 @@ void addRenderCommand(CLI::App& app) {
   sub->add_flag("--no-skip", args->no_skip, "Do not cross homogeneous regions in one step");
   sub->add_flag("--no-fresnel", args->no_fresnel, "Disable Fresnel reflection and transmission losses");
   sub->add_flag("--strict", args->strict, "Treat warnings (e.g. wavelengths outside a material's range) as errors");
-  sub->add_flag("-q,--quiet", args->quiet, "No progress lines");
+  sub->add_flag("-q,--quiet", args->quiet, "No progress lines (same as --progress never)");
+  sub->add_option("--progress", args->progress,
+                  "auto (default: progress with ETA on stderr when it is a terminal), always or never");
   sub->add_option("--light-bands", args->light_bands,
                   "Light simulator wavelength bands (default: 12 dispersive, 3 attenuating, else 1)");
   sub->add_option("--light-splat", args->light_splat,
@@ -94,6 +96,7 @@ void addRenderCommand(CLI::App& app) {
     const RenderArgs& a = *args;
     std::filesystem::path out(a.output), png = std::filesystem::path(a.output).replace_extension(".png");
     if (out.extension() != ".exr") throw CliError("output must end in .exr: " + a.output);
+    (void)progressMode(a.progress, a.quiet);  // a bad --progress fails before any work
     // A size not given is the scene camera's; a given one must be a real size (0 used to mean
     // "the scene's" silently, and a negative --wavelengths the default).
     auto checkRange = [&](const char* name, int v, int lo, int hi) {
@@ -144,7 +147,7 @@ void addRenderCommand(CLI::App& app) {
         }
       }
 
-    Progress progress(a.quiet);
+    Progress progress(progressMode(a.progress, a.quiet));
     std::unique_ptr<vk::Context> ctx;
     if (!a.reference) {
       ctx = vk::Context::create();

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "apps/progress.h"
 #include "core/reference/reference_marcher.h"
 #include "core/render/view_renderer.h"
 #include "core/vk/context.h"
@@ -38,8 +39,8 @@ glm::dvec3 parseVec(const std::string& s, const char* what) {
 struct TraceArgs {
   std::string scene, origin, dir;
   double wavelength = 587.5618, step = 0.25;
-  bool json = false, reference = false;
-  std::string integrator = "rk4";
+  bool json = false, reference = false, quiet = false;
+  std::string integrator = "rk4", progress = "auto";
 };
 
 }  // namespace
@@ -54,19 +55,28 @@ void addTraceCommand(CLI::App& app) {
   sub->add_option("--step", a->step, "Integration step in voxels (default 0.25)");
   sub->add_flag("--json", a->json, "Print JSON");
   sub->add_flag("--reference", a->reference, "Use the double-precision CPU reference instead of the GPU");
+  sub->add_flag("-q,--quiet", a->quiet, "No progress lines (same as --progress never)");
+  sub->add_option("--progress", a->progress,
+                  "auto (default: voxelising progress with ETA on stderr when it is a terminal), always or never");
   sub->callback([a] {
     glm::dvec3 o = parseVec(a->origin, "--origin"), d = parseVec(a->dir, "--dir");
     if (glm::length(d) < 1e-12) throw CliError("--dir must be a non-zero vector");
     if (!(a->wavelength >= 100 && a->wavelength <= 10000)) throw CliError("--wavelength must be in [100, 10000] nm");
     if (!(a->step > 0 && a->step <= 4)) throw CliError("--step must be in (0, 4] voxels");
+    const ProgressMode progress_mode = progressMode(a->progress, a->quiet);
     Scene scene = loadScene(a->scene);
+    // Voxelising a 128³ scene takes seconds; the trace itself is instant.
+    Progress progress(progress_mode);
+    VoxelizeOptions vo;
+    vo.progress = [&](double f, const char*) { progress.update("voxelising", f); };
     MarchSettings ms;
     ms.step_voxels = a->step;
     TraceRequest req{o, glm::normalize(d), a->wavelength};
     std::array<TraceOutcome, 2> modes;
     std::string device;
     if (a->reference) {
-      VolumeSet volume = voxelize(scene);
+      VolumeSet volume = voxelize(scene, vo);
+      progress.finish();
       VolumeField field(volume);
       ReferenceMarcher ref(field, scene.environment);
       modes = {ref.trace(req, ms, 0), ref.trace(req, ms, 1)};
@@ -74,7 +84,8 @@ void addTraceCommand(CLI::App& app) {
     } else {
       auto ctx = vk::Context::create();
       checkVolumeFits(*ctx, makeGrid(scene.volume), scene);
-      VolumeSet volume = voxelize(scene);
+      VolumeSet volume = voxelize(scene, vo);
+      progress.finish();
       ViewRenderer r(*ctx, scene, volume);
       modes = r.traceModes({req}, ms).front();
       device = ctx->deviceName();

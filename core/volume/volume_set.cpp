@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <mutex>
 #include <thread>
 
 namespace eikon {
@@ -97,8 +98,13 @@ void gaussianSmooth(std::vector<float>& f, const std::array<int, 3>& dims, doubl
 }
 
 VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
+  // Calls may come from the worker threads (per slab): one at a time, and skipped rather than
+  // waited for when another thread is reporting.
+  std::mutex progress_mutex;
   auto progress = [&](double x, const char* stage) {
-    if (opt.progress) opt.progress(x, stage);
+    if (!opt.progress) return;
+    std::unique_lock<std::mutex> lock(progress_mutex, std::try_to_lock);
+    if (lock.owns_lock()) opt.progress(x, stage);
   };
   VolumeSet vs;
   vs.grid = makeGrid(scene.volume);
@@ -192,7 +198,9 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
       lo[a] = std::clamp(int(std::floor((bmin[a] - g.origin[a]) / g.h)) - margin, 0, g.dims[a] - 1);
       hi[a] = std::clamp(int(std::ceil((bmax[a] - g.origin[a]) / g.h)) + margin, 0, g.dims[a] - 1);
     }
-    parallelFor(hi[2] - lo[2] + 1, opt.threads, [&](int kk) {
+    const int slabs = hi[2] - lo[2] + 1;
+    std::atomic<int> slabs_done{0};
+    parallelFor(slabs, opt.threads, [&](int kk) {
       const int k = lo[2] + kk;
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int i = lo[0]; i <= hi[0]; ++i) {
@@ -237,6 +245,14 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
           for (int f = 0; f < kFieldCount; ++f) fields[size_t(f)][idx] = fields[size_t(f)][idx] * (1 - fc) + prop[f] * fc;
           if (vs.uniaxial && mat.uniaxial) axis[idx] = ax;
         }
+      // Progress per z slab: a large object alone takes seconds at 256³. The count is read under
+      // the lock, so the reported fractions never decrease.
+      ++slabs_done;
+      if (opt.progress) {
+        std::unique_lock<std::mutex> lock(progress_mutex, std::try_to_lock);
+        if (lock.owns_lock())
+          opt.progress(0.4 * (double(oi) + double(slabs_done.load()) / slabs) / double(scene.objects.size()), "voxelising");
+      }
     });
     progress(0.4 * double(oi + 1) / double(scene.objects.size()), "voxelising");
   }
@@ -281,6 +297,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
       } else {
         vs.index[size_t(m)][size_t(c)] = withGradient(fields[size_t(f)]);
       }
+      progress(0.7 + 0.15 * double(m * 3 + c + 1) / (vs.uniaxial ? 6.0 : 3.0), "gradients");
     }
   progress(0.85, "gradients");
 
@@ -316,6 +333,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
           }
       });
       axis.swap(next);
+      progress(0.85 + 0.05 * double(pass + 1) / reach, "optic axis");
     }
     vs.axis = std::move(axis);
   }
@@ -371,6 +389,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
         }
     });
     dist.swap(out);
+    progress(0.9 + 0.03 * (a + 1), "skip distances");
   }
   for (size_t i = 0; i < N; ++i) vs.emission[i].w = float(dist[i]);
   progress(1.0, "done");

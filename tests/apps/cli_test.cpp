@@ -202,6 +202,69 @@ TEST_F(Cli, EveryShippedSceneRendersCleanUnderStrict) {
   }
 }
 
+// ------------------------------------------------------------------ progress (issue 11)
+
+/// Lines of `err` (progress lines end in '\n' when stderr is not a terminal) that look like
+/// "eikon: STAGE  42.0%  1.2 s, ETA ..." for STAGE starting with `stage`.
+std::vector<std::string> progressLines(const std::string& err, const std::string& stage) {
+  std::vector<std::string> out;
+  std::istringstream in(err);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("eikon: " + stage, 0) == 0 && line.find("%  ") != std::string::npos && line.find(", ETA ") != std::string::npos)
+      out.push_back(line);
+  return out;
+}
+
+// stderr is not a terminal here: no progress lines by default, and none with -q even when forced;
+// --progress always shows each stage with elapsed time and ETA, its first report and its 100%.
+// The lit scene has all three stages: voxelising, light, rendering.
+TEST_F(Cli, RenderProgressOnlyWhenAskedOrOnATerminal) {
+  std::string lit = tinyScene();
+  lit.insert(lit.rfind('}'), R"(, "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}])");
+  const std::string light = " --reference --light-split 8 --light-step 2 --no-light-cache";
+  const Outcome quiet = render(lit, light);
+  ASSERT_EQ(quiet.code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "") << "progress without a terminal";
+  EXPECT_EQ(std::count(quiet.out.begin(), quiet.out.end(), '\n'), 2) << "the summary lines only:\n" << quiet.out;
+  const Outcome never = render(lit, light + " --progress always -q");
+  ASSERT_EQ(never.code, 0) << never.err;
+  EXPECT_EQ(never.err, "");
+  const Outcome forced = render(lit, light + " --progress always");
+  ASSERT_EQ(forced.code, 0) << forced.err;
+  for (const char* stage : {"voxelising", "light 1 light x 1 band x 1 mode", "rendering"}) {
+    const auto lines = progressLines(forced.err, stage);
+    ASSERT_FALSE(lines.empty()) << stage << ":\n" << forced.err;
+    EXPECT_NE(lines.back().find("100.0%"), std::string::npos) << lines.back();
+    EXPECT_NE(lines.back().find("ETA 0.0 s"), std::string::npos) << lines.back();
+  }
+  // Nothing else on stderr: every line is a progress line.
+  const size_t lines = size_t(std::count(forced.err.begin(), forced.err.end(), '\n'));
+  EXPECT_EQ(lines, progressLines(forced.err, "").size()) << forced.err;
+  EXPECT_NE(forced.out.find("eikon: rendered"), std::string::npos) << forced.out;
+}
+
+TEST_F(Cli, TraceProgressOnlyWhenAsked) {
+  const std::string scene = write("scene.json", tinyScene());
+  const std::string args = "trace " + quote(scene) + " --origin 0,0,-5 --dir 0,0,1 --reference";
+  const Outcome quiet = run(args);
+  ASSERT_EQ(quiet.code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+  const Outcome forced = run(args + " --progress always");
+  ASSERT_EQ(forced.code, 0) << forced.err;
+  const auto lines = progressLines(forced.err, "voxelising");
+  ASSERT_FALSE(lines.empty()) << forced.err;
+  EXPECT_NE(lines.back().find("100.0%"), std::string::npos) << lines.back();
+  EXPECT_EQ(forced.out, quiet.out);
+  EXPECT_EQ(run(args + " --progress always -q").err, "");
+}
+
+TEST_F(Cli, BadProgressOptionFailsCleanly) {
+  expectCleanFailure(render(tinyScene(), "--progress sometimes"), "--progress must be auto, always or never");
+  const std::string scene = write("scene.json", tinyScene());
+  expectCleanFailure(run("trace " + quote(scene) + " --origin 0,0,-5 --dir 0,0,1 --progress loud"),
+                     "--progress must be auto, always or never");
+}
+
 // ------------------------------------------------------------------ render: bad input
 
 TEST_F(Cli, RenderMalformedJson) {
