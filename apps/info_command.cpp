@@ -23,12 +23,14 @@ void addInfoCommand(CLI::App& app) {
     auto row = [](const char* label, const std::string& value) {
       std::printf("%-20s%s\n", (std::string(label) + ":").c_str(), value.c_str());
     };
-    row("device", ctx->deviceName() + " (" + ctx->deviceTypeName() + "), Vulkan " + ctx->apiVersionString());
+    row("device",
+        ctx->deviceName() + " (" + ctx->deviceTypeName() + "), Vulkan " + ctx->apiVersionString());
     row("max 3D image side", std::to_string(l.max_image_dimension_3d) + " voxels");
     row("max storage buffer", std::to_string(l.max_storage_buffer_range >> 20) + " MiB");
     row("device heap", std::to_string(l.heap_size >> 20) + " MiB");
     row("shader float64", l.shader_float64 ? "yes" : "no");
-    row("validation layers", std::string(ctx->validationEnabled() ? "on" : "off") + " (EIKON_VALIDATION=1 enables)");
+    row("validation layers",
+        std::string(ctx->validationEnabled() ? "on" : "off") + " (EIKON_VALIDATION=1 enables)");
   });
 }
 

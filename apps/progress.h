@@ -16,6 +16,8 @@
 // until half a second of progress is seen, or when the countdown ran out with the stage unfinished.
 #pragma once
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -26,7 +28,6 @@
 #include <string>
 #include <thread>
 #include <utility>
-#include <unistd.h>
 
 #include "apps/commands.h"
 
@@ -47,7 +48,8 @@ class Progress {
   explicit Progress(ProgressMode mode)
       : tty_(::isatty(2) != 0),
         live_(mode == ProgressMode::Always || (mode == ProgressMode::Auto && tty_)),
-        grace_(mode == ProgressMode::Auto ? std::chrono::milliseconds(1000) : std::chrono::milliseconds(0)),
+        grace_(mode == ProgressMode::Auto ? std::chrono::milliseconds(1000)
+                                          : std::chrono::milliseconds(0)),
         start_(Clock::now()) {
     if (live_) ticker_ = std::thread([this] { tick(); });
   }
@@ -72,9 +74,12 @@ class Progress {
     reported_ = now;
     if (samples_.empty() || now - samples_.back().first >= std::chrono::milliseconds(250))
       samples_.emplace_back(now, fraction_);
-    while (samples_.size() > 2 && now - samples_[1].first > std::chrono::seconds(10)) samples_.pop_front();
+    while (samples_.size() > 2 && now - samples_[1].first > std::chrono::seconds(10))
+      samples_.pop_front();
     if (now - start_ < grace_ && fraction_ < 1.0) return;
-    if (new_stage || !printed_ || fraction_ >= 1.0 || now - drawn_ >= std::chrono::milliseconds(250)) draw(now);
+    if (new_stage || !printed_ || fraction_ >= 1.0 ||
+        now - drawn_ >= std::chrono::milliseconds(250))
+      draw(now);
   }
 
   /// End the progress line (on a terminal) and stop the ticker. Called before summary lines.
@@ -95,8 +100,10 @@ class Progress {
 
   static std::string seconds(double s) {
     char buf[32];
-    if (s < 60) std::snprintf(buf, sizeof buf, "%.1f s", s);
-    else std::snprintf(buf, sizeof buf, "%d min %02d s", int(s / 60), int(s) % 60);
+    if (s < 60)
+      std::snprintf(buf, sizeof buf, "%.1f s", s);
+    else
+      std::snprintf(buf, sizeof buf, "%d min %02d s", int(s / 60), int(s) % 60);
     return buf;
   }
 
@@ -106,14 +113,20 @@ class Progress {
     if (fraction_ >= 1.0) {
       eta = "ETA " + seconds(0.0);
     } else if (!samples_.empty()) {
-      const double span = secs(reported_ - samples_.front().first), rise = fraction_ - samples_.front().second;
-      const double left = span >= 0.5 && rise > 0 ? (1.0 - fraction_) * span / rise - secs(now - reported_) : -1.0;
+      const double span = secs(reported_ - samples_.front().first),
+                   rise = fraction_ - samples_.front().second;
+      const double left =
+          span >= 0.5 && rise > 0 ? (1.0 - fraction_) * span / rise - secs(now - reported_) : -1.0;
       if (left > 0) eta = "ETA " + seconds(left);
     }
     const double pct = std::floor(fraction_ * 1000.0) / 10.0;  // 99.9% until it is done
     const std::string in_stage = seconds(secs(now - stage_start_));
-    if (tty_) std::fprintf(stderr, "\r\033[Keikon: %s %5.1f%%  %s, %s", stage_.c_str(), pct, in_stage.c_str(), eta.c_str());
-    else std::fprintf(stderr, "eikon: %s %5.1f%%  %s, %s\n", stage_.c_str(), pct, in_stage.c_str(), eta.c_str());
+    if (tty_)
+      std::fprintf(stderr, "\r\033[Keikon: %s %5.1f%%  %s, %s", stage_.c_str(), pct,
+                   in_stage.c_str(), eta.c_str());
+    else
+      std::fprintf(stderr, "eikon: %s %5.1f%%  %s, %s\n", stage_.c_str(), pct, in_stage.c_str(),
+                   eta.c_str());
     std::fflush(stderr);
     drawn_ = now;
     printed_ = true;

@@ -34,16 +34,19 @@ struct RenderArgs {
 /// Refuse an output that is one of the render's own inputs (the same file by device and inode:
 /// also through a symbolic or hard link): `-o scenes/diamond_lights.exr` used to replace the
 /// scene's environment map with the render and exit 0.
-void refuseOverwritingInputs(const Scene& scene, const std::filesystem::path& scene_path,
-                             const std::vector<std::pair<std::filesystem::path, const char*>>& outputs) {
-  std::vector<std::pair<std::filesystem::path, std::string>> inputs = {{scene_path, "the scene file"}};
-  if (!scene.environment.image_path.empty()) inputs.push_back({scene.environment.image_path, "the scene's environment map"});
+void refuseOverwritingInputs(
+    const Scene& scene, const std::filesystem::path& scene_path,
+    const std::vector<std::pair<std::filesystem::path, const char*>>& outputs) {
+  std::vector<std::pair<std::filesystem::path, std::string>> inputs = {
+      {scene_path, "the scene file"}};
+  if (!scene.environment.image_path.empty())
+    inputs.push_back({scene.environment.image_path, "the scene's environment map"});
   for (const auto& [out, what] : outputs)
     for (const auto& [in, role] : inputs) {
       std::error_code ec;
       if (std::filesystem::equivalent(out, in, ec))
-        throw CliError(std::string(what) + " '" + out.string() + "' is " + role + " '" + in.string() +
-                       "'; refusing to overwrite an input (choose another -o)");
+        throw CliError(std::string(what) + " '" + out.string() + "' is " + role + " '" +
+                       in.string() + "'; refusing to overwrite an input (choose another -o)");
     }
 }
 
@@ -60,11 +63,14 @@ void addRenderCommand(CLI::App& app) {
   auto* sub = app.add_subcommand("render", "Render a scene to an EXR (linear sRGB) and a PNG preview");
   sub->add_option("scene", args->scene, "Scene JSON file")->required();
   sub->add_option("-o,--output", args->output, "Output EXR path (the PNG preview is written beside it)")->required();
-  sub->add_option("--width", args->width, "Image width in [1, 16384] (default: the scene camera's)");
-  sub->add_option("--height", args->height, "Image height in [1, 16384] (default: the scene camera's)");
+  sub->add_option("--width", args->width,
+                  "Image width in [1, 16384] (default: the scene camera's)");
+  sub->add_option("--height", args->height,
+                  "Image height in [1, 16384] (default: the scene camera's)");
   sub->add_option("--spp", args->spp, "Jittered samples per pixel in [1, 4096] (default 1)");
   sub->add_option("--wavelengths", args->wavelengths,
-                  "Spectral samples per pixel sample in [1, 256], or 0 for RGB mode (default: 16 for dispersive scenes, else 0)");
+                  "Spectral samples per pixel sample in [1, 256], or 0 for RGB mode (default: 16 "
+                  "for dispersive scenes, else 0)");
   sub->add_option("--step", args->step, "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", args->integrator, "euler, midpoint or rk4 (default rk4)");
   sub->add_option("--exposure", args->exposure, "PNG preview exposure in stops (default 0)");
@@ -74,8 +80,9 @@ void addRenderCommand(CLI::App& app) {
   sub->add_flag("--no-fresnel", args->no_fresnel, "Disable Fresnel reflection and transmission losses");
   sub->add_flag("--strict", args->strict, "Treat warnings (e.g. wavelengths outside a material's range) as errors");
   sub->add_flag("-q,--quiet", args->quiet, "No progress lines (same as --progress never)");
-  sub->add_option("--progress", args->progress,
-                  "auto (default: progress with ETA on stderr when it is a terminal), always or never");
+  sub->add_option(
+      "--progress", args->progress,
+      "auto (default: progress with ETA on stderr when it is a terminal), always or never");
   sub->add_option("--light-bands", args->light_bands,
                   "Light simulator wavelength bands (default: 12 dispersive, 3 attenuating, else 1)");
   sub->add_option("--light-splat", args->light_splat,
@@ -101,8 +108,8 @@ void addRenderCommand(CLI::App& app) {
     // "the scene's" silently, and a negative --wavelengths the default).
     auto checkRange = [&](const char* name, int v, int lo, int hi) {
       if (sub->count(name) && (v < lo || v > hi))
-        throw CliError(std::string(name) + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
-                       std::to_string(v));
+        throw CliError(std::string(name) + " must be in [" + std::to_string(lo) + ", " +
+                       std::to_string(hi) + "], got " + std::to_string(v));
     };
     checkRange("--width", a.width, 1, 16384);
     checkRange("--height", a.height, 1, 16384);
@@ -114,10 +121,14 @@ void addRenderCommand(CLI::App& app) {
       throw CliError("--light-splat must be accumulate or highest, got '" + a.light_splat + "'");
     if (a.light_device != "auto" && a.light_device != "gpu" && a.light_device != "cpu")
       throw CliError("--light-device must be auto, gpu or cpu, got '" + a.light_device + "'");
-    if (a.caustics != "pass" && a.caustics != "kill") throw CliError("--caustics must be pass or kill, got '" + a.caustics + "'");
-    if (!(a.light_step >= 0 && a.light_step <= 2)) throw CliError("--light-step must be in (0, 2] voxels");
-    if (!(a.light_split >= 0.25 && a.light_split <= 8)) throw CliError("--light-split must be in [0.25, 8] voxels");
-    if (a.max_patches < 1024 || a.max_patches > (1 << 24)) throw CliError("--max-patches must be in [1024, 16777216]");
+    if (a.caustics != "pass" && a.caustics != "kill")
+      throw CliError("--caustics must be pass or kill, got '" + a.caustics + "'");
+    if (!(a.light_step >= 0 && a.light_step <= 2))
+      throw CliError("--light-step must be in (0, 2] voxels");
+    if (!(a.light_split >= 0.25 && a.light_split <= 8))
+      throw CliError("--light-split must be in [0.25, 8] voxels");
+    if (a.max_patches < 1024 || a.max_patches > (1 << 24))
+      throw CliError("--max-patches must be in [1024, 16777216]");
     Scene scene = loadScene(a.scene);
     for (const std::string& w : scene.warnings) {
       if (a.strict) throw CliError(w + " (--strict)");

@@ -1,13 +1,13 @@
 // eikon trace SCENE.json --origin x,y,z --dir x,y,z --wavelength NM [--json] [--reference]
 // Traces one ray through the voxelised scene and prints, per mode, exit point, exit direction,
 // wave normal, optical path, transmittance, interfaces crossed, total internal reflections and
-// steps (DESIGN §3). Isotropic scenes print one mode, marked "o=e" (--json gives both, identical). Transmittance is the mode's own (Fresnel for its polarisation × attenuation);
-// unpolarised light gives each mode half of the incident power.
+// steps (DESIGN §3). Isotropic scenes print one mode, marked "o=e" (--json gives both, identical).
+// Transmittance is the mode's own (Fresnel for its polarisation × attenuation); unpolarised light
+// gives each mode half of the incident power.
 #include <array>
 #include <cstdio>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "apps/commands.h"
 #include "apps/progress.h"
@@ -57,7 +57,8 @@ void addTraceCommand(CLI::App& app) {
   sub->add_flag("--reference", a->reference, "Use the double-precision CPU reference instead of the GPU");
   sub->add_flag("-q,--quiet", a->quiet, "No progress lines (same as --progress never)");
   sub->add_option("--progress", a->progress,
-                  "auto (default: voxelising progress with ETA on stderr when it is a terminal), always or never");
+                  "auto (default: voxelising progress with ETA on stderr when it is a terminal), "
+                  "always or never");
   sub->callback([a] {
     glm::dvec3 o = parseVec(a->origin, "--origin"), d = parseVec(a->dir, "--dir");
     if (glm::length(d) < 1e-12) throw CliError("--dir must be a non-zero vector");
@@ -119,12 +120,17 @@ void addTraceCommand(CLI::App& app) {
                 isotropic ? " (isotropic scene: the o and e modes coincide)" : "");
     for (int mi = 0; mi < (isotropic ? 1 : 2); ++mi) {
       const TraceOutcome& t = modes[size_t(mi)];
-      std::printf("  %s: exit (%.6f, %.6f, %.6f) dir (%.6f, %.6f, %.6f) wave normal (%.6f, %.6f, %.6f) OPL %.6f mm T %.6f%s\n",
-                  isotropic ? "o=e" : mi == 0 ? "o" : "e", t.exit_point.x, t.exit_point.y, t.exit_point.z,
-                  t.exit_direction.x, t.exit_direction.y, t.exit_direction.z, t.wave_normal.x, t.wave_normal.y,
-                  t.wave_normal.z, t.optical_path_mm, t.transmittance, t.left_volume ? "" : " (stopped inside)");
-      std::printf("  %*s  %d interfaces crossed, %d total internal reflections, %d steps\n", isotropic ? 3 : 1, "",
-                  t.interfaces, t.total_internal_reflections, t.steps);
+      std::printf(
+          "  %s: exit (%.6f, %.6f, %.6f) dir (%.6f, %.6f, %.6f) wave normal (%.6f, %.6f, %.6f) OPL "
+          "%.6f mm T %.6f%s\n",
+          isotropic ? "o=e"
+          : mi == 0 ? "o"
+                    : "e",
+          t.exit_point.x, t.exit_point.y, t.exit_point.z, t.exit_direction.x, t.exit_direction.y,
+          t.exit_direction.z, t.wave_normal.x, t.wave_normal.y, t.wave_normal.z, t.optical_path_mm,
+          t.transmittance, t.left_volume ? "" : " (stopped inside)");
+      std::printf("  %*s  %d interfaces crossed, %d total internal reflections, %d steps\n",
+                  isotropic ? 3 : 1, "", t.interfaces, t.total_internal_reflections, t.steps);
     }
   });
 }

@@ -25,7 +25,9 @@
 
 int main(int argc, char** argv) {
   double min_seconds = 1.0;
-  CLI::App app{"Fits per second of cauchy3 on 50 points: eikon (Ceres) against SciPy's least_squares", "fit_bench"};
+  CLI::App app{
+      "Fits per second of cauchy3 on 50 points: eikon (Ceres) against SciPy's least_squares",
+      "fit_bench"};
   app.add_option("min_seconds", min_seconds, "Least time to spend fitting, in seconds (default 1)")
       ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);

@@ -114,16 +114,22 @@ int main(int argc, char** argv) {
   int resolution = 0, noSkipResolution = 64;
   bool cpu = true, gpu = true;
   std::string scene_path = std::string(EIKON_SOURCE_DIR) + "/scenes/caustic_sphere.json";
-  CLI::App app{"Light simulator: GPU and CPU reference twins on a lit scene (default scenes/caustic_sphere.json)",
-               "light_bench"};
+  CLI::App app{
+      "Light simulator: GPU and CPU reference twins on a lit scene (default "
+      "scenes/caustic_sphere.json)",
+      "light_bench"};
   app.add_option("scene", scene_path, "Scene JSON file with at least one light");
-  app.add_option("--resolution", resolution, "Volume resolution (default: the scene's)")->check(CLI::PositiveNumber);
-  app.add_option("--no-skip-resolution", noSkipResolution, "Resolution of the runs without straight steps (default 64)")
+  app.add_option("--resolution", resolution, "Volume resolution (default: the scene's)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--steps-per-dispatch", gStepsPerDispatch, "GPU time steps per dispatch")->check(CLI::PositiveNumber);
+  app.add_option("--no-skip-resolution", noSkipResolution,
+                 "Resolution of the runs without straight steps (default 64)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--steps-per-dispatch", gStepsPerDispatch, "GPU time steps per dispatch")
+      ->check(CLI::PositiveNumber);
   app.add_flag("!--no-cpu", cpu, "Skip the CPU reference");
   app.add_flag("!--no-gpu", gpu, "Skip the GPU simulator");
-  app.add_option("--threads", gThreads, "CPU thread counts to compare, comma separated (0: all cores)")
+  app.add_option("--threads", gThreads,
+                 "CPU thread counts to compare, comma separated (0: all cores)")
       ->delimiter(',')
       ->check(CLI::Range(0, 1024));
   CLI11_PARSE(app, argc, argv);

@@ -33,9 +33,11 @@ double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722
 
 int main(int argc, char** argv) {
   int W = 800, H = 600;
-  CLI::App app{"Spectral rendering cost and accuracy on scenes/prism_bk7.json (and POV-Ray when on PATH)",
-               "spectral_bench"};
-  app.add_option("width", W, "Image width (default 800, the scene camera's)")->check(CLI::Range(1, 16384));
+  CLI::App app{
+      "Spectral rendering cost and accuracy on scenes/prism_bk7.json (and POV-Ray when on PATH)",
+      "spectral_bench"};
+  app.add_option("width", W, "Image width (default 800, the scene camera's)")
+      ->check(CLI::Range(1, 16384));
   app.add_option("height", H, "Image height (default 600)")->check(CLI::Range(1, 16384));
   CLI11_PARSE(app, argc, argv);
   const std::filesystem::path src(EIKON_SOURCE_DIR);

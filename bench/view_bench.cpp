@@ -6,12 +6,12 @@
 //
 //   build/bench/view_bench [scene.json] [--width W --height H] [--no-cpu]
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <random>
-#include <thread>
-#include <algorithm>
 #include <string>
+#include <thread>
 
 #include "core/reference/reference_marcher.h"
 #include "core/render/view_renderer.h"
@@ -23,8 +23,9 @@ int main(int argc, char** argv) {
   std::string scene_path = std::string(EIKON_SOURCE_DIR) + "/scenes/glass_sphere.json";
   int width = 800, height = 600;
   bool cpu = true;
-  CLI::App app{"View renderer: rays/s, steps/ray and accuracy of the GPU integrators and the CPU reference",
-               "view_bench"};
+  CLI::App app{
+      "View renderer: rays/s, steps/ray and accuracy of the GPU integrators and the CPU reference",
+      "view_bench"};
   app.add_option("scene", scene_path, "Scene JSON file (default scenes/glass_sphere.json)");
   app.add_option("--width", width, "Image width (default 800)")->check(CLI::Range(1, 16384));
   app.add_option("--height", height, "Image height (default 600)")->check(CLI::Range(1, 16384));

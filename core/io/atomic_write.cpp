@@ -32,7 +32,9 @@ std::filesystem::path createTemporary(const std::filesystem::path& path) {
       ::close(fd);
       return tmp;
     }
-    if (errno != EEXIST) throw writeError(path, std::string("cannot create a file beside it: ") + std::strerror(errno));
+    if (errno != EEXIST)
+      throw writeError(path,
+                       std::string("cannot create a file beside it: ") + std::strerror(errno));
   }
   throw writeError(path, "cannot create a temporary file beside it");
 }
@@ -76,10 +78,13 @@ void checkWritable(const std::filesystem::path& path) {
   if (std::filesystem::is_directory(path, ec)) throw writeError(path, "it is a directory");
   // Missing folders are created when writing; here the nearest existing one must take new entries.
   std::filesystem::path dir = path.parent_path();
-  while (!dir.empty() && !std::filesystem::exists(dir, ec)) dir = dir.parent_path();  // "a/b" → "a" → ""
+  while (!dir.empty() && !std::filesystem::exists(dir, ec))
+    dir = dir.parent_path();  // "a/b" → "a" → ""
   if (dir.empty()) dir = ".";
-  if (!std::filesystem::is_directory(dir, ec)) throw writeError(path, "'" + dir.string() + "' is not a folder");
-  if (::access(dir.c_str(), W_OK) != 0) throw writeError(path, "folder '" + dir.string() + "' is not writable");
+  if (!std::filesystem::is_directory(dir, ec))
+    throw writeError(path, "'" + dir.string() + "' is not a folder");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw writeError(path, "folder '" + dir.string() + "' is not writable");
   // access() says yes to root everywhere; creating a probe file is the real test.
   std::filesystem::path probe;
   try {

@@ -7,7 +7,8 @@
 //
 //   1. every file to its own temporary; any failure (full disk, a codec error) removes the
 //      temporaries and leaves every target as it was;
-//   2. with an exclusive flock(2) on the lock file ".<stem>.lock" beside the first target (".x.lock"
+//   2. with an exclusive flock(2) on the lock file ".<stem>.lock" beside the first target
+//   (".x.lock"
 //      for out/x.png and out/x.exr),
 //      each temporary is renamed over its target.
 //

@@ -1,22 +1,22 @@
 #include "core/io/exr.h"
 
 #include <ImfChannelList.h>
+#include <ImfCheckFile.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfTestFile.h>
-#include <ImfCheckFile.h>
 #include <png.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
-#include <array>
 #include <memory>
 #include <stdexcept>
 
@@ -64,13 +64,15 @@ RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_
 
 namespace {
 
-void encodeExr(const std::filesystem::path& file, int width, int height, const std::vector<ExrChannel>& channels) {
+void encodeExr(const std::filesystem::path& file, int width, int height,
+               const std::vector<ExrChannel>& channels) {
   Imf::Header header(width, height);
   header.compression() = Imf::ZIP_COMPRESSION;
   for (const auto& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
   Imf::FrameBuffer fb;
   for (const auto& c : channels)
-    fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data, sizeof(float), size_t(width) * sizeof(float)));
+    fb.insert(c.name,
+              Imf::Slice(Imf::FLOAT, (char*)c.data, sizeof(float), size_t(width) * sizeof(float)));
   Imf::OutputFile out(file.c_str(), header);
   out.setFrameBuffer(fb);
   out.writePixels(height);
@@ -93,9 +95,11 @@ void pngError(png_structp png, png_const_charp msg) {
 
 void pngWarning(png_structp, png_const_charp) {}
 
-void encodePng(const std::filesystem::path& file, int width, int height, const std::vector<unsigned char>& px) {
+void encodePng(const std::filesystem::path& file, int width, int height,
+               const std::vector<unsigned char>& px) {
   FILE* f = std::fopen(file.c_str(), "wb");
-  if (!f) throw std::runtime_error(std::string("cannot open a temporary file: ") + std::strerror(errno));
+  if (!f)
+    throw std::runtime_error(std::string("cannot open a temporary file: ") + std::strerror(errno));
   PngErrorState st;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &st, pngError, pngWarning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
@@ -108,8 +112,8 @@ void encodePng(const std::filesystem::path& file, int width, int height, const s
     throw std::runtime_error(why);
   }
   png_init_io(png, f);
-  png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
   for (int y = 0; y < height; ++y) png_write_row(png, &px[size_t(y) * size_t(width) * 3]);
   png_write_end(png, nullptr);
@@ -120,7 +124,8 @@ void encodePng(const std::filesystem::path& file, int width, int height, const s
 }  // namespace
 
 void writeExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels) {
-  writeFileAtomically(path, [&](const std::filesystem::path& tmp) { encodeExr(tmp, width, height, channels); });
+  writeFileAtomically(
+      path, [&](const std::filesystem::path& tmp) { encodeExr(tmp, width, height, channels); });
 }
 
 FileContent exrRgbContent(int width, int height, const std::vector<float>& rgb) {
@@ -131,15 +136,18 @@ FileContent exrRgbContent(int width, int height, const std::vector<float>& rgb) 
   for (size_t i = 0; i < n; ++i)
     for (size_t c = 0; c < 3; ++c) (*planes)[c][i] = rgb[3 * i + c];
   return [planes, width, height](const std::filesystem::path& tmp) {
-    encodeExr(tmp, width, height, {{"R", (*planes)[0].data()}, {"G", (*planes)[1].data()}, {"B", (*planes)[2].data()}});
+    encodeExr(tmp, width, height,
+              {{"R", (*planes)[0].data()}, {"G", (*planes)[1].data()}, {"B", (*planes)[2].data()}});
   };
 }
 
-void writeExrRgb(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb) {
+void writeExrRgb(const std::filesystem::path& path, int width, int height,
+                 const std::vector<float>& rgb) {
   writeFileAtomically(path, exrRgbContent(width, height, rgb));
 }
 
-FileContent pngPreviewContent(int width, int height, const std::vector<float>& rgb, double exposure) {
+FileContent pngPreviewContent(int width, int height, const std::vector<float>& rgb,
+                              double exposure) {
   size_t n = size_t(width) * size_t(height);
   if (rgb.size() != 3 * n) throw std::invalid_argument("pngPreviewContent: pixel count mismatch");
   auto px = std::make_shared<std::vector<unsigned char>>(3 * n);
@@ -157,11 +165,12 @@ FileContent pngPreviewContent(int width, int height, const std::vector<float>& r
     (*px)[3 * i + 1] = encode(g * k);
     (*px)[3 * i + 2] = encode(b * k);
   }
-  return [px, width, height](const std::filesystem::path& tmp) { encodePng(tmp, width, height, *px); };
+  return
+      [px, width, height](const std::filesystem::path& tmp) { encodePng(tmp, width, height, *px); };
 }
 
-void writePngPreview(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb,
-                     double exposure) {
+void writePngPreview(const std::filesystem::path& path, int width, int height,
+                     const std::vector<float>& rgb, double exposure) {
   writeFileAtomically(path, pngPreviewContent(width, height, rgb, exposure));
 }
 

@@ -3,9 +3,10 @@
 // Every writer goes through core/io/atomic_write.h: it creates the missing folders above its
 // path, writes to "<path>.tmp-XXXXXXXX" in the same folder and renames it into place, so a failed
 // or interrupted run leaves no partial file. The *Content functions encode an image for
-// writeFilesTogether, which writes several files (a render's EXR and PNG) as one set. Readers validate before decoding: Debian's
-// OpenEXR 3.1.5 has a known flaw with deep images, so EXR input is accepted only after
-// Imf::checkOpenEXRFile passes, deep files are rejected, and sizes are capped.
+// writeFilesTogether, which writes several files (a render's EXR and PNG) as one set. Readers
+// validate before decoding: Debian's OpenEXR 3.1.5 has a known flaw with deep images, so EXR input
+// is accepted only after Imf::checkOpenEXRFile passes, deep files are rejected, and sizes are
+// capped.
 #pragma once
 
 #include <filesystem>
@@ -42,7 +43,8 @@ FileContent exrRgbContent(int width, int height, const std::vector<float>& rgb);
 void writeExrRgb(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb);
 
 /// The 8-bit sRGB PNG preview of writePngPreview, for writeFilesTogether (pixels copied).
-FileContent pngPreviewContent(int width, int height, const std::vector<float>& rgb, double exposure = 0.0);
+FileContent pngPreviewContent(int width, int height, const std::vector<float>& rgb,
+                              double exposure = 0.0);
 
 /// Write an 8-bit sRGB PNG preview of linear RGB (3 floats per pixel): multiply by 2^exposure,
 /// Reinhard-style tone map x/(1+x) on luminance-preserving ratio, sRGB transfer. Atomic.

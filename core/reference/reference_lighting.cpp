@@ -39,7 +39,9 @@ LightingSummary simulateLightingWith(const Scene& scene, VolumeSet& volume, cons
     s.wavelength_nm = r.wavelength_nm;
     s.mode = r.mode;
     if (options.progress)
-      s.progress = [&, i](double f) { options.progress((double(i) + std::min(f, 1.0)) / double(runs.size()), label); };
+      s.progress = [&, i](double f) {
+        options.progress((double(i) + std::min(f, 1.0)) / double(runs.size()), label);
+      };
     WavefrontResult res = simulate(s, unitPowerLight(scene.lights[r.light]));
     addLightingRun(volume, r, res.irradiance, res.direction);
     sum.add(res.stats, r.luminance);

@@ -31,12 +31,11 @@
 //   eikon::WavefrontResult r = sim.run(scene.lights[0]);
 #pragma once
 
-#include <glm/glm.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <glm/glm.hpp>
 #include <vector>
 
 #include "core/reference/reference_marcher.h"
@@ -113,8 +112,8 @@ struct WavefrontSettings {
 /// (left the volume, absorbed, killed) and the front's travel against the volume diagonal (the
 /// front moves dt/n mm per step, so in a dense medium the travel estimate runs ahead: capped at
 /// 0.95 until the flux says otherwise). Non-decreasing over a run.
-inline double wavefrontRunFraction(long long steps, double dt, const glm::dvec3& extent, double flux_ended,
-                                   double flux_emitted) {
+inline double wavefrontRunFraction(long long steps, double dt, const glm::dvec3& extent,
+                                   double flux_ended, double flux_emitted) {
   const double travel = std::min(0.95, double(steps) * dt / std::max(glm::length(extent), 1e-12));
   const double ended = flux_emitted > 0 ? std::clamp(flux_ended / flux_emitted, 0.0, 1.0) : 0.0;
   return std::max(travel, ended);

@@ -375,9 +375,9 @@ struct GpuWavefront::Impl {
       st.max_live = std::max<size_t>(st.max_live, total);
       ++dispatches;
       if (s.progress)
-        s.progress(wavefrontRunFraction(dispatches * steps_per_dispatch, s.dt, g.extent,
-                                        st.flux_left + st.flux_caustic + st.flux_energy + st.flux_absorbed,
-                                        st.flux_emitted));
+        s.progress(wavefrontRunFraction(
+            dispatches * steps_per_dispatch, s.dt, g.extent,
+            st.flux_left + st.flux_caustic + st.flux_energy + st.flux_absorbed, st.flux_emitted));
       if (total == 0) break;
       const int dst = 1 - src;
       ensurePatchCapacity(dst, total);

@@ -214,10 +214,12 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   // next band is sized from the last one's time to take ~0.25 s, so even a small image that is
   // slow per ray (many wavelengths, a dense volume) reports progress several times a second.
   const double work = double(img.width) * img.height * s.spp * std::max(1, s.wavelengths);
-  int max_rows = std::clamp(int(std::ceil(double(img.height) * 2.0e5 / std::max(work, 1.0))), EIKON_WG_Y, img.height);
+  int max_rows = std::clamp(int(std::ceil(double(img.height) * 2.0e5 / std::max(work, 1.0))),
+                            EIKON_WG_Y, img.height);
   max_rows = (max_rows + EIKON_WG_Y - 1) / EIKON_WG_Y * EIKON_WG_Y;
   int rows = EIKON_WG_Y;
-  vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
+  vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * sizeof(glm::vec4),
+                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
   I.view.bindBuffer(EIKON_B_OUTPUT, out);
   img.rgb.resize(size_t(img.width) * size_t(img.height) * 3);
   std::vector<glm::vec4> band(size_t(img.width) * size_t(max_rows));
@@ -242,8 +244,10 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
         steps += v.w;
       }
     if (s.progress) s.progress(double(y0 + n) / img.height);
-    const double band_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - band_start).count();
-    const double next = double(n) * 0.25 / std::max(band_s, 1e-3);  // rows for ~0.25 s, at most 8x the last
+    const double band_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - band_start).count();
+    const double next =
+        double(n) * 0.25 / std::max(band_s, 1e-3);  // rows for ~0.25 s, at most 8x the last
     rows = std::clamp(int(std::min(next, 8.0 * n)) / EIKON_WG_Y * EIKON_WG_Y, EIKON_WG_Y, max_rows);
   }
   img.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

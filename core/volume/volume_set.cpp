@@ -242,7 +242,8 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
                               ((f == kAo || f == kAe) ? cov * gprop : glm::dvec3(0.0));
               gradients[size_t(f)][idx] = glm::vec3(gv);
             }
-          for (int f = 0; f < kFieldCount; ++f) fields[size_t(f)][idx] = fields[size_t(f)][idx] * (1 - fc) + prop[f] * fc;
+          for (int f = 0; f < kFieldCount; ++f)
+            fields[size_t(f)][idx] = fields[size_t(f)][idx] * (1 - fc) + prop[f] * fc;
           if (vs.uniaxial && mat.uniaxial) axis[idx] = ax;
         }
       // Progress per z slab: a large object alone takes seconds at 256³. The count is read under
@@ -251,7 +252,9 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
       if (opt.progress) {
         std::unique_lock<std::mutex> lock(progress_mutex, std::try_to_lock);
         if (lock.owns_lock())
-          opt.progress(0.4 * (double(oi) + double(slabs_done.load()) / slabs) / double(scene.objects.size()), "voxelising");
+          opt.progress(
+              0.4 * (double(oi) + double(slabs_done.load()) / slabs) / double(scene.objects.size()),
+              "voxelising");
       }
     });
     progress(0.4 * double(oi + 1) / double(scene.objects.size()), "voxelising");

@@ -61,7 +61,8 @@ TEST_P(BenchHelp, UnknownOptionFailsWithOneLine) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Benchmarks, BenchHelp,
-                         ::testing::Values(Bench{"view_bench", EIKON_VIEW_BENCH}, Bench{"fit_bench", EIKON_FIT_BENCH},
+                         ::testing::Values(Bench{"view_bench", EIKON_VIEW_BENCH},
+                                           Bench{"fit_bench", EIKON_FIT_BENCH},
                                            Bench{"spectral_bench", EIKON_SPECTRAL_BENCH},
                                            Bench{"light_bench", EIKON_LIGHT_BENCH}),
                          [](const auto& param_info) { return std::string(param_info.param.name); });

@@ -193,9 +193,11 @@ TEST_F(Cli, EveryShippedSceneRendersCleanUnderStrict) {
   std::sort(scenes.begin(), scenes.end());
   ASSERT_GE(scenes.size(), 9u) << "scenes/ not found under " << EIKON_SOURCE_DIR;
   for (const fs::path& scene : scenes) {
-    const Outcome r = run("render " + quote(scene.string()) + " -o " + quote(outPath(scene.stem().string() + ".exr")) +
-                          " --strict -q --reference --width 16 --height 12 --spp 1 --wavelengths 4 --light-bands 1"
-                          " --max-patches 1024 --light-split 8 --light-step 2 --no-light-cache");
+    const Outcome r = run(
+        "render " + quote(scene.string()) + " -o " +
+        quote(outPath(scene.stem().string() + ".exr")) +
+        " --strict -q --reference --width 16 --height 12 --spp 1 --wavelengths 4 --light-bands 1"
+        " --max-patches 1024 --light-split 8 --light-step 2 --no-light-cache");
     EXPECT_EQ(r.code, 0) << scene << ": " << r.err;
     EXPECT_EQ(r.err, "") << scene;
     EXPECT_TRUE(fs::is_regular_file(outPath(scene.stem().string() + ".exr"))) << scene;
@@ -210,7 +212,8 @@ std::vector<std::string> progressLines(const std::string& err, const std::string
   std::vector<std::string> out;
   std::istringstream in(err);
   for (std::string line; std::getline(in, line);)
-    if (line.rfind("eikon: " + stage, 0) == 0 && line.find("%  ") != std::string::npos && line.find(", ETA ") != std::string::npos)
+    if (line.rfind("eikon: " + stage, 0) == 0 && line.find("%  ") != std::string::npos &&
+        line.find(", ETA ") != std::string::npos)
       out.push_back(line);
   return out;
 }
@@ -220,12 +223,14 @@ std::vector<std::string> progressLines(const std::string& err, const std::string
 // The lit scene has all three stages: voxelising, light, rendering.
 TEST_F(Cli, RenderProgressOnlyWhenAskedOrOnATerminal) {
   std::string lit = tinyScene();
-  lit.insert(lit.rfind('}'), R"(, "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}])");
+  lit.insert(lit.rfind('}'),
+             R"(, "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}])");
   const std::string light = " --reference --light-split 8 --light-step 2 --no-light-cache";
   const Outcome quiet = render(lit, light);
   ASSERT_EQ(quiet.code, 0) << quiet.err;
   EXPECT_EQ(quiet.err, "") << "progress without a terminal";
-  EXPECT_EQ(std::count(quiet.out.begin(), quiet.out.end(), '\n'), 2) << "the summary lines only:\n" << quiet.out;
+  EXPECT_EQ(std::count(quiet.out.begin(), quiet.out.end(), '\n'), 2) << "the summary lines only:\n"
+                                                                     << quiet.out;
   const Outcome never = render(lit, light + " --progress always -q");
   ASSERT_EQ(never.code, 0) << never.err;
   EXPECT_EQ(never.err, "");
@@ -259,7 +264,8 @@ TEST_F(Cli, TraceProgressOnlyWhenAsked) {
 }
 
 TEST_F(Cli, BadProgressOptionFailsCleanly) {
-  expectCleanFailure(render(tinyScene(), "--progress sometimes"), "--progress must be auto, always or never");
+  expectCleanFailure(render(tinyScene(), "--progress sometimes"),
+                     "--progress must be auto, always or never");
   const std::string scene = write("scene.json", tinyScene());
   expectCleanFailure(run("trace " + quote(scene) + " --origin 0,0,-5 --dir 0,0,1 --progress loud"),
                      "--progress must be auto, always or never");
@@ -310,7 +316,8 @@ TEST_F(Cli, RenderResolutionBeyondTheDeviceLimit) {
 TEST_F(Cli, RenderCreatesMissingOutputFolders) {
   const std::string scene = write("scene.json", tinyScene());
   const fs::path missing = dir_ / "no_such_dir" / "deeper";
-  const Outcome r = run("render " + quote(scene) + " -q --reference -o " + quote((missing / "x.exr").string()));
+  const Outcome r =
+      run("render " + quote(scene) + " -q --reference -o " + quote((missing / "x.exr").string()));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::is_regular_file(missing / "x.exr"));
   EXPECT_TRUE(fs::is_regular_file(missing / "x.png"));
@@ -325,7 +332,8 @@ TEST_F(Cli, RenderCreatesMissingOutputFolders) {
 TEST_F(Cli, RenderOutputFolderIsAFile) {
   const std::string scene = write("scene.json", tinyScene());
   write("plain", "not a folder");
-  const Outcome r = run("render " + quote(scene) + " -o " + quote((dir_ / "plain" / "sub" / "x.exr").string()));
+  const Outcome r =
+      run("render " + quote(scene) + " -o " + quote((dir_ / "plain" / "sub" / "x.exr").string()));
   expectCleanFailure(r, "is not a folder", dir_);
   EXPECT_TRUE(fs::is_regular_file(dir_ / "plain"));
 }
@@ -355,17 +363,21 @@ TEST_F(Cli, RenderOutputDirectoryReadOnly) {
 // byte for byte, and no temporary. It used to delete the previous EXR when the PNG failed.
 TEST_F(Cli, FailedWriteLeavesThePreviousOutputsIntact) {
   const std::string scene = write("scene.json", tinyScene());
-  const std::string common = "render " + quote(scene) + " -q --reference --width 160 --height 120 -o " + quote(outPath());
+  const std::string common =
+      "render " + quote(scene) + " -q --reference --width 160 --height 120 -o " + quote(outPath());
   const Outcome first = run(common);
   ASSERT_EQ(first.code, 0) << first.err;
   const std::string exr = slurp(outPath("render.exr")), png = slurp(outPath("render.png"));
   // The sizes the limit is chosen between (a 160x120 render of the tiny scene: ~22 KB, ~6 KB).
   ASSERT_GT(exr.size(), 12000u);
   ASSERT_LT(png.size(), 8192u);
-  // A different picture (2 spp, brighter preview): had it replaced anything, the bytes would differ.
-  const Outcome r = eikon::test::runProgramWithFileLimit(EIKON_BINARY, common + " --spp 2 --exposure 1", io_, 8192);
+  // A different picture (2 spp, brighter preview): had it replaced anything, the bytes would
+  // differ.
+  const Outcome r = eikon::test::runProgramWithFileLimit(
+      EIKON_BINARY, common + " --spp 2 --exposure 1", io_, 8192);
   EXPECT_NE(r.code, 0);
-  EXPECT_EQ(r.err.rfind("eikon: error: cannot write '" + outPath("render.exr") + "'", 0), 0u) << r.err;
+  EXPECT_EQ(r.err.rfind("eikon: error: cannot write '" + outPath("render.exr") + "'", 0), 0u)
+      << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_EQ(slurp(outPath("render.exr")), exr);
   EXPECT_EQ(slurp(outPath("render.png")), png);
@@ -384,8 +396,11 @@ TEST_F(Cli, FailedWriteLeavesThePreviousOutputsIntact) {
 TEST_F(Cli, PngWriteErrorIsOneEikonLine) {
   const std::string scene = write("scene.json", tinyScene());
   const Outcome r = eikon::test::runProgramWithFileLimit(
-      EIKON_BINARY, "render " + quote(scene) + " -q --reference --width 160 --height 120 -o " + quote(outPath()), io_, 2048);
-  expectCleanFailure(r, "cannot write '" + outPath("render.png") + "': libpng: Write Error (File too large)");
+      EIKON_BINARY,
+      "render " + quote(scene) + " -q --reference --width 160 --height 120 -o " + quote(outPath()),
+      io_, 2048);
+  expectCleanFailure(
+      r, "cannot write '" + outPath("render.png") + "': libpng: Write Error (File too large)");
   EXPECT_EQ(r.err.find("libpng error"), std::string::npos) << r.err;
 }
 
@@ -400,7 +415,8 @@ TEST_F(Cli, RenderRefusesToOverwriteItsInputs) {
   const std::string checker = R"({"type": "checker", "squares": 8})";
   text.replace(text.find(checker), checker.size(), R"({"type": "latlong", "file": "sky.exr"})");
   const std::string scene = write("scene.json", text);
-  Outcome r = run("render " + quote(scene) + " -q --reference -o " + quote((dir_ / "sky.exr").string()));
+  Outcome r =
+      run("render " + quote(scene) + " -q --reference -o " + quote((dir_ / "sky.exr").string()));
   expectCleanFailure(r, "is the scene's environment map", fs::path());
   EXPECT_EQ(slurp(dir_ / "sky.exr"), sky_bytes);
   EXPECT_FALSE(fs::exists(dir_ / "sky.png"));
@@ -430,11 +446,13 @@ TEST_F(Cli, RenderSppZero) { expectCleanFailure(render(tinyScene(), "--spp 0"), 
 // A given size must be a size: --width 0 used to render at the scene's width with exit 0, and
 // --wavelengths -1 at the default. Not given still means the scene's value (RenderTinyScene).
 TEST_F(Cli, RenderZeroOrNegativeSizesAreRejected) {
-  for (const char* bad : {"--width 0", "--height 0", "--width -5", "--height -1", "--spp -2", "--wavelengths -1"}) {
+  for (const char* bad :
+       {"--width 0", "--height 0", "--width -5", "--height -1", "--spp -2", "--wavelengths -1"}) {
     const std::string flag = std::string(bad).substr(0, std::string(bad).find(' '));
     const Outcome r = render(tinyScene(), bad);
     expectCleanFailure(r, flag + " must be in [");
-    EXPECT_NE(r.err.find("got " + std::string(bad).substr(flag.size() + 1)), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("got " + std::string(bad).substr(flag.size() + 1)), std::string::npos)
+        << r.err;
   }
 }
 
@@ -573,28 +591,35 @@ TEST_F(Cli, TraceTextShowsCountsAndIsotropicModes) {
   for (const char* twin : {"", " --reference"}) {
     const Outcome r = run("trace " + quote(iso) + " --origin 0,0,-5 --dir 0,0,1" + twin);
     ASSERT_EQ(r.code, 0) << r.err;
-    EXPECT_NE(r.out.find("isotropic scene: the o and e modes coincide"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("isotropic scene: the o and e modes coincide"), std::string::npos)
+        << r.out;
     EXPECT_NE(r.out.find("  o=e: exit ("), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("  o: "), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("  e: "), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find(" 2 interfaces crossed, 0 total internal reflections, "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(" 2 interfaces crossed, 0 total internal reflections, "),
+              std::string::npos)
+        << r.out;
     // Steps: homogeneous runs are crossed in long straight steps, so only a lower bound is sure:
-    // the 6 mm inside the sphere's smoothed surface region alone takes well over 10 steps of 0.25 h.
+    // the 6 mm inside the sphere's smoothed surface region alone takes well over 10 steps of 0.25
+    // h.
     const auto at = r.out.find(" total internal reflections, ");
     ASSERT_NE(at, std::string::npos);
-    const int steps = std::stoi(r.out.substr(at + std::string(" total internal reflections, ").size()));
+    const int steps =
+        std::stoi(r.out.substr(at + std::string(" total internal reflections, ").size()));
     EXPECT_GT(steps, 10) << r.out;
     EXPECT_NE(r.out.find(std::to_string(steps) + " steps\n"), std::string::npos) << r.out;
   }
   // Uniaxial (calcite-like, optic axis across the ray): two mode lines, each with its counts.
-  const std::string uni = write("uni.json", tinyScene("", R"({"n_o": 1.658, "n_e": 1.486, "optic_axis": [0, 1, 0]})"));
+  const std::string uni =
+      write("uni.json", tinyScene("", R"({"n_o": 1.658, "n_e": 1.486, "optic_axis": [0, 1, 0]})"));
   const Outcome r = run("trace " + quote(uni) + " --origin 0,0,-5 --dir 0,0,1 --reference");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.out.find("coincide"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("  o: exit ("), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("  e: exit ("), std::string::npos) << r.out;
   size_t count = 0;
-  for (size_t p = r.out.find(" 2 interfaces crossed, 0 total internal reflections, "); p != std::string::npos;
+  for (size_t p = r.out.find(" 2 interfaces crossed, 0 total internal reflections, ");
+       p != std::string::npos;
        p = r.out.find(" 2 interfaces crossed, 0 total internal reflections, ", p + 1))
     ++count;
   EXPECT_EQ(count, 2u) << r.out;

@@ -90,7 +90,8 @@ TEST(Progress, GpuLightSimulatorReportsPerDispatch) {
 // (what it made before), all under one label.
 TEST(Progress, LightingDriverReportsWithinRuns) {
   std::string json = test::kGlassSphereLightScene;
-  json.insert(json.rfind('}'), R"(, "lights": [{"type": "directional", "direction": [1, 0, 0], "irradiance": 1}])");
+  json.insert(json.rfind('}'),
+              R"(, "lights": [{"type": "directional", "direction": [1, 0, 0], "irradiance": 1}])");
   const Scene scene = sceneFromJson(json);
   VolumeSet vol = voxelize(scene);
   std::vector<double> f;

@@ -4,9 +4,9 @@
 // different renders).
 #include "core/io/atomic_write.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/file.h>
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -72,14 +72,15 @@ TEST_F(AtomicWrite, FailureOfTheSecondFileLeavesBothTargetsIntact) {
   const fs::path png = dir_ / "x.png", exr = dir_ / "x.exr";
   writeFilesTogether({{png, text("old png")}, {exr, text("old exr")}});
   try {
-    writeFilesTogether({{png, text("new png")},
-                        {exr, [](const fs::path& tmp) {
-                           std::ofstream(tmp) << "half";
-                           throw std::runtime_error("No space left on device");
-                         }}});
+    writeFilesTogether({{png, text("new png")}, {exr, [](const fs::path& tmp) {
+                                                   std::ofstream(tmp) << "half";
+                                                   throw std::runtime_error(
+                                                       "No space left on device");
+                                                 }}});
     FAIL() << "no exception";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), "cannot write '" + exr.string() + "': No space left on device");
+    EXPECT_EQ(std::string(e.what()),
+              "cannot write '" + exr.string() + "': No space left on device");
   }
   EXPECT_EQ(slurp(png), "old png");
   EXPECT_EQ(slurp(exr), "old exr");
@@ -90,7 +91,8 @@ TEST_F(AtomicWrite, TargetThatIsAFolderFailsBeforeAnyTargetChanges) {
   const fs::path png = dir_ / "x.png", exr = dir_ / "x.exr";
   std::ofstream(png) << "old png";
   fs::create_directory(exr);
-  EXPECT_THROW(writeFilesTogether({{png, text("new png")}, {exr, text("new exr")}}), std::runtime_error);
+  EXPECT_THROW(writeFilesTogether({{png, text("new png")}, {exr, text("new exr")}}),
+               std::runtime_error);
   EXPECT_EQ(slurp(png), "old png");
   EXPECT_TRUE(fs::is_directory(exr));
   expectNoTemporaries(dir_);
@@ -100,8 +102,9 @@ TEST_F(AtomicWrite, SingleFileAndBytes) {
   const fs::path f = dir_ / "new" / "one.json";
   writeBytesAtomically(f, "{\"a\": 1}\n");
   EXPECT_EQ(slurp(f), "{\"a\": 1}\n");
-  EXPECT_THROW(writeFileAtomically(f, [](const fs::path&) { throw std::runtime_error("encoder failed"); }),
-               std::runtime_error);
+  EXPECT_THROW(
+      writeFileAtomically(f, [](const fs::path&) { throw std::runtime_error("encoder failed"); }),
+      std::runtime_error);
   EXPECT_EQ(slurp(f), "{\"a\": 1}\n");
   expectNoTemporaries(dir_);
 }
