@@ -1,5 +1,6 @@
 // eikon info: the Vulkan device eikon would use, its limits, and the build.
 #include <cstdio>
+#include <string>
 
 #include "apps/commands.h"
 #include "core/vk/context.h"
@@ -18,13 +19,18 @@ void addInfoCommand(CLI::App& app) {
                 "debug"
 #endif
     );
-    std::printf("device:            %s (%s), Vulkan %s\n", ctx->deviceName().c_str(), ctx->deviceTypeName().c_str(),
-                ctx->apiVersionString().c_str());
-    std::printf("max 3D image side: %u voxels\n", l.max_image_dimension_3d);
-    std::printf("max storage buffer:%llu MiB\n", (unsigned long long)(l.max_storage_buffer_range >> 20));
-    std::printf("device heap:       %llu MiB\n", (unsigned long long)(l.heap_size >> 20));
-    std::printf("shader float64:    %s\n", l.shader_float64 ? "yes" : "no");
-    std::printf("validation layers: %s (EIKON_VALIDATION=1 enables)\n", ctx->validationEnabled() ? "on" : "off");
+    // One column for every value: the labels are padded to the longest ("max storage buffer:").
+    auto row = [](const char* label, const std::string& value) {
+      std::printf("%-20s%s\n", (std::string(label) + ":").c_str(), value.c_str());
+    };
+    row("device",
+        ctx->deviceName() + " (" + ctx->deviceTypeName() + "), Vulkan " + ctx->apiVersionString());
+    row("max 3D image side", std::to_string(l.max_image_dimension_3d) + " voxels");
+    row("max storage buffer", std::to_string(l.max_storage_buffer_range >> 20) + " MiB");
+    row("device heap", std::to_string(l.heap_size >> 20) + " MiB");
+    row("shader float64", l.shader_float64 ? "yes" : "no");
+    row("validation layers",
+        std::string(ctx->validationEnabled() ? "on" : "off") + " (EIKON_VALIDATION=1 enables)");
   });
 }
 

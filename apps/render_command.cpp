@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <utility>
+#include <vector>
 
 #include "apps/commands.h"
 #include "apps/light_cache.h"
@@ -21,7 +23,7 @@ struct RenderArgs {
   std::string scene, output;
   int width = 0, height = 0, spp = 1, wavelengths = -1, threads = 0;
   double step = kDefaultRenderStepVoxels, exposure = 0.0;
-  std::string integrator = "rk4";
+  std::string integrator = "rk4", progress = "auto";
   bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
   // Light simulator (scenes with "lights").
   int light_bands = 0, max_patches = 1 << 20;
@@ -29,6 +31,25 @@ struct RenderArgs {
   std::string light_splat = "accumulate", light_cache, caustics = "pass", light_device = "auto";
   bool no_light = false, no_light_cache = false;
 };
+
+/// Refuse an output that is one of the render's own inputs (the same file by device and inode:
+/// also through a symbolic or hard link): `-o scenes/diamond_lights.exr` used to replace the
+/// scene's environment map with the render and exit 0.
+void refuseOverwritingInputs(
+    const Scene& scene, const std::filesystem::path& scene_path,
+    const std::vector<std::pair<std::filesystem::path, const char*>>& outputs) {
+  std::vector<std::pair<std::filesystem::path, std::string>> inputs = {
+      {scene_path, "the scene file"}};
+  if (!scene.environment.image_path.empty())
+    inputs.push_back({scene.environment.image_path, "the scene's environment map"});
+  for (const auto& [out, what] : outputs)
+    for (const auto& [in, role] : inputs) {
+      std::error_code ec;
+      if (std::filesystem::equivalent(out, in, ec))
+        throw CliError(std::string(what) + " '" + out.string() + "' is " + role + " '" +
+                       in.string() + "'; refusing to overwrite an input (choose another -o)");
+    }
+}
 
 Integrator parseIntegrator(const std::string& s) {
   if (s == "euler") return Integrator::Euler;
@@ -43,11 +64,14 @@ void addRenderCommand(CLI::App& app) {
   auto* sub = app.add_subcommand("render", "Render a scene to an EXR (linear sRGB) and a PNG preview");
   sub->add_option("scene", args->scene, "Scene JSON file")->required();
   sub->add_option("-o,--output", args->output, "Output EXR path (the PNG preview is written beside it)")->required();
-  sub->add_option("--width", args->width, "Image width (default: the scene camera's)");
-  sub->add_option("--height", args->height, "Image height (default: the scene camera's)");
-  sub->add_option("--spp", args->spp, "Jittered samples per pixel (default 1)");
+  sub->add_option("--width", args->width,
+                  "Image width in [1, 16384] (default: the scene camera's)");
+  sub->add_option("--height", args->height,
+                  "Image height in [1, 16384] (default: the scene camera's)");
+  sub->add_option("--spp", args->spp, "Jittered samples per pixel in [1, 4096] (default 1)");
   sub->add_option("--wavelengths", args->wavelengths,
-                  "Spectral samples per pixel sample; 0 = RGB mode (default: 16 for dispersive scenes, else 0)");
+                  "Spectral samples per pixel sample in [1, 256], or 0 for RGB mode (default: 16 "
+                  "for dispersive scenes, else 0)");
   sub->add_option("--step", args->step, "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", args->integrator, "euler, midpoint or rk4 (default rk4)");
   sub->add_option("--exposure", args->exposure, "PNG preview exposure in stops (default 0)");
@@ -56,7 +80,10 @@ void addRenderCommand(CLI::App& app) {
   sub->add_flag("--no-skip", args->no_skip, "Do not cross homogeneous regions in one step");
   sub->add_flag("--no-fresnel", args->no_fresnel, "Disable Fresnel reflection and transmission losses");
   sub->add_flag("--strict", args->strict, "Treat warnings (e.g. wavelengths outside a material's range) as errors");
-  sub->add_flag("-q,--quiet", args->quiet, "No progress lines");
+  sub->add_flag("-q,--quiet", args->quiet, "No progress lines (same as --progress never)");
+  sub->add_option(
+      "--progress", args->progress,
+      "auto (default: progress with ETA on stderr when it is a terminal), always or never");
   sub->add_option("--light-bands", args->light_bands,
                   "Light simulator wavelength bands (default: 12 dispersive, 3 attenuating, else 1)");
   sub->add_option("--light-splat", args->light_splat,
@@ -73,28 +100,42 @@ void addRenderCommand(CLI::App& app) {
                   "Directory of cached light volumes (default $EIKON_CACHE_DIR, $XDG_CACHE_HOME/eikon or ~/.cache/eikon)");
   sub->add_flag("--no-light-cache", args->no_light_cache, "Simulate the light even if a cached result exists, and store none");
   sub->add_flag("--no-light", args->no_light, "Do not simulate the scene's lights (no caustics, in-scatter or lit surfaces)");
-  sub->callback([args] {
+  sub->callback([args, sub] {
     const RenderArgs& a = *args;
     std::filesystem::path out(a.output), png = std::filesystem::path(a.output).replace_extension(".png");
     if (out.extension() != ".exr") throw CliError("output must end in .exr: " + a.output);
-    if (a.spp < 1 || a.spp > 4096) throw CliError("--spp must be in [1, 4096]");
-    if (a.width < 0 || a.height < 0 || a.width > 16384 || a.height > 16384) throw CliError("--width/--height must be in [1, 16384]");
-    if (a.wavelengths < -1 || a.wavelengths > 256) throw CliError("--wavelengths must be in [0, 256]");
+    (void)progressMode(a.progress, a.quiet);  // a bad --progress fails before any work
+    // A size not given is the scene camera's; a given one must be a real size (0 used to mean
+    // "the scene's" silently, and a negative --wavelengths the default).
+    auto checkRange = [&](const char* name, int v, int lo, int hi) {
+      if (sub->count(name) && (v < lo || v > hi))
+        throw CliError(std::string(name) + " must be in [" + std::to_string(lo) + ", " +
+                       std::to_string(hi) + "], got " + std::to_string(v));
+    };
+    checkRange("--width", a.width, 1, 16384);
+    checkRange("--height", a.height, 1, 16384);
+    checkRange("--spp", a.spp, 1, 4096);
+    checkRange("--wavelengths", a.wavelengths, 0, 256);
     if (!(a.step > 0 && a.step <= 4)) throw CliError("--step must be in (0, 4] voxels");
     if (a.light_bands < 0 || a.light_bands > 64) throw CliError("--light-bands must be in [1, 64]");
     if (a.light_splat != "accumulate" && a.light_splat != "highest")
       throw CliError("--light-splat must be accumulate or highest, got '" + a.light_splat + "'");
     if (a.light_device != "auto" && a.light_device != "gpu" && a.light_device != "cpu")
       throw CliError("--light-device must be auto, gpu or cpu, got '" + a.light_device + "'");
-    if (a.caustics != "pass" && a.caustics != "kill") throw CliError("--caustics must be pass or kill, got '" + a.caustics + "'");
-    if (!(a.light_step >= 0 && a.light_step <= 2)) throw CliError("--light-step must be in (0, 2] voxels");
-    if (!(a.light_split >= 0.25 && a.light_split <= 8)) throw CliError("--light-split must be in [0.25, 8] voxels");
-    if (a.max_patches < 1024 || a.max_patches > (1 << 24)) throw CliError("--max-patches must be in [1024, 16777216]");
+    if (a.caustics != "pass" && a.caustics != "kill")
+      throw CliError("--caustics must be pass or kill, got '" + a.caustics + "'");
+    if (!(a.light_step >= 0 && a.light_step <= 2))
+      throw CliError("--light-step must be in (0, 2] voxels");
+    if (!(a.light_split >= 0.25 && a.light_split <= 8))
+      throw CliError("--light-split must be in [0.25, 8] voxels");
+    if (a.max_patches < 1024 || a.max_patches > (1 << 24))
+      throw CliError("--max-patches must be in [1024, 16777216]");
     Scene scene = loadScene(a.scene);
     for (const std::string& w : scene.warnings) {
       if (a.strict) throw CliError(w + " (--strict)");
       std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
     }
+    refuseOverwritingInputs(scene, a.scene, {{out, "the output"}, {png, "the PNG preview"}});
     checkWritable(out);
     checkWritable(png);
     // The defaults are shared with Python (core/render/render_defaults.h).
@@ -119,7 +160,7 @@ void addRenderCommand(CLI::App& app) {
         }
       }
 
-    Progress progress(a.quiet);
+    Progress progress(progressMode(a.progress, a.quiet));
     std::unique_ptr<vk::Context> ctx;
     if (!a.reference) {
       ctx = vk::Context::create();
@@ -172,14 +213,11 @@ void addRenderCommand(CLI::App& app) {
       img = renderer.render(rs);
     }
     progress.finish();
-    writeExrRgb(out, img.width, img.height, img.rgb);
-    try {
-      writePngPreview(png, img.width, img.height, img.rgb, a.exposure);
-    } catch (...) {
-      std::error_code ec;
-      std::filesystem::remove(out, ec);
-      throw;
-    }
+    // The pair as a pair (core/io/atomic_write.h): both files or neither replace what is there,
+    // and a concurrent render to the same -o cannot interleave its pair with this one. The
+    // preview first: it is the smaller, so a full disk is usually met before the EXR is encoded.
+    writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)},
+                        {out, exrRgbContent(img.width, img.height, img.rgb)}});
     for (const std::string& n : light.notes) std::fprintf(stderr, "eikon: note: %s\n", n.c_str());
     if (light_cached)
       std::printf("eikon: light volumes from the cache (%s)\n", (a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache)).c_str());

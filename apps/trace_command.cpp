@@ -1,15 +1,16 @@
 // eikon trace SCENE.json --origin x,y,z --dir x,y,z --wavelength NM [--json] [--reference]
 // Traces one ray through the voxelised scene and prints, per mode, exit point, exit direction,
-// wave normal, optical path and transmittance (docs/design.md §3). Isotropic scenes print both modes,
-// identical. Transmittance is the mode's own (Fresnel for its polarisation × attenuation);
-// unpolarised light gives each mode half of the incident power.
+// wave normal, optical path, transmittance, interfaces crossed, total internal reflections and
+// steps (docs/design.md §3). Isotropic scenes print one mode, marked "o=e" (--json gives both, identical).
+// Transmittance is the mode's own (Fresnel for its polarisation × attenuation); unpolarised light
+// gives each mode half of the incident power.
 #include <array>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
-
 #include "apps/commands.h"
+#include "apps/progress.h"
 #include "core/reference/reference_marcher.h"
 #include "core/render/view_renderer.h"
 #include "core/vk/context.h"
@@ -38,8 +39,8 @@ glm::dvec3 parseVec(const std::string& s, const char* what) {
 struct TraceArgs {
   std::string scene, origin, dir;
   double wavelength = 587.5618, step = 0.25;
-  bool json = false, reference = false;
-  std::string integrator = "rk4";
+  bool json = false, reference = false, quiet = false;
+  std::string integrator = "rk4", progress = "auto";
 };
 
 }  // namespace
@@ -54,12 +55,21 @@ void addTraceCommand(CLI::App& app) {
   sub->add_option("--step", a->step, "Integration step in voxels (default 0.25)");
   sub->add_flag("--json", a->json, "Print JSON");
   sub->add_flag("--reference", a->reference, "Use the double-precision CPU reference instead of the GPU");
+  sub->add_flag("-q,--quiet", a->quiet, "No progress lines (same as --progress never)");
+  sub->add_option("--progress", a->progress,
+                  "auto (default: voxelising progress with ETA on stderr when it is a terminal), "
+                  "always or never");
   sub->callback([a] {
     glm::dvec3 o = parseVec(a->origin, "--origin"), d = parseVec(a->dir, "--dir");
     if (glm::length(d) < 1e-12) throw CliError("--dir must be a non-zero vector");
     if (!(a->wavelength >= 100 && a->wavelength <= 10000)) throw CliError("--wavelength must be in [100, 10000] nm");
     if (!(a->step > 0 && a->step <= 4)) throw CliError("--step must be in (0, 4] voxels");
+    const ProgressMode progress_mode = progressMode(a->progress, a->quiet);
     Scene scene = loadScene(a->scene);
+    // Voxelising a 128³ scene takes seconds; the trace itself is instant.
+    Progress progress(progress_mode);
+    VoxelizeOptions vo;
+    vo.progress = [&](double f, const char*) { progress.update("voxelising", f); };
     MarchSettings ms;
     ms.step_voxels = a->step;
     TraceRequest req{o, glm::normalize(d), a->wavelength};
@@ -68,7 +78,8 @@ void addTraceCommand(CLI::App& app) {
     std::array<TraceOutcome, 2> modes;
     std::string device;
     if (a->reference) {
-      VolumeSet volume = voxelize(scene);
+      VolumeSet volume = voxelize(scene, vo);
+      progress.finish();
       VolumeField field(volume);
       ReferenceMarcher ref(field, scene.environment);
       modes = {ref.trace(req, ms, 0), ref.trace(req, ms, 1)};
@@ -76,7 +87,8 @@ void addTraceCommand(CLI::App& app) {
     } else {
       auto ctx = vk::Context::create();
       checkVolumeFits(*ctx, makeGrid(scene.volume), scene);
-      VolumeSet volume = voxelize(scene);
+      VolumeSet volume = voxelize(scene, vo);
+      progress.finish();
       ViewRenderer r(*ctx, scene, volume);
       modes = r.traceModes({req}, ms).front();
       device = ctx->deviceName();
@@ -103,13 +115,24 @@ void addTraceCommand(CLI::App& app) {
       std::printf("%s\n", j.dump(2).c_str());
       return;
     }
-    std::printf("wavelength %.4f nm on %s\n", a->wavelength, device.c_str());
-    for (int mi = 0; mi < 2; ++mi) {
+    // The text carries what --json carries. An isotropic scene has one mode: the o and e traces
+    // coincide, so it is printed once and said so.
+    const bool isotropic = !scene.anyUniaxial();
+    std::printf("wavelength %.4f nm on %s%s\n", a->wavelength, device.c_str(),
+                isotropic ? " (isotropic scene: the o and e modes coincide)" : "");
+    for (int mi = 0; mi < (isotropic ? 1 : 2); ++mi) {
       const TraceOutcome& t = modes[size_t(mi)];
-      std::printf("  %s: exit (%.6f, %.6f, %.6f) dir (%.6f, %.6f, %.6f) wave normal (%.6f, %.6f, %.6f) OPL %.6f mm T %.6f%s\n",
-                  mi == 0 ? "o" : "e", t.exit_point.x, t.exit_point.y, t.exit_point.z, t.exit_direction.x, t.exit_direction.y,
-                  t.exit_direction.z, t.wave_normal.x, t.wave_normal.y, t.wave_normal.z, t.optical_path_mm,
-                  t.transmittance, t.left_volume ? "" : " (stopped inside)");
+      std::printf(
+          "  %s: exit (%.6f, %.6f, %.6f) dir (%.6f, %.6f, %.6f) wave normal (%.6f, %.6f, %.6f) OPL "
+          "%.6f mm T %.6f%s\n",
+          isotropic ? "o=e"
+          : mi == 0 ? "o"
+                    : "e",
+          t.exit_point.x, t.exit_point.y, t.exit_point.z, t.exit_direction.x, t.exit_direction.y,
+          t.exit_direction.z, t.wave_normal.x, t.wave_normal.y, t.wave_normal.z, t.optical_path_mm,
+          t.transmittance, t.left_volume ? "" : " (stopped inside)");
+      std::printf("  %*s  %d interfaces crossed, %d total internal reflections, %d steps\n",
+                  isotropic ? 3 : 1, "", t.interfaces, t.total_internal_reflections, t.steps);
     }
   });
 }

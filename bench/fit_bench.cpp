@@ -9,6 +9,7 @@
 // the peer runs in another process and only the two rates and their ratio matter).
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,7 +24,13 @@
 #include "anisotropic/index_data.h"
 
 int main(int argc, char** argv) {
-  const double min_seconds = argc > 1 ? std::atof(argv[1]) : 1.0;
+  double min_seconds = 1.0;
+  CLI::App app{
+      "Fits per second of cauchy3 on 50 points: eikon (Ceres) against SciPy's least_squares",
+      "fit_bench"};
+  app.add_option("min_seconds", min_seconds, "Least time to spend fitting, in seconds (default 1)")
+      ->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
   namespace fs = std::filesystem;
   std::string tmpl = (fs::temp_directory_path() / "eikon_fit_bench_XXXXXX").string();
   if (!::mkdtemp(tmpl.data())) {

@@ -15,6 +15,7 @@
 //
 //   light_bench [--resolution N] [--no-skip-resolution M] [--steps-per-dispatch K] [--no-cpu]
 //               [--no-gpu] [--threads T1,T2,…]
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -113,24 +114,26 @@ int main(int argc, char** argv) {
   int resolution = 0, noSkipResolution = 64;
   bool cpu = true, gpu = true;
   std::string scene_path = std::string(EIKON_SOURCE_DIR) + "/scenes/caustic_sphere.json";
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--resolution") && i + 1 < argc) resolution = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--no-skip-resolution") && i + 1 < argc) noSkipResolution = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--steps-per-dispatch") && i + 1 < argc) gStepsPerDispatch = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--no-cpu")) cpu = false;
-    else if (!std::strcmp(argv[i], "--no-gpu")) gpu = false;
-    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) {
-      gThreads.clear();
-      for (const char* t = argv[++i]; *t;) {
-        char* end = nullptr;
-        gThreads.push_back(int(std::strtol(t, &end, 10)));
-        t = *end == ',' ? end + 1 : end;
-        if (end == t && *t) break;
-      }
-      if (gThreads.empty()) gThreads = {0};
-    }
-    else scene_path = argv[i];
-  }
+  CLI::App app{
+      "Light simulator: GPU and CPU reference twins on a lit scene (default "
+      "scenes/caustic_sphere.json)",
+      "light_bench"};
+  app.add_option("scene", scene_path, "Scene JSON file with at least one light");
+  app.add_option("--resolution", resolution, "Volume resolution (default: the scene's)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--no-skip-resolution", noSkipResolution,
+                 "Resolution of the runs without straight steps (default 64)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--steps-per-dispatch", gStepsPerDispatch, "GPU time steps per dispatch")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("!--no-cpu", cpu, "Skip the CPU reference");
+  app.add_flag("!--no-gpu", gpu, "Skip the GPU simulator");
+  app.add_option("--threads", gThreads,
+                 "CPU thread counts to compare, comma separated (0: all cores)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 1024));
+  CLI11_PARSE(app, argc, argv);
+  if (gThreads.empty()) gThreads = {0};
   const Scene scene = loadScene(scene_path);
   if (scene.lights.empty()) {
     std::fprintf(stderr, "light_bench: %s has no light\n", scene_path.c_str());

@@ -7,6 +7,7 @@
 //
 //   spectral_bench [WIDTH HEIGHT]     # default 800 600 (the scene camera); lavapipe on few cores
 //                                     # needs minutes there: pass e.g. 160 120 and say so.
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -31,7 +32,14 @@ double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722
 }  // namespace
 
 int main(int argc, char** argv) {
-  int W = argc > 2 ? std::atoi(argv[1]) : 800, H = argc > 2 ? std::atoi(argv[2]) : 600;
+  int W = 800, H = 600;
+  CLI::App app{
+      "Spectral rendering cost and accuracy on scenes/prism_bk7.json (and POV-Ray when on PATH)",
+      "spectral_bench"};
+  app.add_option("width", W, "Image width (default 800, the scene camera's)")
+      ->check(CLI::Range(1, 16384));
+  app.add_option("height", H, "Image height (default 600)")->check(CLI::Range(1, 16384));
+  CLI11_PARSE(app, argc, argv);
   const std::filesystem::path src(EIKON_SOURCE_DIR);
   // 0. How well the Cauchy fields carry each library material (least-squares A + B/λ² + C/λ⁴ over
   //    380–780 nm, 1 nm samples): max |n_fit − n| and the Abbe number of the fit vs the model.

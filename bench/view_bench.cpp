@@ -5,13 +5,13 @@
 // the CPU reference at RK4 with a 0.05-voxel step.
 //
 //   build/bench/view_bench [scene.json] [--width W --height H] [--no-cpu]
+#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <random>
-#include <thread>
-#include <algorithm>
 #include <string>
+#include <thread>
 
 #include "core/reference/reference_marcher.h"
 #include "core/render/view_renderer.h"
@@ -23,12 +23,14 @@ int main(int argc, char** argv) {
   std::string scene_path = std::string(EIKON_SOURCE_DIR) + "/scenes/glass_sphere.json";
   int width = 800, height = 600;
   bool cpu = true;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--width") && i + 1 < argc) width = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--height") && i + 1 < argc) height = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--no-cpu")) cpu = false;
-    else scene_path = argv[i];
-  }
+  CLI::App app{
+      "View renderer: rays/s, steps/ray and accuracy of the GPU integrators and the CPU reference",
+      "view_bench"};
+  app.add_option("scene", scene_path, "Scene JSON file (default scenes/glass_sphere.json)");
+  app.add_option("--width", width, "Image width (default 800)")->check(CLI::Range(1, 16384));
+  app.add_option("--height", height, "Image height (default 600)")->check(CLI::Range(1, 16384));
+  app.add_flag("!--no-cpu", cpu, "Skip the CPU reference");
+  CLI11_PARSE(app, argc, argv);
   Scene scene = loadScene(scene_path);
   auto ctx = vk::Context::create();
   auto t0 = std::chrono::steady_clock::now();

@@ -1,66 +1,26 @@
 #include "core/io/exr.h"
 
 #include <ImfChannelList.h>
+#include <ImfCheckFile.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfTestFile.h>
-#include <ImfCheckFile.h>
 #include <png.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
-#include <random>
+#include <memory>
 #include <stdexcept>
 
 namespace eikon {
-namespace {
-
-std::filesystem::path tempPathFor(const std::filesystem::path& path) {
-  std::random_device rd;
-  char suffix[32];
-  std::snprintf(suffix, sizeof suffix, ".tmp-%08x", rd());
-  return std::filesystem::path(path.string() + suffix);
-}
-
-/// Run `write(tmp)` then rename tmp over path; remove tmp on any failure.
-template <typename F>
-void atomicWrite(const std::filesystem::path& path, F&& write) {
-  checkWritable(path);
-  auto tmp = tempPathFor(path);
-  try {
-    write(tmp);
-    std::filesystem::rename(tmp, path);
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw;
-  }
-}
-
-}  // namespace
-
-void checkWritable(const std::filesystem::path& path) {
-  auto dir = path.parent_path();
-  if (dir.empty()) dir = ".";
-  if (!std::filesystem::is_directory(dir))
-    throw std::runtime_error("cannot write '" + path.string() + "': directory '" + dir.string() + "' does not exist");
-  if (::access(dir.c_str(), W_OK) != 0)
-    throw std::runtime_error("cannot write '" + path.string() + "': directory '" + dir.string() + "' is not writable");
-  if (std::filesystem::is_directory(path))
-    throw std::runtime_error("cannot write '" + path.string() + "': it is a directory");
-  // access() says yes to root everywhere; creating a probe file is the real test.
-  auto probe = tempPathFor(path);
-  FILE* f = std::fopen(probe.c_str(), "wb");
-  if (!f) throw std::runtime_error("cannot write '" + path.string() + "': cannot create files in '" + dir.string() + "'");
-  std::fclose(f);
-  std::error_code ec;
-  std::filesystem::remove(probe, ec);
-}
 
 RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_height) {
   const std::string p = path.string();
@@ -102,37 +62,95 @@ RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_
   }
 }
 
-void writeExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels) {
-  atomicWrite(path, [&](const std::filesystem::path& tmp) {
-    Imf::Header header(width, height);
-    header.compression() = Imf::ZIP_COMPRESSION;
-    for (const auto& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
-    Imf::FrameBuffer fb;
-    for (const auto& c : channels)
-      fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data, sizeof(float), size_t(width) * sizeof(float)));
-    Imf::OutputFile file(tmp.c_str(), header);
-    file.setFrameBuffer(fb);
-    file.writePixels(height);
-  });
+namespace {
+
+void encodeExr(const std::filesystem::path& file, int width, int height,
+               const std::vector<ExrChannel>& channels) {
+  Imf::Header header(width, height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  for (const auto& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+  Imf::FrameBuffer fb;
+  for (const auto& c : channels)
+    fb.insert(c.name,
+              Imf::Slice(Imf::FLOAT, (char*)c.data, sizeof(float), size_t(width) * sizeof(float)));
+  Imf::OutputFile out(file.c_str(), header);
+  out.setFrameBuffer(fb);
+  out.writePixels(height);
 }
 
-void writeExrRgb(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb) {
-  size_t n = size_t(width) * size_t(height);
-  if (rgb.size() != 3 * n) throw std::invalid_argument("writeExrRgb: pixel count mismatch");
-  std::vector<float> r(n), g(n), b(n);
-  for (size_t i = 0; i < n; ++i) {
-    r[i] = rgb[3 * i];
-    g[i] = rgb[3 * i + 1];
-    b[i] = rgb[3 * i + 2];
+// libpng reports through callbacks; its defaults print "libpng error: ..." / "libpng warning: ..."
+// on stderr themselves. These keep the message (and errno, for I/O failures) so that eikon prints
+// its one line, and drop warnings (none can arise for the 8-bit RGB images written here).
+struct PngErrorState {
+  char message[256] = "";
+  int err = 0;
+};
+
+void pngError(png_structp png, png_const_charp msg) {
+  auto* st = static_cast<PngErrorState*>(png_get_error_ptr(png));
+  st->err = errno;
+  std::snprintf(st->message, sizeof st->message, "%s", msg ? msg : "unknown error");
+  png_longjmp(png, 1);
+}
+
+void pngWarning(png_structp, png_const_charp) {}
+
+void encodePng(const std::filesystem::path& file, int width, int height,
+               const std::vector<unsigned char>& px) {
+  FILE* f = std::fopen(file.c_str(), "wb");
+  if (!f)
+    throw std::runtime_error(std::string("cannot open a temporary file: ") + std::strerror(errno));
+  PngErrorState st;
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &st, pngError, pngWarning);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  // Only plain C state lives between setjmp and a longjmp back here (no destructors skipped).
+  if (!png || !info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(f);
+    std::string why = std::string("libpng: ") + (st.message[0] ? st.message : "cannot allocate");
+    if (st.err != 0) why += std::string(" (") + std::strerror(st.err) + ")";
+    throw std::runtime_error(why);
   }
-  writeExr(path, width, height, {{"R", r.data()}, {"G", g.data()}, {"B", b.data()}});
+  png_init_io(png, f);
+  png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < height; ++y) png_write_row(png, &px[size_t(y) * size_t(width) * 3]);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  if (std::fclose(f) != 0) throw std::runtime_error(std::strerror(errno));
 }
 
-void writePngPreview(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb,
-                     double exposure) {
+}  // namespace
+
+void writeExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels) {
+  writeFileAtomically(
+      path, [&](const std::filesystem::path& tmp) { encodeExr(tmp, width, height, channels); });
+}
+
+FileContent exrRgbContent(int width, int height, const std::vector<float>& rgb) {
   size_t n = size_t(width) * size_t(height);
-  if (rgb.size() != 3 * n) throw std::invalid_argument("writePngPreview: pixel count mismatch");
-  std::vector<unsigned char> px(3 * n);
+  if (rgb.size() != 3 * n) throw std::invalid_argument("exrRgbContent: pixel count mismatch");
+  auto planes = std::make_shared<std::array<std::vector<float>, 3>>();
+  for (auto& p : *planes) p.resize(n);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t c = 0; c < 3; ++c) (*planes)[c][i] = rgb[3 * i + c];
+  return [planes, width, height](const std::filesystem::path& tmp) {
+    encodeExr(tmp, width, height,
+              {{"R", (*planes)[0].data()}, {"G", (*planes)[1].data()}, {"B", (*planes)[2].data()}});
+  };
+}
+
+void writeExrRgb(const std::filesystem::path& path, int width, int height,
+                 const std::vector<float>& rgb) {
+  writeFileAtomically(path, exrRgbContent(width, height, rgb));
+}
+
+FileContent pngPreviewContent(int width, int height, const std::vector<float>& rgb,
+                              double exposure) {
+  size_t n = size_t(width) * size_t(height);
+  if (rgb.size() != 3 * n) throw std::invalid_argument("pngPreviewContent: pixel count mismatch");
+  auto px = std::make_shared<std::vector<unsigned char>>(3 * n);
   const double scale = std::pow(2.0, exposure);
   auto encode = [](double v) {
     v = std::clamp(v, 0.0, 1.0);
@@ -143,29 +161,17 @@ void writePngPreview(const std::filesystem::path& path, int width, int height, c
     double r = rgb[3 * i] * scale, g = rgb[3 * i + 1] * scale, b = rgb[3 * i + 2] * scale;
     double lum = 0.2126 * r + 0.7152 * g + 0.0722 * b;
     double k = lum > 0 ? (lum / (1.0 + lum / 4.0)) / lum : 1.0;  // soft shoulder above ~1
-    px[3 * i] = encode(r * k);
-    px[3 * i + 1] = encode(g * k);
-    px[3 * i + 2] = encode(b * k);
+    (*px)[3 * i] = encode(r * k);
+    (*px)[3 * i + 1] = encode(g * k);
+    (*px)[3 * i + 2] = encode(b * k);
   }
-  atomicWrite(path, [&](const std::filesystem::path& tmp) {
-    FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw std::runtime_error("cannot open '" + tmp.string() + "' for writing");
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-    png_infop info = png ? png_create_info_struct(png) : nullptr;
-    if (!png || !info || setjmp(png_jmpbuf(png))) {
-      png_destroy_write_struct(&png, &info);
-      std::fclose(f);
-      throw std::runtime_error("libpng failed writing '" + path.string() + "'");
-    }
-    png_init_io(png, f);
-    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_write_info(png, info);
-    for (int y = 0; y < height; ++y) png_write_row(png, &px[size_t(y) * size_t(width) * 3]);
-    png_write_end(png, nullptr);
-    png_destroy_write_struct(&png, &info);
-    if (std::fclose(f) != 0) throw std::runtime_error("error closing '" + tmp.string() + "'");
-  });
+  return
+      [px, width, height](const std::filesystem::path& tmp) { encodePng(tmp, width, height, *px); };
+}
+
+void writePngPreview(const std::filesystem::path& path, int width, int height,
+                     const std::vector<float>& rgb, double exposure) {
+  writeFileAtomically(path, pngPreviewContent(width, height, rgb, exposure));
 }
 
 }  // namespace eikon

@@ -1,14 +1,19 @@
-// Image files: OpenEXR (linear HDR, float) in and out, PNG previews, and atomic writes.
+// Image files: OpenEXR (linear HDR, float) in and out, and PNG previews.
 //
-// Every writer writes to "<path>.tmp-XXXX" in the same directory and renames it into place, so a
-// failed or interrupted run leaves no partial file. Readers validate before decoding: Debian's
-// OpenEXR 3.1.5 has a known flaw with deep images, so EXR input is accepted only after
-// Imf::checkOpenEXRFile passes, deep files are rejected, and sizes are capped.
+// Every writer goes through core/io/atomic_write.h: it creates the missing folders above its
+// path, writes to "<path>.tmp-XXXXXXXX" in the same folder and renames it into place, so a failed
+// or interrupted run leaves no partial file. The *Content functions encode an image for
+// writeFilesTogether, which writes several files (a render's EXR and PNG) as one set. Readers
+// validate before decoding: Debian's OpenEXR 3.1.5 has a known flaw with deep images, so EXR input
+// is accepted only after Imf::checkOpenEXRFile passes, deep files are rejected, and sizes are
+// capped.
 #pragma once
 
 #include <filesystem>
 #include <string>
 #include <vector>
+
+#include "core/io/atomic_write.h"
 
 namespace eikon {
 
@@ -30,16 +35,20 @@ struct ExrChannel {
 /// Write float channels to an EXR (ZIP compression) atomically.
 void writeExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels);
 
+/// Linear RGB floats (3 per pixel) as an EXR with R, G, B channels (ZIP), for writeFilesTogether.
+/// The pixels are copied: `rgb` need not outlive the result.
+FileContent exrRgbContent(int width, int height, const std::vector<float>& rgb);
+
 /// Write linear RGB floats (3 per pixel) as an EXR with R, G, B channels, atomically.
 void writeExrRgb(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb);
+
+/// The 8-bit sRGB PNG preview of writePngPreview, for writeFilesTogether (pixels copied).
+FileContent pngPreviewContent(int width, int height, const std::vector<float>& rgb,
+                              double exposure = 0.0);
 
 /// Write an 8-bit sRGB PNG preview of linear RGB (3 floats per pixel): multiply by 2^exposure,
 /// Reinhard-style tone map x/(1+x) on luminance-preserving ratio, sRGB transfer. Atomic.
 void writePngPreview(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb,
                      double exposure = 0.0);
-
-/// Check that `path` can be created (directory exists and is writable); throws with a clear
-/// message otherwise. Call before long work so that it fails early.
-void checkWritable(const std::filesystem::path& path);
 
 }  // namespace eikon

@@ -1,5 +1,6 @@
 #include "core/reference/reference_lighting.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -29,18 +30,24 @@ LightingSummary simulateLightingWith(const Scene& scene, VolumeSet& volume, cons
   auto runs = planLighting(scene, volume, options.bands);
   auto t0 = std::chrono::steady_clock::now();
   clearLighting(volume);
+  // One stage for all runs; each run reports its steps (WavefrontSettings::progress).
+  const std::string label = "light " + describeLighting(runs, scene);
   for (size_t i = 0; i < runs.size(); ++i) {
     const LightingRun& r = runs[i];
-    if (options.progress) options.progress(double(i) / double(runs.size()), "light " + describeLighting(runs, scene));
+    if (options.progress) options.progress(double(i) / double(runs.size()), label);
     WavefrontSettings s = options.wave;
     s.wavelength_nm = r.wavelength_nm;
     s.mode = r.mode;
+    if (options.progress)
+      s.progress = [&, i](double f) {
+        options.progress((double(i) + std::min(f, 1.0)) / double(runs.size()), label);
+      };
     WavefrontResult res = simulate(s, unitPowerLight(scene.lights[r.light]));
     addLightingRun(volume, r, res.irradiance, res.direction);
     sum.add(res.stats, r.luminance);
   }
   smoothLighting(volume, options.smoothing_voxels);
-  if (options.progress) options.progress(1.0, "light");
+  if (options.progress) options.progress(1.0, label);
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return sum;
 }

@@ -4,8 +4,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 
@@ -466,11 +467,16 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
   const glm::dvec3 up = glm::cross(right, fwd);
   const double tanh = std::tan(0.5 * cam.fov_deg * kPi / 180.0), aspect = double(img.width) / img.height;
   const glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
-  std::atomic<int> next{0};
+  std::atomic<int> next{0}, rows_done{0};
   std::atomic<long long> total_steps{0};
+  std::mutex progress_mutex;  // progress per row, one report at a time (skipped when busy)
   auto worker = [&] {
     long long local_steps = 0;
     for (int y = next++; y < img.height; y = next++) {
+      if (y > 0 && s.progress) {
+        std::unique_lock<std::mutex> lock(progress_mutex, std::try_to_lock);
+        if (lock.owns_lock()) s.progress(double(rows_done.load()) / img.height);
+      }
       for (int x = 0; x < img.width; ++x) {
         uint32_t pixel = uint32_t(y * img.width + x);
         glm::dvec3 sum(0.0);
@@ -516,6 +522,7 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
         for (int c = 0; c < 3; ++c) img.rgb[o + size_t(c)] = float(sum[c] / s.spp);
         local_steps += (long long)(steps / s.spp);
       }
+      ++rows_done;
     }
     total_steps += local_steps;
   };
@@ -524,6 +531,7 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
   std::vector<std::thread> pool;
   for (int i = 0; i < t; ++i) pool.emplace_back(worker);
   for (auto& th : pool) th.join();
+  if (s.progress) s.progress(1.0);
   img.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   img.mean_steps = double(total_steps) / (double(img.width) * img.height);
   return img;

@@ -740,6 +740,7 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
   int ping = 0;
   chunks[0].out[1].swap(cur);
   std::vector<const std::vector<Patch>*> in(chunks.size());
+  long long step_count = 0;
   for (;;) {
     size_t n = 0;
     for (size_t c = 0; c < chunks.size(); ++c) {
@@ -818,8 +819,17 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     }
     st.max_live = std::max(st.max_live, size_t(live));
     ping = 1 - ping;
+    ++step_count;
+    if (s_.progress) {
+      double flux_ended = 0.0;
+      for (const Chunk& ch : chunks)
+        flux_ended +=
+            ch.st.flux_left + ch.st.flux_caustic + ch.st.flux_energy + ch.st.flux_absorbed;
+      s_.progress(wavefrontRunFraction(step_count, dt, grid_.extent, flux_ended, st.flux_emitted));
+    }
   }
   pool.reset();
+  if (s_.progress) s_.progress(1.0);  // every patch has ended (or reached max_steps)
   // Reduce the chunks in chunk order (one chunk: its sums unchanged, as 0 + x = x).
   for (const Chunk& ch : chunks) {
     const WavefrontStats& a = ch.st;

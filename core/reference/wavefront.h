@@ -31,10 +31,11 @@
 //   eikon::WavefrontResult r = sim.run(scene.lights[0]);
 #pragma once
 
-#include <glm/glm.hpp>
-
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <glm/glm.hpp>
 #include <vector>
 
 #include "core/reference/reference_marcher.h"
@@ -101,7 +102,22 @@ struct WavefrontSettings {
   /// order (a sum of m terms by up to ~2m·2⁻⁵³ relative; glass-sphere test: ≤ 5e-12). The Field
   /// must allow concurrent calls (VolumeField does; an AnalyticField's function must too).
   int threads = 0;
+  /// Called after every time step (CPU) or dispatch of steps (GPU) with an estimate of the run's
+  /// fraction done (wavefrontRunFraction), from the thread that called run(); may be empty.
+  /// Not part of the physics (not in the light cache key).
+  std::function<void(double)> progress;
 };
+
+/// Estimated fraction of a run done, for progress: the larger of the flux fraction that has ended
+/// (left the volume, absorbed, killed) and the front's travel against the volume diagonal (the
+/// front moves dt/n mm per step, so in a dense medium the travel estimate runs ahead: capped at
+/// 0.95 until the flux says otherwise). Non-decreasing over a run.
+inline double wavefrontRunFraction(long long steps, double dt, const glm::dvec3& extent,
+                                   double flux_ended, double flux_emitted) {
+  const double travel = std::min(0.95, double(steps) * dt / std::max(glm::length(extent), 1e-12));
+  const double ended = flux_emitted > 0 ? std::clamp(flux_ended / flux_emitted, 0.0, 1.0) : 0.0;
+  return std::max(travel, ended);
+}
 
 /// One wavefront element. Corners are in bilinear order (0,0), (1,0), (1,1), (0,1) of the patch's
 /// ray-label parameters. `energy` is the flux carried by the tube (W = light unit·mm² for a

@@ -334,6 +334,7 @@ struct GpuWavefront::Impl {
       ctx.submitAndWait([&](VkCommandBuffer c) { recordStep(c, n, src); });
     }
     std::vector<gpu::WaveTally> tallies;
+    long long dispatches = 0;
     while (n > 0) {
       tallies.resize(groups(n));
       tally.read(tallies.data(), tallies.size() * sizeof(gpu::WaveTally));
@@ -372,6 +373,11 @@ struct GpuWavefront::Impl {
         st.splits += wantSplit;
       }
       st.max_live = std::max<size_t>(st.max_live, total);
+      ++dispatches;
+      if (s.progress)
+        s.progress(wavefrontRunFraction(
+            dispatches * steps_per_dispatch, s.dt, g.extent,
+            st.flux_left + st.flux_caustic + st.flux_energy + st.flux_absorbed, st.flux_emitted));
       if (total == 0) break;
       const int dst = 1 - src;
       ensurePatchCapacity(dst, total);
@@ -382,6 +388,7 @@ struct GpuWavefront::Impl {
       n = total;
       src = dst;
     }
+    if (s.progress) s.progress(1.0);  // every patch has ended (or reached max_steps)
     if (st.flux_caustic > 0) st.caustic_centroid /= st.flux_caustic;
     if (st.flux_probe != 0) {
       st.probe_centroid /= st.flux_probe;

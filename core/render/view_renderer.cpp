@@ -209,18 +209,25 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   double l = s.wavelength_nm * 1e-3;
   p.wavelength = glm::vec4(float(l), float(1.0 / (l * l)), float(1.0 / (l * l * l * l)), 0.0f);
 
-  // Bands of rows so that progress can be reported and no single dispatch runs for long.
+  // Bands of rows so that progress can be reported and no single dispatch runs for long. The band
+  // buffer holds up to ~2e5 rays' worth of rows; the first band is one workgroup row, and each
+  // next band is sized from the last one's time to take ~0.25 s, so even a small image that is
+  // slow per ray (many wavelengths, a dense volume) reports progress several times a second.
   const double work = double(img.width) * img.height * s.spp * std::max(1, s.wavelengths);
-  int rows = std::clamp(int(std::ceil(double(img.height) * 2.0e5 / std::max(work, 1.0))), EIKON_WG_Y, img.height);
-  rows = (rows + EIKON_WG_Y - 1) / EIKON_WG_Y * EIKON_WG_Y;
-  vk::Buffer out(I.ctx, size_t(img.width) * size_t(rows) * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
+  int max_rows = std::clamp(int(std::ceil(double(img.height) * 2.0e5 / std::max(work, 1.0))),
+                            EIKON_WG_Y, img.height);
+  max_rows = (max_rows + EIKON_WG_Y - 1) / EIKON_WG_Y * EIKON_WG_Y;
+  int rows = EIKON_WG_Y;
+  vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * sizeof(glm::vec4),
+                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
   I.view.bindBuffer(EIKON_B_OUTPUT, out);
   img.rgb.resize(size_t(img.width) * size_t(img.height) * 3);
-  std::vector<glm::vec4> band(size_t(img.width) * size_t(rows));
+  std::vector<glm::vec4> band(size_t(img.width) * size_t(max_rows));
   double steps = 0.0;
   auto t0 = std::chrono::steady_clock::now();
-  for (int y0 = 0; y0 < img.height; y0 += rows) {
-    int n = std::min(rows, img.height - y0);
+  for (int y0 = 0, n = 0; y0 < img.height; y0 += n) {
+    n = std::min(rows, img.height - y0);
+    const auto band_start = std::chrono::steady_clock::now();
     p.image = glm::ivec4(img.width, img.height, y0, n);
     I.params.write(&p, sizeof p);
     I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
@@ -237,6 +244,11 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
         steps += v.w;
       }
     if (s.progress) s.progress(double(y0 + n) / img.height);
+    const double band_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - band_start).count();
+    const double next =
+        double(n) * 0.25 / std::max(band_s, 1e-3);  // rows for ~0.25 s, at most 8x the last
+    rows = std::clamp(int(std::min(next, 8.0 * n)) / EIKON_WG_Y * EIKON_WG_Y, EIKON_WG_Y, max_rows);
   }
   img.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   img.mean_steps = steps / (double(img.width) * img.height);

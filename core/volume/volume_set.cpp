@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <mutex>
 #include <thread>
 
 #include "core/volume/host_memory.h"
@@ -135,8 +136,13 @@ double voxelizeHostBytes(const Scene& scene, const Grid& g) {
 }
 
 VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
+  // Calls may come from the worker threads (per slab): one at a time, and skipped rather than
+  // waited for when another thread is reporting.
+  std::mutex progress_mutex;
   auto progress = [&](double x, const char* stage) {
-    if (opt.progress) opt.progress(x, stage);
+    if (!opt.progress) return;
+    std::unique_lock<std::mutex> lock(progress_mutex, std::try_to_lock);
+    if (lock.owns_lock()) opt.progress(x, stage);
   };
   VolumeSet vs;
   vs.grid = makeGrid(scene.volume);
@@ -240,7 +246,9 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
       progress(0.4 * double(oi + 1) / double(scene.objects.size()), "voxelising");
       continue;
     }
-    parallelFor(hi[2] - lo[2] + 1, opt.threads, [&](int kk) {
+    const int slabs = hi[2] - lo[2] + 1;
+    std::atomic<int> slabs_done{0};
+    parallelFor(slabs, opt.threads, [&](int kk) {
       const int k = lo[2] + kk;
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int i = lo[0]; i <= hi[0]; ++i) {
@@ -282,9 +290,20 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
                               ((f == kAo || f == kAe) ? cov * gprop : glm::dvec3(0.0));
               gradients[size_t(f)][idx] = glm::vec3(gv);
             }
-          for (int f = 0; f < kFieldCount; ++f) fields[size_t(f)][idx] = fields[size_t(f)][idx] * (1 - fc) + prop[f] * fc;
+          for (int f = 0; f < kFieldCount; ++f)
+            fields[size_t(f)][idx] = fields[size_t(f)][idx] * (1 - fc) + prop[f] * fc;
           if (vs.uniaxial && mat.uniaxial) axis[idx] = ax;
         }
+      // Progress per z slab: a large object alone takes seconds at 256³. The count is read under
+      // the lock, so the reported fractions never decrease.
+      ++slabs_done;
+      if (opt.progress) {
+        std::unique_lock<std::mutex> lock(progress_mutex, std::try_to_lock);
+        if (lock.owns_lock())
+          opt.progress(
+              0.4 * (double(oi) + double(slabs_done.load()) / slabs) / double(scene.objects.size()),
+              "voxelising");
+      }
     });
     progress(0.4 * double(oi + 1) / double(scene.objects.size()), "voxelising");
   }
@@ -329,6 +348,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
       } else {
         vs.index[size_t(m)][size_t(c)] = withGradient(fields[size_t(f)]);
       }
+      progress(0.7 + 0.15 * double(m * 3 + c + 1) / (vs.uniaxial ? 6.0 : 3.0), "gradients");
     }
   progress(0.85, "gradients");
 
@@ -364,6 +384,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
           }
       });
       axis.swap(next);
+      progress(0.85 + 0.05 * double(pass + 1) / reach, "optic axis");
     }
     vs.axis = std::move(axis);
   }
@@ -419,6 +440,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
         }
     });
     dist.swap(out);
+    progress(0.9 + 0.03 * (a + 1), "skip distances");
   }
   for (size_t i = 0; i < N; ++i) vs.emission[i].w = float(dist[i]);
   progress(1.0, "done");

@@ -1,7 +1,10 @@
 // Running the real `eikon` binary (EIKON_BINARY) as a user would, for the CLI tests.
 #pragma once
 
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -23,12 +26,40 @@ inline std::string slurp(const std::filesystem::path& p) {
   return s.str();
 }
 
-/// Run `[env] eikon ARGS`, capturing stdout and stderr through files in `io_dir`.
-inline Outcome runEikon(const std::string& args, const std::filesystem::path& io_dir, const std::string& env = "") {
-  const std::string cmd = env + (env.empty() ? "" : " ") + std::string(EIKON_BINARY) + " " + args + " >" +
-                          (io_dir / "stdout").string() + " 2>" + (io_dir / "stderr").string() + " </dev/null";
+/// Run `[env] PROGRAM ARGS` (ARGS as the shell splits them), capturing stdout and stderr through
+/// files in `io_dir`. code is the exit status, or -1 when the program was killed by a signal.
+inline Outcome runProgram(const std::string& program, const std::string& args,
+                          const std::filesystem::path& io_dir, const std::string& env = "") {
+  const std::string cmd = env + (env.empty() ? "" : " ") + program + " " + args + " >" +
+                          (io_dir / "stdout").string() + " 2>" + (io_dir / "stderr").string() +
+                          " </dev/null";
   const int st = std::system(cmd.c_str());
   return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(io_dir / "stdout"), slurp(io_dir / "stderr")};
+}
+
+/// runProgram with every file the program writes limited to `max_file_bytes` (RLIMIT_FSIZE, with
+/// SIGXFSZ ignored so that a write beyond it fails with EFBIG): a full disk, reproducibly.
+inline Outcome runProgramWithFileLimit(const std::string& program, const std::string& args,
+                                       const std::filesystem::path& io_dir, long max_file_bytes) {
+  const std::string cmd = program + " " + args + " >" + (io_dir / "stdout").string() + " 2>" +
+                          (io_dir / "stderr").string() + " </dev/null";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::signal(SIGXFSZ, SIG_IGN);  // ignored signals stay ignored across exec
+    const rlimit lim{rlim_t(max_file_bytes), rlim_t(max_file_bytes)};
+    ::setrlimit(RLIMIT_FSIZE, &lim);
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int st = 0;
+  if (pid < 0 || ::waitpid(pid, &st, 0) != pid) return {-1, "", ""};
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(io_dir / "stdout"), slurp(io_dir / "stderr")};
+}
+
+/// Run `[env] eikon ARGS`, capturing stdout and stderr through files in `io_dir`.
+inline Outcome runEikon(const std::string& args, const std::filesystem::path& io_dir,
+                        const std::string& env = "") {
+  return runProgram(EIKON_BINARY, args, io_dir, env);
 }
 
 }  // namespace eikon::test

@@ -131,6 +131,29 @@ TEST_F(Cli, Info) {
   EXPECT_NE(r.out.find("device:"), std::string::npos) << r.out;
 }
 
+// Every "label: value" line of `eikon info` has its value in one column, after at least one space
+// (it printed "max storage buffer:128 MiB").
+TEST_F(Cli, InfoValuesAreAligned) {
+  const Outcome r = run("info");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  size_t column = 0;
+  int rows = 0;
+  while (std::getline(lines, line)) {
+    const size_t colon = line.find(':');
+    if (line.rfind("eikon ", 0) == 0 || colon == std::string::npos) continue;
+    ASSERT_LT(colon + 1, line.size()) << line;
+    EXPECT_EQ(line[colon + 1], ' ') << "no space after the label: " << line;
+    const size_t value = line.find_first_not_of(' ', colon + 1);
+    ASSERT_NE(value, std::string::npos) << line;
+    if (rows++ == 0) column = value;
+    EXPECT_EQ(value, column) << "value not in the column of the first row: " << line;
+  }
+  EXPECT_GE(rows, 6) << r.out;
+  EXPECT_NE(r.out.find("max storage buffer: "), std::string::npos) << r.out;
+}
+
 // ------------------------------------------------------------------ render
 
 TEST_F(Cli, RenderTinyScene) {
@@ -158,6 +181,94 @@ TEST_F(Cli, RenderTinyScene) {
   const std::string png = slurp(outPath("render.png"));
   ASSERT_GE(png.size(), 8u);
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+}
+
+// Every shipped scene renders clean under --strict (warnings are errors): scenes/diamond_brilliant
+// used to warn that diamond is measured over 226-760 nm only. Tiny renders on the CPU twin (no
+// shader compilation), 4 wavelengths, and the light simulation as small as the flags allow.
+TEST_F(Cli, EveryShippedSceneRendersCleanUnderStrict) {
+  std::vector<fs::path> scenes;
+  for (const auto& e : fs::directory_iterator(fs::path(EIKON_SOURCE_DIR) / "scenes"))
+    if (e.path().extension() == ".json") scenes.push_back(e.path());
+  std::sort(scenes.begin(), scenes.end());
+  ASSERT_GE(scenes.size(), 9u) << "scenes/ not found under " << EIKON_SOURCE_DIR;
+  for (const fs::path& scene : scenes) {
+    const Outcome r = run(
+        "render " + quote(scene.string()) + " -o " +
+        quote(outPath(scene.stem().string() + ".exr")) +
+        " --strict -q --reference --width 16 --height 12 --spp 1 --wavelengths 4 --light-bands 1"
+        " --max-patches 1024 --light-split 8 --light-step 2 --no-light-cache");
+    EXPECT_EQ(r.code, 0) << scene << ": " << r.err;
+    EXPECT_EQ(r.err, "") << scene;
+    EXPECT_TRUE(fs::is_regular_file(outPath(scene.stem().string() + ".exr"))) << scene;
+  }
+}
+
+// ------------------------------------------------------------------ progress (issue 11)
+
+/// Lines of `err` (progress lines end in '\n' when stderr is not a terminal) that look like
+/// "eikon: STAGE  42.0%  1.2 s, ETA ..." for STAGE starting with `stage`.
+std::vector<std::string> progressLines(const std::string& err, const std::string& stage) {
+  std::vector<std::string> out;
+  std::istringstream in(err);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("eikon: " + stage, 0) == 0 && line.find("%  ") != std::string::npos &&
+        line.find(", ETA ") != std::string::npos)
+      out.push_back(line);
+  return out;
+}
+
+// stderr is not a terminal here: no progress lines by default, and none with -q even when forced;
+// --progress always shows each stage with elapsed time and ETA, its first report and its 100%.
+// The lit scene has all three stages: voxelising, light, rendering.
+TEST_F(Cli, RenderProgressOnlyWhenAskedOrOnATerminal) {
+  std::string lit = tinyScene();
+  lit.insert(lit.rfind('}'),
+             R"(, "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}])");
+  const std::string light = " --reference --light-split 8 --light-step 2 --no-light-cache";
+  const Outcome quiet = render(lit, light);
+  ASSERT_EQ(quiet.code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "") << "progress without a terminal";
+  EXPECT_EQ(std::count(quiet.out.begin(), quiet.out.end(), '\n'), 2) << "the summary lines only:\n"
+                                                                     << quiet.out;
+  const Outcome never = render(lit, light + " --progress always -q");
+  ASSERT_EQ(never.code, 0) << never.err;
+  EXPECT_EQ(never.err, "");
+  const Outcome forced = render(lit, light + " --progress always");
+  ASSERT_EQ(forced.code, 0) << forced.err;
+  for (const char* stage : {"voxelising", "light 1 light x 1 band x 1 mode", "rendering"}) {
+    const auto lines = progressLines(forced.err, stage);
+    ASSERT_FALSE(lines.empty()) << stage << ":\n" << forced.err;
+    EXPECT_NE(lines.back().find("100.0%"), std::string::npos) << lines.back();
+    EXPECT_NE(lines.back().find("ETA 0.0 s"), std::string::npos) << lines.back();
+  }
+  // Nothing else on stderr: every line is a progress line.
+  const size_t lines = size_t(std::count(forced.err.begin(), forced.err.end(), '\n'));
+  EXPECT_EQ(lines, progressLines(forced.err, "").size()) << forced.err;
+  EXPECT_NE(forced.out.find("eikon: rendered"), std::string::npos) << forced.out;
+}
+
+TEST_F(Cli, TraceProgressOnlyWhenAsked) {
+  const std::string scene = write("scene.json", tinyScene());
+  const std::string args = "trace " + quote(scene) + " --origin 0,0,-5 --dir 0,0,1 --reference";
+  const Outcome quiet = run(args);
+  ASSERT_EQ(quiet.code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+  const Outcome forced = run(args + " --progress always");
+  ASSERT_EQ(forced.code, 0) << forced.err;
+  const auto lines = progressLines(forced.err, "voxelising");
+  ASSERT_FALSE(lines.empty()) << forced.err;
+  EXPECT_NE(lines.back().find("100.0%"), std::string::npos) << lines.back();
+  EXPECT_EQ(forced.out, quiet.out);
+  EXPECT_EQ(run(args + " --progress always -q").err, "");
+}
+
+TEST_F(Cli, BadProgressOptionFailsCleanly) {
+  expectCleanFailure(render(tinyScene(), "--progress sometimes"),
+                     "--progress must be auto, always or never");
+  const std::string scene = write("scene.json", tinyScene());
+  expectCleanFailure(run("trace " + quote(scene) + " --origin 0,0,-5 --dir 0,0,1 --progress loud"),
+                     "--progress must be auto, always or never");
 }
 
 // ------------------------------------------------------------------ render: bad input
@@ -200,11 +311,31 @@ TEST_F(Cli, RenderResolutionBeyondTheDeviceLimit) {
   EXPECT_NE(r.err.find(std::to_string(limit)), std::string::npos) << "message should state the limit " << limit << ": " << r.err;
 }
 
-TEST_F(Cli, RenderOutputDirectoryMissing) {
+// Missing folders of -o are created (the render used to fail: "directory 'out' does not exist"),
+// also for a relative path, which is how a user types it.
+TEST_F(Cli, RenderCreatesMissingOutputFolders) {
   const std::string scene = write("scene.json", tinyScene());
-  const fs::path missing = dir_ / "no_such_dir";
-  expectCleanFailure(run("render " + quote(scene) + " -o " + quote((missing / "x.exr").string())), "does not exist");
-  EXPECT_FALSE(fs::exists(missing));
+  const fs::path missing = dir_ / "no_such_dir" / "deeper";
+  const Outcome r =
+      run("render " + quote(scene) + " -q --reference -o " + quote((missing / "x.exr").string()));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(missing / "x.exr"));
+  EXPECT_TRUE(fs::is_regular_file(missing / "x.png"));
+  const Outcome rel = run("render " + quote(scene) + " -q --reference -o " +
+                          quote(fs::relative(dir_ / "rel" / "y.exr", fs::current_path()).string()));
+  ASSERT_EQ(rel.code, 0) << rel.err;
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "rel" / "y.exr"));
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "rel" / "y.png"));
+}
+
+// A file where a folder of -o should be: one error line before any work, nothing created.
+TEST_F(Cli, RenderOutputFolderIsAFile) {
+  const std::string scene = write("scene.json", tinyScene());
+  write("plain", "not a folder");
+  const Outcome r =
+      run("render " + quote(scene) + " -o " + quote((dir_ / "plain" / "sub" / "x.exr").string()));
+  expectCleanFailure(r, "is not a folder", dir_);
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "plain"));
 }
 
 // An unwritable output directory. As root, permissions do not apply (access(W_OK) succeeds on a
@@ -227,12 +358,103 @@ TEST_F(Cli, RenderOutputDirectoryReadOnly) {
   }
 }
 
+// A render that fails while writing (here: files limited to 8 KiB, so the 6 KB PNG preview is
+// written and the 22 KB EXR is not, as on a full disk) leaves the previous render's EXR and PNG
+// byte for byte, and no temporary. It used to delete the previous EXR when the PNG failed.
+TEST_F(Cli, FailedWriteLeavesThePreviousOutputsIntact) {
+  const std::string scene = write("scene.json", tinyScene());
+  const std::string common =
+      "render " + quote(scene) + " -q --reference --width 160 --height 120 -o " + quote(outPath());
+  const Outcome first = run(common);
+  ASSERT_EQ(first.code, 0) << first.err;
+  const std::string exr = slurp(outPath("render.exr")), png = slurp(outPath("render.png"));
+  // The sizes the limit is chosen between (a 160x120 render of the tiny scene: ~22 KB, ~6 KB).
+  ASSERT_GT(exr.size(), 12000u);
+  ASSERT_LT(png.size(), 8192u);
+  // A different picture (2 spp, brighter preview): had it replaced anything, the bytes would
+  // differ.
+  const Outcome r = eikon::test::runProgramWithFileLimit(
+      EIKON_BINARY, common + " --spp 2 --exposure 1", io_, 8192);
+  EXPECT_NE(r.code, 0);
+  EXPECT_EQ(r.err.rfind("eikon: error: cannot write '" + outPath("render.exr") + "'", 0), 0u)
+      << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(slurp(outPath("render.exr")), exr);
+  EXPECT_EQ(slurp(outPath("render.png")), png);
+  for (auto& e : fs::directory_iterator(out_))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+  // The same render without the limit does replace both (the test above is not vacuous).
+  const Outcome again = run(common + " --spp 2 --exposure 1");
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(slurp(outPath("render.exr")), exr);
+  EXPECT_NE(slurp(outPath("render.png")), png);
+}
+
+// A PNG write error (files limited to 2 KiB: libpng's first 4 KiB write fails) is eikon's one
+// line, naming the file and libpng's reason; libpng's own "libpng error: Write Error" line used to
+// come first.
+TEST_F(Cli, PngWriteErrorIsOneEikonLine) {
+  const std::string scene = write("scene.json", tinyScene());
+  const Outcome r = eikon::test::runProgramWithFileLimit(
+      EIKON_BINARY,
+      "render " + quote(scene) + " -q --reference --width 160 --height 120 -o " + quote(outPath()),
+      io_, 2048);
+  expectCleanFailure(
+      r, "cannot write '" + outPath("render.png") + "': libpng: Write Error (File too large)");
+  EXPECT_EQ(r.err.find("libpng error"), std::string::npos) << r.err;
+}
+
+// An output that is one of the render's inputs is refused with one line and the input is left as
+// it was: -o naming the environment map (directly or through a symbolic link), or a scene file
+// whose name is where the PNG preview would go. Both used to be overwritten with exit 0.
+TEST_F(Cli, RenderRefusesToOverwriteItsInputs) {
+  const std::vector<float> sky(8 * 4 * 3, 0.5f);
+  eikon::writeExrRgb(dir_ / "sky.exr", 8, 4, sky);
+  const std::string sky_bytes = slurp(dir_ / "sky.exr");
+  std::string text = tinyScene();
+  const std::string checker = R"({"type": "checker", "squares": 8})";
+  text.replace(text.find(checker), checker.size(), R"({"type": "latlong", "file": "sky.exr"})");
+  const std::string scene = write("scene.json", text);
+  Outcome r =
+      run("render " + quote(scene) + " -q --reference -o " + quote((dir_ / "sky.exr").string()));
+  expectCleanFailure(r, "is the scene's environment map", fs::path());
+  EXPECT_EQ(slurp(dir_ / "sky.exr"), sky_bytes);
+  EXPECT_FALSE(fs::exists(dir_ / "sky.png"));
+  // The same file under another name.
+  fs::create_symlink(dir_ / "sky.exr", dir_ / "link.exr");
+  r = run("render " + quote(scene) + " -q --reference -o " + quote((dir_ / "link.exr").string()));
+  expectCleanFailure(r, "refusing to overwrite an input", fs::path());
+  EXPECT_TRUE(fs::is_symlink(dir_ / "link.exr"));
+  EXPECT_EQ(slurp(dir_ / "sky.exr"), sky_bytes);
+  // The PNG preview beside -o would replace the scene file.
+  const std::string odd = write("odd.png", tinyScene());
+  r = run("render " + quote(odd) + " -q --reference -o " + quote((dir_ / "odd.exr").string()));
+  expectCleanFailure(r, "is the scene file", fs::path());
+  EXPECT_EQ(slurp(dir_ / "odd.png"), tinyScene());
+  // A scene beside its outputs is fine when the names differ.
+  r = run("render " + quote(scene) + " -q --reference -o " + quote((dir_ / "scene.exr").string()));
+  EXPECT_EQ(r.code, 0) << r.err;
+}
+
 TEST_F(Cli, RenderOutputMustEndInExr) {
   const std::string scene = write("scene.json", tinyScene());
   expectCleanFailure(run("render " + quote(scene) + " -o " + quote(outPath("render.png"))), ".exr");
 }
 
 TEST_F(Cli, RenderSppZero) { expectCleanFailure(render(tinyScene(), "--spp 0"), "--spp"); }
+
+// A given size must be a size: --width 0 used to render at the scene's width with exit 0, and
+// --wavelengths -1 at the default. Not given still means the scene's value (RenderTinyScene).
+TEST_F(Cli, RenderZeroOrNegativeSizesAreRejected) {
+  for (const char* bad :
+       {"--width 0", "--height 0", "--width -5", "--height -1", "--spp -2", "--wavelengths -1"}) {
+    const std::string flag = std::string(bad).substr(0, std::string(bad).find(' '));
+    const Outcome r = render(tinyScene(), bad);
+    expectCleanFailure(r, flag + " must be in [");
+    EXPECT_NE(r.err.find("got " + std::string(bad).substr(flag.size() + 1)), std::string::npos)
+        << r.err;
+  }
+}
 
 TEST_F(Cli, RenderSceneFileMissing) {
   expectCleanFailure(run("render " + quote((dir_ / "nope.json").string()) + " -o " + quote(outPath())), "nope.json");
@@ -358,6 +580,49 @@ TEST_F(Cli, TraceAxialRayPhysics) {
     EXPECT_NEAR(opl, 13.0, 0.2) << twin;
     EXPECT_NEAR(T, 0.9216, 2e-3) << twin;
   }
+}
+
+// The text output carries what --json carries: interfaces crossed, total internal reflections and
+// steps. The axial ray through the sphere crosses exactly 2 interfaces (in, out) and is never
+// totally reflected (normal incidence). An isotropic scene prints one "o=e" line and says the modes
+// coincide; a uniaxial one prints o and e.
+TEST_F(Cli, TraceTextShowsCountsAndIsotropicModes) {
+  const std::string iso = write("scene.json", tinyScene());
+  for (const char* twin : {"", " --reference"}) {
+    const Outcome r = run("trace " + quote(iso) + " --origin 0,0,-5 --dir 0,0,1" + twin);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("isotropic scene: the o and e modes coincide"), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("  o=e: exit ("), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("  o: "), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("  e: "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(" 2 interfaces crossed, 0 total internal reflections, "),
+              std::string::npos)
+        << r.out;
+    // Steps: homogeneous runs are crossed in long straight steps, so only a lower bound is sure:
+    // the 6 mm inside the sphere's smoothed surface region alone takes well over 10 steps of 0.25
+    // h.
+    const auto at = r.out.find(" total internal reflections, ");
+    ASSERT_NE(at, std::string::npos);
+    const int steps =
+        std::stoi(r.out.substr(at + std::string(" total internal reflections, ").size()));
+    EXPECT_GT(steps, 10) << r.out;
+    EXPECT_NE(r.out.find(std::to_string(steps) + " steps\n"), std::string::npos) << r.out;
+  }
+  // Uniaxial (calcite-like, optic axis across the ray): two mode lines, each with its counts.
+  const std::string uni =
+      write("uni.json", tinyScene("", R"({"n_o": 1.658, "n_e": 1.486, "optic_axis": [0, 1, 0]})"));
+  const Outcome r = run("trace " + quote(uni) + " --origin 0,0,-5 --dir 0,0,1 --reference");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.find("coincide"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  o: exit ("), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  e: exit ("), std::string::npos) << r.out;
+  size_t count = 0;
+  for (size_t p = r.out.find(" 2 interfaces crossed, 0 total internal reflections, ");
+       p != std::string::npos;
+       p = r.out.find(" 2 interfaces crossed, 0 total internal reflections, ", p + 1))
+    ++count;
+  EXPECT_EQ(count, 2u) << r.out;
 }
 
 // GPU (float32) vs CPU reference (double) on the same voxel field and the same step size.

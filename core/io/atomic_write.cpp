@@ -1,0 +1,155 @@
+#include "core/io/atomic_write.h"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <optional>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+namespace eikon {
+namespace {
+
+std::runtime_error writeError(const std::filesystem::path& path, const std::string& why) {
+  return std::runtime_error("cannot write '" + path.string() + "': " + why);
+}
+
+/// Create a new empty file "<path>.tmp-XXXXXXXX" (O_EXCL, mode 0666 less the umask, as the
+/// target would get) and return its name.
+std::filesystem::path createTemporary(const std::filesystem::path& path) {
+  std::random_device rd;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    char suffix[32];
+    std::snprintf(suffix, sizeof suffix, ".tmp-%08x", rd());
+    std::filesystem::path tmp(path.string() + suffix);
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      ::close(fd);
+      return tmp;
+    }
+    if (errno != EEXIST)
+      throw writeError(path,
+                       std::string("cannot create a file beside it: ") + std::strerror(errno));
+  }
+  throw writeError(path, "cannot create a temporary file beside it");
+}
+
+void createParentFolders(const std::filesystem::path& path) {
+  const auto dir = path.parent_path();
+  if (dir.empty()) return;
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw writeError(path, "cannot create folder '" + dir.string() + "': " + ec.message());
+}
+
+/// An exclusive flock on a lock file, released (and closed) when destroyed.
+class FileLock {
+ public:
+  explicit FileLock(const std::filesystem::path& lock_path) {
+    fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd_ < 0) throw writeError(lock_path, std::strerror(errno));
+    while (::flock(fd_, LOCK_EX) != 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd_);
+      throw writeError(lock_path, std::string("cannot lock it: ") + std::strerror(err));
+    }
+  }
+  ~FileLock() {
+    ::flock(fd_, LOCK_UN);
+    ::close(fd_);
+  }
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace
+
+void checkWritable(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw writeError(path, "it is a directory");
+  // Missing folders are created when writing; here the nearest existing one must take new entries.
+  std::filesystem::path dir = path.parent_path();
+  while (!dir.empty() && !std::filesystem::exists(dir, ec))
+    dir = dir.parent_path();  // "a/b" → "a" → ""
+  if (dir.empty()) dir = ".";
+  if (!std::filesystem::is_directory(dir, ec))
+    throw writeError(path, "'" + dir.string() + "' is not a folder");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw writeError(path, "folder '" + dir.string() + "' is not writable");
+  // access() says yes to root everywhere; creating a probe file is the real test.
+  std::filesystem::path probe;
+  try {
+    probe = createTemporary(dir / path.filename());
+  } catch (const std::exception&) {
+    throw writeError(path, "cannot create files in '" + dir.string() + "'");
+  }
+  std::filesystem::remove(probe, ec);
+}
+
+std::filesystem::path lockPathFor(const std::filesystem::path& first) {
+  return first.parent_path() / ("." + first.stem().string() + ".lock");
+}
+
+void writeFilesTogether(const std::vector<OutputFile>& files) {
+  if (files.empty()) return;
+  std::vector<std::filesystem::path> tmps;
+  auto removeTemporaries = [&] {
+    std::error_code ec;
+    for (const auto& t : tmps) std::filesystem::remove(t, ec);
+  };
+  try {
+    for (const OutputFile& f : files) {
+      if (std::filesystem::is_directory(f.path)) throw writeError(f.path, "it is a directory");
+      createParentFolders(f.path);
+      tmps.push_back(createTemporary(f.path));
+      try {
+        f.write(tmps.back());
+      } catch (const std::exception& e) {
+        throw writeError(f.path, e.what());
+      }
+    }
+    // One file needs no lock: its rename is atomic by itself.
+    std::optional<FileLock> lock;
+    if (files.size() > 1) lock.emplace(lockPathFor(files.front().path));
+    // Under the lock: a target that became a folder since would fail its rename after earlier
+    // renames had replaced their targets; refuse before replacing anything.
+    for (const OutputFile& f : files)
+      if (std::filesystem::is_directory(f.path)) throw writeError(f.path, "it is a directory");
+    for (size_t i = 0; i < files.size(); ++i) {
+      std::error_code ec;
+      std::filesystem::rename(tmps[i], files[i].path, ec);
+      if (ec) throw writeError(files[i].path, ec.message());
+    }
+  } catch (const std::filesystem::filesystem_error& e) {
+    removeTemporaries();
+    throw writeError(e.path1().empty() ? files.front().path : e.path1(), e.code().message());
+  } catch (...) {
+    removeTemporaries();
+    throw;
+  }
+}
+
+void writeFileAtomically(const std::filesystem::path& path, const FileContent& write) {
+  writeFilesTogether({{path, write}});
+}
+
+void writeBytesAtomically(const std::filesystem::path& path, std::string_view bytes) {
+  writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
+    FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw writeError(path, std::strerror(errno));
+    const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    const int err = errno;
+    if (std::fclose(f) != 0 || !ok) throw writeError(path, std::strerror(ok ? errno : err));
+  });
+}
+
+}  // namespace eikon

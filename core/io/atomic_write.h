@@ -1,0 +1,60 @@
+// Writing output files so that readers and other writers never see a partial or mixed result:
+// the one implementation of atomic file output in eikon (image writers, render outputs, caches).
+//
+// A file is written to a temporary "<name>.tmp-XXXXXXXX" in its target folder (created when
+// missing) and renamed over the target, which POSIX makes atomic within one file system. A set of
+// files that belong together (a render's EXR and its PNG preview) is written as a set:
+//
+//   1. every file to its own temporary; any failure (full disk, a codec error) removes the
+//      temporaries and leaves every target as it was;
+//   2. with an exclusive flock(2) on the lock file ".<stem>.lock" beside the first target
+//   (".x.lock"
+//      for out/x.png and out/x.exr),
+//      each temporary is renamed over its target.
+//
+// Two processes writing the same set at once therefore leave one process's complete set, never an
+// EXR from one and a PNG from the other. The lock file is left in place (deleting it would let a
+// third writer lock a different inode than a second one still holds).
+//
+//   eikon::writeFilesTogether({{"out/x.png", [&](const auto& tmp) { encodePng(tmp); }},
+//                              {"out/x.exr", [&](const auto& tmp) { encodeExr(tmp); }}});
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string_view>
+#include <vector>
+
+namespace eikon {
+
+/// Writes one file's content to the path it is given (a temporary beside the target); throws on
+/// failure, with the reason only: the writer reports "cannot write 'TARGET': reason".
+using FileContent = std::function<void(const std::filesystem::path& tmp)>;
+
+struct OutputFile {
+  std::filesystem::path path;
+  FileContent write;
+};
+
+/// Check that `path` can be created: it is not a folder, and its folder, or the nearest existing
+/// folder above it when folders are missing (the writers create them), takes new files. Throws
+/// std::runtime_error with a clear message otherwise, creating nothing. Call before long work so
+/// that it fails early.
+void checkWritable(const std::filesystem::path& path);
+
+/// Write one file atomically (steps 1 and 2 above for a set of one, without a lock). Throws
+/// std::runtime_error "cannot write 'PATH': why" (the reason from `write` when it threw); the
+/// target is then unchanged.
+void writeFileAtomically(const std::filesystem::path& path, const FileContent& write);
+
+/// Write `bytes` to `path` atomically.
+void writeBytesAtomically(const std::filesystem::path& path, std::string_view bytes);
+
+/// Write the files as a set (see above): all of them replace their targets, or none does.
+/// Throws like writeFileAtomically.
+void writeFilesTogether(const std::vector<OutputFile>& files);
+
+/// The lock file writeFilesTogether holds for a set whose first file is `first`.
+std::filesystem::path lockPathFor(const std::filesystem::path& first);
+
+}  // namespace eikon

@@ -1,0 +1,70 @@
+// The benchmark programs parse their options like the `eikon` CLI (CLI11): --help prints a usage
+// line and exits 0 (it used to end in an uncaught exception), and a bad option is one error line
+// and a non-zero exit. Skipped when the benchmarks are not built (EIKON_BUILD_BENCHMARKS=OFF).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "tests/apps/cli_support.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Bench {
+  const char* name;
+  const char* binary;
+};
+
+class BenchHelp : public ::testing::TestWithParam<Bench> {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "eikon_bench_cli_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
+    dir_ = tmpl;
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  /// Run the benchmark with `args`; skips the test when it was not built.
+  eikon::test::Outcome run(const std::string& args) {
+    const std::string bin = GetParam().binary;
+    if (bin.empty() || !fs::exists(bin)) return {-2, "", ""};
+    return eikon::test::runProgram(bin, args, dir_);
+  }
+  fs::path dir_;
+};
+
+TEST_P(BenchHelp, HelpPrintsUsageAndExitsZero) {
+  if (std::string(GetParam().binary).empty() || !fs::exists(GetParam().binary))
+    GTEST_SKIP() << GetParam().name << " is not built (EIKON_BUILD_BENCHMARKS=OFF)";
+  const eikon::test::Outcome r = run("--help");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("Usage:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(GetParam().name), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--help"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("terminate"), std::string::npos) << r.err;
+}
+
+TEST_P(BenchHelp, UnknownOptionFailsWithOneLine) {
+  if (std::string(GetParam().binary).empty() || !fs::exists(GetParam().binary))
+    GTEST_SKIP() << GetParam().name << " is not built (EIKON_BUILD_BENCHMARKS=OFF)";
+  const eikon::test::Outcome r = run("--no-such-option");
+  EXPECT_NE(r.code, 0);
+  EXPECT_LT(r.code, 128) << "killed by a signal (an uncaught exception aborts): " << r.err;
+  EXPECT_NE(r.err.find("--no-such-option"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("terminate"), std::string::npos) << r.err;
+}
+
+INSTANTIATE_TEST_SUITE_P(Benchmarks, BenchHelp,
+                         ::testing::Values(Bench{"view_bench", EIKON_VIEW_BENCH},
+                                           Bench{"fit_bench", EIKON_FIT_BENCH},
+                                           Bench{"spectral_bench", EIKON_SPECTRAL_BENCH},
+                                           Bench{"light_bench", EIKON_LIGHT_BENCH}),
+                         [](const auto& param_info) { return std::string(param_info.param.name); });
+
+}  // namespace
