@@ -214,11 +214,11 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
       auto v = c->numbers();
       if (v.empty() || v.size() > 6) c->fail("cauchy needs 1 to 6 coefficients [A, B, C, ...] (λ in µm), got " + std::to_string(v.size()));
       d = Dispersion::cauchy(v);
-    } else if (auto c = n.get("conrady")) {
+    } else if (auto cr = n.get("conrady")) {
       // n = n0 + A/λ + B/λ^3.5 (λ in µm); the renderer carries its Cauchy approximation.
-      auto v = c->numbers();
+      auto v = cr->numbers();
       if (v.size() != 3)
-        c->fail("conrady needs [n0, A, B] (n = n0 + A/λ + B/λ^3.5, λ in µm), got " +
+        cr->fail("conrady needs [n0, A, B] (n = n0 + A/λ + B/λ^3.5, λ in µm), got " +
                 std::to_string(v.size()) + " numbers");
       d = Dispersion::conrady(v[0], v[1], v[2]);
     } else {

@@ -350,7 +350,7 @@ TEST_F(FitCli, OutputsNeverReplaceInputsAndFoldersAreCreated) {
   const std::string before = slurp(csv);
   fs::create_directory(dir_ / "sub");
   fs::create_symlink(csv, dir_ / "link.csv");
-  for (const std::string out : {csv, path("sub/../bk7.csv"), path("./bk7.csv"), path("link.csv")}) {
+  for (const std::string& out : {csv, path("sub/../bk7.csv"), path("./bk7.csv"), path("link.csv")}) {
     const Outcome r = run(csv + " -o " + out);
     EXPECT_EQ(r.code, 1) << out;
     EXPECT_EQ(r.err, "eikon: error: " + out + ": the output is the input data file " + csv +
