@@ -10,7 +10,7 @@ command this checks that
     anything (the README elides columns that way).
 Commands run in a scratch folder holding links to the clone's scenes/, materials/, tests/ and
 docs/, so relative paths work and outputs land in the scratch folder. `render` commands get a
-small image (`--width 48 --height 36 --spp 1`) unless they set a size themselves: the README's
+small image (`--width 48 --height 36 --spp 1`, replacing any size the line gives): the README's
 pictures are made at full size by hand, this only checks that the command runs.
 
 usage: readme_commands.py EIKON_BINARY SOURCE_DIR
@@ -61,7 +61,11 @@ def line_pattern(expected):
 
 def check(binary, scratch, no, args, expected):
     argv = list(args)
-    if argv and argv[0] == "render" and "--width" not in argv:
+    if argv and argv[0] == "render":
+        for flag in ("--width", "--height", "--spp"):
+            while flag in argv:
+                i = argv.index(flag)
+                del argv[i:i + 2]
         argv += SMALL_RENDER
     proc = subprocess.run([binary] + argv, cwd=scratch, capture_output=True, text=True,
                           timeout=900, env=dict(os.environ, EIKON_CACHE_DIR=os.path.join(scratch, "cache")))
