@@ -7,11 +7,7 @@
 // crystal, fitted per mode. Prints a table (or, with --json, one JSON object) on stdout;
 // warnings go to stderr as "eikon: warning: ..." (errors with --strict). Output files are
 // written to a temporary file beside the target and renamed, so a failed run leaves nothing.
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
-#include <cerrno>
 #include <charconv>
 #include <cstring>
 #include <cmath>
@@ -25,6 +21,7 @@
 #include "anisotropic/fitting.h"
 #include "anisotropic/index_data.h"
 #include "apps/commands.h"
+#include "core/io/atomic_write.h"
 
 namespace eikon::cli {
 namespace {
@@ -207,66 +204,16 @@ void checkOutputs(const std::vector<std::string>& inputs,
   }
 }
 
-// Writes every file to a temporary sibling first and renames only when all were written. Missing
-// parent folders are created, and removed again (if still empty) when the write fails.
+// The material and YAML files are written as one set through core/io (temporaries renamed only
+// when all were written; missing folders created, and removed again when the write fails).
 void writeAllAtomically(const std::vector<std::pair<std::string, std::string>>& files) {
-  std::vector<std::pair<std::string, std::string>> temps;  // temp, final
-  std::vector<fs::path> created;                           // folders made here, outermost first
-  auto cleanup = [&] {
-    for (auto& t : temps) ::unlink(t.first.c_str());
-    std::error_code ec;
-    for (auto it = created.rbegin(); it != created.rend(); ++it)
-      fs::remove(*it, ec);  // only if empty
-  };
-  for (const auto& [path, content] : files) {
-    fs::path target(path);
-    fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    std::vector<fs::path> missing;
-    std::error_code ec;
-    for (fs::path d = dir; !d.empty() && !fs::exists(d, ec); d = d.parent_path()) {
-      missing.push_back(d);
-      if (d == d.parent_path()) break;
-    }
-    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
-      if (!fs::create_directory(*it, ec)) {
-        cleanup();
-        throw CliError("cannot write " + path + ": cannot create folder " + it->string() + ": " +
-                       (ec ? ec.message() : std::string("it exists")));
-      }
-      created.push_back(*it);
-    }
-    std::string tmpl = (dir / ("." + target.filename().string() + ".tmpXXXXXX")).string();
-    int fd = ::mkstemp(tmpl.data());
-    if (fd < 0) {
-      const int err = errno;
-      cleanup();
-      throw CliError("cannot write " + path + ": " + std::strerror(err));
-    }
-    temps.emplace_back(tmpl, path);
-    size_t done = 0;
-    while (done < content.size()) {
-      ssize_t w = ::write(fd, content.data() + done, content.size() - done);
-      if (w <= 0) {
-        const int err = errno;
-        ::close(fd);
-        cleanup();
-        throw CliError("cannot write " + path + ": " + std::strerror(err));
-      }
-      done += size_t(w);
-    }
-    ::fchmod(fd, 0644);
-    if (::close(fd) != 0) {
-      const int err = errno;
-      cleanup();
-      throw CliError("cannot write " + path + ": " + std::strerror(err));
-    }
+  std::vector<OutputFile> set;
+  for (const auto& [path, content] : files) set.push_back({path, bytesWriter(content)});
+  try {
+    writeFilesTogether(set);
+  } catch (const std::runtime_error& e) {
+    throw CliError(e.what());
   }
-  for (auto& [tmp, final_path] : temps)
-    if (std::rename(tmp.c_str(), final_path.c_str()) != 0) {
-      const int err = errno;
-      cleanup();
-      throw CliError("cannot rename temporary file to " + final_path + ": " + std::strerror(err));
-    }
 }
 
 std::optional<double> parseLoss(const std::string& s) {

@@ -1,11 +1,12 @@
 #include "apps/light_cache.h"
 
+#include "core/io/atomic_write.h"
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <system_error>
-#include <unistd.h>
 #include <vector>
 
 namespace eikon::cli {
@@ -155,32 +156,26 @@ std::string saveLightCache(const std::filesystem::path& dir, uint64_t key, const
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return "cannot create " + dir.string() + ": " + ec.message();
-  std::filesystem::path final_path = entryPath(dir, key);
-  std::string tmpl = final_path.string() + ".tmpXXXXXX";
-  int fd = ::mkstemp(tmpl.data());
-  if (fd < 0) return "cannot write in " + dir.string();
-  ::close(fd);
-  {
-    std::ofstream out(tmpl, std::ios::binary | std::ios::trunc);
-    uint64_t format = kFormat, checksum = payloadChecksum(volume.light_fluence, volume.light_flux);
-    out.write(kMagic, 8);
-    out.write(reinterpret_cast<const char*>(&format), sizeof format);
-    out.write(reinterpret_cast<const char*>(&key), sizeof key);
-    out.write(reinterpret_cast<const char*>(volume.grid.dims.data()), sizeof volume.grid.dims);
-    out.write(reinterpret_cast<const char*>(&checksum), sizeof checksum);
-    out.write(reinterpret_cast<const char*>(volume.light_fluence.data()),
-              std::streamsize(volume.light_fluence.size() * sizeof(glm::vec4)));
-    out.write(reinterpret_cast<const char*>(volume.light_flux.data()),
-              std::streamsize(volume.light_flux.size() * sizeof(glm::vec4)));
-    if (!out) {
-      std::filesystem::remove(tmpl, ec);
-      return "cannot write " + final_path.string();
-    }
-  }
-  std::filesystem::rename(tmpl, final_path, ec);
-  if (ec) {
-    std::filesystem::remove(tmpl, ec);
-    return "cannot write " + final_path.string();
+  const std::filesystem::path final_path = entryPath(dir, key);
+  try {
+    // Atomic (core/io): a reader sees the old entry or the whole new one, never a partial file.
+    writeFileAtomically(final_path, [&](const std::filesystem::path& tmp) {
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+      uint64_t format = kFormat, checksum = payloadChecksum(volume.light_fluence, volume.light_flux);
+      out.write(kMagic, 8);
+      out.write(reinterpret_cast<const char*>(&format), sizeof format);
+      out.write(reinterpret_cast<const char*>(&key), sizeof key);
+      out.write(reinterpret_cast<const char*>(volume.grid.dims.data()), sizeof volume.grid.dims);
+      out.write(reinterpret_cast<const char*>(&checksum), sizeof checksum);
+      out.write(reinterpret_cast<const char*>(volume.light_fluence.data()),
+                std::streamsize(volume.light_fluence.size() * sizeof(glm::vec4)));
+      out.write(reinterpret_cast<const char*>(volume.light_flux.data()),
+                std::streamsize(volume.light_flux.size() * sizeof(glm::vec4)));
+      out.close();
+      if (!out) throw std::runtime_error("write failed (disk full?)");
+    });
+  } catch (const std::exception& e) {
+    return e.what();
   }
   return {};
 }

@@ -39,12 +39,23 @@ std::filesystem::path createTemporary(const std::filesystem::path& path) {
   throw writeError(path, "cannot create a temporary file beside it");
 }
 
-void createParentFolders(const std::filesystem::path& path) {
-  const auto dir = path.parent_path();
-  if (dir.empty()) return;
+/// Create the missing folders above `path`, appending each one made to `created` (outermost
+/// first) so that a failed write can remove them again: no partial output, not even a folder.
+void createParentFolders(const std::filesystem::path& path,
+                         std::vector<std::filesystem::path>& created) {
+  std::vector<std::filesystem::path> missing;
   std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw writeError(path, "cannot create folder '" + dir.string() + "': " + ec.message());
+  for (auto d = path.parent_path(); !d.empty() && !std::filesystem::exists(d, ec);
+       d = d.parent_path()) {
+    missing.push_back(d);
+    if (d == d.parent_path()) break;
+  }
+  for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+    if (!std::filesystem::create_directory(*it, ec) && !std::filesystem::is_directory(*it))
+      throw writeError(path, "cannot create folder '" + it->string() + "': " +
+                                 (ec ? ec.message() : std::string("a file stands there")));
+    created.push_back(*it);
+  }
 }
 
 /// An exclusive flock on a lock file, released (and closed) when destroyed.
@@ -101,15 +112,17 @@ std::filesystem::path lockPathFor(const std::filesystem::path& first) {
 
 void writeFilesTogether(const std::vector<OutputFile>& files) {
   if (files.empty()) return;
-  std::vector<std::filesystem::path> tmps;
+  std::vector<std::filesystem::path> tmps, created;
   auto removeTemporaries = [&] {
     std::error_code ec;
     for (const auto& t : tmps) std::filesystem::remove(t, ec);
+    for (auto it = created.rbegin(); it != created.rend(); ++it)
+      std::filesystem::remove(*it, ec);  // only if still empty
   };
   try {
     for (const OutputFile& f : files) {
       if (std::filesystem::is_directory(f.path)) throw writeError(f.path, "it is a directory");
-      createParentFolders(f.path);
+      createParentFolders(f.path, created);
       tmps.push_back(createTemporary(f.path));
       try {
         f.write(tmps.back());
@@ -142,14 +155,18 @@ void writeFileAtomically(const std::filesystem::path& path, const FileContent& w
   writeFilesTogether({{path, write}});
 }
 
-void writeBytesAtomically(const std::filesystem::path& path, std::string_view bytes) {
-  writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
+FileContent bytesWriter(std::string bytes) {
+  return [bytes = std::move(bytes)](const std::filesystem::path& tmp) {
     FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw writeError(path, std::strerror(errno));
+    if (!f) throw std::runtime_error(std::strerror(errno));
     const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
     const int err = errno;
-    if (std::fclose(f) != 0 || !ok) throw writeError(path, std::strerror(ok ? errno : err));
-  });
+    if (std::fclose(f) != 0 || !ok) throw std::runtime_error(std::strerror(ok ? errno : err));
+  };
+}
+
+void writeBytesAtomically(const std::filesystem::path& path, std::string_view bytes) {
+  writeFileAtomically(path, bytesWriter(std::string(bytes)));
 }
 
 }  // namespace eikon

@@ -22,6 +22,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -49,6 +50,9 @@ void writeFileAtomically(const std::filesystem::path& path, const FileContent& w
 
 /// Write `bytes` to `path` atomically.
 void writeBytesAtomically(const std::filesystem::path& path, std::string_view bytes);
+
+/// The FileContent that writes `bytes` (for sets of in-memory files).
+FileContent bytesWriter(std::string bytes);
 
 /// Write the files as a set (see above): all of them replace their targets, or none does.
 /// Throws like writeFileAtomically.

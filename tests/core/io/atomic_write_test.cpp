@@ -87,6 +87,22 @@ TEST_F(AtomicWrite, FailureOfTheSecondFileLeavesBothTargetsIntact) {
   expectNoTemporaries(dir_);
 }
 
+// Folders made for a set that then fails are removed again (no partial output, not even an empty
+// folder); folders that existed before stay.
+TEST_F(AtomicWrite, FoldersCreatedForAFailedSetAreRemoved) {
+  fs::create_directory(dir_ / "kept");
+  const fs::path a = dir_ / "kept" / "new" / "deeper" / "a.json", b = dir_ / "other" / "b.yml";
+  EXPECT_THROW(writeFilesTogether({{a, text("a")}, {b, [](const fs::path&) {
+                                     throw std::runtime_error("disk full");
+                                   }}}),
+               std::runtime_error);
+  EXPECT_TRUE(fs::is_directory(dir_ / "kept"));
+  EXPECT_FALSE(fs::exists(dir_ / "kept" / "new"));
+  EXPECT_FALSE(fs::exists(dir_ / "other"));
+  writeBytesAtomically(b, "bytes");  // and the bytes writer creates them when it succeeds
+  EXPECT_EQ(slurp(b), "bytes");
+}
+
 TEST_F(AtomicWrite, TargetThatIsAFolderFailsBeforeAnyTargetChanges) {
   const fs::path png = dir_ / "x.png", exr = dir_ / "x.exr";
   std::ofstream(png) << "old png";
