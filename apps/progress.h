@@ -57,6 +57,10 @@ class Progress {
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
 
+  /// A stage whose fraction is not known (building GPU pipelines, uploading volumes): shown with
+  /// its elapsed time only, "eikon: preparing the GPU  2.1 s", redrawn each second.
+  void working(const std::string& stage) { update(stage, kUnknown); }
+
   /// Report `fraction` (0..1) of `stage`. Thread-safe; cheap when nothing is printed.
   void update(const std::string& stage, double fraction) {
     if (!live_) return;
@@ -70,15 +74,17 @@ class Progress {
       printed_ = false;
       samples_.clear();
     }
-    fraction_ = std::clamp(fraction, 0.0, 1.0);
+    const double before = new_stage ? 0.0 : fraction_;
+    fraction_ = fraction == kUnknown ? kUnknown : std::clamp(fraction, 0.0, 1.0);
+    const bool finishing = fraction_ >= 1.0 && before < 1.0;  // 100% is drawn once per stage
     reported_ = now;
     if (samples_.empty() || now - samples_.back().first >= std::chrono::milliseconds(250))
       samples_.emplace_back(now, fraction_);
     while (samples_.size() > 2 && now - samples_[1].first > std::chrono::seconds(10))
       samples_.pop_front();
-    if (now - start_ < grace_ && fraction_ < 1.0) return;
-    if (new_stage || !printed_ || fraction_ >= 1.0 ||
-        now - drawn_ >= std::chrono::milliseconds(250))
+    if (now - start_ < grace_ && !finishing) return;
+    if (fraction_ >= 1.0 && !finishing) return;
+    if (new_stage || !printed_ || finishing || now - drawn_ >= std::chrono::milliseconds(250))
       draw(now);
   }
 
@@ -97,6 +103,7 @@ class Progress {
 
  private:
   using Clock = std::chrono::steady_clock;
+  static constexpr double kUnknown = -1.0;
 
   static std::string seconds(double s) {
     char buf[32];
@@ -109,6 +116,15 @@ class Progress {
 
   void draw(Clock::time_point now) {
     auto secs = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
+    if (fraction_ == kUnknown) {  // no fraction, no ETA: the elapsed time shows it is alive
+      const std::string in_stage = seconds(secs(now - stage_start_));
+      std::fprintf(stderr, tty_ ? "\r\033[Keikon: %s  %s" : "eikon: %s  %s\n", stage_.c_str(),
+                   in_stage.c_str());
+      std::fflush(stderr);
+      drawn_ = now;
+      printed_ = true;
+      return;
+    }
     std::string eta = "ETA --";
     if (fraction_ >= 1.0) {
       eta = "ETA " + seconds(0.0);
@@ -138,7 +154,9 @@ class Progress {
     while (!done_) {
       wake_.wait_for(lock, std::chrono::seconds(1));
       const auto now = Clock::now();
-      if (done_ || stage_.empty() || now - start_ < grace_) continue;
+      // A finished stage is not redrawn while the next has not started ("100%, ETA 0 s" for
+      // seconds said nothing); the commands mark such gaps with working().
+      if (done_ || stage_.empty() || fraction_ >= 1.0 || now - start_ < grace_) continue;
       if (now - drawn_ >= std::chrono::milliseconds(900)) draw(now);
     }
   }

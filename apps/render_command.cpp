@@ -209,6 +209,7 @@ void addRenderCommand(CLI::App& app) {
       ReferenceMarcher ref(field, scene.environment);
       img = ref.render(scene.camera, rs, a.threads);
     } else {
+      progress.working("preparing the GPU (pipelines, volume upload)");
       ViewRenderer renderer(*ctx, scene, volume);
       img = renderer.render(rs);
     }

@@ -88,9 +88,10 @@ void addTraceCommand(CLI::App& app) {
       auto ctx = vk::Context::create();
       checkVolumeFits(*ctx, makeGrid(scene.volume), scene);
       VolumeSet volume = voxelize(scene, vo);
-      progress.finish();
+      progress.working("preparing the GPU (pipelines, volume upload)");
       ViewRenderer r(*ctx, scene, volume);
       modes = r.traceModes({req}, ms).front();
+      progress.finish();
       device = ctx->deviceName();
     }
     auto vec = [](const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };

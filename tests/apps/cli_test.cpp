@@ -261,6 +261,20 @@ TEST_F(Cli, TraceProgressOnlyWhenAsked) {
   EXPECT_NE(lines.back().find("100.0%"), std::string::npos) << lines.back();
   EXPECT_EQ(forced.out, quiet.out);
   EXPECT_EQ(run(args + " --progress always -q").err, "");
+  // The GPU twin: building its pipelines and uploading the volume has no fraction. It is a stage of
+  // its own, shown with its elapsed time, instead of the voxeliser's "100.0%, ETA 0.0 s" redrawn
+  // every second while it runs (seen for 9 s on a 64x48 render).
+  const Outcome gpu = run("trace " + quote(scene) + " --origin 0,0,-5 --dir 0,0,1 --progress always");
+  ASSERT_EQ(gpu.code, 0) << gpu.err;
+  std::istringstream in(gpu.err);
+  int preparing = 0, voxelDone = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("eikon: preparing the GPU", 0) == 0) ++preparing;
+    if (line.rfind("eikon: voxelising", 0) == 0 && line.find("100.0%") != std::string::npos)
+      ++voxelDone;
+  }
+  EXPECT_GE(preparing, 1) << gpu.err;
+  EXPECT_EQ(voxelDone, 1) << "a finished stage is drawn once at 100%:\n" << gpu.err;
 }
 
 TEST_F(Cli, BadProgressOptionFailsCleanly) {
