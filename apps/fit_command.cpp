@@ -2,7 +2,7 @@
 //             [--range-nm LO,HI] [--samples N] [--name NAME] -o MATERIAL.json`
 //
 // Fits a dispersion model to refractive-index data (CSV or refractiveindex.info YAML; see
-// anisotropic/index_data.h) and writes the material file the renderer loads. A CSV with n_o,n_e
+// fitting/index_data.h) and writes the material file the renderer loads. A CSV with n_o,n_e
 // columns, or two single-index files (ordinary first, then extraordinary), makes a uniaxial
 // crystal, fitted per mode. Prints a table (or, with --json, one JSON object) on stdout;
 // warnings go to stderr as "eikon: warning: ..." (errors with --strict). Output files are
@@ -16,12 +16,11 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <yaml-cpp/yaml.h>
 
-#include "anisotropic/fitting.h"
-#include "anisotropic/index_data.h"
 #include "apps/commands.h"
 #include "core/io/atomic_write.h"
+#include "fitting/fitting.h"
+#include "fitting/index_data.h"
 
 namespace eikon::cli {
 namespace {
@@ -162,18 +161,13 @@ std::string yamlEntry(const FitResult& r, const std::string& source) {
   const auto names = parameterNames(r.model);
   for (size_t k = 0; k < names.size(); ++k) comment << (k ? ", " : "") << names[k] << " " << fmt("%.3e", r.sigma[k]);
   comment << "; residual rms " << fmt("%.3e", r.rms) << ", max " << fmt("%.3e", r.max_residual);
-  YAML::Emitter e;
-  e << YAML::BeginMap;
-  e << YAML::Key << "REFERENCES" << YAML::Value
-    << ("eikon fit of " + source + ", model " + modelName(r.model) + " (" + r.label + ")");
-  e << YAML::Key << "COMMENTS" << YAML::Value << comment.str();
-  e << YAML::Key << "DATA" << YAML::Value << YAML::BeginSeq << YAML::BeginMap;
-  e << YAML::Key << "type" << YAML::Value << ("formula " + std::to_string(formula));
-  e << YAML::Key << "wavelength_range" << YAML::Value
-    << (fmt("%.10g", r.range_nm[0] * 1e-3) + " " + fmt("%.10g", r.range_nm[1] * 1e-3));
-  e << YAML::Key << "coefficients" << YAML::Value << coeffs.str();
-  e << YAML::EndMap << YAML::EndSeq << YAML::EndMap;
-  return std::string(e.c_str()) + "\n";
+  RefractiveIndexFormulaEntry entry;
+  entry.references = "eikon fit of " + source + ", model " + modelName(r.model) + " (" + r.label + ")";
+  entry.comments = comment.str();
+  entry.formula = formula;
+  entry.wavelength_range = fmt("%.10g", r.range_nm[0] * 1e-3) + " " + fmt("%.10g", r.range_nm[1] * 1e-3);
+  entry.coefficients = coeffs.str();
+  return formatRefractiveIndexYaml(entry);
 }
 
 // "calcite.yml" + "o" → "calcite-o.yml".

@@ -43,18 +43,10 @@
 #include <string>
 #include <vector>
 
-#include "anisotropic/bm_mapping.h"
-#include "anisotropic/dispersion.h"
-#include "anisotropic/fitting.h"
-#include "anisotropic/fresnel.h"
-#include "anisotropic/index_data.h"
-#include "anisotropic/interface.h"
-#include "anisotropic/pleochroism.h"
-#include "anisotropic/uniaxial.h"
 #include "apps/light_cache.h"
-#include "core/reference/reference_marcher.h"
-#include "core/reference/reference_lighting.h"
 #include "core/io/exr.h"
+#include "core/reference/reference_lighting.h"
+#include "core/reference/reference_marcher.h"
 #include "core/render/light_transport.h"
 #include "core/render/render_defaults.h"
 #include "core/render/view_renderer.h"
@@ -62,6 +54,14 @@
 #include "core/vk/context.h"
 #include "core/volume/march_types.h"
 #include "core/volume/volume_set.h"
+#include "fitting/fitting.h"
+#include "fitting/index_data.h"
+#include "optics/bm_mapping.h"
+#include "optics/dispersion.h"
+#include "optics/fresnel.h"
+#include "optics/interface.h"
+#include "optics/pleochroism.h"
+#include "optics/uniaxial.h"
 
 namespace py = pybind11;
 using namespace eikon;

@@ -1,7 +1,7 @@
 // Index data readers: the strict CSV reader, refractiveindex.info YAML (tabulated and formula
 // blocks, old and new keys), and the nine database formulas against materials.json and against
 // the formulas written out by hand.
-#include "anisotropic/index_data.h"
+#include "fitting/index_data.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "anisotropic/dispersion.h"
-#include "anisotropic/refractiveindex_formula.h"
+#include "fitting/refractiveindex_formula.h"
+#include "optics/dispersion.h"
 
 namespace eikon {
 namespace {
@@ -241,6 +241,35 @@ TEST(RefractiveIndexYaml, BadInputIsOneClearError) {
   expectError(yml("DATA:\n  - type: tabulated k\n    data: |\n        0.5 1e-5\n        0.6 1e-5\n"),
               {"bad.yml", "no data points"});
   expectError(yml("DATA:\n  - type: spline\n"), {"DATA[0].type", "unsupported"});
+}
+
+// The writer `eikon fit --export-yaml` uses: free text with YAML's special characters is quoted by
+// the emitter, and the entry reads back (our reader) as the formula it names. Formula 5 with
+// "1.5 0.004 -2" is n = 1.5 + 0.004/λ² (λ in µm): 1.525 at 0.4, 1.5 + 0.004/0.36 at 0.6,
+// 1.50625 at 0.8.
+TEST(RefractiveIndexYaml, WrittenFormulaEntryReadsBack) {
+  RefractiveIndexFormulaEntry entry;
+  entry.references = "eikon fit of a: b.csv, model cauchy3 # not a comment";
+  entry.comments = "1-sigma: A 1.0e-05, B: 2.0e-07; 'quoted'";
+  entry.formula = 5;
+  entry.wavelength_range = "0.4 0.8";
+  entry.coefficients = "1.5 0.004 -2";
+  const std::string text = formatRefractiveIndexYaml(entry);
+  EXPECT_EQ(text.rfind("REFERENCES:", 0), 0u) << text;
+  EXPECT_NE(text.find("type: formula 5"), std::string::npos) << text;
+  EXPECT_EQ(text.back(), '\n');
+  IndexReadOptions o;
+  o.formula_samples = 3;
+  const IndexData d = parseRefractiveIndexYaml(text, "fit.yml", o);
+  ASSERT_EQ(d.modes.size(), 1u);
+  const IndexSeries& s = d.modes[0];
+  ASSERT_EQ(s.size(), 3u);
+  EXPECT_NEAR(s.lambda_nm[0], 400.0, 1e-9);
+  EXPECT_NEAR(s.lambda_nm[1], 600.0, 1e-9);
+  EXPECT_NEAR(s.lambda_nm[2], 800.0, 1e-9);
+  EXPECT_NEAR(s.n[0], 1.525, 1e-14);
+  EXPECT_NEAR(s.n[1], 1.5 + 0.004 / 0.36, 1e-14);
+  EXPECT_NEAR(s.n[2], 1.50625, 1e-14);
 }
 
 TEST(IndexData, CombineOrdinaryExtraordinary) {

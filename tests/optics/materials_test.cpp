@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "anisotropic/dispersion.h"
+#include "optics/dispersion.h"
 
 namespace {
 

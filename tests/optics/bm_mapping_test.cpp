@@ -1,6 +1,6 @@
 // The Beyerle–McDermid mapping: γ = M_e^{1/2}, the mapped e-surface is the unit sphere, and
 // mapped-space refraction/reflection reproduces the direct quadratic solve (interface.h) exactly.
-#include "anisotropic/bm_mapping.h"
+#include "optics/bm_mapping.h"
 
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 #include <iostream>
 #include <random>
 
-#include "anisotropic/dispersion.h"
-#include "anisotropic/interface.h"
+#include "optics/dispersion.h"
+#include "optics/interface.h"
 
-#include "tests/anisotropic/crystal_fixtures.h"
+#include "tests/optics/crystal_fixtures.h"
 
 namespace {
 

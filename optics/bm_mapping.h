@@ -7,7 +7,7 @@
 // the UNIT sphere |p'| = 1. Beyerle & McDermid (Appl. Opt. 37:7947, 1998) use this to reduce
 // e-wave refraction and reflection to the isotropic laws.
 //
-// WHICH POWER OF γ ACTS ON WHAT (verified numerically, tests/anisotropic/bm_mapping_test.cpp;
+// WHICH POWER OF γ ACTS ON WHAT (verified numerically, tests/optics/bm_mapping_test.cpp;
 // derivation in docs/beyerle-mcdermid.md):
 //   * covectors — wave vectors p, wave normals s, surface normals n̂ — map with γ:
 //         p' = γp,  s' = γs/|γs|,  n' = γn̂/|γn̂|;
@@ -42,7 +42,7 @@
 
 #include <glm/glm.hpp>
 
-#include "anisotropic/uniaxial.h"
+#include "optics/uniaxial.h"
 
 namespace eikon {
 

@@ -1,7 +1,7 @@
 // Isotropic Fresnel (docs/reference-cases.md §5) and the per-mode split at crystal surfaces: exact
 // Maxwell solution (energy conserved, isotropic limit) and the D-projection approximation, whose
 // cost against the exact solution is measured here and quoted in docs/uniaxial-optics.md.
-#include "anisotropic/fresnel.h"
+#include "optics/fresnel.h"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 #include <random>
 #include <stdexcept>
 
-#include "anisotropic/dispersion.h"
+#include "optics/dispersion.h"
 
-#include "tests/anisotropic/crystal_fixtures.h"
+#include "tests/optics/crystal_fixtures.h"
 
 namespace {
 

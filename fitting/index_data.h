@@ -1,5 +1,6 @@
 // Measured (or catalogue) refractive indices to fit dispersion models to: a strict CSV reader
-// and a reader for refractiveindex.info database YAML files.
+// and a reader for refractiveindex.info database YAML files (plus the writer of one formula
+// entry, which `eikon fit --export-yaml` uses, so that yaml-cpp stays inside fitting/).
 //
 // CSV (one header line, then one row per wavelength; `#` starts a comment line, blank lines are
 // skipped; fields are separated by commas, surrounding spaces ignored):
@@ -82,6 +83,21 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
 
 /// Dispatch on the extension: .csv → CSV; .yml/.yaml → YAML; anything else is an error.
 IndexData readIndexData(const std::string& path, const IndexReadOptions& options = {});
+
+/// One refractiveindex.info entry with a single `formula N` block, all fields as the database
+/// writes them: wavelength_range "lo hi" in µm, coefficients space-separated.
+struct RefractiveIndexFormulaEntry {
+  std::string references;
+  std::string comments;
+  int formula = 0;
+  std::string wavelength_range;
+  std::string coefficients;
+};
+
+/// The entry as YAML text (REFERENCES, COMMENTS, DATA: [{type, wavelength_range, coefficients}]),
+/// ending in a newline; yaml-cpp quotes free text as needed, so parseRefractiveIndexYaml reads it
+/// back whatever the references say.
+std::string formatRefractiveIndexYaml(const RefractiveIndexFormulaEntry& entry);
 
 /// Combine two isotropic data sets into one crystal (o from `ordinary`, e from `extraordinary`).
 IndexData combineOrdinaryExtraordinary(IndexData ordinary, IndexData extraordinary);

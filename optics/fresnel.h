@@ -44,7 +44,7 @@
 
 #include <glm/glm.hpp>
 
-#include "anisotropic/uniaxial.h"
+#include "optics/uniaxial.h"
 
 namespace eikon {
 

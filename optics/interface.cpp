@@ -1,4 +1,4 @@
-#include "anisotropic/interface.h"
+#include "optics/interface.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "anisotropic/fitting.h"
+#include "fitting/fitting.h"
 
 #include <ceres/ceres.h>
 #include <glog/logging.h>

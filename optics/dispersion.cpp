@@ -1,4 +1,4 @@
-#include "anisotropic/dispersion.h"
+#include "optics/dispersion.h"
 
 #include <cmath>
 #include <sstream>

@@ -42,7 +42,7 @@
 
 #include <glm/glm.hpp>
 
-#include "anisotropic/uniaxial.h"
+#include "optics/uniaxial.h"
 
 namespace eikon {
 

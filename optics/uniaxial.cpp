@@ -1,4 +1,4 @@
-#include "anisotropic/uniaxial.h"
+#include "optics/uniaxial.h"
 
 #include <algorithm>
 #include <cmath>

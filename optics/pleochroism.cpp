@@ -1,4 +1,4 @@
-#include "anisotropic/pleochroism.h"
+#include "optics/pleochroism.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "anisotropic/bm_mapping.h"
+#include "optics/bm_mapping.h"
 
 #include <cmath>
 

@@ -31,7 +31,7 @@
 
 #include <glm/glm.hpp>
 
-#include "anisotropic/uniaxial.h"
+#include "optics/uniaxial.h"
 
 namespace eikon {
 

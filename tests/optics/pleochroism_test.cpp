@@ -1,14 +1,14 @@
 // Pleochroic attenuation of the e-wave (docs/reference-cases.md §9, docs/design.md §2).
-#include "anisotropic/pleochroism.h"
+#include "optics/pleochroism.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <complex>
 
-#include "anisotropic/dispersion.h"
+#include "optics/dispersion.h"
 
-#include "tests/anisotropic/crystal_fixtures.h"
+#include "tests/optics/crystal_fixtures.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "anisotropic/refractiveindex_formula.h"
+#include "fitting/refractiveindex_formula.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,6 +1,6 @@
 // Dispersion fitting: reference fits (docs/reference-cases.md §6), coverage of the
 // reported 1σ intervals, per-mode crystal fits, Sellmeier refit, robust loss, rank deficiency.
-#include "anisotropic/fitting.h"
+#include "fitting/fitting.h"
 
 #include <gtest/gtest.h>
 
@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "anisotropic/dispersion.h"
-#include "anisotropic/refractiveindex_formula.h"
+#include "fitting/refractiveindex_formula.h"
+#include "optics/dispersion.h"
 
 namespace eikon {
 namespace {

@@ -1,7 +1,7 @@
 // Uniaxial index surface, ray direction and walk-off against docs/reference-cases.md
 // §1, §2 and §8. Indices come from the Ghosh (1999) Sellmeier formulas through eikon::Dispersion,
 // so the tolerances are those of docs/reference-cases.md (1e-6 on n, 1e-4° on angles), not the code's own.
-#include "anisotropic/uniaxial.h"
+#include "optics/uniaxial.h"
 
 #include <gtest/gtest.h>
 
@@ -9,9 +9,9 @@
 #include <limits>
 #include <stdexcept>
 
-#include "anisotropic/dispersion.h"
-#include "anisotropic/fresnel.h"
-#include "anisotropic/interface.h"
+#include "optics/dispersion.h"
+#include "optics/fresnel.h"
+#include "optics/interface.h"
 
 namespace {
 

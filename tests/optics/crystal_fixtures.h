@@ -6,8 +6,8 @@
 
 #include <random>
 
-#include "anisotropic/dispersion.h"
-#include "anisotropic/uniaxial.h"
+#include "optics/dispersion.h"
+#include "optics/uniaxial.h"
 
 namespace eikon::test {
 

@@ -1,16 +1,16 @@
 // Plane-interface refraction and reflection of o- and e-waves (interface.h) against
 // docs/reference-cases.md §3 and against invariants: tangential k conserved, both waves on their index
 // surfaces, energy on the correct side, isotropic Snell when n_o = n_e.
-#include "anisotropic/interface.h"
+#include "optics/interface.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "anisotropic/dispersion.h"
+#include "optics/dispersion.h"
 
-#include "tests/anisotropic/crystal_fixtures.h"
+#include "tests/optics/crystal_fixtures.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "anisotropic/index_data.h"
+#include "fitting/index_data.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "anisotropic/refractiveindex_formula.h"
+#include "fitting/refractiveindex_formula.h"
 
 namespace eikon {
 namespace {
@@ -326,6 +326,19 @@ IndexData readIndexData(const std::string& path, const IndexReadOptions& opt) {
   if (ends(".csv")) return readIndexCsv(path, opt);
   if (ends(".yml") || ends(".yaml")) return readRefractiveIndexYaml(path, opt);
   throw std::invalid_argument(path + ": unknown data format (expected a .csv or a refractiveindex.info .yml file)");
+}
+
+std::string formatRefractiveIndexYaml(const RefractiveIndexFormulaEntry& entry) {
+  YAML::Emitter e;
+  e << YAML::BeginMap;
+  e << YAML::Key << "REFERENCES" << YAML::Value << entry.references;
+  e << YAML::Key << "COMMENTS" << YAML::Value << entry.comments;
+  e << YAML::Key << "DATA" << YAML::Value << YAML::BeginSeq << YAML::BeginMap;
+  e << YAML::Key << "type" << YAML::Value << ("formula " + std::to_string(entry.formula));
+  e << YAML::Key << "wavelength_range" << YAML::Value << entry.wavelength_range;
+  e << YAML::Key << "coefficients" << YAML::Value << entry.coefficients;
+  e << YAML::EndMap << YAML::EndSeq << YAML::EndMap;
+  return std::string(e.c_str()) + "\n";
 }
 
 IndexData combineOrdinaryExtraordinary(IndexData o, IndexData e) {

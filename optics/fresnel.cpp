@@ -1,4 +1,4 @@
-#include "anisotropic/fresnel.h"
+#include "optics/fresnel.h"
 
 #include <algorithm>
 #include <array>
@@ -9,7 +9,7 @@
 #include <string>
 #include <utility>
 
-#include "anisotropic/interface.h"
+#include "optics/interface.h"
 
 namespace eikon {
 namespace {

@@ -45,8 +45,8 @@
 #include <string>
 #include <vector>
 
-#include "anisotropic/dispersion.h"
-#include "anisotropic/index_data.h"
+#include "fitting/index_data.h"
+#include "optics/dispersion.h"
 
 namespace eikon {
 
