@@ -39,7 +39,7 @@ glm::dvec3 parseVec(const std::string& s, const char* what) {
 struct TraceArgs {
   std::string scene, origin, dir;
   double wavelength = 587.5618, step = 0.25;
-  bool json = false, reference = false, quiet = false;
+  bool json = false, reference = false, quiet = false, strict = false;
   std::string integrator = "rk4", progress = "auto";
 };
 
@@ -56,6 +56,7 @@ void addTraceCommand(CLI::App& app) {
   sub->add_flag("--json", a->json, "Print JSON");
   sub->add_flag("--reference", a->reference, "Use the double-precision CPU reference instead of the GPU");
   sub->add_flag("-q,--quiet", a->quiet, "No progress lines (same as --progress never)");
+  sub->add_flag("--strict", a->strict, "Treat the scene's warnings as errors (as render --strict)");
   sub->add_option("--progress", a->progress,
                   "auto (default: voxelising progress with ETA on stderr when it is a terminal), "
                   "always or never");
@@ -73,8 +74,10 @@ void addTraceCommand(CLI::App& app) {
     MarchSettings ms;
     ms.step_voxels = a->step;
     TraceRequest req{o, glm::normalize(d), a->wavelength};
-    for (const std::string& w : scene.warnings)
+    for (const std::string& w : scene.warnings) {
+      if (a->strict) throw CliError(w + " (--strict)");
       std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+    }
     std::array<TraceOutcome, 2> modes;
     std::string device;
     if (a->reference) {

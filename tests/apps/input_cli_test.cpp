@@ -97,6 +97,14 @@ TEST_F(InputCli, TraceWarnsAboutAnObjectCoveringTheVolume) {
   EXPECT_NE(r.err.find("huge.json: /objects/0: the object covers the whole volume"),
             std::string::npos)
       << r.err;
+  // --strict makes it an error, as for render: one line, non-zero exit, nothing on stdout.
+  const Outcome strict = run("trace --reference " + quote((dir_ / "huge.json").string()) +
+                             " --origin 0,0,-5 --dir 0,0,1 --strict");
+  EXPECT_NE(strict.code, 0);
+  EXPECT_EQ(strict.out, "");
+  EXPECT_EQ(std::count(strict.err.begin(), strict.err.end(), '\n'), 1) << strict.err;
+  EXPECT_NE(strict.err.find("covers the whole volume"), std::string::npos) << strict.err;
+  EXPECT_NE(strict.err.find("(--strict)"), std::string::npos) << strict.err;
 }
 
 // ------------------------------------------------------------------ host memory
