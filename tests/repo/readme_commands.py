@@ -7,7 +7,8 @@ lines after it, up to the next `$` line or the end of the block, are its printed
 command this checks that
   * it exits 0, or non-zero when its shown output contains `eikon: error:`;
   * every shown output line appears in what it printed, in order; `...` in a shown line matches
-    anything (the README elides columns that way).
+    anything (the README elides columns that way), and numbers agree to 1e-4 relative (1e-5
+    absolute), so another GPU's float32 rounding passes while a changed result fails.
 Commands run in a scratch folder holding links to the clone's scenes/, materials/, tests/ and
 docs/, so relative paths work and outputs land in the scratch folder. `render` commands get a
 small image (`--width 48 --height 36 --spp 1`, replacing any size the line gives): the README's
@@ -54,9 +55,28 @@ def commands(readme_text):
         yield current
 
 
+NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
+
+
 def line_pattern(expected):
-    parts = [re.escape(p.strip()) for p in expected.split("...")]
+    """A regex for one shown line: `...` matches anything, and every number is captured so that
+    it can be compared with a tolerance (another GPU rounds float32 differently in the last
+    digits; the CPU-side numbers agree exactly)."""
+    def literal(text):
+        out, at = "", 0
+        for m in NUMBER.finditer(text):
+            out += re.escape(text[at:m.start()]) + "(" + NUMBER.pattern + ")"
+            at = m.end()
+        return out + re.escape(text[at:])
+    parts = [literal(p.strip()) for p in expected.split("...")]
     return re.compile(r"\s*" + r".*?".join(parts) + r"\s*$")
+
+
+def numbers_agree(expected, match):
+    want = [float(x) for x in NUMBER.findall(" ".join(p.strip() for p in expected.split("...")))]
+    got = [float(x) for x in match.groups()]
+    return len(want) == len(got) and all(
+        abs(w - g) <= 1e-5 + 1e-4 * abs(w) for w, g in zip(want, got))
 
 
 def check(binary, scratch, no, args, expected):
@@ -80,7 +100,8 @@ def check(binary, scratch, no, args, expected):
     for e in expected:
         pat = line_pattern(e)
         for i in range(at, len(printed)):
-            if pat.match(printed[i]):
+            m = pat.match(printed[i])
+            if m and numbers_agree(e, m):
                 at = i + 1
                 break
         else:
