@@ -1,4 +1,4 @@
-// The eikonal march shared by view.comp and trace.comp (GPU twin of core/reference/marcher.cpp).
+// The eikonal march shared by view.comp and trace.comp (GPU twin of core/reference/reference_marcher.cpp).
 //
 // Ray equation with the spatial arc parameter s (docs/design.md §2; Ihrke et al. 2007 eq. 3):
 //   dx/ds = w / n(x),   dw/ds = ∇n(x),   w = n·dx/ds, invariant |w| = n.
