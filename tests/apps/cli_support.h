@@ -19,6 +19,13 @@ struct Outcome {
   std::string out, err;
 };
 
+/// `s` as one single-quoted shell word (the runners pass their arguments through the shell).
+inline std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
 inline std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream s;

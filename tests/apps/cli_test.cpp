@@ -40,11 +40,7 @@ std::string tinyScene(const std::string& volume_extra = "", const std::string& m
 })";
 }
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using eikon::test::quote;
 
 class Cli : public ::testing::Test {
  protected:

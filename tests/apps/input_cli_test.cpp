@@ -18,11 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 using eikon::test::Outcome;
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using eikon::test::quote;
 
 class InputCli : public ::testing::Test {
  protected:

@@ -11,6 +11,7 @@
 
 #include "core/scene/messages.h"
 #include "core/scene/scene.h"
+#include "tests/core/scene_support.h"
 
 namespace eikon {
 namespace {
@@ -19,43 +20,13 @@ namespace fs = std::filesystem;
 constexpr const char* kOrigin = "input.json";
 
 std::string errorOf(const std::string& text, const fs::path& origin = kOrigin) {
-  try {
-    parseScene(text, origin);
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "the scene parsed:\n" << text;
-  return {};
+  return test::sceneErrorOf(text, origin);
 }
 
-#define EXPECT_INPUT_ERROR(text, json_path, phrase)                                        \
-  do {                                                                                     \
-    const std::string m_ = errorOf(text);                                                  \
-    EXPECT_EQ(m_.rfind(std::string(kOrigin) + ": " + (json_path) + ": ", 0), 0u) << m_;    \
-    EXPECT_NE(m_.find(phrase), std::string::npos) << "lacks '" << (phrase) << "': " << m_; \
-    EXPECT_EQ(m_.find('\n'), std::string::npos) << m_;                                     \
-  } while (0)
+#define EXPECT_INPUT_ERROR(text, json_path, phrase) \
+  EXPECT_TRUE(test::isOneLineSceneError(errorOf(text), kOrigin, json_path, phrase))
 
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_input_test_XXXXXX").string();
-    if (::mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    dir_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  fs::path write(const std::string& name, const std::string& text) const {
-    std::ofstream(dir_ / name, std::ios::binary) << text;
-    return dir_ / name;
-  }
-  const fs::path& path() const { return dir_; }
-
- private:
-  fs::path dir_;
-};
+using test::TempDir;
 
 /// Sets an environment variable for the lifetime of the object.
 class ScopedEnv {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/scene/scene.h"
+#include "tests/core/scene_support.h"
 
 namespace eikon {
 namespace {
@@ -25,23 +26,10 @@ const std::string kVolume =
     R"({"bounds_min": [-12, -12, -12], "bounds_max": [12, 12, 12], "resolution": 32})";
 const std::string kSphere = R"({"shape": "sphere", "radius": 3, "material": "glass"})";
 
-std::string errorOf(const std::string& text) {
-  try {
-    parseScene(text, kOrigin);
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "the scene parsed:\n" << text;
-  return {};
-}
+std::string errorOf(const std::string& text) { return test::sceneErrorOf(text, kOrigin); }
 
-#define EXPECT_LIMIT_ERROR(text, json_path, phrase)                                        \
-  do {                                                                                     \
-    const std::string m_ = errorOf(text);                                                  \
-    EXPECT_EQ(m_.rfind(std::string(kOrigin) + ": " + (json_path) + ": ", 0), 0u) << m_;    \
-    EXPECT_NE(m_.find(phrase), std::string::npos) << "lacks '" << (phrase) << "': " << m_; \
-    EXPECT_EQ(m_.find('\n'), std::string::npos) << m_;                                     \
-  } while (0)
+#define EXPECT_LIMIT_ERROR(text, json_path, phrase) \
+  EXPECT_TRUE(test::isOneLineSceneError(errorOf(text), kOrigin, json_path, phrase))
 
 // ±1e308 bounds: the extent overflows to inf and the GPU's float grid to NaN (trace printed NaN
 // with exit code 0). Every position is limited to ±1e12 mm.

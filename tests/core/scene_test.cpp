@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/scene/scene.h"
+#include "tests/core/scene_support.h"
 
 namespace eikon {
 namespace {
@@ -30,16 +31,7 @@ const std::string kSphere = R"({"shape": "sphere", "center": [0, 0, 0], "radius"
 
 /// Parses `text`, expects a SceneError, returns its message (empty + test failure otherwise).
 std::string errorOf(const std::string& text, const fs::path& origin = kOrigin) {
-  try {
-    parseScene(text, origin);
-  } catch (const SceneError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected eikon::SceneError, got another exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected a SceneError, the scene parsed:\n" << text;
-  return {};
+  return test::sceneErrorOf(text, origin);
 }
 
 // The message must read "FILE: /json/path: ..." and contain `phrase`.
@@ -52,26 +44,7 @@ std::string errorOf(const std::string& text, const fs::path& origin = kOrigin) {
     EXPECT_NE(msg_.find(phrase), std::string::npos) << "message lacks '" << (phrase) << "': " << msg_;       \
   } while (0)
 
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_scene_test_XXXXXX").string();
-    if (::mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    dir_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  fs::path write(const std::string& name, const std::string& text) const {
-    std::ofstream(dir_ / name) << text;
-    return dir_ / name;
-  }
-  const fs::path& path() const { return dir_; }
-
- private:
-  fs::path dir_;
-};
+using test::TempDir;
 
 // ------------------------------------------------------------------ syntax and unknown keys
 
