@@ -15,6 +15,7 @@ namespace eikon {
 
 /// Simulate every light of the scene with the CPU reference and fill volume.light_*. A scene
 /// without lights leaves the volume unlit. Throws std::invalid_argument for bad settings.
-LightingSummary simulateLightingReference(const Scene& scene, VolumeSet& volume, const LightingOptions& options);
+LightingSummary simulateLightingReference(const Scene& scene, VolumeSet& volume,
+                                          const LightingOptions& options);
 
 }  // namespace eikon
