@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "core/reference/reference_marcher.h"
+#include "core/light/seeding.h"
 #include "core/vk/resources.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/scan.spv.h"
@@ -21,10 +21,11 @@ namespace {
 
 /// Compute → compute memory dependency between two dispatches of one command buffer.
 void computeBarrier(VkCommandBuffer c) {
-  VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT,
+  VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr,
+                     VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT,
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT};
-  vkCmdPipelineBarrier(c, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0,
-                       nullptr, 0, nullptr);
+  vkCmdPipelineBarrier(c, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0, nullptr, 0, nullptr);
 }
 
 uint32_t blocksOf(size_t n) { return uint32_t((n + EIKON_SCAN_BLOCK - 1) / EIKON_SCAN_BLOCK); }
@@ -35,8 +36,8 @@ uint32_t blocksOf(size_t n) { return uint32_t((n + EIKON_SCAN_BLOCK - 1) / EIKON
 struct ScanKernel {
   vk::ComputePipeline pipe;
   explicit ScanKernel(vk::Context& ctx)
-      : pipe(ctx, std::span<const uint32_t>(k_scan_spv, sizeof(k_scan_spv) / 4), {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
-             sizeof(gpu::ScanPush), "scan") {}
+      : pipe(ctx, std::span<const uint32_t>(k_scan_spv, sizeof(k_scan_spv) / 4),
+             {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}, sizeof(gpu::ScanPush), "scan") {}
   /// Words a buffer needs to scan up to n values: the levels plus the total slot (the last word).
   static size_t words(size_t n) {
     size_t w = 1;
@@ -53,7 +54,8 @@ struct ScanKernel {
       uint32_t off, n;
     };
     std::vector<Level> lv{{0, n}};
-    while (blocksOf(lv.back().n) > 1) lv.push_back({lv.back().off + lv.back().n, blocksOf(lv.back().n)});
+    while (blocksOf(lv.back().n) > 1)
+      lv.push_back({lv.back().off + lv.back().n, blocksOf(lv.back().n)});
     for (size_t l = 0; l < lv.size(); ++l) {
       const uint32_t sums = l + 1 < lv.size() ? lv[l + 1].off : total_slot;
       gpu::ScanPush push{glm::uvec4(lv[l].off, lv[l].n, sums, 0u)};
@@ -85,12 +87,14 @@ uint32_t GpuScan::exclusiveScan(std::vector<uint32_t>& values) {
   Impl& m = *impl_;
   const size_t words = ScanKernel::words(values.size());
   if (m.buf.handle() == VK_NULL_HANDLE || m.buf.size() < words * sizeof(uint32_t)) {
-    m.buf = vk::Buffer(m.ctx, words * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "scan test");
+    m.buf = vk::Buffer(m.ctx, words * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                       "scan test");
     m.kernel.bind(m.buf);
   }
   m.buf.write(values.data(), values.size() * sizeof(uint32_t));
   const uint32_t slot = uint32_t(words - 1);
-  m.ctx.submitAndWait([&](VkCommandBuffer c) { m.kernel.record(c, uint32_t(values.size()), slot); });
+  m.ctx.submitAndWait(
+      [&](VkCommandBuffer c) { m.kernel.record(c, uint32_t(values.size()), slot); });
   m.buf.read(values.data(), values.size() * sizeof(uint32_t));
   uint32_t total = 0;
   m.buf.read(&total, sizeof total, slot * sizeof(uint32_t));
@@ -103,12 +107,14 @@ struct GpuWavefront::Impl {
   WavefrontSettings s;
   int steps_per_dispatch;
   VolumeField field;
-  std::vector<vk::Image3D> images;  // o: A, B, C (B, C only when dispersive), medium; e: the same, axis
-  bool eMode = false;               // settings.mode == 1 and the volume is uniaxial
+  std::vector<vk::Image3D>
+      images;          // o: A, B, C (B, C only when dispersive), medium; e: the same, axis
+  bool eMode = false;  // settings.mode == 1 and the volume is uniaxial
   vk::Buffer params, splat, patches[2], scan, tally;
   vk::ComputePipeline pipe, countPipe;  // wavefront.comp (propagate, scatter), wavefront_count.comp
   ScanKernel scanner;
-  size_t list_cap = 0;  // patches the scan and tally buffers hold
+  size_t list_cap = 0;                  // patches the scan and tally buffers hold
+  std::vector<gpu::WaveTally> tallies;  // the last pass's, read back
   double il2 = 0, il4 = 0, n_min = 1.0;
 
   Impl(vk::Context& c, const VolumeSet& v, WavefrontSettings settings, int k)
@@ -119,7 +125,8 @@ struct GpuWavefront::Impl {
     if (!(g.h > 0) || g.count() == 0) throw std::invalid_argument("wavefront: empty volume");
     if (s.dt <= 0) s.dt = 0.5 * g.h;
     if (!(s.wavelength_nm > 0)) throw std::invalid_argument("wavefront: wavelength must be > 0");
-    if (s.mode != 0 && s.mode != 1) throw std::invalid_argument("wavefront: mode must be 0 (o) or 1 (e)");
+    if (s.mode != 0 && s.mode != 1)
+      throw std::invalid_argument("wavefront: mode must be 0 (o) or 1 (e)");
     // The e-mode of an isotropic volume is the o-mode (no axis anywhere).
     eMode = s.mode == 1 && vol.uniaxial;
     const double l = s.wavelength_nm * 1e-3;
@@ -132,7 +139,8 @@ struct GpuWavefront::Impl {
     for (int md = 0; md <= (eMode ? 1 : 0); ++md)
       for (size_t i = 0; i < g.count(); ++i) {
         double n = vol.index[size_t(md)][0][i].x;
-        if (vol.dispersive) n += vol.index[size_t(md)][1][i].x * il2 + vol.index[size_t(md)][2][i].x * il4;
+        if (vol.dispersive)
+          n += vol.index[size_t(md)][1][i].x * il2 + vol.index[size_t(md)][2][i].x * il4;
         n_min = std::min(n_min, n);
       }
     if (!(n_min > 0)) throw std::invalid_argument("wavefront: the index volume has n <= 0");
@@ -163,20 +171,24 @@ struct GpuWavefront::Impl {
       upload(vol.emission, "wavefront skip");
     else
       upload(std::vector<glm::vec4>(g.count(), glm::vec4(0.0f)), "wavefront skip");
-    params = vk::Buffer(ctx, sizeof(gpu::WaveParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront params");
+    params = vk::Buffer(ctx, sizeof(gpu::WaveParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                        "wavefront params");
     splat = vk::Buffer(ctx, g.count() * (EIKON_SPLAT_ACC_WORDS + 1) * sizeof(uint32_t),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront splat");
     std::vector<vk::BindingSpec> b;
-    for (uint32_t i : {uint32_t(EIKON_WB_INDEX_A), uint32_t(EIKON_WB_INDEX_B), uint32_t(EIKON_WB_INDEX_C),
-                       uint32_t(EIKON_WB_MEDIUM), uint32_t(EIKON_WB_INDEX_E_A), uint32_t(EIKON_WB_INDEX_E_B),
-                       uint32_t(EIKON_WB_INDEX_E_C), uint32_t(EIKON_WB_MEDIUM_E), uint32_t(EIKON_WB_AXIS),
-                       uint32_t(EIKON_WB_SKIP)})
+    for (uint32_t i :
+         {uint32_t(EIKON_WB_INDEX_A), uint32_t(EIKON_WB_INDEX_B), uint32_t(EIKON_WB_INDEX_C),
+          uint32_t(EIKON_WB_MEDIUM), uint32_t(EIKON_WB_INDEX_E_A), uint32_t(EIKON_WB_INDEX_E_B),
+          uint32_t(EIKON_WB_INDEX_E_C), uint32_t(EIKON_WB_MEDIUM_E), uint32_t(EIKON_WB_AXIS),
+          uint32_t(EIKON_WB_SKIP)})
       b.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t i : {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_SPLAT),
-                       uint32_t(EIKON_WB_PATCHES_B), uint32_t(EIKON_WB_SCAN), uint32_t(EIKON_WB_TALLY)})
+    for (uint32_t i :
+         {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_SPLAT),
+          uint32_t(EIKON_WB_PATCHES_B), uint32_t(EIKON_WB_SCAN), uint32_t(EIKON_WB_TALLY)})
       b.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    pipe = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_wavefront_spv, sizeof(k_wavefront_spv) / 4), b,
-                               sizeof(gpu::WavePush), "wavefront");
+    pipe = vk::ComputePipeline(
+        ctx, std::span<const uint32_t>(k_wavefront_spv, sizeof(k_wavefront_spv) / 4), b,
+        sizeof(gpu::WavePush), "wavefront");
     const size_t med = vol.dispersive ? 3 : 1;
     pipe.bindImage(EIKON_WB_INDEX_A, images[0]);
     pipe.bindImage(EIKON_WB_INDEX_B, images[vol.dispersive ? 1 : 0]);
@@ -194,12 +206,13 @@ struct GpuWavefront::Impl {
     pipe.bindBuffer(EIKON_WB_PARAMS, params);
     pipe.bindBuffer(EIKON_WB_SPLAT, splat);
     std::vector<vk::BindingSpec> cb;
-    for (uint32_t i : {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_PATCHES_B),
-                       uint32_t(EIKON_WB_SCAN), uint32_t(EIKON_WB_TALLY)})
+    for (uint32_t i :
+         {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_PATCHES_B),
+          uint32_t(EIKON_WB_SCAN), uint32_t(EIKON_WB_TALLY)})
       cb.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
     countPipe = vk::ComputePipeline(
-        ctx, std::span<const uint32_t>(k_wavefront_count_spv, sizeof(k_wavefront_count_spv) / 4), cb,
-        sizeof(gpu::WavePush), "wavefront count");
+        ctx, std::span<const uint32_t>(k_wavefront_count_spv, sizeof(k_wavefront_count_spv) / 4),
+        cb, sizeof(gpu::WavePush), "wavefront count");
     countPipe.bindBuffer(EIKON_WB_PARAMS, params);
   }
 
@@ -212,8 +225,10 @@ struct GpuWavefront::Impl {
     // Grow geometrically, but never past the storage-buffer range when the request itself fits
     // (vk::Buffer refuses larger requests with a message: lavapipe allows 128 MiB ≈ 838k patches).
     const VkDeviceSize range = ctx.limits().max_storage_buffer_range;
-    const VkDeviceSize grown = std::max<VkDeviceSize>(bytes, std::min<VkDeviceSize>(2 * buf.size(), range));
-    buf = vk::Buffer(ctx, grown, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, which ? "wavefront patches B" : "wavefront patches A");
+    const VkDeviceSize grown =
+        std::max<VkDeviceSize>(bytes, std::min<VkDeviceSize>(2 * buf.size(), range));
+    buf = vk::Buffer(ctx, grown, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                     which ? "wavefront patches B" : "wavefront patches A");
     pipe.bindBuffer(which ? EIKON_WB_PATCHES_B : EIKON_WB_PATCHES, buf);
     countPipe.bindBuffer(which ? EIKON_WB_PATCHES_B : EIKON_WB_PATCHES, buf);
   }
@@ -223,8 +238,8 @@ struct GpuWavefront::Impl {
   // one storage buffer can hold.
   void ensureListCapacity(size_t n) {
     if (n <= list_cap) return;
-    scan = vk::Buffer(ctx, ScanKernel::words(n) * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                      "wavefront scan");
+    scan = vk::Buffer(ctx, ScanKernel::words(n) * sizeof(uint32_t),
+                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront scan");
     tally = vk::Buffer(ctx, ((n + EIKON_WAVE_WG - 1) / EIKON_WAVE_WG) * sizeof(gpu::WaveTally),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront tally");
     pipe.bindBuffer(EIKON_WB_SCAN, scan);
@@ -266,66 +281,126 @@ struct GpuWavefront::Impl {
     return t;
   }
 
-  WavefrontResult run(const Light& light) {
+  // Stages of run(): seed, scale and parameters, propagate (the dispatch loop), read back.
+
+  /// The seed patches (core/light/seeding.h, as the CPU twin's) in the kernel's layout; counts
+  /// them and their flux into st and returns the largest seed flux in max_seed.
+  std::vector<gpu::WavePatch> seedList(const Light& light, WavefrontStats& st,
+                                       double& max_seed) const {
     const Grid& g = vol.grid;
-    WavefrontResult res;
-    WavefrontStats& st = res.stats;
-    WavefrontSimulator cpu(field, g, s);
-    std::vector<Patch> seeds = cpu.seed(light);
+    std::vector<Patch> seeds = seedWavefront(field, g, s, light);
     st.seeded = seeds.size();
     const glm::dvec3 lo = g.origin, hi = g.boundsMax();
-    double maxSeed = 0;
+    max_seed = 0;
     std::vector<gpu::WavePatch> cur;
     cur.reserve(seeds.size());
     for (Patch& p : seeds) {
       st.flux_emitted += p.energy;
-      maxSeed = std::max(maxSeed, p.energy);
+      max_seed = std::max(max_seed, p.energy);
       const glm::dvec3 c = 0.25 * (p.x[0] + p.x[1] + p.x[2] + p.x[3]);
-      p.entered = c.x >= lo.x && c.y >= lo.y && c.z >= lo.z && c.x <= hi.x && c.y <= hi.y && c.z <= hi.z;
+      p.entered =
+          c.x >= lo.x && c.y >= lo.y && c.z >= lo.z && c.x <= hi.x && c.y <= hi.y && c.z <= hi.z;
       cur.push_back(toGpu(p));
     }
     st.max_live = cur.size();
+    return cur;
+  }
 
-    // Fixed-point scale: one splat is flux_mid·Δs/h³ ≤ maxSeed·(dt/n_min)/h³ =: vmax (a patch's flux
-    // never grows; the centre moves at most dt/n_min per step). With scale = 2^29/(2·vmax) a splat
-    // is ≤ 2^28 units, far inside int32 (the factor 2 covers RK4's overshoot in steep gradients),
-    // and its rounding error is ≤ 0.5/scale = 2^-29·vmax. A 64-bit voxel sum overflows only after
-    // 2^35 maximal splats into one voxel, i.e. never for runs of ≤ 2^20 patches × 2^14 steps.
-    // With straight steps a splat is one voxel's piece of a straight path, at most the voxel
-    // diagonal √3·h long, so that bounds Δs too.
+  /// Fixed-point scale: one splat is flux_mid·Δs/h³ ≤ maxSeed·(dt/n_min)/h³ =: vmax (a patch's flux
+  /// never grows; the centre moves at most dt/n_min per step). With scale = 2^29/(2·vmax) a splat
+  /// is ≤ 2^28 units, far inside int32 (the factor 2 covers RK4's overshoot in steep gradients),
+  /// and its rounding error is ≤ 0.5/scale = 2^-29·vmax. A 64-bit voxel sum overflows only after
+  /// 2^35 maximal splats into one voxel, i.e. never for runs of ≤ 2^20 patches × 2^14 steps.
+  /// With straight steps a splat is one voxel's piece of a straight path, at most the voxel
+  /// diagonal √3·h long, so that bounds Δs too.
+  double splatScale(double max_seed) const {
+    const Grid& g = vol.grid;
     const double h3 = g.h * g.h * g.h;
     const double dsMax = s.skip_empty ? std::max(s.dt / n_min, std::sqrt(3.0) * g.h) : s.dt / n_min;
-    const double vmax = std::max(maxSeed, 1e-300) * dsMax / h3;
-    const double scale = std::ldexp(1.0, 29) / (2.0 * vmax);
+    const double vmax = std::max(max_seed, 1e-300) * dsMax / h3;
+    return std::ldexp(1.0, 29) / (2.0 * vmax);
+  }
 
+  /// Upload the run's parameters (gpu::WaveParams) and zero the splat buffer.
+  void writeParams(double scale) {
+    const Grid& g = vol.grid;
+    const double h3 = g.h * g.h * g.h;
     gpu::WaveParams P{};
-    P.grid_origin = glm::vec4(glm::vec3(lo), float(g.h));
-    P.grid_max = glm::vec4(glm::vec3(hi), float(1.0 / g.h));
+    P.grid_origin = glm::vec4(glm::vec3(g.origin), float(g.h));
+    P.grid_max = glm::vec4(glm::vec3(g.boundsMax()), float(1.0 / g.h));
     int flags = 0;
     if (vol.dispersive) flags |= EIKON_F_DISPERSIVE;
     if (vol.attenuating) flags |= EIKON_F_ATTENUATION;
     if (vol.opaque) flags |= EIKON_F_OPACITY;
     P.grid_dims = glm::ivec4(g.dims[0], g.dims[1], g.dims[2], flags);
-    P.step = glm::vec4(float(s.dt), float(s.split_span_voxels * g.h), float(s.min_energy_fraction), float(1.0 / h3));
+    P.step = glm::vec4(float(s.dt), float(s.split_span_voxels * g.h), float(s.min_energy_fraction),
+                       float(1.0 / h3));
     const double l = s.wavelength_nm * 1e-3;
     P.wavelength = glm::vec4(float(l), float(il2), float(il4), float(scale));
-    P.control = glm::ivec4(s.probe_axis >= 0 && s.probe_axis < 3 ? s.probe_axis : -1, steps_per_dispatch,
-                           s.max_steps, eMode ? 1 : 0);
+    P.control = glm::ivec4(s.probe_axis >= 0 && s.probe_axis < 3 ? s.probe_axis : -1,
+                           steps_per_dispatch, s.max_steps, eMode ? 1 : 0);
     P.probe = glm::vec4(float(s.probe_position), 0.0f, 0.0f, 0.0f);
     P.options = glm::ivec4(s.skip_empty ? 1 : 0, s.pass_caustics ? 1 : 0, 0, 0);
     params.write(&P, sizeof P);
-    std::vector<uint32_t> zero(g.count() * (EIKON_SPLAT_ACC_WORDS + 1), 0u);
+    std::vector<uint32_t> zero(splatWords(), 0u);
     splat.write(zero.data(), zero.size() * sizeof(uint32_t));
+  }
+  size_t splatWords() const { return vol.grid.count() * (EIKON_SPLAT_ACC_WORDS + 1); }
 
-    // The list lives on the GPU. Per pass, one submission: scatter of the previous pass's list
-    // (survivors and children, into the other buffer), propagation, count, scan; the host reads
-    // back the scan total and one WaveTally per 64 patches. Only when the total exceeds
-    // max_patches is there a second submission (rank the split requests, grant the first ones).
+  /// Add the kill tallies of the pass over n patches to st; the pass's split requests and
+  /// survivors go to want_split and survivors.
+  void addTallies(uint32_t n, WavefrontStats& st, size_t& survivors, size_t& want_split) {
+    tallies.resize(groups(n));
+    tally.read(tallies.data(), tallies.size() * sizeof(gpu::WaveTally));
+    survivors = 0, want_split = 0;
+    for (const gpu::WaveTally& t : tallies) {
+      st.flux_left += t.flux_a.x, st.flux_caustic += t.flux_a.y, st.flux_energy += t.flux_a.z;
+      st.flux_absorbed += double(t.flux_a.w) + double(t.flux_b.x);
+      st.flux_live_at_end += t.flux_b.y;
+      st.caustic_centroid += glm::dvec3(glm::vec3(t.caustic_sum));
+      st.kills_left += t.count_a.x, st.kills_caustic += t.count_a.y, st.kills_energy += t.count_a.z;
+      st.kills_opaque += t.count_a.w;
+      st.live_at_end += t.count_b.x;
+      want_split += t.count_b.y;
+      survivors += t.count_b.z;
+      st.steps = std::max(st.steps, int(t.count_b.w));
+      st.probe_centroid += glm::dvec3(glm::vec3(t.probe_pos));
+      st.flux_probe += t.probe_pos.w;
+      st.probe_direction += glm::dvec3(glm::vec3(t.probe_dir));
+    }
+  }
+
+  /// The next list's length when the pass over list `src` (n patches) asks for more than the
+  /// budget. The reference refuses a split when live + 3 > max_patches, in list order. Here: grant
+  /// the first `granted` requests of the list (rank by a scan of 0/1 flags), counting the survivors
+  /// of this pass as live.
+  uint32_t grantSplits(uint32_t n, int src, size_t survivors, size_t want_split,
+                       WavefrontStats& st) {
+    const size_t budget = size_t(s.max_patches);
+    const size_t granted = survivors >= budget ? 0 : std::min(want_split, (budget - survivors) / 3);
+    ctx.submitAndWait([&](VkCommandBuffer c) {
+      pass(c, EIKON_WM_COUNT_SPLITS, n, src);
+      scanner.record(c, n, totalSlot());
+      pass(c, EIKON_WM_COUNT_BUDGET, n, src, uint32_t(granted));
+      scanner.record(c, n, totalSlot());
+    });
+    st.splits += granted;
+    st.splits_refused += want_split - granted;
+    return readTotal();
+  }
+
+  /// The list lives on the GPU. Per pass, one submission: scatter of the previous pass's list
+  /// (survivors and children, into the other buffer), propagation, count, scan; the host reads
+  /// back the scan total and one WaveTally per 64 patches. Only when the total exceeds
+  /// max_patches is there a second submission (rank the split requests, grant the first ones).
+  void propagate(const std::vector<gpu::WavePatch>& cur, WavefrontStats& st) {
+    const Grid& g = vol.grid;
     const size_t budget = size_t(s.max_patches);
     uint32_t n = uint32_t(cur.size());
     int src = 0;
     if (n > 0) {
-      // A list longer than the storage-buffer range allows cannot exist (ensurePatchCapacity throws).
+      // A list longer than the storage-buffer range allows cannot exist (ensurePatchCapacity
+      // throws).
       const size_t fits = size_t(ctx.limits().max_storage_buffer_range / sizeof(gpu::WavePatch));
       ensureListCapacity(std::max(cur.size(), std::min(budget, fits)));
       ensurePatchCapacity(0, n);
@@ -333,42 +408,13 @@ struct GpuWavefront::Impl {
       patches[0].write(cur.data(), cur.size() * sizeof(gpu::WavePatch));
       ctx.submitAndWait([&](VkCommandBuffer c) { recordStep(c, n, src); });
     }
-    std::vector<gpu::WaveTally> tallies;
     long long dispatches = 0;
     while (n > 0) {
-      tallies.resize(groups(n));
-      tally.read(tallies.data(), tallies.size() * sizeof(gpu::WaveTally));
       size_t survivors = 0, wantSplit = 0;
-      for (const gpu::WaveTally& t : tallies) {
-        st.flux_left += t.flux_a.x, st.flux_caustic += t.flux_a.y, st.flux_energy += t.flux_a.z;
-        st.flux_absorbed += double(t.flux_a.w) + double(t.flux_b.x);
-        st.flux_live_at_end += t.flux_b.y;
-        st.caustic_centroid += glm::dvec3(glm::vec3(t.caustic_sum));
-        st.kills_left += t.count_a.x, st.kills_caustic += t.count_a.y, st.kills_energy += t.count_a.z;
-        st.kills_opaque += t.count_a.w;
-        st.live_at_end += t.count_b.x;
-        wantSplit += t.count_b.y;
-        survivors += t.count_b.z;
-        st.steps = std::max(st.steps, int(t.count_b.w));
-        st.probe_centroid += glm::dvec3(glm::vec3(t.probe_pos));
-        st.flux_probe += t.probe_pos.w;
-        st.probe_direction += glm::dvec3(glm::vec3(t.probe_dir));
-      }
+      addTallies(n, st, survivors, wantSplit);
       uint32_t total = readTotal();
       if (total > budget) {
-        // The reference refuses a split when live + 3 > max_patches, in list order. Here: grant
-        // the first `granted` requests of the list (rank by a scan of 0/1 flags), counting the
-        // survivors of this pass as live.
-        const size_t granted = survivors >= budget ? 0 : std::min(wantSplit, (budget - survivors) / 3);
-        ctx.submitAndWait([&](VkCommandBuffer c) {
-          pass(c, EIKON_WM_COUNT_SPLITS, n, src);
-          scanner.record(c, n, totalSlot());
-          pass(c, EIKON_WM_COUNT_BUDGET, n, src, uint32_t(granted));
-          scanner.record(c, n, totalSlot());
-        });
-        total = readTotal();
-        st.splits += granted;
-        st.splits_refused += wantSplit - granted;
+        total = grantSplits(n, src, survivors, wantSplit, st);
       } else {
         st.splits += wantSplit;
       }
@@ -388,14 +434,12 @@ struct GpuWavefront::Impl {
       n = total;
       src = dst;
     }
-    if (s.progress) s.progress(1.0);  // every patch has ended (or reached max_steps)
-    if (st.flux_caustic > 0) st.caustic_centroid /= st.flux_caustic;
-    if (st.flux_probe != 0) {
-      st.probe_centroid /= st.flux_probe;
-      st.probe_direction /= st.flux_probe;
-    }
+  }
 
-    std::vector<uint32_t> words(zero.size());
+  /// The splat buffer as the result's volumes: fixed point (scale) to W/mm², mean direction.
+  void readSplat(double scale, WavefrontResult& res) const {
+    const Grid& g = vol.grid;
+    std::vector<uint32_t> words(splatWords());
     splat.read(words.data(), words.size() * sizeof(uint32_t));
     res.irradiance.resize(g.count());
     res.direction.resize(g.count());
@@ -415,11 +459,29 @@ struct GpuWavefront::Impl {
       res.irradiance[v] = highest ? best : float(acc);
       res.direction[v] = glm::vec4(glm::vec3(acc > 0 ? d / acc : glm::dvec3(0.0)), float(acc));
     }
+  }
+
+  WavefrontResult run(const Light& light) {
+    WavefrontResult res;
+    WavefrontStats& st = res.stats;
+    double maxSeed = 0;
+    const std::vector<gpu::WavePatch> cur = seedList(light, st, maxSeed);
+    const double scale = splatScale(maxSeed);
+    writeParams(scale);
+    propagate(cur, st);
+    if (s.progress) s.progress(1.0);  // every patch has ended (or reached max_steps)
+    if (st.flux_caustic > 0) st.caustic_centroid /= st.flux_caustic;
+    if (st.flux_probe != 0) {
+      st.probe_centroid /= st.flux_probe;
+      st.probe_direction /= st.flux_probe;
+    }
+    readSplat(scale, res);
     return res;
   }
 };
 
-GpuWavefront::GpuWavefront(vk::Context& ctx, const VolumeSet& volume, WavefrontSettings settings, int steps_per_dispatch)
+GpuWavefront::GpuWavefront(vk::Context& ctx, const VolumeSet& volume, WavefrontSettings settings,
+                           int steps_per_dispatch)
     : impl_(std::make_unique<Impl>(ctx, volume, settings, steps_per_dispatch)) {}
 GpuWavefront::~GpuWavefront() = default;
 WavefrontResult GpuWavefront::run(const Light& light) { return impl_->run(light); }

@@ -1,8 +1,9 @@
 // The GPU light simulator (issue 6, docs/design.md §2): the wavefront of patches of
-// core/reference/wavefront.h propagated by a Vulkan compute kernel (shaders/wavefront.comp), one
+// core/light/wavefront_types.h propagated by a Vulkan compute kernel (shaders/wavefront.comp), one
 // thread per patch, RK4 in constant time on the four corners, attenuation, fixed-point atomic
 // splat into the irradiance/direction volumes. Same settings, seeds, kill rules, split rule and
-// result types as the CPU reference, which it is tested against (tests/core/wavefront_gpu_test.cpp).
+// result types as the CPU reference, which it is tested against
+// (tests/core/wavefront_gpu_test.cpp).
 //
 //   eikon::VolumeSet vol = eikon::voxelize(scene);
 //   eikon::GpuWavefront gpu(ctx, vol, settings);
@@ -30,7 +31,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/reference/wavefront.h"
+#include "core/light/wavefront_types.h"
 #include "core/vk/context.h"
 #include "core/volume/volume_set.h"
 
@@ -59,7 +60,8 @@ class GpuWavefront {
   /// volume is the o-mode); it is referenced for seeding and
   /// splitting and must outlive this object. Throws std::invalid_argument for bad settings,
   /// std::runtime_error if the splat buffer exceeds the device's storage-buffer range.
-  GpuWavefront(vk::Context& ctx, const VolumeSet& volume, WavefrontSettings settings, int steps_per_dispatch = 16);
+  GpuWavefront(vk::Context& ctx, const VolumeSet& volume, WavefrontSettings settings,
+               int steps_per_dispatch = 16);
   ~GpuWavefront();
   GpuWavefront(const GpuWavefront&) = delete;
   GpuWavefront& operator=(const GpuWavefront&) = delete;

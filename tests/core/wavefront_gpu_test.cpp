@@ -78,8 +78,8 @@ TEST(WavefrontGpu, HomogeneousBeamMatchesReference) {
 }
 
 // 2. Glass sphere: refraction, a caustic behind the sphere, splits, whispering-gallery patches
-// killed by the energy threshold. Seeds are identical (the GPU uses WavefrontSimulator::seed), so
-// the emitted flux matches to the double sum's round-off. Conservation on the GPU: splits quarter
+// killed by the energy threshold. Seeds are identical (both twins seed with
+// core/light/seeding.h), so the emitted flux matches to the double sum's round-off. Conservation on the GPU: splits quarter
 // float flux exactly and nothing absorbs, so ended = emitted up to the float32 rounding of each
 // seed's flux (≤ 6e-8 relative); we allow 1e-6. The statistics are not bit-identical: a patch
 // whose edge or orientation test is borderline in double may go the other way in float32 and

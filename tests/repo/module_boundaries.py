@@ -1,12 +1,17 @@
 #!/usr/bin/python3
 """Module boundaries of the physics: optics/ (what a scene needs) never depends on fitting/ (the
-`eikon fit` tool), and nothing that touches a scene pulls in Ceres or yaml-cpp.
+`eikon fit` tool), nothing that touches a scene pulls in Ceres or yaml-cpp, and the two twins,
+core/render (GPU) and core/reference (the CPU oracle), are siblings on core/light: neither
+includes nor links the other, and core/light stands on neither.
 
 Checked from the sources, so that a static-library chain cannot hide a dependency:
   - no file under optics/ or core/ includes a fitting/ header, or a Ceres, glog, Eigen or
     yaml-cpp header;
   - no CMakeLists.txt outside fitting/ links Ceres::ceres or yaml-cpp, and none under optics/ or
-    core/ links eikon::fitting / eikon_fitting.
+    core/ links eikon::fitting / eikon_fitting;
+  - no file under core/render/ includes a core/reference/ header or the other way round, and no
+    file under core/light/ includes either; no CMakeLists.txt there links the forbidden twin
+    (eikon::render / eikon_render, eikon::reference / eikon_reference).
 Each violation is printed as FILE:LINE: what.
 usage: module_boundaries.py SOURCE_DIR   — prints "module_boundaries: N passed, M failed".
        module_boundaries.py --self-test  — runs the checks on a made-up tree with known defects.
@@ -24,6 +29,32 @@ CERES_OR_YAML = re.compile(r"\bCeres::\w+|\byaml-cpp\b")
 FITTING_TARGET = re.compile(r"\beikon(::|_)fitting\b")
 # Scene-side folders: what they include and link must stay free of the fitting tool.
 SCENE_SIDE = ("optics/", "core/")
+# The twins and the light module they share: folder -> the folders it must not include or link.
+TWIN_RULES = {
+    "core/render/": ("core/reference/",),
+    "core/reference/": ("core/render/",),
+    "core/light/": ("core/render/", "core/reference/"),
+}
+TWIN_TARGET = {"core/render/": re.compile(r"\beikon(::|_)render\b"),
+               "core/reference/": re.compile(r"\beikon(::|_)reference\b")}
+
+
+def twin_hits(rel, no, line, is_source, is_cmake):
+    """Crossings between the twins on one line of a file under core/render, core/reference or
+    core/light."""
+    hits = []
+    for folder, forbidden in TWIN_RULES.items():
+        if not rel.startswith(folder):
+            continue
+        m = INCLUDE.match(line) if is_source else None
+        for other in forbidden:
+            if m and m.group(1).startswith(other):
+                hits.append(f"{rel}:{no}: includes <{m.group(1)}> ({folder} must not use {other}; "
+                            "shared light code belongs in core/light/)")
+            if is_cmake and TWIN_TARGET[other].search(line.split("#", 1)[0]):
+                hits.append(f"{rel}:{no}: links the {other} library ({folder} must not; the twins "
+                            "are siblings on core/light/)")
+    return hits
 
 
 def files(root):
@@ -54,6 +85,7 @@ def check(root):
         with open(path, encoding="utf-8", errors="replace") as f:
             lines = f.read().split("\n")
         for no, line in enumerate(lines, 1):
+            hits += twin_hits(rel, no, line, is_source, is_cmake)
             if scene_side and is_source:
                 m = INCLUDE.match(line)
                 if m and m.group(1).startswith(FOREIGN_HEADERS):
@@ -77,13 +109,33 @@ def self_test():
         "core/scene/c.cpp": "  #  include <yaml-cpp/yaml.h>\n",
         "core/scene/CMakeLists.txt": "target_link_libraries(s PUBLIC eikon::fitting)\n",
         "apps/CMakeLists.txt": "target_link_libraries(e PRIVATE yaml-cpp)\n",
+        # The twins crossing (the defect issue 12 removed), and the light module leaning on one.
+        "core/render/light_simulator.cpp":
+            '#include "core/light/seeding.h"\n#include "core/reference/wavefront.h"\n',
+        "core/reference/wavefront.h": '#include "core/render/light_simulator.h"\n',
+        "core/render/CMakeLists.txt":
+            "target_link_libraries(r PUBLIC eikon::light\n  eikon_reference)\n",
+        "core/reference/CMakeLists.txt": "target_link_libraries(c PUBLIC eikon::render)\n",
+        "core/light/seeding.cpp": '#include "core/reference/reference_marcher.h"\n',
     }
+    # Each defect must be reported at its FILE:LINE.
+    bad_at = ["core/render/light_simulator.cpp:2:", "core/reference/wavefront.h:1:",
+              "core/render/CMakeLists.txt:2:", "core/reference/CMakeLists.txt:1:",
+              "core/light/seeding.cpp:1:"]
     good = {
         "optics/a.h": '#include "optics/uniaxial.h"\n#include <glm/glm.hpp>\n',
         "core/scene/c.cpp": '#include "optics/dispersion.h"\n// fitting/ is not included here\n',
         "fitting/CMakeLists.txt": "target_link_libraries(f PRIVATE Ceres::ceres yaml-cpp)\n",
         "CMakeLists.txt": "find_package(Ceres 2.1 REQUIRED)\nfind_package(yaml-cpp 0.7 REQUIRED)\n",
         "apps/fit.cpp": '#include "fitting/fitting.h"\n',
+        "core/render/light_simulator.cpp":
+            '#include "core/light/seeding.h"\n// core/reference/wavefront.h: the CPU twin\n',
+        "core/render/CMakeLists.txt":
+            "target_link_libraries(r PUBLIC eikon::light)  # not eikon::reference\n",
+        "core/reference/wavefront.cpp":
+            '#include "core/light/seeding.h"\n#include "core/reference/wavefront.h"\n',
+        "apps/render.cpp":
+            '#include "core/render/light_transport.h"\n#include "core/reference/wavefront.h"\n',
     }
     ok = True
     for tree, expected in ((bad, len(bad)), (good, 0)):
@@ -97,6 +149,11 @@ def self_test():
             if len(hits) != expected:
                 ok = False
                 print(f"self-test: expected {expected} violations, found {len(hits)}: {hits}")
+            if tree is bad:
+                for at in bad_at:
+                    if not any(h.startswith(at) for h in hits):
+                        ok = False
+                        print(f"self-test: no violation reported at {at}: {hits}")
     print(f"module_boundaries self-test: {int(ok)} passed, {int(not ok)} failed")
     return 0 if ok else 1
 
