@@ -405,6 +405,25 @@ TEST(Boundary, VoxelizeBuildsTheFieldOnlyForSharpInterfaces) {
       6.0 * 16 * 16 * 16);
 }
 
+// Region ids are 16-bit: a scene of more objects is refused in one line naming /objects, before
+// anything is allocated; 65535 objects are accepted.
+TEST(Boundary, MoreObjectsThanRegionIdsIsOneLineError) {
+  // Outside the grid: nothing to paint, only the count matters.
+  const Shape dot("sphere", SphereShape{0.01}, glm::dvec3(50.0), glm::dvec3(0.0));
+  Scene s = sceneOf(std::vector<std::pair<Shape, std::string>>(65535, {dot, "glass"}), 8);
+  EXPECT_EQ(fieldOf(s).shapes.size(), 65535u);
+  s.objects.push_back(s.objects.back());
+  try {
+    fieldOf(s);
+    ADD_FAILURE() << "65536 objects accepted";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(
+        std::string(e.what()),
+        "boundary.json: /objects: sharp interfaces allow at most 65535 objects, got 65536 (or set "
+        "\"interfaces\": \"smoothed\")");
+  }
+}
+
 // ------------------------------------------------------------------ error budget (measurement)
 
 // The table of docs/view-renderer.md ("Sharp boundaries: representation and error budget"), not
