@@ -670,7 +670,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   Scene scene;
   scene.file = origin;
   Node root(j, "", file);
-  root.allowKeys({"camera", "environment", "volume", "materials", "objects", "lights", "ambient_index", "description"});
+  root.allowKeys({"camera", "environment", "volume", "materials", "objects", "lights", "ambient_index", "description", "interfaces"});
 
   if (auto c = root.get("camera")) {
     c->allowKeys({"position", "look_at", "up", "fov_deg", "width", "height"});
@@ -756,6 +756,13 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     }
   }
   if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
+  if (auto f = root.get("interfaces")) {
+    const std::string m = f->string();
+    if (m == "sharp" || m == "smoothed")
+      scene.interfaces = m == "sharp" ? Scene::Interfaces::Sharp : Scene::Interfaces::Smoothed;
+    else
+      f->fail("unknown interfaces '" + excerpt(m) + "' (sharp, smoothed)");
+  }
 
   if (auto ms = root.get("materials")) {
     ms->requireObject();

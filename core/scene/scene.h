@@ -137,6 +137,10 @@ struct Scene {
   std::vector<SceneObject> objects;
   std::vector<Light> lights;
   double ambient_index = 1.0;  ///< index of the medium around the objects (air)
+  /// "interfaces": how boundaries between media are marched. Sharp (default): located on the
+  /// boundary field (core/volume/boundary.h) and crossed with exact Snell/Fresnel; Smoothed: the
+  /// smoothed layer is integrated (the fields are built either way).
+  enum class Interfaces { Sharp, Smoothed } interfaces = Interfaces::Sharp;
   /// Messages for the user that are not errors (e.g. a wavelength outside a material's range).
   std::vector<std::string> warnings;
 

@@ -1,8 +1,11 @@
 // VolumeSet: the scene voxelised into the fields both twins (GPU and CPU reference) march through.
 //
-// Pipeline (docs/design.md §1): for each object, anti-aliased coverage (4³ supersampling in voxels the
-// surface crosses) → composite material properties in object order → separable Gaussian
-// pre-smoothing with σ = smoothing_voxels → central-difference gradients. Dispersion is carried
+// Pipeline (docs/design.md §1; one function per stage in volume_set.cpp): for each object, its
+// coverage (analytic: the triweight-smoothed indicator with exact gradients; gaussian: 4³
+// supersampling in voxels the surface crosses) → composite material properties in object order →
+// (gaussian: separable Gaussian pre-smoothing with σ = smoothing_voxels → central-difference
+// gradients) → packed volumes → optic-axis dilation → skip distances → the sharp-boundary field
+// (core/volume/boundary.h; "interfaces": "sharp" scenes). Dispersion is carried
 // by Cauchy coefficient fields, n(λ, x) = A(x) + B(x)/λ² + C(x)/λ⁴ (λ in µm), so one set of
 // volumes serves every wavelength: ∇n(λ) = ∇A + ∇B/λ² + ∇C/λ⁴.
 //
@@ -16,7 +19,8 @@
 //   emission      : (e_r, e_g, e_b, skip) emission and the empty-space skip distance in voxels
 //   axis          : (a_x, a_y, a_z, 0) uniform optic axis, or (c_x, c_y, c_z, −1) for a radial axis
 //                   field about c (uniaxial scenes only; zero where isotropic)
-//   scatter       : (albedo_r, albedo_g, albedo_b, g) single-scattering albedo and Henyey–Greenstein
+//   scatter       : (albedo_r, albedo_g, albedo_b, g) single-scattering albedo and
+//   Henyey–Greenstein
 //                   g of translucent media, or the diffuse reflectance of opaque ones (only when
 //                   some material has an albedo)
 //   light_fluence : (φ_r, φ_g, φ_b, φ_Y) simulated fluence rate (W/mm², linear sRGB and luminance)
@@ -28,27 +32,17 @@
 // so a ray may cross that distance in one straight step (docs/design.md's "distance volume").
 #pragma once
 
-#include <glm/glm.hpp>
-
 #include <array>
 #include <functional>
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
 
 #include "core/scene/scene.h"
+#include "core/volume/boundary.h"
+#include "core/volume/grid.h"
 
 namespace eikon {
-
-struct Grid {
-  std::array<int, 3> dims{};  ///< voxels per axis
-  glm::dvec3 origin{0.0};     ///< bounds_min (mm)
-  glm::dvec3 extent{0.0};     ///< dims · h (mm); may exceed the requested bounds by < 1 voxel
-  double h = 1.0;             ///< voxel edge (mm)
-  size_t count() const { return size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]); }
-  size_t index(int i, int j, int k) const { return (size_t(k) * size_t(dims[1]) + size_t(j)) * size_t(dims[0]) + size_t(i); }
-  glm::dvec3 center(int i, int j, int k) const { return origin + (glm::dvec3(i, j, k) + 0.5) * h; }
-  glm::dvec3 boundsMax() const { return origin + extent; }
-};
 
 struct VolumeSet {
   Grid grid;
@@ -57,16 +51,21 @@ struct VolumeSet {
   bool attenuating = false;  ///< some attenuation is non-zero
   bool emissive = false;     ///< some emission is non-zero
   bool opaque = false;       ///< some opacity is non-zero
-  bool scattering = false;   ///< some material has an albedo (translucent in-scatter or a diffuse surface)
+  bool scattering =
+      false;  ///< some material has an albedo (translucent in-scatter or a diffuse surface)
   double ambient_index = 1.0;
-  std::array<std::array<std::vector<glm::vec4>, 3>, 2> index;  ///< [mode][A,B,C]; e empty if !uniaxial
-  std::array<std::vector<glm::vec4>, 2> medium;                ///< [mode]; e empty if !uniaxial
+  std::array<std::array<std::vector<glm::vec4>, 3>, 2>
+      index;                                     ///< [mode][A,B,C]; e empty if !uniaxial
+  std::array<std::vector<glm::vec4>, 2> medium;  ///< [mode]; e empty if !uniaxial
   std::vector<glm::vec4> emission;
-  std::vector<glm::vec4> axis;  ///< empty unless uniaxial
+  std::vector<glm::vec4> axis;           ///< empty unless uniaxial
   std::vector<glm::vec4> scatter;        ///< empty unless scattering
   std::vector<glm::vec4> light_fluence;  ///< empty until a light simulation (lighting.h) fills it
   std::vector<glm::vec4> light_flux;     ///< same
-  int skip_cap = 32;            ///< largest stored skip distance (voxels)
+  int skip_cap = 32;                     ///< largest stored skip distance (voxels)
+  /// Where the media meet, to sub-voxel accuracy (core/volume/boundary.h); empty when the scene
+  /// asks for "interfaces": "smoothed". Host only for now (not counted in deviceBytes).
+  BoundaryField boundary;
 
   bool lit() const { return !light_fluence.empty(); }
 
@@ -84,7 +83,7 @@ struct VoxelizeOptions {
 Grid makeGrid(const VolumeSpec& spec);
 
 /// Bytes of host memory voxelize() holds at its peak for this scene and grid: the composited
-/// fields, the exact gradients, the output volumes and the skip distances.
+/// fields, the exact gradients, the output volumes, the skip distances and the boundary field.
 double voxelizeHostBytes(const Scene& scene, const Grid& grid);
 
 /// Voxelise a scene. Throws SceneError for inconsistent input (e.g. more than 2^31 voxels) and,
@@ -93,6 +92,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& options = {});
 
 /// Smooth a scalar field in place with a separable Gaussian of σ voxels (truncated at 3σ,
 /// renormalised, clamp-to-edge). Exposed for tests.
-void gaussianSmooth(std::vector<float>& field, const std::array<int, 3>& dims, double sigma, int threads = 0);
+void gaussianSmooth(std::vector<float>& field, const std::array<int, 3>& dims, double sigma,
+                    int threads = 0);
 
 }  // namespace eikon

@@ -1,0 +1,293 @@
+#include "core/volume/boundary.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <string>
+
+#include "core/scene/scene.h"
+
+namespace eikon {
+namespace {
+
+constexpr size_t kMaxRegions = 65535;  // region ids are 16-bit; 0 is the ambient
+
+// The trilinear cell around a point given in voxel coordinates u (voxel centres at integers):
+// its 8 corners (bit 0: +x, bit 1: +y, bit 2: +z) and, per axis, the lower corner and the
+// fraction. Beyond the outermost centres the fraction is clamped (clamp to edge), so the field is
+// constant along that axis there.
+struct Cell {
+  std::array<size_t, 8> idx{};
+  glm::ivec3 lo{0};
+  glm::dvec3 f{0.0};
+  glm::bvec3 clamped{false};
+};
+
+Cell cellAt(const Grid& g, const glm::dvec3& u) {
+  Cell c;
+  glm::ivec3 hi(0);
+  for (int a = 0; a < 3; ++a) {
+    const int n = g.dims[size_t(a)];
+    if (n == 1 || u[a] <= 0.0) {
+      c.lo[a] = 0;
+      c.f[a] = 0.0;
+      c.clamped[a] = true;
+    } else if (u[a] >= n - 1) {
+      c.lo[a] = n - 2;
+      c.f[a] = 1.0;
+      c.clamped[a] = true;
+    } else {
+      c.lo[a] = std::min(int(std::floor(u[a])), n - 2);
+      c.f[a] = u[a] - c.lo[a];
+    }
+    hi[a] = std::min(c.lo[a] + 1, n - 1);
+  }
+  for (int k = 0; k < 8; ++k)
+    c.idx[size_t(k)] = g.index(k & 1 ? hi.x : c.lo.x, k & 2 ? hi.y : c.lo.y, k & 4 ? hi.z : c.lo.z);
+  return c;
+}
+
+// φ_r at the cell's point (voxels) and its gradient in voxel coordinates (= ∂φ_mm/∂x_mm).
+double cellPhi(const BoundaryField& bf, const Cell& c, int r, glm::dvec3* grad) {
+  double phi = 0.0;
+  glm::dvec3 gr(0.0);
+  for (int k = 0; k < 8; ++k) {
+    const size_t i = c.idx[size_t(k)];
+    const double v = bf.region[i] == r ? double(bf.distance[i]) : -double(bf.distance[i]);
+    glm::dvec3 w, dw;
+    for (int a = 0; a < 3; ++a) {
+      const bool up = (k >> a) & 1;
+      w[a] = up ? c.f[a] : 1.0 - c.f[a];
+      dw[a] = c.clamped[a] ? 0.0 : (up ? 1.0 : -1.0);
+    }
+    phi += v * w.x * w.y * w.z;
+    gr += v * glm::dvec3(dw.x * w.y * w.z, w.x * dw.y * w.z, w.x * w.y * dw.z);
+  }
+  if (grad) *grad = gr;
+  return phi;
+}
+
+glm::dvec3 toVoxel(const Grid& g, const glm::dvec3& x) { return (x - g.origin) / g.h - 0.5; }
+
+// The regions of a cell's corners, `exclude` left out, each once.
+std::vector<int> cellRegions(const BoundaryField& bf, const Cell& c, int exclude) {
+  std::vector<int> out;
+  for (size_t i : c.idx) {
+    const int r = bf.region[i];
+    if (r != exclude && std::find(out.begin(), out.end(), r) == out.end()) out.push_back(r);
+  }
+  return out;
+}
+
+// φ_r along u(t) = ua + t·du inside one cell: a cubic, coefficients of t⁰…t³.
+std::array<double, 4> cellCubic(const BoundaryField& bf, const Cell& c, int r, const glm::dvec3& ua,
+                                const glm::dvec3& du) {
+  std::array<double, 4> sum{};
+  for (int k = 0; k < 8; ++k) {
+    const size_t i = c.idx[size_t(k)];
+    const double v = bf.region[i] == r ? double(bf.distance[i]) : -double(bf.distance[i]);
+    std::array<double, 4> p{v, 0.0, 0.0, 0.0};
+    for (int a = 0; a < 3; ++a) {
+      // Fraction along axis a: f = p0 + p1·t (constant where clamped).
+      const double p0 = c.clamped[a] ? c.f[a] : ua[a] - c.lo[a], p1 = c.clamped[a] ? 0.0 : du[a];
+      const bool up = (k >> a) & 1;
+      const double al = up ? p0 : 1.0 - p0, be = up ? p1 : -p1;
+      for (int d = 3; d >= 0; --d)
+        p[size_t(d)] = p[size_t(d)] * al + (d > 0 ? p[size_t(d - 1)] * be : 0.0);
+    }
+    for (size_t d = 0; d < 4; ++d) sum[d] += p[d];
+  }
+  return sum;
+}
+
+double cubicAt(const std::array<double, 4>& p, double t) {
+  return ((p[3] * t + p[2]) * t + p[1]) * t + p[0];
+}
+
+// The first t in [t0, t1] where the cubic turns negative, bisected to `tol`; −1 if none. The
+// interval is split at the cubic's turning points so that each piece is monotone.
+double firstNegative(const std::array<double, 4>& p, double t0, double t1, double tol) {
+  std::vector<double> s{t0};
+  const double A = 3 * p[3], B = 2 * p[2], C = p[1];
+  if (A != 0.0) {
+    const double disc = B * B - 4 * A * C;
+    if (disc >= 0) {
+      const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+      for (double r : {q / A, q != 0.0 ? C / q : t0})
+        if (r > t0 && r < t1) s.push_back(r);
+    }
+  } else if (B != 0.0 && -C / B > t0 && -C / B < t1) {
+    s.push_back(-C / B);
+  }
+  std::sort(s.begin() + 1, s.end());
+  s.push_back(t1);
+  if (cubicAt(p, t0) < 0.0) return t0;
+  for (size_t k = 1; k < s.size(); ++k) {
+    double lo = s[k - 1], hi = s[k];
+    if (cubicAt(p, hi) >= 0.0) continue;
+    for (int it = 0; it < 200 && hi - lo > tol; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (cubicAt(p, mid) >= 0.0 ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+  return -1.0;
+}
+
+// The cell boundaries (and clamp planes) the segment ua + t·du, t ∈ [0, 1], crosses, with 0, 1.
+std::vector<double> cellBreaks(const Grid& g, const glm::dvec3& ua, const glm::dvec3& du) {
+  std::vector<double> ts{0.0, 1.0};
+  for (int a = 0; a < 3; ++a) {
+    if (du[a] == 0.0) continue;
+    const double u0 = std::min(ua[a], ua[a] + du[a]), u1 = std::max(ua[a], ua[a] + du[a]);
+    const double m0 = std::max(std::ceil(u0), 0.0),
+                 m1 = std::min(std::floor(u1), double(g.dims[size_t(a)] - 1));
+    for (double m = m0; m <= m1; m += 1.0) {
+      const double t = (m - ua[a]) / du[a];
+      if (t > 0.0 && t < 1.0) ts.push_back(t);
+    }
+  }
+  std::sort(ts.begin(), ts.end());
+  return ts;
+}
+
+// Refine a crossing on the owner's exact signed distance: the nearest sign change to the field's
+// t, bracketed in brackets widening from 0.05 to 3.2 voxels. False if none is found.
+bool refineOnShape(const Shape& s, bool leaving_owner, const glm::dvec3& a, const glm::dvec3& b,
+                   double len_vox, double& t) {
+  auto outside = [&](double x) { return s.signedDistance(a + x * (b - a)) > 0.0; };
+  for (double w = 0.05; w <= 3.2; w *= 4.0) {
+    double lo = std::max(0.0, t - w / len_vox), hi = std::min(1.0, t + w / len_vox);
+    // Leaving the owner: inside (sd ≤ 0) at lo, outside at hi; entering it: the reverse.
+    if (outside(lo) == leaving_owner || outside(hi) != leaving_owner) continue;
+    for (int it = 0; it < 200 && (hi - lo) * len_vox > 1e-12; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (outside(mid) != leaving_owner ? lo : hi) = mid;
+    }
+    t = 0.5 * (lo + hi);
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+double boundaryHostBytes(const Grid& g) {
+  return (sizeof(float) + sizeof(uint16_t)) * double(g.dims[0]) * double(g.dims[1]) *
+         double(g.dims[2]);
+}
+
+BoundaryField buildBoundaryField(const Scene& scene, const Grid& g, int threads) {
+  if (scene.objects.size() > kMaxRegions)
+    throw SceneError(scene.file.string() + ": /objects: sharp interfaces allow at most " +
+                     std::to_string(kMaxRegions) + " objects, got " +
+                     std::to_string(scene.objects.size()) +
+                     " (or set \"interfaces\": \"smoothed\")");
+  BoundaryField bf;
+  bf.grid = g;
+  bf.region.assign(g.count(), 0);
+  bf.distance.assign(g.count(), bf.cap);
+  std::map<std::string, int> material_ids;
+  bf.media = {""};
+  for (const auto& [name, m] : scene.materials) {
+    material_ids.emplace(name, int(material_ids.size()) + 1);
+    bf.media.push_back(name);
+  }
+  bf.medium = {0};
+  for (const SceneObject& obj : scene.objects) {
+    bf.shapes.push_back(obj.shape);
+    bf.medium.push_back(material_ids.at(obj.material));
+  }
+  // Objects in scene order, each painting over the earlier ones where it contains the centre (the
+  // compositing's order). Inside object i the distance restarts at −sd_i; outside it, sd_i bounds
+  // the distance to the region boundary it makes (the region r < i + 1 is cut by it).
+  const int margin = int(std::ceil(bf.cap)) + 1;
+  for (size_t oi = 0; oi < scene.objects.size(); ++oi) {
+    const Shape& shape = scene.objects[oi].shape;
+    auto [bmin, bmax] = shape.bounds();
+    int lo[3], hi[3];
+    if (!voxelRange(bmin, bmax, g, margin, lo, hi)) continue;
+    parallelFor(hi[2] - lo[2] + 1, threads, [&](int kk) {
+      const int k = lo[2] + kk;
+      for (int j = lo[1]; j <= hi[1]; ++j)
+        for (int i = lo[0]; i <= hi[0]; ++i) {
+          const size_t idx = g.index(i, j, k);
+          const double s = shape.signedDistance(g.center(i, j, k)) / g.h;
+          if (s <= 0.0) {
+            bf.region[idx] = uint16_t(oi + 1);
+            bf.distance[idx] = float(std::min(-s, double(bf.cap)));
+          } else {
+            bf.distance[idx] = std::min(bf.distance[idx], float(std::min(s, double(bf.cap))));
+          }
+        }
+    });
+  }
+  return bf;
+}
+
+double boundaryPhi(const BoundaryField& bf, const glm::dvec3& x, int region, glm::dvec3* gradient) {
+  const Cell c = cellAt(bf.grid, toVoxel(bf.grid, x));
+  return cellPhi(bf, c, region, gradient) * bf.grid.h;
+}
+
+int boundaryRegion(const BoundaryField& bf, const glm::dvec3& x) {
+  const Cell c = cellAt(bf.grid, toVoxel(bf.grid, x));
+  const std::vector<int> regions = cellRegions(bf, c, -1);
+  int best = regions.front();
+  double best_phi = -1e300;
+  for (int r : regions) {
+    const double phi = regions.size() == 1 ? 0.0 : cellPhi(bf, c, r, nullptr);
+    if (phi > best_phi) best_phi = phi, best = r;
+  }
+  return best;
+}
+
+BoundaryCrossing locateCrossing(const BoundaryField& bf, const glm::dvec3& a, const glm::dvec3& b,
+                                const LocateOptions& opt) {
+  BoundaryCrossing out;
+  const Grid& g = bf.grid;
+  out.from = boundaryRegion(bf, a);
+  const glm::dvec3 ua = toVoxel(g, a), du = toVoxel(g, b) - ua;
+  const double len_vox = glm::length(du);
+  if (!(len_vox > 0.0)) return out;
+  const double tol = std::max(opt.tolerance_voxels, 1e-12) / len_vox;
+  const std::vector<double> ts = cellBreaks(g, ua, du);
+  for (size_t k = 1; k < ts.size(); ++k) {
+    if (ts[k] <= ts[k - 1]) continue;
+    const Cell c = cellAt(g, ua + 0.5 * (ts[k - 1] + ts[k]) * du);
+    const std::vector<int> others = cellRegions(bf, c, out.from);
+    if (others.empty()) continue;  // φ is a mean of positive distances: no zero in this cell
+    const double t = firstNegative(cellCubic(bf, c, out.from, ua, du), ts[k - 1], ts[k], tol);
+    if (t < 0.0) continue;
+    // The region entered: of the others, the one with the largest φ just past the zero.
+    const Cell past = cellAt(g, ua + std::min(t + tol, ts[k]) * du);
+    double best = -1e300;
+    for (int r : others) {
+      const double phi = cellPhi(bf, past, r, nullptr);
+      if (phi > best) best = phi, out.to = r;
+    }
+    out.found = true;
+    out.t = t;
+    break;
+  }
+  if (!out.found) return out;
+  out.owner = std::max(out.from, out.to);
+  out.from_medium = bf.medium[size_t(out.from)];
+  out.to_medium = bf.medium[size_t(out.to)];
+  glm::dvec3 grad;
+  out.point = a + out.t * (b - a);
+  cellPhi(bf, cellAt(g, toVoxel(g, out.point)), out.from, &grad);
+  if (glm::length(grad) > 0.0) out.field_normal = -glm::normalize(grad);
+  out.normal = out.field_normal;
+  if (opt.analytic && out.owner >= 1) {
+    const Shape& s = bf.shapes[size_t(out.owner - 1)];
+    const bool leaving = out.from == out.owner;
+    if (refineOnShape(s, leaving, a, b, len_vox, out.t)) out.point = a + out.t * (b - a);
+    const glm::dvec3 n = s.distanceGradient(out.point);
+    if (glm::length(n) > 0.0) out.normal = (leaving ? 1.0 : -1.0) * glm::normalize(n);
+  }
+  return out;
+}
+
+}  // namespace eikon

@@ -1,0 +1,93 @@
+// Sharp material boundaries (issue 13): where the media of a scene meet, located to sub-voxel
+// accuracy, so that a march can cross homogeneous media in straight segments and apply exact
+// Snell/Fresnel at the crossing instead of integrating through a smoothed layer.
+//
+// Representation (docs/view-renderer.md, "Sharp boundaries: representation and error budget"):
+//   region[v]   : the region that owns voxel v's centre: 0 = the ambient medium, r = i + 1 for
+//                 scene object i. Objects are painted in scene order, later over earlier (as the
+//                 voxeliser composites them), so region r is S_i minus every later object.
+//   distance[v] : the distance (in voxels, capped at `cap`) from v's centre to the boundary of its
+//                 own region: inside region r ≥ 1, min(−sd_i, sd_j for j > i); in the ambient,
+//                 min_j sd_j (sd the shapes' signed distances). Zero sets are exact; magnitudes
+//                 are exact near a face away from edges (convex polyhedra use max over planes).
+// Seen from a region A, the signed field φ_A = +distance where region = A, −distance elsewhere,
+// trilinear between voxel centres: φ_A > 0 in A, and the first zero of φ_A along a segment is
+// where the segment leaves A. Across a plane between two regions φ_A is linear, which trilinear
+// interpolation reproduces exactly (float rounding only); on curved surfaces the error is
+// second order in h (≤ 3h²/(8 r_min) for a sphere). The surface crossed belongs to the later of
+// the two regions' objects (max(from, to)), whose analytic shape gives the exact normal and,
+// optionally, refines the crossing on its own signed distance.
+//
+// A boundary between two regions of the same material is reported too (equal media on both
+// sides: Snell and Fresnel leave the ray unchanged). Features thinner than a voxel whose 8
+// surrounding voxel centres all lie in one region (a tip, a fin) are not seen by the field.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <string>
+#include <vector>
+
+#include "core/scene/shapes.h"
+#include "core/volume/grid.h"
+
+namespace eikon {
+
+struct Scene;
+
+struct BoundaryField {
+  Grid grid;
+  std::vector<uint16_t> region;  ///< per voxel, x-fastest (see above)
+  std::vector<float> distance;   ///< per voxel, in voxels, 0 ≤ distance ≤ cap
+  float cap = 4.0f;              ///< larger distances are stored as cap (only cells the boundary
+                                 ///< crosses are solved, and their corners lie within √3 voxels)
+  std::vector<Shape> shapes;     ///< shapes[r − 1]: the shape of region r ≥ 1
+  std::vector<int> medium;       ///< medium[r]: 0 = ambient, 1 + index in scene.materials' order
+  std::vector<std::string> media;  ///< media[m]: the material name of medium m ("" = ambient)
+
+  bool empty() const { return region.empty(); }
+};
+
+/// Host bytes of a boundary field on this grid (the float distance and the 16-bit region).
+double boundaryHostBytes(const Grid& grid);
+
+/// Build the field for a scene on a grid (the voxeliser's, makeGrid(scene.volume)). Throws
+/// SceneError if the scene has more objects than a 16-bit region id holds.
+BoundaryField buildBoundaryField(const Scene& scene, const Grid& grid, int threads = 0);
+
+/// φ_A at a world point (mm; > 0 inside region A), trilinear; its gradient (∂φ/∂x, unitless) in
+/// *gradient when given.
+double boundaryPhi(const BoundaryField& field, const glm::dvec3& x, int region,
+                   glm::dvec3* gradient = nullptr);
+
+/// The region at a world point: of the regions of the 8 voxels around it, the one whose φ is
+/// largest (the one whose φ is positive where two regions meet).
+int boundaryRegion(const BoundaryField& field, const glm::dvec3& x);
+
+struct LocateOptions {
+  /// The crossing is bracketed on the trilinear field to this width (voxels) along the segment.
+  double tolerance_voxels = 1e-6;
+  /// Refine the crossing on the crossed shape's exact signed distance and take its normal
+  /// (analytic shapes); false: the trilinear field's zero and gradient only (what a mesh gives).
+  bool analytic = true;
+};
+
+struct BoundaryCrossing {
+  bool found = false;
+  double t = 1.0;                ///< the crossing as a fraction of the segment [a, b]
+  glm::dvec3 point{0.0};         ///< world (mm)
+  glm::dvec3 normal{0.0};        ///< unit, pointing from `from` into `to` (analytic when asked)
+  glm::dvec3 field_normal{0.0};  ///< −∇φ_from normalised: the field's own normal
+  int from = 0, to = 0;          ///< regions on the two sides
+  int from_medium = 0, to_medium = 0;
+  int owner = 0;  ///< the region whose shape's surface is crossed: max(from, to)
+};
+
+/// The first point where the segment [a, b] (world, mm) leaves the region of `a`: a walk over
+/// the trilinear cells the segment crosses; in each cell whose corners are not all in that
+/// region φ is a cubic in t, split at its turning points into monotone pieces, and the first
+/// sign change is bisected to `tolerance_voxels`. found = false when [a, b] stays in one region.
+BoundaryCrossing locateCrossing(const BoundaryField& field, const glm::dvec3& a,
+                                const glm::dvec3& b, const LocateOptions& options = {});
+
+}  // namespace eikon

@@ -1,0 +1,69 @@
+// The voxel grid shared by every volume of a VolumeSet (the fields, the skip distances and the
+// sharp-boundary field of core/volume/boundary.h).
+//
+// Conventions: voxel (i, j, k) has its centre at origin + (i + ½, j + ½, k + ½)·h, h the voxel
+// edge in mm; arrays are x-fastest. Samples between centres are trilinear; outside the grid the
+// nearest voxel is used (clamp to edge).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstddef>
+#include <glm/glm.hpp>
+#include <thread>
+#include <vector>
+
+namespace eikon {
+
+struct Grid {
+  std::array<int, 3> dims{};  ///< voxels per axis
+  glm::dvec3 origin{0.0};     ///< bounds_min (mm)
+  glm::dvec3 extent{0.0};     ///< dims · h (mm); may exceed the requested bounds by < 1 voxel
+  double h = 1.0;             ///< voxel edge (mm)
+  size_t count() const { return size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]); }
+  size_t index(int i, int j, int k) const {
+    return (size_t(k) * size_t(dims[1]) + size_t(j)) * size_t(dims[0]) + size_t(i);
+  }
+  glm::dvec3 center(int i, int j, int k) const { return origin + (glm::dvec3(i, j, k) + 0.5) * h; }
+  glm::dvec3 boundsMax() const { return origin + extent; }
+};
+
+/// The voxel index range [lo, hi] of a world box widened by `margin` voxels, clamped to the grid.
+/// The clamping is done in double before converting to int: an object far outside the volume
+/// (centre 1e300, or 4294967296 mm) gives voxel coordinates beyond int's range, whose conversion
+/// is undefined behaviour (UBSan: signed overflow). False if the box misses the grid (or is NaN).
+inline bool voxelRange(const glm::dvec3& bmin, const glm::dvec3& bmax, const Grid& g, int margin,
+                       int lo[3], int hi[3]) {
+  for (int a = 0; a < 3; ++a) {
+    const double top = double(g.dims[a] - 1);
+    double l = std::floor((bmin[a] - g.origin[a]) / g.h) - margin;
+    double h = std::ceil((bmax[a] - g.origin[a]) / g.h) + margin;
+    if (!(l <= top) || !(h >= 0.0) || !(l <= h)) return false;  // also false for NaN
+    lo[a] = int(std::max(l, 0.0));
+    hi[a] = int(std::min(h, top));
+  }
+  return true;
+}
+
+/// body(i) for i in [0, n) on `threads` threads (0 = hardware concurrency), dealt out one at a
+/// time (slabs of a grid take unequal times).
+template <typename F>
+void parallelFor(int n, int threads, F&& body) {
+  int t = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  t = std::min(t, n);
+  if (t <= 1) {
+    for (int i = 0; i < n; ++i) body(i);
+    return;
+  }
+  std::atomic<int> next{0};
+  std::vector<std::thread> pool;
+  for (int w = 0; w < t; ++w)
+    pool.emplace_back([&] {
+      for (int i = next++; i < n; i = next++) body(i);
+    });
+  for (auto& th : pool) th.join();
+}
+
+}  // namespace eikon
