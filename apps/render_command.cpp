@@ -7,9 +7,10 @@
 #include <vector>
 
 #include "apps/commands.h"
-#include "apps/light_cache.h"
 #include "apps/progress.h"
 #include "core/io/exr.h"
+#include "core/light/light_cache.h"
+#include "core/reference/reference_lighting.h"
 #include "core/reference/reference_marcher.h"
 #include "core/render/light_transport.h"
 #include "core/render/render_defaults.h"

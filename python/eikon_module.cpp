@@ -43,8 +43,8 @@
 #include <string>
 #include <vector>
 
-#include "apps/light_cache.h"
 #include "core/io/exr.h"
+#include "core/light/light_cache.h"
 #include "core/reference/reference_lighting.h"
 #include "core/reference/reference_marcher.h"
 #include "core/render/light_transport.h"
@@ -289,8 +289,8 @@ struct Prepared {
     bool cached = false;
     {
       py::gil_scoped_release release;
-      const uint64_t key = cache_dir.empty() ? 0 : cli::lightCacheKey(*scene, *volume, lo, on_cpu);
-      if (!cache_dir.empty() && cli::loadLightCache(cache_dir, key, *volume)) {
+      const uint64_t key = cache_dir.empty() ? 0 : lightCacheKey(*scene, *volume, lo, on_cpu);
+      if (!cache_dir.empty() && loadLightCache(cache_dir, key, *volume)) {
         cached = true;
       } else {
         if (on_cpu)
@@ -298,7 +298,7 @@ struct Prepared {
         else
           simulateLighting(*ctx, *scene, *volume, lo);
         // A cache that cannot be written only costs time next time.
-        if (!cache_dir.empty()) cli::saveLightCache(cache_dir, key, *volume);
+        if (!cache_dir.empty()) saveLightCache(cache_dir, key, *volume);
       }
     }
     dropRenderers();
@@ -347,7 +347,7 @@ std::shared_ptr<Prepared> cachedPrepared(const std::shared_ptr<Scene>& s) {
 std::string lightCacheDir(const py::object& light_cache) {
   if (light_cache.is_none()) return {};
   if (py::isinstance<py::bool_>(light_cache))
-    return light_cache.cast<bool>() ? cli::defaultLightCacheDir().string() : std::string();
+    return light_cache.cast<bool>() ? defaultLightCacheDir().string() : std::string();
   return py::str(light_cache).cast<std::string>();
 }
 

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/reference/field.h"
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"

@@ -12,12 +12,35 @@
 //   eikon::RenderImage img = ref.render(scene.camera, settings);
 #pragma once
 
-#include "core/reference/field.h"
+#include <functional>
+#include <memory>
+
 #include "core/scene/scene.h"
+#include "core/volume/field.h"
 #include "core/volume/march_types.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {
+
+/// An analytic, non-absorbing index field n(x) with its exact gradient, inside a box.
+class AnalyticField : public Field {
+ public:
+  using IndexFn = std::function<void(const glm::dvec3&, double&, glm::dvec3&)>;
+  AnalyticField(IndexFn fn, glm::dvec3 bmin, glm::dvec3 bmax, double cell)
+      : fn_(std::move(fn)), bmin_(bmin), bmax_(bmax), cell_(cell) {}
+  void index(const glm::dvec3& x, double, double, double& n, glm::dvec3& grad) const override { fn_(x, n, grad); }
+  glm::dvec4 medium(const glm::dvec3&) const override { return glm::dvec4(0.0); }
+  glm::dvec3 emission(const glm::dvec3&) const override { return glm::dvec3(0.0); }
+  double skipDistance(const glm::dvec3&) const override { return 0.0; }
+  glm::dvec3 boundsMin() const override { return bmin_; }
+  glm::dvec3 boundsMax() const override { return bmax_; }
+  double cellSize() const override { return cell_; }
+
+ private:
+  IndexFn fn_;
+  glm::dvec3 bmin_, bmax_;
+  double cell_;
+};
 
 class ReferenceMarcher {
  public:
@@ -30,8 +53,8 @@ class ReferenceMarcher {
 
  private:
   struct Result;
-  Result march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar,
-               const MarchSettings& m, int mode) const;
+  Result march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar, const MarchSettings& m,
+               int mode) const;
   const Field& field_;
   const Environment& env_;
 };
