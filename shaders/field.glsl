@@ -1,8 +1,9 @@
 // The field/medium layer of the GPU twin: how a kernel reads the voxelised VolumeSet and the
 // per-point physics of a medium (docs/design.md §2), written once for every kernel that marches
 // through it (march.glsl for view.comp and trace.comp, wavefront.comp). Its CPU twin is
-// core/reference/field.{h,cpp}: the same functions under the same names in double precision,
-// sharing no code with this file (docs/twins.md).
+// core/reference/field.{h,cpp} (the sampling: VolumeField, core/volume/field.cpp): the same
+// functions under the same names in double precision, sharing no code with this file
+// (docs/twins.md).
 //
 // The including kernel declares, before `#include "field.glsl"`:
 //   P                 its parameter block, with grid_origin (xyz: bounds_min, w: voxel edge h) and

@@ -87,7 +87,8 @@ void storeOther(uint i, WavePatch p) {
 
 bool eMode() { return P.control.w == 1; }
 
-// Wave vector along the unit direction s at x on the simulated mode's shell (onShell in wavefront.cpp).
+// Wave vector along the unit direction s at x on the simulated mode's shell (onModeShell in
+// core/light/seeding.cpp, which PatchStepper::onShell calls).
 vec3 onShell(vec3 x, vec3 s) {
   float n = sampleIndex(x, 0).x;
   if (eMode()) {
@@ -139,7 +140,7 @@ void rk4(inout vec3 x, inout vec3 w, float dt) {
 
 bool insideBounds(vec3 x) { return all(greaterThanEqual(x, P.grid_origin.xyz)) && all(lessThanEqual(x, P.grid_max.xyz)); }
 
-// Does the ray o + s·d (s ≥ 0) meet the bounds? (rayHitsBox in wavefront.cpp)
+// Does the ray o + s·d (s ≥ 0) meet the bounds? (rayHitsBox in core/light/seeding.h)
 bool rayHitsBox(vec3 o, vec3 d) {
   float t0 = 0.0, t1 = 1e30;
   for (int a = 0; a < 3; ++a) {
