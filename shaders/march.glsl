@@ -44,35 +44,6 @@ void setWavelength(float lambda_um, bool scalar) {
   gScalar = scalar;
 }
 
-bool hasFlag(int f) { return (P.grid_dims.w & f) != 0; }
-
-struct Stencil {
-  ivec3 i0;
-  ivec3 i1;
-  vec3 f;
-};
-
-Stencil stencilAt(vec3 x) {
-  vec3 g = (x - P.grid_origin.xyz) * P.grid_extent.w - 0.5;
-  vec3 fl = floor(g);
-  Stencil s;
-  s.f = g - fl;
-  ivec3 i = ivec3(fl);
-  ivec3 dmax = P.grid_dims.xyz - 1;
-  s.i0 = clamp(i, ivec3(0), dmax);
-  s.i1 = clamp(i + 1, ivec3(0), dmax);
-  return s;
-}
-
-#define TRI(img, s)                                                                              \
-  mix(mix(mix(imageLoad(img, s.i0), imageLoad(img, ivec3(s.i1.x, s.i0.y, s.i0.z)), s.f.x),      \
-          mix(imageLoad(img, ivec3(s.i0.x, s.i1.y, s.i0.z)), imageLoad(img, ivec3(s.i1.x, s.i1.y, s.i0.z)), s.f.x), \
-          s.f.y),                                                                                \
-      mix(mix(imageLoad(img, ivec3(s.i0.x, s.i0.y, s.i1.z)), imageLoad(img, ivec3(s.i1.x, s.i0.y, s.i1.z)), s.f.x), \
-          mix(imageLoad(img, ivec3(s.i0.x, s.i1.y, s.i1.z)), imageLoad(img, s.i1), s.f.x), s.f.y), \
-      s.f.z)
-
-// (n, ∂n/∂x, ∂n/∂y, ∂n/∂z) at x for the current wavelength; mode 0 = o, 1 = e.
 // Wavelength sharing (view.comp, spectral mode): while marching the first wavelength of a pixel
 // sample, note whether any sample saw dispersion (B or C ≠ 0) and record every environment lookup
 // as (direction, weight). If none did, and nothing else depends on λ (no attenuation, emission,
@@ -84,31 +55,14 @@ bool gRecordOverflow = false;
 int gNumRecorded = 0;
 vec4 gRecorded[6];
 
-vec4 sampleIndex(vec3 x, int mode) {
-  Stencil s = stencilAt(x);
-  vec4 a;
-  if (mode == 0) {
-    a = TRI(idxOA, s);
-    if (hasFlag(EIKON_F_DISPERSIVE)) {
-      vec4 b = TRI(idxOB, s), c = TRI(idxOC, s);
-      if (any(notEqual(b, vec4(0.0))) || any(notEqual(c, vec4(0.0)))) gDispersiveHit = true;
-      a += b * gIl2 + c * gIl4;
-    }
-  } else {
-    a = TRI(idxEA, s);
-    if (hasFlag(EIKON_F_DISPERSIVE)) {
-      vec4 b = TRI(idxEB, s), c = TRI(idxEC, s);
-      if (any(notEqual(b, vec4(0.0))) || any(notEqual(c, vec4(0.0)))) gDispersiveHit = true;
-      a += b * gIl2 + c * gIl4;
-    }
-  }
-  return a;
-}
-
-vec4 sampleMedium(vec3 x, int mode) {
-  Stencil s = stencilAt(x);
-  return mode == 0 ? TRI(mediumO, s) : TRI(mediumE, s);
-}
+#define EIKON_FIELD_INV_H P.grid_extent.w
+#define EIKON_FIELD_LAMBDA_UM gLambdaUm
+#define EIKON_FIELD_IL2 gIl2
+#define EIKON_FIELD_IL4 gIl4
+#define EIKON_FIELD_HAS_AXIS hasFlag(EIKON_F_UNIAXIAL)
+#define EIKON_FIELD_ON_DISPERSION(b, c) \
+  if (any(notEqual(b, vec4(0.0))) || any(notEqual(c, vec4(0.0)))) gDispersiveHit = true
+#include "field.glsl"
 
 vec3 sampleEmission(vec3 x) {
   Stencil s = stencilAt(x);
@@ -120,15 +74,6 @@ vec4 sampleScatter(vec3 x) {
   if (!hasFlag(EIKON_F_SCATTER)) return vec4(0.0);
   Stencil s = stencilAt(x);
   return TRI(scatterImg, s);
-}
-
-// Band values (σ at 612, 549, 465 nm) → value at gLambdaUm, linear between, constant beyond.
-float bandAt(vec3 rgb) {
-  float l = gLambdaUm * 1000.0;
-  if (l <= 465.0) return rgb.b;
-  if (l >= 612.0) return rgb.r;
-  if (l <= 549.0) return rgb.b + (rgb.g - rgb.b) * (l - 465.0) / (549.0 - 465.0);
-  return rgb.g + (rgb.r - rgb.g) * (l - 549.0) / (612.0 - 549.0);
 }
 
 // Linear sRGB colour → smooth spectrum value at gLambdaUm (core/spectrum/rgb_to_spectrum.h).
@@ -265,37 +210,16 @@ struct MarchResult {
   int tir;
 };
 
-// Optic axis at x: xyz = unit axis (zero where there is no crystal), w = 1/r for a radial field
-// about a centre c (a = (x − c)/r, r = |x − c|), else 0. The texel of the nearest voxel holds either
-// the uniform axis (w = 0) or the centre (w = −1).
-vec4 axisField(vec3 x) {
-  if (!hasFlag(EIKON_F_UNIAXIAL)) return vec4(0.0);
-  ivec3 vi = clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_extent.w)), ivec3(0), P.grid_dims.xyz - 1);
-  vec4 t = imageLoad(axisImg, vi);
-  if (t.w > -0.5) return vec4(t.xyz, 0.0);
-  vec3 d = x - t.xyz;
-  float r = length(d);
-  return r > 1e-6 ? vec4(d / r, 1.0 / r) : vec4(0.0, 0.0, 1.0, 0.0);
-}
 vec3 axisAt(vec3 x) { return axisField(x).xyz; }
-
-// The e-mode's inverse dielectric-like matrix M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e² applied to p.
-vec3 applyM(vec3 p, vec3 a, float no, float ne) {
-  float pa = dot(p, a);
-  return a * pa / (no * no) + (p - a * pa) / (ne * ne);
-}
 
 // Derivatives of (x, w) with respect to ray arc length s.
 //  o-mode (docs/design.md §2, isotropic form): dx/ds = w/n, dw/ds = ∇n on the shell |w| = n.
-//  e-mode (Hamiltonian H = ½(pᵀM_e p − 1), w = p): dx/dτ = M p,
-//    dp/dτ = −½ pᵀ(∂M/∂x)p = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e (+ the axis term of a
-//    radial field, below),
-//    divided by |M p| to step in arc length. Where there is no axis the e-mode is the o-mode.
+//  e-mode (Hamiltonian H = ½(pᵀM_e p − 1), w = p): eModeRates (field.glsl) divided by |M p| to
+//    step in arc length. Where there is no axis the e-mode is the o-mode.
 void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
   vec4 o = sampleIndex(x, 0);
   vec4 af = mode == 1 ? axisField(x) : vec4(0.0);
-  vec3 a = af.xyz;
-  if (dot(a, a) < 0.25) {
+  if (!hasAxis(af.xyz)) {
     // Isotropic Hamiltonian M = I/n² in ray arc length: dx/ds = w/|w|, dw/ds = |w|∇n/n. On the
     // shell |w| = n this is dx/ds = w/n, dw/ds = ∇n; off it the ray still moves at unit speed and
     // |w|/n is an invariant of the flow, and it is the e-mode's equation with n_o = n_e.
@@ -304,13 +228,8 @@ void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
     dw = o.yzw * (lw / o.x);
     return;
   }
-  vec4 e = sampleIndex(x, 1);
-  float pa = dot(w, a), p2 = dot(w, w);
-  vec3 Mp = applyM(w, a, o.x, e.x);
-  vec3 dp = (pa * pa / (o.x * o.x * o.x)) * o.yzw + ((p2 - pa * pa) / (e.x * e.x * e.x)) * e.yzw;
-  // A varying axis adds −½ ∂(pᵀMp)/∂x from ∂a/∂x = (I − aaᵀ)/r (radial field):
-  // −(p·a)(1/n_o² − 1/n_e²)(p − (p·a)a)/r.
-  if (af.w > 0.0) dp -= pa * (1.0 / (o.x * o.x) - 1.0 / (e.x * e.x)) * (w - pa * a) * af.w;
+  vec3 Mp, dp;
+  eModeRates(w, af, o, sampleIndex(x, 1), Mp, dp);
   float L = length(Mp);
   dx = Mp / L;
   dw = dp / L;
@@ -320,26 +239,19 @@ void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
 vec3 rayDirection(vec3 x, vec3 w, int mode) {
   if (mode == 0) return normalize(w);
   vec3 a = axisAt(x);
-  if (dot(a, a) < 0.25) return normalize(w);
+  if (!hasAxis(a)) return normalize(w);
   return normalize(applyM(w, a, sampleIndex(x, 0).x, sampleIndex(x, 1).x));
 }
 
-// Attenuation per unit ray length of `mode` at x for wave vector w (band values or the value at λ).
-// e-mode: σ(θ) = n(θ)³[σ_o cos²θ/n_o³ + σ_e sin²θ/n_e³] per unit wave-normal length (docs/design.md §2,
-// first order in the extinction), times cos ρ = s·t for the length along the ray.
+// Attenuation per unit ray length of `mode` at x for wave vector w (band values or the value at λ);
+// the e-mode's is pleochroic (attenuationE, field.glsl).
 vec3 attenuationAt(vec3 x, vec3 w, int mode) {
   vec3 so = sigmaOf(sampleMedium(x, 0).xyz);
   if (mode == 0) return so;
   vec3 a = axisAt(x);
-  if (dot(a, a) < 0.25) return so;
+  if (!hasAxis(a)) return so;
   vec3 se = sigmaOf(sampleMedium(x, 1).xyz);
-  float no = sampleIndex(x, 0).x, ne = sampleIndex(x, 1).x;
-  vec3 s = normalize(w);
-  float c = dot(s, a), c2 = c * c, s2 = 1.0 - c2;
-  float inv_n2 = c2 / (no * no) + s2 / (ne * ne);
-  float n = inversesqrt(inv_n2);
-  vec3 t = normalize(applyM(w, a, no, ne));
-  return n * n * n * (so * c2 / (no * no * no) + se * s2 / (ne * ne * ne)) * dot(s, t);
+  return attenuationE(so, se, w, a, sampleIndex(x, 0).x, sampleIndex(x, 1).x);
 }
 
 // Fresnel (Rs, Rp) weights of a mode at an interface: the share of its D field along the
@@ -356,6 +268,225 @@ float sWeight(vec3 s_crystal, vec3 a, vec3 N, vec3 dIn, int mode) {
   return mode == 0 ? wo : 1.0 - wo;
 }
 
+// ---- The march, stage by stage (the same stages, under the same names, as ReferenceMarcher's in
+// core/reference/reference_marcher.cpp; docs/twins.md) ----
+
+// The state of one march between its stages.
+struct MarchState {
+  vec3 x;        // position (mm)
+  vec3 w;        // wave vector (|w| = n for the o-mode)
+  vec4 nn;       // (n_o, ∇n_o) at x
+  vec3 T;        // throughput
+  vec3 L;        // radiance gathered so far
+  bool stopped;  // at an opaque surface
+  // The interface layer being crossed: where it opened, w before it, Σ∇n·ds over it, its peak.
+  bool inLayer;
+  float peak;
+  vec3 wBefore;
+  vec3 gAcc;
+  vec3 xOpen;
+};
+
+// What an integration step leaves for the stages after it.
+struct StepEnd {
+  vec3 x0, w0;  // the step's start
+  vec4 ne;      // (n_e, ∇n_e) at the step's end (the o-mode's where isotropic)
+  vec3 aHere;   // optic axis there (e-mode)
+  bool eHere;   // the e-mode in a crystal there
+  vec3 gradN;   // the gradient the layer normal accumulates
+};
+
+const int kStepNone = 0;   // not homogeneous here: integrate
+const int kStepTaken = 1;  // a straight step was taken
+const int kStepStop = 2;   // the march ends (opaque surface, or out of the volume)
+
+// Homogeneous region (skip distance D ≥ 2 voxels): one straight, exact step of (D − 1.5)·h along
+// the ray direction, with the emission and attenuation integrated in closed form.
+int straightStep(inout MarchState S, inout MarchResult R, int mode) {
+  vec4 em = vec4(0.0);
+  if (!S.inLayer && !hasFlag(EIKON_F_NO_SKIP)) em = imageLoad(emissionImg, voxelAt(S.x));
+  if (em.w < 2.0) return kStepNone;
+  const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
+  const float h = P.grid_origin.w;
+  vec3 dir = rayDirection(S.x, S.w, mode);
+  float tb0, tb1;
+  boxHit(S.x, dir, bmin, bmax, tb0, tb1);
+  float tExit = max(tb1, 0.0);
+  float len = (em.w - 1.5) * h;
+  // A lit scattering medium is homogeneous but its light is not: sample the light every voxel.
+  bool scattering = hasFlag(EIKON_F_LIT) && hasFlag(EIKON_F_SCATTER) && dot(sampleScatter(S.x).xyz, vec3(1.0)) > 0.0;
+  if (scattering) len = min(len, h);
+  bool leaving = len >= tExit;
+  len = min(len, tExit);
+  if (hasFlag(EIKON_F_OPACITY) && sampleMedium(S.x, mode).w >= 0.5) {
+    S.L += S.T * (colourOf(em.xyz) / sampleMedium(S.x, mode).w + diffuseSurface(S.x, mode));
+    S.stopped = true;
+    return kStepStop;
+  }
+  if (hasFlag(EIKON_F_EMISSION) || hasFlag(EIKON_F_ATTENUATION)) {
+    vec3 sig = hasFlag(EIKON_F_ATTENUATION) ? attenuationAt(S.x, S.w, mode) : vec3(0.0);
+    vec3 e = colourOf(em.xyz);
+    // In-scatter with the light at the middle of this straight step, constant over it.
+    if (scattering) e += inScatter(S.x + 0.5 * len * dir, dir, sig);
+    vec3 att = exp(-sig * len);
+    // ∫₀^len T e^{−σs} e ds = T e (1 − e^{−σ len})/σ  (→ T e len as σ → 0)
+    S.L += S.T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
+    S.T *= att;
+  }
+  R.opl += dot(S.w, dir) * len;  // ∫ p·dx
+  S.x += dir * len;
+  return leaving ? kStepStop : kStepTaken;
+}
+
+// One integration step of the ray equation (Euler, midpoint or RK4), then the fields at its end,
+// the optical path and (o-mode) the drift of the invariant |w| = n.
+StepEnd integrateStep(inout MarchState S, inout MarchResult R, int mode) {
+  const float ds = P.march.x * P.grid_origin.w;
+  const int integrator = int(P.march.w);
+  StepEnd E;
+  E.x0 = S.x;
+  E.w0 = S.w;
+  float n0 = S.nn.x;
+  vec3 k1x, k1w, k2x, k2w, k3x, k3w, k4x, k4w;
+  deriv(S.x, S.w, mode, k1x, k1w);
+  if (integrator == EIKON_INT_EULER) {
+    S.x += ds * k1x;
+    S.w += ds * k1w;
+  } else if (integrator == EIKON_INT_MIDPOINT) {
+    deriv(S.x + 0.5 * ds * k1x, S.w + 0.5 * ds * k1w, mode, k2x, k2w);
+    S.x += ds * k2x;
+    S.w += ds * k2w;
+  } else {
+    deriv(S.x + 0.5 * ds * k1x, S.w + 0.5 * ds * k1w, mode, k2x, k2w);
+    deriv(S.x + 0.5 * ds * k2x, S.w + 0.5 * ds * k2w, mode, k3x, k3w);
+    deriv(S.x + ds * k3x, S.w + ds * k3w, mode, k4x, k4w);
+    S.x += ds / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+    S.w += ds / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+  }
+  S.nn = sampleIndex(S.x, 0);
+  E.gradN = S.nn.yzw;
+  E.aHere = mode == 1 ? axisAt(S.x) : vec3(0.0);
+  E.eHere = mode == 1 && hasAxis(E.aHere);
+  E.ne = E.eHere ? sampleIndex(S.x, 1) : S.nn;
+  if (mode == 0) {
+    R.drift = max(R.drift, abs(length(S.w) - S.nn.x));
+    R.opl += 0.5 * (n0 + S.nn.x) * ds;
+  } else {
+    R.opl += 0.5 * dot(E.w0 + S.w, S.x - E.x0);
+    if (E.eHere) E.gradN = 0.5 * (S.nn.yzw + E.ne.yzw);
+  }
+  return E;
+}
+
+// Emission, attenuation and in-scatter at the step's midpoint (only sampled where the scene has
+// any); true if the step ended on an opaque surface.
+bool mediumAlongStep(inout MarchState S, StepEnd E, int mode) {
+  const float ds = P.march.x * P.grid_origin.w;
+  vec3 xm = 0.5 * (E.x0 + S.x);
+  if (hasFlag(EIKON_F_EMISSION)) S.L += S.T * colourOf(sampleEmission(xm)) * ds;
+  if (hasFlag(EIKON_F_ATTENUATION)) {
+    vec3 sig = attenuationAt(xm, 0.5 * (E.w0 + S.w), mode);
+    if (hasFlag(EIKON_F_LIT) && hasFlag(EIKON_F_SCATTER)) S.L += S.T * inScatter(xm, normalize(S.x - E.x0), sig) * ds;
+    S.T *= exp(-sig * ds);
+  }
+  if (hasFlag(EIKON_F_OPACITY) && sampleMedium(S.x, mode).w >= 0.5) {
+    // Surface emission: the emission field over the coverage (opacity ≥ 0.5 here), as the albedo.
+    S.L += S.T * (colourOf(sampleEmission(S.x)) / sampleMedium(S.x, mode).w + diffuseSurface(S.x, mode));
+    S.stopped = true;
+    return true;
+  }
+  return false;
+}
+
+// Back on the constraint surface H = 0 (|w| = n for the o-mode, wᵀM_e w = 1 for the e-mode)
+// along the layer normal N: the tangential part of w is what the interface conserves (Snell).
+// The stored central-difference gradient is not exactly the derivative of the trilinear n, which
+// makes H drift by ~1e-4 across a sharp layer. Only for thin layers (interfaces no thicker than
+// 12 voxels along their normal), never across gradient-index bodies; skipped if the normal part
+// would change much.
+void projectOnShell(inout MarchState S, StepEnd E, vec3 N) {
+  float wn = dot(S.w, N);
+  vec3 wt = S.w - wn * N;
+  if (!E.eHere) {
+    float rem = S.nn.x * S.nn.x - dot(wt, wt);
+    if (rem > 0.25 * wn * wn) S.w = wt + sign(wn) * sqrt(rem) * N;
+  } else {
+    // (wt + λN)ᵀ M (wt + λN) = 1: qa λ² + 2 qb λ + qc = 0, root nearest the current wn.
+    vec3 MN = applyM(N, E.aHere, S.nn.x, E.ne.x);
+    float qa = dot(N, MN), qb = dot(wt, MN), qc = dot(wt, applyM(wt, E.aHere, S.nn.x, E.ne.x)) - 1.0;
+    float disc = qb * qb - qa * qc;
+    if (disc > 0.0) {
+      float l1 = (-qb + sqrt(disc)) / qa, l2 = (-qb - sqrt(disc)) / qa;
+      float lam = abs(l1 - wn) < abs(l2 - wn) ? l1 : l2;
+      if (abs(lam - wn) < 0.5 * abs(wn)) S.w = wt + lam * N;
+    }
+  }
+}
+
+// Fresnel at a crossed layer of normal N (transmitted fraction 1 − R, with the full unpolarised
+// equations, and an external reflection that samples the environment), or a total internal
+// reflection, which the ODE produced by itself (no Fresnel loss).
+void fresnelAtLayer(inout MarchState S, inout MarchResult R, vec3 N, int mode) {
+  vec3 dIn = normalize(S.wBefore), dOut = normalize(S.w);
+  float ci = dot(dIn, N), co = dot(dOut, N);
+  float n1 = length(S.wBefore), n2 = length(S.w);
+  if (ci * co > 0.0) {
+    // Which side is the crystal? The end of the layer with the larger birefringence (the
+    // axis field itself is dilated into the air around crystals).
+    float bOut = abs(sampleIndex(S.x, 1).x - sampleIndex(S.x, 0).x);
+    float bIn = abs(sampleIndex(S.xOpen, 1).x - sampleIndex(S.xOpen, 0).x);
+    bool outCrystal = bOut >= bIn;
+    vec3 a = axisAt(outCrystal ? S.x : S.xOpen);
+    float wsw = sWeight(outCrystal ? dOut : dIn, a, N, dIn, mode);
+    vec2 rsp = fresnelRsRp(abs(ci), n1, n2);
+    float Rf = hasFlag(EIKON_F_UNIAXIAL) ? wsw * rsp.x + (1.0 - wsw) * rsp.y : 0.5 * (rsp.x + rsp.y);
+    if (n2 > n1) S.L += environmentWeighted(S.T * Rf, reflect(dIn, N));
+    S.T *= 1.0 - Rf;
+    R.interfaces++;
+  } else {
+    R.tir++;
+  }
+}
+
+// Interface bookkeeping: a layer opens where |∇n|·h rises above 1e-6 and closes where it falls
+// back; a closed layer whose peak exceeded march.y was an interface (projectOnShell, fresnelAtLayer).
+void layerStep(inout MarchState S, inout MarchResult R, StepEnd E, int mode) {
+  const float h = P.grid_origin.w, ds = P.march.x * h;
+  const float thrLow = 1e-6, thrIface = P.march.y;
+  float g = max(length(S.nn.yzw), length(E.ne.yzw)) * h;
+  if (!S.inLayer && g > thrLow) {
+    S.inLayer = true;
+    S.wBefore = E.w0;
+    S.gAcc = vec3(0.0);
+    S.peak = 0.0;
+    S.xOpen = E.x0;
+  }
+  if (!S.inLayer) return;
+  S.gAcc += E.gradN * ds;
+  S.peak = max(S.peak, g);
+  if (!(g <= thrLow)) return;
+  S.inLayer = false;
+  vec3 N = dot(S.gAcc, S.gAcc) > 0.0 ? normalize(S.gAcc) : vec3(0.0);
+  if (dot(N, N) > 0.0 && abs(dot(S.x - S.xOpen, N)) <= 12.0 * h) projectOnShell(S, E, N);
+  if (S.peak > thrIface && !hasFlag(EIKON_F_NO_FRESNEL) && dot(N, N) > 0.0) fresnelAtLayer(S, R, N, mode);
+}
+
+// Left the volume? The ray is straight outside (fields clamp to the uniform edge voxels): cut the
+// step at the boundary, with w there (linear within the step), not at the overshoot.
+bool clipToVolume(inout MarchState S, inout MarchResult R, StepEnd E) {
+  const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
+  if (!any(lessThan(S.x, bmin)) && !any(greaterThan(S.x, bmax))) return false;
+  vec3 dd = normalize(S.x - E.x0);
+  float a0, a1;
+  boxHit(E.x0, dd, bmin, bmax, a0, a1);
+  float stepLen = length(S.x - E.x0);
+  float keep = clamp(max(a1, 0.0) / max(stepLen, 1e-30), 0.0, 1.0);
+  R.opl -= (1.0 - keep) * 0.5 * dot(E.w0 + S.w, S.x - E.x0);
+  S.x = E.x0 + (S.x - E.x0) * keep;
+  S.w = mix(E.w0, S.w, keep);
+  return true;
+}
+
 MarchResult march(vec3 o, vec3 d, int mode) {
   MarchResult R;
   R.radiance = vec3(0.0);
@@ -367,8 +498,6 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   R.interfaces = 0;
   R.tir = 0;
   const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
-  const float h = P.grid_origin.w;
-  const float ambient = P.march.z;
   float t0, t1;
   if (!boxHit(o, d, bmin, bmax, t0, t1)) {
     R.radiance = environmentWeighted(vec3(1.0), d);
@@ -378,185 +507,38 @@ MarchResult march(vec3 o, vec3 d, int mode) {
     return R;
   }
   t0 = max(t0, 0.0);
-  vec3 x = o + d * t0;
-  R.opl = ambient * t0;
-  vec4 nn = sampleIndex(x, 0);
-  vec3 w = nn.x * d;  // the volume's faces are isotropic (air): p = n d
-  const float ds = P.march.x * h;
-  const int integrator = int(P.march.w);
-  const float thrLow = 1e-6, thrIface = P.march.y;
-  bool inLayer = false;
-  float peak = 0.0;
-  vec3 wBefore = w, gAcc = vec3(0.0), xOpen = x;
-  vec3 T = vec3(1.0), L = vec3(0.0);
-  bool stopped = false;
+  MarchState S;
+  S.x = o + d * t0;
+  R.opl = P.march.z * t0;  // the ambient index
+  S.nn = sampleIndex(S.x, 0);
+  S.w = S.nn.x * d;  // the volume's faces are isotropic (air): p = n d
+  S.T = vec3(1.0);
+  S.L = vec3(0.0);
+  S.stopped = false;
+  S.inLayer = false;
+  S.peak = 0.0;
+  S.wBefore = S.w;
+  S.gAcc = vec3(0.0);
+  S.xOpen = S.x;
   const int maxSteps = P.limits.x;
   int steps = 0;
   for (; steps < maxSteps; ++steps) {
-    // Homogeneous region: one straight, exact step along the ray direction.
-    vec4 em = vec4(0.0);
-    if (!inLayer && !hasFlag(EIKON_F_NO_SKIP))
-      em = imageLoad(emissionImg, clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_extent.w)), ivec3(0), P.grid_dims.xyz - 1));
-    if (em.w >= 2.0) {
-      vec3 dir = rayDirection(x, w, mode);
-      float tb0, tb1;
-      boxHit(x, dir, bmin, bmax, tb0, tb1);
-      float tExit = max(tb1, 0.0);
-      float len = (em.w - 1.5) * h;
-      // A lit scattering medium is homogeneous but its light is not: sample the light every voxel.
-      bool scattering = hasFlag(EIKON_F_LIT) && hasFlag(EIKON_F_SCATTER) && dot(sampleScatter(x).xyz, vec3(1.0)) > 0.0;
-      if (scattering) len = min(len, h);
-      bool leaving = len >= tExit;
-      len = min(len, tExit);
-      if (hasFlag(EIKON_F_OPACITY) && sampleMedium(x, mode).w >= 0.5) {
-        L += T * (colourOf(em.xyz) / sampleMedium(x, mode).w + diffuseSurface(x, mode));
-        stopped = true;
-        break;
-      }
-      if (hasFlag(EIKON_F_EMISSION) || hasFlag(EIKON_F_ATTENUATION)) {
-        vec3 sig = hasFlag(EIKON_F_ATTENUATION) ? attenuationAt(x, w, mode) : vec3(0.0);
-        vec3 e = colourOf(em.xyz);
-        // In-scatter with the light at the middle of this straight step, constant over it.
-        if (scattering) e += inScatter(x + 0.5 * len * dir, dir, sig);
-        vec3 att = exp(-sig * len);
-        // ∫₀^len T e^{−σs} e ds = T e (1 − e^{−σ len})/σ  (→ T e len as σ → 0)
-        L += T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
-        T *= att;
-      }
-      R.opl += dot(w, dir) * len;  // ∫ p·dx
-      x += dir * len;
-      if (leaving) break;
-      continue;
-    }
-    // One integration step of the ray equation.
-    vec3 x0 = x, w0 = w;
-    float n0 = nn.x;
-    vec3 k1x, k1w, k2x, k2w, k3x, k3w, k4x, k4w;
-    deriv(x, w, mode, k1x, k1w);
-    if (integrator == EIKON_INT_EULER) {
-      x += ds * k1x;
-      w += ds * k1w;
-    } else if (integrator == EIKON_INT_MIDPOINT) {
-      deriv(x + 0.5 * ds * k1x, w + 0.5 * ds * k1w, mode, k2x, k2w);
-      x += ds * k2x;
-      w += ds * k2w;
-    } else {
-      deriv(x + 0.5 * ds * k1x, w + 0.5 * ds * k1w, mode, k2x, k2w);
-      deriv(x + 0.5 * ds * k2x, w + 0.5 * ds * k2w, mode, k3x, k3w);
-      deriv(x + ds * k3x, w + ds * k3w, mode, k4x, k4w);
-      x += ds / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
-      w += ds / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
-    }
-    nn = sampleIndex(x, 0);
-    vec3 gradN = nn.yzw;
-    vec3 aHere = mode == 1 ? axisAt(x) : vec3(0.0);
-    bool eHere = mode == 1 && dot(aHere, aHere) >= 0.25;
-    vec4 ne = eHere ? sampleIndex(x, 1) : nn;
-    if (mode == 0) {
-      R.drift = max(R.drift, abs(length(w) - nn.x));
-      R.opl += 0.5 * (n0 + nn.x) * ds;
-    } else {
-      R.opl += 0.5 * dot(w0 + w, x - x0);
-      if (eHere) gradN = 0.5 * (nn.yzw + ne.yzw);
-    }
-    // Medium at the step midpoint (only sampled where the scene has any).
-    vec3 xm = 0.5 * (x0 + x);
-    if (hasFlag(EIKON_F_EMISSION)) L += T * colourOf(sampleEmission(xm)) * ds;
-    if (hasFlag(EIKON_F_ATTENUATION)) {
-      vec3 sig = attenuationAt(xm, 0.5 * (w0 + w), mode);
-      if (hasFlag(EIKON_F_LIT) && hasFlag(EIKON_F_SCATTER)) L += T * inScatter(xm, normalize(x - x0), sig) * ds;
-      T *= exp(-sig * ds);
-    }
-    if (hasFlag(EIKON_F_OPACITY) && sampleMedium(x, mode).w >= 0.5) {
-      // Surface emission: the emission field over the coverage (opacity ≥ 0.5 here), as the albedo.
-      L += T * (colourOf(sampleEmission(x)) / sampleMedium(x, mode).w + diffuseSurface(x, mode));
-      stopped = true;
-      break;
-    }
-    // Interface bookkeeping.
-    float g = max(length(nn.yzw), length(ne.yzw)) * h;
-    if (!inLayer && g > thrLow) {
-      inLayer = true;
-      wBefore = w0;
-      gAcc = vec3(0.0);
-      peak = 0.0;
-      xOpen = x0;
-    }
-    if (inLayer) {
-      gAcc += gradN * ds;
-      peak = max(peak, g);
-      if (g <= thrLow) {
-        inLayer = false;
-        vec3 N = dot(gAcc, gAcc) > 0.0 ? normalize(gAcc) : vec3(0.0);
-        if (dot(N, N) > 0.0 && abs(dot(x - xOpen, N)) <= 12.0 * h) {
-          // Back on the constraint surface H = 0 (|w| = n for the o-mode, wᵀM_e w = 1 for the
-          // e-mode) along the layer normal: the tangential part of w is what the interface
-          // conserves (Snell). The stored central-difference gradient is not exactly the
-          // derivative of the trilinear n, which makes H drift by ~1e-4 across a sharp layer.
-          // Only for thin layers (interfaces no thicker than 12 voxels along their normal),
-          // never across gradient-index bodies; skipped if the normal part would change much.
-          float wn = dot(w, N);
-          vec3 wt = w - wn * N;
-          if (!eHere) {
-            float rem = nn.x * nn.x - dot(wt, wt);
-            if (rem > 0.25 * wn * wn) w = wt + sign(wn) * sqrt(rem) * N;
-          } else {
-            // (wt + λN)ᵀ M (wt + λN) = 1: qa λ² + 2 qb λ + qc = 0, root nearest the current wn.
-            vec3 MN = applyM(N, aHere, nn.x, ne.x);
-            float qa = dot(N, MN), qb = dot(wt, MN), qc = dot(wt, applyM(wt, aHere, nn.x, ne.x)) - 1.0;
-            float disc = qb * qb - qa * qc;
-            if (disc > 0.0) {
-              float l1 = (-qb + sqrt(disc)) / qa, l2 = (-qb - sqrt(disc)) / qa;
-              float lam = abs(l1 - wn) < abs(l2 - wn) ? l1 : l2;
-              if (abs(lam - wn) < 0.5 * abs(wn)) w = wt + lam * N;
-            }
-          }
-        }
-        if (peak > thrIface && !hasFlag(EIKON_F_NO_FRESNEL) && dot(N, N) > 0.0) {
-          vec3 dIn = normalize(wBefore), dOut = normalize(w);
-          float ci = dot(dIn, N), co = dot(dOut, N);
-          float n1 = length(wBefore), n2 = length(w);
-          if (ci * co > 0.0) {
-            // Which side is the crystal? The end of the layer with the larger birefringence (the
-            // axis field itself is dilated into the air around crystals).
-            float bOut = abs(sampleIndex(x, 1).x - sampleIndex(x, 0).x);
-            float bIn = abs(sampleIndex(xOpen, 1).x - sampleIndex(xOpen, 0).x);
-            bool outCrystal = bOut >= bIn;
-            vec3 a = axisAt(outCrystal ? x : xOpen);
-            float wsw = sWeight(outCrystal ? dOut : dIn, a, N, dIn, mode);
-            vec2 rsp = fresnelRsRp(abs(ci), n1, n2);
-            float Rf = hasFlag(EIKON_F_UNIAXIAL) ? wsw * rsp.x + (1.0 - wsw) * rsp.y : 0.5 * (rsp.x + rsp.y);
-            if (n2 > n1) L += environmentWeighted(T * Rf, reflect(dIn, N));
-            T *= 1.0 - Rf;
-            R.interfaces++;
-          } else {
-            R.tir++;
-          }
-        }
-      }
-    }
-    // Left the volume? The ray is straight outside (fields clamp to the uniform edge voxels).
-    if (any(lessThan(x, bmin)) || any(greaterThan(x, bmax))) {
-      vec3 dd = normalize(x - x0);
-      float a0, a1;
-      boxHit(x0, dd, bmin, bmax, a0, a1);
-      float stepLen = length(x - x0);
-      float keep = clamp(max(a1, 0.0) / max(stepLen, 1e-30), 0.0, 1.0);
-      R.opl -= (1.0 - keep) * 0.5 * dot(w0 + w, x - x0);
-      x = x0 + (x - x0) * keep;
-      // w at the boundary, not at the overshoot (linear within the step).
-      w = mix(w0, w, keep);
-      break;
-    }
+    const int straight = straightStep(S, R, mode);
+    if (straight == kStepStop) break;
+    if (straight == kStepTaken) continue;
+    StepEnd E = integrateStep(S, R, mode);
+    if (mediumAlongStep(S, E, mode)) break;
+    layerStep(S, R, E, mode);
+    if (clipToVolume(S, R, E)) break;
   }
   R.steps = steps;
-  R.exit_point = x;
-  R.exit_dir = rayDirection(x, w, mode);
-  R.wave_normal = normalize(w);
-  R.left = !stopped && steps < maxSteps;
-  if (R.left) L += environmentWeighted(T, R.exit_dir);
-  R.radiance = L;
-  R.throughput = T;
+  R.exit_point = S.x;
+  R.exit_dir = rayDirection(S.x, S.w, mode);
+  R.wave_normal = normalize(S.w);
+  R.left = !S.stopped && steps < maxSteps;
+  if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
+  R.radiance = S.L;
+  R.throughput = S.T;
   return R;
 }
 

@@ -43,10 +43,10 @@
 layout(local_size_x = EIKON_WAVE_WG) in;
 
 layout(std430, binding = EIKON_WB_PARAMS) readonly buffer ParamsBuf { WaveParams P; };
-layout(binding = EIKON_WB_INDEX_A, rgba32f) readonly uniform image3D idxA;
-layout(binding = EIKON_WB_INDEX_B, rgba32f) readonly uniform image3D idxB;
-layout(binding = EIKON_WB_INDEX_C, rgba32f) readonly uniform image3D idxC;
-layout(binding = EIKON_WB_MEDIUM, rgba32f) readonly uniform image3D medium;
+layout(binding = EIKON_WB_INDEX_A, rgba32f) readonly uniform image3D idxOA;
+layout(binding = EIKON_WB_INDEX_B, rgba32f) readonly uniform image3D idxOB;
+layout(binding = EIKON_WB_INDEX_C, rgba32f) readonly uniform image3D idxOC;
+layout(binding = EIKON_WB_MEDIUM, rgba32f) readonly uniform image3D mediumO;
 layout(binding = EIKON_WB_INDEX_E_A, rgba32f) readonly uniform image3D idxEA;
 layout(binding = EIKON_WB_INDEX_E_B, rgba32f) readonly uniform image3D idxEB;
 layout(binding = EIKON_WB_INDEX_E_C, rgba32f) readonly uniform image3D idxEC;
@@ -78,108 +78,39 @@ void storeOther(uint i, WavePatch p) {
     patchesB[i] = p;
 }
 
-bool hasFlag(int f) { return (P.grid_dims.w & f) != 0; }
-
-// Trilinear stencil, cell-centred samples, clamp to edge (march.glsl stencilAt / VolumeField).
-struct Stencil {
-  ivec3 i0;
-  ivec3 i1;
-  vec3 f;
-};
-
-Stencil stencilAt(vec3 x) {
-  vec3 g = (x - P.grid_origin.xyz) * P.grid_max.w - 0.5;
-  vec3 fl = floor(g);
-  Stencil s;
-  s.f = g - fl;
-  ivec3 i = ivec3(fl);
-  ivec3 dmax = P.grid_dims.xyz - 1;
-  s.i0 = clamp(i, ivec3(0), dmax);
-  s.i1 = clamp(i + 1, ivec3(0), dmax);
-  return s;
-}
-
-#define TRI(img, s)                                                                              \
-  mix(mix(mix(imageLoad(img, s.i0), imageLoad(img, ivec3(s.i1.x, s.i0.y, s.i0.z)), s.f.x),      \
-          mix(imageLoad(img, ivec3(s.i0.x, s.i1.y, s.i0.z)), imageLoad(img, ivec3(s.i1.x, s.i1.y, s.i0.z)), s.f.x), \
-          s.f.y),                                                                                \
-      mix(mix(imageLoad(img, ivec3(s.i0.x, s.i0.y, s.i1.z)), imageLoad(img, ivec3(s.i1.x, s.i0.y, s.i1.z)), s.f.x), \
-          mix(imageLoad(img, ivec3(s.i0.x, s.i1.y, s.i1.z)), imageLoad(img, s.i1), s.f.x), s.f.y), \
-      s.f.z)
-
-// (n, ∇n) at the simulator's wavelength.
-vec4 sampleIndex(vec3 x) {
-  Stencil s = stencilAt(x);
-  vec4 a = TRI(idxA, s);
-  if (hasFlag(EIKON_F_DISPERSIVE)) a += TRI(idxB, s) * P.wavelength.y + TRI(idxC, s) * P.wavelength.z;
-  return a;
-}
-
-// (n_e, ∇n_e) at the simulator's wavelength (e-mode only).
-vec4 sampleIndexE(vec3 x) {
-  Stencil s = stencilAt(x);
-  vec4 a = TRI(idxEA, s);
-  if (hasFlag(EIKON_F_DISPERSIVE)) a += TRI(idxEB, s) * P.wavelength.y + TRI(idxEC, s) * P.wavelength.z;
-  return a;
-}
+#define EIKON_FIELD_INV_H P.grid_max.w
+#define EIKON_FIELD_LAMBDA_UM P.wavelength.x
+#define EIKON_FIELD_IL2 P.wavelength.y
+#define EIKON_FIELD_IL4 P.wavelength.z
+#define EIKON_FIELD_HAS_AXIS true
+#include "field.glsl"
 
 bool eMode() { return P.control.w == 1; }
 
-// Optic axis at x (axisField in march.glsl / VolumeField): xyz unit axis (zero where isotropic),
-// w = 1/r for a radial field about the stored centre, else 0. Nearest voxel.
-vec4 axisField(vec3 x) {
-  ivec3 vi = clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_max.w)), ivec3(0), P.grid_dims.xyz - 1);
-  vec4 t = imageLoad(axisImg, vi);
-  if (t.w > -0.5) return vec4(t.xyz, 0.0);
-  vec3 d = x - t.xyz;
-  float r = length(d);
-  return r > 1e-6 ? vec4(d / r, 1.0 / r) : vec4(0.0, 0.0, 1.0, 0.0);
-}
-
-// M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e².
-vec3 applyM(vec3 p, vec3 a, float no, float ne) {
-  float pa = dot(p, a);
-  return a * (pa / (no * no)) + (p - a * pa) / (ne * ne);
-}
-
-// Wave vector along the unit direction s at x on the simulated mode's shell (onShell in wavefront.cpp).
+// Wave vector along the unit direction s at x on the simulated mode's shell (onModeShell in
+// core/light/seeding.cpp, which PatchStepper::onShell calls).
 vec3 onShell(vec3 x, vec3 s) {
-  float n = sampleIndex(x).x;
+  float n = sampleIndex(x, 0).x;
   if (eMode()) {
     vec3 a = axisField(x).xyz;
-    if (dot(a, a) >= 0.25) return s * inversesqrt(dot(s, applyM(s, a, n, sampleIndexE(x).x)));
+    if (hasAxis(a)) return onShellE(s, a, n, sampleIndex(x, 1).x);
   }
   return s * n;
 }
 
-// (σ at 612, 549, 465 nm, opacity); zero when the volume has neither.
-vec4 sampleMedium(vec3 x) {
+// (σ at 612, 549, 465 nm, opacity) of the o-mode; zero when the volume has neither.
+vec4 mediumAt(vec3 x) {
   if (!hasFlag(EIKON_F_ATTENUATION) && !hasFlag(EIKON_F_OPACITY)) return vec4(0.0);
-  Stencil s = stencilAt(x);
-  return TRI(medium, s);
+  return sampleMedium(x, 0);
 }
 
-// Band values → σ at λ (same rule as sigmaAt in wavefront.cpp and bandAt in march.glsl).
-float sigmaAt(vec3 rgb) {
-  float l = P.wavelength.x * 1000.0;
-  if (l <= 465.0) return rgb.b;
-  if (l >= 612.0) return rgb.r;
-  if (l <= 549.0) return rgb.b + (rgb.g - rgb.b) * (l - 465.0) / (549.0 - 465.0);
-  return rgb.g + (rgb.r - rgb.g) * (l - 549.0) / (612.0 - 549.0);
-}
-
+// Constant-time rates: dx/dt = w/n², dw/dt = ∇n/n; in a crystal of the e-mode eModeRates (field.glsl).
 void deriv(vec3 x, vec3 w, out vec3 dx, out vec3 dw) {
-  vec4 a = sampleIndex(x);
+  vec4 a = sampleIndex(x, 0);
   if (eMode()) {
     vec4 af = axisField(x);
-    vec3 ax = af.xyz;
-    if (dot(ax, ax) >= 0.25) {
-      vec4 e = sampleIndexE(x);
-      float pa = dot(w, ax), p2 = dot(w, w);
-      dx = applyM(w, ax, a.x, e.x);
-      dw = (pa * pa / (a.x * a.x * a.x)) * a.yzw + ((p2 - pa * pa) / (e.x * e.x * e.x)) * e.yzw;
-      // Radial axis field (∂a/∂x = (I − aaᵀ)/r): −(p·a)(1/n_o² − 1/n_e²)(p − (p·a)a)/r.
-      if (af.w > 0.0) dw -= pa * (1.0 / (a.x * a.x) - 1.0 / (e.x * e.x)) * (w - pa * ax) * af.w;
+    if (hasAxis(af.xyz)) {
+      eModeRates(w, af, a, sampleIndex(x, 1), dx, dw);
       return;
     }
   }
@@ -187,19 +118,14 @@ void deriv(vec3 x, vec3 w, out vec3 dx, out vec3 dw) {
   dw = a.yzw / a.x;
 }
 
-// e-mode attenuation per unit ray length at x for wave vector w: σ(θ)·cos ρ (attenuationAt in
-// march.glsl), at the simulator's wavelength; the o-mode σ where there is no axis.
+// e-mode attenuation per unit ray length at x for wave vector w: σ(θ)·cos ρ (attenuationE,
+// field.glsl), at the simulator's wavelength; the o-mode σ where there is no axis.
 float sigmaE(vec3 x, vec3 w) {
-  float so = sigmaAt(sampleMedium(x).xyz);
+  float so = bandAt(mediumAt(x).xyz);
   vec3 a = axisField(x).xyz;
-  if (dot(a, a) < 0.25 || !(dot(w, w) > 0.0)) return so;
-  float se = hasFlag(EIKON_F_ATTENUATION) ? sigmaAt(TRI(mediumE, stencilAt(x)).xyz) : 0.0;
-  float no = sampleIndex(x).x, ne = sampleIndexE(x).x;
-  vec3 sn = normalize(w);
-  float c = dot(sn, a), c2 = c * c, s2 = 1.0 - c2;
-  float n = inversesqrt(c2 / (no * no) + s2 / (ne * ne));
-  vec3 t = normalize(applyM(w, a, no, ne));
-  return n * n * n * (so * c2 / (no * no * no) + se * s2 / (ne * ne * ne)) * dot(sn, t);
+  if (!hasAxis(a) || !(dot(w, w) > 0.0)) return so;
+  float se = hasFlag(EIKON_F_ATTENUATION) ? bandAt(sampleMedium(x, 1).xyz) : 0.0;
+  return attenuationE(vec3(so), vec3(se), w, a, sampleIndex(x, 0).x, sampleIndex(x, 1).x).x;
 }
 
 void rk4(inout vec3 x, inout vec3 w, float dt) {
@@ -214,7 +140,7 @@ void rk4(inout vec3 x, inout vec3 w, float dt) {
 
 bool insideBounds(vec3 x) { return all(greaterThanEqual(x, P.grid_origin.xyz)) && all(lessThanEqual(x, P.grid_max.xyz)); }
 
-// Does the ray o + s·d (s ≥ 0) meet the bounds? (rayHitsBox in wavefront.cpp)
+// Does the ray o + s·d (s ≥ 0) meet the bounds? (rayHitsBox in core/light/seeding.h)
 bool rayHitsBox(vec3 o, vec3 d) {
   float t0 = 0.0, t1 = 1e30;
   for (int a = 0; a < 3; ++a) {
@@ -271,10 +197,7 @@ float maxEdgeOf(vec3 x[4]) {
 // docs/light-simulator.md, "Straight steps") ----
 
 // Skip distance D (voxels) of the voxel holding x (VolumeField::skipDistance: nearest voxel, clamped).
-float skipAt(vec3 x) {
-  ivec3 vi = clamp(ivec3(floor((x - P.grid_origin.xyz) * P.grid_max.w)), ivec3(0), P.grid_dims.xyz - 1);
-  return imageLoad(skipImg, vi).w;
-}
+float skipAt(vec3 x) { return imageLoad(skipImg, voxelAt(x)).w; }
 
 // The centre's straight path c0 + s·u, s ∈ [0, L], deposits flux(s)·len/h³ into every voxel it
 // crosses (flux(s) = E0·exp(−σs) at the piece's midpoint, len the piece's length), and
@@ -355,7 +278,7 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, out vec3 v[4]) {
     D[k] = skipAt(x[k]);
     if (D[k] < 2.0) return 0;
   }
-  if (sampleMedium(c0).w >= 0.5) return 0;
+  if (mediumAt(c0).w >= 0.5) return 0;
   const vec3 wm = 0.25 * (w[0] + w[1] + w[2] + w[3]);
   const float wl = length(wm);
   if (!(wl > 0.0)) return 0;
@@ -382,7 +305,7 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, out vec3 v[4]) {
     kmax = min(kmax, 1.0);
   } else if (ds1 > 0.0) {
     const vec3 m = c0 + 0.5 * dt * vc;
-    const float sigma = eMode() ? sigmaE(m, wm) : sigmaAt(sampleMedium(m).xyz);
+    const float sigma = eMode() ? sigmaE(m, wm) : bandAt(mediumAt(m).xyz);
     if (sigma > 0.0 && thr > 0.0) kmax = min(kmax, floor(log(flux.x / thr) / (sigma * ds1)) + 1.0);
   }
   if (kmax < 1.0) return 0;
@@ -403,6 +326,128 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, out vec3 v[4]) {
   return K;
 }
 
+// ---- One propagation, stage by stage (the same stages, under the same names, as the reference's
+// in core/reference/wavefront.cpp; docs/twins.md) ----
+
+// What a patch's step leaves for the stages after it.
+struct PatchStep {
+  int kStraight;  // time steps taken along straight lines (0: one RK4 step)
+  vec3 c0, c1;    // the centre before and after
+  vec3 wm0;       // the mean w before
+  vec3 dA, dB, dC, dD;  // straight step: the diagonals at the start and their change per time step
+  float ds;       // |c1 − c0|
+  float sigma;    // attenuation at the step's midpoint
+  float E0;       // flux before the step
+  float fluxMid;  // flux at the step's middle
+};
+
+vec3 meanOf(vec3 w[4]) { return 0.25 * (w[0] + w[1] + w[2] + w[3]); }
+
+// Advance the corners by one RK4 time step, or by k time steps along straight lines (w is then
+// unchanged: ∇n = 0), and count the time steps in state.w.
+PatchStep moveStep(inout vec3 x[4], inout vec3 w[4], inout WavePatch p) {
+  const float dt = P.step.x;
+  PatchStep st;
+  st.c0 = centreOf(x);
+  st.wm0 = meanOf(w);
+  vec3 vel[4];
+  st.kStraight = straightSteps(x, w, p.flux, p.state, vel);
+  st.dA = vec3(0.0), st.dB = vec3(0.0), st.dC = vec3(0.0), st.dD = vec3(0.0);
+  if (st.kStraight > 0) {
+    st.dA = x[2] - x[0], st.dB = dt * (vel[2] - vel[0]), st.dC = x[3] - x[1], st.dD = dt * (vel[3] - vel[1]);
+    const float T = float(st.kStraight) * dt;
+    for (int k = 0; k < 4; ++k) x[k] += T * vel[k];
+    p.state.w += st.kStraight;
+  } else {
+    for (int k = 0; k < 4; ++k) rk4(x[k], w[k], dt);
+    ++p.state.w;
+  }
+  st.c1 = centreOf(x);
+  st.ds = length(st.c1 - st.c0);
+  return st;
+}
+
+// flux ← flux·exp(−σΔs), σ at the midpoint of the centre's path; returns the medium there.
+vec4 attenuateStep(inout WavePatch p, inout PatchStep st, vec3 w[4]) {
+  const vec3 m = 0.5 * (st.c0 + st.c1);
+  const vec4 med = mediumAt(m);
+  st.sigma = eMode() ? sigmaE(m, 0.5 * (st.wm0 + meanOf(w))) : bandAt(med.xyz);
+  st.E0 = p.flux.x;
+  float att = exp(-st.sigma * st.ds);
+  st.fluxMid = p.flux.x * exp(-0.5 * st.sigma * st.ds);
+  p.flux.w += p.flux.x * (1.0 - att);
+  p.flux.x *= att;
+  return med;
+}
+
+// Splat the step (splatSegment after a straight step, else splatAt at the midpoint); returns the
+// propagation direction: ŵ for the o-mode, the centre's motion (the energy direction) for the e-mode.
+vec3 splatStep(PatchStep st, vec3 x[4], vec3 w[4]) {
+  const float area = length(0.5 * cross(x[2] - x[0], x[3] - x[1]));
+  const vec3 wm = meanOf(w);
+  const float wl = length(wm);
+  const vec3 dir = eMode() ? (st.ds > 0.0 ? (st.c1 - st.c0) / st.ds : vec3(0.0)) : (wl > 0.0 ? wm / wl : vec3(0.0));
+  if (st.kStraight > 0) {
+    if (st.ds > 0.0)
+      splatSegment(st.c0, (st.c1 - st.c0) / st.ds, st.ds, st.E0, st.sigma, dir, st.ds / float(st.kStraight), st.dA,
+                   st.dB, st.dC, st.dD);
+  } else {
+    splatAt(0.5 * (st.c0 + st.c1), st.fluxMid * st.ds * P.step.w, area > 0.0 ? st.fluxMid / area : 0.0, dir);
+  }
+  return dir;
+}
+
+// Probe plane: the centre crossed it over this step (the side before the step is that of c0;
+// the reference keeps the side through splits, which differs only for a child whose centre
+// lies across the plane from its parent's).
+void probeStep(PatchStep st, inout vec4 probePos, inout vec3 probeDir) {
+  const int probeAxis = P.control.x;
+  if (probeAxis < 0) return;
+  const float pp = P.probe.x;
+  const bool before = st.c0[probeAxis] >= pp, after = st.c1[probeAxis] >= pp;
+  if (before == after) return;
+  const float sg = after ? 1.0 : -1.0, span = st.c1[probeAxis] - st.c0[probeAxis];
+  const float f = span != 0.0 ? clamp((pp - st.c0[probeAxis]) / span, 0.0, 1.0) : 0.5;
+  // Flux at the crossing: mid-step (RK4 step) or at the crossing point (straight step).
+  const float fx = st.kStraight > 0 ? st.E0 * exp(-st.sigma * f * st.ds) : st.fluxMid;
+  probePos += sg * fx * vec4(st.c0 + f * (st.c1 - st.c0), 1.0);
+  if (st.ds > 0.0) probeDir += sg * fx * (st.c1 - st.c0) / st.ds;
+}
+
+// The end-of-step tests, in the reference's order: opaque, left, caustic (or passed through),
+// energy, split. True if the patch stops here (p.state.x says why).
+bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) {
+  if (med.w >= 0.5) {
+    p.state.x = EIKON_PATCH_OPAQUE;
+    return true;
+  }
+  const vec3 wm = meanOf(w);
+  const float wl = length(wm);
+  if (insideBounds(st.c1)) {
+    p.state.z = 1;
+  } else if (p.state.z != 0 || !(wl > 0.0) || !rayHitsBox(st.c1, wm / wl)) {
+    p.state.x = EIKON_PATCH_LEFT;
+    return true;
+  }
+  const float o = dot(0.5 * cross(x[2] - x[0], x[3] - x[1]), wm);
+  if ((o > 0.0 && p.state.y < 0) || (o < 0.0 && p.state.y > 0)) {
+    if (P.options.y == 0) {
+      p.state.x = EIKON_PATCH_CAUSTIC;
+      return true;
+    }
+    p.state.y = -p.state.y;  // pass_caustics: through the focal line, orientation reversed
+  }
+  if (p.flux.x < P.step.z * p.flux.z) {
+    p.state.x = EIKON_PATCH_ENERGY;
+    return true;
+  }
+  if (maxEdgeOf(x) > P.step.y) {
+    p.state.x = EIKON_PATCH_SPLIT;
+    return true;
+  }
+  return false;
+}
+
 void propagate(uint id) {
   if (id >= pc.control.x) return;
   WavePatch p = loadPatch(id);
@@ -417,89 +462,17 @@ void propagate(uint id) {
   }
   vec4 probePos = vec4(0.0);
   vec3 probeDir = vec3(0.0);
-  const int probeAxis = P.control.x;
   vec3 x[4], w[4];
   for (int k = 0; k < 4; ++k) {
     x[k] = p.x[k].xyz;
     w[k] = p.w[k].xyz;
   }
-  const float dt = P.step.x, maxEdge = P.step.y;
   for (int it = 0; it < P.control.y && p.state.w < P.control.z; ++it) {
-    vec3 c0 = centreOf(x), wm0 = 0.25 * (w[0] + w[1] + w[2] + w[3]);
-    vec3 vel[4];
-    const int kStraight = straightSteps(x, w, p.flux, p.state, vel);
-    vec3 dA = vec3(0.0), dB = vec3(0.0), dC = vec3(0.0), dD = vec3(0.0);
-    if (kStraight > 0) {
-      // Straight step: k time steps along straight lines; w is unchanged (∇n = 0).
-      dA = x[2] - x[0], dB = dt * (vel[2] - vel[0]), dC = x[3] - x[1], dD = dt * (vel[3] - vel[1]);
-      const float T = float(kStraight) * dt;
-      for (int k = 0; k < 4; ++k) x[k] += T * vel[k];
-      p.state.w += kStraight;
-    } else {
-      for (int k = 0; k < 4; ++k) rk4(x[k], w[k], dt);
-      ++p.state.w;
-    }
-    vec3 c1 = centreOf(x), m = 0.5 * (c0 + c1);
-    float ds = length(c1 - c0);
-    vec4 med = sampleMedium(m);
-    float sigma = eMode() ? sigmaE(m, 0.5 * (wm0 + 0.25 * (w[0] + w[1] + w[2] + w[3]))) : sigmaAt(med.xyz);
-    const float E0 = p.flux.x;
-    float att = exp(-sigma * ds), fluxMid = p.flux.x * exp(-0.5 * sigma * ds);
-    p.flux.w += p.flux.x * (1.0 - att);
-    p.flux.x *= att;
-    vec3 va = 0.5 * cross(x[2] - x[0], x[3] - x[1]);
-    float area = length(va);
-    vec3 wm = 0.25 * (w[0] + w[1] + w[2] + w[3]);
-    float wl = length(wm);
-    // o-mode: ŵ; e-mode: the energy direction, that of the centre's motion (as the reference).
-    vec3 dir = eMode() ? (ds > 0.0 ? (c1 - c0) / ds : vec3(0.0)) : (wl > 0.0 ? wm / wl : vec3(0.0));
-    if (kStraight > 0) {
-      if (ds > 0.0) splatSegment(c0, (c1 - c0) / ds, ds, E0, sigma, dir, ds / float(kStraight), dA, dB, dC, dD);
-    } else {
-      splatAt(m, fluxMid * ds * P.step.w, area > 0.0 ? fluxMid / area : 0.0, dir);
-    }
-    // Probe plane: the centre crossed it over this step (the side before the step is that of c0;
-    // the reference keeps the side through splits, which differs only for a child whose centre
-    // lies across the plane from its parent's).
-    if (probeAxis >= 0) {
-      const float pp = P.probe.x;
-      const bool before = c0[probeAxis] >= pp, after = c1[probeAxis] >= pp;
-      if (before != after) {
-        const float sg = after ? 1.0 : -1.0, span = c1[probeAxis] - c0[probeAxis];
-        const float f = span != 0.0 ? clamp((pp - c0[probeAxis]) / span, 0.0, 1.0) : 0.5;
-        // Flux at the crossing: mid-step (RK4 step) or at the crossing point (straight step).
-        const float fx = kStraight > 0 ? E0 * exp(-sigma * f * ds) : fluxMid;
-        probePos += sg * fx * vec4(c0 + f * (c1 - c0), 1.0);
-        if (ds > 0.0) probeDir += sg * fx * (c1 - c0) / ds;
-      }
-    }
-    if (med.w >= 0.5) {
-      p.state.x = EIKON_PATCH_OPAQUE;
-      break;
-    }
-    if (insideBounds(c1)) {
-      p.state.z = 1;
-    } else if (p.state.z != 0 || !(wl > 0.0) || !rayHitsBox(c1, wm / wl)) {
-      p.state.x = EIKON_PATCH_LEFT;
-      break;
-    }
-    float o = dot(va, wm);
-    if ((o > 0.0 && p.state.y < 0) || (o < 0.0 && p.state.y > 0)) {
-      if (P.options.y != 0) {
-        p.state.y = -p.state.y;  // pass_caustics: through the focal line, orientation reversed
-      } else {
-        p.state.x = EIKON_PATCH_CAUSTIC;
-        break;
-      }
-    }
-    if (p.flux.x < P.step.z * p.flux.z) {
-      p.state.x = EIKON_PATCH_ENERGY;
-      break;
-    }
-    if (maxEdgeOf(x) > maxEdge) {
-      p.state.x = EIKON_PATCH_SPLIT;
-      break;
-    }
+    PatchStep st = moveStep(x, w, p);
+    const vec4 med = attenuateStep(p, st, w);
+    splatStep(st, x, w);
+    probeStep(st, probePos, probeDir);
+    if (endOfStep(p, st, med, x, w)) break;
   }
   p.x[0] = vec4(x[0], probePos.x);
   p.x[1] = vec4(x[1], probePos.y);

@@ -1,0 +1,61 @@
+// The CPU twin's field/medium layer: see field.h (GPU twin: shaders/field.glsl).
+#include "core/reference/field.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "optics/pleochroism.h"
+
+namespace eikon {
+
+// ------------------------------------------------------------------ field.glsl's functions
+namespace field {
+
+glm::dvec4 sampleIndex(const Field& f, const glm::dvec3& x, double il2, double il4, int mode) {
+  double n;
+  glm::dvec3 g;
+  if (mode == 0)
+    f.index(x, il2, il4, n, g);
+  else
+    f.indexE(x, il2, il4, n, g);
+  return {n, g};
+}
+
+glm::dvec4 sampleMedium(const Field& f, const glm::dvec3& x, int mode) {
+  return mode == 0 ? f.medium(x) : f.mediumE(x);
+}
+
+double bandAt(const glm::dvec3& rgb, double l) {
+  if (l <= 465.0) return rgb.b;
+  if (l >= 612.0) return rgb.r;
+  if (l <= 549.0) return rgb.b + (rgb.g - rgb.b) * (l - 465.0) / (549.0 - 465.0);
+  return rgb.g + (rgb.r - rgb.g) * (l - 549.0) / (612.0 - 549.0);
+}
+
+glm::dvec4 axisField(const Field& f, const glm::dvec3& x) { return f.axisField(x); }
+
+bool hasAxis(const glm::dvec3& a) { return glm::dot(a, a) >= 0.25; }
+
+glm::dvec3 applyM(const glm::dvec3& p, const glm::dvec3& a, double no, double ne) {
+  const double pa = glm::dot(p, a);
+  return a * pa / (no * no) + (p - a * pa) / (ne * ne);
+}
+
+void eModeRates(const glm::dvec3& p, const glm::dvec4& af, const glm::dvec4& o, const glm::dvec4& e,
+                glm::dvec3& Mp, glm::dvec3& dp) {
+  const glm::dvec3 a(af), go(o.y, o.z, o.w), ge(e.y, e.z, e.w);
+  const double no = o.x, ne = e.x, pa = glm::dot(p, a), p2 = glm::dot(p, p);
+  Mp = applyM(p, a, no, ne);
+  dp = (pa * pa / (no * no * no)) * go + ((p2 - pa * pa) / (ne * ne * ne)) * ge;
+  if (af.w > 0.0) dp -= pa * (1.0 / (no * no) - 1.0 / (ne * ne)) * (p - pa * a) * af.w;
+}
+
+glm::dvec3 attenuationE(const glm::dvec3& so, const glm::dvec3& se, const glm::dvec3& w,
+                        const glm::dvec3& a, double no, double ne) {
+  const glm::dvec3 s = glm::normalize(w), t = glm::normalize(applyM(w, a, no, ne));
+  const double theta = std::acos(std::clamp(glm::dot(s, a), -1.0, 1.0));
+  return extraordinaryAttenuation(theta, no, ne, so, se) * glm::dot(s, t);
+}
+
+}  // namespace field
+}  // namespace eikon
