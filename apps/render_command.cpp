@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "apps/commands.h"
-#include "apps/light_cache.h"
 #include "apps/progress.h"
 #include "core/io/exr.h"
+#include "core/light/light_cache.h"
 #include "core/render/render_defaults.h"
 #include "core/session/session.h"
 #include "core/vk/context.h"
@@ -133,7 +133,7 @@ LightRequest lightRequest(const RenderArgs& a) {
 }
 
 std::filesystem::path lightCacheDir(const RenderArgs& a) {
-  return a.light_cache.empty() ? cli::defaultLightCacheDir() : std::filesystem::path(a.light_cache);
+  return a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache);
 }
 
 /// A warning, or with --strict the error it becomes.

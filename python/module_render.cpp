@@ -9,8 +9,8 @@
 #include <mutex>
 #include <optional>
 
-#include "apps/light_cache.h"
 #include "core/io/exr.h"
+#include "core/light/light_cache.h"
 #include "core/vk/context.h"
 #include "python/module.h"
 
@@ -72,7 +72,7 @@ std::shared_ptr<Prepared> cachedPrepared(const std::shared_ptr<Scene>& s) {
 std::string lightCacheDir(const py::object& light_cache) {
   if (light_cache.is_none()) return {};
   if (py::isinstance<py::bool_>(light_cache))
-    return light_cache.cast<bool>() ? cli::defaultLightCacheDir().string() : std::string();
+    return light_cache.cast<bool>() ? defaultLightCacheDir().string() : std::string();
   return py::str(light_cache).cast<std::string>();
 }
 

@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/light/seeding.h"
+
 namespace eikon {
 namespace {
 
@@ -23,49 +25,14 @@ double sigmaAt(const glm::dvec3& rgb, double l) {
   return rgb.g + (rgb.r - rgb.g) * (l - 549.0) / (612.0 - 549.0);
 }
 
-glm::dvec3 centre(const Patch& p) { return 0.25 * (p.x[0] + p.x[1] + p.x[2] + p.x[3]); }
-glm::dvec3 meanW(const Patch& p) { return 0.25 * (p.w[0] + p.w[1] + p.w[2] + p.w[3]); }
-/// Vector area (normal · area) of the quad from its diagonals; exact for planar quads.
-glm::dvec3 vectorArea(const Patch& p) { return 0.5 * glm::cross(p.x[2] - p.x[0], p.x[3] - p.x[1]); }
-int orientationOf(const Patch& p) {
-  double s = glm::dot(vectorArea(p), meanW(p));
-  return s > 0 ? 1 : (s < 0 ? -1 : 0);
-}
-
-bool inside(const glm::dvec3& x, const glm::dvec3& lo, const glm::dvec3& hi) {
-  return x.x >= lo.x && x.y >= lo.y && x.z >= lo.z && x.x <= hi.x && x.y <= hi.y && x.z <= hi.z;
-}
-
-/// Does the ray o + s·d (s ≥ 0) meet the box?
-bool rayHitsBox(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& lo, const glm::dvec3& hi) {
-  double t0 = 0.0, t1 = 1e300;
-  for (int a = 0; a < 3; ++a) {
-    if (d[a] == 0.0) {
-      if (o[a] < lo[a] || o[a] > hi[a]) return false;
-      continue;
-    }
-    double ta = (lo[a] - o[a]) / d[a], tb = (hi[a] - o[a]) / d[a];
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-  }
-  return t0 <= t1;
-}
-
-/// Solid angle of the spherical triangle with unit vertices a, b, c (Van Oosterom & Strackee).
-double triangleSolidAngle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-  double num = std::abs(glm::dot(a, glm::cross(b, c)));
-  double den = 1.0 + glm::dot(a, b) + glm::dot(b, c) + glm::dot(c, a);
-  return 2.0 * std::atan2(num, den);
-}
-
-bool hasAxis(const glm::dvec3& a) { return glm::dot(a, a) >= 0.25; }  // as the marcher: zero outside crystals
-
-/// M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e² (docs/design.md §2).
-glm::dvec3 applyM(const glm::dvec3& p, const glm::dvec3& a, double no, double ne) {
-  const double pa = glm::dot(p, a);
-  return a * (pa / (no * no)) + (p - a * pa) / (ne * ne);
-}
+// Patch geometry shared with the seeding (core/light/seeding.h).
+using light::applyM;
+using light::centre;
+using light::hasAxis;
+using light::inside;
+using light::meanW;
+using light::rayHitsBox;
+using light::vectorArea;
 
 /// One chunk of a run (WavefrontSettings::threads): chunk c advances slice c of every step's
 /// list, n·c/T ≤ i < n·(c + 1)/T (n patches, T chunks), always on the same thread. It splats into
@@ -179,157 +146,18 @@ constexpr size_t kMinPatchesPerChunk = 64;
 }  // namespace
 
 glm::dvec3 WavefrontSimulator::onShell(const glm::dvec3& x, const glm::dvec3& s) const {
-  double n;
-  glm::dvec3 g;
-  field_.index(x, il2_, il4_, n, g);
-  if (s_.mode == 1) {
-    const glm::dvec3 a(field_.axisField(x));
-    if (hasAxis(a)) {
-      double ne;
-      field_.indexE(x, il2_, il4_, ne, g);
-      return s / std::sqrt(glm::dot(s, applyM(s, a, n, ne)));
-    }
-  }
-  return n * s;
+  return onModeShell(field_, s_.mode, il2_, il4_, x, s);
 }
 
 WavefrontSimulator::WavefrontSimulator(const Field& field, const Grid& splat_grid, const WavefrontSettings& settings)
-    : field_(field), grid_(splat_grid), s_(settings) {
-  if (!(grid_.h > 0) || grid_.count() == 0) throw std::invalid_argument("wavefront: empty splat grid");
-  if (s_.dt <= 0) s_.dt = 0.5 * grid_.h;
-  if (s_.point_radius <= 0) s_.point_radius = 0.5 * grid_.h;
-  if (!(s_.split_span_voxels > 0)) throw std::invalid_argument("wavefront: split_span_voxels must be > 0");
-  if (!(s_.seed_span_voxels > 0)) throw std::invalid_argument("wavefront: seed_span_voxels must be > 0");
-  if (s_.max_steps < 1) throw std::invalid_argument("wavefront: max_steps must be >= 1");
-  if (s_.max_patches < 1) throw std::invalid_argument("wavefront: max_patches must be >= 1");
-  if (s_.point_cells_per_face < 1) throw std::invalid_argument("wavefront: point_cells_per_face must be >= 1");
-  if (!(s_.wavelength_nm > 0)) throw std::invalid_argument("wavefront: wavelength must be > 0");
-  if (s_.mode != 0 && s_.mode != 1) throw std::invalid_argument("wavefront: mode must be 0 (o) or 1 (e)");
-  if (s_.beam_min_cells < 1) throw std::invalid_argument("wavefront: beam_min_cells must be >= 1");
-  if (s_.threads < 0) throw std::invalid_argument("wavefront: threads must be >= 0");
+    : field_(field), grid_(splat_grid), s_(checkedWavefrontSettings(settings, splat_grid)) {
   const double l_um = s_.wavelength_nm * 1e-3;
   il2_ = 1.0 / (l_um * l_um);
   il4_ = il2_ * il2_;
 }
 
 std::vector<Patch> WavefrontSimulator::seed(const Light& light) const {
-  const glm::dvec3 lo = field_.boundsMin(), hi = field_.boundsMax();
-  std::vector<Patch> out;
-  if (light.type == Light::Type::Directional) {
-    const double len = glm::length(light.direction);
-    if (!(len > 0)) throw std::invalid_argument("wavefront: directional light without a direction");
-    const glm::dvec3 d = light.direction / len;
-    // Basis with u × v = d: a is the coordinate axis least aligned with d.
-    int ai = 0;
-    for (int a = 1; a < 3; ++a)
-      if (std::abs(d[a]) < std::abs(d[ai])) ai = a;
-    glm::dvec3 a(0.0);
-    a[ai] = 1.0;
-    const glm::dvec3 u = glm::normalize(glm::cross(a, d)), v = glm::cross(d, u);
-    double s0 = 1e300, umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
-    for (int c = 0; c < 8; ++c) {
-      glm::dvec3 p((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-      s0 = std::min(s0, glm::dot(p, d));
-      umin = std::min(umin, glm::dot(p, u)), umax = std::max(umax, glm::dot(p, u));
-      vmin = std::min(vmin, glm::dot(p, v)), vmax = std::max(vmax, glm::dot(p, v));
-    }
-    double edge = s_.seed_span_voxels * grid_.h;
-    const double R = light.beam_radius;
-    const bool beam = R > 0;
-    int nu, nv;
-    double du, dv;
-    double pu = 0, pv = 0;  // beam axis in the launch plane
-    if (beam) {
-      // A grid of exact squares centred on the beam axis, symmetric about it in u and v, so that
-      // the launched cells (centre within R) form a disc whose flux centroid is on the axis.
-      edge = std::min(edge, R / s_.beam_min_cells);
-      pu = glm::dot(light.position, u), pv = glm::dot(light.position, v);
-      const int half = int(std::ceil(R / edge - 1e-9));
-      nu = nv = 2 * half;
-      du = dv = edge;
-      umin = pu - half * edge, vmin = pv - half * edge;
-    } else {
-      nu = std::max(1, int(std::ceil((umax - umin) / edge - 1e-9)));
-      nv = std::max(1, int(std::ceil((vmax - vmin) / edge - 1e-9)));
-      du = (umax - umin) / nu, dv = (vmax - vmin) / nv;
-    }
-    const glm::dvec3 base = s0 * d;
-    for (int j = 0; j < nv; ++j)
-      for (int i = 0; i < nu; ++i) {
-        const double uc[4] = {umin + i * du, umin + (i + 1) * du, umin + (i + 1) * du, umin + i * du};
-        const double vc[4] = {vmin + j * dv, vmin + j * dv, vmin + (j + 1) * dv, vmin + (j + 1) * dv};
-        if (beam) {
-          const double cu = umin + (i + 0.5) * du - pu, cv = vmin + (j + 0.5) * dv - pv;
-          if (cu * cu + cv * cv > R * R) continue;
-        }
-        Patch p;
-        for (int k = 0; k < 4; ++k) {
-          p.x[size_t(k)] = base + uc[k] * u + vc[k] * v;
-          p.w[size_t(k)] = onShell(p.x[size_t(k)], d);
-        }
-        if (!rayHitsBox(centre(p), d, lo, hi)) continue;
-        p.area0 = du * dv;
-        p.energy = light.irradiance * p.area0;
-        p.orientation = orientationOf(p);
-        p.seed_energy = p.energy;
-        out.push_back(p);
-      }
-  } else {
-    const bool spot = light.type == Light::Type::Spot;
-    int N = s_.point_cells_per_face;
-    glm::dvec3 axis(0.0);
-    double cosCone = -2.0;
-    if (spot) {
-      const double len = glm::length(light.direction);
-      if (!(len > 0)) throw std::invalid_argument("wavefront: spot light without a direction");
-      if (!(light.cone_half_angle_deg > 0)) throw std::invalid_argument("wavefront: spot light cone must be > 0");
-      axis = light.direction / len;
-      const double half = light.cone_half_angle_deg * 3.14159265358979323846 / 180.0;
-      cosCone = std::cos(half);
-      // The cone meets a cube face (at distance 1) in a disc of radius ≈ tan(half); a cell edge
-      // there is 2/N, so N ≥ 2·beam_min_cells/tan(half) puts beam_min_cells cells across it.
-      if (half < 0.25 * 3.14159265358979323846)
-        N = std::max(N, std::min(4096, int(std::ceil(2.0 * s_.beam_min_cells / std::tan(half)))));
-    }
-    const double eps = s_.point_radius;
-    const glm::dvec3 src = light.position;
-    for (int ax = 0; ax < 3; ++ax)
-      for (int sg = -1; sg <= 1; sg += 2) {
-        const int ua = (ax + 1) % 3, va = (ax + 2) % 3;
-        for (int j = 0; j < N; ++j)
-          for (int i = 0; i < N; ++i) {
-            const double a0 = -1.0 + 2.0 * i / N, a1 = -1.0 + 2.0 * (i + 1) / N;
-            const double b0 = -1.0 + 2.0 * j / N, b1 = -1.0 + 2.0 * (j + 1) / N;
-            if (spot) {
-              glm::dvec3 q(0.0);
-              q[ax] = sg;
-              q[ua] = 0.5 * (a0 + a1);
-              q[va] = 0.5 * (b0 + b1);
-              if (glm::dot(glm::normalize(q), axis) < cosCone) continue;
-            }
-            const double ac[4] = {a0, a1, a1, a0}, bc[4] = {b0, b0, b1, b1};
-            Patch p;
-            glm::dvec3 dir[4];
-            for (int k = 0; k < 4; ++k) {
-              glm::dvec3 q(0.0);
-              q[ax] = sg;
-              q[ua] = ac[k];
-              q[va] = bc[k];
-              dir[k] = glm::normalize(q);
-              p.x[size_t(k)] = src + eps * dir[k];
-              p.w[size_t(k)] = onShell(p.x[size_t(k)], dir[k]);
-            }
-            if (!rayHitsBox(centre(p), glm::normalize(meanW(p)), lo, hi)) continue;
-            const double omega = triangleSolidAngle(dir[0], dir[1], dir[2]) + triangleSolidAngle(dir[0], dir[2], dir[3]);
-            p.area0 = glm::length(vectorArea(p));
-            p.energy = light.irradiance * omega;
-            p.orientation = orientationOf(p);
-            p.seed_energy = p.energy;
-            out.push_back(p);
-          }
-      }
-  }
-  return out;
+  return seedWavefront(field_, grid_, s_, light);
 }
 
 WavefrontResult WavefrontSimulator::run(const Light& light) const {

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "core/reference/reference_marcher.h"
+#include "core/light/seeding.h"
 #include "core/vk/resources.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/scan.spv.h"
@@ -270,8 +270,7 @@ struct GpuWavefront::Impl {
     const Grid& g = vol.grid;
     WavefrontResult res;
     WavefrontStats& st = res.stats;
-    WavefrontSimulator cpu(field, g, s);
-    std::vector<Patch> seeds = cpu.seed(light);
+    std::vector<Patch> seeds = seedWavefront(field, g, s, light);
     st.seeded = seeds.size();
     const glm::dvec3 lo = g.origin, hi = g.boundsMax();
     double maxSeed = 0;

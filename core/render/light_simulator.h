@@ -1,5 +1,5 @@
 // The GPU light simulator (issue 6, docs/design.md §2): the wavefront of patches of
-// core/reference/wavefront.h propagated by a Vulkan compute kernel (shaders/wavefront.comp), one
+// core/light/wavefront_types.h propagated by a Vulkan compute kernel (shaders/wavefront.comp), one
 // thread per patch, RK4 in constant time on the four corners, attenuation, fixed-point atomic
 // splat into the irradiance/direction volumes. Same settings, seeds, kill rules, split rule and
 // result types as the CPU reference, which it is tested against (tests/core/wavefront_gpu_test.cpp).
@@ -30,7 +30,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/reference/wavefront.h"
+#include "core/light/wavefront_types.h"
 #include "core/vk/context.h"
 #include "core/volume/volume_set.h"
 

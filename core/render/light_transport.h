@@ -1,6 +1,6 @@
 // Light transport for a whole scene on the GPU: every light, wavelength band and mode of
-// planLighting() (core/volume/lighting.h) propagated by GpuWavefront and folded into the
-// VolumeSet's light volumes, which ViewRenderer then reads for in-scatter and diffuse surfaces.
+// planLighting() (core/light/lighting.h) propagated by GpuWavefront and folded into the
+// VolumeSet's light volumes by the shared driver (core/light/lighting_driver.h), which ViewRenderer then reads for in-scatter and diffuse surfaces.
 // The CPU twin is simulateLightingReference (core/reference/reference_lighting.h).
 //
 //   eikon::VolumeSet vol = eikon::voxelize(scene);
@@ -11,7 +11,7 @@
 // then, unlit.
 #pragma once
 
-#include "core/reference/reference_lighting.h"
+#include "core/light/lighting_driver.h"
 #include "core/vk/context.h"
 #include "core/volume/volume_set.h"
 

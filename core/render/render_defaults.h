@@ -11,7 +11,7 @@
 
 #include <string>
 
-#include "core/reference/reference_lighting.h"
+#include "core/light/lighting_driver.h"
 #include "core/scene/scene.h"
 #include "core/volume/march_types.h"
 

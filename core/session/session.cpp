@@ -2,7 +2,8 @@
 
 #include <cmath>
 
-#include "apps/light_cache.h"
+#include "core/light/light_cache.h"
+#include "core/reference/reference_lighting.h"
 #include "core/reference/reference_marcher.h"
 #include "core/render/light_transport.h"
 #include "core/render/render_defaults.h"
@@ -160,15 +161,15 @@ LightOutcome Session::simulateLight(const LightRequest& light, bool cpu_render,
   out.on_cpu = cpu_render || lightOnCpu(light.device, ctx_.get());
   const bool use_cache = !cache_dir.empty();
   // The key hashes every field of the volume (~0.3 s at 128³): only when the cache is used.
-  const uint64_t key = use_cache ? cli::lightCacheKey(*scene_, volume, lo, out.on_cpu) : 0;
+  const uint64_t key = use_cache ? lightCacheKey(*scene_, volume, lo, out.on_cpu) : 0;
   std::string notice;
-  if (use_cache && cli::loadLightCache(cache_dir, key, volume, &notice)) out.cached = true;
+  if (use_cache && loadLightCache(cache_dir, key, volume, &notice)) out.cached = true;
   if (!notice.empty()) out.warnings.push_back("light cache: " + printable(notice));
   if (!out.cached) {
     out.summary = out.on_cpu ? simulateLightingReference(*scene_, volume, lo)
                              : simulateLighting(context(), *scene_, volume, lo);
     if (use_cache) {
-      std::string err = cli::saveLightCache(cache_dir, key, volume);
+      std::string err = saveLightCache(cache_dir, key, volume);
       if (!err.empty()) out.warnings.push_back("light cache: " + err);
     }
   }

@@ -30,7 +30,7 @@
 #include <string>
 #include <vector>
 
-#include "core/reference/reference_lighting.h"
+#include "core/light/lighting_driver.h"
 #include "core/scene/scene.h"
 #include "core/volume/march_types.h"
 #include "core/volume/volume_set.h"

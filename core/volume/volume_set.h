@@ -22,7 +22,7 @@
 //   light_fluence : (φ_r, φ_g, φ_b, φ_Y) simulated fluence rate (W/mm², linear sRGB and luminance)
 //   light_flux    : (F_x, F_y, F_z, 0) the net flux vector of φ_Y (W/mm²): F/φ_Y is the mean
 //                   propagation direction, −F·N the irradiance on a surface of outward normal N
-//                   (both only after a light simulation: core/volume/lighting.h)
+//                   (both only after a light simulation: core/light/lighting.h)
 // The skip distance D is the Chebyshev distance (in voxels, capped) from the voxel to the nearest
 // voxel whose fields differ from a neighbour's: within (D − 1) voxels every field is constant,
 // so a ray may cross that distance in one straight step (docs/design.md's "distance volume").

@@ -1,7 +1,9 @@
-// From light-simulator runs to the light volumes the view renderer reads (docs/design.md §1: LightSimulator
-// → irradiance + light-direction volumes, per wavelength band, per mode → ViewRenderer).
+// From light-simulator runs to the light volumes the view renderer reads (docs/design.md §1:
+// LightSimulator → irradiance + light-direction volumes, per wavelength band, per mode →
+// ViewRenderer).
 //
-// The simulator (core/reference/wavefront.h, core/render/light_simulator.h) propagates one light
+// The simulator (core/reference/wavefront.h, core/render/light_simulator.h; both seeded by
+// core/light/seeding.h) propagates one light
 // at one wavelength in one mode. A lit scene needs, for every light, one run per wavelength band
 // (dispersive or attenuating scenes: the paths or the losses depend on λ) and per mode (uniaxial
 // scenes: o and e, each carrying half of the unpolarised power). planLighting() lists those runs
@@ -28,9 +30,8 @@
 //   }
 #pragma once
 
-#include <glm/glm.hpp>
-
 #include <cstddef>
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
 
@@ -40,12 +41,12 @@
 namespace eikon {
 
 struct LightingRun {
-  size_t light = 0;             ///< index into Scene::lights
+  size_t light = 0;  ///< index into Scene::lights
   double wavelength_nm = 587.56;
   double band_lo_nm = 380.0, band_hi_nm = 780.0;
-  int mode = 0;                 ///< 0: o (isotropic), 1: e
-  glm::dvec3 rgb{0.0};          ///< linear-sRGB weight of this run's unit-power volumes (incl. ½ per mode)
-  double luminance = 0.0;       ///< luminance weight (Y of rgb)
+  int mode = 0;         ///< 0: o (isotropic), 1: e
+  glm::dvec3 rgb{0.0};  ///< linear-sRGB weight of this run's unit-power volumes (incl. ½ per mode)
+  double luminance = 0.0;  ///< luminance weight (Y of rgb)
 };
 
 /// Bands used when `bands` ≤ 0: 12 for dispersive scenes (a prism's spectrum), 3 for attenuating

@@ -1,4 +1,4 @@
-#include "core/volume/lighting.h"
+#include "core/light/lighting.h"
 
 #include <algorithm>
 #include <cmath>
@@ -27,17 +27,20 @@ Light unitPowerLight(const Light& light) {
 }
 
 std::vector<LightingRun> planLighting(const Scene& scene, const VolumeSet& volume, int bands) {
-  if (bands > 64) throw std::invalid_argument("at most 64 light bands, got " + std::to_string(bands));
+  if (bands > 64)
+    throw std::invalid_argument("at most 64 light bands, got " + std::to_string(bands));
   const int K = bands > 0 ? bands : defaultLightBands(volume);
   const int modes = volume.uniaxial ? 2 : 1;
   const double lo = spectrum::kVisibleMinNm, hi = spectrum::kVisibleMaxNm;
   std::vector<LightingRun> runs;
   for (size_t li = 0; li < scene.lights.size(); ++li) {
     const Light& light = scene.lights[li];
-    glm::dvec3 total = spectrum::spectrumToLinearSrgb([&](double l) { return light.spectralPower(l); });
+    glm::dvec3 total =
+        spectrum::spectrumToLinearSrgb([&](double l) { return light.spectralPower(l); });
     double Y = luminanceOf(total);
     if (!(Y > 0))
-      throw std::invalid_argument("light " + std::to_string(li) + " has no luminous power in 380-780 nm");
+      throw std::invalid_argument("light " + std::to_string(li) +
+                                  " has no luminous power in 380-780 nm");
     for (int b = 0; b < K; ++b) {
       double b0 = lo + (hi - lo) * b / K, b1 = lo + (hi - lo) * (b + 1) / K;
       glm::dvec3 rgb = total;
@@ -109,7 +112,8 @@ void smoothLighting(VolumeSet& volume, double sigma_voxels, int threads) {
       if (field == &volume.light_flux && c == 3) continue;
       for (size_t i = 0; i < N; ++i) f[i] = (*field)[i][c] * weight[i];
       gaussianSmooth(f, volume.grid.dims, sigma_voxels, threads);
-      for (size_t i = 0; i < N; ++i) (*field)[i][c] = !opaque ? f[i] : den[i] > 1e-3f ? f[i] / den[i] : 0.0f;
+      for (size_t i = 0; i < N; ++i)
+        (*field)[i][c] = !opaque ? f[i] : den[i] > 1e-3f ? f[i] / den[i] : 0.0f;
     }
 }
 
@@ -117,9 +121,10 @@ std::string describeLighting(const std::vector<LightingRun>& runs, const Scene& 
   size_t modes = 1;
   for (const auto& r : runs) modes = std::max(modes, size_t(r.mode + 1));
   size_t bands = scene.lights.empty() ? 0 : runs.size() / modes / scene.lights.size();
-  return std::to_string(scene.lights.size()) + (scene.lights.size() == 1 ? " light" : " lights") + " x " +
-         std::to_string(bands) + (bands == 1 ? " band" : " bands") + " x " + std::to_string(modes) +
-         (modes == 1 ? " mode" : " modes") + " = " + std::to_string(runs.size()) + " runs";
+  return std::to_string(scene.lights.size()) + (scene.lights.size() == 1 ? " light" : " lights") +
+         " x " + std::to_string(bands) + (bands == 1 ? " band" : " bands") + " x " +
+         std::to_string(modes) + (modes == 1 ? " mode" : " modes") + " = " +
+         std::to_string(runs.size()) + " runs";
 }
 
 }  // namespace eikon

@@ -16,15 +16,16 @@
 #include <filesystem>
 #include <string>
 
-#include "core/reference/reference_lighting.h"
+#include "core/light/lighting_driver.h"
 #include "core/volume/volume_set.h"
 
-namespace eikon::cli {
+namespace eikon {
 
 /// $EIKON_CACHE_DIR, else $XDG_CACHE_HOME/eikon, else $HOME/.cache/eikon.
 std::filesystem::path defaultLightCacheDir();
 
-uint64_t lightCacheKey(const Scene& scene, const VolumeSet& volume, const LightingOptions& options, bool reference);
+uint64_t lightCacheKey(const Scene& scene, const VolumeSet& volume, const LightingOptions& options,
+                       bool reference);
 
 /// Fill volume.light_* from the cache; false if there is no valid entry for the key. An entry
 /// that exists but is corrupted (bad magic, truncated, wrong size, checksum mismatch) also gives
@@ -36,4 +37,4 @@ bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& v
 /// message (empty on success), not thrown: a cache that cannot be written only costs time.
 std::string saveLightCache(const std::filesystem::path& dir, uint64_t key, const VolumeSet& volume);
 
-}  // namespace eikon::cli
+}  // namespace eikon

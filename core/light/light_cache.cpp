@@ -1,6 +1,4 @@
-#include "apps/light_cache.h"
-
-#include "core/io/atomic_write.h"
+#include "core/light/light_cache.h"
 
 #include <cstdio>
 #include <cstdlib>
@@ -9,7 +7,9 @@
 #include <system_error>
 #include <vector>
 
-namespace eikon::cli {
+#include "core/io/atomic_write.h"
+
+namespace eikon {
 namespace {
 
 constexpr uint64_t kFormat = 2;  // 2: a checksum of the payload in the header
@@ -31,7 +31,9 @@ class Hasher {
     word(tail ^ (uint64_t(n) << 56));
   }
   template <typename T>
-  void value(const T& v) { bytes(&v, sizeof v); }
+  void value(const T& v) {
+    bytes(&v, sizeof v);
+  }
   template <typename T>
   void vec(const std::vector<T>& v) {
     value(v.size());
@@ -70,12 +72,15 @@ std::filesystem::path entryPath(const std::filesystem::path& dir, uint64_t key) 
 
 std::filesystem::path defaultLightCacheDir() {
   if (const char* d = std::getenv("EIKON_CACHE_DIR"); d && *d) return d;
-  if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d) return std::filesystem::path(d) / "eikon";
-  if (const char* d = std::getenv("HOME"); d && *d) return std::filesystem::path(d) / ".cache" / "eikon";
+  if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d)
+    return std::filesystem::path(d) / "eikon";
+  if (const char* d = std::getenv("HOME"); d && *d)
+    return std::filesystem::path(d) / ".cache" / "eikon";
   return {};
 }
 
-uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOptions& o, bool reference) {
+uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOptions& o,
+                       bool reference) {
   Hasher h;
   h.value(kFormat);
   h.value(reference);
@@ -151,7 +156,8 @@ bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& v
   return true;
 }
 
-std::string saveLightCache(const std::filesystem::path& dir, uint64_t key, const VolumeSet& volume) {
+std::string saveLightCache(const std::filesystem::path& dir, uint64_t key,
+                           const VolumeSet& volume) {
   if (dir.empty()) return "no cache directory (set EIKON_CACHE_DIR or HOME)";
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
@@ -161,7 +167,8 @@ std::string saveLightCache(const std::filesystem::path& dir, uint64_t key, const
     // Atomic (core/io): a reader sees the old entry or the whole new one, never a partial file.
     writeFileAtomically(final_path, [&](const std::filesystem::path& tmp) {
       std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      uint64_t format = kFormat, checksum = payloadChecksum(volume.light_fluence, volume.light_flux);
+      uint64_t format = kFormat,
+               checksum = payloadChecksum(volume.light_fluence, volume.light_flux);
       out.write(kMagic, 8);
       out.write(reinterpret_cast<const char*>(&format), sizeof format);
       out.write(reinterpret_cast<const char*>(&key), sizeof key);
@@ -180,4 +187,4 @@ std::string saveLightCache(const std::filesystem::path& dir, uint64_t key, const
   return {};
 }
 
-}  // namespace eikon::cli
+}  // namespace eikon
