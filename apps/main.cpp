@@ -5,6 +5,7 @@
 
 #include "apps/commands.h"
 #include "core/scene/messages.h"
+#include "core/session/session.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"eikon: eikonal rendering of gems, prisms and crystals (see README.md)", "eikon"};
@@ -20,6 +21,9 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::fputs(eikon::errorLine(std::string(e.what()) + " (run with --help)").c_str(), stderr);
     return 2;
+  } catch (const eikon::SettingError& e) {  // the session's range checks: the option as typed
+    std::fputs(eikon::errorLine("--" + std::string(e.what())).c_str(), stderr);
+    return 1;
   } catch (const eikon::cli::CliError& e) {
     std::fputs(eikon::errorLine(e.what()).c_str(), stderr);
     return e.exit_code;

@@ -284,8 +284,10 @@ Dispersion FitResult::dispersion() const {
   return d;
 }
 
-FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
-  const std::string who = d.label.empty() ? std::string("n") : d.label;
+// fitDispersion's stages: check the data, equilibrate the columns, solve, and turn the solution
+// and its covariance into a FitResult.
+namespace {
+void checkSeries(const IndexSeries& d, const FitOptions& opt, const std::string& who) {
   const int N = int(d.size());
   const int P = parameterCount(opt.model);
   if (d.n.size() != d.lambda_nm.size() || (d.weighted() && d.sigma.size() != d.lambda_nm.size()))
@@ -302,31 +304,37 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
   for (int i = 0; i < N; ++i)
     if (!(std::isfinite(d.lambda_nm[i]) && d.lambda_nm[i] > 0 && std::isfinite(d.n[i])))
       throw std::invalid_argument(who + ": point " + std::to_string(i) + " is not finite or has λ <= 0");
+}
 
-  std::vector<double> w(size_t(N), 1.0);
-  if (d.weighted())
-    for (int i = 0; i < N; ++i) w[size_t(i)] = 1.0 / d.sigma[size_t(i)];
-
-  std::vector<double> p0 = startValues(opt.model, d, w, who);
-
-  // Column equilibration: s_k = 1/‖∂r/∂p_k‖ at the start, so q = p/s has unit-norm columns.
+/// Column equilibration: s_k = 1/‖∂r/∂p_k‖ at the start, so q = p/s has unit-norm columns.
+std::vector<double> columnScales(const IndexSeries& d, const FitOptions& opt,
+                                 const std::vector<double>& w, const std::vector<double>& p0,
+                                 const std::string& who) {
+  const int N = int(d.size());
+  const int P = parameterCount(opt.model);
   std::vector<double> scale(size_t(P), 0.0);
-  {
-    double g[6];
-    for (int i = 0; i < N; ++i) {
-      modelIndex(opt.model, p0.data(), d.lambda_nm[size_t(i)], g);
-      for (int k = 0; k < P; ++k) scale[size_t(k)] += std::pow(g[k] * w[size_t(i)], 2);
-    }
-    for (int k = 0; k < P; ++k) {
-      if (!(scale[size_t(k)] > 0.0) || !std::isfinite(scale[size_t(k)]))
-        throw std::runtime_error(who + ": rank-deficient fit: the data do not constrain " +
-                                 parameterNames(opt.model)[size_t(k)]);
-      scale[size_t(k)] = 1.0 / std::sqrt(scale[size_t(k)]);
-    }
+  double g[6];
+  for (int i = 0; i < N; ++i) {
+    modelIndex(opt.model, p0.data(), d.lambda_nm[size_t(i)], g);
+    for (int k = 0; k < P; ++k) scale[size_t(k)] += std::pow(g[k] * w[size_t(i)], 2);
   }
-  std::vector<double> q(static_cast<size_t>(P), 0.0);
-  for (int k = 0; k < P; ++k) q[size_t(k)] = p0[size_t(k)] / scale[size_t(k)];
+  for (int k = 0; k < P; ++k) {
+    if (!(scale[size_t(k)] > 0.0) || !std::isfinite(scale[size_t(k)]))
+      throw std::runtime_error(who + ": rank-deficient fit: the data do not constrain " +
+                               parameterNames(opt.model)[size_t(k)]);
+    scale[size_t(k)] = 1.0 / std::sqrt(scale[size_t(k)]);
+  }
+  return scale;
+}
 
+/// Solves for the scaled coefficients q (in place); returns the iterations taken and the P×P
+/// covariance of q.
+std::pair<int, std::vector<double>> solveScaled(const IndexSeries& d, const FitOptions& opt,
+                                                const std::vector<double>& w,
+                                                const std::vector<double>& scale,
+                                                std::vector<double>& q, const std::string& who) {
+  const int N = int(d.size());
+  const int P = parameterCount(opt.model);
   ceres::Problem::Options po;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(po);
@@ -374,20 +382,19 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
                              std::to_string(opt.max_iterations) + " iterations (" + summary.message + ")");
   std::vector<double> cq(size_t(P * P));
   cov.GetCovarianceBlock(q.data(), q.data(), cq.data());
+  return {int(summary.iterations.size()), std::move(cq)};
+}
 
-  FitResult r;
-  r.model = opt.model;
-  r.label = who;
-  r.points = N;
-  r.weighted = d.weighted();
-  r.huber_delta = opt.huber_delta;
-  r.iterations = int(summary.iterations.size());
-  r.range_nm = {d.lambda_nm.front(), d.lambda_nm.back()};
-  for (int k = 0; k < P; ++k) r.coeffs.push_back(scale[size_t(k)] * q[size_t(k)]);
-
+/// Residual statistics, the coefficients' covariance and σ, the goodness-of-fit warning and the
+/// Abbe numbers of a solved fit (r.coeffs set).
+void summarize(FitResult& r, const IndexSeries& d, const std::vector<double>& w,
+               const std::vector<double>& scale, const std::vector<double>& cq) {
+  const int N = int(d.size());
+  const int P = parameterCount(r.model);
+  const std::string& who = r.label;
   double ss = 0.0;  // Σ (n_model − n)²
   for (int i = 0; i < N; ++i) {
-    const double e = modelIndex(opt.model, r.coeffs.data(), d.lambda_nm[size_t(i)]) - d.n[size_t(i)];
+    const double e = modelIndex(r.model, r.coeffs.data(), d.lambda_nm[size_t(i)]) - d.n[size_t(i)];
     ss += e * e;
     r.chi2 += std::pow(e * w[size_t(i)], 2);
     r.max_residual = std::max(r.max_residual, std::abs(e));
@@ -409,16 +416,46 @@ FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
     const double nu = N - P, h = 2.0 / (9.0 * nu);
     const double z = (std::cbrt(*r.chi2_reduced) - (1.0 - h)) / std::sqrt(h);
     if (z > 3.09)
-      r.warnings.push_back(who + ": chi2_red = " + std::to_string(*r.chi2_reduced).substr(0, 6) + " for " +
-                           std::to_string(N - P) + " degrees of freedom (p < 1e-3): " + modelName(opt.model) +
-                           " does not describe the data within their sigma, so its error bars are too small; "
-                           "try a model with more terms");
+      r.warnings.push_back(
+          who + ": chi2_red = " + std::to_string(*r.chi2_reduced).substr(0, 6) + " for " +
+          std::to_string(N - P) + " degrees of freedom (p < 1e-3): " + modelName(r.model) +
+          " does not describe the data within their sigma, so its error bars are too small; "
+          "try a model with more terms");
   }
   const Dispersion disp = r.dispersion();
   r.n_F = disp.index(fraunhofer::F);
   r.n_d = disp.index(fraunhofer::d);
   r.n_C = disp.index(fraunhofer::C);
   r.abbe = disp.abbeNumber();
+}
+}  // namespace
+
+FitResult fitDispersion(const IndexSeries& d, const FitOptions& opt) {
+  const std::string who = d.label.empty() ? std::string("n") : d.label;
+  const int N = int(d.size());
+  const int P = parameterCount(opt.model);
+  checkSeries(d, opt, who);
+
+  std::vector<double> w(size_t(N), 1.0);
+  if (d.weighted())
+    for (int i = 0; i < N; ++i) w[size_t(i)] = 1.0 / d.sigma[size_t(i)];
+
+  std::vector<double> p0 = startValues(opt.model, d, w, who);
+  const std::vector<double> scale = columnScales(d, opt, w, p0, who);
+  std::vector<double> q(static_cast<size_t>(P), 0.0);
+  for (int k = 0; k < P; ++k) q[size_t(k)] = p0[size_t(k)] / scale[size_t(k)];
+  auto [iterations, cq] = solveScaled(d, opt, w, scale, q, who);
+
+  FitResult r;
+  r.model = opt.model;
+  r.label = who;
+  r.points = N;
+  r.weighted = d.weighted();
+  r.huber_delta = opt.huber_delta;
+  r.iterations = iterations;
+  r.range_nm = {d.lambda_nm.front(), d.lambda_nm.back()};
+  for (int k = 0; k < P; ++k) r.coeffs.push_back(scale[size_t(k)] * q[size_t(k)]);
+  summarize(r, d, w, scale, cq);
   return r;
 }
 

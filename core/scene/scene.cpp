@@ -664,236 +664,257 @@ static Light parseLight(const Node& l) {
   return light;
 }
 
-Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
-  const std::string file = origin.string();
-  const json j = parseJson(text, file);
-  Scene scene;
-  scene.file = origin;
-  Node root(j, "", file);
-  root.allowKeys({"camera", "environment", "volume", "materials", "objects", "lights", "ambient_index", "description", "interfaces"});
+// parseScene's stages, one per top-level key of the scene (and the checks of each object against
+// the volume); each fails with the JSON path of what it reads.
+static void parseCamera(const Node& c, Camera& cam) {
+  c.allowKeys({"position", "look_at", "up", "fov_deg", "width", "height"});
+  if (auto v = c.get("position")) cam.position = v->position();
+  if (auto v = c.get("look_at")) cam.look_at = v->position();
+  if (auto v = c.get("up")) cam.up = v->unitVector();
+  if (auto v = c.get("fov_deg")) cam.fov_deg = v->number(0.0, 179.0, true);
+  if (auto v = c.get("width")) cam.width = v->integer(1, 16384);
+  if (auto v = c.get("height")) cam.height = v->integer(1, 16384);
+  glm::dvec3 fwd = cam.look_at - cam.position;
+  if (glm::length(fwd) < 1e-9) c.fail("position and look_at coincide");
+  if (glm::length(glm::cross(glm::normalize(fwd), cam.up)) < 1e-6)
+    c.fail("up is parallel to the viewing direction");
+}
 
-  if (auto c = root.get("camera")) {
-    c->allowKeys({"position", "look_at", "up", "fov_deg", "width", "height"});
-    auto& cam = scene.camera;
-    if (auto v = c->get("position")) cam.position = v->position();
-    if (auto v = c->get("look_at")) cam.look_at = v->position();
-    if (auto v = c->get("up")) cam.up = v->unitVector();
-    if (auto v = c->get("fov_deg")) cam.fov_deg = v->number(0.0, 179.0, true);
-    if (auto v = c->get("width")) cam.width = v->integer(1, 16384);
-    if (auto v = c->get("height")) cam.height = v->integer(1, 16384);
-    glm::dvec3 fwd = cam.look_at - cam.position;
-    if (glm::length(fwd) < 1e-9) c->fail("position and look_at coincide");
-    if (glm::length(glm::cross(glm::normalize(fwd), cam.up)) < 1e-6) c->fail("up is parallel to the viewing direction");
-  }
-
-  if (auto e = root.get("environment")) {
-    auto& env = scene.environment;
-    std::string type = e->at("type").string();
-    if (type == "checker") {
-      e->allowKeys({"type", "squares", "color_a", "color_b", "intensity"});
-      env.type = Environment::Type::Checker;
-      if (auto v = e->get("squares")) env.squares = v->integer(1, 4096);
-      if (auto v = e->get("color_a")) env.color_a = v->color();
-      if (auto v = e->get("color_b")) env.color_b = v->color();
-    } else if (type == "constant") {
-      e->allowKeys({"type", "radiance", "intensity"});
-      env.type = Environment::Type::Constant;
-      if (auto v = e->get("radiance")) env.radiance = v->color();
-    } else if (type == "latlong") {
-      e->allowKeys({"type", "file", "intensity"});
-      env.type = Environment::Type::LatLong;
-      std::filesystem::path p = e->at("file").string();
-      if (p.is_relative()) p = origin.parent_path() / p;
-      env.image_path = p;
-      std::error_code ec;
-      if (std::filesystem::is_directory(p, ec))
-        e->at("file").fail(p.string() + ": is a directory, expected an EXR image");
-      try {
-        auto img = readExrRgba(p, 16384, 8192);
-        env.image_width = img.width;
-        env.image_height = img.height;
-        env.image_rgba = std::move(img.rgba);
-      } catch (const std::exception& ex) {
-        e->at("file").fail(ex.what());
-      }
-    } else {
-      e->at("type").fail("unknown environment type '" + excerpt(type) +
-                         "' (checker, constant, latlong)");
+static void parseEnvironment(const Node& e, const std::filesystem::path& origin, Environment& env) {
+  std::string type = e.at("type").string();
+  if (type == "checker") {
+    e.allowKeys({"type", "squares", "color_a", "color_b", "intensity"});
+    env.type = Environment::Type::Checker;
+    if (auto v = e.get("squares")) env.squares = v->integer(1, 4096);
+    if (auto v = e.get("color_a")) env.color_a = v->color();
+    if (auto v = e.get("color_b")) env.color_b = v->color();
+  } else if (type == "constant") {
+    e.allowKeys({"type", "radiance", "intensity"});
+    env.type = Environment::Type::Constant;
+    if (auto v = e.get("radiance")) env.radiance = v->color();
+  } else if (type == "latlong") {
+    e.allowKeys({"type", "file", "intensity"});
+    env.type = Environment::Type::LatLong;
+    std::filesystem::path p = e.at("file").string();
+    if (p.is_relative()) p = origin.parent_path() / p;
+    env.image_path = p;
+    std::error_code ec;
+    if (std::filesystem::is_directory(p, ec))
+      e.at("file").fail(p.string() + ": is a directory, expected an EXR image");
+    try {
+      auto img = readExrRgba(p, 16384, 8192);
+      env.image_width = img.width;
+      env.image_height = img.height;
+      env.image_rgba = std::move(img.rgba);
+    } catch (const std::exception& ex) {
+      e.at("file").fail(ex.what());
     }
-    if (auto v = e->get("intensity")) env.intensity = v->number(0.0, 1e9);
+  } else {
+    e.at("type").fail("unknown environment type '" + excerpt(type) +
+                      "' (checker, constant, latlong)");
   }
+  if (auto v = e.get("intensity")) env.intensity = v->number(0.0, 1e9);
+}
 
-  if (auto v = root.get("volume")) {
-    v->allowKeys({"bounds_min", "bounds_max", "resolution", "smoothing_voxels", "smoothing_method"});
-    auto& vol = scene.volume;
-    if (auto b = v->get("bounds_min")) vol.bounds_min = b->position();
-    if (auto b = v->get("bounds_max")) vol.bounds_max = b->position();
-    glm::dvec3 ext = vol.bounds_max - vol.bounds_min;
-    if (!(ext.x > 0 && ext.y > 0 && ext.z > 0)) v->fail("bounds_max must exceed bounds_min on every axis");
-    if (auto r = v->get("resolution")) vol.resolution = r->integer(4, 1 << 20);  // device limit checked at upload
-    const double h = std::max(ext.x, std::max(ext.y, ext.z)) / vol.resolution;
-    if (!(h >= kMinVoxelMm))
-      (v->has("resolution") ? v->at("resolution") : *v)
-          .fail("the voxel edge (longest side / resolution) is " + fmt(h) +
-                " mm, below the smallest " + fmt(kMinVoxelMm) +
-                " mm; enlarge the bounds or lower the resolution");
-    const bool min_farther = glm::length(vol.bounds_min) > glm::length(vol.bounds_max);
-    const char* far_key = min_farther ? "bounds_min" : "bounds_max";
-    const double offset = glm::length(min_farther ? vol.bounds_min : vol.bounds_max) / h;
-    if (!(offset <= kMaxOffsetVoxels))
-      (v->has(far_key) ? v->at(far_key) : *v)
-          .fail("the volume reaches " + fmt(offset) + " voxels (of " + fmt(h) +
-                " mm) from the origin; the GPU's " +
-                "single-precision positions resolve the grid only within " + fmt(kMaxOffsetVoxels) +
-                " voxels of it (move the scene towards the origin or lower the resolution)");
-    if (auto s = v->get("smoothing_voxels")) vol.smoothing_voxels = s->number(0.0, 8.0);
-    if (auto s = v->get("smoothing_method")) {
-      std::string m = s->string();
-      if (m == "analytic") vol.smoothing = VolumeSpec::Smoothing::Analytic;
-      else if (m == "gaussian") vol.smoothing = VolumeSpec::Smoothing::Gaussian;
-      else
-        s->fail("unknown smoothing_method '" + excerpt(m) + "' (analytic, gaussian)");
-    }
-  }
-  if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
-  if (auto f = root.get("interfaces")) {
-    const std::string m = f->string();
-    if (m == "sharp" || m == "smoothed")
-      scene.interfaces = m == "sharp" ? Scene::Interfaces::Sharp : Scene::Interfaces::Smoothed;
+static void parseVolume(const Node& v, VolumeSpec& vol) {
+  v.allowKeys({"bounds_min", "bounds_max", "resolution", "smoothing_voxels", "smoothing_method"});
+  if (auto b = v.get("bounds_min")) vol.bounds_min = b->position();
+  if (auto b = v.get("bounds_max")) vol.bounds_max = b->position();
+  glm::dvec3 ext = vol.bounds_max - vol.bounds_min;
+  if (!(ext.x > 0 && ext.y > 0 && ext.z > 0))
+    v.fail("bounds_max must exceed bounds_min on every axis");
+  if (auto r = v.get("resolution"))
+    vol.resolution = r->integer(4, 1 << 20);  // device limit checked at upload
+  const double h = std::max(ext.x, std::max(ext.y, ext.z)) / vol.resolution;
+  if (!(h >= kMinVoxelMm))
+    (v.has("resolution") ? v.at("resolution") : v)
+        .fail("the voxel edge (longest side / resolution) is " + fmt(h) +
+              " mm, below the smallest " + fmt(kMinVoxelMm) +
+              " mm; enlarge the bounds or lower the resolution");
+  const bool min_farther = glm::length(vol.bounds_min) > glm::length(vol.bounds_max);
+  const char* far_key = min_farther ? "bounds_min" : "bounds_max";
+  const double offset = glm::length(min_farther ? vol.bounds_min : vol.bounds_max) / h;
+  if (!(offset <= kMaxOffsetVoxels))
+    (v.has(far_key) ? v.at(far_key) : v)
+        .fail("the volume reaches " + fmt(offset) + " voxels (of " + fmt(h) +
+              " mm) from the origin; the GPU's " +
+              "single-precision positions resolve the grid only within " + fmt(kMaxOffsetVoxels) +
+              " voxels of it (move the scene towards the origin or lower the resolution)");
+  if (auto s = v.get("smoothing_voxels")) vol.smoothing_voxels = s->number(0.0, 8.0);
+  if (auto s = v.get("smoothing_method")) {
+    std::string m = s->string();
+    if (m == "analytic")
+      vol.smoothing = VolumeSpec::Smoothing::Analytic;
+    else if (m == "gaussian")
+      vol.smoothing = VolumeSpec::Smoothing::Gaussian;
     else
-      f->fail("unknown interfaces '" + excerpt(m) + "' (sharp, smoothed)");
+      s->fail("unknown smoothing_method '" + excerpt(m) + "' (analytic, gaussian)");
   }
+}
 
-  if (auto ms = root.get("materials")) {
-    ms->requireObject();
-    for (auto it = ms->raw().begin(); it != ms->raw().end(); ++it)
-      scene.materials[it.key()] = parseMaterial(
-          Node(it.value(), ms->path() + "/" + excerpt(it.key()), file), it.key(), false);
+/// An object's material not defined under /materials comes from the material library.
+static void loadLibraryMaterial(const Node& o, const SceneObject& obj, Scene& scene) {
+  // A library name is a file name inside a library directory, never a path: "../x" or
+  // "/abs/x" would read any JSON file on the machine.
+  const std::string& name = obj.material;
+  if (name.empty() || name == "." || name == ".." ||
+      name.find_first_of(std::string("/\\\0", 3)) != std::string::npos)
+    o.at("material")
+        .fail("material name '" + excerpt(name) +
+              "' is not a plain name (no '/', '\\' or NUL, not '.' or " +
+              "'..'): library materials are looked up inside the material library only; define " +
+              "others under /materials");
+  for (const auto& dir : materialSearchPath()) {
+    auto p = dir / (obj.material + ".json");
+    if (std::filesystem::exists(p)) {
+      scene.materials[obj.material] = loadMaterialFile(p);
+      return;
+    }
   }
+  o.at("material")
+      .fail("unknown material '" + excerpt(obj.material) +
+            "' (not defined under /materials and not in the material library)");
+}
 
-  auto objs = root.at("objects");
+/// An object wholly outside the volume would vanish from the render, and one that covers it
+/// would fill it with no surface inside: neither may happen silently. The shape lies within its
+/// bounding sphere (exact for spheres), and every shape is convex, so it covers the box if it
+/// holds the box's 8 corners. Returns whether it covers the volume (then warned about).
+static bool checkObjectInVolume(const Node& o, const SceneObject& obj, Scene& scene,
+                                const std::string& file) {
+  const auto& vol = scene.volume;
+  auto [lo, hi] = obj.shape.bounds();
+  const double r = 0.5 * (hi.x - lo.x);
+  const glm::dvec3 c = obj.shape.center();
+  if (glm::length(c - glm::clamp(c, vol.bounds_min, vol.bounds_max)) > r)
+    o.fail("the object lies entirely outside the volume " + box(vol) +
+           ", so nothing of it would be rendered; move it inside or enlarge the volume");
+  bool covers = true;
+  for (int corner = 0; corner < 8 && covers; ++corner)
+    covers = obj.shape.contains(glm::dvec3(corner & 1 ? vol.bounds_max.x : vol.bounds_min.x,
+                                           corner & 2 ? vol.bounds_max.y : vol.bounds_min.y,
+                                           corner & 4 ? vol.bounds_max.z : vol.bounds_min.z));
+  if (covers)
+    scene.warnings.push_back(
+        printable(file + ": " + o.path() + ": the object covers the whole volume " + box(vol) +
+                  ": it fills the volume and none of its surface is inside, so it bends no ray " +
+                  "(shrink it or enlarge the volume)"));
+  return covers;
+}
+
+/// A gradient-index profile must give n ≥ 1 wherever the object is inside the volume (sampled on
+/// a 17³ lattice of the overlap of its box with the volume).
+static void checkGrinIndex(const Node& o, const SceneObject& obj, const Material& mat,
+                           const VolumeSpec& vol) {
+  auto [lo, hi] = obj.shape.bounds();
+  lo = glm::max(lo, vol.bounds_min);
+  hi = glm::min(hi, vol.bounds_max);
+  for (int k = 0; k <= 16; ++k)
+    for (int jj = 0; jj <= 16; ++jj)
+      for (int ii = 0; ii <= 16; ++ii) {
+        glm::dvec3 p = lo + (hi - lo) * glm::dvec3(ii, jj, k) / 16.0;
+        if (!obj.shape.contains(p)) continue;
+        double n = mat.grin.type == GrinProfile::Type::Linear
+                       ? mat.grin.n0 + glm::dot(mat.grin.gradient, p - mat.grin.origin)
+                       : mat.grin.index(p);
+        if (mat.grin.type == GrinProfile::Type::Luneburg) {
+          double r2 = glm::dot(p - mat.grin.origin, p - mat.grin.origin) /
+                      (mat.grin.radius * mat.grin.radius);
+          n = r2 <= 2.0 ? std::sqrt(2.0 - r2) : std::nan("");
+        }
+        if (!(n >= 1.0))
+          o.at("material")
+              .fail("gradient-index material '" + excerpt(obj.material) + "' gives n = " + fmt(n) +
+                    ", below 1, inside this object at (" + fmt(p.x) + ", " + fmt(p.y) + ", " +
+                    fmt(p.z) + ")");
+      }
+}
+
+/// /objects: each object, its material (from the library if not defined in the scene) and its
+/// checks against the volume. Returns the objects that cover the whole volume.
+static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::string& file) {
   if (!objs.isArray()) objs.fail("expected an array of objects");
   std::set<size_t> covering;  // objects that cover the whole volume (warned about once)
   for (size_t i = 0; i < objs.size(); ++i) {
     Node o = objs.index(i);
     SceneObject obj = parseObject(o);
-    if (!scene.materials.count(obj.material)) {
-      // A library name is a file name inside a library directory, never a path: "../x" or
-      // "/abs/x" would read any JSON file on the machine.
-      const std::string& name = obj.material;
-      if (name.empty() || name == "." || name == ".." ||
-          name.find_first_of(std::string("/\\\0", 3)) != std::string::npos)
-        o.at("material")
-            .fail(
-                "material name '" + excerpt(name) +
-                "' is not a plain name (no '/', '\\' or NUL, not '.' or " +
-                "'..'): library materials are looked up inside the material library only; define " +
-                "others under /materials");
-      bool found = false;
-      for (const auto& dir : materialSearchPath()) {
-        auto p = dir / (obj.material + ".json");
-        if (std::filesystem::exists(p)) {
-          scene.materials[obj.material] = loadMaterialFile(p);
-          found = true;
-          break;
-        }
-      }
-      if (!found)
-        o.at("material")
-            .fail("unknown material '" + excerpt(obj.material) +
-                  "' (not defined under /materials and not in the material library)");
-    }
+    if (!scene.materials.count(obj.material)) loadLibraryMaterial(o, obj, scene);
     const Material& mat = scene.materials[obj.material];
     if (obj.radial_axis && !mat.uniaxial) o.at("optic_axis_field").fail("optic_axis_field given for an isotropic material");
     if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis && !obj.radial_axis)
       o.fail("uniaxial material '" + excerpt(obj.material) +
              "' needs an optic_axis (on the object or the material)");
     if (!mat.uniaxial && obj.optic_axis) o.at("optic_axis").fail("optic_axis given for an isotropic material");
-    {
-      // An object wholly outside the volume would vanish from the render, and one that covers it
-      // would fill it with no surface inside: neither may happen silently. The shape lies within
-      // its bounding sphere (exact for spheres), and every shape is convex, so it covers the box
-      // if it holds the box's 8 corners.
-      const auto& vol = scene.volume;
-      auto [lo, hi] = obj.shape.bounds();
-      const double r = 0.5 * (hi.x - lo.x);
-      const glm::dvec3 c = obj.shape.center();
-      if (glm::length(c - glm::clamp(c, vol.bounds_min, vol.bounds_max)) > r)
-        o.fail("the object lies entirely outside the volume " + box(vol) +
-               ", so nothing of it would be rendered; move it inside or enlarge the volume");
-      bool covers = true;
-      for (int corner = 0; corner < 8 && covers; ++corner)
-        covers = obj.shape.contains(glm::dvec3(corner & 1 ? vol.bounds_max.x : vol.bounds_min.x,
-                                               corner & 2 ? vol.bounds_max.y : vol.bounds_min.y,
-                                               corner & 4 ? vol.bounds_max.z : vol.bounds_min.z));
-      if (covers) {
-        scene.warnings.push_back(printable(
-            file + ": " + o.path() + ": the object covers the whole volume " + box(vol) +
-            ": it fills the volume and none of its surface is inside, so it bends no ray " +
-            "(shrink it or enlarge the volume)"));
-        covering.insert(i);
-      }
-    }
-    if (mat.grin.type != GrinProfile::Type::None) {
-      // The profile must give n ≥ 1 wherever the object is inside the volume (sampled on a 17³
-      // lattice of the overlap of its box with the volume).
-      auto [lo, hi] = obj.shape.bounds();
-      lo = glm::max(lo, scene.volume.bounds_min);
-      hi = glm::min(hi, scene.volume.bounds_max);
-      for (int k = 0; k <= 16; ++k)
-        for (int jj = 0; jj <= 16; ++jj)
-          for (int ii = 0; ii <= 16; ++ii) {
-            glm::dvec3 p = lo + (hi - lo) * glm::dvec3(ii, jj, k) / 16.0;
-            if (!obj.shape.contains(p)) continue;
-            double n = mat.grin.type == GrinProfile::Type::Linear ? mat.grin.n0 + glm::dot(mat.grin.gradient, p - mat.grin.origin)
-                                                                  : mat.grin.index(p);
-            if (mat.grin.type == GrinProfile::Type::Luneburg) {
-              double r2 = glm::dot(p - mat.grin.origin, p - mat.grin.origin) / (mat.grin.radius * mat.grin.radius);
-              n = r2 <= 2.0 ? std::sqrt(2.0 - r2) : std::nan("");
-            }
-            if (!(n >= 1.0))
-              o.at("material")
-                  .fail("gradient-index material '" + excerpt(obj.material) +
-                        "' gives n = " + fmt(n) + ", below 1, inside this object at (" + fmt(p.x) +
-                        ", " + fmt(p.y) + ", " + fmt(p.z) + ")");
-          }
-    }
+    if (checkObjectInVolume(o, obj, scene, file)) covering.insert(i);
+    if (mat.grin.type != GrinProfile::Type::None) checkGrinIndex(o, obj, mat, scene.volume);
     scene.objects.push_back(std::move(obj));
   }
+  return covering;
+}
 
-  // The volume's faces must lie in the ambient medium (rays leave straight from there): warn if an
-  // object comes within the smoothing reach (3σ + 1 voxel) of a face, sampled on each face.
-  {
-    const auto& v = scene.volume;
-    glm::dvec3 ext = v.bounds_max - v.bounds_min;
-    double h = std::max(ext.x, std::max(ext.y, ext.z)) / v.resolution;
-    double margin = (3.0 * v.smoothing_voxels + 1.0) * h;
-    for (size_t i = 0; i < scene.objects.size(); ++i) {
-      // An object with the ambient index everywhere (a haze, an opaque floor) refracts nothing.
-      const Material& mat = scene.materials[scene.objects[i].material];
-      bool refracts = mat.uniaxial || mat.grin.type != GrinProfile::Type::None;
-      for (double l = 380.0; l <= 780.0 && !refracts; l += 40.0)
-        refracts = std::abs(mat.n_o.index(l) - scene.ambient_index) > 1e-12;
-      if (!refracts || covering.count(i)) continue;
-      double closest = 1e300;
-      for (int axis = 0; axis < 3; ++axis)
-        for (int side = 0; side < 2; ++side)
-          for (int a = 0; a <= 24; ++a)
-            for (int b = 0; b <= 24; ++b) {
-              glm::dvec3 q;
-              q[axis] = side ? v.bounds_max[axis] : v.bounds_min[axis];
-              q[(axis + 1) % 3] = v.bounds_min[(axis + 1) % 3] + ext[(axis + 1) % 3] * a / 24.0;
-              q[(axis + 2) % 3] = v.bounds_min[(axis + 2) % 3] + ext[(axis + 2) % 3] * b / 24.0;
-              closest = std::min(closest, scene.objects[i].shape.signedDistance(q));
-            }
-      if (closest < margin)
-        scene.warnings.push_back(printable(
-            file + ": /objects/" + std::to_string(i) + ": the object comes within " +
-            fmt(std::max(closest, 0.0)) + " mm of the volume's boundary (smoothing reach " +
-            fmt(margin) + " mm); rays leaving through it are not refracted there"));
-    }
+/// The volume's faces must lie in the ambient medium (rays leave straight from there): warn if an
+/// object comes within the smoothing reach (3σ + 1 voxel) of a face, sampled on each face.
+static void warnObjectsNearFaces(Scene& scene, const std::set<size_t>& covering,
+                                 const std::string& file) {
+  const auto& v = scene.volume;
+  glm::dvec3 ext = v.bounds_max - v.bounds_min;
+  double h = std::max(ext.x, std::max(ext.y, ext.z)) / v.resolution;
+  double margin = (3.0 * v.smoothing_voxels + 1.0) * h;
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    // An object with the ambient index everywhere (a haze, an opaque floor) refracts nothing.
+    const Material& mat = scene.materials[scene.objects[i].material];
+    bool refracts = mat.uniaxial || mat.grin.type != GrinProfile::Type::None;
+    for (double l = 380.0; l <= 780.0 && !refracts; l += 40.0)
+      refracts = std::abs(mat.n_o.index(l) - scene.ambient_index) > 1e-12;
+    if (!refracts || covering.count(i)) continue;
+    double closest = 1e300;
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = 0; side < 2; ++side)
+        for (int a = 0; a <= 24; ++a)
+          for (int b = 0; b <= 24; ++b) {
+            glm::dvec3 q;
+            q[axis] = side ? v.bounds_max[axis] : v.bounds_min[axis];
+            q[(axis + 1) % 3] = v.bounds_min[(axis + 1) % 3] + ext[(axis + 1) % 3] * a / 24.0;
+            q[(axis + 2) % 3] = v.bounds_min[(axis + 2) % 3] + ext[(axis + 2) % 3] * b / 24.0;
+            closest = std::min(closest, scene.objects[i].shape.signedDistance(q));
+          }
+    if (closest < margin)
+      scene.warnings.push_back(
+          printable(file + ": /objects/" + std::to_string(i) + ": the object comes within " +
+                    fmt(std::max(closest, 0.0)) + " mm of the volume's boundary (smoothing reach " +
+                    fmt(margin) + " mm); rays leaving through it are not refracted there"));
   }
+}
 
+// "interfaces": how material boundaries are represented (docs/scene-format.md).
+static Scene::Interfaces parseInterfaces(const Node& f) {
+  const std::string m = f.string();
+  if (m == "sharp") return Scene::Interfaces::Sharp;
+  if (m == "smoothed") return Scene::Interfaces::Smoothed;
+  f.fail("unknown interfaces '" + excerpt(m) + "' (sharp, smoothed)");
+}
+
+Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
+  const std::string file = origin.string();
+  const json j = parseJson(text, file);
+  Scene scene;
+  scene.file = origin;
+  Node root(j, "", file);
+  root.allowKeys({"camera", "environment", "volume", "materials", "objects", "lights",
+                  "ambient_index", "description", "interfaces"});
+  if (auto c = root.get("camera")) parseCamera(*c, scene.camera);
+  if (auto e = root.get("environment")) parseEnvironment(*e, origin, scene.environment);
+  if (auto v = root.get("volume")) parseVolume(*v, scene.volume);
+  if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
+  if (auto f = root.get("interfaces")) scene.interfaces = parseInterfaces(*f);
+  if (auto ms = root.get("materials")) {
+    ms->requireObject();
+    for (auto it = ms->raw().begin(); it != ms->raw().end(); ++it)
+      scene.materials[it.key()] = parseMaterial(
+          Node(it.value(), ms->path() + "/" + excerpt(it.key()), file), it.key(), false);
+  }
+  const std::set<size_t> covering = parseObjects(root.at("objects"), scene, file);
+  warnObjectsNearFaces(scene, covering, file);
   if (auto ls = root.get("lights")) {
     if (!ls->isArray()) ls->fail("expected an array of lights");
     for (size_t i = 0; i < ls->size(); ++i) scene.lights.push_back(parseLight(ls->index(i)));

@@ -37,6 +37,83 @@ int typeRank(VkPhysicalDeviceType t) {
   }
 }
 
+/// Validation needs the Khronos layer installed; its absence is an error, not a silent skip.
+void requireValidationLayer() {
+  uint32_t n = 0;
+  VK_CHECK(vkEnumerateInstanceLayerProperties(&n, nullptr));
+  std::vector<VkLayerProperties> props(n);
+  VK_CHECK(vkEnumerateInstanceLayerProperties(&n, props.data()));
+  bool found = std::any_of(props.begin(), props.end(), [](const auto& p) {
+    return std::strcmp(p.layerName, kValidationLayer) == 0;
+  });
+  if (!found)
+    throw std::runtime_error(
+        "Vulkan validation was requested (EIKON_VALIDATION=1) but VK_LAYER_KHRONOS_validation is "
+        "not installed (Debian package vulkan-validationlayers)");
+}
+
+/// The device named by the option or $EIKON_DEVICE (an index or part of its name), else the
+/// most capable kind: discrete, integrated, virtual GPU, then a CPU device such as lavapipe.
+VkPhysicalDevice chooseDevice(const std::vector<VkPhysicalDevice>& devices,
+                              const std::string& option) {
+  std::string selector = option;
+  if (selector.empty())
+    if (const char* env = std::getenv("EIKON_DEVICE")) selector = env;
+  VkPhysicalDevice chosen = VK_NULL_HANDLE;
+  if (!selector.empty()) {
+    bool numeric = std::all_of(selector.begin(), selector.end(),
+                               [](unsigned char c) { return std::isdigit(c); });
+    for (uint32_t i = 0; i < uint32_t(devices.size()); ++i) {
+      VkPhysicalDeviceProperties p;
+      vkGetPhysicalDeviceProperties(devices[i], &p);
+      if ((numeric && std::stoul(selector) == i) ||
+          (!numeric && lower(p.deviceName).find(lower(selector)) != std::string::npos)) {
+        chosen = devices[i];
+        break;
+      }
+    }
+    if (!chosen)
+      throw std::runtime_error("EIKON_DEVICE='" + selector +
+                               "' matches no Vulkan device (see 'eikon info')");
+  } else {
+    int best = 99;
+    for (auto d : devices) {
+      VkPhysicalDeviceProperties p;
+      vkGetPhysicalDeviceProperties(d, &p);
+      if (typeRank(p.deviceType) < best) {
+        best = typeRank(p.deviceType);
+        chosen = d;
+      }
+    }
+  }
+  return chosen;
+}
+
+uint32_t computeQueueFamily(VkPhysicalDevice chosen, const char* device_name) {
+  uint32_t qcount = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(chosen, &qcount, nullptr);
+  std::vector<VkQueueFamilyProperties> qprops(qcount);
+  vkGetPhysicalDeviceQueueFamilyProperties(chosen, &qcount, qprops.data());
+  for (uint32_t i = 0; i < qcount; ++i)
+    if (qprops[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return i;
+  throw std::runtime_error(std::string("device '") + device_name + "' has no compute queue");
+}
+
+DeviceLimits deviceLimits(VkPhysicalDevice chosen, const VkPhysicalDeviceProperties& props,
+                          const VkPhysicalDeviceFeatures& supported) {
+  DeviceLimits limits{};
+  VkPhysicalDeviceMemoryProperties mem;
+  vkGetPhysicalDeviceMemoryProperties(chosen, &mem);
+  for (uint32_t i = 0; i < mem.memoryHeapCount; ++i)
+    if (mem.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      limits.heap_size = std::max<uint64_t>(limits.heap_size, mem.memoryHeaps[i].size);
+  limits.max_image_dimension_3d = props.limits.maxImageDimension3D;
+  limits.max_storage_buffer_range = props.limits.maxStorageBufferRange;
+  limits.max_compute_workgroup_invocations = props.limits.maxComputeWorkGroupInvocations;
+  limits.shader_float64 = supported.shaderFloat64 == VK_TRUE;
+  return limits;
+}
+
 }  // namespace
 
 std::unique_ptr<Context> Context::create(const ContextOptions& options) {
@@ -51,16 +128,7 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
 
   std::vector<const char*> layers, extensions;
   if (validation) {
-    uint32_t n = 0;
-    VK_CHECK(vkEnumerateInstanceLayerProperties(&n, nullptr));
-    std::vector<VkLayerProperties> props(n);
-    VK_CHECK(vkEnumerateInstanceLayerProperties(&n, props.data()));
-    bool found = std::any_of(props.begin(), props.end(),
-                             [](const auto& p) { return std::strcmp(p.layerName, kValidationLayer) == 0; });
-    if (!found)
-      throw std::runtime_error(
-          "Vulkan validation was requested (EIKON_VALIDATION=1) but VK_LAYER_KHRONOS_validation is "
-          "not installed (Debian package vulkan-validationlayers)");
+    requireValidationLayer();
     layers.push_back(kValidationLayer);
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   }
@@ -100,48 +168,11 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
   std::vector<VkPhysicalDevice> devices(count);
   VK_CHECK(vkEnumeratePhysicalDevices(ctx->instance_, &count, devices.data()));
 
-  std::string selector = options.device;
-  if (selector.empty())
-    if (const char* env = std::getenv("EIKON_DEVICE")) selector = env;
-  VkPhysicalDevice chosen = VK_NULL_HANDLE;
-  if (!selector.empty()) {
-    bool numeric = std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); });
-    for (uint32_t i = 0; i < count; ++i) {
-      VkPhysicalDeviceProperties p;
-      vkGetPhysicalDeviceProperties(devices[i], &p);
-      if ((numeric && std::stoul(selector) == i) ||
-          (!numeric && lower(p.deviceName).find(lower(selector)) != std::string::npos)) {
-        chosen = devices[i];
-        break;
-      }
-    }
-    if (!chosen) throw std::runtime_error("EIKON_DEVICE='" + selector + "' matches no Vulkan device (see 'eikon info')");
-  } else {
-    int best = 99;
-    for (auto d : devices) {
-      VkPhysicalDeviceProperties p;
-      vkGetPhysicalDeviceProperties(d, &p);
-      if (typeRank(p.deviceType) < best) {
-        best = typeRank(p.deviceType);
-        chosen = d;
-      }
-    }
-  }
+  VkPhysicalDevice chosen = chooseDevice(devices, options.device);
   ctx->physical_ = chosen;
   vkGetPhysicalDeviceProperties(chosen, &ctx->props_);
 
-  uint32_t qcount = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(chosen, &qcount, nullptr);
-  std::vector<VkQueueFamilyProperties> qprops(qcount);
-  vkGetPhysicalDeviceQueueFamilyProperties(chosen, &qcount, qprops.data());
-  bool have_queue = false;
-  for (uint32_t i = 0; i < qcount; ++i)
-    if (qprops[i].queueFlags & VK_QUEUE_COMPUTE_BIT) {
-      ctx->queue_family_ = i;
-      have_queue = true;
-      break;
-    }
-  if (!have_queue) throw std::runtime_error(std::string("device '") + ctx->props_.deviceName + "' has no compute queue");
+  ctx->queue_family_ = computeQueueFamily(chosen, ctx->props_.deviceName);
 
   VkPhysicalDeviceFeatures supported{};
   vkGetPhysicalDeviceFeatures(chosen, &supported);
@@ -165,15 +196,7 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
   pci.queueFamilyIndex = ctx->queue_family_;
   VK_CHECK(vkCreateCommandPool(ctx->device_, &pci, nullptr, &ctx->pool_));
 
-  VkPhysicalDeviceMemoryProperties mem;
-  vkGetPhysicalDeviceMemoryProperties(chosen, &mem);
-  for (uint32_t i = 0; i < mem.memoryHeapCount; ++i)
-    if (mem.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
-      ctx->limits_.heap_size = std::max<uint64_t>(ctx->limits_.heap_size, mem.memoryHeaps[i].size);
-  ctx->limits_.max_image_dimension_3d = ctx->props_.limits.maxImageDimension3D;
-  ctx->limits_.max_storage_buffer_range = ctx->props_.limits.maxStorageBufferRange;
-  ctx->limits_.max_compute_workgroup_invocations = ctx->props_.limits.maxComputeWorkGroupInvocations;
-  ctx->limits_.shader_float64 = supported.shaderFloat64 == VK_TRUE;
+  ctx->limits_ = deviceLimits(chosen, ctx->props_, supported);
   return ctx;
 }
 

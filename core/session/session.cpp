@@ -1,0 +1,235 @@
+#include "core/session/session.h"
+
+#include <cmath>
+
+#include "core/light/light_cache.h"
+#include "core/reference/reference_lighting.h"
+#include "core/reference/reference_marcher.h"
+#include "core/render/light_transport.h"
+#include "core/render/render_defaults.h"
+#include "core/render/view_renderer.h"
+#include "core/vk/context.h"
+
+namespace eikon {
+
+// ---------------------------------------------------------------- settings and their ranges
+
+namespace {
+void checkRange(const char* name, int v, int lo, int hi) {
+  if (v < lo || v > hi)
+    throw SettingError(name, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                                 "], got " + std::to_string(v));
+}
+}  // namespace
+
+Integrator parseIntegrator(const std::string& s) {
+  if (s == "euler") return Integrator::Euler;
+  if (s == "midpoint") return Integrator::Midpoint;
+  if (s == "rk4") return Integrator::RK4;
+  throw SettingError("integrator", "must be euler, midpoint or rk4");
+}
+
+void checkMarchStep(double step_voxels) {
+  if (!(step_voxels > 0 && step_voxels <= 4))
+    throw SettingError("step", "must be in (0, 4] voxels");
+}
+
+// A size not given is the scene camera's; a given one must be a real size (0 used to mean "the
+// scene's" silently, and a negative wavelength count the default).
+void checkViewRequest(const ViewRequest& v) {
+  if (v.width) checkRange("width", *v.width, 1, 16384);
+  if (v.height) checkRange("height", *v.height, 1, 16384);
+  checkRange("spp", v.spp, 1, 4096);
+  if (v.wavelengths) checkRange("wavelengths", *v.wavelengths, 0, 256);
+  if (v.march) checkMarchStep(v.march->step_voxels);
+}
+
+RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
+  RenderSettings rs = defaultRenderSettings(scene);
+  rs.width = v.width.value_or(0);
+  rs.height = v.height.value_or(0);
+  rs.spp = v.spp;
+  if (v.wavelengths) rs.wavelengths = *v.wavelengths;
+  rs.wavelength_nm = v.wavelength_nm;
+  if (v.march) rs.march = *v.march;
+  return rs;
+}
+
+std::vector<std::string> materialRangeWarnings(const Scene& scene, const RenderSettings& rs) {
+  std::vector<std::string> out;
+  for (const auto& [name, m] : scene.materials)
+    for (const Dispersion* d : {&m.n_o, &m.n_e}) {
+      bool outside = rs.wavelengths > 0 ? !(d->inRange(380.0) && d->inRange(780.0))
+                                        : !d->inRange(rs.wavelength_nm);
+      if (outside && d->rangeNm()) {
+        out.push_back("material '" + name + "' is measured over " +
+                      std::to_string(int((*d->rangeNm())[0])) + "-" +
+                      std::to_string(int((*d->rangeNm())[1])) +
+                      " nm; rendering outside that range extrapolates");
+        break;
+      }
+    }
+  return out;
+}
+
+void checkLightRequest(const LightRequest& l) {
+  if (l.bands < 0 || l.bands > 64) throw SettingError("light-bands", "must be in [1, 64]");
+  if (l.splat != "accumulate" && l.splat != "highest")
+    throw SettingError("light-splat", "must be accumulate or highest, got '" + l.splat + "'");
+  if (l.device != "auto" && l.device != "gpu" && l.device != "cpu")
+    throw SettingError("light-device", "must be auto, gpu or cpu, got '" + l.device + "'");
+  if (l.caustics != "pass" && l.caustics != "kill")
+    throw SettingError("caustics", "must be pass or kill, got '" + l.caustics + "'");
+  if (!(l.step_voxels >= 0 && l.step_voxels <= 2))
+    throw SettingError("light-step", "must be in (0, 2] voxels");
+  if (!(l.split_voxels >= 0.25 && l.split_voxels <= 8))
+    throw SettingError("light-split", "must be in [0.25, 8] voxels");
+  if (l.max_patches < 1024 || l.max_patches > (1 << 24))
+    throw SettingError("max-patches", "must be in [1024, 16777216]");
+}
+
+LightingOptions lightingOptions(const LightRequest& l, double voxel_mm) {
+  LightingOptions lo = defaultLightingOptions();
+  lo.bands = l.bands;
+  lo.wave.splat = l.splat == "highest" ? WavefrontSettings::Splat::HighestEnergy
+                                       : WavefrontSettings::Splat::Accumulate;
+  lo.wave.dt = l.step_voxels * voxel_mm;
+  lo.wave.split_span_voxels = l.split_voxels;
+  lo.wave.max_patches = l.max_patches;
+  lo.wave.pass_caustics = l.caustics == "pass";
+  lo.wave.threads = l.threads;
+  lo.smoothing_voxels = l.smoothing_voxels;
+  return lo;
+}
+
+void checkTraceRequest(const TraceRequest& ray) {
+  if (glm::length(ray.direction) < 1e-12) throw SettingError("dir", "must be a non-zero vector");
+  if (!(ray.wavelength_nm >= 100 && ray.wavelength_nm <= 10000))
+    throw SettingError("wavelength", "must be in [100, 10000] nm");
+}
+
+// ---------------------------------------------------------------- the session
+
+std::shared_ptr<vk::Context> newContext() { return vk::Context::create(); }
+
+Session::Session(std::shared_ptr<Scene> scene, ContextSource context)
+    : scene_(std::move(scene)), context_source_(std::move(context)) {}
+
+Session::~Session() = default;
+
+vk::Context& Session::context() {
+  if (!ctx_) {
+    auto ctx = context_source_();
+    checkVolumeFits(*ctx, makeGrid(scene_->volume), *scene_);
+    ctx_ = std::move(ctx);
+  }
+  return *ctx_;
+}
+
+VolumeSet& Session::prepare(bool gpu) {
+  if (gpu) context();
+  if (!volume_) {
+    VoxelizeOptions vo;
+    vo.threads = threads_;
+    if (progress_.update)
+      vo.progress = [this](double f, const char*) { progress_.update("voxelising", f); };
+    volume_ = std::make_unique<VolumeSet>(voxelize(*scene_, vo));
+    voxelized_spec_ = scene_->volume;
+  }
+  return *volume_;
+}
+
+std::string Session::deviceName(bool gpu) {
+  return gpu ? context().deviceName() : std::string("CPU reference (double)");
+}
+
+void Session::dropRenderers() {
+  gpu_.reset();
+  cpu_.reset();
+  field_.reset();
+}
+
+LightOutcome Session::simulateLight(const LightRequest& light, bool cpu_render,
+                                    const std::filesystem::path& cache_dir) {
+  LightOutcome out;
+  VolumeSet& volume = prepare(!cpu_render);
+  LightingOptions lo = lightingOptions(light, volume.grid.h);
+  if (progress_.update)
+    lo.progress = [this](double f, const std::string& what) { progress_.update(what.c_str(), f); };
+  // Which twin simulates: CPU renders use the CPU throughout; on a CPU Vulkan device (lavapipe)
+  // the double-precision CPU twin is also the faster one (docs/light-simulator.md).
+  out.on_cpu = cpu_render || lightOnCpu(light.device, ctx_.get());
+  const bool use_cache = !cache_dir.empty();
+  // The key hashes every field of the volume (~0.3 s at 128³): only when the cache is used.
+  const uint64_t key = use_cache ? lightCacheKey(*scene_, volume, lo, out.on_cpu) : 0;
+  std::string notice;
+  if (use_cache && loadLightCache(cache_dir, key, volume, &notice)) out.cached = true;
+  if (!notice.empty()) out.warnings.push_back("light cache: " + printable(notice));
+  if (!out.cached) {
+    out.summary = out.on_cpu ? simulateLightingReference(*scene_, volume, lo)
+                             : simulateLighting(context(), *scene_, volume, lo);
+    if (use_cache) {
+      std::string err = saveLightCache(cache_dir, key, volume);
+      if (!err.empty()) out.warnings.push_back("light cache: " + err);
+    }
+  }
+  dropRenderers();  // renderers made before hold the unlit volume
+  return out;
+}
+
+ViewRenderer& Session::gpuRenderer() {
+  prepare(true);
+  if (!gpu_) {
+    if (progress_.working) progress_.working("preparing the GPU (pipelines, volume upload)");
+    gpu_ = std::make_unique<ViewRenderer>(*ctx_, *scene_, *volume_);
+  }
+  return *gpu_;
+}
+
+ReferenceMarcher& Session::cpuMarcher() {
+  prepare(false);
+  if (!cpu_) {
+    field_ = std::make_unique<VolumeField>(*volume_);
+    cpu_ = std::make_unique<ReferenceMarcher>(*field_, scene_->environment);
+  }
+  return *cpu_;
+}
+
+RenderImage Session::render(const RenderSettings& settings, bool gpu) {
+  RenderSettings rs = settings;
+  if (progress_.update && !rs.progress)
+    rs.progress = [this](double f) { progress_.update("rendering", f); };
+  if (gpu) return gpuRenderer().render(rs);
+  Camera cam = scene_->camera;
+  if (rs.width > 0) cam.width = rs.width;
+  if (rs.height > 0) cam.height = rs.height;
+  return cpuMarcher().render(cam, rs, threads_);
+}
+
+std::vector<std::array<TraceOutcome, 2>> Session::trace(const std::vector<TraceRequest>& rays,
+                                                        const MarchSettings& ms, bool gpu) {
+  const bool uni = scene_->anyUniaxial();
+  std::vector<std::array<TraceOutcome, 2>> out;
+  if (gpu) {
+    ViewRenderer& r = gpuRenderer();
+    if (uni) {
+      out = r.traceModes(rays, ms);
+    } else {
+      auto o = r.trace(rays, ms);
+      out.reserve(o.size());
+      for (const auto& t : o) out.push_back({t, t});
+    }
+  } else {
+    ReferenceMarcher& r = cpuMarcher();
+    out.reserve(rays.size());
+    for (const auto& q : rays) {
+      TraceOutcome o = r.trace(q, ms, 0);
+      out.push_back({o, uni ? r.trace(q, ms, 1) : o});
+    }
+  }
+  if (out.size() != rays.size())
+    throw std::runtime_error("trace: outcome count differs from the ray count");
+  return out;
+}
+
+}  // namespace eikon

@@ -1,0 +1,170 @@
+// One front-end-neutral entry to eikon's pipeline, called by `eikon render`, `eikon trace`
+// (apps/) and the Python module (python/): prepare a scene (its Vulkan device and its voxelised
+// volume, each made once and on first need), simulate its light (GPU or CPU twin, through the
+// light cache), render it and trace rays in both modes, on the GPU twin or the CPU twin. The
+// range checks of the user's settings live here too, so that the CLI and Python refuse the same
+// settings with the same words (docs/design.md §3).
+//
+//   auto scene = std::make_shared<eikon::Scene>(eikon::loadScene("scenes/glass_sphere.json"));
+//   eikon::ViewRequest view;  view.width = 320;
+//   eikon::checkViewRequest(view);                          // throws eikon::SettingError
+//   eikon::Session session(scene);                          // nothing made yet
+//   RenderImage img = session.render(eikon::renderSettings(*scene, view), /*gpu=*/true);
+//   auto both = session.trace({{origin, dir, 587.56}}, MarchSettings{}, /*gpu=*/false);  // [o, e]
+//
+// A SettingError names the setting in neutral words ("width", "light-splat": the CLI's option
+// without its dashes) and says what is wrong ("must be in [1, 16384], got 0"); each front end
+// spells the name its way (`--width`, Python's `width=` keyword).
+//
+// Not thread-safe: one caller at a time (Python holds one per Renderer and releases the GIL only
+// around a call). The scene is shared: the caller may edit its camera between renders; edits to
+// its volume need a new Session.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/light/lighting_driver.h"
+#include "core/scene/scene.h"
+#include "core/volume/march_types.h"
+#include "core/volume/volume_set.h"
+
+namespace eikon {
+namespace vk {
+class Context;
+}
+class ViewRenderer;
+class ReferenceMarcher;
+class VolumeField;
+
+/// A setting out of its range, or an unknown name: what() is "<setting> <complaint>".
+class SettingError : public std::invalid_argument {
+ public:
+  SettingError(const std::string& setting, const std::string& complaint)
+      : std::invalid_argument(setting + " " + complaint),
+        setting_(setting),
+        complaint_(complaint) {}
+  const std::string& setting() const { return setting_; }
+  const std::string& complaint() const { return complaint_; }
+
+ private:
+  std::string setting_, complaint_;
+};
+
+/// What a render is asked for; an unset value takes the default of core/render/render_defaults.h.
+struct ViewRequest {
+  std::optional<int> width, height;    ///< [1, 16384]; unset: the scene camera's
+  int spp = 1;                         ///< [1, 4096] jittered samples per pixel
+  std::optional<int> wavelengths;      ///< [0, 256] (0 = RGB); unset: defaultWavelengths(scene)
+  double wavelength_nm = 587.5618;     ///< the index wavelength of the RGB mode
+  std::optional<MarchSettings> march;  ///< step in (0, 4] voxels; unset: the render defaults
+};
+
+/// "euler", "midpoint" or "rk4"; else SettingError("integrator", ...).
+Integrator parseIntegrator(const std::string& name);
+/// March step in (0, 4] voxels; else SettingError("step", ...).
+void checkMarchStep(double step_voxels);
+/// Every range of a ViewRequest (SettingError for the first one out of range).
+void checkViewRequest(const ViewRequest& view);
+/// defaultRenderSettings(scene) with what the request sets.
+RenderSettings renderSettings(const Scene& scene, const ViewRequest& view);
+/// One line per material whose measured range the render leaves ("material 'x' is measured over
+/// 400-700 nm; rendering outside that range extrapolates"): spectral renders need 380-780 nm, RGB
+/// renders the index wavelength.
+std::vector<std::string> materialRangeWarnings(const Scene& scene, const RenderSettings& settings);
+
+/// The light simulator as the user asks for it (defaults: defaultLightingOptions()).
+struct LightRequest {
+  int bands = 0;                     ///< [0, 64]; 0: defaultLightBands
+  std::string splat = "accumulate";  ///< accumulate (fluence rate) or highest
+  double step_voxels = 0.0;          ///< time step in voxels, [0, 2]; 0: 0.5
+  double split_voxels = 1.0;         ///< split patches longer than this, [0.25, 8]
+  int max_patches = 1 << 20;         ///< live patches, [1024, 2^24]
+  std::string caustics = "pass";     ///< pass (through a fold caustic) or kill (Tevs)
+  double smoothing_voxels = 1.0;     ///< σ of the final smoothing of the light volumes
+  std::string device = "auto";       ///< auto (lightOnCpu), gpu or cpu
+  int threads = 0;                   ///< CPU twin threads (0: all, at most 8)
+};
+void checkLightRequest(const LightRequest& light);
+/// The simulator options of a request for voxels of `voxel_mm`.
+LightingOptions lightingOptions(const LightRequest& light, double voxel_mm);
+
+/// A ray's wavelength in [100, 10000] nm ("wavelength") and a non-zero direction ("dir").
+void checkTraceRequest(const TraceRequest& ray);
+
+/// What simulateLight did.
+struct LightOutcome {
+  LightingSummary summary;            ///< runs == 0 when nothing was simulated
+  bool cached = false;                ///< the light volumes came from the cache
+  bool on_cpu = false;                ///< which twin simulated (or would have)
+  std::vector<std::string> warnings;  ///< "light cache: ..." (unreadable entry, unwritable folder)
+};
+
+/// Progress callbacks; both may be empty.
+struct SessionProgress {
+  std::function<void(const char* what, double fraction)> update;
+  std::function<void(const char* what)> working;  ///< a stage without a fraction
+};
+
+using ContextSource = std::function<std::shared_ptr<vk::Context>()>;
+/// A fresh Vulkan context (validation as EIKON_VALIDATION says), for a session of its own.
+std::shared_ptr<vk::Context> newContext();
+
+class Session {
+ public:
+  explicit Session(std::shared_ptr<Scene> scene, ContextSource context = newContext);
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  const std::shared_ptr<Scene>& scene() const { return scene_; }
+  void setProgress(SessionProgress progress) { progress_ = std::move(progress); }
+  void setThreads(int threads) { threads_ = threads; }  ///< voxelising and the CPU twin
+
+  /// The Vulkan context, made on first use; the scene's volume is checked against its limits
+  /// then (checkVolumeFits), before anything is voxelised.
+  vk::Context& context();
+  bool hasContext() const { return ctx_ != nullptr; }
+  /// The context (gpu) and the voxelised volume, each made once.
+  VolumeSet& prepare(bool gpu);
+  bool voxelized() const { return volume_ != nullptr; }
+  /// The scene's volume settings when it was voxelised.
+  const VolumeSpec& voxelizedSpec() const { return voxelized_spec_; }
+  /// "CPU reference (double)" or the Vulkan device's name.
+  std::string deviceName(bool gpu);
+
+  /// Simulate the scene's lights into the volume (callers skip scenes without lights): by the CPU
+  /// twin when cpu_render or lightOnCpu(light.device) says so, else the GPU twin; through the light
+  /// cache in `cache_dir` unless it is empty. Renderers made before are rebuilt on their next use.
+  LightOutcome simulateLight(const LightRequest& light, bool cpu_render,
+                             const std::filesystem::path& cache_dir);
+  RenderImage render(const RenderSettings& settings, bool gpu);
+  /// Both modes {o, e} of each ray. Isotropic scenes: one march, reported as both (the e-mode is
+  /// the o-mode by definition).
+  std::vector<std::array<TraceOutcome, 2>> trace(const std::vector<TraceRequest>& rays,
+                                                 const MarchSettings& march, bool gpu);
+
+ private:
+  void dropRenderers();
+  ViewRenderer& gpuRenderer();
+  ReferenceMarcher& cpuMarcher();
+
+  std::shared_ptr<Scene> scene_;
+  ContextSource context_source_;
+  SessionProgress progress_;
+  int threads_ = 0;
+  std::shared_ptr<vk::Context> ctx_;
+  std::unique_ptr<VolumeSet> volume_;
+  VolumeSpec voxelized_spec_;
+  std::unique_ptr<ViewRenderer> gpu_;
+  std::unique_ptr<VolumeField> field_;
+  std::unique_ptr<ReferenceMarcher> cpu_;
+};
+
+}  // namespace eikon

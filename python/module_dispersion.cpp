@@ -1,0 +1,146 @@
+// eikon.Dispersion, eikon.Material and the material library (load_material).
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
+
+#include "core/scene/scene.h"
+#include "optics/dispersion.h"
+#include "python/module.h"
+
+namespace eikon::python {
+
+namespace {
+void bindDispersionClass(py::module_& m) {
+  py::dict fr;
+  fr["F"] = fraunhofer::F;
+  fr["d"] = fraunhofer::d;
+  fr["D"] = fraunhofer::D;
+  fr["C"] = fraunhofer::C;
+  m.attr("FRAUNHOFER") = fr;
+
+  py::class_<Dispersion>(m, "Dispersion", "n(λ) of one material or mode; λ in nm.")
+      .def_static("constant", &Dispersion::constant, py::arg("n"))
+      .def_static(
+          "cauchy", [](const py::handle& c) { return Dispersion::cauchy(toVector(c)); },
+          py::arg("coeffs"), "n = Σ c_k/λ^{2k}, λ in µm")
+      .def_static(
+          "sellmeier",
+          [](const py::handle& b, const py::handle& c) {
+            return Dispersion::sellmeier(toVector(b), toVector(c));
+          },
+          py::arg("B"), py::arg("C"), "SCHOTT Sellmeier, C in µm²")
+      .def_static("conrady", &Dispersion::conrady, py::arg("n0"), py::arg("A"), py::arg("B"),
+                  "n = n0 + A/λ + B/λ^3.5, λ in µm")
+      .def(
+          "with_range",
+          [](Dispersion d, double lo, double hi) {
+            d.withRange(lo, hi);
+            return d;
+          },
+          py::arg("lo_nm"), py::arg("hi_nm"))
+      .def_property_readonly("kind",
+                             [](const Dispersion& d) -> const char* {
+                               switch (d.kind()) {
+                                 case Dispersion::Kind::Constant:
+                                   return "constant";
+                                 case Dispersion::Kind::Cauchy:
+                                   return "cauchy";
+                                 case Dispersion::Kind::Sellmeier:
+                                   return "sellmeier";
+                                 case Dispersion::Kind::Conrady:
+                                   return "conrady";
+                               }
+                               return "unknown";
+                             })
+      .def_property_readonly("coefficients",
+                             [](const Dispersion& d) { return fromVector(d.coefficients()); })
+      .def_property_readonly("sellmeier_c",
+                             [](const Dispersion& d) { return fromVector(d.sellmeierC()); })
+      .def_property_readonly("range_nm",
+                             [](const Dispersion& d) -> py::object {
+                               if (!d.rangeNm()) return py::none();
+                               return py::make_tuple((*d.rangeNm())[0], (*d.rangeNm())[1]);
+                             })
+      .def(
+          "index",
+          [](const Dispersion& d, py::array_t<double> l) {
+            return py::vectorize([&d](double x) { return d.index(x); })(l);
+          },
+          py::arg("lambda_nm"), "n(λ), broadcasting over arrays")
+      .def(
+          "derivative",
+          [](const Dispersion& d, py::array_t<double> l) {
+            return py::vectorize([&d](double x) { return d.derivative(x); })(l);
+          },
+          py::arg("lambda_nm"), "dn/dλ in 1/nm")
+      .def("abbe_number", &Dispersion::abbeNumber, "V_d = (n_d − 1)/(n_F − n_C)")
+      .def(
+          "cauchy_approximation",
+          [](const Dispersion& d, double lo, double hi) {
+            auto c = d.cauchyApproximation(lo, hi);
+            py::dict r;
+            r["coeffs"] = py::make_tuple(c.coeffs[0], c.coeffs[1], c.coeffs[2]);
+            r["max_error"] = c.max_error;
+            r["rms_error"] = c.rms_error;
+            return r;
+          },
+          py::arg("lo_nm"), py::arg("hi_nm"))
+      .def("describe", &Dispersion::describe)
+      .def("__repr__",
+           [](const Dispersion& d) { return "<eikon.Dispersion " + d.describe() + ">"; });
+}
+
+// Materials: the scene's and the library's (materials/<name>.json).
+void bindMaterials(py::module_& m) {
+  py::class_<Material>(m, "Material", "A material from the library or a scene (read-only view).")
+      .def_readonly("name", &Material::name)
+      .def_readonly("source", &Material::source)
+      .def_readonly("uniaxial", &Material::uniaxial)
+      .def_property_readonly(
+          "n", [](const Material& x) { return x.n_o; }, "index (isotropic) = n_o")
+      .def_readonly("n_o", &Material::n_o)
+      .def_readonly("n_e", &Material::n_e)
+      .def_property_readonly("optic_axis",
+                             [](const Material& x) -> py::object {
+                               return x.optic_axis ? py::object(fromVec3(*x.optic_axis))
+                                                   : py::none();
+                             })
+      .def(
+          "uniaxial_at",
+          [](const Material& x, double lambda_nm, py::object axis) {
+            if (!x.uniaxial) throw std::invalid_argument(x.name + " is not uniaxial");
+            glm::dvec3 a =
+                axis.is_none() ? x.optic_axis.value_or(glm::dvec3(0, 0, 1)) : toVec3(axis);
+            return Uniaxial(x.n_o.index(lambda_nm), x.n_e.index(lambda_nm), a);
+          },
+          py::arg("lambda_nm"), py::arg("axis") = py::none(), "the crystal at one wavelength")
+      .def("__repr__", [](const Material& x) {
+        return "<eikon.Material " + x.name + (x.uniaxial ? " (uniaxial)>" : ">");
+      });
+
+  m.def(
+      "load_material",
+      [](const std::string& name_or_path) {
+        std::filesystem::path p(name_or_path);
+        if (p.extension() == ".json" && std::filesystem::exists(p)) return loadMaterialFile(p);
+        for (const auto& dir : materialSearchPath()) {
+          auto f = dir / (name_or_path + ".json");
+          if (std::filesystem::exists(f)) return loadMaterialFile(f);
+        }
+        throw std::invalid_argument("no material '" + name_or_path +
+                                    "' in the library search path");
+      },
+      py::arg("name_or_path"),
+      "a library material by name (materials/<name>.json) or a material file");
+  m.def("material_search_path", &materialSearchPath);
+}
+}  // namespace
+
+void bindDispersion(py::module_& m) {
+  bindDispersionClass(m);
+  bindMaterials(m);
+}
+
+}  // namespace eikon::python

@@ -1,0 +1,324 @@
+// eikon.Renderer and the module-level render()/trace(): a Python face of eikon::Session
+// (core/session/session.h), which `eikon render` and `eikon trace` run too, so that Python and
+// the CLI prepare, light, render and trace a scene the same way and refuse the same settings.
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <atomic>
+#include <mutex>
+#include <optional>
+
+#include "core/io/exr.h"
+#include "core/light/light_cache.h"
+#include "core/vk/context.h"
+#include "python/module.h"
+
+namespace eikon::python {
+namespace {
+
+// Voxelisations done by this module (eikon.voxelize_count()): lets tests see that a cached
+// prepared scene is reused instead of voxelised again.
+std::atomic<long> g_voxelizations{0};
+
+// A Renderer: a session of its own on the module's shared Vulkan context. Calls into the session
+// release the GIL (it never calls back into Python).
+struct Prepared {
+  std::shared_ptr<Scene> scene;
+  Session session;
+
+  explicit Prepared(std::shared_ptr<Scene> s) : scene(s), session(std::move(s), context) {}
+  template <class F>
+  decltype(auto) run(F&& f) {
+    const bool voxelized = session.voxelized();
+    struct Count {  // counted also when f throws after voxelising
+      Session& s;
+      bool before;
+      ~Count() {
+        if (!before && s.voxelized()) ++g_voxelizations;
+      }
+    } count{session, voxelized};
+    py::gil_scoped_release release;
+    return f(session);
+  }
+};
+
+bool sameSpec(const VolumeSpec& a, const VolumeSpec& b) {
+  return a.bounds_min == b.bounds_min && a.bounds_max == b.bounds_max &&
+         a.resolution == b.resolution && a.smoothing_voxels == b.smoothing_voxels &&
+         a.smoothing == b.smoothing;
+}
+
+// The module-level render()/trace() keep the last scene they prepared: a second call with the
+// same Scene object (and the same volume settings) reuses its voxelised volume, GPU renderer and
+// light volumes instead of voxelising again. Camera edits need nothing (renders read the camera);
+// a changed `scene.volume` or another Scene object prepares afresh. Only one scene is kept (a
+// volume can take hundreds of MB); eikon.clear_cache() drops it.
+std::shared_ptr<Prepared> g_last_prepared;
+std::weak_ptr<Scene> g_last_scene;
+std::mutex g_prepared_mutex;
+
+std::shared_ptr<Prepared> cachedPrepared(const std::shared_ptr<Scene>& s) {
+  std::lock_guard<std::mutex> lock(g_prepared_mutex);
+  if (g_last_prepared && g_last_scene.lock() == s &&
+      (!g_last_prepared->session.voxelized() ||
+       sameSpec(g_last_prepared->session.voxelizedSpec(), s->volume)))
+    return g_last_prepared;
+  g_last_prepared = std::make_shared<Prepared>(s);
+  g_last_scene = s;
+  return g_last_prepared;
+}
+
+std::string lightCacheDir(const py::object& light_cache) {
+  if (light_cache.is_none()) return {};
+  if (py::isinstance<py::bool_>(light_cache))
+    return light_cache.cast<bool>() ? defaultLightCacheDir().string() : std::string();
+  return py::str(light_cache).cast<std::string>();
+}
+
+bool isGpu(const std::string& device) {
+  if (device == "gpu") return true;
+  if (device == "cpu") return false;
+  throw std::invalid_argument("device must be 'gpu' or 'cpu', got '" + device + "'");
+}
+
+py::array_t<float> imageArray(const RenderImage& img) {
+  py::array_t<float> a({py::ssize_t(img.height), py::ssize_t(img.width), py::ssize_t(3)});
+  std::copy(img.rgb.begin(), img.rgb.end(), a.mutable_data());
+  return a;
+}
+
+py::dict grid(Prepared& p) {
+  const VolumeSet& v = p.run([](Session& s) -> const VolumeSet& { return s.prepare(false); });
+  const Grid& g = v.grid;
+  py::dict d;
+  d["dims"] = py::make_tuple(g.dims[0], g.dims[1], g.dims[2]);
+  d["origin"] = fromVec3(g.origin);
+  d["extent"] = fromVec3(g.extent);
+  d["h"] = g.h;
+  d["uniaxial"] = v.uniaxial;
+  d["dispersive"] = v.dispersive;
+  return d;
+}
+
+// As `eikon render` does by default: a scene with lights gets its light simulated before the
+// first render (unless simulate_light() already did), by the twin the session picks (the CPU
+// reference for CPU renders, as --reference), through the CLI's light cache when `light_cache`
+// names one.
+py::array_t<float> render(Prepared& p, int width, int height, int spp,
+                          std::optional<int> wavelengths, double wavelength_nm,
+                          std::optional<MarchSettings> march, const std::string& device,
+                          int threads, bool light, const py::object& light_cache) {
+  const bool gpu = isGpu(device);
+  ViewRequest view;  // the CLI's defaults (core/session/session.h), then what the caller chose
+  if (width != 0) view.width = width;
+  if (height != 0) view.height = height;
+  view.spp = spp;
+  view.wavelengths = wavelengths;
+  view.wavelength_nm = wavelength_nm;
+  view.march = march;
+  checkSetting([&] { checkViewRequest(view); });
+  const RenderSettings settings = renderSettings(*p.scene, view);
+  const std::string cache_dir = light ? lightCacheDir(light_cache) : std::string();
+  const RenderImage img = p.run([&](Session& s) {
+    s.setThreads(threads);
+    if (light && !p.scene->lights.empty() && !s.prepare(gpu).lit()) {
+      LightRequest l;
+      l.threads = threads;
+      s.simulateLight(l, !gpu, cache_dir);  // an unwritable cache only costs time next time
+    }
+    return s.render(settings, gpu);
+  });
+  return imageArray(img);
+}
+
+py::dict simulateLight(Prepared& p, int bands, const std::string& splat, double step_voxels,
+                       double smoothing_voxels, const std::string& caustics,
+                       const std::string& device) {
+  const bool gpu = isGpu(device);
+  LightRequest l;
+  l.bands = bands;
+  l.splat = splat;
+  l.step_voxels = step_voxels;
+  l.smoothing_voxels = smoothing_voxels;
+  l.caustics = caustics;
+  l.device = device;
+  checkSetting([&] { checkLightRequest(l); });
+  const LightingSummary sum =
+      p.run([&](Session& s) { return s.simulateLight(l, !gpu, {}).summary; });
+  py::dict d;
+  d["runs"] = sum.runs;
+  d["seconds"] = sum.seconds;
+  d["patches"] = sum.patches;
+  d["flux_emitted"] = sum.flux_emitted;
+  d["flux_left"] = sum.flux_left;
+  d["flux_caustic"] = sum.flux_caustic;
+  d["flux_energy"] = sum.flux_energy;
+  d["flux_absorbed"] = sum.flux_absorbed;
+  d["conservation_error"] = sum.conservationError();
+  d["device"] = device;
+  return d;
+}
+
+py::dict lightVolumes(Prepared& p) {
+  const VolumeSet& v = p.run([](Session& s) -> const VolumeSet& { return s.prepare(false); });
+  if (!v.lit()) throw std::runtime_error("no light volumes: call simulate_light() first");
+  const Grid& g = v.grid;
+  auto arr = [&](const std::vector<glm::vec4>& x) {
+    py::array_t<float> a(
+        {py::ssize_t(g.dims[2]), py::ssize_t(g.dims[1]), py::ssize_t(g.dims[0]), py::ssize_t(4)});
+    std::copy(&x[0].x, &x[0].x + 4 * x.size(), a.mutable_data());
+    return a;
+  };
+  py::dict d;
+  d["fluence"] = arr(v.light_fluence);
+  d["flux"] = arr(v.light_flux);
+  return d;
+}
+
+std::vector<std::array<TraceOutcome, 2>> traceBoth(Prepared& p,
+                                                   const std::vector<TraceRequest>& req,
+                                                   const std::optional<MarchSettings>& march,
+                                                   const std::string& device) {
+  const bool gpu = isGpu(device);
+  const MarchSettings ms = march.value_or(MarchSettings{});
+  checkSetting([&] {
+    for (const TraceRequest& q : req) checkTraceRequest(q);
+    checkMarchStep(ms.step_voxels);
+  });
+  return p.run([&](Session& s) { return s.trace(req, ms, gpu); });
+}
+
+py::dict traceRays(Prepared& p, const py::handle& origins, const py::handle& directions,
+                   const py::handle& wavelength_nm, std::optional<MarchSettings> march,
+                   const std::string& device) {
+  auto req = makeRequests(origins, directions, wavelength_nm);
+  auto both = traceBoth(p, req, march, device);
+  py::dict modes;
+  const char* names[2] = {"o", "e"};
+  for (int k = 0; k < 2; ++k) {
+    std::vector<TraceOutcome> col;
+    col.reserve(both.size());
+    for (const auto& b : both) col.push_back(b[size_t(k)]);
+    modes[names[k]] = outcomesArrays(col, names[k]);
+  }
+  py::array_t<double> lam(py::ssize_t(req.size()));
+  for (size_t i = 0; i < req.size(); ++i) lam.mutable_at(py::ssize_t(i)) = req[i].wavelength_nm;
+  py::dict d;
+  d["wavelength_nm"] = lam;
+  d["device"] = device;
+  d["modes"] = modes;
+  return d;
+}
+
+py::dict traceOne(Prepared& p, const py::handle& origin, const py::handle& direction,
+                  double wavelength_nm, std::optional<MarchSettings> march,
+                  const std::string& device) {
+  TraceRequest q{toVec3(origin), toVec3(direction), wavelength_nm};
+  auto both = traceBoth(p, {q}, march, device).at(0);
+  py::list modes;
+  modes.append(outcomeDict(both[0], "o"));
+  modes.append(outcomeDict(both[1], "e"));
+  py::dict d;
+  d["wavelength_nm"] = wavelength_nm;
+  d["device"] = device;
+  d["modes"] = modes;
+  return d;
+}
+
+py::array_t<float> readExr(const std::string& path) {
+  RgbaImage im = readExrRgba(path, 16384, 16384);
+  py::array_t<float> a({py::ssize_t(im.height), py::ssize_t(im.width), py::ssize_t(3)});
+  float* d = a.mutable_data();
+  for (size_t i = 0; i < size_t(im.width) * size_t(im.height); ++i)
+    for (int c = 0; c < 3; ++c) d[3 * i + size_t(c)] = im.rgba[4 * i + size_t(c)];
+  return a;
+}
+
+void bindModuleCalls(py::module_& m) {
+  m.def(
+      "render",
+      [](std::shared_ptr<Scene> s, py::kwargs kw) {
+        auto p = py::cast(cachedPrepared(s));
+        return p.attr("render")(**kw);
+      },
+      py::arg("scene"),
+      "render(scene, width=, height=, spp=, wavelengths=, wavelength_nm=, march=, "
+      "device='gpu'|'cpu', light=, "
+      "light_cache=) — Renderer.render on the module's cached prepared scene (voxelised once per "
+      "Scene object "
+      "and volume settings)");
+  m.def(
+      "trace",
+      [](std::shared_ptr<Scene> s, py::args a, py::kwargs kw) {
+        auto p = py::cast(cachedPrepared(s));
+        return p.attr("trace")(*a, **kw);
+      },
+      py::arg("scene"),
+      "trace(scene, origin, direction, wavelength_nm=, march=, device=) — see Renderer.trace");
+  m.def(
+      "clear_cache",
+      [] {
+        std::lock_guard<std::mutex> lock(g_prepared_mutex);
+        g_last_prepared.reset();
+        g_last_scene.reset();
+      },
+      "drop the scene that module-level render()/trace() keep prepared");
+  m.def(
+      "voxelize_count", [] { return g_voxelizations.load(); },
+      "how many times this module has voxelised a scene (each Renderer once, module-level calls "
+      "once per scene)");
+  m.def("read_exr", &readExr, py::arg("path"),
+        "(H, W, 3) float32 linear RGB of an EXR (e.g. what `eikon render` wrote)");
+}
+}  // namespace
+
+void bindRenderer(py::module_& m) {
+  py::class_<Prepared, std::shared_ptr<Prepared>>(
+      m, "Renderer",
+      "A scene voxelised once and marched on the GPU (ViewRenderer) or the CPU (ReferenceMarcher).")
+      .def(py::init(
+               [](std::shared_ptr<Scene> s) { return std::make_shared<Prepared>(std::move(s)); }),
+           py::arg("scene"))
+      .def_property_readonly("scene", [](const Prepared& p) { return p.scene; })
+      .def("grid", &grid, "voxel grid facts (voxelises on first call)")
+      .def("render", &render, py::arg("width") = 0, py::arg("height") = 0, py::arg("spp") = 1,
+           py::arg("wavelengths") = py::none(), py::arg("wavelength_nm") = 587.5618,
+           py::arg("march") = py::none(), py::arg("device") = "gpu", py::arg("threads") = 0,
+           py::arg("light") = true, py::arg("light_cache") = true,
+           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: wavelengths=None "
+           "is 16 for a "
+           "dispersive scene, else 0 (RGB; > 0 = spectral with that many samples); march=None is "
+           "0.5-voxel RK4 "
+           "steps; light=True simulates a lit scene's lights before its first render (unless "
+           "simulate_light() "
+           "did), on the twin the CLI picks, through the CLI's light cache (light_cache=True: the "
+           "default "
+           "folder, a path: that folder, False: none); light=False leaves an unsimulated scene "
+           "unlit (--no-light)")
+      .def(
+          "simulate_light", &simulateLight, py::arg("bands") = 0, py::arg("splat") = "accumulate",
+          py::arg("step_voxels") = 0.5, py::arg("smoothing_voxels") = 1.0,
+          py::arg("caustics") = "pass", py::arg("device") = "gpu",
+          "simulate the scene's lights (docs/lighting.md) into the volume that later renders read; "
+          "returns the summed run statistics")
+      .def("light_volumes", &lightVolumes,
+           "{'fluence': (Z, Y, X, 4) φ_r, φ_g, φ_b, φ_Y (W/mm²), 'flux': (Z, Y, X, 4) net flux "
+           "vector} "
+           "on the voxel grid (index [k, j, i] is the voxel centred at origin + (i + ½, j + ½, k + "
+           "½)·h)")
+      .def("trace_rays", &traceRays, py::arg("origins"), py::arg("directions"),
+           py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(),
+           py::arg("device") = "gpu",
+           "many rays: {'wavelength_nm': (N,), 'device', 'modes': {'o': {key: (N,3)|(N,)}, 'e': "
+           "...}}")
+      .def("trace", &traceOne, py::arg("origin"), py::arg("direction"),
+           py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(),
+           py::arg("device") = "gpu",
+           "one ray, the CLI JSON shape: {'wavelength_nm', 'device', 'modes': [{'mode': 'o', ...}, "
+           "...]}");
+
+  bindModuleCalls(m);
+}
+
+}  // namespace eikon::python

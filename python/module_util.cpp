@@ -1,0 +1,195 @@
+// The module's shared helpers: numpy ↔ glm conversions, trace dicts, the session's setting
+// errors in Python's words, and the one Vulkan context (python/module.h).
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+
+#include "core/vk/context.h"
+#include "python/module.h"
+
+namespace eikon::python {
+
+glm::dvec3 toVec3(const py::handle& h) {
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
+  if (!a || a.size() != 3) throw std::invalid_argument("expected a 3-vector");
+  const double* p = a.data();
+  return {p[0], p[1], p[2]};
+}
+py::array_t<double> fromVec3(const glm::dvec3& v) {
+  py::array_t<double> a(3);
+  auto m = a.mutable_unchecked<1>();
+  for (py::ssize_t i = 0; i < 3; ++i) m(i) = v[int(i)];
+  return a;
+}
+py::array_t<double> fromMat3(const glm::dmat3& M) {  // glm is column-major: M[col][row]
+  py::array_t<double> a({3, 3});
+  auto m = a.mutable_unchecked<2>();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m(r, c) = M[c][r];
+  return a;
+}
+std::vector<double> toVector(const py::handle& h) {
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
+  if (!a || a.ndim() != 1) throw std::invalid_argument("expected a 1-D sequence of numbers");
+  return {a.data(), a.data() + a.size()};
+}
+py::array_t<double> fromVector(const std::vector<double>& v) {
+  return py::array_t<double>(py::ssize_t(v.size()), v.data());
+}
+
+Mode parseMode(const std::string& s) {
+  if (s == "o" || s == "ordinary") return Mode::Ordinary;
+  if (s == "e" || s == "extraordinary") return Mode::Extraordinary;
+  throw std::invalid_argument("mode must be 'o' or 'e', got '" + s + "'");
+}
+std::string integratorName(Integrator i) {
+  return i == Integrator::Euler ? "euler" : i == Integrator::Midpoint ? "midpoint" : "rk4";
+}
+// Python's keyword for each setting the session checks (its SettingError::setting()).
+void rethrowSetting(const SettingError& e) {
+  static const std::map<std::string, std::string> keyword = {{"step", "march.step_voxels"},
+                                                             {"light-bands", "bands"},
+                                                             {"light-splat", "splat"},
+                                                             {"light-step", "step_voxels"},
+                                                             {"light-device", "device"},
+                                                             {"light-split", "split_voxels"},
+                                                             {"max-patches", "max_patches"},
+                                                             {"wavelength", "wavelength_nm"},
+                                                             {"dir", "direction"}};
+  auto it = keyword.find(e.setting());
+  throw std::invalid_argument((it == keyword.end() ? e.setting() : it->second) + " " +
+                              e.complaint());
+}
+
+// ---------------------------------------------------------------- Vulkan context (lazy, shared)
+namespace {
+std::mutex g_ctx_mutex;
+std::shared_ptr<vk::Context> g_ctx;
+}  // namespace
+
+std::shared_ptr<vk::Context> context() {
+  std::lock_guard<std::mutex> lock(g_ctx_mutex);
+  if (!g_ctx) {
+    vk::ContextOptions opt;  // validation follows EIKON_VALIDATION=1
+    g_ctx = std::shared_ptr<vk::Context>(vk::Context::create(opt).release());
+  }
+  return g_ctx;
+}
+
+py::dict outcomeDict(const TraceOutcome& t, const char* mode) {
+  py::dict d;
+  d["mode"] = mode;
+  d["exit_point"] = fromVec3(t.exit_point);
+  d["exit_direction"] = fromVec3(t.exit_direction);
+  d["wave_normal"] = fromVec3(t.wave_normal);
+  d["optical_path_mm"] = t.optical_path_mm;
+  d["transmittance"] = t.transmittance;
+  d["left_volume"] = t.left_volume;
+  d["steps"] = t.steps;
+  d["invariant_drift"] = t.invariant_drift;
+  d["interfaces"] = t.interfaces;
+  d["total_internal_reflections"] = t.total_internal_reflections;
+  return d;
+}
+
+// Column-wise arrays of many outcomes of one mode.
+py::dict outcomesArrays(const std::vector<TraceOutcome>& v, const char* mode) {
+  const py::ssize_t N = py::ssize_t(v.size());
+  py::array_t<double> xp({N, py::ssize_t(3)}), xd({N, py::ssize_t(3)}), wn({N, py::ssize_t(3)});
+  py::array_t<double> opl(N), tr(N), drift(N);
+  py::array_t<bool> left(N);
+  py::array_t<int> steps(N), ifc(N), tir(N);
+  auto a = xp.mutable_unchecked<2>(), b = xd.mutable_unchecked<2>(), c = wn.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < N; ++i) {
+    const auto& t = v[size_t(i)];
+    for (int k = 0; k < 3; ++k) {
+      a(i, k) = t.exit_point[k];
+      b(i, k) = t.exit_direction[k];
+      c(i, k) = t.wave_normal[k];
+    }
+    opl.mutable_at(i) = t.optical_path_mm;
+    tr.mutable_at(i) = t.transmittance;
+    drift.mutable_at(i) = t.invariant_drift;
+    left.mutable_at(i) = t.left_volume;
+    steps.mutable_at(i) = t.steps;
+    ifc.mutable_at(i) = t.interfaces;
+    tir.mutable_at(i) = t.total_internal_reflections;
+  }
+  py::dict d;
+  d["mode"] = mode;
+  d["exit_point"] = xp;
+  d["exit_direction"] = xd;
+  d["wave_normal"] = wn;
+  d["optical_path_mm"] = opl;
+  d["transmittance"] = tr;
+  d["left_volume"] = left;
+  d["steps"] = steps;
+  d["invariant_drift"] = drift;
+  d["interfaces"] = ifc;
+  d["total_internal_reflections"] = tir;
+  return d;
+}
+
+// (N,3) rays from origins/directions (each (3,) or (N,3)) and wavelengths (scalar or (N,)).
+std::vector<TraceRequest> makeRequests(const py::handle& origins, const py::handle& directions,
+                                       const py::handle& wavelengths) {
+  auto O = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(origins);
+  auto D = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(directions);
+  auto L = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(wavelengths);
+  if (!O || !D || !L)
+    throw std::invalid_argument("origins, directions and wavelengths must be numeric");
+  auto rows = [](const py::array_t<double>& a, const char* what) -> py::ssize_t {
+    if (a.ndim() == 1 && a.shape(0) == 3) return -1;
+    if (a.ndim() == 2 && a.shape(1) == 3) return a.shape(0);
+    throw std::invalid_argument(std::string(what) + " must have shape (3,) or (N, 3)");
+  };
+  py::ssize_t no = rows(O, "origins"), nd = rows(D, "directions");
+  py::ssize_t nl = L.ndim() == 0 ? -1 : (L.ndim() == 1 ? L.shape(0) : -2);
+  if (nl == -2) throw std::invalid_argument("wavelengths must be a scalar or 1-D");
+  py::ssize_t N = std::max({no, nd, nl, py::ssize_t(1)});
+  for (py::ssize_t n : {no, nd, nl})
+    if (n >= 0 && n != N)
+      throw std::invalid_argument("origins, directions and wavelengths disagree in length");
+  std::vector<TraceRequest> req(static_cast<size_t>(N));
+  for (py::ssize_t i = 0; i < N; ++i) {
+    const double* o = O.data() + (no < 0 ? 0 : 3 * i);
+    const double* d = D.data() + (nd < 0 ? 0 : 3 * i);
+    req[size_t(i)].origin = {o[0], o[1], o[2]};
+    req[size_t(i)].direction = {d[0], d[1], d[2]};
+    req[size_t(i)].wavelength_nm = L.data()[nl < 0 ? 0 : i];
+  }
+  return req;
+}
+
+void bindVulkan(py::module_& m) {
+  m.def(
+      "validation_messages",
+      []() {
+        std::lock_guard<std::mutex> lock(g_ctx_mutex);
+        return g_ctx ? g_ctx->validationMessages() : std::vector<std::string>{};
+      },
+      "messages of the Khronos validation layer so far (EIKON_VALIDATION=1); [] without a context");
+  m.def(
+      "device_info",
+      []() {
+        auto c = context();
+        py::dict d;
+        d["name"] = c->deviceName();
+        d["type"] = c->deviceTypeName();
+        d["api_version"] = c->apiVersionString();
+        d["validation"] = c->validationEnabled();
+        return d;
+      },
+      "create the Vulkan context if needed and describe its device");
+  // Drop the module's reference to the Vulkan context before interpreter teardown (Renderers
+  // still alive keep their own reference and release it when collected).
+  py::module_::import("atexit").attr("register")(py::cpp_function([]() {
+    std::lock_guard<std::mutex> lock(g_ctx_mutex);
+    g_ctx.reset();
+  }));
+}
+
+}  // namespace eikon::python

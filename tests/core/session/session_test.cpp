@@ -1,0 +1,133 @@
+// eikon::Session (core/session/session.h): the range checks both front ends share, the settings a
+// request turns into, and one straight ray through air marched by the CPU twin of a session.
+#include "core/session/session.h"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+
+namespace eikon {
+namespace {
+
+/// The SettingError a check raises: "setting|complaint", or "" (a test failure) when it passes.
+template <class F>
+std::string settingErrorOf(F&& check) {
+  try {
+    check();
+  } catch (const SettingError& e) {
+    EXPECT_EQ(std::string(e.what()), e.setting() + " " + e.complaint());
+    return e.setting() + "|" + e.complaint();
+  }
+  ADD_FAILURE() << "expected a SettingError";
+  return {};
+}
+
+TEST(Session, ViewRangesAreTheCliWords) {
+  ViewRequest v;
+  v.width = 0;
+  EXPECT_EQ(settingErrorOf([&] { checkViewRequest(v); }), "width|must be in [1, 16384], got 0");
+  v.width = 16384;
+  v.height = 16385;
+  EXPECT_EQ(settingErrorOf([&] { checkViewRequest(v); }),
+            "height|must be in [1, 16384], got 16385");
+  v.height.reset();
+  v.spp = 4097;
+  EXPECT_EQ(settingErrorOf([&] { checkViewRequest(v); }), "spp|must be in [1, 4096], got 4097");
+  v.spp = 1;
+  v.wavelengths = -1;
+  EXPECT_EQ(settingErrorOf([&] { checkViewRequest(v); }),
+            "wavelengths|must be in [0, 256], got -1");
+  v.wavelengths = 0;
+  v.march = MarchSettings{};
+  v.march->step_voxels = 0.0;
+  EXPECT_EQ(settingErrorOf([&] { checkViewRequest(v); }), "step|must be in (0, 4] voxels");
+  v.march->step_voxels = 4.0;
+  EXPECT_NO_THROW(checkViewRequest(v));
+  EXPECT_EQ(settingErrorOf([] { parseIntegrator("verlet"); }),
+            "integrator|must be euler, midpoint or rk4");
+  EXPECT_EQ(parseIntegrator("midpoint"), Integrator::Midpoint);
+}
+
+TEST(Session, LightAndTraceRangesAreTheCliWords) {
+  LightRequest l;
+  EXPECT_NO_THROW(checkLightRequest(l));
+  l.splat = "max";
+  EXPECT_EQ(settingErrorOf([&] { checkLightRequest(l); }),
+            "light-splat|must be accumulate or highest, got 'max'");
+  l.splat = "highest";
+  l.caustics = "stop";
+  EXPECT_EQ(settingErrorOf([&] { checkLightRequest(l); }),
+            "caustics|must be pass or kill, got 'stop'");
+  l.caustics = "kill";
+  l.max_patches = 1023;
+  EXPECT_EQ(settingErrorOf([&] { checkLightRequest(l); }),
+            "max-patches|must be in [1024, 16777216]");
+  l.max_patches = 1024;
+  l.step_voxels = 2.5;
+  EXPECT_EQ(settingErrorOf([&] { checkLightRequest(l); }), "light-step|must be in (0, 2] voxels");
+
+  TraceRequest ray{{0, 0, 0}, {0, 0, 0}, 587.56};
+  EXPECT_EQ(settingErrorOf([&] { checkTraceRequest(ray); }), "dir|must be a non-zero vector");
+  ray.direction = {0, 0, 2};
+  ray.wavelength_nm = 99.0;
+  EXPECT_EQ(settingErrorOf([&] { checkTraceRequest(ray); }),
+            "wavelength|must be in [100, 10000] nm");
+}
+
+// A BK7-like sphere (Sellmeier: dispersive) in a 16 mm box; the ray along z at x = y = −6 mm never
+// comes near it (closest 7 mm, the smoothing reach < 3 mm), so it crosses air: straight, OPL =
+// the 15 mm from z = −7 to the face z = 8, no interface, and the e-mode is the o-mode.
+const char* kScene = R"({
+  "camera": {"position": [0, 0, -40], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 30,
+             "width": 8, "height": 6},
+  "volume": {"bounds_min": [-8, -8, -8], "bounds_max": [8, 8, 8], "resolution": 16},
+  "materials": {"glass": {"n": {"sellmeier": [1.03961212, 0.231792344, 1.01046945,
+                                               0.00600069867, 0.0200179144, 103.560653]}}},
+  "objects": [{"shape": "sphere", "center": [2, 2, 0], "radius": 3, "material": "glass"}]
+})";
+
+TEST(Session, RequestsTakeTheRenderDefaults) {
+  const Scene scene = parseScene(kScene, "session.json");
+  ViewRequest v;
+  RenderSettings rs = renderSettings(scene, v);
+  EXPECT_EQ(rs.width, 0);         // the camera's
+  EXPECT_EQ(rs.wavelengths, 16);  // dispersive
+  EXPECT_DOUBLE_EQ(rs.march.step_voxels, 0.5);
+  v.width = 40;
+  v.wavelengths = 0;
+  rs = renderSettings(scene, v);
+  EXPECT_EQ(rs.width, 40);
+  EXPECT_EQ(rs.wavelengths, 0);
+  // The default light options: dt = step · h.
+  LightRequest l;
+  l.step_voxels = 0.5;
+  EXPECT_DOUBLE_EQ(lightingOptions(l, 2.0).wave.dt, 1.0);
+}
+
+TEST(Session, CpuTwinTracesBothModesAndVoxelisesOnce) {
+  Session session(std::make_shared<Scene>(parseScene(kScene, "session.json")),
+                  []() -> std::shared_ptr<vk::Context> {
+                    ADD_FAILURE() << "a CPU session made a Vulkan context";
+                    return nullptr;
+                  });
+  const VolumeSet* first = &session.prepare(false);
+  EXPECT_EQ(&session.prepare(false), first);
+  EXPECT_FALSE(session.hasContext());
+  EXPECT_EQ(session.deviceName(false), "CPU reference (double)");
+  const auto both = session.trace({{{-6, -6, -7}, {0, 0, 1}, 587.56}}, MarchSettings{}, false);
+  ASSERT_EQ(both.size(), 1u);
+  for (const TraceOutcome& t : both[0]) {
+    EXPECT_TRUE(t.left_volume);
+    EXPECT_NEAR(t.exit_point.x, -6.0, 1e-9);
+    EXPECT_NEAR(t.exit_point.y, -6.0, 1e-9);
+    EXPECT_NEAR(t.exit_point.z, 8.0, 1e-6);
+    EXPECT_NEAR(t.exit_direction.z, 1.0, 1e-12);
+    EXPECT_NEAR(t.optical_path_mm, 15.0, 1e-6);
+    EXPECT_EQ(t.interfaces, 0);
+  }
+  EXPECT_FALSE(session.hasContext());
+}
+
+}  // namespace
+}  // namespace eikon
