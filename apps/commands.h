@@ -12,7 +12,8 @@ namespace eikon::cli {
 
 /// A user-facing error: printed as one line, exit status `code`.
 struct CliError : std::runtime_error {
-  explicit CliError(const std::string& what, int code = 1) : std::runtime_error(what), exit_code(code) {}
+  explicit CliError(const std::string& what, int code = 1)
+      : std::runtime_error(what), exit_code(code) {}
   int exit_code;
 };
 

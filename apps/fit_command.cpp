@@ -9,9 +9,9 @@
 // written to a temporary file beside the target and renamed, so a failed run leaves nothing.
 
 #include <charconv>
-#include <cstring>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -49,7 +49,9 @@ std::string fmt(const char* f, double v) {
 
 json nullable(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
 
-std::string lossName(const FitResult& r) { return r.huber_delta ? "huber:" + fmt("%g", *r.huber_delta) : "none"; }
+std::string lossName(const FitResult& r) {
+  return r.huber_delta ? "huber:" + fmt("%g", *r.huber_delta) : "none";
+}
 
 bool isCauchy(DispersionModel m) {
   return m == DispersionModel::Cauchy2 || m == DispersionModel::Cauchy3;
@@ -100,7 +102,8 @@ json materialIndex(const FitResult& r) {
 json reportMode(const FitResult& r) {
   json coeffs = json::object(), sig = json::object();
   const auto names = parameterNames(r.model);
-  for (size_t k = 0; k < names.size(); ++k) coeffs[names[k]] = r.coeffs[k], sig[names[k]] = r.sigma[k];
+  for (size_t k = 0; k < names.size(); ++k)
+    coeffs[names[k]] = r.coeffs[k], sig[names[k]] = r.sigma[k];
   json j = fitStats(r);
   j["coefficients"] = coeffs;
   j["sigma"] = sig;
@@ -112,19 +115,24 @@ json reportMode(const FitResult& r) {
 
 void printTable(std::ostream& os, const IndexData& data, const std::vector<FitResult>& fits) {
   const FitResult& f0 = fits.front();
-  os << "eikon fit: " << data.source << ", model " << modelName(f0.model) << ", loss " << lossName(f0) << "\n";
+  os << "eikon fit: " << data.source << ", model " << modelName(f0.model) << ", loss "
+     << lossName(f0) << "\n";
   for (const FitResult& r : fits) {
-    os << "\n" << r.label << ": " << r.points << " points, " << fmt("%g", r.range_nm[0]) << "-"
+    os << "\n"
+       << r.label << ": " << r.points << " points, " << fmt("%g", r.range_nm[0]) << "-"
        << fmt("%g", r.range_nm[1]) << " nm, "
-       << (r.weighted ? "weighted by sigma" : "unweighted (sigma of n estimated from the scatter)") << "\n";
+       << (r.weighted ? "weighted by sigma" : "unweighted (sigma of n estimated from the scatter)")
+       << "\n";
     const auto names = parameterNames(r.model);
     for (size_t k = 0; k < names.size(); ++k)
       os << "  " << names[k] << std::string(4 - std::min<size_t>(4, names[k].size()), ' ') << "= "
          << fmt("%15.8e", r.coeffs[k]) << "  +/- " << fmt("%.2e", r.sigma[k]) << "\n";
-    os << "  residual rms " << fmt("%.3e", r.rms) << ", max " << fmt("%.3e", r.max_residual) << ", chi2_red "
-       << (r.chi2_reduced ? fmt("%.3f", *r.chi2_reduced) : std::string("- (no sigma column)")) << "\n";
-    os << "  n_F " << fmt("%.6f", r.n_F) << "  n_d " << fmt("%.6f", r.n_d) << "  n_C " << fmt("%.6f", r.n_C)
-       << "  V_d " << fmt("%.2f", r.abbe) << "\n";
+    os << "  residual rms " << fmt("%.3e", r.rms) << ", max " << fmt("%.3e", r.max_residual)
+       << ", chi2_red "
+       << (r.chi2_reduced ? fmt("%.3f", *r.chi2_reduced) : std::string("- (no sigma column)"))
+       << "\n";
+    os << "  n_F " << fmt("%.6f", r.n_F) << "  n_d " << fmt("%.6f", r.n_d) << "  n_C "
+       << fmt("%.6f", r.n_C) << "  V_d " << fmt("%.2f", r.abbe) << "\n";
     if (!isCauchy(r.model)) {
       const CauchyApproximation ap = rendererApproximation(r);
       os << "  renderer: cauchy [" << fmt("%.8e", ap.coeffs[0]) << ", " << fmt("%.8e", ap.coeffs[1])
@@ -159,13 +167,16 @@ std::string yamlEntry(const FitResult& r, const std::string& source) {
   std::ostringstream comment;
   comment << "1-sigma: ";
   const auto names = parameterNames(r.model);
-  for (size_t k = 0; k < names.size(); ++k) comment << (k ? ", " : "") << names[k] << " " << fmt("%.3e", r.sigma[k]);
+  for (size_t k = 0; k < names.size(); ++k)
+    comment << (k ? ", " : "") << names[k] << " " << fmt("%.3e", r.sigma[k]);
   comment << "; residual rms " << fmt("%.3e", r.rms) << ", max " << fmt("%.3e", r.max_residual);
   RefractiveIndexFormulaEntry entry;
-  entry.references = "eikon fit of " + source + ", model " + modelName(r.model) + " (" + r.label + ")";
+  entry.references =
+      "eikon fit of " + source + ", model " + modelName(r.model) + " (" + r.label + ")";
   entry.comments = comment.str();
   entry.formula = formula;
-  entry.wavelength_range = fmt("%.10g", r.range_nm[0] * 1e-3) + " " + fmt("%.10g", r.range_nm[1] * 1e-3);
+  entry.wavelength_range =
+      fmt("%.10g", r.range_nm[0] * 1e-3) + " " + fmt("%.10g", r.range_nm[1] * 1e-3);
   entry.coefficients = coeffs.str();
   return formatRefractiveIndexYaml(entry);
 }
@@ -213,7 +224,8 @@ void writeAllAtomically(const std::vector<std::pair<std::string, std::string>>& 
 std::optional<double> parseLoss(const std::string& s) {
   if (s.empty() || s == "none") return std::nullopt;
   const std::string prefix = "huber:";
-  if (s.rfind(prefix, 0) != 0) throw CliError("--loss must be 'huber:DELTA' or 'none', got '" + s + "'");
+  if (s.rfind(prefix, 0) != 0)
+    throw CliError("--loss must be 'huber:DELTA' or 'none', got '" + s + "'");
   const std::string v = s.substr(prefix.size());
   double d = 0.0;
   auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), d);
@@ -258,8 +270,7 @@ void run(const FitArgs& a) {
       std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
     }
 
-  const std::string name =
-      !a.name.empty() ? a.name : fs::path(a.data[0]).stem().string();
+  const std::string name = !a.name.empty() ? a.name : fs::path(a.data[0]).stem().string();
   const std::string source = "eikon fit of " + data.source + ", model " + modelName(fo.model);
   std::vector<std::pair<std::string, std::string>> files;
   if (!a.output.empty()) {
@@ -270,8 +281,10 @@ void run(const FitArgs& a) {
     } else {
       m["n_o"] = materialIndex(fits[0]);
       m["n_e"] = materialIndex(fits[1]);
-      m["fit"] = {{"model", modelName(fo.model)}, {"loss", lossName(fits[0])},
-                  {"n_o", fitStats(fits[0])}, {"n_e", fitStats(fits[1])}};
+      m["fit"] = {{"model", modelName(fo.model)},
+                  {"loss", lossName(fits[0])},
+                  {"n_o", fitStats(fits[0])},
+                  {"n_e", fitStats(fits[1])}};
     }
     files.emplace_back(a.output, m.dump(2) + "\n");
   }
@@ -292,8 +305,11 @@ void run(const FitArgs& a) {
     for (const FitResult& r : fits)
       for (const std::string& w : r.warnings) warnings.push_back(w);
     for (const FitResult& r : fits) modes[r.label] = reportMode(r);
-    json out = {{"source", data.source}, {"model", modelName(fo.model)}, {"loss", lossName(fits[0])},
-                {"modes", modes}, {"warnings", warnings}};
+    json out = {{"source", data.source},
+                {"model", modelName(fo.model)},
+                {"loss", lossName(fits[0])},
+                {"modes", modes},
+                {"warnings", warnings}};
     json written = json::array();
     for (auto& f : files) written.push_back(f.first);
     out["written"] = written;
@@ -318,7 +334,8 @@ class FitFormatter final : public CLI::Formatter {
 
 void addFitCommand(CLI::App& app) {
   auto args = std::make_shared<FitArgs>();
-  auto* sub = app.add_subcommand("fit", "Fit a dispersion model to refractive-index data (CSV or refractiveindex.info YAML)");
+  auto* sub = app.add_subcommand(
+      "fit", "Fit a dispersion model to refractive-index data (CSV or refractiveindex.info YAML)");
   sub->formatter(std::make_shared<FitFormatter>());
   sub->add_option(
          "DATA", args->data,
@@ -329,14 +346,20 @@ void addFitCommand(CLI::App& app) {
       ->type_name("FILE")
       ->required()
       ->expected(1, 2);
-  sub->add_option("--model", args->model, "cauchy2 | cauchy3 | sellmeier1 | sellmeier2 | sellmeier3 | conrady")
+  sub->add_option("--model", args->model,
+                  "cauchy2 | cauchy3 | sellmeier1 | sellmeier2 | sellmeier3 | conrady")
       ->capture_default_str();
-  sub->add_option("--loss", args->loss, "robust loss 'huber:DELTA' (DELTA in sigma units with a sigma column, else in index units)");
+  sub->add_option(
+      "--loss", args->loss,
+      "robust loss 'huber:DELTA' (DELTA in sigma units with a sigma column, else in index units)");
   sub->add_flag("--json", args->json_out, "print the fit as one JSON object instead of a table");
-  sub->add_option("--export-yaml", args->export_yaml, "also write a refractiveindex.info formula entry (crystals: FILE-o/-e)");
+  sub->add_option("--export-yaml", args->export_yaml,
+                  "also write a refractiveindex.info formula entry (crystals: FILE-o/-e)");
   sub->add_flag("--strict", args->strict, "treat warnings (e.g. unsorted rows) as errors");
   sub->add_option("-o,--output", args->output, "material JSON file for the renderer");
-  sub->add_option("--range-nm", args->range_nm, "fit only LO,HI nm (formulas are sampled inside it)")->delimiter(',');
+  sub->add_option("--range-nm", args->range_nm,
+                  "fit only LO,HI nm (formulas are sampled inside it)")
+      ->delimiter(',');
   sub->add_option("--samples", args->samples,
                   "samples per refractiveindex.info formula block (2 to 100000)")
       ->capture_default_str();

@@ -44,10 +44,14 @@ class QuietGlog {
 
 int sellmeierTerms(DispersionModel m) {
   switch (m) {
-    case DispersionModel::Sellmeier1: return 1;
-    case DispersionModel::Sellmeier2: return 2;
-    case DispersionModel::Sellmeier3: return 3;
-    default: return 0;
+    case DispersionModel::Sellmeier1:
+      return 1;
+    case DispersionModel::Sellmeier2:
+      return 2;
+    case DispersionModel::Sellmeier3:
+      return 3;
+    default:
+      return 0;
   }
 }
 
@@ -55,7 +59,8 @@ int sellmeierTerms(DispersionModel m) {
 // so that Ceres' covariance rank test compares like with like).
 class PointResidual final : public ceres::CostFunction {
  public:
-  PointResidual(DispersionModel m, const std::vector<double>& scale, double lambda_nm, double n, double w)
+  PointResidual(DispersionModel m, const std::vector<double>& scale, double lambda_nm, double n,
+                double w)
       : m_(m), scale_(scale), lambda_nm_(lambda_nm), n_(n), w_(w) {
     set_num_residuals(1);
     mutable_parameter_block_sizes()->push_back(int(scale.size()));
@@ -83,7 +88,8 @@ class PointResidual final : public ceres::CostFunction {
 // Huber needs one block per point; without it one block is several times faster to set up).
 class AllResiduals final : public ceres::CostFunction {
  public:
-  AllResiduals(DispersionModel m, const std::vector<double>& scale, const IndexSeries& d, const std::vector<double>& w)
+  AllResiduals(DispersionModel m, const std::vector<double>& scale, const IndexSeries& d,
+               const std::vector<double>& w)
       : m_(m), scale_(scale), d_(d), w_(w) {
     set_num_residuals(int(d.size()));
     mutable_parameter_block_sizes()->push_back(int(scale.size()));
@@ -118,8 +124,8 @@ Eigen::VectorXd linearSolve(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) 
 }
 
 // Start values (see fitting.h): exact linear solution for Cauchy/Conrady, pole grid for Sellmeier.
-std::vector<double> startValues(DispersionModel m, const IndexSeries& d, const std::vector<double>& w,
-                                const std::string& who) {
+std::vector<double> startValues(DispersionModel m, const IndexSeries& d,
+                                const std::vector<double>& w, const std::string& who) {
   const int N = int(d.size());
   const int P = parameterCount(m);
   const int K = sellmeierTerms(m);
@@ -141,7 +147,8 @@ std::vector<double> startValues(DispersionModel m, const IndexSeries& d, const s
   }
   // Sellmeier: n² − 1 = Σ Bᵢ λ²/(λ² − Cᵢ) is linear in B for fixed C. Weight in n² space is
   // w/(2n) since δ(n²) ≈ 2n δn.
-  const double lmin2 = std::pow(d.lambda_nm.front() * 1e-3, 2), lmax2 = std::pow(d.lambda_nm.back() * 1e-3, 2);
+  const double lmin2 = std::pow(d.lambda_nm.front() * 1e-3, 2),
+               lmax2 = std::pow(d.lambda_nm.back() * 1e-3, 2);
   auto geom = [](double a, double b, int count) {
     std::vector<double> v;
     for (int i = 0; i < count; ++i) v.push_back(a * std::pow(b / a, i / double(count - 1)));
@@ -185,7 +192,8 @@ std::vector<double> startValues(DispersionModel m, const IndexSeries& d, const s
     }
     if (std::isfinite(cost) && cost < best_cost) best_cost = cost, best = p;
   }
-  if (best.empty()) throw std::runtime_error(who + ": no usable Sellmeier start found (every pole set failed)");
+  if (best.empty())
+    throw std::runtime_error(who + ": no usable Sellmeier start found (every pole set failed)");
   return best;
 }
 
@@ -198,39 +206,54 @@ DispersionModel parseDispersionModel(const std::string& name) {
   if (name == "sellmeier2") return DispersionModel::Sellmeier2;
   if (name == "sellmeier3") return DispersionModel::Sellmeier3;
   if (name == "conrady") return DispersionModel::Conrady;
-  throw std::invalid_argument("unknown model '" + name +
-                              "' (expected cauchy2, cauchy3, sellmeier1, sellmeier2, sellmeier3 or conrady)");
+  throw std::invalid_argument(
+      "unknown model '" + name +
+      "' (expected cauchy2, cauchy3, sellmeier1, sellmeier2, sellmeier3 or conrady)");
 }
 
 std::string modelName(DispersionModel m) {
   switch (m) {
-    case DispersionModel::Cauchy2: return "cauchy2";
-    case DispersionModel::Cauchy3: return "cauchy3";
-    case DispersionModel::Sellmeier1: return "sellmeier1";
-    case DispersionModel::Sellmeier2: return "sellmeier2";
-    case DispersionModel::Sellmeier3: return "sellmeier3";
-    case DispersionModel::Conrady: return "conrady";
+    case DispersionModel::Cauchy2:
+      return "cauchy2";
+    case DispersionModel::Cauchy3:
+      return "cauchy3";
+    case DispersionModel::Sellmeier1:
+      return "sellmeier1";
+    case DispersionModel::Sellmeier2:
+      return "sellmeier2";
+    case DispersionModel::Sellmeier3:
+      return "sellmeier3";
+    case DispersionModel::Conrady:
+      return "conrady";
   }
   return "?";
 }
 
 int parameterCount(DispersionModel m) {
   switch (m) {
-    case DispersionModel::Cauchy2: return 2;
-    case DispersionModel::Cauchy3: return 3;
-    case DispersionModel::Conrady: return 3;
-    default: return 2 * sellmeierTerms(m);
+    case DispersionModel::Cauchy2:
+      return 2;
+    case DispersionModel::Cauchy3:
+      return 3;
+    case DispersionModel::Conrady:
+      return 3;
+    default:
+      return 2 * sellmeierTerms(m);
   }
 }
 
 std::vector<std::string> parameterNames(DispersionModel m) {
   switch (m) {
-    case DispersionModel::Cauchy2: return {"A", "B"};
-    case DispersionModel::Cauchy3: return {"A", "B", "C"};
-    case DispersionModel::Conrady: return {"n0", "A", "B"};
+    case DispersionModel::Cauchy2:
+      return {"A", "B"};
+    case DispersionModel::Cauchy3:
+      return {"A", "B", "C"};
+    case DispersionModel::Conrady:
+      return {"n0", "A", "B"};
     default: {
       std::vector<std::string> b, c;
-      for (int i = 1; i <= sellmeierTerms(m); ++i) b.push_back("B" + std::to_string(i)), c.push_back("C" + std::to_string(i));
+      for (int i = 1; i <= sellmeierTerms(m); ++i)
+        b.push_back("B" + std::to_string(i)), c.push_back("C" + std::to_string(i));
       b.insert(b.end(), c.begin(), c.end());
       return b;
     }
@@ -265,8 +288,8 @@ double modelIndex(DispersionModel m, const double* p, double lambda_nm, double* 
       if (g)
         for (int i = 0; i < K; ++i) {
           const double den = l2 - p[K + i];
-          g[i] = l2 / den / (2.0 * n);                           // ∂n/∂Bᵢ
-          g[K + i] = p[i] * l2 / (den * den) / (2.0 * n);         // ∂n/∂Cᵢ
+          g[i] = l2 / den / (2.0 * n);                     // ∂n/∂Bᵢ
+          g[K + i] = p[i] * l2 / (den * den) / (2.0 * n);  // ∂n/∂Cᵢ
         }
       return n;
     }
@@ -293,17 +316,19 @@ void checkSeries(const IndexSeries& d, const FitOptions& opt, const std::string&
   if (d.n.size() != d.lambda_nm.size() || (d.weighted() && d.sigma.size() != d.lambda_nm.size()))
     throw std::invalid_argument(who + ": wavelength, index and sigma columns differ in length");
   if (N < P)
-    throw std::invalid_argument(who + ": " + std::to_string(N) + " points are fewer than the " + std::to_string(P) +
-                                " coefficients of " + modelName(opt.model));
+    throw std::invalid_argument(who + ": " + std::to_string(N) + " points are fewer than the " +
+                                std::to_string(P) + " coefficients of " + modelName(opt.model));
   if (N == P && !d.weighted())
-    throw std::invalid_argument(who + ": " + std::to_string(N) + " points for " + std::to_string(P) +
-                                " coefficients leave no degree of freedom to estimate uncertainties; add points or a "
-                                "sigma column");
+    throw std::invalid_argument(
+        who + ": " + std::to_string(N) + " points for " + std::to_string(P) +
+        " coefficients leave no degree of freedom to estimate uncertainties; add points or a "
+        "sigma column");
   if (opt.huber_delta && !(std::isfinite(*opt.huber_delta) && *opt.huber_delta > 0.0))
     throw std::invalid_argument("huber delta must be a finite number > 0");
   for (int i = 0; i < N; ++i)
     if (!(std::isfinite(d.lambda_nm[i]) && d.lambda_nm[i] > 0 && std::isfinite(d.n[i])))
-      throw std::invalid_argument(who + ": point " + std::to_string(i) + " is not finite or has λ <= 0");
+      throw std::invalid_argument(who + ": point " + std::to_string(i) +
+                                  " is not finite or has λ <= 0");
 }
 
 /// Column equilibration: s_k = 1/‖∂r/∂p_k‖ at the start, so q = p/s has unit-norm columns.
@@ -342,8 +367,9 @@ std::pair<int, std::vector<double>> solveScaled(const IndexSeries& d, const FitO
   if (opt.huber_delta) loss = std::make_unique<ceres::HuberLoss>(*opt.huber_delta);
   if (loss) {
     for (int i = 0; i < N; ++i)
-      problem.AddResidualBlock(new PointResidual(opt.model, scale, d.lambda_nm[size_t(i)], d.n[size_t(i)], w[size_t(i)]),
-                               loss.get(), q.data());
+      problem.AddResidualBlock(
+          new PointResidual(opt.model, scale, d.lambda_nm[size_t(i)], d.n[size_t(i)], w[size_t(i)]),
+          loss.get(), q.data());
   } else {
     problem.AddResidualBlock(new AllResiduals(opt.model, scale, d, w), nullptr, q.data());
   }
@@ -360,7 +386,8 @@ std::pair<int, std::vector<double>> solveScaled(const IndexSeries& d, const FitO
   std::optional<QuietGlog> quiet(std::in_place);
   ceres::Solve(so, &problem, &summary);
   if (!summary.IsSolutionUsable())
-    throw std::runtime_error(who + ": " + modelName(opt.model) + " fit failed (" + summary.message + ")");
+    throw std::runtime_error(who + ": " + modelName(opt.model) + " fit failed (" + summary.message +
+                             ")");
 
   ceres::Covariance::Options co;
   co.algorithm_type = ceres::DENSE_SVD;
@@ -372,14 +399,16 @@ std::pair<int, std::vector<double>> solveScaled(const IndexSeries& d, const FitO
   const bool covariance_ok = cov.Compute(blocks, &problem);
   quiet.reset();
   if (!covariance_ok)
-    throw std::runtime_error(who + ": rank-deficient " + modelName(opt.model) +
-                             " fit: the data cannot determine all coefficients (covariance is singular); "
-                             "use a model with fewer terms or data over a wider range");
+    throw std::runtime_error(
+        who + ": rank-deficient " + modelName(opt.model) +
+        " fit: the data cannot determine all coefficients (covariance is singular); "
+        "use a model with fewer terms or data over a wider range");
   // Checked after the covariance: a fit that wanders along a flat valley until the iteration
   // limit is usually rank-deficient, and that is the more useful message.
   if (summary.termination_type == ceres::NO_CONVERGENCE)
     throw std::runtime_error(who + ": " + modelName(opt.model) + " fit did not converge in " +
-                             std::to_string(opt.max_iterations) + " iterations (" + summary.message + ")");
+                             std::to_string(opt.max_iterations) + " iterations (" +
+                             summary.message + ")");
   std::vector<double> cq(size_t(P * P));
   cov.GetCovarianceBlock(q.data(), q.data(), cq.data());
   return {int(summary.iterations.size()), std::move(cq)};
@@ -407,8 +436,10 @@ void summarize(FitResult& r, const IndexSeries& d, const std::vector<double>& w,
   r.covariance.resize(size_t(P * P));
   for (int a = 0; a < P; ++a)
     for (int b = 0; b < P; ++b)
-      r.covariance[size_t(a * P + b)] = factor * scale[size_t(a)] * scale[size_t(b)] * cq[size_t(a * P + b)];
-  for (int k = 0; k < P; ++k) r.sigma.push_back(std::sqrt(std::max(0.0, r.covariance[size_t(k * P + k)])));
+      r.covariance[size_t(a * P + b)] =
+          factor * scale[size_t(a)] * scale[size_t(b)] * cq[size_t(a * P + b)];
+  for (int k = 0; k < P; ++k)
+    r.sigma.push_back(std::sqrt(std::max(0.0, r.covariance[size_t(k * P + k)])));
 
   // Goodness of fit (weighted data): with the Wilson–Hilferty cube-root normal approximation of
   // χ²_ν, z = ((χ²/ν)^{1/3} − (1 − 2/(9ν))) / sqrt(2/(9ν)); z > 3.09 means p < 1e-3.

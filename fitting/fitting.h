@@ -32,8 +32,9 @@
 //
 // Example:
 //   eikon::IndexData data = eikon::readIndexData("bk7.csv");
-//   eikon::FitResult r = eikon::fitDispersion(data.modes[0], {.model = eikon::DispersionModel::Cauchy3});
-//   r.coeffs;  r.sigma;  r.rms;  r.abbe;  r.dispersion().index(550.0);
+//   eikon::FitResult r = eikon::fitDispersion(data.modes[0], {.model =
+//   eikon::DispersionModel::Cauchy3}); r.coeffs;  r.sigma;  r.rms;  r.abbe;
+//   r.dispersion().index(550.0);
 //
 // Common mistakes: fitting Sellmeier to a narrow visible range (the poles are not determined:
 // rank-deficient); reading σ as a prediction error of n (it is the error of the coefficient);
@@ -52,7 +53,8 @@ namespace eikon {
 
 enum class DispersionModel { Cauchy2, Cauchy3, Sellmeier1, Sellmeier2, Sellmeier3, Conrady };
 
-/// "cauchy2", "cauchy3", "sellmeier1".."sellmeier3", "conrady"; throws std::invalid_argument otherwise.
+/// "cauchy2", "cauchy3", "sellmeier1".."sellmeier3", "conrady"; throws std::invalid_argument
+/// otherwise.
 DispersionModel parseDispersionModel(const std::string& name);
 std::string modelName(DispersionModel m);
 /// Number of free coefficients P.
@@ -82,12 +84,12 @@ struct FitResult {
   bool weighted = false;               ///< a σ column was given
   double chi2 = 0.0;                   ///< Σ rᵢ² (weighted) at the optimum, no robust loss
   std::optional<double> chi2_reduced;  ///< χ²/(N−P), only for weighted data with N > P
-  double residual_std = 0.0;           ///< s = sqrt(Σ (n_model − n)² / (N−P)) (index units; 0 if N = P)
-  double rms = 0.0;                    ///< sqrt(mean (n_model − n)²)
-  double max_residual = 0.0;           ///< max |n_model − n|
-  std::array<double, 2> range_nm{};    ///< data span
+  double residual_std = 0.0;  ///< s = sqrt(Σ (n_model − n)² / (N−P)) (index units; 0 if N = P)
+  double rms = 0.0;           ///< sqrt(mean (n_model − n)²)
+  double max_residual = 0.0;               ///< max |n_model − n|
+  std::array<double, 2> range_nm{};        ///< data span
   double n_F = 0.0, n_d = 0.0, n_C = 0.0;  ///< fitted n at the Fraunhofer F, d, C lines
-  double abbe = 0.0;                   ///< V_d = (n_d − 1)/(n_F − n_C)
+  double abbe = 0.0;                       ///< V_d = (n_d − 1)/(n_F − n_C)
   int iterations = 0;
   std::optional<double> huber_delta;
   /// Recoverable problems, e.g. χ²_red too large for the σ given (p < 1e-3).

@@ -28,8 +28,8 @@ std::vector<std::string> splitCommas(const std::string& line) {
   size_t start = 0;
   for (;;) {
     size_t comma = line.find(',', start);
-    out.push_back(trim(std::string_view(line).substr(start, comma == std::string::npos ? std::string::npos
-                                                                                        : comma - start)));
+    out.push_back(trim(std::string_view(line).substr(
+        start, comma == std::string::npos ? std::string::npos : comma - start)));
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
@@ -75,14 +75,19 @@ struct Pending {
   std::optional<std::array<double, 2>> window_nm;
 
   void add(double lambda_nm, double n, std::optional<double> sigma, const std::string& at) {
-    if (!std::isfinite(lambda_nm)) throw std::invalid_argument(at + ": wavelength is not a finite number");
-    if (!std::isfinite(n)) throw std::invalid_argument(at + ": " + series.label + " is not a finite number");
-    if (lambda_nm <= 0.0) throw std::invalid_argument(at + ": wavelength must be > 0, got " + fmt(lambda_nm));
+    if (!std::isfinite(lambda_nm))
+      throw std::invalid_argument(at + ": wavelength is not a finite number");
+    if (!std::isfinite(n))
+      throw std::invalid_argument(at + ": " + series.label + " is not a finite number");
+    if (lambda_nm <= 0.0)
+      throw std::invalid_argument(at + ": wavelength must be > 0, got " + fmt(lambda_nm));
     if (window_nm && (lambda_nm < (*window_nm)[0] || lambda_nm > (*window_nm)[1])) return;
-    if (n < 1.0) throw std::invalid_argument(at + ": " + series.label + " must be >= 1, got " + fmt(n));
+    if (n < 1.0)
+      throw std::invalid_argument(at + ": " + series.label + " must be >= 1, got " + fmt(n));
     if (sigma) {
       if (!std::isfinite(*sigma) || *sigma <= 0.0)
-        throw std::invalid_argument(at + ": sigma of " + series.label + " must be a finite number > 0");
+        throw std::invalid_argument(at + ": sigma of " + series.label +
+                                    " must be a finite number > 0");
       series.sigma.push_back(*sigma);
     }
     series.lambda_nm.push_back(lambda_nm);
@@ -96,19 +101,23 @@ IndexSeries finish(Pending p, const std::string& name, const IndexReadOptions& o
                    std::vector<std::string>& warnings) {
   const IndexSeries& s = p.series;
   if (s.size() == 0)
-    throw std::invalid_argument(name + ": no data points" + (opt.window_nm ? " inside the wavelength window" : ""));
+    throw std::invalid_argument(name + ": no data points" +
+                                (opt.window_nm ? " inside the wavelength window" : ""));
   if (s.size() < 2)
-    throw std::invalid_argument(name + ": only one data point (" + p.where[0] + "); a dispersion fit needs at least 2");
+    throw std::invalid_argument(name + ": only one data point (" + p.where[0] +
+                                "); a dispersion fit needs at least 2");
   std::vector<size_t> order(s.size());
   std::iota(order.begin(), order.end(), size_t{0});
   const bool sorted = std::is_sorted(s.lambda_nm.begin(), s.lambda_nm.end());
   if (!sorted) {
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return s.lambda_nm[a] < s.lambda_nm[b]; });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return s.lambda_nm[a] < s.lambda_nm[b]; });
   }
   for (size_t k = 1; k < order.size(); ++k) {
     if (s.lambda_nm[order[k]] == s.lambda_nm[order[k - 1]])
-      throw std::invalid_argument(p.where[order[k]] + ": duplicate wavelength " + fmt(s.lambda_nm[order[k]]) +
-                                  " nm (also at " + p.where[order[k - 1]] + ")");
+      throw std::invalid_argument(p.where[order[k]] + ": duplicate wavelength " +
+                                  fmt(s.lambda_nm[order[k]]) + " nm (also at " +
+                                  p.where[order[k - 1]] + ")");
   }
   if (!sorted) {
     IndexSeries out;
@@ -118,7 +127,8 @@ IndexSeries finish(Pending p, const std::string& name, const IndexReadOptions& o
       out.n.push_back(s.n[i]);
       if (s.weighted()) out.sigma.push_back(s.sigma[i]);
     }
-    warnings.push_back(name + ": " + out.label + " rows are not in ascending wavelength order; sorted them");
+    warnings.push_back(name + ": " + out.label +
+                       " rows are not in ascending wavelength order; sorted them");
     return out;
   }
   return s;
@@ -135,7 +145,8 @@ void checkOptions(const IndexReadOptions& opt) {
 
 }  // namespace
 
-IndexData parseIndexCsv(const std::string& text, const std::string& name, const IndexReadOptions& opt) {
+IndexData parseIndexCsv(const std::string& text, const std::string& name,
+                        const IndexReadOptions& opt) {
   checkOptions(opt);
   IndexData data;
   data.source = name;
@@ -157,15 +168,22 @@ IndexData parseIndexCsv(const std::string& text, const std::string& name, const 
     if (header.empty()) {
       header = fields;
       header_line = line_no;
-      if (header[0] == "wavelength_nm") unit_to_nm = 1.0;
-      else if (header[0] == "wavelength_um") unit_to_nm = 1000.0;
+      if (header[0] == "wavelength_nm")
+        unit_to_nm = 1.0;
+      else if (header[0] == "wavelength_um")
+        unit_to_nm = 1000.0;
       else if (parseNumber(header[0]))
-        throw std::invalid_argument(at + ": missing header; the first line must be "
-                                    "'wavelength_nm,n[,sigma]' or 'wavelength_nm,n_o,n_e[,sigma_o,sigma_e]' "
-                                    "(or wavelength_um)");
+        throw std::invalid_argument(
+            at +
+            ": missing header; the first line must be "
+            "'wavelength_nm,n[,sigma]' or 'wavelength_nm,n_o,n_e[,sigma_o,sigma_e]' "
+            "(or wavelength_um)");
       else
-        throw std::invalid_argument(at + ": first column must be 'wavelength_nm' or 'wavelength_um' (the unit "
-                                    "is never guessed), got '" + header[0] + "'");
+        throw std::invalid_argument(
+            at +
+            ": first column must be 'wavelength_nm' or 'wavelength_um' (the unit "
+            "is never guessed), got '" +
+            header[0] + "'");
       std::vector<std::string> rest(header.begin() + 1, header.end());
       using V = std::vector<std::string>;
       if (rest == V{"n"}) {
@@ -185,12 +203,15 @@ IndexData parseIndexCsv(const std::string& text, const std::string& name, const 
       continue;
     }
     if (fields.size() != header.size())
-      throw std::invalid_argument(at + ": expected " + std::to_string(header.size()) + " fields (as in the header on line " +
-                                  std::to_string(header_line) + "), got " + std::to_string(fields.size()));
+      throw std::invalid_argument(at + ": expected " + std::to_string(header.size()) +
+                                  " fields (as in the header on line " +
+                                  std::to_string(header_line) + "), got " +
+                                  std::to_string(fields.size()));
     std::vector<double> v(fields.size());
     for (size_t i = 0; i < fields.size(); ++i) {
       auto x = parseNumber(fields[i]);
-      if (!x) throw std::invalid_argument(at + ": " + header[i] + " '" + fields[i] + "' is not a number");
+      if (!x)
+        throw std::invalid_argument(at + ": " + header[i] + " '" + fields[i] + "' is not a number");
       v[i] = *x;
     }
     const double lnm = v[0] * unit_to_nm;
@@ -215,18 +236,22 @@ IndexData readIndexCsv(const std::string& path, const IndexReadOptions& opt) {
   return parseIndexCsv(readFile(path), path, opt);
 }
 
-IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& name, const IndexReadOptions& opt) {
+IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& name,
+                                   const IndexReadOptions& opt) {
   checkOptions(opt);
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(name + ":" + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);
+    throw std::invalid_argument(name + ":" + std::to_string(e.mark.line + 1) +
+                                ": malformed YAML: " + e.msg);
   }
   if (!root || root.IsNull()) throw std::invalid_argument(name + ": empty file");
-  if (!root.IsMap()) throw std::invalid_argument(name + ": expected a refractiveindex.info file (a map with DATA)");
+  if (!root.IsMap())
+    throw std::invalid_argument(name + ": expected a refractiveindex.info file (a map with DATA)");
   const YAML::Node blocks = root["DATA"];
-  if (!blocks) throw std::invalid_argument(name + ": no DATA key (not a refractiveindex.info file?)");
+  if (!blocks)
+    throw std::invalid_argument(name + ": no DATA key (not a refractiveindex.info file?)");
   if (!blocks.IsSequence() || blocks.size() == 0)
     throw std::invalid_argument(name + ": DATA must be a non-empty list of blocks");
 
@@ -240,7 +265,8 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
     const YAML::Node blk = blocks[i];
     auto scalar = [&](const char* key) -> std::string {
       const YAML::Node v = blk[key];
-      if (!v || !v.IsScalar()) throw std::invalid_argument(path + "." + key + ": missing or not a scalar");
+      if (!v || !v.IsScalar())
+        throw std::invalid_argument(path + "." + key + ": missing or not a scalar");
       return v.as<std::string>();
     };
     auto numbers = [&](const std::string& s, const std::string& where) {
@@ -266,8 +292,8 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
         const std::string at = path + ".data row " + std::to_string(++r);
         auto v = numbers(row, at);
         if (v.size() != cols)
-          throw std::invalid_argument(at + ": expected " + std::to_string(cols) + " numbers (" + type + "), got " +
-                                      std::to_string(v.size()));
+          throw std::invalid_argument(at + ": expected " + std::to_string(cols) + " numbers (" +
+                                      type + "), got " + std::to_string(v.size()));
         p.add(v[0] * 1000.0, v[1], std::nullopt, at);  // database λ is in µm
       }
       if (r == 0) throw std::invalid_argument(path + ".data: no rows");
@@ -278,12 +304,17 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
       const std::string num = trim(type.substr(8));
       auto [ptr, ec] = std::from_chars(num.data(), num.data() + num.size(), k);
       if (ec != std::errc() || ptr != num.data() + num.size() || k < 1 || k > 9)
-        throw std::invalid_argument(path + ".type: unknown formula '" + type + "' (expected formula 1 to 9)");
-      const char* range_key = blk["wavelength_range"] ? "wavelength_range" : blk["range"] ? "range" : nullptr;
-      if (!range_key) throw std::invalid_argument(path + ": formula without 'wavelength_range' (or 'range')");
+        throw std::invalid_argument(path + ".type: unknown formula '" + type +
+                                    "' (expected formula 1 to 9)");
+      const char* range_key = blk["wavelength_range"] ? "wavelength_range"
+                              : blk["range"]          ? "range"
+                                                      : nullptr;
+      if (!range_key)
+        throw std::invalid_argument(path + ": formula without 'wavelength_range' (or 'range')");
       auto range = numbers(scalar(range_key), path + "." + range_key);
       if (range.size() != 2 || !(range[0] > 0 && range[1] > range[0]))
-        throw std::invalid_argument(path + "." + range_key + ": expected two wavelengths 0 < lo < hi (µm)");
+        throw std::invalid_argument(path + "." + range_key +
+                                    ": expected two wavelengths 0 < lo < hi (µm)");
       std::vector<double> coeffs = numbers(scalar("coefficients"), path + ".coefficients");
       std::optional<RefractiveIndexFormula> f;
       try {
@@ -300,11 +331,13 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
       const int m = opt.formula_samples;
       for (int j = 0; j < m; ++j) {
         const double lnm = lo + (hi - lo) * j / double(m - 1);
-        p.add(lnm, f->index(lnm * 1e-3), std::nullopt, path + " (" + type + " at " + fmt(lnm) + " nm)");
+        p.add(lnm, f->index(lnm * 1e-3), std::nullopt,
+              path + " (" + type + " at " + fmt(lnm) + " nm)");
       }
     } else {
-      throw std::invalid_argument(path + ".type: unsupported type '" + type +
-                                  "' (expected tabulated n, tabulated nk, tabulated k, formula 1..9)");
+      throw std::invalid_argument(
+          path + ".type: unsupported type '" + type +
+          "' (expected tabulated n, tabulated nk, tabulated k, formula 1..9)");
     }
   }
   data.modes.push_back(finish(std::move(p), name, opt, data.warnings));
@@ -320,12 +353,14 @@ IndexData readIndexData(const std::string& path, const IndexReadOptions& opt) {
     std::string e(ext);
     if (path.size() < e.size()) return false;
     std::string tail = path.substr(path.size() - e.size());
-    std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+    std::transform(tail.begin(), tail.end(), tail.begin(),
+                   [](unsigned char ch) { return char(std::tolower(ch)); });
     return tail == e;
   };
   if (ends(".csv")) return readIndexCsv(path, opt);
   if (ends(".yml") || ends(".yaml")) return readRefractiveIndexYaml(path, opt);
-  throw std::invalid_argument(path + ": unknown data format (expected a .csv or a refractiveindex.info .yml file)");
+  throw std::invalid_argument(
+      path + ": unknown data format (expected a .csv or a refractiveindex.info .yml file)");
 }
 
 std::string formatRefractiveIndexYaml(const RefractiveIndexFormulaEntry& entry) {
@@ -343,8 +378,9 @@ std::string formatRefractiveIndexYaml(const RefractiveIndexFormulaEntry& entry) 
 
 IndexData combineOrdinaryExtraordinary(IndexData o, IndexData e) {
   if (o.modes.size() != 1 || e.modes.size() != 1)
-    throw std::invalid_argument("ordinary and extraordinary data must each be a single isotropic series (" +
-                                o.source + ", " + e.source + ")");
+    throw std::invalid_argument(
+        "ordinary and extraordinary data must each be a single isotropic series (" + o.source +
+        ", " + e.source + ")");
   IndexData out;
   out.source = o.source + " + " + e.source;
   out.modes = {std::move(o.modes[0]), std::move(e.modes[0])};

@@ -42,10 +42,10 @@ namespace eikon {
 
 /// One dispersion curve n(λ): wavelengths ascending, in nm.
 struct IndexSeries {
-  std::string label;                ///< "n", "n_o" or "n_e"
-  std::vector<double> lambda_nm;    ///< ascending, > 0, no repeats
-  std::vector<double> n;            ///< refractive index at lambda_nm
-  std::vector<double> sigma;        ///< 1σ of n per point, or empty (unweighted)
+  std::string label;              ///< "n", "n_o" or "n_e"
+  std::vector<double> lambda_nm;  ///< ascending, > 0, no repeats
+  std::vector<double> n;          ///< refractive index at lambda_nm
+  std::vector<double> sigma;      ///< 1σ of n per point, or empty (unweighted)
   size_t size() const { return lambda_nm.size(); }
   bool weighted() const { return !sigma.empty(); }
 };

@@ -11,7 +11,8 @@ RefractiveIndexFormula::RefractiveIndexFormula(int type, std::vector<double> coe
   if (type_ < 1 || type_ > 9)
     throw std::invalid_argument("unknown refractiveindex.info formula " + std::to_string(type_) +
                                 " (expected 1 to 9)");
-  if (c_.empty()) throw std::invalid_argument("formula " + std::to_string(type_) + " has no coefficients");
+  if (c_.empty())
+    throw std::invalid_argument("formula " + std::to_string(type_) + " has no coefficients");
   for (double x : c_)
     if (!std::isfinite(x)) throw std::invalid_argument("formula coefficient is not finite");
   const size_t max_terms[] = {0, 17, 17, 17, 17, 11, 11, 6, 4, 6};

@@ -8,12 +8,11 @@
 //   1 Sellmeier     n² − 1 = C1 + Σᵢ C₂ᵢ λ² / (λ² − C₂ᵢ₊₁²)           (poles as wavelengths)
 //   2 Sellmeier-2   n² − 1 = C1 + Σᵢ C₂ᵢ λ² / (λ² − C₂ᵢ₊₁)            (poles squared; SCHOTT)
 //   3 Polynomial    n²     = C1 + Σᵢ C₂ᵢ λ^C₂ᵢ₊₁
-//   4 RII           n²     = C1 + C2 λ^C3/(λ² − C4^C5) + C6 λ^C7/(λ² − C8^C9) + Σ_{k≥10} C_k λ^C_{k+1}
-//   5 Cauchy        n      = C1 + Σᵢ C₂ᵢ λ^C₂ᵢ₊₁
-//   6 Gases         n − 1  = C1 + Σᵢ C₂ᵢ / (C₂ᵢ₊₁ − λ⁻²)
-//   7 Herzberger    n      = C1 + C2/(λ²−0.028) + C3/(λ²−0.028)² + C4 λ² + C5 λ⁴ + C6 λ⁶
-//   8 Retro         (n² − 1)/(n² + 2) = C1 + C2 λ²/(λ² − C3) + C4 λ²
-//   9 Exotic        n²     = C1 + C2/(λ² − C3) + C4 (λ − C5) / ((λ − C5)² + C6)
+//   4 RII           n²     = C1 + C2 λ^C3/(λ² − C4^C5) + C6 λ^C7/(λ² − C8^C9) + Σ_{k≥10} C_k
+//   λ^C_{k+1} 5 Cauchy        n      = C1 + Σᵢ C₂ᵢ λ^C₂ᵢ₊₁ 6 Gases         n − 1  = C1 + Σᵢ C₂ᵢ /
+//   (C₂ᵢ₊₁ − λ⁻²) 7 Herzberger    n      = C1 + C2/(λ²−0.028) + C3/(λ²−0.028)² + C4 λ² + C5 λ⁴ + C6
+//   λ⁶ 8 Retro         (n² − 1)/(n² + 2) = C1 + C2 λ²/(λ² − C3) + C4 λ² 9 Exotic        n²     = C1
+//   + C2/(λ² − C3) + C4 (λ − C5) / ((λ − C5)² + C6)
 //
 // Missing trailing coefficients count as zero (the database omits them), so e.g. formula 4 with
 // five coefficients is valid.
@@ -46,7 +45,9 @@ class RefractiveIndexFormula {
   double index(double lambda_um) const;
 
  private:
-  double c(std::size_t k) const { return k >= 1 && k <= c_.size() ? c_[k - 1] : 0.0; }  // k is 1-based (C1 = c(1))
+  double c(std::size_t k) const {
+    return k >= 1 && k <= c_.size() ? c_[k - 1] : 0.0;
+  }  // k is 1-based (C1 = c(1))
   int type_;
   std::vector<double> c_;  // c_[0] is C1
 };

@@ -52,8 +52,8 @@ void createParentFolders(const std::filesystem::path& path,
   }
   for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
     if (!std::filesystem::create_directory(*it, ec) && !std::filesystem::is_directory(*it))
-      throw writeError(path, "cannot create folder '" + it->string() + "': " +
-                                 (ec ? ec.message() : std::string("a file stands there")));
+      throw writeError(path, "cannot create folder '" + it->string() +
+                                 "': " + (ec ? ec.message() : std::string("a file stands there")));
     created.push_back(*it);
   }
 }

@@ -24,20 +24,25 @@ namespace eikon {
 
 RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_height) {
   const std::string p = path.string();
-  if (!std::filesystem::is_regular_file(path)) throw std::runtime_error("'" + p + "': no such file");
+  if (!std::filesystem::is_regular_file(path))
+    throw std::runtime_error("'" + p + "': no such file");
   bool tiled = false, deep = false, multipart = false;
-  if (!Imf::isOpenExrFile(p.c_str(), tiled, deep, multipart)) throw std::runtime_error("'" + p + "' is not an OpenEXR file");
-  if (deep) throw std::runtime_error("'" + p + "' is a deep EXR image; deep images are not supported");
+  if (!Imf::isOpenExrFile(p.c_str(), tiled, deep, multipart))
+    throw std::runtime_error("'" + p + "' is not an OpenEXR file");
+  if (deep)
+    throw std::runtime_error("'" + p + "' is a deep EXR image; deep images are not supported");
   // checkOpenEXRFile returns true when it found a problem.
   if (Imf::checkOpenEXRFile(p.c_str(), /*reduceMemory=*/true, /*reduceTime=*/true))
-    throw std::runtime_error("'" + p + "' failed the OpenEXR integrity check (corrupt or unsafe file)");
+    throw std::runtime_error("'" + p +
+                             "' failed the OpenEXR integrity check (corrupt or unsafe file)");
   try {
     Imf::InputFile file(p.c_str());
     const auto dw = file.header().dataWindow();
     long w = long(dw.max.x) - dw.min.x + 1, h = long(dw.max.y) - dw.min.y + 1;
     if (w <= 0 || h <= 0 || w > max_width || h > max_height)
-      throw std::runtime_error("'" + p + "': image size " + std::to_string(w) + "x" + std::to_string(h) +
-                               " outside the accepted 1.." + std::to_string(max_width) + " x 1.." + std::to_string(max_height));
+      throw std::runtime_error("'" + p + "': image size " + std::to_string(w) + "x" +
+                               std::to_string(h) + " outside the accepted 1.." +
+                               std::to_string(max_width) + " x 1.." + std::to_string(max_height));
     const auto& ch = file.header().channels();
     if (!ch.findChannel("R") || !ch.findChannel("G") || !ch.findChannel("B"))
       throw std::runtime_error("'" + p + "': expected R, G and B channels");
@@ -46,14 +51,17 @@ RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_
     img.height = int(h);
     img.rgba.assign(size_t(w * h * 4), 1.0f);
     Imf::FrameBuffer fb;
-    char* base = reinterpret_cast<char*>(img.rgba.data()) - (long(dw.min.x) + long(dw.min.y) * w) * 4 * long(sizeof(float));
+    char* base = reinterpret_cast<char*>(img.rgba.data()) -
+                 (long(dw.min.x) + long(dw.min.y) * w) * 4 * long(sizeof(float));
     const char* names[4] = {"R", "G", "B", "A"};
     for (int c = 0; c < 4; ++c)
-      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 4 * sizeof(float), size_t(4 * w) * sizeof(float), 1, 1, c == 3 ? 1.0 : 0.0));
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 4 * sizeof(float),
+                                     size_t(4 * w) * sizeof(float), 1, 1, c == 3 ? 1.0 : 0.0));
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
     for (float v : img.rgba)
-      if (!std::isfinite(v)) throw std::runtime_error("'" + p + "' contains NaN or infinite pixels");
+      if (!std::isfinite(v))
+        throw std::runtime_error("'" + p + "' contains NaN or infinite pixels");
     return img;
   } catch (const std::runtime_error&) {
     throw;
@@ -123,7 +131,8 @@ void encodePng(const std::filesystem::path& file, int width, int height,
 
 }  // namespace
 
-void writeExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels) {
+void writeExr(const std::filesystem::path& path, int width, int height,
+              const std::vector<ExrChannel>& channels) {
   writeFileAtomically(
       path, [&](const std::filesystem::path& tmp) { encodeExr(tmp, width, height, channels); });
 }

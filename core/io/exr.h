@@ -33,14 +33,16 @@ struct ExrChannel {
 };
 
 /// Write float channels to an EXR (ZIP compression) atomically.
-void writeExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels);
+void writeExr(const std::filesystem::path& path, int width, int height,
+              const std::vector<ExrChannel>& channels);
 
 /// Linear RGB floats (3 per pixel) as an EXR with R, G, B channels (ZIP), for writeFilesTogether.
 /// The pixels are copied: `rgb` need not outlive the result.
 FileContent exrRgbContent(int width, int height, const std::vector<float>& rgb);
 
 /// Write linear RGB floats (3 per pixel) as an EXR with R, G, B channels, atomically.
-void writeExrRgb(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb);
+void writeExrRgb(const std::filesystem::path& path, int width, int height,
+                 const std::vector<float>& rgb);
 
 /// The 8-bit sRGB PNG preview of writePngPreview, for writeFilesTogether (pixels copied).
 FileContent pngPreviewContent(int width, int height, const std::vector<float>& rgb,
@@ -48,7 +50,7 @@ FileContent pngPreviewContent(int width, int height, const std::vector<float>& r
 
 /// Write an 8-bit sRGB PNG preview of linear RGB (3 floats per pixel): multiply by 2^exposure,
 /// Reinhard-style tone map x/(1+x) on luminance-preserving ratio, sRGB transfer. Atomic.
-void writePngPreview(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb,
-                     double exposure = 0.0);
+void writePngPreview(const std::filesystem::path& path, int width, int height,
+                     const std::vector<float>& rgb, double exposure = 0.0);
 
 }  // namespace eikon

@@ -189,10 +189,10 @@ glm::dvec3 onModeShell(const Field& field, int mode, double il2, double il4, con
   field.index(x, il2, il4, n, g);
   if (mode == 1) {
     const glm::dvec3 a(field.axisField(x));
-    if (light::hasAxis(a)) {
+    if (field::hasAxis(a)) {
       double ne;
       field.indexE(x, il2, il4, ne, g);
-      return s / std::sqrt(glm::dot(s, light::applyM(s, a, n, ne)));
+      return s / std::sqrt(glm::dot(s, field::applyM(s, a, n, ne)));
     }
   }
   return n * s;

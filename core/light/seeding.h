@@ -55,16 +55,6 @@ inline bool rayHitsBox(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec
   return t0 <= t1;
 }
 
-inline bool hasAxis(const glm::dvec3& a) {
-  return glm::dot(a, a) >= 0.25;
-}  // as the marcher: zero outside crystals
-
-/// M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e² (docs/design.md §2).
-inline glm::dvec3 applyM(const glm::dvec3& p, const glm::dvec3& a, double no, double ne) {
-  const double pa = glm::dot(p, a);
-  return a * (pa / (no * no)) + (p - a * pa) / (ne * ne);
-}
-
 }  // namespace light
 
 /// The settings a run uses on `grid`: dt ≤ 0 becomes 0.5·h, point_radius ≤ 0 becomes 0.5·h.

@@ -34,13 +34,6 @@ double bandAt(const glm::dvec3& rgb, double l) {
 
 glm::dvec4 axisField(const Field& f, const glm::dvec3& x) { return f.axisField(x); }
 
-bool hasAxis(const glm::dvec3& a) { return glm::dot(a, a) >= 0.25; }
-
-glm::dvec3 applyM(const glm::dvec3& p, const glm::dvec3& a, double no, double ne) {
-  const double pa = glm::dot(p, a);
-  return a * pa / (no * no) + (p - a * pa) / (ne * ne);
-}
-
 void eModeRates(const glm::dvec3& p, const glm::dvec4& af, const glm::dvec4& o, const glm::dvec4& e,
                 glm::dvec3& Mp, glm::dvec3& dp) {
   const glm::dvec3 a(af), go(o.y, o.z, o.w), ge(e.y, e.z, e.w);

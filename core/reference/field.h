@@ -29,10 +29,7 @@ glm::dvec4 sampleMedium(const Field& f, const glm::dvec3& x, int mode);
 double bandAt(const glm::dvec3& rgb, double lambda_nm);
 /// Optic axis at x: (unit axis or zero, 1/r of a radial field or 0) (Field::axisField).
 glm::dvec4 axisField(const Field& f, const glm::dvec3& x);
-/// A crystal is where the axis is set (it is zero, not merely short, elsewhere).
-bool hasAxis(const glm::dvec3& a);
-/// M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e² (docs/design.md §2).
-glm::dvec3 applyM(const glm::dvec3& p, const glm::dvec3& a, double no, double ne);
+// hasAxis and applyM are core/volume/field.h's (the seeding in core/light uses them too).
 /// The e-mode's Hamiltonian rates for wave vector p, axis field af = (a, 1/r), o = (n_o, ∇n_o),
 /// e = (n_e, ∇n_e): Mp = dx/dτ = M_e p and dp = dp/dτ = −½ pᵀ(∂M_e/∂x)p
 ///   = (p·a)²/n_o³ ∇n_o + (|p|² − (p·a)²)/n_e³ ∇n_e − [radial] (p·a)(1/n_o² − 1/n_e²)(p −

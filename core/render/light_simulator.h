@@ -3,7 +3,7 @@
 // thread per patch, RK4 in constant time on the four corners, attenuation, fixed-point atomic
 // splat into the irradiance/direction volumes. Same settings, seeds, kill rules, split rule and
 // result types as the CPU reference, which it is tested against
-// (tests/core/wavefront_gpu_test.cpp).
+// (tests/core/render/wavefront_gpu_test.cpp).
 //
 //   eikon::VolumeSet vol = eikon::voxelize(scene);
 //   eikon::GpuWavefront gpu(ctx, vol, settings);

@@ -2,11 +2,10 @@
 #include "core/spectrum/color.h"
 
 #include <cmath>
-#include <stdexcept>
-#include <string>
-
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
+#include <stdexcept>
+#include <string>
 
 #include "core/spectrum/cie1931.h"
 
@@ -28,8 +27,8 @@ glm::dmat3 computeSrgbToXyz() {
   return glm::dmat3(r * s.x, g * s.y, b * s.z);
 }
 
-const glm::dmat3 kBradford = fromRows({0.8951, 0.2664, -0.1614}, {-0.7502, 1.7135, 0.0367},
-                                      {0.0389, -0.0685, 1.0296});
+const glm::dmat3 kBradford =
+    fromRows({0.8951, 0.2664, -0.1614}, {-0.7502, 1.7135, 0.0367}, {0.0389, -0.0685, 1.0296});
 
 }  // namespace
 
@@ -58,8 +57,12 @@ double srgbDecode(double encoded) {
   return std::pow((encoded + 0.055) / 1.055, 2.4);
 }
 
-glm::dvec3 srgbEncode(const glm::dvec3& v) { return {srgbEncode(v.x), srgbEncode(v.y), srgbEncode(v.z)}; }
-glm::dvec3 srgbDecode(const glm::dvec3& v) { return {srgbDecode(v.x), srgbDecode(v.y), srgbDecode(v.z)}; }
+glm::dvec3 srgbEncode(const glm::dvec3& v) {
+  return {srgbEncode(v.x), srgbEncode(v.y), srgbEncode(v.z)};
+}
+glm::dvec3 srgbDecode(const glm::dvec3& v) {
+  return {srgbDecode(v.x), srgbDecode(v.y), srgbDecode(v.z)};
+}
 
 glm::dvec2 xyzToXy(const glm::dvec3& xyz) {
   const double s = xyz.x + xyz.y + xyz.z;
@@ -68,7 +71,8 @@ glm::dvec2 xyzToXy(const glm::dvec3& xyz) {
 }
 
 glm::dvec3 xyToXyz(const glm::dvec2& xy, double Y) {
-  if (!(xy.y > 0.0)) throw std::invalid_argument("xyToXyz: chromaticity y must be > 0, got " + std::to_string(xy.y));
+  if (!(xy.y > 0.0))
+    throw std::invalid_argument("xyToXyz: chromaticity y must be > 0, got " + std::to_string(xy.y));
   return {xy.x * Y / xy.y, Y, (1.0 - xy.x - xy.y) * Y / xy.y};
 }
 
@@ -78,7 +82,8 @@ glm::dmat3 bradfordAdaptation(const glm::dvec3& srcWhiteXyz, const glm::dvec3& d
   const glm::dvec3 s = kBradford * srcWhiteXyz;
   const glm::dvec3 d = kBradford * dstWhiteXyz;
   if (!(s.x > 0 && s.y > 0 && s.z > 0 && d.x > 0 && d.y > 0 && d.z > 0)) {
-    throw std::invalid_argument("bradfordAdaptation: white points must have positive cone responses");
+    throw std::invalid_argument(
+        "bradfordAdaptation: white points must have positive cone responses");
   }
   glm::dmat3 scale(1.0);
   scale[0][0] = d.x / s.x;
@@ -112,7 +117,8 @@ glm::dmat3 spectralToLinearSrgbMatrix() {
 }
 
 glm::dvec3 spectralXyzToLinearSrgb(const glm::dvec3& xyzE) {
-  static const glm::dmat3 m = xyzToLinearSrgbMatrix() * bradfordAdaptation(equalEnergyWhiteXyz(), d65WhiteXyz());
+  static const glm::dmat3 m =
+      xyzToLinearSrgbMatrix() * bradfordAdaptation(equalEnergyWhiteXyz(), d65WhiteXyz());
   return m * xyzE;
 }
 

@@ -18,8 +18,9 @@
 // Worked example:
 //   using namespace eikon::spectrum;
 //   glm::dvec3 rgb = spectrumToLinearSrgb([](double) { return 0.5; });   // (0.5, 0.5, 0.5)
-//   glm::dvec3 xyz = linearSrgbToXyz({1, 0, 0});                          // (0.4124, 0.2126, 0.0193)
-//   double v = srgbEncode(0.18);                                          // 0.4614 (PNG preview)
+//   glm::dvec3 xyz = linearSrgbToXyz({1, 0, 0});                          // (0.4124, 0.2126,
+//   0.0193) double v = srgbEncode(0.18);                                          // 0.4614 (PNG
+//   preview)
 //
 // Common mistakes:
 //  - Feeding ∫ S cmf dλ (units of S·nm, Y ≈ 107 for S = 1) to xyzToLinearSrgb(): normalise first,
@@ -31,7 +32,6 @@
 #pragma once
 
 #include <functional>
-
 #include <glm/mat3x3.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>

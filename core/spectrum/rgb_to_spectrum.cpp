@@ -16,11 +16,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/mat3x3.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <glm/mat3x3.hpp>
 
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
@@ -36,7 +35,8 @@ std::vector<double> solveDense(std::vector<double> m, std::vector<double> rhs, i
     int p = c;
     for (int r = c + 1; r < n; ++r)
       if (std::abs(m[r * n + c]) > std::abs(m[p * n + c])) p = r;
-    if (std::abs(m[p * n + c]) < 1e-300) throw std::runtime_error("rgb_to_spectrum: singular KKT system");
+    if (std::abs(m[p * n + c]) < 1e-300)
+      throw std::runtime_error("rgb_to_spectrum: singular KKT system");
     if (p != c) {
       for (int k = 0; k < n; ++k) std::swap(m[c * n + k], m[p * n + k]);
       std::swap(rhs[c], rhs[p]);
@@ -176,13 +176,14 @@ std::array<float, kN * 3> fitBasis() {
 }  // namespace
 
 const std::array<float, kBasisSamples * 3>& basisTable() {
-  static const std::array<float, kN * 3> table = fitBasis();
+  static const std::array<float, kN* 3> table = fitBasis();
   return table;
 }
 
 glm::dvec3 basisAt(double lambdaNm) {
   if (std::isnan(lambdaNm) || lambdaNm <= 0.0) {
-    throw std::invalid_argument("basisAt: wavelength must be a positive number of nm, got " + std::to_string(lambdaNm));
+    throw std::invalid_argument("basisAt: wavelength must be a positive number of nm, got " +
+                                std::to_string(lambdaNm));
   }
   const auto& t = basisTable();
   const double x = std::clamp((lambdaNm - kBasisMinNm) / kBasisStepNm, 0.0, double(kN - 1));

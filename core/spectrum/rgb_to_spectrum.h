@@ -1,5 +1,6 @@
-// RGB → smooth spectrum: turning a linear sRGB colour (an environment texel) into a reflectance-like
-// spectrum S(λ) the spectral renderer can evaluate at any wavelength, on the CPU and in GLSL.
+// RGB → smooth spectrum: turning a linear sRGB colour (an environment texel) into a
+// reflectance-like spectrum S(λ) the spectral renderer can evaluate at any wavelength, on the CPU
+// and in GLSL.
 //
 // Method ("spectral primary decomposition", after Mallett & Yuksel, EGSR 2019): three smooth basis
 // spectra b_r(λ), b_g(λ), b_b(λ) with
@@ -23,7 +24,8 @@
 // Worked example:
 //   using namespace eikon::spectrum;
 //   double s = rgbToSpectrum({0.2, 0.2, 0.2}, 612.0);  // 0.2 exactly
-//   glm::dvec3 back = spectrumToLinearSrgb([](double l) { return rgbToSpectrum({0.8, 0.3, 0.1}, l); });
+//   glm::dvec3 back = spectrumToLinearSrgb([](double l) { return rgbToSpectrum({0.8, 0.3, 0.1}, l);
+//   });
 //   // back ≈ (0.8, 0.3, 0.1) within 1e-6
 //
 // Common mistakes:
@@ -35,7 +37,6 @@
 #pragma once
 
 #include <array>
-
 #include <glm/vec3.hpp>
 
 namespace eikon::spectrum {

@@ -20,8 +20,10 @@ double wavelengthJitter(std::uint32_t pixelIndex, std::uint32_t sampleIndex, std
   return static_cast<double>(pcgHash(seed + k) >> 8u) * (1.0 / 16777216.0);
 }
 
-std::vector<double> stratifiedWavelengths(std::uint32_t pixelIndex, std::uint32_t sampleIndex, std::uint32_t n) {
-  if (n == 0) throw std::invalid_argument("stratifiedWavelengths: need at least one wavelength (N = 0)");
+std::vector<double> stratifiedWavelengths(std::uint32_t pixelIndex, std::uint32_t sampleIndex,
+                                          std::uint32_t n) {
+  if (n == 0)
+    throw std::invalid_argument("stratifiedWavelengths: need at least one wavelength (N = 0)");
   std::vector<double> out(n);
   const double width = (kVisibleMaxNm - kVisibleMinNm) / n;
   for (std::uint32_t k = 0; k < n; ++k)

@@ -21,10 +21,9 @@
 //
 // Worked example:
 //   using namespace eikon::spectrum;
-//   auto lambdas = stratifiedWavelengths(/*pixel*/ 1234, /*sample*/ 0, /*N*/ 8);  // 8 values, one per 50 nm
-//   std::vector<SpectralSample> s;
-//   for (double l : lambdas) s.push_back({l, radianceAt(l)});
-//   glm::dvec3 rgb = spectralToLinearSrgb(s);   // this pixel's colour estimate
+//   auto lambdas = stratifiedWavelengths(/*pixel*/ 1234, /*sample*/ 0, /*N*/ 8);  // 8 values, one
+//   per 50 nm std::vector<SpectralSample> s; for (double l : lambdas) s.push_back({l,
+//   radianceAt(l)}); glm::dvec3 rgb = spectralToLinearSrgb(s);   // this pixel's colour estimate
 //
 // Common mistakes:
 //  - Averaging RGB estimates with a different N per pixel without the 1/N inside the weight: use
@@ -35,9 +34,8 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
-
 #include <glm/vec3.hpp>
+#include <vector>
 
 namespace eikon::spectrum {
 
@@ -56,7 +54,8 @@ double wavelengthJitter(std::uint32_t pixelIndex, std::uint32_t sampleIndex, std
 
 /// The N stratified jittered wavelengths (nm, ascending, λ_k in stratum k of [380, 780]) for one
 /// pixel sample. Throws std::invalid_argument for N = 0.
-std::vector<double> stratifiedWavelengths(std::uint32_t pixelIndex, std::uint32_t sampleIndex, std::uint32_t n);
+std::vector<double> stratifiedWavelengths(std::uint32_t pixelIndex, std::uint32_t sampleIndex,
+                                          std::uint32_t n);
 
 /// Monte Carlo weight of one of N stratified samples at λ (nm): cmf(λ)·(kVisibleMaxNm −
 /// kVisibleMinNm)/N, in nm. Σ radiance_k·weight_k estimates ∫ S cmf dλ. Throws

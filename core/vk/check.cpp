@@ -4,7 +4,9 @@ namespace eikon::vk {
 
 const char* resultName(VkResult r) {
   switch (r) {
-#define EIKON_CASE(x) case x: return #x;
+#define EIKON_CASE(x) \
+  case x:             \
+    return #x;
     EIKON_CASE(VK_SUCCESS)
     EIKON_CASE(VK_NOT_READY)
     EIKON_CASE(VK_TIMEOUT)
@@ -28,7 +30,8 @@ const char* resultName(VkResult r) {
     EIKON_CASE(VK_ERROR_INVALID_EXTERNAL_HANDLE)
     EIKON_CASE(VK_ERROR_FRAGMENTATION)
 #undef EIKON_CASE
-    default: return "VK_RESULT_UNKNOWN_CODE";
+    default:
+      return "VK_RESULT_UNKNOWN_CODE";
   }
 }
 

@@ -25,9 +25,9 @@ class VulkanError : public std::runtime_error {
 
 }  // namespace eikon::vk
 
-#define VK_CHECK(call)                                                                \
-  do {                                                                                \
-    VkResult eikon_vk_result_ = (call);                                               \
-    if (eikon_vk_result_ != VK_SUCCESS)                                               \
-      ::eikon::vk::throwVulkanError(eikon_vk_result_, #call, __FILE__, __LINE__);     \
+#define VK_CHECK(call)                                                            \
+  do {                                                                            \
+    VkResult eikon_vk_result_ = (call);                                           \
+    if (eikon_vk_result_ != VK_SUCCESS)                                           \
+      ::eikon::vk::throwVulkanError(eikon_vk_result_, #call, __FILE__, __LINE__); \
   } while (0)

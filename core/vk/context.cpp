@@ -23,17 +23,23 @@ VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBits
 }
 
 std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
   return s;
 }
 
 int typeRank(VkPhysicalDeviceType t) {
   switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
-    default: return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return 3;
+    default:
+      return 4;
   }
 }
 
@@ -153,7 +159,8 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
   if (validation) ici.pNext = &dci;
   VkResult r = vkCreateInstance(&ici, nullptr, &ctx->instance_);
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
-    throw VulkanError(r, "no Vulkan driver found: install mesa-vulkan-drivers (lavapipe) or a GPU driver");
+    throw VulkanError(
+        r, "no Vulkan driver found: install mesa-vulkan-drivers (lavapipe) or a GPU driver");
   VK_CHECK(r);
   if (validation) {
     auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
@@ -164,7 +171,8 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
 
   uint32_t count = 0;
   VK_CHECK(vkEnumeratePhysicalDevices(ctx->instance_, &count, nullptr));
-  if (count == 0) throw std::runtime_error("no Vulkan physical device: install mesa-vulkan-drivers (lavapipe)");
+  if (count == 0)
+    throw std::runtime_error("no Vulkan physical device: install mesa-vulkan-drivers (lavapipe)");
   std::vector<VkPhysicalDevice> devices(count);
   VK_CHECK(vkEnumeratePhysicalDevices(ctx->instance_, &count, devices.data()));
 
@@ -216,25 +224,31 @@ Context::~Context() {
 
 std::string Context::deviceTypeName() const {
   switch (props_.deviceType) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU";
-    default: return "other";
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return "discrete GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return "integrated GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return "virtual GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return "CPU";
+    default:
+      return "other";
   }
 }
 
 std::string Context::apiVersionString() const {
   uint32_t v = props_.apiVersion;
-  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
-         std::to_string(VK_API_VERSION_PATCH(v));
+  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) +
+         "." + std::to_string(VK_API_VERSION_PATCH(v));
 }
 
 uint32_t Context::findMemoryType(uint32_t type_bits, VkMemoryPropertyFlags required) const {
   VkPhysicalDeviceMemoryProperties mem;
   vkGetPhysicalDeviceMemoryProperties(physical_, &mem);
   for (uint32_t i = 0; i < mem.memoryTypeCount; ++i)
-    if ((type_bits & (1u << i)) && (mem.memoryTypes[i].propertyFlags & required) == required) return i;
+    if ((type_bits & (1u << i)) && (mem.memoryTypes[i].propertyFlags & required) == required)
+      return i;
   throw std::runtime_error("no Vulkan memory type with the required properties");
 }
 

@@ -24,8 +24,9 @@ Buffer::Buffer(const Context& ctx, VkDeviceSize bytes, VkBufferUsageFlags usage,
   vkGetBufferMemoryRequirements(device_, buffer_, &req);
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   ai.allocationSize = req.size;
-  ai.memoryTypeIndex = ctx.findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                                                   VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+  ai.memoryTypeIndex =
+      ctx.findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                                 VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
   VkResult r = vkAllocateMemory(device_, &ai, nullptr, &memory_);
   if (r != VK_SUCCESS) {
     release();
@@ -72,7 +73,8 @@ void Buffer::read(void* dst, VkDeviceSize bytes, VkDeviceSize offset) const {
 }
 
 // ---------------------------------------------------------------- Image3D
-Image3D::Image3D(const Context& ctx, std::array<uint32_t, 3> extent, VkFormat format, std::string name)
+Image3D::Image3D(const Context& ctx, std::array<uint32_t, 3> extent, VkFormat format,
+                 std::string name)
     : device_(ctx.device()), extent_(extent), format_(format), name_(std::move(name)) {
   for (uint32_t e : extent)
     if (e == 0 || e > ctx.limits().max_image_dimension_3d)
@@ -83,7 +85,8 @@ Image3D::Image3D(const Context& ctx, std::array<uint32_t, 3> extent, VkFormat fo
   VkFormatProperties fp;
   vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice(), format, &fp);
   if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT))
-    throw std::runtime_error("volume '" + name_ + "': the device cannot use this format as a storage image");
+    throw std::runtime_error("volume '" + name_ +
+                             "': the device cannot use this format as a storage image");
   VkImageCreateInfo ii{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   ii.imageType = VK_IMAGE_TYPE_3D;
   ii.format = format;
@@ -99,15 +102,16 @@ Image3D::Image3D(const Context& ctx, std::array<uint32_t, 3> extent, VkFormat fo
   vkGetImageMemoryRequirements(device_, image_, &req);
   if (req.size > ctx.limits().heap_size)
     throw std::runtime_error("volume '" + name_ + "' needs " + std::to_string(req.size >> 20) +
-                             " MiB, more than the device heap (" + std::to_string(ctx.limits().heap_size >> 20) + " MiB)");
+                             " MiB, more than the device heap (" +
+                             std::to_string(ctx.limits().heap_size >> 20) + " MiB)");
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   ai.allocationSize = req.size;
   ai.memoryTypeIndex = ctx.findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   VkResult r = vkAllocateMemory(device_, &ai, nullptr, &memory_);
   if (r != VK_SUCCESS) {
     release();
-    throw VulkanError(r, "volume '" + name_ + "': cannot allocate " + std::to_string(req.size >> 20) +
-                             " MiB (" + resultName(r) + ")");
+    throw VulkanError(r, "volume '" + name_ + "': cannot allocate " +
+                             std::to_string(req.size >> 20) + " MiB (" + resultName(r) + ")");
   }
   VK_CHECK(vkBindImageMemory(device_, image_, memory_, 0));
   VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
@@ -156,18 +160,19 @@ void Image3D::upload(const Context& ctx, const void* data, VkDeviceSize bytes) {
     b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     b.image = image_;
     b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
-                         nullptr, 0, nullptr, 1, &b);
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                         0, nullptr, 0, nullptr, 1, &b);
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {extent_[0], extent_[1], extent_[2]};
-    vkCmdCopyBufferToImage(cmd, staging.handle(), image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    vkCmdCopyBufferToImage(cmd, staging.handle(), image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                           &region);
     b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
     b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
     b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
-                         nullptr, 0, nullptr, 1, &b);
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         0, 0, nullptr, 0, nullptr, 1, &b);
   });
 }
 
@@ -175,7 +180,10 @@ void Image3D::upload(const Context& ctx, const void* data, VkDeviceSize bytes) {
 ComputePipeline::ComputePipeline(const Context& ctx, std::span<const uint32_t> spirv,
                                  std::vector<BindingSpec> bindings, uint32_t push_constant_bytes,
                                  std::string name)
-    : device_(ctx.device()), push_bytes_(push_constant_bytes), bindings_(std::move(bindings)), name_(std::move(name)) {
+    : device_(ctx.device()),
+      push_bytes_(push_constant_bytes),
+      bindings_(std::move(bindings)),
+      name_(std::move(name)) {
   VkShaderModuleCreateInfo si{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   si.codeSize = spirv.size_bytes();
   si.pCode = spirv.data();
@@ -185,9 +193,12 @@ ComputePipeline::ComputePipeline(const Context& ctx, std::span<const uint32_t> s
   uint32_t n_images = 0, n_buffers = 0, n_uniform = 0;
   for (const auto& b : bindings_) {
     lb.push_back({b.binding, b.type, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-    if (b.type == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE) ++n_images;
-    else if (b.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER) ++n_uniform;
-    else ++n_buffers;
+    if (b.type == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE)
+      ++n_images;
+    else if (b.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER)
+      ++n_uniform;
+    else
+      ++n_buffers;
   }
   VkDescriptorSetLayoutCreateInfo dl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   dl.bindingCount = uint32_t(lb.size());
@@ -284,10 +295,12 @@ void ComputePipeline::bindImage(uint32_t binding, const Image3D& image) {
   vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
 }
 
-void ComputePipeline::dispatch(VkCommandBuffer cmd, uint32_t gx, uint32_t gy, uint32_t gz, const void* push) const {
+void ComputePipeline::dispatch(VkCommandBuffer cmd, uint32_t gx, uint32_t gy, uint32_t gz,
+                               const void* push) const {
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
-  if (push_bytes_ && push) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, push);
+  if (push_bytes_ && push)
+    vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, push);
   vkCmdDispatch(cmd, gx, gy, gz);
 }
 

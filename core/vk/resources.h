@@ -5,8 +5,8 @@
 //   vk::Buffer out(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
 //   vk::Image3D vol(ctx, {128,128,128}, VK_FORMAT_R32G32B32A32_SFLOAT, "index");
 //   vol.upload(data.data(), data.size() * sizeof(float));
-//   vk::ComputePipeline pipe(ctx, spirv, {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}, ...}, sizeof(Push));
-//   pipe.bindImage(0, vol); pipe.bindBuffer(1, out);
+//   vk::ComputePipeline pipe(ctx, spirv, {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}, ...},
+//   sizeof(Push)); pipe.bindImage(0, vol); pipe.bindBuffer(1, out);
 //   ctx.submitAndWait([&](VkCommandBuffer c){ pipe.dispatch(c, gx, gy, 1, &push); });
 //
 // Common mistakes: reading a storage image in GLSL without a format qualifier; forgetting that
@@ -91,8 +91,9 @@ struct BindingSpec {
 class ComputePipeline {
  public:
   ComputePipeline() = default;
-  ComputePipeline(const Context& ctx, std::span<const uint32_t> spirv, std::vector<BindingSpec> bindings,
-                  uint32_t push_constant_bytes, std::string name);
+  ComputePipeline(const Context& ctx, std::span<const uint32_t> spirv,
+                  std::vector<BindingSpec> bindings, uint32_t push_constant_bytes,
+                  std::string name);
   ~ComputePipeline();
   ComputePipeline(ComputePipeline&& o) noexcept { *this = std::move(o); }
   ComputePipeline& operator=(ComputePipeline&& o) noexcept;

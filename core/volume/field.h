@@ -84,4 +84,16 @@ class VolumeField : public Field {
   const VolumeSet& v_;
 };
 
+namespace field {
+/// A crystal is where the axis is set (it is zero, not merely short, elsewhere): the GLSL
+/// hasAxis of shaders/field.glsl. Here, below both twins, so that core/light's seeding and
+/// core/reference's marches use one definition.
+inline bool hasAxis(const glm::dvec3& a) { return glm::dot(a, a) >= 0.25; }
+/// M_e p = aaᵀp/n_o² + (I − aaᵀ)p/n_e² (docs/design.md §2): the GLSL applyM.
+inline glm::dvec3 applyM(const glm::dvec3& p, const glm::dvec3& a, double no, double ne) {
+  const double pa = glm::dot(p, a);
+  return a * pa / (no * no) + (p - a * pa) / (ne * ne);
+}
+}  // namespace field
+
 }  // namespace eikon

@@ -28,15 +28,18 @@ using eikon::test::Outcome;
 using eikon::test::slurp;
 
 // A small glass sphere (n = 1.5, r = 3 mm) in a 10 mm volume of 32³ voxels, a 32x24 camera.
-std::string tinyScene(const std::string& volume_extra = "", const std::string& material = R"({"n": 1.5})",
+std::string tinyScene(const std::string& volume_extra = "",
+                      const std::string& material = R"({"n": 1.5})",
                       const std::string& object_extra = "") {
   return R"({
   "camera": {"position": [0, 0, -30], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 20, "width": 32, "height": 24},
   "environment": {"type": "checker", "squares": 8},
   "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "smoothing_voxels": 0.75)" +
          (volume_extra.empty() ? std::string(R"(, "resolution": 32)") : ", " + volume_extra) + R"(},
-  "materials": {"glass": )" + material + R"(},
-  "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "glass")" + object_extra + R"(}]
+  "materials": {"glass": )" +
+         material + R"(},
+  "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "glass")" +
+         object_extra + R"(}]
 })";
 }
 
@@ -66,18 +69,22 @@ class Cli : public ::testing::Test {
   /// Run `eikon ARGS` with validation layers on; stdout/stderr captured.
   Outcome run(const std::string& args) const {
     Outcome o = eikon::test::runEikon(args, io_, "EIKON_VALIDATION=1");
-    EXPECT_EQ(o.err.find("[vulkan validation]"), std::string::npos) << "validation messages:\n" << o.err;
+    EXPECT_EQ(o.err.find("[vulkan validation]"), std::string::npos) << "validation messages:\n"
+                                                                    << o.err;
     return o;
   }
-  std::string outPath(const std::string& name = "render.exr") const { return (out_ / name).string(); }
+  std::string outPath(const std::string& name = "render.exr") const {
+    return (out_ / name).string();
+  }
 
-  /// Exactly one stderr line "eikon: error: ..." containing `phrase`, non-zero exit, nothing left in
-  /// `dir` (the output directory) but what was there before.
+  /// Exactly one stderr line "eikon: error: ..." containing `phrase`, non-zero exit, nothing left
+  /// in `dir` (the output directory) but what was there before.
   void expectCleanFailure(const Outcome& r, const std::string& phrase, const fs::path& dir) const {
     EXPECT_NE(r.code, 0);
     EXPECT_EQ(r.err.rfind("eikon: error: ", 0), 0u) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_NE(r.err.find(phrase), std::string::npos) << "stderr lacks '" << phrase << "': " << r.err;
+    EXPECT_NE(r.err.find(phrase), std::string::npos)
+        << "stderr lacks '" << phrase << "': " << r.err;
     std::error_code ec;
     if (fs::is_directory(dir, ec))
       for (auto& e : fs::directory_iterator(dir, ec)) {
@@ -87,7 +94,9 @@ class Cli : public ::testing::Test {
         EXPECT_NE(e.path().extension(), ".png") << "output left: " << n;
       }
   }
-  void expectCleanFailure(const Outcome& r, const std::string& phrase) const { expectCleanFailure(r, phrase, out_); }
+  void expectCleanFailure(const Outcome& r, const std::string& phrase) const {
+    expectCleanFailure(r, phrase, out_);
+  }
 
   Outcome render(const std::string& scene_text, const std::string& extra = "") {
     const std::string scene = write("scene.json", scene_text);
@@ -103,7 +112,8 @@ class Cli : public ::testing::Test {
 TEST_F(Cli, TopLevelHelp) {
   const Outcome r = run("--help");
   EXPECT_EQ(r.code, 0) << r.err;
-  for (const char* s : {"render", "trace", "info", "fit"}) EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+  for (const char* s : {"render", "trace", "info", "fit"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
 }
 
 TEST_F(Cli, RenderHelp) {
@@ -260,7 +270,8 @@ TEST_F(Cli, TraceProgressOnlyWhenAsked) {
   // The GPU twin: building its pipelines and uploading the volume has no fraction. It is a stage of
   // its own, shown with its elapsed time, instead of the voxeliser's "100.0%, ETA 0.0 s" redrawn
   // every second while it runs (seen for 9 s on a 64x48 render).
-  const Outcome gpu = run("trace " + quote(scene) + " --origin 0,0,-5 --dir 0,0,1 --progress always");
+  const Outcome gpu =
+      run("trace " + quote(scene) + " --origin 0,0,-5 --dir 0,0,1 --progress always");
   ASSERT_EQ(gpu.code, 0) << gpu.err;
   std::istringstream in(gpu.err);
   int preparing = 0, voxelDone = 0;
@@ -302,8 +313,10 @@ TEST_F(Cli, RenderIndexBelowOne) {
 
 TEST_F(Cli, RenderZeroSize) {
   std::string s = tinyScene();
-  const std::string sphere = R"({"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "glass"})";
-  s.replace(s.find(sphere), sphere.size(), R"({"shape": "box", "size": [2, 0, 2], "material": "glass"})");
+  const std::string sphere =
+      R"({"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "glass"})";
+  s.replace(s.find(sphere), sphere.size(),
+            R"({"shape": "box", "size": [2, 0, 2], "material": "glass"})");
   expectCleanFailure(render(s), "/objects/0/size");
 }
 
@@ -318,7 +331,8 @@ TEST_F(Cli, RenderResolutionBeyondTheDeviceLimit) {
   const long res = std::max(5000L, limit + 1);
   const Outcome r = render(tinyScene(R"("resolution": )" + std::to_string(res)));
   expectCleanFailure(r, "/volume/resolution");
-  EXPECT_NE(r.err.find(std::to_string(limit)), std::string::npos) << "message should state the limit " << limit << ": " << r.err;
+  EXPECT_NE(r.err.find(std::to_string(limit)), std::string::npos)
+      << "message should state the limit " << limit << ": " << r.err;
 }
 
 // Missing folders of -o are created (the render used to fail: "directory 'out' does not exist"),
@@ -354,11 +368,12 @@ TEST_F(Cli, RenderOutputDirectoryReadOnly) {
   const std::string scene = write("scene.json", tinyScene());
   const fs::path ro = dir_ / "readonly";
   fs::create_directories(ro);
-  fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read | fs::perms::group_exec |
-                          fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                          fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
   chmodded_.push_back(ro);
   if (::access(ro.c_str(), W_OK) != 0) {
-    expectCleanFailure(run("render " + quote(scene) + " -o " + quote((ro / "x.exr").string())), "not writable", ro);
+    expectCleanFailure(run("render " + quote(scene) + " -o " + quote((ro / "x.exr").string())),
+                       "not writable", ro);
     EXPECT_TRUE(fs::is_empty(ro));
   } else {
     const Outcome r = run("render " + quote(scene) + " -o /proc/eikon_cli_test.exr");
@@ -467,11 +482,13 @@ TEST_F(Cli, RenderZeroOrNegativeSizesAreRejected) {
 }
 
 TEST_F(Cli, RenderSceneFileMissing) {
-  expectCleanFailure(run("render " + quote((dir_ / "nope.json").string()) + " -o " + quote(outPath())), "nope.json");
+  expectCleanFailure(
+      run("render " + quote((dir_ / "nope.json").string()) + " -o " + quote(outPath())),
+      "nope.json");
 }
 
-// CLI-syntax errors (a missing required option, an unknown flag) are bad input too: docs/design.md §4 /
-// the CLI contract say one "eikon: error:" line and a non-zero exit, like every other error.
+// CLI-syntax errors (a missing required option, an unknown flag) are bad input too: docs/design.md
+// §4 / the CLI contract say one "eikon: error:" line and a non-zero exit, like every other error.
 TEST_F(Cli, RenderMissingOutputOptionIsOneErrorLine) {
   const std::string scene = write("scene.json", tinyScene());
   expectCleanFailure(run("render " + quote(scene)), "--output");
@@ -479,7 +496,8 @@ TEST_F(Cli, RenderMissingOutputOptionIsOneErrorLine) {
 
 TEST_F(Cli, UnknownOptionIsOneErrorLine) {
   const std::string scene = write("scene.json", tinyScene());
-  expectCleanFailure(run("render " + quote(scene) + " -o " + quote(outPath()) + " --bogus"), "--bogus");
+  expectCleanFailure(run("render " + quote(scene) + " -o " + quote(outPath()) + " --bogus"),
+                     "--bogus");
 }
 
 // ------------------------------------------------------------------ trace
@@ -496,7 +514,8 @@ TEST_F(Cli, TraceOriginWithTwoNumbers) {
 
 TEST_F(Cli, TraceNegativeWavelength) {
   const std::string scene = write("scene.json", tinyScene());
-  expectCleanFailure(run("trace " + quote(scene) + " --origin 0,0,-4 --dir 0,0,1 --wavelength -5"), "--wavelength");
+  expectCleanFailure(run("trace " + quote(scene) + " --origin 0,0,-4 --dir 0,0,1 --wavelength -5"),
+                     "--wavelength");
 }
 
 TEST_F(Cli, TraceNonFiniteOrigin) {
@@ -586,7 +605,8 @@ TEST_F(Cli, TraceAxialRayPhysics) {
     EXPECT_NEAR(p[2], 5.0, 1e-5) << twin;
     EXPECT_NEAR(d[2], 1.0, 1e-5) << twin;
     const double opl = m["optical_path_mm"], T = m["transmittance"];
-    std::printf("[ measured ]%s axial OPL %.6f mm (expected 13), T %.6f (expected 0.9216)\n", twin, opl, T);
+    std::printf("[ measured ]%s axial OPL %.6f mm (expected 13), T %.6f (expected 0.9216)\n", twin,
+                opl, T);
     EXPECT_NEAR(opl, 13.0, 0.2) << twin;
     EXPECT_NEAR(T, 0.9216, 2e-3) << twin;
   }
@@ -657,8 +677,10 @@ TEST_F(Cli, TraceGpuAgreesWithReference) {
     dp = std::max(dp, std::abs(pg[i] - pc[i]));
     dd = std::max(dd, std::abs(dg[i] - dc[i]));
   }
-  std::printf("[ measured ] GPU vs reference: exit point %.2e mm, direction %.2e; OPL %.9f vs %.9f\n", dp, dd,
-              g["modes"][0]["optical_path_mm"].get<double>(), c["modes"][0]["optical_path_mm"].get<double>());
+  std::printf(
+      "[ measured ] GPU vs reference: exit point %.2e mm, direction %.2e; OPL %.9f vs %.9f\n", dp,
+      dd, g["modes"][0]["optical_path_mm"].get<double>(),
+      c["modes"][0]["optical_path_mm"].get<double>());
   EXPECT_LT(dp, 1e-4);
   EXPECT_LT(dd, 1e-4);
   // The ray was actually bent (the comparison is not trivially between two straight lines).
@@ -718,7 +740,8 @@ TEST_F(Cli, RenderSimulatesLightOnceThenUsesTheCache) {
   // environment (0.1) is the same in both.
   EXPECT_GT(lit_sum, 1.3 * dark_sum);
   // The GPU simulator gives the same picture as the CPU reference (the default on lavapipe): the
-  // twins' light volumes agree to ~1e-5 (tests/core/wavefront_gpu_test.cpp); allow 1e-3 of the sum.
+  // twins' light volumes agree to ~1e-5 (tests/core/render/wavefront_gpu_test.cpp); allow 1e-3 of
+  // the sum.
   const Outcome gpu = render(scene, "-q --caustics kill --no-light-cache --light-device gpu");
   ASSERT_EQ(gpu.code, 0) << gpu.err;
   EXPECT_NE(gpu.out.find("simulated 1 light runs on llvmpipe"), std::string::npos) << gpu.out;
@@ -730,10 +753,12 @@ TEST_F(Cli, RenderSimulatesLightOnceThenUsesTheCache) {
 
 TEST_F(Cli, BadLightOptionsFailCleanly) {
   expectCleanFailure(render(tinyScene(), "--light-bands 100"), "--light-bands");
-  expectCleanFailure(render(tinyScene(), "--light-splat brightest"), "--light-splat must be accumulate or highest");
+  expectCleanFailure(render(tinyScene(), "--light-splat brightest"),
+                     "--light-splat must be accumulate or highest");
   expectCleanFailure(render(tinyScene(), "--max-patches 10"), "--max-patches");
   expectCleanFailure(render(tinyScene(), "--light-split 0.1"), "--light-split");
-  expectCleanFailure(render(tinyScene(), "--light-device tpu"), "--light-device must be auto, gpu or cpu");
+  expectCleanFailure(render(tinyScene(), "--light-device tpu"),
+                     "--light-device must be auto, gpu or cpu");
   expectCleanFailure(render(tinyScene(), "--caustics ignore"), "--caustics must be pass or kill");
 }
 

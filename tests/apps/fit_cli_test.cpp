@@ -57,7 +57,8 @@ class FitCli : public ::testing::Test {
     EXPECT_NE(r.err.find(must_contain), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(path("out.json")));
     for (auto& e : fs::directory_iterator(dir_))
-      EXPECT_EQ(e.path().filename().string().find(".out.json.tmp"), std::string::npos) << "temporary file left";
+      EXPECT_EQ(e.path().filename().string().find(".out.json.tmp"), std::string::npos)
+          << "temporary file left";
   }
   fs::path dir_;
 };
@@ -106,10 +107,13 @@ TEST_F(FitCli, CrystalMaterialFileAndYamlExport) {
   std::ostringstream s;
   s << "wavelength_nm,n_o,n_e\n";
   // Ghosh formula 2 has C1 ≠ 0: n² = 1 + C1 + …; fold C1 in as a term with a pole at 0.
-  const auto o_full = eikon::Dispersion::sellmeier({0.73358749, 0.96464345, 1.82831454}, {0.0, 0.0194325203, 120});
-  const auto e_full = eikon::Dispersion::sellmeier({0.35859695, 0.8242783, 0.14429128}, {0.0, 0.0106689543, 120});
+  const auto o_full =
+      eikon::Dispersion::sellmeier({0.73358749, 0.96464345, 1.82831454}, {0.0, 0.0194325203, 120});
+  const auto e_full =
+      eikon::Dispersion::sellmeier({0.35859695, 0.8242783, 0.14429128}, {0.0, 0.0106689543, 120});
   s.precision(10);
-  for (double l = 400; l <= 700; l += 10) s << l << "," << o_full.index(l) << "," << e_full.index(l) << "\n";
+  for (double l = 400; l <= 700; l += 10)
+    s << l << "," << o_full.index(l) << "," << e_full.index(l) << "\n";
   const std::string csv = write("calcite.csv", s.str());
   const Outcome r = run(csv + " -o " + path("out.json") + " --export-yaml " + path("calcite.yml"));
   ASSERT_EQ(r.code, 0) << r.err;
@@ -118,7 +122,9 @@ TEST_F(FitCli, CrystalMaterialFileAndYamlExport) {
   EXPECT_FALSE(m.contains("optic_axis"));
   ASSERT_TRUE(m.contains("n_o") && m.contains("n_e"));
   const double l2 = std::pow(eikon::fraunhofer::d * 1e-3, 2);
-  auto nd = [&](const json& c) { return c[0].get<double>() + c[1].get<double>() / l2 + c[2].get<double>() / (l2 * l2); };
+  auto nd = [&](const json& c) {
+    return c[0].get<double>() + c[1].get<double>() / l2 + c[2].get<double>() / (l2 * l2);
+  };
   EXPECT_NEAR(nd(m["n_o"]["cauchy"]), 1.658461, 1e-4);  // materials.json calcite o, d line
   EXPECT_NEAR(nd(m["n_e"]["cauchy"]), 1.486185, 1e-4);
   // The exported formula entries read back (our own reader) to the same curve.
@@ -131,7 +137,9 @@ TEST_F(FitCli, CrystalMaterialFileAndYamlExport) {
     EXPECT_DOUBLE_EQ(d.modes[0].lambda_nm.front(), 400.0);
     const auto& c = m[key]["cauchy"];
     const double lu2 = std::pow(d.modes[0].lambda_nm[1] * 1e-3, 2);
-    EXPECT_NEAR(d.modes[0].n[1], c[0].get<double>() + c[1].get<double>() / lu2 + c[2].get<double>() / (lu2 * lu2), 1e-10);
+    EXPECT_NEAR(d.modes[0].n[1],
+                c[0].get<double>() + c[1].get<double>() / lu2 + c[2].get<double>() / (lu2 * lu2),
+                1e-10);
   }
 }
 
@@ -155,8 +163,10 @@ TEST_F(FitCli, BadInputFailsWithOneLineAndNoFile) {
   bad("one.csv", "wavelength_nm,n\n500,1.52\n", "one data point");
   bad("few.csv", "wavelength_nm,n\n500,1.52\n600,1.51\n", "fewer than the 3 coefficients");
   bad("nan.csv", "wavelength_nm,n\n500,1.52\n600,nan\n700,1.50\n800,1.49\n", "nan.csv:3");
-  bad("neg.csv", "wavelength_nm,n\n-500,1.52\n600,1.51\n700,1.50\n800,1.49\n", "wavelength must be > 0");
-  bad("dup.csv", "wavelength_nm,n\n500,1.52\n600,1.51\n600,1.51\n800,1.49\n", "duplicate wavelength");
+  bad("neg.csv", "wavelength_nm,n\n-500,1.52\n600,1.51\n700,1.50\n800,1.49\n",
+      "wavelength must be > 0");
+  bad("dup.csv", "wavelength_nm,n\n500,1.52\n600,1.51\n600,1.51\n800,1.49\n",
+      "duplicate wavelength");
   bad("low.csv", "wavelength_nm,n\n500,1.52\n600,0.5\n700,1.50\n800,1.49\n", "must be >= 1");
   bad("unit.csv", "wavelength,n\n500,1.52\n600,1.51\n700,1.50\n800,1.49\n", "wavelength_nm");
   bad("bad.yml", "DATA: [\n  - type: formula 2\n", "malformed YAML");
@@ -350,7 +360,8 @@ TEST_F(FitCli, OutputsNeverReplaceInputsAndFoldersAreCreated) {
   const std::string before = slurp(csv);
   fs::create_directory(dir_ / "sub");
   fs::create_symlink(csv, dir_ / "link.csv");
-  for (const std::string& out : {csv, path("sub/../bk7.csv"), path("./bk7.csv"), path("link.csv")}) {
+  for (const std::string& out :
+       {csv, path("sub/../bk7.csv"), path("./bk7.csv"), path("link.csv")}) {
     const Outcome r = run(csv + " -o " + out);
     EXPECT_EQ(r.code, 1) << out;
     EXPECT_EQ(r.err, "eikon: error: " + out + ": the output is the input data file " + csv +

@@ -26,10 +26,12 @@ nlohmann::json materials() {
 RefractiveIndexFormula referenceFormula(const std::string& material, const std::string& mode) {
   const nlohmann::json all = materials();
   const auto& m = all.at(material).at(mode);
-  return RefractiveIndexFormula(m.at("formula_type").get<int>(), m.at("coefficients").get<std::vector<double>>());
+  return RefractiveIndexFormula(m.at("formula_type").get<int>(),
+                                m.at("coefficients").get<std::vector<double>>());
 }
 
-IndexSeries sample(const RefractiveIndexFormula& f, double lo_nm, double hi_nm, double step_nm, const char* label = "n") {
+IndexSeries sample(const RefractiveIndexFormula& f, double lo_nm, double hi_nm, double step_nm,
+                   const char* label = "n") {
   IndexSeries s;
   s.label = label;
   for (double l = lo_nm; l <= hi_nm + 1e-9; l += step_nm) {
@@ -44,7 +46,8 @@ double rel(double a, double b) { return std::abs(a - b) / std::abs(b); }
 // §6: N-BK7 (SCHOTT Sellmeier) sampled every 1 nm over 400–700 nm, cauchy3 by unweighted least
 // squares: A = 1.5043298, B = 4.3491984e-3, C = −1.8769767e-5, RMS 2.56e-5, max 6.94e-5.
 // Same samples and same estimator, so only the 8 printed digits limit agreement (rel 1e-6); the
-// physics checks (RMS < 3e-5, |Δn| < 1e-4 at F/d/C vs the Sellmeier values) are the ones §6 asks for.
+// physics checks (RMS < 3e-5, |Δn| < 1e-4 at F/d/C vs the Sellmeier values) are the ones §6 asks
+// for.
 TEST(DispersionFit, NBK7Cauchy3ReproducesReference) {
   const IndexSeries s = sample(referenceFormula("N-BK7", "n"), 400.0, 700.0, 1.0);
   ASSERT_EQ(s.size(), 301u);
@@ -87,7 +90,8 @@ TEST(DispersionFit, Sellmeier3RefitRecoversBK7Curve) {
   const FitResult r = fitDispersion(s, {.model = DispersionModel::Sellmeier3});
   const Dispersion fitted = r.dispersion();
   double worst = 0.0;
-  for (double l = 300.0; l <= 2500.0; l += 1.0) worst = std::max(worst, std::abs(fitted.index(l) - truth.index(l * 1e-3)));
+  for (double l = 300.0; l <= 2500.0; l += 1.0)
+    worst = std::max(worst, std::abs(fitted.index(l) - truth.index(l * 1e-3)));
   EXPECT_LT(worst, 1e-6);
   EXPECT_LT(r.rms, 1e-7);
 }
@@ -102,7 +106,8 @@ TEST(DispersionFit, CrystalsFittedPerMode) {
     int idx = 0;
     for (const std::string mode : {"o", "e"}) {
       SCOPED_TRACE(crystal + " " + mode);
-      const IndexSeries s = sample(referenceFormula(crystal, mode), 400.0, 700.0, 2.0, mode == "o" ? "n_o" : "n_e");
+      const IndexSeries s =
+          sample(referenceFormula(crystal, mode), 400.0, 700.0, 2.0, mode == "o" ? "n_o" : "n_e");
       const FitResult r = fitDispersion(s, {.model = DispersionModel::Cauchy3});
       const auto& lines = m.at(crystal).at(mode).at("n_at_lines_computed");
       EXPECT_NEAR(r.n_F, lines.at("F").get<double>(), 1e-4);
@@ -113,8 +118,10 @@ TEST(DispersionFit, CrystalsFittedPerMode) {
       EXPECT_NEAR(r.abbe, m.at(crystal).at("Vd_computed").at(mode).get<double>(), 0.5);
       nd[idx++] = r.n_d;
     }
-    if (crystal == "calcite") EXPECT_LT(nd[1], nd[0]);  // negative crystal
-    else EXPECT_GT(nd[1], nd[0]);                       // quartz is positive
+    if (crystal == "calcite")
+      EXPECT_LT(nd[1], nd[0]);  // negative crystal
+    else
+      EXPECT_GT(nd[1], nd[0]);  // quartz is positive
   }
 }
 
@@ -148,22 +155,28 @@ TEST(DispersionFit, OneSigmaIntervalsCoverTruthAtNominalRate) {
     }
     const FitResult r = fitDispersion(d, {.model = DispersionModel::Cauchy3});
     chi2_sum += *r.chi2_reduced;
-    for (int k = 0; k < 3; ++k) covered[k] += std::abs(r.coeffs[size_t(k)] - truth[k]) <= r.sigma[size_t(k)];
+    for (int k = 0; k < 3; ++k)
+      covered[k] += std::abs(r.coeffs[size_t(k)] - truth[k]) <= r.sigma[size_t(k)];
     // Same data without the σ column: error bars from the scatter.
     d.sigma.clear();
     const FitResult u = fitDispersion(d, {.model = DispersionModel::Cauchy3});
-    for (int k = 0; k < 3; ++k) covered_unweighted[k] += std::abs(u.coeffs[size_t(k)] - truth[k]) <= u.sigma[size_t(k)];
+    for (int k = 0; k < 3; ++k)
+      covered_unweighted[k] += std::abs(u.coeffs[size_t(k)] - truth[k]) <= u.sigma[size_t(k)];
   }
   const double p_gauss = 0.6827, p_t27 = 0.6738;
   for (int k = 0; k < 3; ++k) {
-    EXPECT_NEAR(covered[k] / double(seeds), p_gauss, 4 * std::sqrt(p_gauss * (1 - p_gauss) / seeds)) << "coeff " << k;
-    EXPECT_NEAR(covered_unweighted[k] / double(seeds), p_t27, 4 * std::sqrt(p_t27 * (1 - p_t27) / seeds)) << "coeff " << k;
+    EXPECT_NEAR(covered[k] / double(seeds), p_gauss, 4 * std::sqrt(p_gauss * (1 - p_gauss) / seeds))
+        << "coeff " << k;
+    EXPECT_NEAR(covered_unweighted[k] / double(seeds), p_t27,
+                4 * std::sqrt(p_t27 * (1 - p_t27) / seeds))
+        << "coeff " << k;
   }
-  std::printf("coverage (sigma column): A %.3f  B %.3f  C %.3f; (from scatter): A %.3f  B %.3f  C %.3f; "
-              "mean chi2_red %.3f\n",
-              covered[0] / double(seeds), covered[1] / double(seeds), covered[2] / double(seeds),
-              covered_unweighted[0] / double(seeds), covered_unweighted[1] / double(seeds),
-              covered_unweighted[2] / double(seeds), chi2_sum / seeds);
+  std::printf(
+      "coverage (sigma column): A %.3f  B %.3f  C %.3f; (from scatter): A %.3f  B %.3f  C %.3f; "
+      "mean chi2_red %.3f\n",
+      covered[0] / double(seeds), covered[1] / double(seeds), covered[2] / double(seeds),
+      covered_unweighted[0] / double(seeds), covered_unweighted[1] / double(seeds),
+      covered_unweighted[2] / double(seeds), chi2_sum / seeds);
   EXPECT_NEAR(chi2_sum / seeds, 1.0, 4 * std::sqrt(2.0 / (N - 3)) / std::sqrt(double(seeds)));
 }
 
@@ -187,11 +200,12 @@ TEST(DispersionFit, HuberLossResistsAnOutlier) {
     d.sigma.push_back(1e-5);
   }
   const FitResult plain = fitDispersion(d, {.model = DispersionModel::Cauchy3});
-  const FitResult robust = fitDispersion(d, {.model = DispersionModel::Cauchy3, .huber_delta = 1.0});
+  const FitResult robust =
+      fitDispersion(d, {.model = DispersionModel::Cauchy3, .huber_delta = 1.0});
   EXPECT_GT(std::abs(plain.n_d - n_true(fraunhofer::d)), 5e-5);
   EXPECT_LT(std::abs(robust.n_d - n_true(fraunhofer::d)), 1e-5);
   EXPECT_GT(*plain.chi2_reduced, 100.0);  // the outlier is 500 σ away
-  ASSERT_EQ(plain.warnings.size(), 1u);  // χ² test: the model does not fit within σ
+  ASSERT_EQ(plain.warnings.size(), 1u);   // χ² test: the model does not fit within σ
   EXPECT_NE(plain.warnings[0].find("chi2_red"), std::string::npos);
 }
 
@@ -228,7 +242,8 @@ TEST(DispersionFit, FewerPointsThanParametersIsAnError) {
   const FitResult r = fitDispersion(d, {.model = DispersionModel::Cauchy3});
   EXPECT_FALSE(r.chi2_reduced.has_value());
   EXPECT_LT(r.max_residual, 1e-12);
-  EXPECT_THROW(fitDispersion(d, {.model = DispersionModel::Cauchy3, .huber_delta = -1.0}), std::invalid_argument);
+  EXPECT_THROW(fitDispersion(d, {.model = DispersionModel::Cauchy3, .huber_delta = -1.0}),
+               std::invalid_argument);
 }
 
 // Conrady n = n0 + A/λ + B/λ^3.5 is linear: exact data gives back exact coefficients.
@@ -241,7 +256,8 @@ TEST(DispersionFit, ConradyRecoversExactCoefficients) {
     d.n.push_back(p[0] + p[1] / (l * 1e-3) + p[2] * std::pow(l * 1e-3, -3.5));
   }
   const FitResult r = fitDispersion(d, {.model = DispersionModel::Conrady});
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(r.coeffs[size_t(k)], p[k], 1e-9 * std::max(1.0, std::abs(p[k])));
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(r.coeffs[size_t(k)], p[k], 1e-9 * std::max(1.0, std::abs(p[k])));
 }
 
 // Conrady is a renderer material model (issue 11): Dispersion::conrady evaluates the closed form
@@ -287,13 +303,16 @@ TEST(DispersionFit, ConradyIsADispersionModel) {
 // analytic Jacobian with central differences (relative step 1e-6: error O(h²) ≈ 1e-10 relative).
 TEST(DispersionFit, ModelIndexMatchesDispersionAndDerivatives) {
   const double cauchy[3] = {1.5, 4.3e-3, -1.9e-5};
-  const double sell[6] = {1.03961212, 0.231792344, 1.01046945, 0.00600069867, 0.0200179144, 103.560653};
+  const double sell[6] = {1.03961212,    0.231792344,  1.01046945,
+                          0.00600069867, 0.0200179144, 103.560653};
   const Dispersion dc = Dispersion::cauchy({cauchy[0], cauchy[1], cauchy[2]});
-  const Dispersion ds = Dispersion::sellmeier({sell[0], sell[1], sell[2]}, {sell[3], sell[4], sell[5]});
+  const Dispersion ds =
+      Dispersion::sellmeier({sell[0], sell[1], sell[2]}, {sell[3], sell[4], sell[5]});
   for (double l : {400.0, 550.0, 700.0, 1500.0}) {
     EXPECT_NEAR(modelIndex(DispersionModel::Cauchy3, cauchy, l), dc.index(l), 1e-14);
     EXPECT_NEAR(modelIndex(DispersionModel::Sellmeier3, sell, l), ds.index(l), 1e-14);
-    for (auto [m, p0] : {std::pair{DispersionModel::Cauchy3, cauchy}, std::pair{DispersionModel::Sellmeier3, sell}}) {
+    for (auto [m, p0] : {std::pair{DispersionModel::Cauchy3, cauchy},
+                         std::pair{DispersionModel::Sellmeier3, sell}}) {
       const int P = parameterCount(m);
       double g[6];
       modelIndex(m, p0, l, g);
@@ -305,20 +324,23 @@ TEST(DispersionFit, ModelIndexMatchesDispersionAndDerivatives) {
         const double up = modelIndex(m, p, l);
         p[k] = p0[k] - h;
         const double dn = modelIndex(m, p, l);
-        EXPECT_NEAR(g[k], (up - dn) / (2 * h), 1e-6 * std::abs(g[k]) + 1e-9) << modelName(m) << " k=" << k;
+        EXPECT_NEAR(g[k], (up - dn) / (2 * h), 1e-6 * std::abs(g[k]) + 1e-9)
+            << modelName(m) << " k=" << k;
       }
     }
   }
 }
 
 TEST(DispersionFit, ModelNames) {
-  for (auto m : {DispersionModel::Cauchy2, DispersionModel::Cauchy3, DispersionModel::Sellmeier1,
-                 DispersionModel::Sellmeier2, DispersionModel::Sellmeier3, DispersionModel::Conrady}) {
+  for (auto m :
+       {DispersionModel::Cauchy2, DispersionModel::Cauchy3, DispersionModel::Sellmeier1,
+        DispersionModel::Sellmeier2, DispersionModel::Sellmeier3, DispersionModel::Conrady}) {
     EXPECT_EQ(parseDispersionModel(modelName(m)), m);
     EXPECT_EQ(int(parameterNames(m).size()), parameterCount(m));
   }
   EXPECT_THROW(parseDispersionModel("cauchy4"), std::invalid_argument);
-  EXPECT_EQ(parameterNames(DispersionModel::Sellmeier2), (std::vector<std::string>{"B1", "B2", "C1", "C2"}));
+  EXPECT_EQ(parameterNames(DispersionModel::Sellmeier2),
+            (std::vector<std::string>{"B1", "B2", "C1", "C2"}));
 }
 
 }  // namespace

@@ -29,9 +29,10 @@ void expectError(F fn, std::initializer_list<const char*> parts) {
 }
 
 TEST(IndexCsv, IsotropicWithSigma) {
-  const IndexData d = parseIndexCsv("# BK7 by hand\nwavelength_nm, n, sigma\n486.1327,1.522376,1e-5\n\n"
-                                    "587.5618, 1.516800 ,2e-5\r\n656.2725,1.514322,1e-5\n",
-                                    "bk7.csv");
+  const IndexData d = parseIndexCsv(
+      "# BK7 by hand\nwavelength_nm, n, sigma\n486.1327,1.522376,1e-5\n\n"
+      "587.5618, 1.516800 ,2e-5\r\n656.2725,1.514322,1e-5\n",
+      "bk7.csv");
   ASSERT_EQ(d.modes.size(), 1u);
   EXPECT_FALSE(d.uniaxial());
   EXPECT_EQ(d.modes[0].label, "n");
@@ -50,7 +51,9 @@ TEST(IndexCsv, MicrometresAreConverted) {
 
 TEST(IndexCsv, CrystalColumns) {
   const IndexData d = parseIndexCsv(
-      "wavelength_nm,n_o,n_e,sigma_o,sigma_e\n486.1,1.6676,1.4905,1e-4,2e-4\n656.3,1.6545,1.4843,1e-4,2e-4\n", "c.csv");
+      "wavelength_nm,n_o,n_e,sigma_o,sigma_e\n486.1,1.6676,1.4905,1e-4,2e-4\n656.3,1.6545,1.4843,"
+      "1e-4,2e-4\n",
+      "c.csv");
   ASSERT_TRUE(d.uniaxial());
   EXPECT_EQ(d.modes[0].label, "n_o");
   EXPECT_EQ(d.modes[1].label, "n_e");
@@ -59,7 +62,8 @@ TEST(IndexCsv, CrystalColumns) {
 }
 
 TEST(IndexCsv, UnsortedRowsAreSortedWithOneWarning) {
-  const IndexData d = parseIndexCsv("wavelength_nm,n_o,n_e\n600,1.65,1.48\n500,1.66,1.49\n550,1.655,1.485\n", "u.csv");
+  const IndexData d = parseIndexCsv(
+      "wavelength_nm,n_o,n_e\n600,1.65,1.48\n500,1.66,1.49\n550,1.655,1.485\n", "u.csv");
   EXPECT_EQ(d.modes[0].lambda_nm, (std::vector<double>{500, 550, 600}));
   EXPECT_EQ(d.modes[1].n, (std::vector<double>{1.49, 1.485, 1.48}));
   ASSERT_EQ(d.warnings.size(), 1u);
@@ -77,8 +81,10 @@ TEST(IndexCsv, BadInputIsOneClearError) {
   expectError(csv("wavelength_nm,n\n0,1.5\n600,1.4\n"), {"bad.csv:2", "wavelength must be > 0"});
   expectError(csv("wavelength_nm,n\n-500,1.5\n600,1.4\n"), {"bad.csv:2", "wavelength must be > 0"});
   expectError(csv("wavelength_nm,n\n500,1.5\n600,0.9\n"), {"bad.csv:3", "n must be >= 1"});
-  expectError(csv("wavelength_nm,n\n500,1.5\n600,1.4\n500,1.5\n"), {"bad.csv:4", "duplicate wavelength 500", "bad.csv:2"});
-  expectError(csv("wavelength,n\n500,1.5\n600,1.4\n"), {"bad.csv:1", "wavelength_nm", "never guessed"});
+  expectError(csv("wavelength_nm,n\n500,1.5\n600,1.4\n500,1.5\n"),
+              {"bad.csv:4", "duplicate wavelength 500", "bad.csv:2"});
+  expectError(csv("wavelength,n\n500,1.5\n600,1.4\n"),
+              {"bad.csv:1", "wavelength_nm", "never guessed"});
   expectError(csv("500,1.5\n600,1.4\n"), {"bad.csv:1", "missing header"});
   expectError(csv("wavelength_nm,index\n500,1.5\n"), {"bad.csv:1", "unrecognised header"});
   expectError(csv("wavelength_nm,n\n500,1.5,3\n600,1.4\n"), {"bad.csv:2", "expected 2 fields"});
@@ -95,7 +101,8 @@ TEST(IndexCsv, MissingFileIsAnError) {
 TEST(IndexCsv, WindowKeepsOnlyPointsInside) {
   IndexReadOptions o;
   o.window_nm = std::array<double, 2>{450.0, 650.0};
-  const IndexData d = parseIndexCsv("wavelength_nm,n\n400,1.53\n500,1.52\n600,1.51\n700,1.50\n", "w.csv", o);
+  const IndexData d =
+      parseIndexCsv("wavelength_nm,n\n400,1.53\n500,1.52\n600,1.51\n700,1.50\n", "w.csv", o);
   EXPECT_EQ(d.modes[0].lambda_nm, (std::vector<double>{500, 600}));
 }
 
@@ -114,8 +121,10 @@ TEST(RefractiveIndexFormula, MatchesMaterialsJsonAtFraunhoferLines) {
       const RefractiveIndexFormula f(mat[mode]["formula_type"].get<int>(),
                                      mat[mode]["coefficients"].get<std::vector<double>>());
       const auto& lines = mat[mode]["n_at_lines_computed"];
-      for (auto [line, nm] : {std::pair{"F", fraunhofer::F}, {"d", fraunhofer::d}, {"C", fraunhofer::C}}) {
-        EXPECT_NEAR(f.index(nm * 1e-3), lines[line].get<double>(), 6e-7) << name << " " << mode << " " << line;
+      for (auto [line, nm] :
+           {std::pair{"F", fraunhofer::F}, {"d", fraunhofer::d}, {"C", fraunhofer::C}}) {
+        EXPECT_NEAR(f.index(nm * 1e-3), lines[line].get<double>(), 6e-7)
+            << name << " " << mode << " " << line;
         ++checked;
       }
     }
@@ -127,9 +136,11 @@ TEST(RefractiveIndexFormula, MatchesMaterialsJsonAtFraunhoferLines) {
 TEST(RefractiveIndexFormula, AllNineFormulasByHand) {
   const double l = 0.55, l2 = l * l;
   // 1 and 2 are the same curve when formula 1's poles are the square roots of formula 2's.
-  EXPECT_NEAR(RefractiveIndexFormula(1, {0.1, 1.0, std::sqrt(0.01), 0.5, std::sqrt(100.0)}).index(l),
-              RefractiveIndexFormula(2, {0.1, 1.0, 0.01, 0.5, 100.0}).index(l), 1e-14);
-  EXPECT_NEAR(RefractiveIndexFormula(2, {0.1, 1.0, 0.01}).index(l), std::sqrt(1.1 + l2 / (l2 - 0.01)), 1e-14);
+  EXPECT_NEAR(
+      RefractiveIndexFormula(1, {0.1, 1.0, std::sqrt(0.01), 0.5, std::sqrt(100.0)}).index(l),
+      RefractiveIndexFormula(2, {0.1, 1.0, 0.01, 0.5, 100.0}).index(l), 1e-14);
+  EXPECT_NEAR(RefractiveIndexFormula(2, {0.1, 1.0, 0.01}).index(l),
+              std::sqrt(1.1 + l2 / (l2 - 0.01)), 1e-14);
   EXPECT_NEAR(RefractiveIndexFormula(3, {2.25, 0.01, -2, -0.001, 2}).index(l),
               std::sqrt(2.25 + 0.01 / l2 - 0.001 * l2), 1e-14);
   EXPECT_NEAR(RefractiveIndexFormula(4, {2.0, 0.1, 2, 0.2, 2, 0.05, 0, 3, 2, 0.01, -2}).index(l),
@@ -137,14 +148,18 @@ TEST(RefractiveIndexFormula, AllNineFormulasByHand) {
   // 5 with exponents −2, −4 is eikon's Cauchy.
   EXPECT_NEAR(RefractiveIndexFormula(5, {1.5, 4.3e-3, -2, -1.9e-5, -4}).index(l),
               Dispersion::cauchy({1.5, 4.3e-3, -1.9e-5}).index(550.0), 1e-14);
-  EXPECT_NEAR(RefractiveIndexFormula(6, {1e-4, 0.02, 150.0}).index(l), 1.0 + 1e-4 + 0.02 / (150.0 - 1.0 / l2), 1e-14);
+  EXPECT_NEAR(RefractiveIndexFormula(6, {1e-4, 0.02, 150.0}).index(l),
+              1.0 + 1e-4 + 0.02 / (150.0 - 1.0 / l2), 1e-14);
   const double q = 1.0 / (l2 - 0.028);
   EXPECT_NEAR(RefractiveIndexFormula(7, {1.5, 0.01, 0.001, -0.002, 1e-4, -1e-6}).index(l),
-              1.5 + 0.01 * q + 0.001 * q * q - 0.002 * l2 + 1e-4 * l2 * l2 - 1e-6 * l2 * l2 * l2, 1e-14);
+              1.5 + 0.01 * q + 0.001 * q * q - 0.002 * l2 + 1e-4 * l2 * l2 - 1e-6 * l2 * l2 * l2,
+              1e-14);
   // 8: Lorentz–Lorenz; with only C1 = (n²−1)/(n²+2) it returns n.
   EXPECT_NEAR(RefractiveIndexFormula(8, {(2.25 - 1) / (2.25 + 2)}).index(l), 1.5, 1e-14);
-  EXPECT_NEAR(RefractiveIndexFormula(9, {2.0, 0.05, 0.03, 0.01, 0.3, 0.02}).index(l),
-              std::sqrt(2.0 + 0.05 / (l2 - 0.03) + 0.01 * (l - 0.3) / ((l - 0.3) * (l - 0.3) + 0.02)), 1e-14);
+  EXPECT_NEAR(
+      RefractiveIndexFormula(9, {2.0, 0.05, 0.03, 0.01, 0.3, 0.02}).index(l),
+      std::sqrt(2.0 + 0.05 / (l2 - 0.03) + 0.01 * (l - 0.3) / ((l - 0.3) * (l - 0.3) + 0.02)),
+      1e-14);
   EXPECT_THROW(RefractiveIndexFormula(10, {1.0}), std::invalid_argument);
   EXPECT_THROW(RefractiveIndexFormula(2, {}), std::invalid_argument);
   EXPECT_THROW(RefractiveIndexFormula(8, {1, 2, 3, 4, 5}), std::invalid_argument);
@@ -178,7 +193,8 @@ TEST(RefractiveIndexYaml, FormulaIsSampledOverItsRange) {
   const IndexSeries w = parseRefractiveIndexYaml(kBk7Yaml, "bk7.yml", o).modes[0];
   EXPECT_EQ(w.size(), 301u);
   EXPECT_DOUBLE_EQ(w.lambda_nm[1], 401.0);
-  const Dispersion bk7 = Dispersion::sellmeier({1.03961212, 0.231792344, 1.01046945}, {0.00600069867, 0.0200179144, 103.560653});
+  const Dispersion bk7 = Dispersion::sellmeier({1.03961212, 0.231792344, 1.01046945},
+                                               {0.00600069867, 0.0200179144, 103.560653});
   EXPECT_NEAR(w.n[100], bk7.index(500.0), 1e-15);
 }
 
@@ -214,8 +230,9 @@ SPECS:
 // Database nk files often start in the EUV where n < 1: an error on its own, skipped when the
 // caller's window excludes it.
 TEST(RefractiveIndexYaml, WindowSkipsRowsOutsideBeforeChecks) {
-  const char* text = "DATA:\n  - type: tabulated nk\n    data: |\n        0.03 0.93 0.08\n"
-                     "        0.45 1.47 0\n        0.55 1.46 0\n        0.65 1.456 0\n";
+  const char* text =
+      "DATA:\n  - type: tabulated nk\n    data: |\n        0.03 0.93 0.08\n"
+      "        0.45 1.47 0\n        0.55 1.46 0\n        0.65 1.456 0\n";
   EXPECT_THROW(parseRefractiveIndexYaml(text, "euv.yml"), std::invalid_argument);
   IndexReadOptions o;
   o.window_nm = std::array<double, 2>{400.0, 700.0};
@@ -223,23 +240,32 @@ TEST(RefractiveIndexYaml, WindowSkipsRowsOutsideBeforeChecks) {
 }
 
 TEST(RefractiveIndexYaml, BadInputIsOneClearError) {
-  auto yml = [](const std::string& text) { return [text] { parseRefractiveIndexYaml(text, "bad.yml"); }; };
+  auto yml = [](const std::string& text) {
+    return [text] { parseRefractiveIndexYaml(text, "bad.yml"); };
+  };
   expectError(yml(""), {"bad.yml", "empty"});
   expectError(yml("DATA: [\n  - type: formula 2\n"), {"bad.yml:", "malformed YAML"});
-  expectError(yml("DATA:\n  - type: formula 2\n   coefficients: 1 2\n  x"), {"bad.yml", "malformed YAML"});
+  expectError(yml("DATA:\n  - type: formula 2\n   coefficients: 1 2\n  x"),
+              {"bad.yml", "malformed YAML"});
   expectError(yml("REFERENCES: x\n"), {"bad.yml", "no DATA"});
-  expectError(yml("DATA:\n  - type: formula 12\n    wavelength_range: 0.4 0.7\n    coefficients: 1\n"),
-              {"bad.yml: DATA[0].type", "formula 12"});
-  expectError(yml("DATA:\n  - type: formula 2\n    coefficients: 0 1 0.01\n"), {"DATA[0]", "wavelength_range"});
-  expectError(yml("DATA:\n  - type: formula 2\n    wavelength_range: 0.7 0.4\n    coefficients: 0 1 0.01\n"),
+  expectError(
+      yml("DATA:\n  - type: formula 12\n    wavelength_range: 0.4 0.7\n    coefficients: 1\n"),
+      {"bad.yml: DATA[0].type", "formula 12"});
+  expectError(yml("DATA:\n  - type: formula 2\n    coefficients: 0 1 0.01\n"),
+              {"DATA[0]", "wavelength_range"});
+  expectError(yml("DATA:\n  - type: formula 2\n    wavelength_range: 0.7 0.4\n    coefficients: 0 "
+                  "1 0.01\n"),
               {"DATA[0].wavelength_range", "lo < hi"});
-  expectError(yml("DATA:\n  - type: formula 2\n    wavelength_range: 0.4 0.7\n    coefficients: 0 one 0.01\n"),
+  expectError(yml("DATA:\n  - type: formula 2\n    wavelength_range: 0.4 0.7\n    coefficients: 0 "
+                  "one 0.01\n"),
               {"DATA[0].coefficients", "'one'"});
-  expectError(yml("DATA:\n  - type: tabulated n\n    data: |\n        0.5 1.5 3\n"), {"DATA[0].data row 1", "expected 2"});
+  expectError(yml("DATA:\n  - type: tabulated n\n    data: |\n        0.5 1.5 3\n"),
+              {"DATA[0].data row 1", "expected 2"});
   expectError(yml("DATA:\n  - type: tabulated n\n    data: |\n        0.5 1.5\n        0.5 1.6\n"),
               {"duplicate wavelength 500"});
-  expectError(yml("DATA:\n  - type: tabulated k\n    data: |\n        0.5 1e-5\n        0.6 1e-5\n"),
-              {"bad.yml", "no data points"});
+  expectError(
+      yml("DATA:\n  - type: tabulated k\n    data: |\n        0.5 1e-5\n        0.6 1e-5\n"),
+      {"bad.yml", "no data points"});
   expectError(yml("DATA:\n  - type: spline\n"), {"DATA[0].type", "unsupported"});
 }
 

@@ -92,10 +92,10 @@ TEST_F(AtomicWrite, FailureOfTheSecondFileLeavesBothTargetsIntact) {
 TEST_F(AtomicWrite, FoldersCreatedForAFailedSetAreRemoved) {
   fs::create_directory(dir_ / "kept");
   const fs::path a = dir_ / "kept" / "new" / "deeper" / "a.json", b = dir_ / "other" / "b.yml";
-  EXPECT_THROW(writeFilesTogether({{a, text("a")}, {b, [](const fs::path&) {
-                                     throw std::runtime_error("disk full");
-                                   }}}),
-               std::runtime_error);
+  EXPECT_THROW(
+      writeFilesTogether(
+          {{a, text("a")}, {b, [](const fs::path&) { throw std::runtime_error("disk full"); }}}),
+      std::runtime_error);
   EXPECT_TRUE(fs::is_directory(dir_ / "kept"));
   EXPECT_FALSE(fs::exists(dir_ / "kept" / "new"));
   EXPECT_FALSE(fs::exists(dir_ / "other"));

@@ -1,6 +1,6 @@
 // The seed patches both light simulators launch (core/light/seeding.h): a spot light's cells carry
 // the cone's solid angle and are centred on its axis. The GPU twin seeds with the same function, so
-// the twins' tests (tests/core/wavefront_gpu_test.cpp) compare runs from identical seeds.
+// the twins' tests (tests/core/render/wavefront_gpu_test.cpp) compare runs from identical seeds.
 #include "core/light/seeding.h"
 
 #include <gtest/gtest.h>

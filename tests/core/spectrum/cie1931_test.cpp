@@ -1,11 +1,12 @@
 // CIE 1931 table checks: the published integrals and landmarks of the 2° observer.
+#include "core/spectrum/cie1931.h"
+
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-#include <gtest/gtest.h>
-
-#include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
 
 using namespace eikon::spectrum;
@@ -70,7 +71,8 @@ TEST(Cie1931, SpectralLocusAt520nm) {
   // And through the renderer's colour chain and back (sRGB → XYZ_D65 → undo Bradford): same xy.
   const glm::dvec3 rgb = spectralToLinearSrgbMatrix() * cmf(520.0);
   const glm::dvec3 xyzD65 = linearSrgbToXyz(rgb);
-  const glm::dvec3 xyzE = glm::inverse(bradfordAdaptation(equalEnergyWhiteXyz(), d65WhiteXyz())) * xyzD65;
+  const glm::dvec3 xyzE =
+      glm::inverse(bradfordAdaptation(equalEnergyWhiteXyz(), d65WhiteXyz())) * xyzD65;
   const glm::dvec2 xy2 = xyzToXy(xyzE);
   EXPECT_NEAR(xy2.x, xy.x, 1e-6);
   EXPECT_NEAR(xy2.y, xy.y, 1e-6);

@@ -1,12 +1,13 @@
 // Colour conversions: sRGB matrices, transfer curve, Bradford, and "flat spectrum is white".
-#include <cmath>
-#include <cstdio>
+#include "core/spectrum/color.h"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
 #include <glm/matrix.hpp>
 
 #include "core/spectrum/cie1931.h"
-#include "core/spectrum/color.h"
 #include "core/spectrum/illuminants.h"
 
 using namespace eikon::spectrum;
@@ -14,13 +15,15 @@ using namespace eikon::spectrum;
 TEST(Color, SrgbMatrixMatchesIec61966) {
   // IEC 61966-2-1 prints the matrix to 4 decimals: agreement to 5e-5.
   const glm::dmat3 m = linearSrgbToXyzMatrix();
-  const double expect[3][3] = {{0.4124, 0.3576, 0.1805}, {0.2126, 0.7152, 0.0722}, {0.0193, 0.1192, 0.9505}};
+  const double expect[3][3] = {
+      {0.4124, 0.3576, 0.1805}, {0.2126, 0.7152, 0.0722}, {0.0193, 0.1192, 0.9505}};
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c][r], expect[r][c], 5e-5) << r << "," << c;
 }
 
 TEST(Color, PrimariesRoundTrip) {
-  for (glm::dvec3 p : {glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 1), glm::dvec3(1, 1, 1)}) {
+  for (glm::dvec3 p :
+       {glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 1), glm::dvec3(1, 1, 1)}) {
     const glm::dvec3 back = xyzToLinearSrgb(linearSrgbToXyz(p));
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(back[k], p[k], 1e-14);
   }
@@ -56,8 +59,8 @@ TEST(Color, FlatSpectrumIsExactlyWhite) {
 }
 
 TEST(Color, D65Chromaticity) {
-  // CIE 15: D65 is (0.31272, 0.32903) computed from the 5 nm SPD with the 5 nm CMFs. We integrate the
-  // linearly interpolated 5 nm SPD against the 1 nm CMFs; interpolation moves xy by ~1e-5 (and
+  // CIE 15: D65 is (0.31272, 0.32903) computed from the 5 nm SPD with the 5 nm CMFs. We integrate
+  // the linearly interpolated 5 nm SPD against the 1 nm CMFs; interpolation moves xy by ~1e-5 (and
   // the 5 nm summation by 2e-5), so the tolerance is 2e-4 as in the issue, measured 7e-6.
   glm::dvec3 xyz(0.0);
   for (int l = 360; l <= 830; ++l) xyz += cmf(l) * d65(l);

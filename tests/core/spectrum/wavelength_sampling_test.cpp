@@ -1,10 +1,10 @@
 // Stratified wavelength sampler: strata, hash values, and unbiasedness for a flat spectrum.
-#include <cmath>
-#include <cstdio>
+#include "core/spectrum/wavelength_sampling.h"
 
 #include <gtest/gtest.h>
 
-#include "core/spectrum/wavelength_sampling.h"
+#include <cmath>
+#include <cstdio>
 
 using namespace eikon::spectrum;
 
@@ -34,7 +34,8 @@ TEST(WavelengthSampling, FlatSpectrumAveragesToWhite) {
     double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
     for (int p = 0; p < pixels; ++p) {
       std::vector<SpectralSample> s;
-      for (double l : stratifiedWavelengths(static_cast<std::uint32_t>(p), 0, n)) s.push_back({l, 1.0});
+      for (double l : stratifiedWavelengths(static_cast<std::uint32_t>(p), 0, n))
+        s.push_back({l, 1.0});
       const glm::dvec3 rgb = spectralToLinearSrgb(s);
       for (int k = 0; k < 3; ++k) sum[k] += rgb[k], sum2[k] += rgb[k] * rgb[k];
     }

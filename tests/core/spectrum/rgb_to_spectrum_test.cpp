@@ -1,12 +1,13 @@
 // RGB → spectrum: greys are flat, colours round-trip, spectra are non-negative.
+#include "core/spectrum/rgb_to_spectrum.h"
+
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include <gtest/gtest.h>
-
 #include "core/spectrum/color.h"
-#include "core/spectrum/rgb_to_spectrum.h"
 
 using namespace eikon::spectrum;
 
@@ -30,7 +31,8 @@ TEST(RgbToSpectrum, RoundTripOnAGrid) {
     for (int g = 0; g <= 10; ++g)
       for (int b = 0; b <= 10; ++b) {
         const glm::dvec3 rgb(r / 10.0, g / 10.0, b / 10.0);
-        const glm::dvec3 back = spectrumToLinearSrgb([&](double l) { return rgbToSpectrum(rgb, l); });
+        const glm::dvec3 back =
+            spectrumToLinearSrgb([&](double l) { return rgbToSpectrum(rgb, l); });
         for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(back[k] - rgb[k]));
       }
   std::printf("rgb->spectrum->rgb worst error over 11^3 grid: %.3g\n", worst);
@@ -42,7 +44,8 @@ TEST(RgbToSpectrum, NonNegativeForInGamut) {
   for (int r = 0; r <= 4; ++r)
     for (int g = 0; g <= 4; ++g)
       for (int b = 0; b <= 4; ++b)
-        for (double l = 380.0; l <= 780.0; l += 1.0) EXPECT_GE(rgbToSpectrum({r / 4.0, g / 4.0, b / 4.0}, l), 0.0);
+        for (double l = 380.0; l <= 780.0; l += 1.0)
+          EXPECT_GE(rgbToSpectrum({r / 4.0, g / 4.0, b / 4.0}, l), 0.0);
 }
 
 TEST(RgbToSpectrum, RejectsBadWavelength) {
