@@ -210,6 +210,7 @@ class PatchStepper {
   // Sharp interfaces.
   const WavefrontMedium& mediumOf(int region) const { return sharp_->media[size_t(region)]; }
   glm::dvec3 mediumVelocity(int region, const glm::dvec3& w) const;
+  double mediumSigma(int region, const glm::dvec3& w) const;
   void sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& st) const;
   bool crossInterface(const BoundaryCrossing& c, Patch& p, int k, double& transmission) const;
   bool straddles(const Patch& p) const;
@@ -285,6 +286,14 @@ glm::dvec3 PatchStepper::mediumVelocity(int region, const glm::dvec3& w) const {
     return pa / (m.n * m.n) * m.axis + (w - pa * m.axis) / (m.n_e * m.n_e);
   }
   return w / (m.n * m.n);
+}
+
+// Attenuation per unit ray length in region r for wave vector w: σ_o, or in a crystal of the
+// e-mode the pleochroic σ(θ)·cos ρ of field::attenuationE (as sigmaE on the smoothed path).
+double PatchStepper::mediumSigma(int region, const glm::dvec3& w) const {
+  const WavefrontMedium& m = mediumOf(region);
+  if (!eMode_ || !(m.n_e > 0.0) || (m.sigma == 0.0 && m.sigma_e == 0.0)) return m.sigma;
+  return field::attenuationE(glm::dvec3(m.sigma), glm::dvec3(m.sigma_e), w, m.axis, m.n, m.n_e).x;
 }
 
 // Corner k at the crossing c (p.x[k] its point, p.w[k] the incident wave vector): the exact laws
@@ -375,17 +384,17 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
       // The trilinear field's zero lies just past the exact surface where the corner was turned
       // (curved faces: by up to 3h²/8r): not a new boundary, so go on past it.
       const double t = std::min(1.0, c.t + 1e-6 * h_ / std::max(len, 1e-300));
-      absorb += mediumOf(r).sigma * t * len;
+      absorb += mediumSigma(r, p.w[size_t(k)]) * t * len;
       x += t * d;
       T *= 1.0 - t;
       continue;
     }
     if (!c.found) {
-      absorb += mediumOf(r).sigma * len;
+      absorb += mediumSigma(r, p.w[size_t(k)]) * len;
       x += d;
       break;
     }
-    absorb += mediumOf(r).sigma * c.t * len;
+    absorb += mediumSigma(r, p.w[size_t(k)]) * c.t * len;
     x = c.point;
     T *= 1.0 - c.t;
     c.from = r;  // the corner's own region, whatever the field says at its start
@@ -902,6 +911,25 @@ bool SharpInterfaces::active() const {
   if (!boundary || boundary->empty() || media.size() < boundary->shapes.size() + 1) return false;
   return std::all_of(media.begin(), media.end(),
                      [](const WavefrontMedium& m) { return m.homogeneous; });
+}
+
+SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm) {
+  SharpInterfaces si;
+  if (volume.boundary.empty() || volume.media.empty()) return si;
+  si.boundary = &volume.boundary;
+  for (const MediumRecord& r : volume.media.regions) {
+    WavefrontMedium m;
+    m.n = mediumIndex(r.n_o, wavelength_nm);
+    if (r.uniaxial && !r.radial_axis) {
+      m.n_e = mediumIndex(r.n_e, wavelength_nm);
+      m.axis = r.axis;
+    }
+    m.sigma = field::bandAt(r.sigma_o, wavelength_nm);
+    m.sigma_e = field::bandAt(r.sigma_e, wavelength_nm);
+    m.homogeneous = r.homogeneous;
+    si.media.push_back(m);
+  }
+  return si;
 }
 
 WavefrontSimulator::WavefrontSimulator(const Field& field, const Grid& splat_grid,

@@ -56,7 +56,8 @@ struct WavefrontMedium {
   double n = 1.0;    ///< index; in a crystal the ordinary index n_o
   double n_e = 0.0;  ///< > 0: a uniaxial crystal with this principal extraordinary index
   glm::dvec3 axis{0.0, 0.0, 1.0};  ///< the crystal's optic axis (unit; ignored when n_e = 0)
-  double sigma = 0.0;              ///< attenuation (1/mm), either mode
+  double sigma = 0.0;              ///< attenuation (1/mm) of the o-mode (and of isotropic media)
+  double sigma_e = 0.0;  ///< crystals: the principal e attenuation (σ(θ) as field::attenuationE)
   /// false: the medium varies in space (GRIN, an optic-axis field); the sharp path then does not
   /// apply and the run uses the smoothed field throughout.
   bool homogeneous = true;
@@ -71,6 +72,12 @@ struct SharpInterfaces {
   /// Whether the sharp path applies (see above).
   bool active() const;
 };
+
+/// The sharp interfaces of a voxelised scene at a wavelength: its boundary field (referenced) and
+/// its media table (VolumeSet::media, core/volume/media.h) evaluated there: n_o, n_e with each
+/// material's own dispersion formula, σ_o, σ_e interpolated between the bands (field::bandAt).
+/// Inactive when the scene was voxelised with "interfaces": "smoothed" (no boundary field).
+SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm);
 
 class WavefrontSimulator {
  public:
