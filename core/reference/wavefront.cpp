@@ -304,13 +304,14 @@ double PatchStepper::mediumSigma(int region, const glm::dvec3& w) const {
 // crystal: the exact exit transmission of the mode; crystal → crystal: the phase-matched wave of
 // the same mode, no loss. Where the outgoing wave does not exist, total internal reflection: the
 // mirror (same mode), no loss, the corner's mirror bit flips and it stays in its region. Equal
-// media: only the region changes. Multiplies `transmission` by T; true if the corner was turned.
+// media, or an opaque one entered: only the region changes. Multiplies `transmission` by T; true if
+// the corner was turned.
 bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k,
                                   double& transmission) const {
   const WavefrontMedium &a = mediumOf(c.from), &b = mediumOf(c.to);
   glm::dvec3 N = glm::length(c.normal) > 0 ? c.normal : c.field_normal;
   const bool same = a.n == b.n && a.n_e == b.n_e && (a.n_e == 0.0 || a.axis == b.axis);
-  if (same || !(glm::length(N) > 0)) {
+  if (same || b.opaque || !(glm::length(N) > 0)) {
     p.region[size_t(k)] = c.to;
     return false;
   }
@@ -927,6 +928,7 @@ SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm
     m.sigma = field::bandAt(r.sigma_o, wavelength_nm);
     m.sigma_e = field::bandAt(r.sigma_e, wavelength_nm);
     m.homogeneous = r.homogeneous;
+    m.opaque = r.opaque();
     si.media.push_back(m);
   }
   return si;

@@ -58,6 +58,9 @@ struct WavefrontMedium {
   glm::dvec3 axis{0.0, 0.0, 1.0};  ///< the crystal's optic axis (unit; ignored when n_e = 0)
   double sigma = 0.0;              ///< attenuation (1/mm) of the o-mode (and of isotropic media)
   double sigma_e = 0.0;  ///< crystals: the principal e attenuation (σ(θ) as field::attenuationE)
+  /// Opaque (opacity ≥ 0.5): a corner enters unturned and without Fresnel loss; the patch is
+  /// ended as absorbed where the field's opacity says so, as on the smoothed path.
+  bool opaque = false;
   /// false: the medium varies in space (GRIN, an optic-axis field); the sharp path then does not
   /// apply and the run uses the smoothed field throughout.
   bool homogeneous = true;
