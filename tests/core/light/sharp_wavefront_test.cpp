@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "core/reference/wavefront.h"
 #include "core/volume/volume_set.h"
@@ -56,21 +57,33 @@ SharpInterfaces oneGlass(const VolumeSet& vol, double n) {
 
 // ---------------------------------------------------------------- slab
 // A glass slab (n = 1.5) of thickness 1 mm (faces z = ±0.5, 60 mm wide: its sides lie outside the
-// volume), h = 0.1 mm. A beam of radius 0.3 mm in the x–z plane at incidence i whose axis meets the
-// entry face at the origin's (0, 0, −0.5). Behind the slab (probe z = 1.0) the axis is displaced by
-// t·(tan i − tan r) along −x against the straight line and leaves along the incident direction.
+// volume), at 64 and 128 voxels along x (h = 0.195, 0.098 mm). A beam of radius 0.3 mm in the x–z
+// plane at incidence i whose axis meets the entry face at the origin's (0, 0, −0.5). Behind the
+// slab (probe z = 1.0) the axis is displaced by t·(tan i − tan r) along −x against the straight
+// line and leaves along the incident direction.
 const char* kSlab = R"({
   "camera": {"width": 8, "height": 8},
   "environment": {"type": "constant", "radiance": 1},
-  "volume": {"bounds_min": [-6.0, -0.5, -1.0], "bounds_max": [6.5, 0.5, 1.2], "resolution": 125},
+  "volume": {"bounds_min": [-6.0, -0.5, -1.0], "bounds_max": [6.5, 0.5, 1.2], "resolution": RES},
   "objects": [{"shape": "box", "center": [0, 0, 0], "size": [60, 60, 1], "material": "glass"}],
   "materials": {"glass": {"n": 1.5}}
 })";
 
+void slabAtEachIncidence(const VolumeSet& vol);
+
 TEST(SharpWavefront, SlabDisplacesTheBeamAndTransmitsTheFresnelPower) {
-  const Scene scene = sceneFromJson(kSlab);
-  const VolumeSet vol = voxelize(scene);
-  ASSERT_FALSE(vol.boundary.empty());
+  for (const char* res : {"64", "128"}) {
+    std::string json = kSlab;
+    json.replace(json.find("RES"), 3, res);
+    const Scene scene = sceneFromJson(json);
+    const VolumeSet vol = voxelize(scene);
+    ASSERT_FALSE(vol.boundary.empty());
+    std::printf("[ measured ] sharp slab at resolution %s (h = %.4f mm)\n", res, vol.grid.h);
+    slabAtEachIncidence(vol);
+  }
+}
+
+void slabAtEachIncidence(const VolumeSet& vol) {
   VolumeField field(vol);
   const double n = 1.5, t = 1.0, zIn = -0.5, zProbe = 1.0;
   const SharpInterfaces sharp = oneGlass(vol, n);
