@@ -378,7 +378,8 @@ TEST(SharpWavefront, EdgeBehindTheApexIsSharperThanSmoothed) {
 // stopped on. The bookkeeping must close: emitted = left + caustic + energy + absorbed +
 // reflected + live, to summation round-off (1e-9 relative, as GlassSphereConservesFlux), and the
 // reflected share must lie between the normal-incidence loss of the lit disc's two passes
-// 1 − (1 − R₀)² = 0.0784 (times the disc's share of the emitted flux) and 1.
+// 1 − (1 − R₀)² = 0.0784 (times the disc's share of the emitted flux) and 1. Two threads give the
+// single-threaded counts.
 TEST(SharpWavefront, GlassSphereConservesFluxAtSharpSurfaces) {
   const Scene scene = sceneFromJson(kGlassSphereLightScene);
   const VolumeSet vol = voxelize(scene);
@@ -408,6 +409,16 @@ TEST(SharpWavefront, GlassSphereConservesFluxAtSharpSurfaces) {
       std::chrono::duration<double>(t1 - t0).count(),
       std::chrono::duration<double>(t2 - t1).count(), sm.stats.splits, st.splits);
   EXPECT_NEAR(ended, st.flux_emitted, 1e-9 * st.flux_emitted);
+  // Two threads: the same counts as one (the chunks of WavefrontSettings::threads; the boundary
+  // field and the media are only read), fluxes to summation order.
+  WavefrontSettings s2 = s;
+  s2.threads = 2;
+  const WavefrontStats st2 = WavefrontSimulator(field, vol.grid, s2, sharp).run(light).stats;
+  EXPECT_EQ(st2.splits, st.splits);
+  EXPECT_EQ(st2.kills_caustic, st.kills_caustic);
+  EXPECT_EQ(st2.kills_left, st.kills_left);
+  EXPECT_EQ(st2.interface_events, st.interface_events);
+  EXPECT_NEAR(st2.flux_reflected, st.flux_reflected, 1e-12 * st.flux_emitted);
   EXPECT_GT(st.flux_reflected, 0.0784 * disc * st.flux_emitted * 0.99);
   EXPECT_LT(st.flux_reflected, disc * st.flux_emitted);
 }
