@@ -9,8 +9,8 @@ namespace eikon {
 
 double LightingSummary::conservationError() const {
   if (!(flux_emitted > 0)) return 0.0;
-  return std::abs(flux_emitted -
-                  (flux_left + flux_caustic + flux_energy + flux_absorbed + flux_live_at_end)) /
+  return std::abs(flux_emitted - (flux_left + flux_caustic + flux_energy + flux_absorbed +
+                                  flux_reflected + flux_live_at_end)) /
          flux_emitted;
 }
 
@@ -22,6 +22,7 @@ void LightingSummary::add(const WavefrontStats& s, double weight) {
   flux_caustic += weight * s.flux_caustic;
   flux_energy += weight * s.flux_energy;
   flux_absorbed += weight * s.flux_absorbed;
+  flux_reflected += weight * s.flux_reflected;
   flux_live_at_end += weight * s.flux_live_at_end;
 }
 

@@ -39,7 +39,8 @@ struct LightingSummary {
   size_t patches = 0;    ///< patches processed: seeded + 4 per split
   double flux_emitted = 0, flux_left = 0, flux_caustic = 0, flux_energy = 0, flux_absorbed = 0,
          flux_live_at_end = 0;
-  /// |emitted − (left + caustic + energy + absorbed + live)| / emitted: the bookkeeping balance.
+  double flux_reflected = 0;  ///< sharp interfaces: lost to Fresnel reflection
+  /// |emitted − (left + caustic + energy + absorbed + reflected + live)| / emitted: the balance.
   std::vector<std::string>
       notes;  ///< what the driver changed, for the user (e.g. a lowered patch budget)
   double conservationError() const;

@@ -112,6 +112,10 @@ struct Patch {
   bool entered = false;        ///< the centre has been inside the field's bounds
   int probe_side = 0;          ///< −1 / +1: side of the probe plane the centre is on
   int steps = 0;               ///< time steps taken (a straight step of k counts k)
+  /// Sharp interfaces (CPU twin): each corner's region of the boundary field, and a bit per corner
+  /// set after an odd number of total internal reflections (a mirror reverses the orientation).
+  std::array<int, 4> region{};
+  unsigned mirrored = 0;
 };
 
 struct WavefrontStats {
@@ -123,18 +127,20 @@ struct WavefrontStats {
   size_t splits = 0;               ///< parents split into four
   size_t splits_refused = 0;       ///< splits not done because max_patches would be exceeded
   size_t kills_left = 0, kills_caustic = 0, kills_energy = 0, kills_opaque = 0;
-  size_t live_at_end = 0;    ///< patches still alive when max_steps ran out (0 if the loop ended)
-  double flux_emitted = 0;   ///< Σ seed flux (only seeds whose centre ray meets the volume)
-  double flux_left = 0;      ///< carried out of the volume
-  double flux_caustic = 0;   ///< carried by patches killed at an orientation flip
-  double flux_energy = 0;    ///< carried by patches killed below the energy threshold
-  double flux_absorbed = 0;  ///< removed by exp(−σΔs) along the way, plus opaque kills
+  size_t live_at_end = 0;     ///< patches still alive when max_steps ran out (0 if the loop ended)
+  double flux_emitted = 0;    ///< Σ seed flux (only seeds whose centre ray meets the volume)
+  double flux_left = 0;       ///< carried out of the volume
+  double flux_caustic = 0;    ///< carried by patches killed at an orientation flip
+  double flux_energy = 0;     ///< carried by patches killed below the energy threshold
+  double flux_absorbed = 0;   ///< removed by exp(−σΔs) along the way, plus opaque kills
+  double flux_reflected = 0;  ///< sharp interfaces: lost to Fresnel reflection (1 − T) at them
   double flux_live_at_end = 0;
   double flux_probe = 0;  ///< net flux crossing the probe plane in the +axis direction
   /// Flux of patches that ended (any reason, or still live at max_steps) on the upstream side of
   /// the probe plane. Without absorption, flux_probe + flux_ended_before_probe = flux_emitted.
   double flux_ended_before_probe = 0;
   size_t caustic_crossings = 0;  ///< orientation flips passed (pass_caustics; CPU reference only)
+  size_t interface_events = 0;   ///< sharp interfaces: corner refractions and reflections
   glm::dvec3 caustic_centroid{
       0.0};  ///< flux-weighted mean centre of the patches killed at caustics
   /// Probe plane: (net) flux-weighted mean of the points where patch centres cross it (mm; the

@@ -14,6 +14,8 @@
 
 #include "core/light/seeding.h"
 #include "core/reference/field.h"
+#include "optics/fresnel.h"
+#include "optics/interface.h"
 
 namespace eikon {
 namespace {
@@ -144,6 +146,10 @@ struct PatchStep {
   double sigma = 0.0;  ///< attenuation at the step's midpoint
   double E0 = 0.0;     ///< flux before the step
   double fluxMid = 0.0;  ///< flux at the step's middle
+  // Sharp interfaces: the factors of the corners' crossings over the step, each the product over
+  // the four corners of a fourth root (Fresnel transmission; attenuation exp(−σ·length)).
+  double fresnel = 1.0;
+  double attenuation = 1.0;
 };
 
 /// The per-patch physics of one WavefrontSimulator::run: the functions and stages of
@@ -151,7 +157,8 @@ struct PatchStep {
 /// chunks call it concurrently, each with its own Chunk.
 class PatchStepper {
  public:
-  PatchStepper(const Field& f, const Grid& grid, const WavefrontSettings& s, double il2, double il4)
+  PatchStepper(const Field& f, const Grid& grid, const WavefrontSettings& s, double il2, double il4,
+               const SharpInterfaces* sharp)
       : f_(f),
         grid_(grid),
         s_(s),
@@ -163,7 +170,13 @@ class PatchStepper {
         h3_(grid.h * grid.h * grid.h),
         dt_(s.dt),
         maxEdge_(s.split_span_voxels * grid.h),
-        eMode_(s.mode == 1) {}
+        eMode_(s.mode == 1),
+        sharp_(sharp && sharp->active() ? sharp : nullptr) {}
+
+  /// Sharp interfaces: the region a seed corner starts in and its wave vector along s on that
+  /// region's shell (the run's seeds are moved onto the media's shells with it).
+  int regionAt(const glm::dvec3& x) const { return boundaryRegion(*sharp_->boundary, x); }
+  glm::dvec3 mediumShell(int region, const glm::dvec3& s) const;
 
   /// One patch's step (propagate in wavefront.comp): advance, splat, count, end it or emit it
   /// (split against `budget`) into *ch.next. keep: also record it in ch.surv before emission.
@@ -194,6 +207,13 @@ class PatchStepper {
   void probeStep(Chunk& ch, const PatchStep& st, Patch& p) const;
   bool endOfStep(Chunk& ch, Patch& p, const PatchStep& st, const glm::dvec4& med) const;
   void ended(Chunk& ch, const Patch& p) const;
+  // Sharp interfaces.
+  const WavefrontMedium& mediumOf(int region) const { return sharp_->media[size_t(region)]; }
+  glm::dvec3 mediumVelocity(int region, const glm::dvec3& w) const;
+  double mediumSigma(int region, const glm::dvec3& w) const;
+  void sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& st) const;
+  bool crossInterface(const BoundaryCrossing& c, Patch& p, int k, double& transmission) const;
+  bool straddles(const Patch& p) const;
 
   const Field& f_;
   const Grid& grid_;
@@ -202,6 +222,7 @@ class PatchStepper {
   glm::dvec3 lo_, hi_;
   double h_, h3_, dt_, maxEdge_;
   bool eMode_;
+  const SharpInterfaces* sharp_;  ///< null: the smoothed path
 };
 
 // Wave vector along the unit direction s at x on the simulated mode's shell (wavefront.comp
@@ -247,6 +268,150 @@ void PatchStepper::rk4(glm::dvec3& x, glm::dvec3& w) const {
   deriv(x + dt * k3x, w + dt * k3w, k4x, k4w);
   x += dt / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
   w += dt / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+}
+
+// Sharp interfaces: the wave vector along the unit direction s on the shell of region r's medium
+// (|w| = n; the e-mode in a crystal: sᵀM_e s scaled to 1), and the constant-time velocity there
+// (w/n², or M_e w), as deriv() has them in a constant field.
+glm::dvec3 PatchStepper::mediumShell(int region, const glm::dvec3& s) const {
+  const WavefrontMedium& m = mediumOf(region);
+  if (eMode_ && m.n_e > 0.0) return s / std::sqrt(glm::dot(s, mediumVelocity(region, s)));
+  return m.n * s;
+}
+
+glm::dvec3 PatchStepper::mediumVelocity(int region, const glm::dvec3& w) const {
+  const WavefrontMedium& m = mediumOf(region);
+  if (eMode_ && m.n_e > 0.0) {
+    const double pa = glm::dot(w, m.axis);
+    return pa / (m.n * m.n) * m.axis + (w - pa * m.axis) / (m.n_e * m.n_e);
+  }
+  return w / (m.n * m.n);
+}
+
+// Attenuation per unit ray length in region r for wave vector w: σ_o, or in a crystal of the
+// e-mode the pleochroic σ(θ)·cos ρ of field::attenuationE (as sigmaE on the smoothed path).
+double PatchStepper::mediumSigma(int region, const glm::dvec3& w) const {
+  const WavefrontMedium& m = mediumOf(region);
+  if (!eMode_ || !(m.n_e > 0.0) || (m.sigma == 0.0 && m.sigma_e == 0.0)) return m.sigma;
+  return field::attenuationE(glm::dvec3(m.sigma), glm::dvec3(m.sigma_e), w, m.axis, m.n, m.n_e).x;
+}
+
+// Corner k at the crossing c (p.x[k] its point, p.w[k] the incident wave vector): the exact laws
+// of optics/ between the media of c.from and c.to (docs/light-simulator.md, "Sharp interfaces").
+// Isotropic ↔ isotropic: Snell and the unpolarised Fresnel T = 1 − R; into a crystal: the run's
+// mode (o by Snell with n_o, e by the closed form of the e-wave normal) with the exact Maxwell
+// share of the unpolarised power, doubled because a mode's run carries half the light; out of a
+// crystal: the exact exit transmission of the mode; crystal → crystal: the phase-matched wave of
+// the same mode, no loss. Where the outgoing wave does not exist, total internal reflection: the
+// mirror (same mode), no loss, the corner's mirror bit flips and it stays in its region. Equal
+// media, or an opaque one entered: only the region changes. Multiplies `transmission` by T; true if
+// the corner was turned.
+bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k,
+                                  double& transmission) const {
+  const WavefrontMedium &a = mediumOf(c.from), &b = mediumOf(c.to);
+  glm::dvec3 N = glm::length(c.normal) > 0 ? c.normal : c.field_normal;
+  const bool same = a.n == b.n && a.n_e == b.n_e && (a.n_e == 0.0 || a.axis == b.axis);
+  if (same || b.opaque || !(glm::length(N) > 0)) {
+    p.region[size_t(k)] = c.to;
+    return false;
+  }
+  glm::dvec3& w = p.w[size_t(k)];
+  const glm::dvec3 s = glm::normalize(w);
+  const Mode mode = eMode_ ? Mode::Extraordinary : Mode::Ordinary;
+  const bool inA = a.n_e > 0.0, inB = b.n_e > 0.0;
+  ModeWave out;
+  double T = 1.0;
+  bool mirror = false;
+  if (!inA && !inB) {
+    out = refractIsotropic(s, N, a.n, b.n);
+    if (out.exists) T = 1.0 - fresnelReflectance(std::abs(glm::dot(s, N)), a.n, b.n).R;
+  } else if (!inA) {
+    const Uniaxial X(b.n, b.n_e, b.axis);
+    const ModePair pair = refractIntoUniaxial(s, N, a.n, X);
+    out = eMode_ ? pair.e : pair.o;
+    if (out.exists) {
+      const ModeSplit sp = uniaxialEntryExact(s, N, a.n, X);
+      T = 2.0 * (eMode_ ? sp.e : sp.o);
+    }
+  } else if (!inB) {
+    const Uniaxial X(a.n, a.n_e, a.axis);
+    out = refractOutOfUniaxial(X, mode, s, N, b.n);
+    if (out.exists)
+      T = uniaxialExitExact(X, mode, s, N, b.n).transmitted;
+    else
+      out = reflectInsideUniaxial(X, mode, s, N), mirror = true;
+  } else {
+    const Uniaxial A(a.n, a.n_e, a.axis), B(b.n, b.n_e, b.axis);
+    const glm::dvec3 m = glm::dot(mediumVelocity(c.from, w), N) >= 0 ? N : -N;
+    const glm::dvec3 pt = w - glm::dot(w, m) * m;
+    out = solveInterfaceMode(pt, m, B.hamiltonianMatrix(mode), true);
+    if (!out.exists)
+      out = solveInterfaceMode(pt, m, A.hamiltonianMatrix(mode), false), mirror = true;
+  }
+  if (!out.exists && !mirror) {
+    // Total internal reflection into an isotropic medium, or a crystal mode that cannot enter.
+    out = inA ? reflectInsideUniaxial(Uniaxial(a.n, a.n_e, a.axis), mode, s, N)
+              : reflectIsotropic(s, N, a.n);
+    mirror = true;
+  }
+  if (!out.exists) {  // degenerate (grazing): go on unturned
+    p.region[size_t(k)] = c.to;
+    return false;
+  }
+  w = out.p();
+  if (mirror) {
+    p.mirrored ^= 1u << k;
+  } else {
+    p.region[size_t(k)] = c.to;
+    transmission *= T;
+  }
+  return true;
+}
+
+// Sharp interfaces: corner k moves for the time T through homogeneous media, straight in its
+// region's medium up to the first boundary (locateCrossing, refined on the exact shape), turned
+// there (crossInterface) and on for the rest of T. Its share of the patch's factors: (T_F)^¼ of
+// each transmission, exp(−σ·length/4) of the attenuation along its path.
+void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& st) const {
+  const BoundaryField& bf = *sharp_->boundary;
+  glm::dvec3& x = p.x[size_t(k)];
+  double absorb = 0.0, trans = 1.0;
+  for (int guard = 0; T > 0.0; ++guard) {
+    const int r = p.region[size_t(k)];
+    const glm::dvec3 d = T * mediumVelocity(r, p.w[size_t(k)]);
+    const double len = glm::length(d);
+    BoundaryCrossing c = guard < 16 ? locateCrossing(bf, x, x + d) : BoundaryCrossing{};
+    if (c.found && c.from != r && c.to == r) {
+      // The trilinear field's zero lies just past the exact surface where the corner was turned
+      // (curved faces: by up to 3h²/8r): not a new boundary, so go on past it.
+      const double t = std::min(1.0, c.t + 1e-6 * h_ / std::max(len, 1e-300));
+      absorb += mediumSigma(r, p.w[size_t(k)]) * t * len;
+      x += t * d;
+      T *= 1.0 - t;
+      continue;
+    }
+    if (!c.found) {
+      absorb += mediumSigma(r, p.w[size_t(k)]) * len;
+      x += d;
+      break;
+    }
+    absorb += mediumSigma(r, p.w[size_t(k)]) * c.t * len;
+    x = c.point;
+    T *= 1.0 - c.t;
+    c.from = r;  // the corner's own region, whatever the field says at its start
+    if (crossInterface(c, p, k, trans)) ++ch.st.interface_events;
+  }
+  st.fresnel *= std::pow(trans, 0.25);
+  st.attenuation *= std::exp(-0.25 * absorb);
+}
+
+// Sharp interfaces: the corners lie in different regions, or only some have been mirrored. Such a
+// patch is being torn by a boundary: it is not split (a new corner would mix the sides) and its
+// orientation is not tested for a caustic until all four are on one side.
+bool PatchStepper::straddles(const Patch& p) const {
+  const bool oneRegion =
+      p.region[1] == p.region[0] && p.region[2] == p.region[0] && p.region[3] == p.region[0];
+  return !oneRegion || (p.mirrored != 0u && p.mirrored != 15u);
 }
 
 void PatchStepper::splatAt(Chunk& ch, const glm::dvec3& m, double fluxDs, double irr,
@@ -330,7 +495,7 @@ void PatchStepper::splatSegment(Chunk& ch, const glm::dvec3& c0, const glm::dvec
 // steps would act: an edge longer than the split span (split), an orientation flip (caustic), the
 // centre leaving (after having been inside, or its ray missing the bounds).
 int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4]) const {
-  if (!s_.skip_empty) return 0;
+  if (!s_.skip_empty || sharp_) return 0;
   const glm::dvec3 c0 = centre(p);
   double Dmin = f_.skipDistance(c0);
   if (Dmin < 2.0) return 0;
@@ -402,7 +567,7 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
     double e = 0;
     for (int k = 0; k < 4; ++k)
       e = std::max(e, glm::length(p.x[size_t((k + 1) % 4)] - p.x[size_t(k)]));
-    if (e <= maxEdge_) {
+    if (e <= maxEdge_ || (sharp_ && straddles(p))) {
       ch.next->push_back(p);
       continue;
     }
@@ -423,7 +588,9 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
                   (1 - fa) * fb * p.x[3];
         glm::dvec3 w = (1 - fa) * (1 - fb) * p.w[0] + fa * (1 - fb) * p.w[1] + fa * fb * p.w[2] +
                        (1 - fa) * fb * p.w[3];
-        if (a == 1 || b == 1)
+        if ((a == 1 || b == 1) && sharp_)
+          w = mediumShell(p.region[0], glm::normalize(w));  // the region's medium's shell
+        else if (a == 1 || b == 1)
           w = onShell(X[b][a], glm::normalize(w));  // back onto the mode's shell
         W[b][a] = w;
       }
@@ -452,7 +619,10 @@ PatchStep PatchStepper::moveStep(Chunk& ch, Patch& p) const {
   st.wm0 = eMode_ ? meanW(p) : glm::dvec3(0.0);
   glm::dvec3 vel[4];
   st.kStraight = straightSteps(p, vel);
-  if (st.kStraight > 0) {
+  if (sharp_) {
+    for (int k = 0; k < 4; ++k) sharpCorner(ch, p, k, dt_, st);
+    ++p.steps;
+  } else if (st.kStraight > 0) {
     // diag: the diagonals at the start and their change per time step (the area along the path).
     st.diag[0] = p.x[2] - p.x[0], st.diag[1] = dt_ * (vel[2] - vel[0]);
     st.diag[2] = p.x[3] - p.x[1], st.diag[3] = dt_ * (vel[3] - vel[1]);
@@ -476,10 +646,17 @@ PatchStep PatchStepper::moveStep(Chunk& ch, Patch& p) const {
 glm::dvec4 PatchStepper::attenuateStep(Chunk& ch, Patch& p, PatchStep& st) const {
   const glm::dvec3 m = 0.5 * (st.c0 + st.c1);
   const glm::dvec4 med = f_.medium(m);
-  st.sigma = eMode_ ? sigmaE(m, 0.5 * (st.wm0 + meanW(p))) : bandAt(glm::dvec3(med));
+  if (sharp_) {
+    // The corners' Fresnel losses, then their attenuation; σ: the mean over the centre's path.
+    ch.st.flux_reflected += p.energy * (1.0 - st.fresnel);
+    p.energy *= st.fresnel;
+    st.sigma = st.ds > 0 ? -std::log(st.attenuation) / st.ds : 0.0;
+  } else {
+    st.sigma = eMode_ ? sigmaE(m, 0.5 * (st.wm0 + meanW(p))) : bandAt(glm::dvec3(med));
+  }
   st.E0 = p.energy;
-  const double att = std::exp(-st.sigma * st.ds);
-  st.fluxMid = p.energy * std::exp(-0.5 * st.sigma * st.ds);
+  const double att = sharp_ ? st.attenuation : std::exp(-st.sigma * st.ds);
+  st.fluxMid = p.energy * (sharp_ ? std::sqrt(att) : std::exp(-0.5 * st.sigma * st.ds));
   ch.st.flux_absorbed += p.energy * (1.0 - att);
   p.energy *= att;
   p.transmittance *= att;
@@ -552,10 +729,15 @@ bool PatchStepper::endOfStep(Chunk& ch, Patch& p, const PatchStep& st,
     return true;
   }
   const double o = glm::dot(vectorArea(p), wm);
-  if (s_.pass_caustics && ((o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0))) {
+  // Sharp interfaces: a mirror reverses the orientation; a patch torn by a boundary is not tested.
+  const int orient = sharp_ && p.mirrored != 0u ? -p.orientation : p.orientation;
+  const bool flip = (o > 0 && orient < 0) || (o < 0 && orient > 0);
+  if (sharp_ && straddles(p)) {
+    // no caustic test while the corners are on different sides
+  } else if (s_.pass_caustics && flip) {
     p.orientation = -p.orientation;  // through the focal line; the next flip is the next caustic
     ++ch.st.caustic_crossings;
-  } else if ((o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0)) {
+  } else if (flip) {
     ++ch.st.kills_caustic;
     ch.st.flux_caustic += p.energy;
     ch.st.caustic_centroid += p.energy * st.c1;
@@ -670,6 +852,8 @@ void reduceChunks(std::vector<Chunk>& chunks, WavefrontStats& st, std::vector<do
     st.flux_caustic += a.flux_caustic;
     st.flux_energy += a.flux_energy;
     st.flux_absorbed += a.flux_absorbed;
+    st.flux_reflected += a.flux_reflected;
+    st.interface_events += a.interface_events;
     st.flux_probe += a.flux_probe;
     st.flux_ended_before_probe += a.flux_ended_before_probe;
     st.caustic_crossings += a.caustic_crossings;
@@ -724,12 +908,45 @@ glm::dvec3 WavefrontSimulator::onShell(const glm::dvec3& x, const glm::dvec3& s)
   return onModeShell(field_, s_.mode, il2_, il4_, x, s);
 }
 
+bool SharpInterfaces::active() const {
+  if (!boundary || boundary->empty() || media.size() < boundary->shapes.size() + 1) return false;
+  return std::all_of(media.begin(), media.end(),
+                     [](const WavefrontMedium& m) { return m.homogeneous; });
+}
+
+SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm) {
+  SharpInterfaces si;
+  if (volume.boundary.empty() || volume.media.empty()) return si;
+  si.boundary = &volume.boundary;
+  for (const MediumRecord& r : volume.media.regions) {
+    WavefrontMedium m;
+    m.n = mediumIndex(r.n_o, wavelength_nm);
+    if (r.uniaxial && !r.radial_axis) {
+      m.n_e = mediumIndex(r.n_e, wavelength_nm);
+      m.axis = r.axis;
+    }
+    m.sigma = field::bandAt(r.sigma_o, wavelength_nm);
+    m.sigma_e = field::bandAt(r.sigma_e, wavelength_nm);
+    m.homogeneous = r.homogeneous;
+    m.opaque = r.opaque();
+    si.media.push_back(m);
+  }
+  return si;
+}
+
 WavefrontSimulator::WavefrontSimulator(const Field& field, const Grid& splat_grid,
                                        const WavefrontSettings& settings)
     : field_(field), grid_(splat_grid), s_(checkedWavefrontSettings(settings, splat_grid)) {
   const double l_um = s_.wavelength_nm * 1e-3;
   il2_ = 1.0 / (l_um * l_um);
   il4_ = il2_ * il2_;
+}
+
+WavefrontSimulator::WavefrontSimulator(const Field& field, const Grid& splat_grid,
+                                       const WavefrontSettings& settings,
+                                       const SharpInterfaces& sharp)
+    : WavefrontSimulator(field, splat_grid, settings) {
+  if (sharp.active()) sharp_ = &sharp;
 }
 
 std::vector<Patch> WavefrontSimulator::seed(const Light& light) const {
@@ -750,7 +967,13 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
 
   std::vector<Patch> cur = seed(light);
   st.seeded = cur.size();
+  const PatchStepper stepper(field_, grid_, s_, il2_, il4_, sharp_);
   for (Patch& p : cur) {
+    if (sharp_)  // each corner in its region, on that medium's shell along its launch direction
+      for (size_t k = 0; k < 4; ++k) {
+        p.region[k] = stepper.regionAt(p.x[k]);
+        p.w[k] = stepper.mediumShell(p.region[k], glm::normalize(p.w[k]));
+      }
     st.flux_emitted += p.energy;
     const glm::dvec3 c = centre(p);
     p.entered = inside(c, lo, hi);
@@ -758,7 +981,6 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
   }
   long long live = (long long)cur.size();  // patches alive (moving or at max_steps)
   st.max_live = cur.size();
-  const PatchStepper stepper(field_, grid_, s_, il2_, il4_);
 
   // Patches that have used up max_steps stay live (and counted in `live`) but move no further.
   // Each step cuts its list into T = nChunks contiguous chunks (Chunk). With one chunk the budget
