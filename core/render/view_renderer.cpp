@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/render/boundary_device.h"
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
@@ -40,6 +41,8 @@ void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scen
   if (scattering) images += 1;
   if (!scene.lights.empty()) images += 2;
   double bytes = double(grid.count()) * 16.0 * double(images);
+  // The sharp-boundary field: a 32-bit region id and a float distance per voxel.
+  if (scene.interfaces == Scene::Interfaces::Sharp) bytes += double(grid.count()) * 8.0;
   if (bytes > 0.9 * double(lim.heap_size))
     throw std::runtime_error(scene.file.string() + ": /volume/resolution: the volume needs " +
                              std::to_string(int64_t(bytes / (1 << 20))) + " MiB of device memory but the device heap has " +
@@ -56,6 +59,7 @@ struct ViewRenderer::Impl {
   std::vector<vk::Image3D> images;
   size_t scatterImage = 0, fluenceImage = 0, fluxImage = 0;  // 0: not present (index A bound instead)
   vk::Buffer params, env, tables;
+  BoundaryDevice boundary;  // the sharp-boundary field (placeholders when smoothed)
   vk::ComputePipeline view, tracer;
   int skip_cap = 32;
   double ambient = 1.0;
@@ -98,6 +102,7 @@ struct ViewRenderer::Impl {
       upload(v.light_flux, "light flux");
     }
 
+    boundary = BoundaryDevice(ctx, v.boundary, scene.file.string());
     params = vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
     const auto& e = scene.environment;
     if (e.type == Environment::Type::LatLong) {
@@ -124,6 +129,7 @@ struct ViewRenderer::Impl {
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE), uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
     view = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4), common, 0, "view");
     auto traceBindings = common;
     traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
@@ -150,6 +156,7 @@ struct ViewRenderer::Impl {
     p.bindBuffer(EIKON_B_PARAMS, params);
     p.bindBuffer(EIKON_B_ENV_IMAGE, env);
     p.bindBuffer(EIKON_B_TABLES, tables);
+    boundary.bind(p);
   }
 
   gpu::ViewParams baseParams(const MarchSettings& m, int flags_extra) const {
