@@ -552,6 +552,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
     cp.fields.clear();
     progress(0.99, "boundaries");
     vs.boundary = buildBoundaryField(scene, g, opt.threads);
+    vs.media = buildMediaTable(scene);
   }
   progress(1.0, "done");
   return vs;

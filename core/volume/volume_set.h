@@ -41,6 +41,7 @@
 #include "core/scene/scene.h"
 #include "core/volume/boundary.h"
 #include "core/volume/grid.h"
+#include "core/volume/media.h"
 
 namespace eikon {
 
@@ -66,6 +67,8 @@ struct VolumeSet {
   /// Where the media meet, to sub-voxel accuracy (core/volume/boundary.h); empty when the scene
   /// asks for "interfaces": "smoothed". On the device: core/render/boundary_device.h.
   BoundaryField boundary;
+  /// The medium of each boundary-field region (core/volume/media.h), with `boundary`.
+  MediaTable media;
 
   bool lit() const { return !light_fluence.empty(); }
 

@@ -1,0 +1,152 @@
+#include "core/volume/media.h"
+
+#include <cmath>
+
+#include "core/scene/scene.h"
+
+namespace eikon {
+namespace {
+
+MediumDispersion dispersionRecord(const Dispersion& d) {
+  MediumDispersion r;
+  r.kind = MediumDispersion::Kind(int(d.kind()));
+  const std::vector<double>& a = d.coefficients();
+  r.terms = int(std::min<size_t>(a.size(), 6));
+  r.coeff.fill(0.0);
+  for (size_t k = 0; k < size_t(r.terms); ++k) r.coeff[k] = a[k];
+  const std::vector<double>& c = d.sellmeierC();
+  for (size_t k = 0; k < std::min<size_t>(c.size(), 6); ++k) r.sellmeier_c[k] = c[k];
+  return r;
+}
+
+glm::dvec3 bands(const Attenuation& a) { return glm::dvec3(a.at(612.0), a.at(549.0), a.at(465.0)); }
+
+MediumRecord objectRecord(const SceneObject& obj, const Material& mat) {
+  MediumRecord m;
+  m.n_o = dispersionRecord(mat.n_o);
+  m.n_e = mat.uniaxial ? dispersionRecord(mat.n_e) : m.n_o;
+  m.uniaxial = mat.uniaxial;
+  m.radial_axis = mat.uniaxial && obj.radial_axis;
+  if (m.radial_axis)
+    m.axis_centre = obj.shape.center();
+  else if (mat.uniaxial)
+    m.axis = glm::normalize(obj.optic_axis ? *obj.optic_axis : *mat.optic_axis);
+  m.sigma_o = bands(mat.attenuation_o);
+  m.sigma_e = mat.uniaxial ? bands(mat.attenuation_e) : m.sigma_o;
+  m.opacity = mat.opacity;
+  m.emission = mat.emission;
+  m.albedo = mat.albedo;
+  m.phase_g = mat.phase_g;
+  m.grin_type = int(mat.grin.type);
+  m.grin_n0 = mat.grin.n0;
+  m.grin_radius = mat.grin.radius;
+  m.grin_gradient = mat.grin.gradient;
+  m.grin_origin = mat.grin.origin;
+  m.homogeneous = m.grin_type == 0 && !m.radial_axis;
+  return m;
+}
+
+GrinProfile grinOf(const MediumRecord& m) {
+  GrinProfile g;
+  g.type = GrinProfile::Type(m.grin_type);
+  g.n0 = m.grin_n0;
+  g.gradient = m.grin_gradient;
+  g.origin = m.grin_origin;
+  g.radius = m.grin_radius;
+  return g;
+}
+
+void packDispersion(const MediumDispersion& d, float* v) {
+  for (size_t k = 0; k < 6; ++k) {
+    v[k] = float(d.coeff[k]);
+    v[6 + k] = float(d.sellmeier_c[k]);
+  }
+}
+
+}  // namespace
+
+MediaTable buildMediaTable(const Scene& scene) {
+  MediaTable t;
+  MediumRecord ambient;
+  ambient.n_o.coeff[0] = scene.ambient_index;
+  ambient.n_e = ambient.n_o;
+  t.regions.push_back(ambient);
+  // Medium ids as the boundary field numbers them (1 + index in scene.materials' order).
+  for (const SceneObject& obj : scene.objects) {
+    const Material& mat = scene.materials.at(obj.material);
+    MediumRecord m = objectRecord(obj, mat);
+    m.medium = 1 + int(std::distance(scene.materials.begin(), scene.materials.find(obj.material)));
+    t.regions.push_back(m);
+  }
+  return t;
+}
+
+double mediumIndex(const MediumDispersion& d, double lambda_nm) {
+  const double l = lambda_nm * 1e-3, l2 = l * l;
+  switch (d.kind) {
+    case MediumDispersion::Kind::Constant:
+      return d.coeff[0];
+    case MediumDispersion::Kind::Cauchy: {
+      double n = 0.0, p = 1.0;
+      for (int k = 0; k < d.terms; ++k, p /= l2) n += d.coeff[size_t(k)] * p;
+      return n;
+    }
+    case MediumDispersion::Kind::Sellmeier: {
+      double n2 = 1.0;
+      for (int k = 0; k < d.terms; ++k)
+        n2 += d.coeff[size_t(k)] * l2 / (l2 - d.sellmeier_c[size_t(k)]);
+      return n2 > 0.0 ? std::sqrt(n2) : std::nan("");
+    }
+    case MediumDispersion::Kind::Conrady:
+      return d.coeff[0] + d.coeff[1] / l + d.coeff[2] / (l2 * l * std::sqrt(l));
+  }
+  return std::nan("");
+}
+
+double mediumIndexAt(const MediumRecord& m, int mode, double lambda_nm, const glm::dvec3& x,
+                     glm::dvec3* grad) {
+  if (grad) *grad = glm::dvec3(0.0);
+  if (m.grin_type != 0) {  // a GRIN profile replaces the (isotropic) index
+    const GrinProfile g = grinOf(m);
+    if (grad) *grad = g.indexGradient(x);
+    return g.index(x);
+  }
+  return mediumIndex(mode == 1 ? m.n_e : m.n_o, lambda_nm);
+}
+
+glm::dvec4 mediumAxisField(const MediumRecord& m, const glm::dvec3& x) {
+  if (!m.uniaxial) return glm::dvec4(0.0);
+  if (!m.radial_axis) return glm::dvec4(m.axis, 0.0);
+  const glm::dvec3 r = x - m.axis_centre;
+  const double len = glm::length(r);
+  if (!(len > 1e-12)) return glm::dvec4(0.0, 0.0, 1.0, 0.0);  // the centre: any axis
+  return glm::dvec4(r / len, 1.0 / len);
+}
+
+std::vector<float> packMediaTable(const MediaTable& table) {
+  std::vector<float> out(table.regions.size() * size_t(kMediumVec4s) * 4, 0.0f);
+  for (size_t r = 0; r < table.regions.size(); ++r) {
+    const MediumRecord& m = table.regions[r];
+    float* v = out.data() + r * size_t(kMediumVec4s) * 4;
+    v[0] = float(int(m.n_o.kind));
+    v[1] = float(m.n_o.terms);
+    v[2] = float(int(m.n_e.kind));
+    v[3] = float(m.n_e.terms);
+    packDispersion(m.n_o, v + 4);
+    packDispersion(m.n_e, v + 16);
+    const int flags = (m.homogeneous ? kMediumHomogeneous : 0) |
+                      (m.uniaxial ? kMediumUniaxial : 0) | (m.radial_axis ? kMediumRadialAxis : 0) |
+                      (m.grin_type != 0 ? kMediumGrin : 0) | (m.opaque() ? kMediumOpaque : 0);
+    const glm::dvec4 rows[] = {
+        {m.axis, double(flags)},         {m.sigma_o, m.opacity},
+        {m.sigma_e, m.phase_g},          {m.emission, double(m.medium)},
+        {m.albedo, double(m.grin_type)}, {m.grin_n0, m.grin_gradient},
+        {m.grin_origin, m.grin_radius},  {m.axis_centre, 0.0},
+    };
+    for (size_t i = 0; i < 8; ++i)
+      for (int c = 0; c < 4; ++c) v[(7 + i) * 4 + size_t(c)] = float(rows[i][c]);
+  }
+  return out;
+}
+
+}  // namespace eikon

@@ -1,0 +1,106 @@
+// The medium table of the sharp march (issue 13; docs/view-renderer.md "Sharp interfaces: the
+// march"): one record per region of the boundary field (core/volume/boundary.h; region 0 = the
+// ambient medium, region r = scene object r − 1), built once per scene, that both twins read.
+//
+// Why a table and not the index volumes: in a sharp march a ray knows which region it is in, so
+// the medium there is a constant (or an analytic function), not a trilinear sample of smoothed
+// fields. The record carries the material's OWN dispersion formula (Sellmeier, Cauchy, Conrady
+// or constant coefficients, evaluated at the ray's wavelength), not the Cauchy fit of the index
+// volumes, so an interface sees the exact n(λ) of both media. A region is `homogeneous` when
+// nothing in it varies in space (no GRIN profile, no radial optic-axis field): a march crosses
+// it in one straight segment.
+//
+// The GPU uploads packMediaTable's floats as a storage buffer of vec4s, kMediumVec4s per region,
+// region r at vec4 index r·kMediumVec4s (std430: a vec4 array has no padding). Layout of one
+// record (the names are shaders' accessor names; all lengths mm, σ per mm):
+//   v0          : (kind_o, terms_o, kind_e, terms_e)   kind: MediumDispersion::Kind as a float
+//   v1 .. v3    : n_o coefficients: coeff[0..5], sellmeier_c[0..5] (12 floats, unused = 0)
+//   v4 .. v6    : n_e coefficients, the same layout (a copy of n_o for isotropic media)
+//   v7          : (axis.xyz, flags)   flags: bit 0 homogeneous, 1 uniaxial, 2 radial axis,
+//                                     3 GRIN, 4 opaque (opacity ≥ 0.5)
+//   v8          : (σ_o at 612, 549, 465 nm, opacity)
+//   v9          : (σ_e at 612, 549, 465 nm, phase g)
+//   v10         : (emission rgb, medium id)      medium id: BoundaryField::medium[r]
+//   v11         : (albedo rgb, GRIN type)        GrinProfile::Type as a float (0 = none)
+//   v12         : (GRIN n0, GRIN gradient xyz)
+//   v13         : (GRIN origin / centre xyz, GRIN radius)
+//   v14         : (radial-axis centre xyz, 0)
+//   v15         : reserved (0)
+//
+//   eikon::MediaTable media = eikon::buildMediaTable(scene);
+//   double n = eikon::mediumIndex(media.regions[r].n_o, 587.5618);
+//   std::vector<float> gpu = eikon::packMediaTable(media);   // regions · kMediumVec4s · 4 floats
+#pragma once
+
+#include <array>
+#include <glm/glm.hpp>
+#include <vector>
+
+namespace eikon {
+
+struct Scene;
+
+/// A dispersion formula as coefficients (optics/dispersion.h's forms, λ in µm inside):
+///   Constant : n = coeff[0]
+///   Cauchy   : n = Σ_k coeff[k] / λ^{2k}                        (terms = number of coefficients)
+///   Sellmeier: n² = 1 + Σ_k coeff[k] λ² / (λ² − sellmeier_c[k])  (SCHOTT form)
+///   Conrady  : n = coeff[0] + coeff[1]/λ + coeff[2]/λ^3.5
+struct MediumDispersion {
+  enum class Kind { Constant = 0, Cauchy = 1, Sellmeier = 2, Conrady = 3 } kind = Kind::Constant;
+  int terms = 1;
+  std::array<double, 6> coeff{1.0, 0, 0, 0, 0, 0};
+  std::array<double, 6> sellmeier_c{};
+};
+
+/// The medium of one region.
+struct MediumRecord {
+  MediumDispersion n_o, n_e;  ///< n_e = n_o for isotropic media
+  bool homogeneous = true;    ///< nothing varies in space inside the region
+  bool uniaxial = false;
+  bool radial_axis = false;     ///< a(x) = (x − axis_centre)/|x − axis_centre|
+  glm::dvec3 axis{0.0};         ///< unit optic axis (uniaxial, not radial); zero otherwise
+  glm::dvec3 axis_centre{0.0};  ///< centre of a radial axis field
+  glm::dvec3 sigma_o{0.0}, sigma_e{0.0};  ///< attenuation per mm at the bands 612, 549, 465 nm
+  double opacity = 0.0;
+  glm::dvec3 emission{0.0};
+  glm::dvec3 albedo{0.0};
+  double phase_g = 0.0;
+  int medium = 0;  ///< BoundaryField::medium[r]: 0 = ambient, 1 + index in scene.materials' order
+  /// GRIN profile (core/scene/scene.h GrinProfile; type 0 = none): n0, gradient, origin, radius.
+  int grin_type = 0;
+  double grin_n0 = 1.0, grin_radius = 1.0;
+  glm::dvec3 grin_gradient{0.0}, grin_origin{0.0};
+
+  bool opaque() const { return opacity >= 0.5; }
+};
+
+struct MediaTable {
+  std::vector<MediumRecord> regions;  ///< regions[r], r = 0 the ambient medium
+  bool empty() const { return regions.empty(); }
+};
+
+/// vec4s per region in packMediaTable's layout.
+inline constexpr int kMediumVec4s = 16;
+/// Flag bits of v7.w.
+inline constexpr int kMediumHomogeneous = 1, kMediumUniaxial = 2, kMediumRadialAxis = 4,
+                     kMediumGrin = 8, kMediumOpaque = 16;
+
+/// One record per region of the scene's boundary field (region 0: the ambient index, clear).
+MediaTable buildMediaTable(const Scene& scene);
+
+/// n(λ) of a dispersion record at lambda_nm (NaN at a Sellmeier pole, as Dispersion::index).
+double mediumIndex(const MediumDispersion& d, double lambda_nm);
+
+/// n_o (mode 0) or n_e (mode 1) of a region's material at λ; for a GRIN region the index at x
+/// (and its gradient in *grad when given); elsewhere ∇n = 0.
+double mediumIndexAt(const MediumRecord& m, int mode, double lambda_nm, const glm::dvec3& x,
+                     glm::dvec3* grad = nullptr);
+
+/// The optic axis field of a region at x: (unit axis, 1/r of a radial field or 0); zero for
+/// isotropic media (core/reference/field.h axisField's convention).
+glm::dvec4 mediumAxisField(const MediumRecord& m, const glm::dvec3& x);
+
+/// The table as floats for the GPU (layout above), regions · kMediumVec4s · 4 of them.
+std::vector<float> packMediaTable(const MediaTable& table);
+
+}  // namespace eikon
