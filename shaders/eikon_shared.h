@@ -43,6 +43,15 @@ using uvec4 = glm::uvec4;
 #define EIKON_B_BOUNDARY_DIST 19
 #define EIKON_B_SHAPES 20
 #define EIKON_B_BOUNDARY_QUERIES 21  // boundary_probe.comp only (tests: GPU vs CPU twin)
+// The medium table of the sharp march (core/volume/media.h packMediaTable): EIKON_MEDIUM_VEC4S
+// vec4s per region; flag bits of row 7's w as kMedium* there.
+#define EIKON_B_MEDIA 22
+#define EIKON_MEDIUM_VEC4S 16
+#define EIKON_MEDIUM_HOMOGENEOUS 1
+#define EIKON_MEDIUM_UNIAXIAL 2
+#define EIKON_MEDIUM_RADIAL_AXIS 4
+#define EIKON_MEDIUM_GRIN 8
+#define EIKON_MEDIUM_OPAQUE 16
 
 // ViewParams.flags bits.
 #define EIKON_F_DISPERSIVE 1
@@ -55,6 +64,7 @@ using uvec4 = glm::uvec4;
 #define EIKON_F_OPACITY 128     // some opaque object
 #define EIKON_F_SCATTER 256     // some material has an albedo (in-scatter or a diffuse surface)
 #define EIKON_F_LIT 512         // light volumes from the light simulator are bound
+#define EIKON_F_SHARP 1024      // sharp interfaces: march region by region (shaders/sharp.glsl)
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0

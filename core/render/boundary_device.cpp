@@ -1,5 +1,6 @@
 #include "core/render/boundary_device.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <stdexcept>
 #include <type_traits>
@@ -52,7 +53,7 @@ std::vector<glm::vec4> packShapeTable(const BoundaryField& field) {
   return table;
 }
 
-void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field,
+void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field, const MediaTable& media,
                        const std::string& file) {
   const auto& lim = ctx.limits();
   const std::string where = (file.empty() ? std::string("scene") : file) + ": /objects: ";
@@ -74,17 +75,31 @@ void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field,
                              " bytes but the device's storage buffers hold at most " +
                              std::to_string(lim.max_storage_buffer_range) +
                              " (or set \"interfaces\": \"smoothed\")");
+  const double media_bytes =
+      16.0 * kMediumVec4s * std::max<double>(double(media.regions.size()), 1);
+  if (media_bytes > double(lim.max_storage_buffer_range))
+    throw std::runtime_error(
+        where + "the medium table needs " + std::to_string(int64_t(media_bytes)) +
+        " bytes but the device's storage buffers hold at most " +
+        std::to_string(lim.max_storage_buffer_range) + " (or set \"interfaces\": \"smoothed\")");
 }
 
 std::vector<vk::BindingSpec> boundaryBindings() {
   return {{EIKON_B_REGION, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE},
           {EIKON_B_BOUNDARY_DIST, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE},
-          {EIKON_B_SHAPES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}};
+          {EIKON_B_SHAPES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+          {EIKON_B_MEDIA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}};
 }
 
 BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& field,
-                               const std::string& file) {
-  checkBoundaryFits(ctx, field, file);
+                               const MediaTable& media, const std::string& file) {
+  static_assert(kMediumVec4s == EIKON_MEDIUM_VEC4S &&
+                    kMediumHomogeneous == EIKON_MEDIUM_HOMOGENEOUS &&
+                    kMediumUniaxial == EIKON_MEDIUM_UNIAXIAL &&
+                    kMediumRadialAxis == EIKON_MEDIUM_RADIAL_AXIS &&
+                    kMediumGrin == EIKON_MEDIUM_GRIN && kMediumOpaque == EIKON_MEDIUM_OPAQUE,
+                "the medium table's layout is declared twice (media.h, eikon_shared.h)");
+  checkBoundaryFits(ctx, field, media, file);
   present_ = !field.empty();
   std::array<uint32_t, 3> ext{1, 1, 1};
   if (present_)
@@ -105,12 +120,18 @@ BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& fiel
   shapes_ = vk::Buffer(ctx, table.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                        "shape table");
   shapes_.write(table.data(), table.size() * sizeof(glm::vec4));
+  std::vector<float> packed = packMediaTable(media);
+  if (packed.empty()) packed.assign(size_t(kMediumVec4s) * 4, 0.0f);
+  media_ = vk::Buffer(ctx, packed.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                      "medium table");
+  media_.write(packed.data(), packed.size() * sizeof(float));
 }
 
 void BoundaryDevice::bind(vk::ComputePipeline& p) const {
   p.bindImage(EIKON_B_REGION, region_);
   p.bindImage(EIKON_B_BOUNDARY_DIST, distance_);
   p.bindBuffer(EIKON_B_SHAPES, shapes_);
+  p.bindBuffer(EIKON_B_MEDIA, media_);
 }
 
 std::vector<gpu::BoundaryAnswer> probeBoundary(vk::Context& ctx, const BoundaryField& field,
@@ -118,7 +139,7 @@ std::vector<gpu::BoundaryAnswer> probeBoundary(vk::Context& ctx, const BoundaryF
                                                double tolerance_voxels) {
   if (queries.empty()) return {};
   if (field.empty()) throw std::invalid_argument("probeBoundary: the boundary field is empty");
-  BoundaryDevice dev(ctx, field);
+  BoundaryDevice dev(ctx, field, MediaTable{});
   auto bindings = boundaryBindings();
   for (uint32_t b :
        {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_BOUNDARY_QUERIES), uint32_t(EIKON_B_OUTPUT)})

@@ -216,7 +216,7 @@ TEST(BoundaryDevice, RefusesFieldLargerThanTheDeviceAllows) {
   bf.region = {0};
   bf.distance = {0.0f};
   try {
-    BoundaryDevice dev(test::context(), bf, "big.json");
+    BoundaryDevice dev(test::context(), bf, MediaTable{}, "big.json");
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
     const std::string msg = e.what();
