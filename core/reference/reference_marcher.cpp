@@ -15,7 +15,10 @@
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
 #include "core/spectrum/wavelength_sampling.h"
+#include "core/volume/boundary.h"
+#include "core/volume/media.h"
 #include "optics/fresnel.h"
+#include "optics/interface.h"
 
 namespace eikon {
 namespace {
@@ -60,6 +63,7 @@ struct MarchState {
   glm::dvec4 nn{0.0};         ///< (n_o, ∇n_o) at x
   glm::dvec3 T{1.0}, L{0.0};  ///< throughput, radiance gathered so far
   bool stopped = false;       ///< at an opaque surface
+  int region = 0;             ///< sharp march: the boundary-field region the ray is in
   /// The interface layer being crossed: where it opened, w before it, Σ∇n·ds over it, its peak.
   bool inLayer = false;
   double peak = 0.0;
@@ -76,6 +80,9 @@ struct StepEnd {
 };
 
 enum class Straight { None, Taken, Stop };
+/// How a stage of the sharp march ended: still inside its region, at a boundary crossing, or
+/// out of the volume.
+enum class SharpEvent { Go, Cross, Leave };
 
 /// One march of ReferenceMarcher: the ray's constants and the functions and stages of
 /// shaders/march.glsl under the same names, in double precision (docs/twins.md).
@@ -93,7 +100,9 @@ class RayMarch {
         h_(f.cellSize()),
         ds_(m.step_voxels * f.cellSize()),
         bmin_(f.boundsMin()),
-        bmax_(f.boundsMax()) {
+        bmax_(f.boundsMax()),
+        bf_(f.boundary()),
+        media_(f.media()) {
     const double l_um = lambda_nm * 1e-3;
     il2_ = 1.0 / (l_um * l_um);
     il4_ = il2_ * il2_;
@@ -125,6 +134,22 @@ class RayMarch {
   void fresnelAtLayer(MarchState& S, MarchResult& R, const glm::dvec3& N) const;
   void layerStep(MarchState& S, MarchResult& R, const StepEnd& E) const;
   bool clipToVolume(MarchState& S, MarchResult& R, const StepEnd& E) const;
+  // The stages of the sharp march (docs/view-renderer.md "Sharp interfaces: the march").
+  MarchResult marchSharp(const glm::dvec3& o, const glm::dvec3& d) const;
+  const MediumRecord& rec(int region) const { return media_->regions[size_t(region)]; }
+  double regionIndex(int region, int mode, const glm::dvec3& x, glm::dvec3* grad = nullptr) const {
+    return mediumIndexAt(rec(region), mode, lambda_nm_, x, grad);
+  }
+  void sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& d) const;
+  glm::dvec3 sharpDirection(const MarchState& S) const;
+  BoundaryCrossing nextCrossing(const glm::dvec3& a, const glm::dvec3& b, int region) const;
+  void absorbAlong(MarchState& S, const glm::dvec3& dir, double len) const;
+  SharpEvent sharpSegment(MarchState& S, MarchResult& R, BoundaryCrossing& c) const;
+  void sharpDeriv(int region, const glm::dvec3& x, const glm::dvec3& w, glm::dvec3& dx,
+                  glm::dvec3& dw) const;
+  void sharpRk4(int region, double ds, glm::dvec3& x, glm::dvec3& w) const;
+  SharpEvent sharpStep(MarchState& S, MarchResult& R, BoundaryCrossing& c) const;
+  void crossInterface(MarchState& S, MarchResult& R, const BoundaryCrossing& c) const;
 
   const Field& f_;
   const Environment& env_;
@@ -135,6 +160,8 @@ class RayMarch {
   bool lit_;
   double h_, ds_;
   glm::dvec3 bmin_, bmax_;
+  const BoundaryField* bf_;  ///< non-null: the sharp march (with media_)
+  const MediaTable* media_;
 };
 
 // Derivatives with respect to ray arc length; see shaders/march.glsl deriv().
@@ -401,6 +428,7 @@ bool RayMarch::clipToVolume(MarchState& S, MarchResult& R, const StepEnd& E) con
 }
 
 MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
+  if (bf_ && media_) return marchSharp(o, d);
   MarchResult R;
   double t0, t1;
   if (!boxHit(o, d, bmin_, bmax_, t0, t1)) {
@@ -431,6 +459,254 @@ MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
   R.steps = steps;
   R.exit_point = S.x;
   R.exit_dir = rayDirection(S.x, S.w);
+  R.wave_normal = glm::normalize(S.w);
+  R.left = !S.stopped && steps < m_.max_steps;
+  if (R.left) S.L += S.T * environment(R.exit_dir);
+  R.radiance = S.L;
+  R.throughput = S.T;
+  return R;
+}
+
+// ------------------------------------------------------------------ the sharp march
+// Stages of the same names in shaders/march.glsl (docs/twins.md). The ray carries its region;
+// homogeneous regions are crossed in one straight segment, varying ones (GRIN, radial axis) are
+// integrated with RK4 on the region's own analytic medium; every segment or step chord is tested
+// with locateCrossing, and at a crossing the exact interface laws of optics/ are applied.
+
+/// How far past a crossing (voxels) a search may skip a sliver where the trilinear region field
+/// and the exact surface disagree (≤ 3h²/(8r) for a sphere of radius r voxels; 0 on planes).
+constexpr double kSliverVoxels = 0.25;
+/// The step past a sliver's end at which the search restarts (voxels).
+constexpr double kNudgeVoxels = 1e-4;
+
+// Box entry: the region there, and the wave vector of the mode in its medium along d.
+void RayMarch::sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& d) const {
+  S.x = x;
+  S.region = boundaryRegion(*bf_, x);
+  const MediumRecord& m = rec(S.region);
+  double n = regionIndex(S.region, 0, x);
+  const glm::dvec4 af = mediumAxisField(m, x);
+  if (mode_ == 1 && field::hasAxis(glm::dvec3(af)))
+    n = Uniaxial(n, regionIndex(S.region, 1, x), glm::dvec3(af)).extraordinaryIndex(d);
+  S.w = n * d;
+}
+
+// The ray (energy) direction in the ray's region: w/|w|, or M_e w for the e-mode in a crystal.
+glm::dvec3 RayMarch::sharpDirection(const MarchState& S) const {
+  const glm::dvec4 af = mediumAxisField(rec(S.region), S.x);
+  if (mode_ == 0 || !field::hasAxis(glm::dvec3(af))) return glm::normalize(S.w);
+  return glm::normalize(field::applyM(S.w, glm::dvec3(af), regionIndex(S.region, 0, S.x),
+                                      regionIndex(S.region, 1, S.x)));
+}
+
+// The first crossing on [a, b] out of the ray's region. Just past a crossing of a curved surface
+// the trilinear field may still place the ray on the side it came from; such a sliver (a crossing
+// into the ray's own region within kSliverVoxels) is skipped, not crossed twice.
+BoundaryCrossing RayMarch::nextCrossing(const glm::dvec3& a, const glm::dvec3& b,
+                                        int region) const {
+  const double total = glm::length(b - a);
+  if (!(total > 0.0)) return BoundaryCrossing{};
+  const glm::dvec3 dir = (b - a) / total;
+  glm::dvec3 start = a;
+  for (int k = 0; k < 4; ++k) {
+    BoundaryCrossing c = locateCrossing(*bf_, start, b);
+    if (!c.found) return c;
+    const double along = glm::dot(c.point - a, dir);
+    const bool sliver = c.from != region && c.to == region && along <= kSliverVoxels * h_;
+    if (!sliver) {
+      c.t = std::clamp(along / total, 0.0, 1.0);
+      c.from = region;
+      return c;
+    }
+    start = a + (along + kNudgeVoxels * h_) * dir;
+    if (along + kNudgeVoxels * h_ >= total) return BoundaryCrossing{};
+  }
+  return BoundaryCrossing{};
+}
+
+// Emission, attenuation (exact: e^{−σ len}) and in-scatter along a straight piece in the ray's
+// region (march.glsl absorbAlong).
+void RayMarch::absorbAlong(MarchState& S, const glm::dvec3& dir, double len) const {
+  const MediumRecord& m = rec(S.region);
+  glm::dvec3 sig = sigmaOf(m.sigma_o);
+  const glm::dvec4 af = mediumAxisField(m, S.x);
+  if (mode_ == 1 && field::hasAxis(glm::dvec3(af)))
+    sig = field::attenuationE(sig, sigmaOf(m.sigma_e), S.w, glm::dvec3(af),
+                              regionIndex(S.region, 0, S.x), regionIndex(S.region, 1, S.x));
+  glm::dvec3 e = colourOf(m.emission);
+  if (lit_ && m.albedo.x + m.albedo.y + m.albedo.z > 0.0)
+    e += inScatter(S.x + 0.5 * len * dir, dir, sig);
+  for (int c = 0; c < 3; ++c) {
+    const double a = std::exp(-sig[c] * len);
+    S.L[c] += S.T[c] * (sig[c] > 1e-6 ? e[c] * (1.0 - a) / sig[c] : e[c] * len);
+    S.T[c] *= a;
+  }
+}
+
+// Homogeneous region: one straight segment to the volume's exit (a voxel at a time in a lit
+// scattering medium, so that in-scatter is sampled) or to the first crossing on it.
+SharpEvent RayMarch::sharpSegment(MarchState& S, MarchResult& R, BoundaryCrossing& c) const {
+  const MediumRecord& m = rec(S.region);
+  const glm::dvec3 dir = sharpDirection(S);
+  double tb0, tb1;
+  boxHit(S.x, dir, bmin_, bmax_, tb0, tb1);
+  double len = std::max(tb1, 0.0);
+  bool leaving = true;
+  if (lit_ && m.albedo.x + m.albedo.y + m.albedo.z > 0.0 && len > h_) {
+    len = h_;
+    leaving = false;
+  }
+  c = nextCrossing(S.x, S.x + dir * len, S.region);
+  if (c.found) len *= c.t;
+  absorbAlong(S, dir, len);
+  R.opl += glm::dot(S.w, dir) * len;
+  S.x = c.found ? c.point : S.x + dir * len;
+  return c.found ? SharpEvent::Cross : leaving ? SharpEvent::Leave : SharpEvent::Go;
+}
+
+// The ray equation in a varying region from its own analytic medium (deriv's twin).
+void RayMarch::sharpDeriv(int region, const glm::dvec3& x, const glm::dvec3& w, glm::dvec3& dx,
+                          glm::dvec3& dw) const {
+  glm::dvec3 g;
+  const double n = regionIndex(region, 0, x, &g);
+  const glm::dvec4 af = mode_ == 1 ? mediumAxisField(rec(region), x) : glm::dvec4(0.0);
+  if (!field::hasAxis(glm::dvec3(af))) {
+    const double lw = glm::length(w);
+    dx = w / lw;
+    dw = g * (lw / n);
+    return;
+  }
+  glm::dvec3 ge;
+  const double ne = regionIndex(region, 1, x, &ge);
+  glm::dvec3 Mp, dp;
+  field::eModeRates(w, af, glm::dvec4(n, g), glm::dvec4(ne, ge), Mp, dp);
+  const double L = glm::length(Mp);
+  dx = Mp / L;
+  dw = dp / L;
+}
+
+void RayMarch::sharpRk4(int region, double ds, glm::dvec3& x, glm::dvec3& w) const {
+  glm::dvec3 k1x, k1w, k2x, k2w, k3x, k3w, k4x, k4w;
+  sharpDeriv(region, x, w, k1x, k1w);
+  sharpDeriv(region, x + 0.5 * ds * k1x, w + 0.5 * ds * k1w, k2x, k2w);
+  sharpDeriv(region, x + 0.5 * ds * k2x, w + 0.5 * ds * k2w, k3x, k3w);
+  sharpDeriv(region, x + ds * k3x, w + ds * k3w, k4x, k4w);
+  x += ds / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+  w += ds / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+}
+
+// Varying region: one RK4 step, cut at the volume's exit or at the first crossing of its chord.
+SharpEvent RayMarch::sharpStep(MarchState& S, MarchResult& R, BoundaryCrossing& c) const {
+  const glm::dvec3 x0 = S.x, w0 = S.w;
+  glm::dvec3 x1 = x0, w1 = w0;
+  double ds = ds_;
+  sharpRk4(S.region, ds, x1, w1);
+  double a0, a1;
+  const glm::dvec3 chord = x1 - x0;
+  const bool out =
+      !boxHit(x0, glm::normalize(chord), bmin_, bmax_, a0, a1) || a1 < glm::length(chord);
+  double keep = out ? std::clamp(std::max(a1, 0.0) / glm::length(chord), 0.0, 1.0) : 1.0;
+  c = nextCrossing(x0, x0 + keep * chord, S.region);
+  if (c.found) keep *= c.t;
+  if (keep < 1.0) {  // redo the shorter step so that w belongs to where it ends
+    x1 = x0, w1 = w0, ds *= keep;
+    sharpRk4(S.region, ds, x1, w1);
+    if (c.found) x1 = c.point;
+  }
+  const double n0 = regionIndex(S.region, 0, x0), n1 = regionIndex(S.region, 0, x1);
+  R.opl += mode_ == 0 ? 0.5 * (n0 + n1) * ds : 0.5 * glm::dot(w0 + w1, x1 - x0);
+  if (mode_ == 0) R.drift = std::max(R.drift, std::abs(glm::length(w1) - n1));
+  S.x = 0.5 * (x0 + x1);
+  S.w = 0.5 * (w0 + w1);
+  absorbAlong(S, glm::normalize(x1 - x0 + 1e-300), glm::length(x1 - x0));
+  S.x = x1;
+  S.w = w1;
+  return c.found ? SharpEvent::Cross : out ? SharpEvent::Leave : SharpEvent::Go;
+}
+
+// The exact laws at a crossing (optics/interface.h, optics/fresnel.h): Snell, or the o/e waves
+// into / out of a crystal; TIR is a lossless mirror; otherwise the ray carries (1 − R) on and an
+// external reflection adds R × environment(mirror direction), as the smoothed path does.
+void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCrossing& c) const {
+  const MediumRecord &A = rec(S.region), &B = rec(c.to);
+  const glm::dvec3 x = S.x, N = c.normal, s = glm::normalize(S.w);
+  const glm::dvec4 afA = mediumAxisField(A, x), afB = mediumAxisField(B, x);
+  if (B.opaque() ||
+      (A.medium == B.medium && A.grin_type == 0 && glm::dvec3(afA) == glm::dvec3(afB))) {
+    S.region = c.to;  // equal media: nothing changes (an opaque one stops the ray next)
+    return;
+  }
+  const Mode mode = mode_ == 1 ? Mode::Extraordinary : Mode::Ordinary;
+  const double n1 = glm::length(S.w);
+  ModeWave out;
+  if (!A.uniaxial && !B.uniaxial) {
+    out = refractIsotropic(s, N, n1, regionIndex(c.to, 0, x));
+  } else if (!A.uniaxial || B.uniaxial) {  // crystal → crystal: as if from an isotropic n1
+    const Uniaxial cr(regionIndex(c.to, 0, x), regionIndex(c.to, 1, x), glm::dvec3(afB));
+    const ModePair mp = refractIntoUniaxial(s, N, n1, cr);
+    out = mode_ == 1 ? mp.e : mp.o;
+  } else {
+    const Uniaxial cr(regionIndex(S.region, 0, x), regionIndex(S.region, 1, x), glm::dvec3(afA));
+    out = refractOutOfUniaxial(cr, mode, s, N, regionIndex(c.to, 0, x));
+  }
+  if (!out.exists) {  // total internal reflection: a mirror, no loss; the ray stays in A
+    if (A.uniaxial) {
+      const Uniaxial cr(regionIndex(S.region, 0, x), regionIndex(S.region, 1, x), glm::dvec3(afA));
+      const ModeWave r = reflectInsideUniaxial(cr, mode, s, N);
+      S.w = r.exists ? r.p() : glm::reflect(S.w, N);
+    } else {
+      S.w = glm::reflect(S.w, N);
+    }
+    R.tir++;
+    return;
+  }
+  if (m_.fresnel) {
+    const FresnelReflectance rsp = fresnelReflectance(std::abs(glm::dot(s, N)), n1, out.n);
+    double Rf = 0.5 * (rsp.Rs + rsp.Rp);
+    if (A.uniaxial || B.uniaxial) {
+      const bool intoCrystal = B.uniaxial;
+      const double wsw =
+          sWeight(intoCrystal ? out.s : s, glm::dvec3(intoCrystal ? afB : afA), N, s, mode_);
+      Rf = wsw * rsp.Rs + (1.0 - wsw) * rsp.Rp;
+    }
+    if (out.n > n1) S.L += S.T * Rf * environment(glm::reflect(s, N));
+    S.T *= 1.0 - Rf;
+  }
+  R.interfaces++;
+  S.w = out.p();
+  S.region = c.to;
+}
+
+MarchResult RayMarch::marchSharp(const glm::dvec3& o, const glm::dvec3& d) const {
+  MarchResult R;
+  double t0, t1;
+  if (!boxHit(o, d, bmin_, bmax_, t0, t1)) {
+    R.radiance = environment(d);
+    R.exit_point = o;
+    R.exit_dir = d;
+    R.wave_normal = d;
+    return R;
+  }
+  t0 = std::max(t0, 0.0);
+  MarchState S;
+  sharpEnter(S, o + d * t0, d);
+  R.opl = f_.ambientIndex() * t0;
+  int steps = 0;
+  for (; steps < m_.max_steps; ++steps) {
+    const MediumRecord& m = rec(S.region);
+    if (m.opaque()) {  // surface emission over the coverage, as the smoothed path
+      S.L += S.T * (colourOf(m.emission) / m.opacity + diffuseSurface(S.x));
+      S.stopped = true;
+      break;
+    }
+    BoundaryCrossing c;
+    const SharpEvent ev = m.homogeneous ? sharpSegment(S, R, c) : sharpStep(S, R, c);
+    if (ev == SharpEvent::Leave) break;
+    if (ev == SharpEvent::Cross) crossInterface(S, R, c);
+  }
+  R.steps = steps;
+  R.exit_point = S.x;
+  R.exit_dir = sharpDirection(S);
   R.wave_normal = glm::normalize(S.w);
   R.left = !S.stopped && steps < m_.max_steps;
   if (R.left) S.L += S.T * environment(R.exit_dir);

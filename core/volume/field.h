@@ -54,6 +54,11 @@ class Field {
   virtual glm::dvec3 lightFlux(const glm::dvec3&) const { return glm::dvec3(0.0); }
   /// True once light volumes are present (in-scatter and diffuse surfaces are then lit).
   virtual bool lit() const { return false; }
+  /// The sharp boundaries and their media (core/volume/boundary.h, media.h), or null where the
+  /// medium has none (an analytic field, a scene with "interfaces": "smoothed"): marchers then
+  /// integrate through the smoothed layers.
+  virtual const BoundaryField* boundary() const { return nullptr; }
+  virtual const MediaTable* media() const { return nullptr; }
 };
 
 /// Trilinear sampling of a VolumeSet (same stencil and clamping as the shader).
@@ -78,6 +83,10 @@ class VolumeField : public Field {
   glm::dvec4 lightFluence(const glm::dvec3& x) const override;
   glm::dvec3 lightFlux(const glm::dvec3& x) const override;
   bool lit() const override { return v_.lit(); }
+  const BoundaryField* boundary() const override {
+    return v_.boundary.empty() || v_.media.empty() ? nullptr : &v_.boundary;
+  }
+  const MediaTable* media() const override { return boundary() ? &v_.media : nullptr; }
 
  private:
   glm::dvec4 trilinear(const std::vector<glm::vec4>& f, const glm::dvec3& x) const;

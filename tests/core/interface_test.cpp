@@ -15,7 +15,9 @@ namespace eikon::test {
 namespace {
 
 // A glass slab n = 1.5 between z = −3 and z = 3 (a plate), volume 20 mm, 100 voxels (h = 0.2 mm).
+// The smoothed march: the expected offset below is the quadrature of the smoothed profile.
 const char* kPlate = R"({
+  "interfaces": "smoothed",
   "camera": {"position": [0, 0, -60], "look_at": [0, 0, 0], "width": 32, "height": 24},
   "environment": {"type": "constant", "radiance": 1},
   "volume": {"bounds_min": [-10, -10, -10], "bounds_max": [10, 10, 10], "resolution": 100, "smoothing_voxels": 0.75},

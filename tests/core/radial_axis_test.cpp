@@ -12,7 +12,9 @@
 namespace eikon::test {
 namespace {
 
+// The smoothed march on both twins (the sharp CPU march: sharp_interfaces_test.cpp).
 const char* kSpherulite = R"({
+  "interfaces": "smoothed",
   "camera": {"width": 8, "height": 8},
   "environment": {"type": "constant", "radiance": 1},
   "volume": {"bounds_min": [-7, -7, -7], "bounds_max": [7, 7, 7], "resolution": 112},

@@ -144,6 +144,7 @@ TEST(Spectral, FlatSpectrumMeanConvergesUnbiased) {
 
 // The prism of prism_test.cpp: apex up (+y), extruded along z, side 10 mm, centroid at the origin.
 const char* kPrism = R"({
+  "interfaces": "smoothed",
   "camera": {"width": 8, "height": 8},
   "environment": {"type": "constant", "radiance": 1},
   "volume": {"bounds_min": [-8, -8, -8], "bounds_max": [8, 8, 8], "resolution": 128},
@@ -211,7 +212,8 @@ TEST(Spectral, GpuMatchesCpuInSpectralMode) {
   // on both twins, so the images agree up to float32 marching (edge pixels may differ where a ray
   // grazes a checker edge; compare the mean and the 95th percentile of |ΔRGB|).
   const char* json = R"({
-    "camera": {"position": [30, 0, -45], "look_at": [0, 0, 0], "fov_deg": 20, "width": 24, "height": 18},
+    "interfaces": "smoothed",
+  "camera": {"position": [30, 0, -45], "look_at": [0, 0, 0], "fov_deg": 20, "width": 24, "height": 18},
     "environment": {"type": "checker", "squares": 24},
     "volume": {"bounds_min": [-6, -6, -6], "bounds_max": [6, 6, 6], "resolution": 48},
     "objects": [{"shape": "prism", "apex_deg": 60, "side": 8, "height": 8, "rotation_deg": [90, 0, 0], "material": "N-BK7"}]

@@ -12,6 +12,7 @@ namespace eikon::test {
 namespace {
 
 const char* kSphere = R"({
+  "interfaces": "smoothed",
   "camera": {"position": [0, 0, -60], "look_at": [0, 0, 0], "fov_deg": 30, "width": 64, "height": 48},
   "environment": {"type": "checker", "squares": 16, "color_a": [0.9, 0.9, 0.85], "color_b": [0.1, 0.12, 0.2]},
   "volume": {"bounds_min": [-12, -12, -12], "bounds_max": [12, 12, 12], "resolution": 96, "smoothing_voxels": 0.75},

@@ -93,13 +93,16 @@ glm::dvec2 eLateral(const Profile& c, glm::dvec3 axis, double no, double ne, glm
 double deg(double rad) { return rad / kDeg; }
 
 // --------------------------------------------------------------------------- scenes
+// Every scene here is marched through the smoothed layers ("interfaces": "smoothed"): the
+// expectations are the layers' quadratures, and the GPU twin is compared with the CPU twin on the
+// same path. The sharp march is tested in tests/core/reference/sharp_interfaces_test.cpp.
 
 // A calcite plate (library Sellmeier → Cauchy) between z = −5 and z = 5, infinite in x and y.
 // 140 voxels over 14 mm along z: h = 0.1 mm, σ = 0.75 voxel = 0.075 mm (layers ±0.225 mm).
 std::string plateScene(const std::string& material, const std::string& axis,
                        double thickness = 10.0, const std::string& materials = "") {
   return R"({
-  "camera": {"width": 8, "height": 8},
+  "interfaces": "smoothed", "camera": {"width": 8, "height": 8},
   "environment": {"type": "constant", "radiance": 1},
   "volume": {"bounds_min": [-4, -2, -7], "bounds_max": [4, 2, 7], "resolution": 140, "smoothing_voxels": 0.75},
   )" + (materials.empty() ? std::string() : "\"materials\": {" + materials + "},") +
@@ -114,7 +117,7 @@ std::string plateScene(const std::string& material, const std::string& axis,
 // reports its ray direction and wave normal there. h = 0.1 mm, σ = 0.075 mm.
 std::string halfSpaceScene(const std::string& material, const std::string& axis) {
   return R"({
-  "camera": {"width": 8, "height": 8},
+  "interfaces": "smoothed", "camera": {"width": 8, "height": 8},
   "environment": {"type": "constant", "radiance": 1},
   "volume": {"bounds_min": [-4, -4, -3], "bounds_max": [4, 4, 5], "resolution": 80, "smoothing_voxels": 0.75},
   "objects": [{"shape": "box", "center": [0, 0, 15], "size": [60, 60, 30], "material": ")" +
@@ -394,14 +397,14 @@ TEST(UniaxialMarch, EqualIndicesMatchIsotropicRenderer) {
   // docs/birefringence.md).
   const std::string vol =
       R"("volume": {"bounds_min": [-7, -7, -7], "bounds_max": [7, 7, 7], "resolution": 70, "smoothing_voxels": 0.75},
-  "camera": {"width": 8, "height": 8}, "environment": {"type": "constant", "radiance": 1},)";
+  "interfaces": "smoothed", "camera": {"width": 8, "height": 8}, "environment": {"type": "constant", "radiance": 1},)";
   MarchSettings ms;
   ms.fresnel = false;
   {
     Twins cr(plateScene("x", "[0.3, 0.8, 0.52]", 6.0,
                         R"("x": {"n_o": 1.6, "n_e": 1.6, "optic_axis": [0, 0, 1]})"));
     Twins iso(
-        R"({"camera": {"width": 8, "height": 8}, "environment": {"type": "constant", "radiance": 1},
+        R"({"interfaces": "smoothed", "camera": {"width": 8, "height": 8}, "environment": {"type": "constant", "radiance": 1},
       "volume": {"bounds_min": [-4, -2, -7], "bounds_max": [4, 2, 7], "resolution": 140, "smoothing_voxels": 0.75},
       "materials": {"x": {"n": 1.6}}, "objects": [{"shape": "box", "center": [0, 0, 0], "size": [60, 60, 6], "material": "x"}]})");
     for (double a : {0.0, 20.0, 40.0}) {
@@ -477,11 +480,11 @@ TEST(UniaxialMarch, EqualIndicesMatchIsotropicRenderer) {
   std::printf("  GPU worst %.2e mm\n", worstG);
   // Fresnel, one interface (the ray ends inside a half space): ½(T_o + T_e) = isotropic T.
   Twins crH(R"({"volume": {"bounds_min": [-4, -4, -3], "bounds_max": [4, 4, 5], "resolution": 80},
-    "camera": {"width": 8, "height": 8}, "environment": {"type": "constant", "radiance": 1},
+    "interfaces": "smoothed", "camera": {"width": 8, "height": 8}, "environment": {"type": "constant", "radiance": 1},
     "materials": {"x": {"n_o": 1.6, "n_e": 1.6, "optic_axis": [0.3, 0.8, 0.52]}},
     "objects": [{"shape": "box", "center": [0, 0, 15], "size": [60, 60, 30], "material": "x"}]})");
   Twins isoH(R"({"volume": {"bounds_min": [-4, -4, -3], "bounds_max": [4, 4, 5], "resolution": 80},
-    "camera": {"width": 8, "height": 8}, "environment": {"type": "constant", "radiance": 1},
+    "interfaces": "smoothed", "camera": {"width": 8, "height": 8}, "environment": {"type": "constant", "radiance": 1},
     "materials": {"x": {"n": 1.6}},
     "objects": [{"shape": "box", "center": [0, 0, 15], "size": [60, 60, 30], "material": "x"}]})");
   MarchSettings mf;
@@ -572,7 +575,7 @@ TEST(UniaxialMarch, GpuAgreesWithReferenceThroughCalciteSphere) {
   // Same budget as twins_test.cpp (float32 vs double over ~200 steps; grazing and multiply
   // reflected rays amplify round-off): 97% of the rays agree to 1e-3 mm and 1e-4, per mode.
   Twins t(R"({"volume": {"bounds_min": [-7, -7, -7], "bounds_max": [7, 7, 7], "resolution": 70},
-    "camera": {"width": 8, "height": 8}, "environment": {"type": "constant", "radiance": 1},
+    "interfaces": "smoothed", "camera": {"width": 8, "height": 8}, "environment": {"type": "constant", "radiance": 1},
     "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 5.5, "material": "calcite", "optic_axis": [0.2, 0.9, 0.4]}]})");
   std::mt19937 rng(99);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
