@@ -371,6 +371,12 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   }
   t0 = max(t0, 0.0);
   MarchState S;
+  S.nn = vec4(0.0);  // unused by the sharp march, but defined
+  S.inLayer = false;
+  S.peak = 0.0;
+  S.wBefore = vec3(0.0);
+  S.gAcc = vec3(0.0);
+  S.xOpen = vec3(0.0);
   S.T = vec3(1.0);
   S.L = vec3(0.0);
   S.stopped = false;
