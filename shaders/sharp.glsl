@@ -62,12 +62,19 @@ float regionIndex(int r, int mode, vec3 x, out vec3 grad) {
     grad = g.yzw;
     return g.x + dot(g.yzw, d);
   }
-  if (grin == 2) {  // Luneburg
-    if (2.0 - r2 > 1.0) grad = -d / (R2 * sqrt(2.0 - r2));
-    return sqrt(max(2.0 - r2, 1.0));
+  // Luneburg and fisheye: the profile's own formula continued smoothly past the surface inside
+  // the region (RK4's stages may sample just outside; mediumIndexAt), not clamped at n = 1.
+  if (grin == 2 && r2 < 1.9) {
+    float n = sqrt(2.0 - r2);
+    grad = -d / (R2 * n);
+    return n;
   }
-  if (g.x / (1.0 + r2) > 1.0) grad = -2.0 * g.x * d / (R2 * (1.0 + r2) * (1.0 + r2));
-  return max(g.x / (1.0 + r2), 1.0);  // Maxwell fisheye
+  if (grin == 3) {
+    grad = -2.0 * g.x * d / (R2 * (1.0 + r2) * (1.0 + r2));
+    return g.x / (1.0 + r2);
+  }
+  if (2.0 - r2 > 1.0) grad = -d / (R2 * sqrt(2.0 - r2));  // Luneburg beyond r² = 1.9R²
+  return sqrt(max(2.0 - r2, 1.0));
 }
 
 float regionIndex(int r, int mode, vec3 x) {

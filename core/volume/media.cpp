@@ -108,6 +108,20 @@ double mediumIndexAt(const MediumRecord& m, int mode, double lambda_nm, const gl
   if (grad) *grad = glm::dvec3(0.0);
   if (m.grin_type != 0) {  // a GRIN profile replaces the (isotropic) index
     const GrinProfile g = grinOf(m);
+    // Inside its region the profile's own formula, continued smoothly past the surface (RK4's
+    // stages may sample just outside): GrinProfile clamps n ≥ 1 there, a kink that would cut
+    // the integrator to low order in the last step before a crossing.
+    const glm::dvec3 r = x - g.origin;
+    const double q = glm::dot(r, r) / (g.radius * g.radius);
+    if (g.type == GrinProfile::Type::Luneburg && q < 1.9) {
+      const double n = std::sqrt(2.0 - q);
+      if (grad) *grad = -r / (g.radius * g.radius * n);
+      return n;
+    }
+    if (g.type == GrinProfile::Type::MaxwellFisheye) {
+      if (grad) *grad = -2.0 * g.n0 * r / (g.radius * g.radius * (1.0 + q) * (1.0 + q));
+      return g.n0 / (1.0 + q);
+    }
     if (grad) *grad = g.indexGradient(x);
     return g.index(x);
   }

@@ -92,7 +92,8 @@ MediaTable buildMediaTable(const Scene& scene);
 double mediumIndex(const MediumDispersion& d, double lambda_nm);
 
 /// n_o (mode 0) or n_e (mode 1) of a region's material at λ; for a GRIN region the index at x
-/// (and its gradient in *grad when given); elsewhere ∇n = 0.
+/// and its gradient in *grad when given (the profile's formula, continued smoothly past the
+/// surface for RK4 stages just outside); elsewhere ∇n = 0.
 double mediumIndexAt(const MediumRecord& m, int mode, double lambda_nm, const glm::dvec3& x,
                      glm::dvec3* grad = nullptr);
 

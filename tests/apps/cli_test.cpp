@@ -40,6 +40,12 @@ std::string tinyScene(const std::string& volume_extra = "", const std::string& m
 })";
 }
 
+/// The same scene marched through smoothed layers (tests of the layer march and of GPU-vs-CPU
+/// agreement while the GPU twin marches smoothed).
+std::string smoothedScene(const std::string& scene) {
+  return R"({"interfaces": "smoothed",)" + scene.substr(1);
+}
+
 using eikon::test::quote;
 
 class Cli : public ::testing::Test {
@@ -597,11 +603,7 @@ TEST_F(Cli, TraceAxialRayPhysics) {
 // totally reflected (normal incidence). An isotropic scene prints one "o=e" line and says the modes
 // coincide; a uniaxial one prints o and e.
 TEST_F(Cli, TraceTextShowsCountsAndIsotropicModes) {
-  // The step count's lower bound below is the smoothed march's (a sharp march crosses the sphere
-  // in 2 straight segments): this scene keeps "interfaces": "smoothed".
-  std::string smoothed = tinyScene();
-  smoothed.insert(smoothed.find('{') + 1, R"("interfaces": "smoothed", )");
-  const std::string iso = write("scene.json", smoothed);
+  const std::string iso = write("scene.json", smoothedScene(tinyScene()));
   for (const char* twin : {"", " --reference"}) {
     const Outcome r = run("trace " + quote(iso) + " --origin 0,0,-5 --dir 0,0,1" + twin);
     ASSERT_EQ(r.code, 0) << r.err;
@@ -645,7 +647,7 @@ TEST_F(Cli, TraceTextShowsCountsAndIsotropicModes) {
 // same sign, and the refraction at the sphere turns a direction error δ (≈ 1e-6 rad) into
 // ≤ 1e-5 mm over the 10 mm path ⇒ 1e-4 mm. The directions are compared to 1e-4 likewise.
 TEST_F(Cli, TraceGpuAgreesWithReference) {
-  const std::string scene = write("scene.json", tinyScene());
+  const std::string scene = write("scene.json", smoothedScene(tinyScene()));
   const Outcome gpu = run("trace " + quote(scene) + " " + TraceCase{}.args);
   ASSERT_EQ(gpu.code, 0) << gpu.err;
   const Outcome cpu = run("trace " + quote(scene) + " " + TraceCase{}.args + " --reference");

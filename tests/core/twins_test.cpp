@@ -11,6 +11,7 @@
 namespace eikon::test {
 namespace {
 
+// The smoothed march on both twins (the GPU twin has no sharp march yet).
 const char* kSphere = R"({
   "interfaces": "smoothed",
   "camera": {"position": [0, 0, -60], "look_at": [0, 0, 0], "fov_deg": 30, "width": 64, "height": 48},
