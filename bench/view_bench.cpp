@@ -4,7 +4,11 @@
 // variant's accuracy: mean and max exit-direction error of 2000 rays through the sphere against
 // the CPU reference at RK4 with a 0.05-voxel step.
 //
-//   build/bench/view_bench [scene.json] [--width W --height H] [--no-cpu]
+//   build/bench/view_bench [scene.json] [--width W --height H] [--no-cpu] [--interfaces]
+//
+// --interfaces: only the sharp vs smoothed comparison (issue 13): the scene voxelised both ways
+// ("interfaces": "sharp" / "smoothed"), rendered at the default settings; time and steps per ray
+// (sharp: one step per straight segment or RK4 step; smoothed: per integration step) and the ratio.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -19,6 +23,42 @@
 
 using namespace eikon;
 
+// Render the scene with sharp and with smoothed interfaces (GPU, and the CPU twin unless
+// --no-cpu): seconds and steps per ray of each, and their ratios.
+int compareInterfaces(vk::Context& ctx, const Scene& scene, int width, int height, bool cpu) {
+  RenderSettings rs;
+  rs.width = width;
+  rs.height = height;
+  double t[2][2] = {{0, 0}, {0, 0}}, steps[2][2] = {{0, 0}, {0, 0}};
+  const Scene::Interfaces kinds[2] = {Scene::Interfaces::Sharp, Scene::Interfaces::Smoothed};
+  for (int k = 0; k < 2; ++k) {
+    Scene s = scene;
+    s.interfaces = kinds[k];
+    const VolumeSet vol = voxelize(s);
+    ViewRenderer gpu(ctx, s, vol);
+    gpu.render(rs);  // warm-up
+    const RenderImage g = gpu.render(rs);
+    t[k][0] = g.seconds;
+    steps[k][0] = g.mean_steps;
+    std::printf("%-9s GPU: %8.3f s, %8.1f steps/ray\n", k ? "smoothed" : "sharp", g.seconds,
+                g.mean_steps);
+    if (!cpu) continue;
+    VolumeField field(vol);
+    ReferenceMarcher ref(field, s.environment);
+    const RenderImage c = ref.render(s.camera, rs);
+    t[k][1] = c.seconds;
+    steps[k][1] = c.mean_steps;
+    std::printf("%-9s CPU: %8.3f s, %8.1f steps/ray\n", k ? "smoothed" : "sharp", c.seconds,
+                c.mean_steps);
+  }
+  std::printf("ratio smoothed / sharp, GPU: time %.2f, steps %.2f\n", t[1][0] / t[0][0],
+              steps[1][0] / std::max(steps[0][0], 1e-9));
+  if (cpu)
+    std::printf("ratio smoothed / sharp, CPU: time %.2f, steps %.2f\n", t[1][1] / t[0][1],
+                steps[1][1] / std::max(steps[0][1], 1e-9));
+  return 0;
+}
+
 int main(int argc, char** argv) {
   std::string scene_path = std::string(EIKON_SOURCE_DIR) + "/scenes/glass_sphere.json";
   int width = 800, height = 600;
@@ -30,17 +70,21 @@ int main(int argc, char** argv) {
   app.add_option("--width", width, "Image width (default 800)")->check(CLI::Range(1, 16384));
   app.add_option("--height", height, "Image height (default 600)")->check(CLI::Range(1, 16384));
   app.add_flag("!--no-cpu", cpu, "Skip the CPU reference");
+  bool interfaces = false;
+  app.add_flag("--interfaces", interfaces, "Only compare sharp and smoothed interfaces");
   CLI11_PARSE(app, argc, argv);
   Scene scene = loadScene(scene_path);
   auto ctx = vk::Context::create();
+  if (interfaces) return compareInterfaces(*ctx, scene, width, height, cpu);
   auto t0 = std::chrono::steady_clock::now();
   VolumeSet vol = voxelize(scene);
   double vox_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ViewRenderer gpu(*ctx, scene, vol);
   VolumeField field(vol);
   ReferenceMarcher ref(field, scene.environment);
-  std::printf("scene %s, %dx%d, volume %dx%dx%d (voxelised in %.2f s), device %s\n", scene_path.c_str(), width, height,
-              vol.grid.dims[0], vol.grid.dims[1], vol.grid.dims[2], vox_s, ctx->deviceName().c_str());
+  std::printf("scene %s, %dx%d, volume %dx%dx%d (voxelised in %.2f s), device %s\n",
+              scene_path.c_str(), width, height, vol.grid.dims[0], vol.grid.dims[1],
+              vol.grid.dims[2], vox_s, ctx->deviceName().c_str());
 
   // Accuracy rays: aimed at the sphere's disc from the camera.
   std::mt19937 rng(7);
@@ -49,7 +93,8 @@ int main(int argc, char** argv) {
   while (rays.size() < 2000) {
     double x = u(rng) * 9.0, y = u(rng) * 9.0;
     if (x * x + y * y > 80.0) continue;
-    rays.push_back({scene.camera.position, glm::normalize(glm::dvec3(x, y, 0) - scene.camera.position), 587.5618});
+    rays.push_back({scene.camera.position,
+                    glm::normalize(glm::dvec3(x, y, 0) - scene.camera.position), 587.5618});
   }
   MarchSettings truth;
   truth.step_voxels = 0.05;
@@ -77,8 +122,8 @@ int main(int argc, char** argv) {
       {"RK4, 0.5 voxel, skip", mk(Integrator::RK4, 0.5, true, true)},
       {"RK4, 0.25 voxel, skip (default)", mk(Integrator::RK4, 0.25, true, true)},
   };
-  std::printf("\n%-34s %10s %10s %11s %12s %12s\n", "GPU variant", "time [s]", "rays/s", "steps/ray", "mean err",
-              "max err");
+  std::printf("\n%-34s %10s %10s %11s %12s %12s\n", "GPU variant", "time [s]", "rays/s",
+              "steps/ray", "mean err", "max err");
   double naive_s = 0, default_s = 0;
   for (const auto& v : variants) {
     RenderSettings rs;
@@ -94,8 +139,9 @@ int main(int argc, char** argv) {
       mean += e / double(rays.size());
       mx = std::max(mx, e);
     }
-    std::printf("%-34s %10.3f %10.3g %11.1f %11.2e° %11.2e°\n", v.name, img.seconds, width * height / img.seconds,
-                img.mean_steps, mean * 180 / 3.14159265358979, mx * 180 / 3.14159265358979);
+    std::printf("%-34s %10.3f %10.3g %11.1f %11.2e° %11.2e°\n", v.name, img.seconds,
+                width * height / img.seconds, img.mean_steps, mean * 180 / 3.14159265358979,
+                mx * 180 / 3.14159265358979);
     if (v.name[0] == 'n') naive_s = img.seconds;
     default_s = img.seconds;
   }
@@ -107,7 +153,8 @@ int main(int argc, char** argv) {
     RenderImage c = ref.render(scene.camera, rs);
     std::printf("CPU reference (double, %u threads, default settings): %.3f s, %.3g rays/s\n",
                 std::thread::hardware_concurrency(), c.seconds, width * height / c.seconds);
-    std::printf("ratio GPU / CPU reference speed (default settings): %.2f\n", c.seconds / default_s);
+    std::printf("ratio GPU / CPU reference speed (default settings): %.2f\n",
+                c.seconds / default_s);
   }
   return 0;
 }

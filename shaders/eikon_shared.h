@@ -36,6 +36,22 @@ using uvec4 = glm::uvec4;
 #define EIKON_B_SCATTER 15        // (albedo rgb, HG g) — VolumeSet::scatter
 #define EIKON_B_LIGHT_FLUENCE 16  // (φ_r, φ_g, φ_b, φ_Y) simulated fluence rate — VolumeSet::light_fluence
 #define EIKON_B_LIGHT_FLUX 17     // (F_x, F_y, F_z, 0) net flux vector of φ_Y — VolumeSet::light_flux
+// The sharp-boundary field (core/volume/boundary.h; shaders/boundary.glsl): region ids (R32_UINT),
+// distances in voxels (R32_SFLOAT) and the shape table (vec4 records, layout below). A smoothed
+// scene binds 1-voxel placeholders (region 0, distance = cap) and an empty table.
+#define EIKON_B_REGION 18
+#define EIKON_B_BOUNDARY_DIST 19
+#define EIKON_B_SHAPES 20
+#define EIKON_B_BOUNDARY_QUERIES 21  // boundary_probe.comp only (tests: GPU vs CPU twin)
+// The medium table of the sharp march (core/volume/media.h packMediaTable): EIKON_MEDIUM_VEC4S
+// vec4s per region; flag bits of row 7's w as kMedium* there.
+#define EIKON_B_MEDIA 22
+#define EIKON_MEDIUM_VEC4S 16
+#define EIKON_MEDIUM_HOMOGENEOUS 1
+#define EIKON_MEDIUM_UNIAXIAL 2
+#define EIKON_MEDIUM_RADIAL_AXIS 4
+#define EIKON_MEDIUM_GRIN 8
+#define EIKON_MEDIUM_OPAQUE 16
 
 // ViewParams.flags bits.
 #define EIKON_F_DISPERSIVE 1
@@ -48,6 +64,7 @@ using uvec4 = glm::uvec4;
 #define EIKON_F_OPACITY 128     // some opaque object
 #define EIKON_F_SCATTER 256     // some material has an albedo (in-scatter or a diffuse surface)
 #define EIKON_F_LIT 512         // light volumes from the light simulator are bound
+#define EIKON_F_SHARP 1024      // sharp interfaces: march region by region (shaders/sharp.glsl)
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0
@@ -67,6 +84,19 @@ using uvec4 = glm::uvec4;
 #define EIKON_BASIS_COUNT 81
 #define EIKON_MATRIX_OFFSET 552
 #define EIKON_TABLE_COUNT 555
+
+// Shape table (EIKON_B_SHAPES; packed by core/render/boundary_device.cpp): the shape of region
+// r ≥ 1 is the record at vec4 index EIKON_SHAPE_STRIDE·(r − 1):
+//   [0] (kind EIKON_SHAPE_*, first plane (vec4 index), plane count, 0)   integers stored as floats
+//   [1] (centre (mm), 0)
+//   [2..4] the columns of the local → world rotation R (local p = Rᵀ(x − c): p_i = col_i · (x − c))
+//   [5] sphere: (radius, 0, 0, 0); box: (size/2, 0); rounded box: (size/2 − radius, radius)
+// then the planes of the convex shapes, (local unit outward normal, d): inside where n·p ≤ d.
+#define EIKON_SHAPE_STRIDE 6
+#define EIKON_SHAPE_SPHERE 0
+#define EIKON_SHAPE_BOX 1
+#define EIKON_SHAPE_ROUNDED_BOX 2
+#define EIKON_SHAPE_CONVEX 3
 
 struct ViewParams {
   vec4 cam_pos;      // xyz: eye (mm); w: tan(fov_y / 2)
@@ -100,6 +130,22 @@ struct TraceResult {
   vec4 stats;           // x: steps; y: max | |w| − n | (invariant drift); z: interfaces; w: TIR count
 };
 
+// One query of boundary_probe.comp: the GLSL boundary functions at a point and on a segment.
+struct BoundaryQuery {
+  vec4 a;  // xyz: point / segment start (mm); w: the region r of φ_r(a) (boundaryPhi)
+  vec4 b;  // xyz: segment end (mm); w: 1 = analytic refinement on the crossed shape
+  vec4 s;  // x: a region ≥ 1 whose shape's signed distance and gradient are evaluated at a
+};
+
+// Its answer (the CPU twins: boundaryPhi, boundaryRegion, locateCrossing, Shape::signedDistance,
+// Shape::distanceGradient).
+struct BoundaryAnswer {
+  vec4 phi;       // x: φ_r(a) (mm); yzw: ∇φ_r(a)
+  ivec4 regions;  // x: boundaryRegion(a); y: crossing found (0/1); z: from; w: to
+  vec4 crossing;  // xyz: crossing point (mm); w: t along [a, b]
+  vec4 normal;    // xyz: unit normal from `from` into `to`; w: unused
+  vec4 shape;     // x: signed distance of shape s at a (mm); yzw: its gradient (world)
+};
 
 // ---- Light simulator (wavefront.comp; CPU twin core/reference/wavefront.h) ----
 #define EIKON_WAVE_WG 64
@@ -191,6 +237,8 @@ struct WavePatch {
 #ifdef __cplusplus
 static_assert(sizeof(ViewParams) == 15 * 16, "ViewParams must be vec4-packed");
 static_assert(sizeof(TraceRay) == 32 && sizeof(TraceResult) == 64, "trace records must be vec4-packed");
+static_assert(sizeof(BoundaryQuery) == 48 && sizeof(BoundaryAnswer) == 80,
+              "boundary probe records must be vec4-packed");
 static_assert(sizeof(WavePush) == 16 && sizeof(ScanPush) == 16 && sizeof(WaveTally) == 7 * 16,
               "wavefront push/tally records must be vec4-packed");
 static_assert(sizeof(WaveParams) == 8 * 16 && sizeof(WavePatch) == 10 * 16, "wavefront records must be vec4-packed");

@@ -28,6 +28,10 @@ layout(binding = EIKON_B_LIGHT_FLUENCE, rgba32f) readonly uniform image3D lightF
 layout(binding = EIKON_B_LIGHT_FLUX, rgba32f) readonly uniform image3D lightFluxImg;
 layout(std430, binding = EIKON_B_ENV_IMAGE) readonly buffer EnvBuf { vec4 envTexels[]; };
 layout(std430, binding = EIKON_B_TABLES) readonly buffer TableBuf { vec4 tables[]; };
+layout(binding = EIKON_B_REGION, r32ui) readonly uniform uimage3D regionImg;
+layout(binding = EIKON_B_BOUNDARY_DIST, r32f) readonly uniform image3D boundaryDist;
+layout(std430, binding = EIKON_B_SHAPES) readonly buffer ShapeBuf { vec4 shapeTable[]; };
+layout(std430, binding = EIKON_B_MEDIA) readonly buffer MediaBuf { vec4 mediaTable[]; };
 
 const float kPi = 3.14159265358979323846;
 
@@ -63,6 +67,7 @@ vec4 gRecorded[6];
 #define EIKON_FIELD_ON_DISPERSION(b, c) \
   if (any(notEqual(b, vec4(0.0))) || any(notEqual(c, vec4(0.0)))) gDispersiveHit = true
 #include "field.glsl"
+#include "boundary.glsl"
 
 vec3 sampleEmission(vec3 x) {
   Stencil s = stencilAt(x);
@@ -279,6 +284,7 @@ struct MarchState {
   vec3 T;        // throughput
   vec3 L;        // radiance gathered so far
   bool stopped;  // at an opaque surface
+  int region;    // sharp march: the boundary-field region the ray is in
   // The interface layer being crossed: where it opened, w before it, Σ∇n·ds over it, its peak.
   bool inLayer;
   float peak;
@@ -487,7 +493,14 @@ bool clipToVolume(inout MarchState S, inout MarchResult R, StepEnd E) {
   return true;
 }
 
+#include "sharp.glsl"
+
+// The host specialises this constant (with EIKON_F_SHARP): the pipeline holds one of the two
+// marches, which halves what lavapipe compiles.
+layout(constant_id = 0) const bool kSharpMarch = false;
+
 MarchResult march(vec3 o, vec3 d, int mode) {
+  if (kSharpMarch) return marchSharp(o, d, mode);
   MarchResult R;
   R.radiance = vec3(0.0);
   R.throughput = vec3(1.0);
@@ -515,6 +528,7 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   S.T = vec3(1.0);
   S.L = vec3(0.0);
   S.stopped = false;
+  S.region = 0;
   S.inLayer = false;
   S.peak = 0.0;
   S.wBefore = S.w;

@@ -27,7 +27,11 @@ void main() {
   TraceRay ray = rays[i];
   setWavelength(ray.origin.w, true);
   vec3 d = normalize(ray.direction.xyz);
-  TraceResult o = pack(march(ray.origin.xyz, d, 0));
-  results[2 * i] = o;
-  results[2 * i + 1] = hasFlag(EIKON_F_UNIAXIAL) ? pack(march(ray.origin.xyz, d, 1)) : o;
+  // One call site of march() (lavapipe compiles every inlined copy): the modes are a loop.
+  int modes = hasFlag(EIKON_F_UNIAXIAL) ? 2 : 1;
+  for (int mode = 0; mode < modes; ++mode) {
+    TraceResult o = pack(march(ray.origin.xyz, d, mode));
+    results[2 * i + mode] = o;
+    if (modes == 1) results[2 * i + 1] = o;
+  }
 }

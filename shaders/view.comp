@@ -44,54 +44,55 @@ void main() {
     float u = ((float(px) + jitter.x) / float(W) * 2.0 - 1.0) * P.cam_pos.w * P.cam_forward.w;
     float v = (1.0 - (float(py) + jitter.y) / float(H) * 2.0) * P.cam_pos.w;
     vec3 d = normalize(P.cam_forward.xyz + u * P.cam_right.xyz + v * P.cam_up.xyz);
-    if (hasFlag(EIKON_F_SPECTRAL)) {
-      int N = P.limits.z;
-      uint seed = pcg_hash(pixelIndex + pcg_hash(uint(s)));
-      vec3 xyz = vec3(0.0);
-      // Wavelength sharing (march.glsl): only where nothing but the index can depend on λ.
-      const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
-      bool share = (P.grid_dims.w & lambdaDependent) == 0;
-      bool reuse = false;
-      for (int k = 0; k < N; ++k) {
+    // One call site of march() (lavapipe compiles every inlined copy of the march): the RGB mode
+    // is one "wavelength" of radiance triplets, and the modes of a crystal are a loop.
+    bool spectral = hasFlag(EIKON_F_SPECTRAL);
+    int N = spectral ? P.limits.z : 1;
+    int modes = hasFlag(EIKON_F_UNIAXIAL) ? 2 : 1;  // unpolarised: each mode carries 1/modes
+    uint seed = pcg_hash(pixelIndex + pcg_hash(uint(s)));
+    vec3 xyz = vec3(0.0);
+    // Wavelength sharing (march.glsl): only where nothing but the index can depend on λ.
+    const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
+    bool share = spectral && (P.grid_dims.w & lambdaDependent) == 0;
+    bool reuse = false;
+    for (int k = 0; k < N; ++k) {
+      float lambda = 0.0;
+      if (spectral) {
         float uk = float(pcg_hash(seed + uint(k)) >> 8u) * (1.0 / 16777216.0);
-        float lambda = 380.0 + (float(k) + uk) * (400.0 / float(N));
+        lambda = 380.0 + (float(k) + uk) * (400.0 / float(N));
         setWavelength(lambda * 1e-3, true);
-        if (reuse) {
-          float rad = 0.0;
-          for (int j = 0; j < gNumRecorded; ++j) rad += gRecorded[j].w * environment(gRecorded[j].xyz).x;
-          xyz += rad * cmf(lambda) * (400.0 / float(N));
-          continue;
-        }
-        gRecord = share && k == 0;
-        gNumRecorded = 0;
-        gRecordOverflow = false;
-        gDispersiveHit = false;
-        MarchResult r = march(P.cam_pos.xyz, d, 0);
-        reuse = gRecord && !gDispersiveHit && !gRecordOverflow;
-        gRecord = false;
-        float rad = r.radiance.x;
-        steps += float(r.steps) / float(N);
-        if (hasFlag(EIKON_F_UNIAXIAL)) {  // unpolarised: each mode carries half
-          MarchResult re = march(P.cam_pos.xyz, d, 1);
-          rad = 0.5 * (rad + re.radiance.x);
-          steps += float(re.steps) / float(N);
-        }
-        xyz += rad * cmf(lambda) * (400.0 / float(N));
+      } else {
+        setWavelength(P.wavelength.x, false);
       }
+      if (reuse) {
+        float rad = 0.0;
+        for (int j = 0; j < gNumRecorded; ++j) rad += gRecorded[j].w * environment(gRecorded[j].xyz).x;
+        xyz += rad * cmf(lambda) * (400.0 / float(N));
+        continue;
+      }
+      vec3 rad = vec3(0.0);
+      for (int mode = 0; mode < modes; ++mode) {
+        if (mode == 0) {
+          gRecord = share && k == 0;
+          gNumRecorded = 0;
+          gRecordOverflow = false;
+          gDispersiveHit = false;
+        }
+        MarchResult r = march(P.cam_pos.xyz, d, mode);
+        if (mode == 0) {
+          reuse = gRecord && !gDispersiveHit && !gRecordOverflow;
+          gRecord = false;
+        }
+        rad += modes == 2 ? 0.5 * r.radiance : r.radiance;
+        steps += float(r.steps) / float(N);
+      }
+      if (spectral) xyz += rad.x * cmf(lambda) * (400.0 / float(N));
+      else sum += rad;
+    }
+    if (spectral) {
       mat3 M = mat3(tables[EIKON_MATRIX_OFFSET].xyz, tables[EIKON_MATRIX_OFFSET + 1].xyz,
                     tables[EIKON_MATRIX_OFFSET + 2].xyz);
       sum += xyz * M;  // rows stored: rgb_i = dot(row_i, xyz)
-    } else {
-      setWavelength(P.wavelength.x, false);
-      MarchResult r = march(P.cam_pos.xyz, d, 0);
-      vec3 rad = r.radiance;
-      steps += float(r.steps);
-      if (hasFlag(EIKON_F_UNIAXIAL)) {  // unpolarised: each mode carries half
-        MarchResult re = march(P.cam_pos.xyz, d, 1);
-        rad = 0.5 * (rad + re.radiance);
-        steps += float(re.steps);
-      }
-      sum += rad;
     }
   }
   pixels[int(gid.y) * W + px] = vec4(sum / float(spp), steps / float(spp));

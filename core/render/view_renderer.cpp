@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/render/boundary_device.h"
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
@@ -40,6 +41,8 @@ void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scen
   if (scattering) images += 1;
   if (!scene.lights.empty()) images += 2;
   double bytes = double(grid.count()) * 16.0 * double(images);
+  // The sharp-boundary field: a 32-bit region id and a float distance per voxel.
+  if (scene.interfaces == Scene::Interfaces::Sharp) bytes += double(grid.count()) * 8.0;
   if (bytes > 0.9 * double(lim.heap_size))
     throw std::runtime_error(scene.file.string() + ": /volume/resolution: the volume needs " +
                              std::to_string(int64_t(bytes / (1 << 20))) + " MiB of device memory but the device heap has " +
@@ -52,10 +55,12 @@ struct ViewRenderer::Impl {
   Grid grid;
   bool uniaxial = false, dispersive = false, attenuating = false, emissive = false, opaque = false;
   bool scattering = false, lit = false;
+  bool sharp = false;  // march region by region (shaders/sharp.glsl), as the CPU twin does
   // [oA, oB, oC, (eA, eB, eC), medO, (medE), emission, (axis), (scatter), (fluence, flux)]
   std::vector<vk::Image3D> images;
   size_t scatterImage = 0, fluenceImage = 0, fluxImage = 0;  // 0: not present (index A bound instead)
   vk::Buffer params, env, tables;
+  BoundaryDevice boundary;  // the sharp-boundary field (placeholders when smoothed)
   vk::ComputePipeline view, tracer;
   int skip_cap = 32;
   double ambient = 1.0;
@@ -98,6 +103,8 @@ struct ViewRenderer::Impl {
       upload(v.light_flux, "light flux");
     }
 
+    boundary = BoundaryDevice(ctx, v.boundary, v.media, scene.file.string());
+    sharp = !v.boundary.empty() && !v.media.empty();
     params = vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
     const auto& e = scene.environment;
     if (e.type == Environment::Type::LatLong) {
@@ -124,10 +131,13 @@ struct ViewRenderer::Impl {
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE), uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    view = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4), common, 0, "view");
+    for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
+    // constant_id 0 (march.glsl kSharpMarch): the sharp or the smoothed march, not both.
+    const std::vector<uint32_t> spec{sharp ? 1u : 0u};
+    view = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4), common, 0, "view", spec);
     auto traceBindings = common;
     traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    tracer = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4), traceBindings, 0, "trace");
+    tracer = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4), traceBindings, 0, "trace", spec);
     for (auto* p : {&view, &tracer}) bindCommon(*p);
   }
 
@@ -150,6 +160,7 @@ struct ViewRenderer::Impl {
     p.bindBuffer(EIKON_B_PARAMS, params);
     p.bindBuffer(EIKON_B_ENV_IMAGE, env);
     p.bindBuffer(EIKON_B_TABLES, tables);
+    boundary.bind(p);
   }
 
   gpu::ViewParams baseParams(const MarchSettings& m, int flags_extra) const {
@@ -172,6 +183,7 @@ struct ViewRenderer::Impl {
     if (opaque) flags |= EIKON_F_OPACITY;
     if (scattering) flags |= EIKON_F_SCATTER;
     if (lit) flags |= EIKON_F_LIT;
+    if (sharp) flags |= EIKON_F_SHARP;
     if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
     if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);

@@ -55,6 +55,9 @@ class Shape {
   std::pair<glm::dvec3, glm::dvec3> bounds() const;
   /// World-space outward normals of a convex shape's faces (empty for curved shapes).
   std::vector<Plane> worldPlanes() const;
+  /// The local geometry and the local → world rotation (the GPU shape table packs them).
+  const ShapeGeometry& geometry() const { return geometry_; }
+  const glm::dmat3& rotation() const { return rotation_; }
 
  private:
   glm::dvec3 toLocal(const glm::dvec3& world) const;

@@ -179,7 +179,7 @@ void Image3D::upload(const Context& ctx, const void* data, VkDeviceSize bytes) {
 // ---------------------------------------------------------------- ComputePipeline
 ComputePipeline::ComputePipeline(const Context& ctx, std::span<const uint32_t> spirv,
                                  std::vector<BindingSpec> bindings, uint32_t push_constant_bytes,
-                                 std::string name)
+                                 std::string name, std::vector<uint32_t> specialization)
     : device_(ctx.device()),
       push_bytes_(push_constant_bytes),
       bindings_(std::move(bindings)),
@@ -218,6 +218,12 @@ ComputePipeline::ComputePipeline(const Context& ctx, std::span<const uint32_t> s
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = module_;
   ci.stage.pName = "main";
+  std::vector<VkSpecializationMapEntry> entries;
+  for (uint32_t i = 0; i < uint32_t(specialization.size()); ++i)
+    entries.push_back({i, i * uint32_t(sizeof(uint32_t)), sizeof(uint32_t)});
+  VkSpecializationInfo spec{uint32_t(entries.size()), entries.data(),
+                            specialization.size() * sizeof(uint32_t), specialization.data()};
+  if (!specialization.empty()) ci.stage.pSpecializationInfo = &spec;
   ci.layout = layout_;
   VK_CHECK(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline_));
 

@@ -88,12 +88,14 @@ struct BindingSpec {
 };
 
 /// A compute pipeline with one descriptor set and an optional push-constant block.
+/// `specialization[i]` is the 32-bit value of the shader's `layout(constant_id = i)` constant
+/// (the driver folds it and drops the code it disables: a smaller, faster-to-compile pipeline).
 class ComputePipeline {
  public:
   ComputePipeline() = default;
   ComputePipeline(const Context& ctx, std::span<const uint32_t> spirv,
-                  std::vector<BindingSpec> bindings, uint32_t push_constant_bytes,
-                  std::string name);
+                  std::vector<BindingSpec> bindings, uint32_t push_constant_bytes, std::string name,
+                  std::vector<uint32_t> specialization = {});
   ~ComputePipeline();
   ComputePipeline(ComputePipeline&& o) noexcept { *this = std::move(o); }
   ComputePipeline& operator=(ComputePipeline&& o) noexcept;

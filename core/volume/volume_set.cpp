@@ -6,6 +6,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <variant>
 
 #include "core/volume/host_memory.h"
 
@@ -61,7 +62,14 @@ size_t VolumeSet::deviceBytes() const {
   for (const auto& m : medium) texels += m.size();
   texels +=
       emission.size() + axis.size() + scatter.size() + light_fluence.size() + light_flux.size();
-  return texels * sizeof(glm::vec4);
+  // The boundary field (core/render/boundary_device.h): a 32-bit region id and a float distance
+  // per voxel, the shape table (6 vec4 per shape, one per convex plane) and the medium table.
+  size_t shape_entries = 6 * boundary.shapes.size();
+  for (const Shape& s : boundary.shapes)
+    if (const auto* c = std::get_if<ConvexShape>(&s.geometry())) shape_entries += c->planes.size();
+  return texels * sizeof(glm::vec4) + boundary.region.size() * sizeof(uint32_t) +
+         boundary.distance.size() * sizeof(float) + shape_entries * sizeof(glm::vec4) +
+         media.regions.size() * size_t(kMediumVec4s) * sizeof(glm::vec4);
 }
 
 void gaussianSmooth(std::vector<float>& f, const std::array<int, 3>& dims, double sigma,

@@ -65,7 +65,7 @@ struct VolumeSet {
   std::vector<glm::vec4> light_flux;     ///< same
   int skip_cap = 32;                     ///< largest stored skip distance (voxels)
   /// Where the media meet, to sub-voxel accuracy (core/volume/boundary.h); empty when the scene
-  /// asks for "interfaces": "smoothed". Host only for now (not counted in deviceBytes).
+  /// asks for "interfaces": "smoothed". On the device: core/render/boundary_device.h.
   BoundaryField boundary;
   /// The medium of each boundary-field region (core/volume/media.h), with `boundary`.
   MediaTable media;

@@ -1,0 +1,177 @@
+#include "core/render/boundary_device.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <stdexcept>
+#include <type_traits>
+#include <variant>
+
+#include "shaders/boundary_probe.spv.h"
+
+namespace eikon {
+namespace {
+
+// The shape record of one shape (eikon_shared.h): header, centre, rotation columns, parameters.
+// Its planes go to `planes` (vec4 indices counted from the table's start by the caller).
+void packShape(const Shape& shape, int first_plane, std::vector<glm::vec4>& out,
+               std::vector<glm::vec4>& planes) {
+  glm::vec4 head(0.0f), par(0.0f);
+  std::visit(
+      [&](const auto& g) {
+        using T = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<T, SphereShape>) {
+          head.x = EIKON_SHAPE_SPHERE;
+          par.x = float(g.radius);
+        } else if constexpr (std::is_same_v<T, BoxShape>) {
+          head.x = EIKON_SHAPE_BOX;
+          par = glm::vec4(glm::vec3(0.5 * g.size), 0.0f);
+        } else if constexpr (std::is_same_v<T, RoundedBoxShape>) {
+          head.x = EIKON_SHAPE_ROUNDED_BOX;
+          par = glm::vec4(glm::vec3(0.5 * g.size - glm::dvec3(g.radius)), float(g.radius));
+        } else {
+          head = glm::vec4(float(EIKON_SHAPE_CONVEX), float(first_plane + int(planes.size())),
+                           float(g.planes.size()), 0.0f);
+          for (const Plane& p : g.planes)
+            planes.push_back(glm::vec4(glm::vec3(p.normal), float(p.d)));
+        }
+      },
+      shape.geometry());
+  out.push_back(head);
+  out.push_back(glm::vec4(glm::vec3(shape.center()), 0.0f));
+  for (int c = 0; c < 3; ++c) out.push_back(glm::vec4(glm::vec3(shape.rotation()[c]), 0.0f));
+  out.push_back(par);
+}
+
+}  // namespace
+
+std::vector<glm::vec4> packShapeTable(const BoundaryField& field) {
+  std::vector<glm::vec4> table, planes;
+  const int first_plane = EIKON_SHAPE_STRIDE * int(field.shapes.size());
+  for (const Shape& s : field.shapes) packShape(s, first_plane, table, planes);
+  table.insert(table.end(), planes.begin(), planes.end());
+  if (table.empty()) table.push_back(glm::vec4(0.0f));
+  return table;
+}
+
+void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field, const MediaTable& media,
+                       const std::string& file) {
+  const auto& lim = ctx.limits();
+  const std::string where = (file.empty() ? std::string("scene") : file) + ": /objects: ";
+  if (!field.empty())
+    for (int a = 0; a < 3; ++a)
+      if (uint32_t(field.grid.dims[size_t(a)]) > lim.max_image_dimension_3d)
+        throw std::runtime_error(where + "the boundary field needs " +
+                                 std::to_string(field.grid.dims[size_t(a)]) +
+                                 " voxels per side but the device allows at most " +
+                                 std::to_string(lim.max_image_dimension_3d));
+  // Records and planes, counted without packing: 6 vec4 per shape plus one per plane.
+  double entries = EIKON_SHAPE_STRIDE * double(field.shapes.size());
+  for (const Shape& s : field.shapes)
+    if (const auto* c = std::get_if<ConvexShape>(&s.geometry()))
+      entries += double(c->planes.size());
+  const double bytes = 16.0 * std::max(entries, 1.0);
+  if (bytes > double(lim.max_storage_buffer_range))
+    throw std::runtime_error(where + "the shape table needs " + std::to_string(int64_t(bytes)) +
+                             " bytes but the device's storage buffers hold at most " +
+                             std::to_string(lim.max_storage_buffer_range) +
+                             " (or set \"interfaces\": \"smoothed\")");
+  const double media_bytes =
+      16.0 * kMediumVec4s * std::max<double>(double(media.regions.size()), 1);
+  if (media_bytes > double(lim.max_storage_buffer_range))
+    throw std::runtime_error(
+        where + "the medium table needs " + std::to_string(int64_t(media_bytes)) +
+        " bytes but the device's storage buffers hold at most " +
+        std::to_string(lim.max_storage_buffer_range) + " (or set \"interfaces\": \"smoothed\")");
+}
+
+std::vector<vk::BindingSpec> boundaryBindings() {
+  return {{EIKON_B_REGION, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE},
+          {EIKON_B_BOUNDARY_DIST, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE},
+          {EIKON_B_SHAPES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+          {EIKON_B_MEDIA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}};
+}
+
+BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& field,
+                               const MediaTable& media, const std::string& file) {
+  static_assert(kMediumVec4s == EIKON_MEDIUM_VEC4S &&
+                    kMediumHomogeneous == EIKON_MEDIUM_HOMOGENEOUS &&
+                    kMediumUniaxial == EIKON_MEDIUM_UNIAXIAL &&
+                    kMediumRadialAxis == EIKON_MEDIUM_RADIAL_AXIS &&
+                    kMediumGrin == EIKON_MEDIUM_GRIN && kMediumOpaque == EIKON_MEDIUM_OPAQUE,
+                "the medium table's layout is declared twice (media.h, eikon_shared.h)");
+  checkBoundaryFits(ctx, field, media, file);
+  present_ = !field.empty();
+  std::array<uint32_t, 3> ext{1, 1, 1};
+  if (present_)
+    ext = {uint32_t(field.grid.dims[0]), uint32_t(field.grid.dims[1]),
+           uint32_t(field.grid.dims[2])};
+  const std::vector<float> cap{field.cap};
+  const auto& dist = present_ ? field.distance : cap;
+  // R32_UINT, not R16_UINT: 16-bit storage images need the optional
+  // shaderStorageImageExtendedFormats feature; 32-bit uint is a format every device must offer.
+  const std::vector<uint32_t> reg =
+      present_ ? std::vector<uint32_t>(field.region.begin(), field.region.end())
+               : std::vector<uint32_t>{0u};
+  region_ = vk::Image3D(ctx, ext, VK_FORMAT_R32_UINT, "boundary region");
+  region_.upload(ctx, reg.data(), reg.size() * sizeof(uint32_t));
+  distance_ = vk::Image3D(ctx, ext, VK_FORMAT_R32_SFLOAT, "boundary distance");
+  distance_.upload(ctx, dist.data(), dist.size() * sizeof(float));
+  const std::vector<glm::vec4> table = packShapeTable(field);
+  shapes_ = vk::Buffer(ctx, table.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                       "shape table");
+  shapes_.write(table.data(), table.size() * sizeof(glm::vec4));
+  std::vector<float> packed = packMediaTable(media);
+  if (packed.empty()) packed.assign(size_t(kMediumVec4s) * 4, 0.0f);
+  media_ = vk::Buffer(ctx, packed.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                      "medium table");
+  media_.write(packed.data(), packed.size() * sizeof(float));
+}
+
+void BoundaryDevice::bind(vk::ComputePipeline& p) const {
+  p.bindImage(EIKON_B_REGION, region_);
+  p.bindImage(EIKON_B_BOUNDARY_DIST, distance_);
+  p.bindBuffer(EIKON_B_SHAPES, shapes_);
+  p.bindBuffer(EIKON_B_MEDIA, media_);
+}
+
+std::vector<gpu::BoundaryAnswer> probeBoundary(vk::Context& ctx, const BoundaryField& field,
+                                               const std::vector<gpu::BoundaryQuery>& queries,
+                                               double tolerance_voxels) {
+  if (queries.empty()) return {};
+  if (field.empty()) throw std::invalid_argument("probeBoundary: the boundary field is empty");
+  BoundaryDevice dev(ctx, field, MediaTable{});
+  auto bindings = boundaryBindings();
+  for (uint32_t b :
+       {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_BOUNDARY_QUERIES), uint32_t(EIKON_B_OUTPUT)})
+    bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+  vk::ComputePipeline pipe(
+      ctx, std::span<const uint32_t>(k_boundary_probe_spv, sizeof(k_boundary_probe_spv) / 4),
+      bindings, 0, "boundary probe");
+  gpu::ViewParams p{};
+  const Grid& g = field.grid;
+  p.grid_origin = glm::vec4(glm::vec3(g.origin), float(g.h));
+  p.grid_extent = glm::vec4(glm::vec3(g.extent), float(1.0 / g.h));
+  p.grid_dims = glm::ivec4(g.dims[0], g.dims[1], g.dims[2], 0);
+  p.march = glm::vec4(float(tolerance_voxels), 0.0f, 0.0f, 0.0f);
+  p.image = glm::ivec4(int(queries.size()), 1, 0, 1);
+  vk::Buffer params(ctx, sizeof p, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "probe params");
+  params.write(&p, sizeof p);
+  vk::Buffer qb(ctx, queries.size() * sizeof(gpu::BoundaryQuery),
+                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "boundary queries");
+  qb.write(queries.data(), queries.size() * sizeof(gpu::BoundaryQuery));
+  vk::Buffer ab(ctx, queries.size() * sizeof(gpu::BoundaryAnswer),
+                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "boundary answers");
+  dev.bind(pipe);
+  pipe.bindBuffer(EIKON_B_PARAMS, params);
+  pipe.bindBuffer(EIKON_B_BOUNDARY_QUERIES, qb);
+  pipe.bindBuffer(EIKON_B_OUTPUT, ab);
+  ctx.submitAndWait([&](VkCommandBuffer cmd) {
+    pipe.dispatch(cmd, uint32_t((queries.size() + EIKON_TRACE_WG - 1) / EIKON_TRACE_WG), 1, 1,
+                  nullptr);
+  });
+  std::vector<gpu::BoundaryAnswer> out(queries.size());
+  ab.read(out.data(), out.size() * sizeof(gpu::BoundaryAnswer));
+  return out;
+}
+
+}  // namespace eikon

@@ -1,0 +1,57 @@
+// The sharp-boundary field on the device (issue 13): the VolumeSet's BoundaryField
+// (core/volume/boundary.h) as a region image (R32_UINT), a distance image (R32_SFLOAT, voxels) and
+// the shape table (vec4 records, layout in shaders/eikon_shared.h), bound at EIKON_B_REGION,
+// EIKON_B_BOUNDARY_DIST and EIKON_B_SHAPES for the GLSL twins in shaders/boundary.glsl, and the
+// medium table of the sharp march (core/volume/media.h packMediaTable) at EIKON_B_MEDIA.
+//
+//   eikon::BoundaryDevice dev(ctx, volume.boundary, volume.media);   // refuses clearly if too big
+//   dev.bind(pipeline);                                // pipeline built with boundaryBindings()
+//
+// An empty field ("interfaces": "smoothed") uploads 1-voxel placeholders (region 0, distance =
+// cap) and a one-entry table, so that kernels can always bind the three resources.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/vk/context.h"
+#include "core/vk/resources.h"
+#include "core/volume/boundary.h"
+#include "core/volume/media.h"
+#include "shaders/eikon_shared.h"
+
+namespace eikon {
+
+/// The shape table of a field, packed as the GLSL reads it (eikon_shared.h, EIKON_SHAPE_*); one
+/// zero entry when the field has no shapes.
+std::vector<glm::vec4> packShapeTable(const BoundaryField& field);
+
+/// Throw a one-line std::runtime_error (naming `file`) if the field cannot live on this device:
+/// its image sides, the shape and medium tables' storage-buffer range.
+void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field, const MediaTable& media,
+                       const std::string& file);
+
+/// The descriptor bindings of the four resources (add them to a pipeline's binding list).
+std::vector<vk::BindingSpec> boundaryBindings();
+
+class BoundaryDevice {
+ public:
+  BoundaryDevice() = default;
+  BoundaryDevice(const vk::Context& ctx, const BoundaryField& field, const MediaTable& media,
+                 const std::string& file = "");
+  void bind(vk::ComputePipeline& pipeline) const;
+  bool present() const { return present_; }
+
+ private:
+  vk::Image3D region_, distance_;
+  vk::Buffer shapes_, media_;
+  bool present_ = false;
+};
+
+/// Evaluate the GLSL boundary functions (shaders/boundary_probe.comp) for each query; the
+/// crossing is bisected to `tolerance_voxels`. For the GPU-vs-CPU tests of the sharp twins.
+std::vector<gpu::BoundaryAnswer> probeBoundary(vk::Context& ctx, const BoundaryField& field,
+                                               const std::vector<gpu::BoundaryQuery>& queries,
+                                               double tolerance_voxels = 1e-6);
+
+}  // namespace eikon

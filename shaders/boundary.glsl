@@ -1,0 +1,372 @@
+// The sharp-boundary field on the GPU (issue 13): the GLSL twin of core/volume/boundary.{h,cpp}
+// under the same names — boundaryPhi, boundaryRegion, locateCrossing — and of the analytic shapes'
+// signed distance and gradient (core/scene/shapes.cpp), in single precision. docs/twins.md lists
+// the pairs; tests/core/volume/boundary_gpu_test.cpp holds them to each other.
+//
+// The including kernel declares, before `#include "boundary.glsl"`:
+//   P              its parameter block with grid_origin (xyz: bounds_min (mm), w: voxel edge h)
+//                  and grid_dims (xyz: voxels per axis);
+//   regionImg      layout(r32ui) uimage3D: the region owning each voxel centre (0 = ambient);
+//   boundaryDist   layout(r32f) image3D: the distance (voxels, ≤ cap) to its region's boundary;
+//   shapeTable     vec4[]: the shape table (layout in eikon_shared.h, EIKON_SHAPE_*).
+// Everything here follows the CPU code step by step (same cell walk, same cubic split at its
+// turning points, same bisections, same tie rules), so the two differ by float rounding only.
+#ifndef EIKON_BOUNDARY_GLSL
+#define EIKON_BOUNDARY_GLSL
+
+// ---- Analytic shapes (core/scene/shapes.cpp) ----
+
+int shapeKind(int s) { return int(shapeTable[EIKON_SHAPE_STRIDE * s].x); }
+
+// Local coordinates p = Rᵀ(x − c) of world point x in shape s (s = region − 1).
+vec3 shapeLocal(int s, vec3 x) {
+  int o = EIKON_SHAPE_STRIDE * s;
+  vec3 d = x - shapeTable[o + 1].xyz;
+  return vec3(dot(shapeTable[o + 2].xyz, d), dot(shapeTable[o + 3].xyz, d),
+              dot(shapeTable[o + 4].xyz, d));
+}
+
+float boxDistance(vec3 p, vec3 half_size) {
+  vec3 q = abs(p) - half_size;
+  return length(max(q, vec3(0.0))) + min(max(q.x, max(q.y, q.z)), 0.0);
+}
+
+vec3 boxGradient(vec3 p, vec3 half_size) {
+  vec3 q = abs(p) - half_size;
+  vec3 sgn = vec3(p.x < 0.0 ? -1.0 : 1.0, p.y < 0.0 ? -1.0 : 1.0, p.z < 0.0 ? -1.0 : 1.0);
+  vec3 outside = max(q, vec3(0.0));
+  if (length(outside) > 0.0) return sgn * outside / length(outside);
+  int a = q.x > q.y ? (q.x > q.z ? 0 : 2) : (q.y > q.z ? 1 : 2);
+  vec3 g = vec3(0.0);
+  g[a] = sgn[a];
+  return g;
+}
+
+// Signed distance (mm, negative inside) of shape s at world point x: Shape::signedDistance.
+float shapeSignedDistance(int s, vec3 x) {
+  int o = EIKON_SHAPE_STRIDE * s;
+  vec4 head = shapeTable[o], par = shapeTable[o + 5];
+  vec3 p = shapeLocal(s, x);
+  int kind = int(head.x);
+  if (kind == EIKON_SHAPE_SPHERE) return length(p) - par.x;
+  if (kind == EIKON_SHAPE_BOX) return boxDistance(p, par.xyz);
+  if (kind == EIKON_SHAPE_ROUNDED_BOX) return boxDistance(p, par.xyz) - par.w;
+  float m = -3.0e38;
+  for (int k = 0; k < int(head.z); ++k) {
+    vec4 pl = shapeTable[int(head.y) + k];
+    m = max(m, dot(pl.xyz, p) - pl.w);
+  }
+  return m;
+}
+
+// ∇ of the signed distance (world; the active face's normal for convex shapes):
+// Shape::distanceGradient.
+vec3 shapeDistanceGradient(int s, vec3 x) {
+  int o = EIKON_SHAPE_STRIDE * s;
+  vec4 head = shapeTable[o], par = shapeTable[o + 5];
+  vec3 p = shapeLocal(s, x);
+  int kind = int(head.x);
+  vec3 g;
+  if (kind == EIKON_SHAPE_SPHERE) {
+    float l = length(p);
+    g = l > 0.0 ? p / l : vec3(0.0, 0.0, 1.0);
+  } else if (kind == EIKON_SHAPE_BOX || kind == EIKON_SHAPE_ROUNDED_BOX) {
+    g = boxGradient(p, par.xyz);
+  } else {
+    float m = -3.0e38;
+    g = vec3(0.0);
+    for (int k = 0; k < int(head.z); ++k) {
+      vec4 pl = shapeTable[int(head.y) + k];
+      float v = dot(pl.xyz, p) - pl.w;
+      if (v > m) {
+        m = v;
+        g = pl.xyz;
+      }
+    }
+  }
+  return g.x * shapeTable[o + 2].xyz + g.y * shapeTable[o + 3].xyz + g.z * shapeTable[o + 4].xyz;
+}
+
+// ---- The trilinear cell (boundary.cpp: Cell, cellAt) ----
+
+// A cell around voxel coordinates u (voxel centres at integers), with its 8 corners' regions and
+// distances loaded (bit 0: +x, bit 1: +y, bit 2: +z). Clamped axes (beyond the outermost centres)
+// have a constant fraction and no derivative.
+struct BoundaryCell {
+  ivec3 lo;
+  vec3 f;
+  bvec3 clamped;
+  int reg[8];
+  float dist[8];
+};
+
+vec3 boundaryToVoxel(vec3 x) { return (x - P.grid_origin.xyz) / P.grid_origin.w - 0.5; }
+
+BoundaryCell boundaryCellAt(vec3 u) {
+  BoundaryCell c;
+  ivec3 hi;
+  for (int a = 0; a < 3; ++a) {
+    int n = P.grid_dims[a];
+    if (n == 1 || u[a] <= 0.0) {
+      c.lo[a] = 0;
+      c.f[a] = 0.0;
+      c.clamped[a] = true;
+    } else if (u[a] >= float(n - 1)) {
+      c.lo[a] = n - 2;
+      c.f[a] = 1.0;
+      c.clamped[a] = true;
+    } else {
+      c.lo[a] = min(int(floor(u[a])), n - 2);
+      c.f[a] = u[a] - float(c.lo[a]);
+      c.clamped[a] = false;
+    }
+    hi[a] = min(c.lo[a] + 1, n - 1);
+  }
+  for (int k = 0; k < 8; ++k) {
+    ivec3 v = ivec3((k & 1) != 0 ? hi.x : c.lo.x, (k & 2) != 0 ? hi.y : c.lo.y,
+                    (k & 4) != 0 ? hi.z : c.lo.z);
+    c.reg[k] = int(imageLoad(regionImg, v).x);
+    c.dist[k] = imageLoad(boundaryDist, v).x;
+  }
+  return c;
+}
+
+// φ_r at the cell's point (voxels) and its gradient in voxel coordinates (= ∂φ_mm/∂x_mm).
+float boundaryCellPhi(BoundaryCell c, int r, out vec3 grad) {
+  float phi = 0.0;
+  grad = vec3(0.0);
+  for (int k = 0; k < 8; ++k) {
+    float v = c.reg[k] == r ? c.dist[k] : -c.dist[k];
+    vec3 w, dw;
+    for (int a = 0; a < 3; ++a) {
+      bool up = ((k >> a) & 1) != 0;
+      w[a] = up ? c.f[a] : 1.0 - c.f[a];
+      dw[a] = c.clamped[a] ? 0.0 : (up ? 1.0 : -1.0);
+    }
+    phi += v * w.x * w.y * w.z;
+    grad += v * vec3(dw.x * w.y * w.z, w.x * dw.y * w.z, w.x * w.y * dw.z);
+  }
+  return phi;
+}
+
+// φ_r along u(t) = ua + t·du inside the cell: a cubic, coefficients of t⁰…t³.
+vec4 boundaryCellCubic(BoundaryCell c, int r, vec3 ua, vec3 du) {
+  vec4 sum = vec4(0.0);
+  for (int k = 0; k < 8; ++k) {
+    float v = c.reg[k] == r ? c.dist[k] : -c.dist[k];
+    vec4 p = vec4(v, 0.0, 0.0, 0.0);
+    for (int a = 0; a < 3; ++a) {
+      float p0 = c.clamped[a] ? c.f[a] : ua[a] - float(c.lo[a]);
+      float p1 = c.clamped[a] ? 0.0 : du[a];
+      bool up = ((k >> a) & 1) != 0;
+      float al = up ? p0 : 1.0 - p0, be = up ? p1 : -p1;
+      p = vec4(p.x * al, p.y * al + p.x * be, p.z * al + p.y * be, p.w * al + p.z * be);
+    }
+    sum += p;
+  }
+  return sum;
+}
+
+float boundaryCubicAt(vec4 p, float t) { return ((p.w * t + p.z) * t + p.y) * t + p.x; }
+
+// The first t in [t0, t1] where the cubic turns negative, bisected to tol; −1 if none. The
+// interval is split at the cubic's turning points so that each piece is monotone.
+float boundaryFirstNegative(vec4 p, float t0, float t1, float tol) {
+  if (boundaryCubicAt(p, t0) < 0.0) return t0;
+  float s[4];
+  int n = 0;
+  s[n++] = t0;
+  float A = 3.0 * p.w, B = 2.0 * p.z, C = p.y;
+  if (A != 0.0) {
+    float disc = B * B - 4.0 * A * C;
+    if (disc >= 0.0) {
+      float q = -0.5 * (B + (B < 0.0 ? -sqrt(disc) : sqrt(disc)));
+      float r0 = q / A, r1 = q != 0.0 ? C / q : t0;
+      if (r1 < r0) {
+        float tmp = r0;
+        r0 = r1;
+        r1 = tmp;
+      }
+      if (r0 > t0 && r0 < t1) s[n++] = r0;
+      if (r1 > t0 && r1 < t1) s[n++] = r1;
+    }
+  } else if (B != 0.0 && -C / B > t0 && -C / B < t1) {
+    s[n++] = -C / B;
+  }
+  s[n++] = t1;
+  for (int k = 1; k < n; ++k) {
+    float lo = s[k - 1], hi = s[k];
+    if (boundaryCubicAt(p, hi) >= 0.0) continue;
+    for (int it = 0; it < 64 && hi - lo > tol; ++it) {
+      float mid = 0.5 * (lo + hi);
+      if (mid <= lo || mid >= hi) break;  // float resolution reached
+      if (boundaryCubicAt(p, mid) >= 0.0) lo = mid;
+      else hi = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+  return -1.0;
+}
+
+// ---- The public functions ----
+
+// φ_region at world point x (mm; > 0 inside the region), its gradient in grad.
+float boundaryPhi(vec3 x, int region, out vec3 grad) {
+  return boundaryCellPhi(boundaryCellAt(boundaryToVoxel(x)), region, grad) * P.grid_origin.w;
+}
+
+// The region at x: of the 8 surrounding voxels' regions, the one whose φ is largest (first in
+// corner order on ties, as on the CPU).
+int boundaryRegionOfCell(BoundaryCell c) {
+  int best = c.reg[0];
+  bool single = true;
+  for (int k = 1; k < 8; ++k) single = single && c.reg[k] == best;
+  if (single) return best;
+  float bestPhi = -3.0e38;
+  vec3 g;
+  for (int k = 0; k < 8; ++k) {
+    bool seen = false;
+    for (int j = 0; j < k; ++j) seen = seen || c.reg[j] == c.reg[k];
+    if (seen) continue;
+    float phi = boundaryCellPhi(c, c.reg[k], g);
+    if (phi > bestPhi) {
+      bestPhi = phi;
+      best = c.reg[k];
+    }
+  }
+  return best;
+}
+
+int boundaryRegion(vec3 x) { return boundaryRegionOfCell(boundaryCellAt(boundaryToVoxel(x))); }
+
+struct BoundaryCrossing {
+  bool found;
+  float t;      // along [a, b]
+  vec3 point;   // world (mm)
+  vec3 normal;  // unit, from `from` into `to` (analytic when asked)
+  int from;
+  int to;
+};
+
+// Refine a crossing on the owner shape's exact signed distance: the nearest sign change to t,
+// bracketed in brackets widening from 0.05 to 3.2 voxels (boundary.cpp: refineOnShape).
+bool boundaryRefineOnShape(int s, bool leavingOwner, vec3 a, vec3 b, float lenVox, inout float t) {
+  for (float w = 0.05; w <= 3.2; w *= 4.0) {
+    float lo = max(0.0, t - w / lenVox), hi = min(1.0, t + w / lenVox);
+    if ((shapeSignedDistance(s, mix(a, b, lo)) > 0.0) == leavingOwner ||
+        (shapeSignedDistance(s, mix(a, b, hi)) > 0.0) != leavingOwner)
+      continue;
+    for (int it = 0; it < 64; ++it) {
+      float mid = 0.5 * (lo + hi);
+      if (mid <= lo || mid >= hi) break;
+      if ((shapeSignedDistance(s, mix(a, b, mid)) > 0.0) != leavingOwner) lo = mid;
+      else hi = mid;
+    }
+    t = 0.5 * (lo + hi);
+    return true;
+  }
+  return false;
+}
+
+// The crossing in the cell between breaks t0 and t1 of the walk, if any: t and the region entered.
+bool boundaryCrossCell(int from, vec3 ua, vec3 du, float t0, float t1, float tol,
+                       inout BoundaryCrossing out_) {
+  BoundaryCell c = boundaryCellAt(ua + 0.5 * (t0 + t1) * du);
+  bool others = false;
+  for (int k = 0; k < 8; ++k) others = others || c.reg[k] != from;
+  if (!others) return false;  // φ is a mean of positive distances: no zero in this cell
+  // The cubic in s = t − t0 about the cell's entry point: the same polynomial as the CPU's in t,
+  // but its coefficients stay of the order of the cell's distances (in t over a long segment they
+  // grow as |du|³ and cancel in float).
+  float s = boundaryFirstNegative(boundaryCellCubic(c, from, ua + t0 * du, du), 0.0, t1 - t0, tol);
+  if (s < 0.0) return false;
+  float t = t0 + s;
+  // The region entered: of the others, the one with the largest φ just past the zero.
+  BoundaryCell past = boundaryCellAt(ua + min(t + tol, t1) * du);
+  float best = -3.0e38;
+  vec3 g;
+  for (int k = 0; k < 8; ++k) {
+    bool seen = c.reg[k] == from;
+    for (int j = 0; j < k; ++j) seen = seen || c.reg[j] == c.reg[k];
+    if (seen) continue;
+    float phi = boundaryCellPhi(past, c.reg[k], g);
+    if (phi > best) {
+      best = phi;
+      out_.to = c.reg[k];
+    }
+  }
+  out_.found = true;
+  out_.t = t;
+  return true;
+}
+
+// The first point where [a, b] (world, mm) leaves the region of a (boundary.h: locateCrossing),
+// walking the trilinear cells the segment crosses in order; tolVoxels: the bisection's bracket
+// along the segment (floats resolve ~1e-6 of the segment at best).
+BoundaryCrossing locateCrossing(vec3 a, vec3 b, float tolVoxels, bool analytic) {
+  BoundaryCrossing out_;
+  out_.found = false;
+  out_.t = 1.0;
+  out_.point = b;
+  out_.normal = vec3(0.0);
+  out_.from = boundaryRegion(a);
+  out_.to = 0;
+  vec3 ua = boundaryToVoxel(a), du = boundaryToVoxel(b) - ua;
+  float lenVox = length(du);
+  if (!(lenVox > 0.0)) return out_;
+  float tol = max(tolVoxels, 1e-12) / lenVox;
+  // Per axis, the next voxel-centre plane m the segment crosses in (0, 1), and the last one.
+  ivec3 m, mEnd, stepDir;
+  for (int ax = 0; ax < 3; ++ax) {
+    int n = P.grid_dims[ax];
+    if (du[ax] > 0.0) {
+      m[ax] = max(int(ceil(ua[ax])), 0);
+      if (float(m[ax]) <= ua[ax]) m[ax] += 1;
+      mEnd[ax] = min(int(floor(ua[ax] + du[ax])), n - 1);
+      stepDir[ax] = 1;
+    } else if (du[ax] < 0.0) {
+      m[ax] = min(int(floor(ua[ax])), n - 1);
+      if (float(m[ax]) >= ua[ax]) m[ax] -= 1;
+      mEnd[ax] = max(int(ceil(ua[ax] + du[ax])), 0);
+      stepDir[ax] = -1;
+    } else {
+      m[ax] = 0;
+      mEnd[ax] = 0;
+      stepDir[ax] = 0;
+    }
+  }
+  float t0 = 0.0;
+  int maxBreaks = P.grid_dims.x + P.grid_dims.y + P.grid_dims.z + 4;
+  for (int it = 0; it < maxBreaks && t0 < 1.0; ++it) {
+    float t1 = 1.0;
+    int axis = -1;
+    for (int ax = 0; ax < 3; ++ax) {
+      if (stepDir[ax] == 0 || (m[ax] - mEnd[ax]) * stepDir[ax] > 0) continue;
+      float t = (float(m[ax]) - ua[ax]) / du[ax];
+      if (t < t1) {
+        t1 = t;
+        axis = ax;
+      }
+    }
+    if (axis >= 0) m[axis] += stepDir[axis];
+    if (t1 > t0 && boundaryCrossCell(out_.from, ua, du, t0, t1, tol, out_)) break;
+    t0 = max(t0, t1);
+    if (axis < 0) break;
+  }
+  if (!out_.found) return out_;
+  int owner = max(out_.from, out_.to);
+  out_.point = mix(a, b, out_.t);
+  vec3 grad;
+  boundaryCellPhi(boundaryCellAt(boundaryToVoxel(out_.point)), out_.from, grad);
+  if (length(grad) > 0.0) out_.normal = -normalize(grad);
+  if (analytic && owner >= 1) {
+    bool leaving = out_.from == owner;
+    if (boundaryRefineOnShape(owner - 1, leaving, a, b, lenVox, out_.t))
+      out_.point = mix(a, b, out_.t);
+    vec3 n = shapeDistanceGradient(owner - 1, out_.point);
+    if (length(n) > 0.0) out_.normal = (leaving ? 1.0 : -1.0) * normalize(n);
+  }
+  return out_;
+}
+
+#endif  // EIKON_BOUNDARY_GLSL

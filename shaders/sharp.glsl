@@ -1,0 +1,417 @@
+// The sharp march (issue 13; docs/view-renderer.md "Sharp interfaces: the march"): the GPU twin of
+// RayMarch::marchSharp and its stages in core/reference/reference_marcher.cpp, under the same
+// names (docs/twins.md). Included by march.glsl after MarchState/MarchResult and the medium
+// helpers; reads the boundary field and shape table (boundary.glsl) and the medium table
+// (mediaTable: core/volume/media.h packMediaTable, EIKON_MEDIUM_VEC4S vec4s per region).
+//
+// The ray carries its region; a homogeneous region is crossed in one straight segment, a varying
+// one (GRIN, radial optic axis) is integrated with RK4 on the region's own analytic medium; each
+// segment or step chord is tested with locateCrossing, and at a crossing the exact interface laws
+// (optics/interface.h, optics/fresnel.h) are applied.
+#ifndef EIKON_SHARP_GLSL
+#define EIKON_SHARP_GLSL
+
+// How far past a crossing (voxels) a search may skip a sliver where the trilinear region field and
+// the exact surface disagree (≤ 3h²/(8r) for a sphere of radius r voxels; 0 on planes), and the
+// step past a sliver's end at which the search restarts.
+const float kSliverVoxels = 0.25;
+const float kNudgeVoxels = 1e-4;
+
+// ---- The medium table (core/volume/media.h) ----
+
+vec4 mediumRow(int r, int k) { return mediaTable[r * EIKON_MEDIUM_VEC4S + k]; }
+int mediumFlags(int r) { return int(mediumRow(r, 7).w); }
+bool mediumHomogeneous(int r) { return (mediumFlags(r) & EIKON_MEDIUM_HOMOGENEOUS) != 0; }
+bool mediumUniaxial(int r) { return (mediumFlags(r) & EIKON_MEDIUM_UNIAXIAL) != 0; }
+bool mediumOpaque(int r) { return (mediumFlags(r) & EIKON_MEDIUM_OPAQUE) != 0; }
+
+// n of a region's dispersion record (mode 0: n_o, 1: n_e) at the march's wavelength: the
+// material's own formula (mediumIndex). Notes dispersion for wavelength sharing (view.comp).
+float mediumIndex(int r, int mode) {
+  vec4 head = mediumRow(r, 0);
+  int kind = int(mode == 1 ? head.z : head.x), terms = min(int(mode == 1 ? head.w : head.y), 6);
+  int b = mode == 1 ? 4 : 1;
+  vec4 c0 = mediumRow(r, b), c1 = mediumRow(r, b + 1), c2 = mediumRow(r, b + 2);
+  float coeff[6] = float[6](c0.x, c0.y, c0.z, c0.w, c1.x, c1.y);
+  float sc[6] = float[6](c1.z, c1.w, c2.x, c2.y, c2.z, c2.w);
+  if (kind == 0) return coeff[0];
+  if (kind != 1 || terms > 1) gDispersiveHit = true;
+  float l = gLambdaUm, l2 = l * l;
+  if (kind == 1) {
+    float n = 0.0, p = 1.0;
+    for (int k = 0; k < terms; ++k, p /= l2) n += coeff[k] * p;
+    return n;
+  }
+  if (kind == 2) {
+    float n2 = 1.0;
+    for (int k = 0; k < terms; ++k) n2 += coeff[k] * l2 / (l2 - sc[k]);
+    return n2 > 0.0 ? sqrt(n2) : uintBitsToFloat(0x7fc00000u);
+  }
+  return coeff[0] + coeff[1] / l + coeff[2] / (l2 * l * sqrt(l));
+}
+
+// n_o / n_e of region r at x and its gradient (mediumIndexAt): a GRIN profile replaces the index.
+float regionIndex(int r, int mode, vec3 x, out vec3 grad) {
+  grad = vec3(0.0);
+  int grin = int(mediumRow(r, 11).w);
+  if (grin == 0) return mediumIndex(r, mode);
+  vec4 g = mediumRow(r, 12), c = mediumRow(r, 13);  // (n0, ∇n), (origin, radius)
+  vec3 d = x - c.xyz;
+  float R2 = c.w * c.w, r2 = dot(d, d) / R2;
+  if (grin == 1) {  // linear
+    grad = g.yzw;
+    return g.x + dot(g.yzw, d);
+  }
+  // Luneburg and fisheye: the profile's own formula continued smoothly past the surface inside
+  // the region (RK4's stages may sample just outside; mediumIndexAt), not clamped at n = 1.
+  if (grin == 2 && r2 < 1.9) {
+    float n = sqrt(2.0 - r2);
+    grad = -d / (R2 * n);
+    return n;
+  }
+  if (grin == 3) {
+    grad = -2.0 * g.x * d / (R2 * (1.0 + r2) * (1.0 + r2));
+    return g.x / (1.0 + r2);
+  }
+  if (2.0 - r2 > 1.0) grad = -d / (R2 * sqrt(2.0 - r2));  // Luneburg beyond r² = 1.9R²
+  return sqrt(max(2.0 - r2, 1.0));
+}
+
+float regionIndex(int r, int mode, vec3 x) {
+  vec3 g;
+  return regionIndex(r, mode, x, g);
+}
+
+// The optic axis field of a region at x: (unit axis, 1/r of a radial field or 0); zero where
+// isotropic (mediumAxisField).
+vec4 regionAxisField(int r, vec3 x) {
+  int f = mediumFlags(r);
+  if ((f & EIKON_MEDIUM_UNIAXIAL) == 0) return vec4(0.0);
+  if ((f & EIKON_MEDIUM_RADIAL_AXIS) == 0) return vec4(mediumRow(r, 7).xyz, 0.0);
+  vec3 d = x - mediumRow(r, 14).xyz;
+  float len = length(d);
+  if (!(len > 1e-12)) return vec4(0.0, 0.0, 1.0, 0.0);
+  return vec4(d / len, 1.0 / len);
+}
+
+// ---- The interface laws (optics/interface.cpp) ----
+
+struct ModeWave {
+  bool exists;
+  vec3 s;   // unit wave normal
+  float n;  // |p|
+  vec3 t;   // unit ray direction ∝ M p
+};
+
+// M p for the medium of an outgoing wave: M_e (eMat, axis a) or I/n_o².
+vec3 applyMedium(vec3 p, bool eMat, vec3 a, float no, float ne) {
+  return eMat ? applyM(p, a, no, ne) : p / (no * no);
+}
+
+// The outgoing wave with tangential wave vector pt (⊥ m) on the shell pᵀMp = 1: the root of the
+// quadratic in the normal component along (transmitted) or against (reflected) m.
+ModeWave solveInterfaceMode(vec3 pt, vec3 m, bool eMat, vec3 a, float no, float ne, bool transmitted) {
+  ModeWave w;
+  w.exists = false;
+  w.s = vec3(0.0);
+  w.n = 0.0;
+  w.t = vec3(0.0);
+  vec3 Mm = applyMedium(m, eMat, a, no, ne);
+  float A = dot(m, Mm), B = 2.0 * dot(pt, Mm), C = dot(pt, applyMedium(pt, eMat, a, no, ne)) - 1.0;
+  float disc = B * B - 4.0 * A * C;
+  if (disc < 0.0) return w;  // evanescent for this mode
+  float root = sqrt(disc);
+  float q = (-B + (transmitted ? root : -root)) / (2.0 * A);
+  vec3 p = pt + q * m;
+  w.n = length(p);
+  w.s = p / w.n;
+  w.t = normalize(applyMedium(p, eMat, a, no, ne));
+  w.exists = true;
+  return w;
+}
+
+vec3 orientNormal(vec3 N, vec3 flow) { return dot(N, flow) < 0.0 ? -N : N; }
+
+// ---- The stages (RayMarch::sharp*) ----
+
+// Box entry: the region there, and the wave vector of the mode in its medium along d.
+void sharpEnter(inout MarchState S, vec3 x, vec3 d, int mode) {
+  S.x = x;
+  S.region = boundaryRegion(x);
+  float n = regionIndex(S.region, 0, x);
+  vec4 af = regionAxisField(S.region, x);
+  if (mode == 1 && hasAxis(af.xyz))
+    n = inversesqrt(dot(d, applyM(d, af.xyz, n, regionIndex(S.region, 1, x))));
+  S.w = n * d;
+}
+
+// The ray (energy) direction in the ray's region: w/|w|, or M_e w for the e-mode in a crystal.
+vec3 sharpDirection(MarchState S, int mode) {
+  vec4 af = regionAxisField(S.region, S.x);
+  if (mode == 0 || !hasAxis(af.xyz)) return normalize(S.w);
+  return normalize(applyM(S.w, af.xyz, regionIndex(S.region, 0, S.x), regionIndex(S.region, 1, S.x)));
+}
+
+// The first crossing on [a, b] out of the ray's region, skipping slivers (a crossing back into the
+// ray's own region within kSliverVoxels of a).
+BoundaryCrossing nextCrossing(vec3 a, vec3 b, int region) {
+  BoundaryCrossing none;
+  none.found = false;
+  none.t = 1.0;
+  none.point = b;
+  none.normal = vec3(0.0);
+  none.from = region;
+  none.to = region;
+  float total = length(b - a);
+  if (!(total > 0.0)) return none;
+  vec3 dir = (b - a) / total;
+  float h = P.grid_origin.w;
+  vec3 start = a;
+  for (int k = 0; k < 4; ++k) {
+    BoundaryCrossing c = locateCrossing(start, b, 1e-6, true);
+    if (!c.found) return c;
+    float along = dot(c.point - a, dir);
+    bool sliver = c.from != region && c.to == region && along <= kSliverVoxels * h;
+    if (!sliver) {
+      c.t = clamp(along / total, 0.0, 1.0);
+      c.from = region;
+      return c;
+    }
+    start = a + (along + kNudgeVoxels * h) * dir;
+    if (along + kNudgeVoxels * h >= total) return none;
+  }
+  return none;
+}
+
+// Emission, attenuation (exact: e^{−σ len}) and in-scatter along a straight piece in the ray's
+// region.
+void absorbAlong(inout MarchState S, vec3 dir, float len, int mode) {
+  int r = S.region;
+  vec3 sig = sigmaOf(mediumRow(r, 8).xyz);
+  vec4 af = regionAxisField(r, S.x);
+  if (mode == 1 && hasAxis(af.xyz))
+    sig = attenuationE(sig, sigmaOf(mediumRow(r, 9).xyz), S.w, af.xyz, regionIndex(r, 0, S.x),
+                       regionIndex(r, 1, S.x));
+  vec3 e = colourOf(mediumRow(r, 10).xyz);
+  vec3 alb = mediumRow(r, 11).xyz;
+  if (hasFlag(EIKON_F_LIT) && alb.x + alb.y + alb.z > 0.0) e += inScatter(S.x + 0.5 * len * dir, dir, sig);
+  vec3 att = exp(-sig * len);
+  S.L += S.T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
+  S.T *= att;
+}
+
+const int kSharpGo = 0;     // still inside the region
+const int kSharpCross = 1;  // at a boundary crossing
+const int kSharpLeave = 2;  // out of the volume
+
+// The ray equation in a varying region from its own analytic medium (deriv's twin).
+void sharpDeriv(int region, vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
+  vec3 g;
+  float n = regionIndex(region, 0, x, g);
+  vec4 af = mode == 1 ? regionAxisField(region, x) : vec4(0.0);
+  if (!hasAxis(af.xyz)) {
+    float lw = length(w);
+    dx = w / lw;
+    dw = g * (lw / n);
+    return;
+  }
+  vec3 ge;
+  float ne = regionIndex(region, 1, x, ge);
+  vec3 Mp, dp;
+  eModeRates(w, af, vec4(n, g), vec4(ne, ge), Mp, dp);
+  float L = length(Mp);
+  dx = Mp / L;
+  dw = dp / L;
+}
+
+// Classical RK4 as a loop over its four stages (one inlined sharpDeriv: lavapipe compiles every
+// inlined copy), summed in the CPU's order k1 + 2k2 + 2k3 + k4.
+void sharpRk4(int region, float ds, int mode, inout vec3 x, inout vec3 w) {
+  vec3 kx = vec3(0.0), kw = vec3(0.0), sx = vec3(0.0), sw = vec3(0.0);
+  for (int st = 0; st < 4; ++st) {
+    float c = st == 0 ? 0.0 : (st == 3 ? 1.0 : 0.5);
+    vec3 dx, dw;
+    sharpDeriv(region, x + c * ds * kx, w + c * ds * kw, mode, dx, dw);
+    float b = (st == 0 || st == 3) ? 1.0 : 2.0;
+    sx += b * dx;
+    sw += b * dw;
+    kx = dx;
+    kw = dw;
+  }
+  x += ds / 6.0 * sx;
+  w += ds / 6.0 * sw;
+}
+
+// One piece of the march in the ray's region, the CPU's two stages in one function so that
+// nextCrossing and absorbAlong are inlined once:
+//   sharpSegment (homogeneous region): one straight segment to the volume's exit (a voxel at a
+//     time in a lit scattering medium) or to the first crossing on it;
+//   sharpStep (varying region): one RK4 step, cut at the volume's exit or at the first crossing
+//     of its chord (the step is redone shorter so that w belongs to where it ends).
+int sharpAdvance(inout MarchState S, inout MarchResult R, out BoundaryCrossing c, int mode) {
+  const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
+  const float h = P.grid_origin.w;
+  bool straight = mediumHomogeneous(S.region);
+  vec3 x0 = S.x, w0 = S.w, x1 = x0, w1 = w0, dir;
+  float len = 0.0, ds = P.march.x * h, keep = 1.0;
+  bool leaving = true;
+  if (straight) {  // sharpSegment
+    dir = sharpDirection(S, mode);
+    float tb0, tb1;
+    boxHit(S.x, dir, bmin, bmax, tb0, tb1);
+    len = max(tb1, 0.0);
+    vec3 alb = mediumRow(S.region, 11).xyz;
+    if (hasFlag(EIKON_F_LIT) && alb.x + alb.y + alb.z > 0.0 && len > h) {
+      len = h;
+      leaving = false;
+    }
+    x1 = S.x + dir * len;
+  } else {  // sharpStep
+    sharpRk4(S.region, ds, mode, x1, w1);
+    vec3 chord = x1 - x0;
+    float a0, a1;
+    leaving = !boxHit(x0, normalize(chord), bmin, bmax, a0, a1) || a1 < length(chord);
+    keep = leaving ? clamp(max(a1, 0.0) / length(chord), 0.0, 1.0) : 1.0;
+    x1 = x0 + keep * chord;
+  }
+  c = nextCrossing(x0, x1, S.region);
+  if (straight) {
+    if (c.found) len *= c.t;
+    R.opl += dot(S.w, dir) * len;
+    x1 = c.found ? c.point : S.x + dir * len;
+  } else {
+    if (c.found) keep *= c.t;
+    if (keep < 1.0) {
+      x1 = x0;
+      w1 = w0;
+      ds *= keep;
+      sharpRk4(S.region, ds, mode, x1, w1);
+      if (c.found) x1 = c.point;
+    }
+    float n0 = regionIndex(S.region, 0, x0), n1 = regionIndex(S.region, 0, x1);
+    R.opl += mode == 0 ? 0.5 * (n0 + n1) * ds : 0.5 * dot(w0 + w1, x1 - x0);
+    if (mode == 0) R.drift = max(R.drift, abs(length(w1) - n1));
+    S.x = 0.5 * (x0 + x1);
+    S.w = 0.5 * (w0 + w1);
+    dir = normalize(x1 - x0 + 1e-30);
+    len = length(x1 - x0);
+  }
+  absorbAlong(S, dir, len, mode);
+  S.x = x1;
+  S.w = w1;
+  return c.found ? kSharpCross : leaving ? kSharpLeave : kSharpGo;
+}
+
+// The exact laws at a crossing: Snell, or the o/e waves into / out of a crystal; TIR is a lossless
+// mirror; otherwise the ray carries (1 − R) on and an external reflection adds R × environment.
+// (refractIsotropic, refractIntoUniaxial, refractOutOfUniaxial and reflectInsideUniaxial are one
+// solveInterfaceMode each: the incident wave's tangential part on the outgoing mode's shell.)
+void crossInterface(inout MarchState S, inout MarchResult R, BoundaryCrossing c, int mode) {
+  int A = S.region, B = c.to;
+  vec3 x = S.x, N = c.normal, s = normalize(S.w);
+  vec4 afA = regionAxisField(A, x), afB = regionAxisField(B, x);
+  bool uA = mediumUniaxial(A), uB = mediumUniaxial(B);
+  if (mediumOpaque(B) || (mediumRow(A, 10).w == mediumRow(B, 10).w && int(mediumRow(A, 11).w) == 0 &&
+                          afA.xyz == afB.xyz)) {
+    S.region = B;  // equal media: nothing changes (an opaque one stops the ray next)
+    return;
+  }
+  float noA = regionIndex(A, 0, x), neA = regionIndex(A, 1, x);
+  float noB = regionIndex(B, 0, x), neB = regionIndex(B, 1, x);
+  float n1 = length(S.w);
+  // Leaving a crystal the normal is oriented along the incident ray (energy) direction and the
+  // incident wave's index is the mode's n(θ); otherwise along s with |w|.
+  bool outOfCrystal = uA && !uB;
+  bool eIn = uA && mode == 1;
+  vec3 flowA = eIn ? normalize(applyM(s, afA.xyz, noA, neA)) : s;
+  float nIn = outOfCrystal ? (eIn ? inversesqrt(dot(s, applyM(s, afA.xyz, noA, neA))) : noA) : n1;
+  vec3 m = orientNormal(N, outOfCrystal ? flowA : s);
+  vec3 pt = nIn * s - dot(nIn * s, m) * m;
+  bool eOut = uB && mode == 1;  // into a crystal: the mode's shell there
+  ModeWave o = solveInterfaceMode(pt, m, eOut, afB.xyz, noB, neB, true);
+  if (!o.exists) {  // total internal reflection: a mirror, no loss; the ray stays in A
+    if (uA) {
+      m = orientNormal(N, flowA);
+      float nr = eIn ? inversesqrt(dot(s, applyM(s, afA.xyz, noA, neA))) : noA;
+      vec3 ptr = nr * s - dot(nr * s, m) * m;
+      ModeWave r = solveInterfaceMode(ptr, m, eIn, afA.xyz, noA, neA, false);
+      S.w = r.exists ? r.n * r.s : reflect(S.w, N);
+    } else {
+      S.w = reflect(S.w, N);
+    }
+    R.tir++;
+    return;
+  }
+  if (!hasFlag(EIKON_F_NO_FRESNEL)) {
+    vec2 rsp = fresnelRsRp(min(1.0, abs(dot(s, N))), n1, o.n);
+    float Rf = 0.5 * (rsp.x + rsp.y);
+    if (uA || uB) {
+      float wsw = sWeight(uB ? o.s : s, uB ? afB.xyz : afA.xyz, N, s, mode);
+      Rf = wsw * rsp.x + (1.0 - wsw) * rsp.y;
+    }
+    if (o.n > n1) S.L += environmentWeighted(S.T * Rf, reflect(s, N));
+    S.T *= 1.0 - Rf;
+  }
+  R.interfaces++;
+  S.w = o.n * o.s;
+  S.region = B;
+}
+
+MarchResult marchSharp(vec3 o, vec3 d, int mode) {
+  MarchResult R;
+  R.radiance = vec3(0.0);
+  R.throughput = vec3(1.0);
+  R.opl = 0.0;
+  R.left = true;
+  R.steps = 0;
+  R.drift = 0.0;
+  R.interfaces = 0;
+  R.tir = 0;
+  const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
+  float t0, t1;
+  if (!boxHit(o, d, bmin, bmax, t0, t1)) {
+    R.radiance = environmentWeighted(vec3(1.0), d);
+    R.exit_point = o;
+    R.exit_dir = d;
+    R.wave_normal = d;
+    return R;
+  }
+  t0 = max(t0, 0.0);
+  MarchState S;
+  S.nn = vec4(0.0);  // unused by the sharp march, but defined
+  S.inLayer = false;
+  S.peak = 0.0;
+  S.wBefore = vec3(0.0);
+  S.gAcc = vec3(0.0);
+  S.xOpen = vec3(0.0);
+  S.T = vec3(1.0);
+  S.L = vec3(0.0);
+  S.stopped = false;
+  sharpEnter(S, o + d * t0, d, mode);
+  R.opl = P.march.z * t0;
+  const int maxSteps = P.limits.x;
+  int steps = 0;
+  for (; steps < maxSteps; ++steps) {
+    if (mediumOpaque(S.region)) {  // surface emission over the coverage, as the smoothed path
+      S.L += S.T * (colourOf(mediumRow(S.region, 10).xyz) / mediumRow(S.region, 8).w +
+                    diffuseSurface(S.x, mode));
+      S.stopped = true;
+      break;
+    }
+    BoundaryCrossing c;
+    int ev = sharpAdvance(S, R, c, mode);
+    if (ev == kSharpLeave) break;
+    if (ev == kSharpCross) crossInterface(S, R, c, mode);
+  }
+  R.steps = steps;
+  R.exit_point = S.x;
+  R.exit_dir = sharpDirection(S, mode);
+  R.wave_normal = normalize(S.w);
+  R.left = !S.stopped && steps < maxSteps;
+  if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
+  R.radiance = S.L;
+  R.throughput = S.T;
+  return R;
+}
+
+#endif  // EIKON_SHARP_GLSL
