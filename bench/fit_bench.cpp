@@ -56,7 +56,8 @@ int main(int argc, char** argv) {
   const eikon::IndexSeries data = eikon::readIndexCsv(csv).modes[0];
 
   // eikon: the full fitDispersion (start, Ceres solve, ceres::Covariance, summary).
-  eikon::FitResult r = eikon::fitDispersion(data, {.model = eikon::DispersionModel::Cauchy3});  // warm-up
+  eikon::FitResult r =
+      eikon::fitDispersion(data, {.model = eikon::DispersionModel::Cauchy3});  // warm-up
   int fits = 0;
   const auto t0 = std::chrono::steady_clock::now();
   double elapsed = 0.0;
@@ -68,8 +69,8 @@ int main(int argc, char** argv) {
   const double eikon_rate = fits / elapsed;
 
   // SciPy peer, same data, same run.
-  const std::string cmd = "/usr/bin/python3 " + std::string(EIKON_SOURCE_DIR) + "/bench/fit_peer_scipy.py " + csv +
-                          " " + std::to_string(min_seconds);
+  const std::string cmd = "/usr/bin/python3 " + std::string(EIKON_SOURCE_DIR) +
+                          "/bench/fit_peer_scipy.py " + csv + " " + std::to_string(min_seconds);
   std::string peer_out;
   if (FILE* p = ::popen(cmd.c_str(), "r")) {
     char buf[4096];
@@ -86,7 +87,8 @@ int main(int argc, char** argv) {
   const auto pc = peer["coeffs"].get<std::vector<double>>();
 
   std::printf("cauchy3 fit, 50 points (N-BK7 400-700 nm + noise 1e-5), one run\n");
-  std::printf("  eikon (Ceres %s, LM + covariance): %10.0f fits/s  (%d fits)\n", "2.1", eikon_rate, fits);
+  std::printf("  eikon (Ceres %s, LM + covariance): %10.0f fits/s  (%d fits)\n", "2.1", eikon_rate,
+              fits);
   std::printf("  SciPy %s least_squares (lm):   %10.0f fits/s  (%d fits)\n",
               peer["scipy"].get<std::string>().c_str(), scipy_rate, peer["fits"].get<int>());
   std::printf("  ratio eikon/SciPy: %.1fx\n", eikon_rate / scipy_rate);
@@ -96,8 +98,8 @@ int main(int argc, char** argv) {
     const double d = std::abs(r.coeffs[size_t(k)] - pc[size_t(k)]);
     max_abs = std::max(max_abs, d);
     max_sig = std::max(max_sig, d / r.sigma[size_t(k)]);
-    std::printf("  %s: eikon % .12e  scipy % .12e  |diff| %.2e (%.1e sigma)\n", names[k], r.coeffs[size_t(k)],
-                pc[size_t(k)], d, d / r.sigma[size_t(k)]);
+    std::printf("  %s: eikon % .12e  scipy % .12e  |diff| %.2e (%.1e sigma)\n", names[k],
+                r.coeffs[size_t(k)], pc[size_t(k)], d, d / r.sigma[size_t(k)]);
   }
   std::printf("  largest coefficient difference: %.2e (%.1e of its 1-sigma)\n", max_abs, max_sig);
   return 0;

@@ -47,13 +47,17 @@ struct Run {
 
 void print(const char* name, const Run& r) {
   const WavefrontStats& s = r.st;
-  const double ended = s.flux_left + s.flux_caustic + s.flux_energy + s.flux_absorbed + s.flux_live_at_end;
-  std::printf("  %-6s %8.2f s  %10.0f patches  %9.3g patches/s  steps %5d  splits %zu (refused %zu)\n", name, r.s,
-              r.patches(), r.patches() / r.s, s.steps, s.splits, s.splits_refused);
-  std::printf("       flux emitted %.9g = left %.9g + caustic %.9g + energy %.9g + absorbed %.9g + live %.9g"
-              "  (balance %+.2e relative)\n",
-              s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_energy, s.flux_absorbed, s.flux_live_at_end,
-              (ended - s.flux_emitted) / s.flux_emitted);
+  const double ended =
+      s.flux_left + s.flux_caustic + s.flux_energy + s.flux_absorbed + s.flux_live_at_end;
+  std::printf(
+      "  %-6s %8.2f s  %10.0f patches  %9.3g patches/s  steps %5d  splits %zu (refused %zu)\n",
+      name, r.s, r.patches(), r.patches() / r.s, s.steps, s.splits, s.splits_refused);
+  std::printf(
+      "       flux emitted %.9g = left %.9g + caustic %.9g + energy %.9g + absorbed %.9g + live "
+      "%.9g"
+      "  (balance %+.2e relative)\n",
+      s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_energy, s.flux_absorbed,
+      s.flux_live_at_end, (ended - s.flux_emitted) / s.flux_emitted);
   if (s.straight_steps > 0)
     std::printf("       straight steps %zu covering %zu time steps (%.1f each)\n", s.straight_steps,
                 s.straight_time_steps, double(s.straight_time_steps) / double(s.straight_steps));
@@ -73,8 +77,9 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
   const VolumeSet vol = voxelize(scene);
   WavefrontSettings s;
   s.skip_empty = skip;
-  std::printf("\nvolume %dx%dx%d (h = %.4g mm), straight steps %s\n", vol.grid.dims[0], vol.grid.dims[1],
-              vol.grid.dims[2], vol.grid.h, skip ? "on (skip_empty = true)" : "off (skip_empty = false)");
+  std::printf("\nvolume %dx%dx%d (h = %.4g mm), straight steps %s\n", vol.grid.dims[0],
+              vol.grid.dims[1], vol.grid.dims[2], vol.grid.h,
+              skip ? "on (skip_empty = true)" : "off (skip_empty = false)");
   Pair p;
   if (ctx) {
     GpuWavefront gpu(*ctx, vol, s, gStepsPerDispatch);
@@ -100,9 +105,11 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
       print(name, run);
       p.cpu.push_back(run);
       if (p.cpu.size() > 1)
-        std::printf("  speed-up of %d threads over %d: %.2fx\n", threads, gThreads[0], p.cpu[0].s / run.s);
+        std::printf("  speed-up of %d threads over %d: %.2fx\n", threads, gThreads[0],
+                    p.cpu[0].s / run.s);
       if (p.haveGpu)
-        std::printf("  GPU/CPU speed ratio (patches/s): %.2f\n", (p.gpu.patches() / p.gpu.s) / (run.patches() / run.s));
+        std::printf("  GPU/CPU speed ratio (patches/s): %.2f\n",
+                    (p.gpu.patches() / p.gpu.s) / (run.patches() / run.s));
     }
   }
   return p;
@@ -142,17 +149,21 @@ int main(int argc, char** argv) {
   if (resolution <= 0) resolution = scene.volume.resolution;
   std::unique_ptr<vk::Context> ctx;
   if (gpu) ctx = vk::Context::create();
-  std::printf("scene %s, light 0, WavefrontSettings defaults, GPU steps per dispatch %d, device %s\n",
-              scene_path.c_str(), gStepsPerDispatch, ctx ? ctx->deviceName().c_str() : "(no GPU)");
+  std::printf(
+      "scene %s, light 0, WavefrontSettings defaults, GPU steps per dispatch %d, device %s\n",
+      scene_path.c_str(), gStepsPerDispatch, ctx ? ctx->deviceName().c_str() : "(no GPU)");
 
   const Pair full = simulate(ctx.get(), scene, resolution, true, cpu);
-  std::printf("\nWithout straight steps at resolution %d (lower than %d: without skipping the full resolution "
-              "takes minutes per twin here):",
-              noSkipResolution, resolution);
+  std::printf(
+      "\nWithout straight steps at resolution %d (lower than %d: without skipping the full "
+      "resolution "
+      "takes minutes per twin here):",
+      noSkipResolution, resolution);
   const Pair low = simulate(ctx.get(), scene, noSkipResolution, false, cpu);
   std::printf("\nThe same resolution %d with straight steps, for the speed-up:", noSkipResolution);
   const Pair lowSkip = simulate(ctx.get(), scene, noSkipResolution, true, cpu);
-  std::printf("\nspeed-up of straight steps at resolution %d (time without / with):", noSkipResolution);
+  std::printf("\nspeed-up of straight steps at resolution %d (time without / with):",
+              noSkipResolution);
   if (gpu) std::printf(" GPU %.2fx", low.gpu.s / lowSkip.gpu.s);
   for (size_t i = 0; i < low.cpu.size(); ++i)
     std::printf(" CPU/%d %.2fx", gThreads[i], low.cpu[i].s / lowSkip.cpu[i].s);

@@ -43,10 +43,12 @@ int main(int argc, char** argv) {
   const std::filesystem::path src(EIKON_SOURCE_DIR);
   // 0. How well the Cauchy fields carry each library material (least-squares A + B/λ² + C/λ⁴ over
   //    380–780 nm, 1 nm samples): max |n_fit − n| and the Abbe number of the fit vs the model.
-  std::printf("0. Cauchy fit of the library materials over 380-780 nm (what the renderer carries)\n"
-              "   material          index   model          max|dn|   rms|dn|   V_d model  V_d fit\n");
+  std::printf(
+      "0. Cauchy fit of the library materials over 380-780 nm (what the renderer carries)\n"
+      "   material          index   model          max|dn|   rms|dn|   V_d model  V_d fit\n");
   std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(src / "materials")) files.push_back(e.path());
+  for (const auto& e : std::filesystem::directory_iterator(src / "materials"))
+    files.push_back(e.path());
   std::sort(files.begin(), files.end());
   for (const auto& f : files) {
     Material m = loadMaterialFile(f);
@@ -59,7 +61,8 @@ int main(int argc, char** argv) {
       };
       double vFit = (n(587.5618) - 1) / (n(486.1327) - n(656.2725));
       std::printf("   %-16s  %-5s  %-13.13s  %9.2e %9.2e  %9.2f  %7.2f\n", m.name.c_str(),
-                  m.uniaxial ? (k ? "n_e" : "n_o") : "n", d.describe().c_str(), fit.max_error, fit.rms_error, d.abbeNumber(), vFit);
+                  m.uniaxial ? (k ? "n_e" : "n_o") : "n", d.describe().c_str(), fit.max_error,
+                  fit.rms_error, d.abbeNumber(), vFit);
     }
   }
   std::printf("\n");
@@ -73,8 +76,10 @@ int main(int argc, char** argv) {
   t0 = std::chrono::steady_clock::now();
   ViewRenderer renderer(*ctx, scene, vol);
   double tSetup = seconds(t0);
-  std::printf("spectral_bench: scenes/prism_bk7.json, %dx%d, %d^3-class volume (voxelise %.2f s, upload %.2f s) on %s\n",
-              W, H, scene.volume.resolution, tVox, tSetup, ctx->deviceName().c_str());
+  std::printf(
+      "spectral_bench: scenes/prism_bk7.json, %dx%d, %d^3-class volume (voxelise %.2f s, upload "
+      "%.2f s) on %s\n",
+      W, H, scene.volume.resolution, tVox, tSetup, ctx->deviceName().c_str());
 
   auto render = [&](int n) {
     RenderSettings rs;
@@ -83,23 +88,28 @@ int main(int argc, char** argv) {
     rs.wavelengths = n;
     return renderer.render(rs);
   };
-  render(1);  // warm-up: the first render pays pipeline creation / shader JIT (13 s at 160x120 on lavapipe)
+  render(1);  // warm-up: the first render pays pipeline creation / shader JIT (13 s at 160x120 on
+              // lavapipe)
   std::vector<int> ns = {1, 2, 4, 8, 16, 32};
   std::vector<RenderImage> imgs;
   for (int n : ns) imgs.push_back(render(n));
   RenderImage ref = render(128);
 
-  std::printf("\n1. GPU cost of N wavelengths (march time, ratio to N = 1)\n   N   seconds   ratio   ns/ray\n");
+  std::printf(
+      "\n1. GPU cost of N wavelengths (march time, ratio to N = 1)\n   N   seconds   ratio   "
+      "ns/ray\n");
   const double t1 = imgs[0].seconds;
   for (size_t k = 0; k < ns.size(); ++k)
     std::printf("  %3d  %8.3f  %6.2f  %7.1f\n", ns[k], imgs[k].seconds, imgs[k].seconds / t1,
                 1e9 * imgs[k].seconds / (double(W) * H * ns[k]));
-  std::printf("  128  %8.3f  %6.2f  %7.1f\n", ref.seconds, ref.seconds / t1, 1e9 * ref.seconds / (double(W) * H * 128));
+  std::printf("  128  %8.3f  %6.2f  %7.1f\n", ref.seconds, ref.seconds / t1,
+              1e9 * ref.seconds / (double(W) * H * 128));
 
   // Colour error over the pixels where the reference shows the spectrum (luminance > 0.1; the
   // sky is 0.02): RMS of |ΔRGB| / mean reference luminance there, and the RMS chromaticity error.
-  std::printf("\n2. Colour error vs N (reference N = 128, spp 1, same pixel positions)\n"
-              "   N   rel. RMS |dRGB|   mean |dRGB|/lum   (pixels in the spectrum: ");
+  std::printf(
+      "\n2. Colour error vs N (reference N = 128, spp 1, same pixel positions)\n"
+      "   N   rel. RMS |dRGB|   mean |dRGB|/lum   (pixels in the spectrum: ");
   std::vector<size_t> mask;
   double lumSum = 0.0;
   for (size_t i = 0; i < size_t(W) * H; ++i)
@@ -124,15 +134,18 @@ int main(int argc, char** argv) {
                 s1 / double(mask.size()) / lumMean);
   }
 
-  std::printf("\n3. eikon vs POV-Ray 3.7 (same view, %dx%d, 1 sample per pixel, 16 wavelengths)\n", W, H);
+  std::printf("\n3. eikon vs POV-Ray 3.7 (same view, %dx%d, 1 sample per pixel, 16 wavelengths)\n",
+              W, H);
   if (std::system("command -v povray > /dev/null 2>&1") != 0) {
     std::printf("   povray not found on PATH: peer skipped (apt-get install povray to run it)\n");
     return 0;
   }
   const size_t k16 = 4;
-  std::filesystem::path out = std::filesystem::temp_directory_path() / "eikon_spectral_bench_povray.png";
-  std::string cmd = "povray +I" + (src / "bench/povray/prism_bk7.pov").string() + " +O" + out.string() + " +W" +
-                    std::to_string(W) + " +H" + std::to_string(H) + " -A -D -V +FN -GA > /dev/null 2>&1";
+  std::filesystem::path out =
+      std::filesystem::temp_directory_path() / "eikon_spectral_bench_povray.png";
+  std::string cmd = "povray +I" + (src / "bench/povray/prism_bk7.pov").string() + " +O" +
+                    out.string() + " +W" + std::to_string(W) + " +H" + std::to_string(H) +
+                    " -A -D -V +FN -GA > /dev/null 2>&1";
   t0 = std::chrono::steady_clock::now();
   int rc = std::system(cmd.c_str());
   double tPov = seconds(t0);
@@ -143,6 +156,7 @@ int main(int argc, char** argv) {
   const double tEikon = imgs[k16].seconds, tEikonAll = tVox + tSetup + tEikon;
   std::printf("   POV-Ray (parse + photons + trace, wall): %.3f s\n", tPov);
   std::printf("   eikon N = 16 march: %.3f s   -> eikon/POV-Ray %.2f\n", tEikon, tEikon / tPov);
-  std::printf("   eikon N = 16 incl. voxelise + upload: %.3f s -> eikon/POV-Ray %.2f\n", tEikonAll, tEikonAll / tPov);
+  std::printf("   eikon N = 16 incl. voxelise + upload: %.3f s -> eikon/POV-Ray %.2f\n", tEikonAll,
+              tEikonAll / tPov);
   return 0;
 }

@@ -1,7 +1,7 @@
 // The Beyerle–McDermid space mapping: makes the extraordinary wave pseudo-isotropic.
 //
-// Essay. The e-mode's index surface pᵀ M_e p = 1 (docs/design.md §2, M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e²)
-// is an ellipsoid in wave-vector space. With the symmetric positive matrix
+// Essay. The e-mode's index surface pᵀ M_e p = 1 (docs/design.md §2, M_e = aaᵀ/n_o² + (I −
+// aaᵀ)/n_e²) is an ellipsoid in wave-vector space. With the symmetric positive matrix
 //     γ = O·diag(1/n_e, 1/n_e, 1/n_o)·Oᵀ = aaᵀ/n_o + (I − aaᵀ)/n_e = M_e^{1/2}
 // (O any rotation whose third column is the optic axis a) the mapped wave vector p' = γp lies on
 // the UNIT sphere |p'| = 1. Beyerle & McDermid (Appl. Opt. 37:7947, 1998) use this to reduce

@@ -9,7 +9,8 @@ namespace {
 
 void requireFinite(const std::vector<double>& v, const char* what) {
   for (double x : v)
-    if (!std::isfinite(x)) throw std::invalid_argument(std::string(what) + ": coefficient is not finite");
+    if (!std::isfinite(x))
+      throw std::invalid_argument(std::string(what) + ": coefficient is not finite");
 }
 
 // Solve the 3x3 normal equations with partial pivoting.
@@ -19,7 +20,8 @@ std::array<double, 3> solve3(std::array<std::array<double, 4>, 3> m) {
     for (int r = col + 1; r < 3; ++r)
       if (std::abs(m[r][col]) > std::abs(m[piv][col])) piv = r;
     std::swap(m[col], m[piv]);
-    if (m[col][col] == 0.0) throw std::runtime_error("cauchyApproximation: singular normal equations");
+    if (m[col][col] == 0.0)
+      throw std::runtime_error("cauchyApproximation: singular normal equations");
     for (int r = 0; r < 3; ++r) {
       if (r == col) continue;
       double f = m[r][col] / m[col][col];
@@ -129,7 +131,8 @@ double Dispersion::derivative(double lambda_nm) const {
     }
     case Kind::Sellmeier: {
       double dn2 = 0.0;  // d/dλ of B λ²/(λ² − C) = −2 B C λ/(λ² − C)²
-      for (size_t i = 0; i < a_.size(); ++i) dn2 += -2.0 * a_[i] * c_[i] * l / ((l2 - c_[i]) * (l2 - c_[i]));
+      for (size_t i = 0; i < a_.size(); ++i)
+        dn2 += -2.0 * a_[i] * c_[i] * l / ((l2 - c_[i]) * (l2 - c_[i]));
       return dn2 / (2.0 * index(lambda_nm)) * 1e-3;
     }
     case Kind::Conrady:  // d/dλ of A λ⁻¹ + B λ^-3.5
@@ -139,7 +142,8 @@ double Dispersion::derivative(double lambda_nm) const {
 }
 
 CauchyApproximation Dispersion::cauchyApproximation(double lo_nm, double hi_nm) const {
-  if (!(lo_nm > 0 && hi_nm >= lo_nm)) throw std::invalid_argument("cauchyApproximation: bad window");
+  if (!(lo_nm > 0 && hi_nm >= lo_nm))
+    throw std::invalid_argument("cauchyApproximation: bad window");
   CauchyApproximation out;
   if (kind_ == Kind::Constant || (kind_ == Kind::Cauchy && a_.size() <= 3)) {
     for (size_t k = 0; k < a_.size(); ++k) out.coeffs[k] = a_[k];
@@ -152,7 +156,9 @@ CauchyApproximation Dispersion::cauchyApproximation(double lo_nm, double hi_nm) 
   // from 1.6e-4 to 2.6e-4 at the violet end, where the eye is least sensitive.
   std::array<std::array<double, 4>, 3> m{};
   const int samples = std::max(3, int(std::lround(hi_nm - lo_nm)) + 1);
-  auto weight = [](double lnm) { return std::exp(-0.5 * ((lnm - 560.0) / 80.0) * ((lnm - 560.0) / 80.0)) + 0.05; };
+  auto weight = [](double lnm) {
+    return std::exp(-0.5 * ((lnm - 560.0) / 80.0) * ((lnm - 560.0) / 80.0)) + 0.05;
+  };
   for (int i = 0; i < samples; ++i) {
     double lnm = lo_nm + (hi_nm - lo_nm) * i / double(samples - 1);
     double l2 = (lnm * 1e-3) * (lnm * 1e-3);
@@ -189,10 +195,23 @@ std::string Dispersion::describe() const {
     s << ']';
   };
   switch (kind_) {
-    case Kind::Constant: s << a_[0]; break;
-    case Kind::Cauchy: s << "cauchy"; list(a_); break;
-    case Kind::Sellmeier: s << "sellmeier B"; list(a_); s << " C"; list(c_); break;
-    case Kind::Conrady: s << "conrady"; list(a_); break;
+    case Kind::Constant:
+      s << a_[0];
+      break;
+    case Kind::Cauchy:
+      s << "cauchy";
+      list(a_);
+      break;
+    case Kind::Sellmeier:
+      s << "sellmeier B";
+      list(a_);
+      s << " C";
+      list(c_);
+      break;
+    case Kind::Conrady:
+      s << "conrady";
+      list(a_);
+      break;
   }
   return s.str();
 }

@@ -10,8 +10,8 @@
 // A model may carry the wavelength range over which its coefficients were measured; evaluating
 // outside it is the caller's decision (warning or error), never silently clamped here.
 //
-// The GPU stores Cauchy coefficient *fields* A(x), B(x), C(x) (docs/design.md §2, Dispersion), so every
-// model can produce the three Cauchy coefficients that represent it over a wavelength window:
+// The GPU stores Cauchy coefficient *fields* A(x), B(x), C(x) (docs/design.md §2, Dispersion), so
+// every model can produce the three Cauchy coefficients that represent it over a wavelength window:
 // exactly for Constant and Cauchy (≤ 3 terms), by least squares for Sellmeier and Conrady, with
 // the fit error reported so that callers can show it.
 //
@@ -19,7 +19,8 @@
 //   auto bk7 = eikon::Dispersion::sellmeier({1.03961212, 0.231792344, 1.01046945},
 //                                           {0.00600069867, 0.0200179144, 103.560653});
 //   double nd = bk7.index(587.5618);                       // 1.516800
-//   auto fit = bk7.cauchyApproximation(380.0, 780.0);       // fit.coeffs = {A, B, C}, fit.max_error
+//   auto fit = bk7.cauchyApproximation(380.0, 780.0);       // fit.coeffs = {A, B, C},
+//   fit.max_error
 //
 // Common mistakes: passing λ in µm to index(); giving Sellmeier Cᵢ as resonance wavelengths
 // (refractiveindex.info formula 1) instead of their squares (formula 2 / SCHOTT).
@@ -72,8 +73,8 @@ class Dispersion {
   double derivative(double lambda_nm) const;
 
   /// Cauchy {A,B,C} representing this model over [lo_nm, hi_nm]: exact when possible, else a
-  /// least-squares fit on 1 nm samples weighted towards 560 nm (see dispersion.cpp; docs/design.md §2
-  /// "report the fit error").
+  /// least-squares fit on 1 nm samples weighted towards 560 nm (see dispersion.cpp; docs/design.md
+  /// §2 "report the fit error").
   CauchyApproximation cauchyApproximation(double lo_nm, double hi_nm) const;
 
   /// Abbe number V_d = (n_d − 1)/(n_F − n_C) at the Fraunhofer d, F, C lines.

@@ -23,11 +23,14 @@ struct CV {
 CV cv(glm::dvec3 v) { return {v.x, v.y, v.z}; }
 CV operator+(CV a, CV b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 CV operator*(cd s, CV a) { return {s * a.x, s * a.y, s * a.z}; }
-CV cross(CV a, CV b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+CV cross(CV a, CV b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 cd dot(CV a, glm::dvec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 CV conj(CV a) { return {std::conj(a.x), std::conj(a.y), std::conj(a.z)}; }
 CV mul(const glm::dmat3& M, CV v) {  // glm is column-major: M[col][row]
-  return {M[0][0] * v.x + M[1][0] * v.y + M[2][0] * v.z, M[0][1] * v.x + M[1][1] * v.y + M[2][1] * v.z,
+  return {M[0][0] * v.x + M[1][0] * v.y + M[2][0] * v.z,
+          M[0][1] * v.x + M[1][1] * v.y + M[2][1] * v.z,
           M[0][2] * v.x + M[1][2] * v.y + M[2][2] * v.z};
 }
 double norm(CV a) { return std::sqrt(std::norm(a.x) + std::norm(a.y) + std::norm(a.z)); }
@@ -73,9 +76,12 @@ std::array<Wave, 2> isotropicWaves(glm::dvec3 p_t, glm::dvec3 m, double n, bool 
 }
 
 /// The o and e outgoing waves of a crystal.
-std::array<Wave, 2> crystalWaves(glm::dvec3 p_t, glm::dvec3 m, const Uniaxial& c, bool transmitted) {
-  const CV po = cv(p_t) + outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Ordinary), transmitted) * cv(m);
-  const CV pe = cv(p_t) + outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Extraordinary), transmitted) * cv(m);
+std::array<Wave, 2> crystalWaves(glm::dvec3 p_t, glm::dvec3 m, const Uniaxial& c,
+                                 bool transmitted) {
+  const CV po =
+      cv(p_t) + outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Ordinary), transmitted) * cv(m);
+  const CV pe =
+      cv(p_t) + outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Extraordinary), transmitted) * cv(m);
   const CV a = cv(c.axis);
   const glm::dmat3 eps_inv = glm::inverse(c.epsilon());
   CV Eo = cross(po, a);
@@ -97,7 +103,9 @@ std::array<double, 4> solveBoundary(const Wave& in, const std::array<Wave, 2>& o
   const glm::dvec3 e1 = anyPerpendicular(m), e2 = glm::cross(m, e1);
   const std::array<const Wave*, 4> cols{&out1[0], &out1[1], &out2[0], &out2[1]};
   std::array<std::array<cd, 5>, 4> a{};
-  auto rows = [&](const Wave& w) { return std::array<cd, 4>{dot(w.E, e1), dot(w.E, e2), dot(w.H, e1), dot(w.H, e2)}; };
+  auto rows = [&](const Wave& w) {
+    return std::array<cd, 4>{dot(w.E, e1), dot(w.E, e2), dot(w.H, e1), dot(w.H, e2)};
+  };
   for (size_t c = 0; c < 4; ++c) {
     const auto r = rows(*cols[c]);
     const double sign = c < 2 ? 1.0 : -1.0;  // side-1 fields add to the incident one
@@ -110,7 +118,8 @@ std::array<double, 4> solveBoundary(const Wave& in, const std::array<Wave, 2>& o
     for (size_t r = col + 1; r < 4; ++r)
       if (std::abs(a[r][col]) > std::abs(a[piv][col])) piv = r;
     std::swap(a[col], a[piv]);
-    if (std::abs(a[col][col]) == 0.0) throw std::runtime_error("uniaxial Fresnel: singular boundary system");
+    if (std::abs(a[col][col]) == 0.0)
+      throw std::runtime_error("uniaxial Fresnel: singular boundary system");
     for (size_t r = 0; r < 4; ++r) {
       if (r == col) continue;
       const cd f = a[r][col] / a[col][col];
@@ -128,7 +137,8 @@ std::array<double, 4> solveBoundary(const Wave& in, const std::array<Wave, 2>& o
 
 glm::dvec3 unitNormal(glm::dvec3 normal, glm::dvec3 flow) {
   const double len = glm::length(normal);
-  if (!(len > 0.0) || !std::isfinite(len)) throw std::invalid_argument("Fresnel: normal has zero length");
+  if (!(len > 0.0) || !std::isfinite(len))
+    throw std::invalid_argument("Fresnel: normal has zero length");
   const glm::dvec3 m = normal / len;
   return glm::dot(m, flow) < 0.0 ? -m : m;
 }
@@ -190,7 +200,8 @@ glm::dvec3 displacementDirection(const Uniaxial& c, Mode mode, glm::dvec3 s) {
   return mode == Mode::Ordinary ? d_o : glm::normalize(glm::cross(u, d_o));
 }
 
-ModeSplit uniaxialEntryExact(glm::dvec3 s_in, glm::dvec3 normal, double n1, const Uniaxial& crystal) {
+ModeSplit uniaxialEntryExact(glm::dvec3 s_in, glm::dvec3 normal, double n1,
+                             const Uniaxial& crystal) {
   requirePositive(n1, "n1");
   const glm::dvec3 u = glm::normalize(s_in);
   const glm::dvec3 m = unitNormal(normal, u);
@@ -198,7 +209,8 @@ ModeSplit uniaxialEntryExact(glm::dvec3 s_in, glm::dvec3 normal, double n1, cons
   const auto refl = isotropicWaves(p_t, m, n1, false);
   const auto trans = crystalWaves(p_t, m, crystal, true);
   const CV es = cv(sDirection(p_t, m));
-  const std::array<Wave, 2> incident{makeWave(cv(p_in), es), makeWave(cv(p_in), cross(cv(p_in), es))};
+  const std::array<Wave, 2> incident{makeWave(cv(p_in), es),
+                                     makeWave(cv(p_in), cross(cv(p_in), es))};
   ModeSplit out;
   for (const Wave& in : incident) {  // unpolarised = mean over two orthogonal polarisations
     const auto f = solveBoundary(in, refl, trans, m);
@@ -228,7 +240,8 @@ ModeSplit uniaxialExitExact(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in,
   return out;
 }
 
-ModeSplit uniaxialEntryApprox(glm::dvec3 s_in, glm::dvec3 normal, double n1, const Uniaxial& crystal) {
+ModeSplit uniaxialEntryApprox(glm::dvec3 s_in, glm::dvec3 normal, double n1,
+                              const Uniaxial& crystal) {
   requirePositive(n1, "n1");
   const glm::dvec3 u = glm::normalize(s_in);
   const glm::dvec3 m = unitNormal(normal, u);

@@ -78,9 +78,11 @@ struct ModeSplit {
 };
 
 /// Exact: isotropic n1 → crystal, unpolarised incidence (Maxwell boundary conditions).
-ModeSplit uniaxialEntryExact(glm::dvec3 s_in, glm::dvec3 normal, double n1, const Uniaxial& crystal);
+ModeSplit uniaxialEntryExact(glm::dvec3 s_in, glm::dvec3 normal, double n1,
+                             const Uniaxial& crystal);
 /// Approximation (D-projection per mode, see essay). Reduces exactly to isotropic when n_o = n_e.
-ModeSplit uniaxialEntryApprox(glm::dvec3 s_in, glm::dvec3 normal, double n1, const Uniaxial& crystal);
+ModeSplit uniaxialEntryApprox(glm::dvec3 s_in, glm::dvec3 normal, double n1,
+                              const Uniaxial& crystal);
 /// Exact: a `mode` wave inside the crystal hits the surface; n2 outside. TIR → transmitted 0.
 ModeSplit uniaxialExitExact(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in, glm::dvec3 normal,
                             double n2);

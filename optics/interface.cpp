@@ -9,7 +9,8 @@ namespace {
 /// Unit normal oriented along `flow` (the incident energy direction).
 glm::dvec3 orient(glm::dvec3 normal, glm::dvec3 flow) {
   const double len = glm::length(normal);
-  if (!(len > 0.0) || !std::isfinite(len)) throw std::invalid_argument("interface: normal has zero length");
+  if (!(len > 0.0) || !std::isfinite(len))
+    throw std::invalid_argument("interface: normal has zero length");
   glm::dvec3 m = normal / len;
   return glm::dot(m, flow) < 0.0 ? -m : m;
 }
@@ -38,7 +39,8 @@ ModeWave solveInterfaceMode(glm::dvec3 p_t, glm::dvec3 m, const glm::dmat3& M, b
   return w;
 }
 
-ModePair refractIntoUniaxial(glm::dvec3 s_in, glm::dvec3 normal, double n1, const Uniaxial& crystal) {
+ModePair refractIntoUniaxial(glm::dvec3 s_in, glm::dvec3 normal, double n1,
+                             const Uniaxial& crystal) {
   const glm::dvec3 u = glm::normalize(s_in);
   const glm::dvec3 m = orient(normal, u);
   const glm::dvec3 pt = tangential(n1 * u, m);
@@ -46,20 +48,22 @@ ModePair refractIntoUniaxial(glm::dvec3 s_in, glm::dvec3 normal, double n1, cons
           solveInterfaceMode(pt, m, crystal.hamiltonianMatrix(Mode::Extraordinary), true)};
 }
 
-ModeWave refractOutOfUniaxial(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in, glm::dvec3 normal,
-                              double n2) {
+ModeWave refractOutOfUniaxial(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in,
+                              glm::dvec3 normal, double n2) {
   const glm::dvec3 u = glm::normalize(s_in);
   const glm::dvec3 m = orient(normal, crystal.rayDirection(mode, u));
   const glm::dvec3 pt = tangential(crystal.index(mode, u) * u, m);
   return solveInterfaceMode(pt, m, isotropicM(n2), true);
 }
 
-ModeWave reflectInsideUniaxial(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in, glm::dvec3 normal) {
+ModeWave reflectInsideUniaxial(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in,
+                               glm::dvec3 normal) {
   const ModePair both = reflectInsideUniaxialBoth(crystal, mode, s_in, normal);
   return mode == Mode::Ordinary ? both.o : both.e;
 }
 
-ModePair reflectInsideUniaxialBoth(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in, glm::dvec3 normal) {
+ModePair reflectInsideUniaxialBoth(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in,
+                                   glm::dvec3 normal) {
   const glm::dvec3 u = glm::normalize(s_in);
   const glm::dvec3 m = orient(normal, crystal.rayDirection(mode, u));
   const glm::dvec3 pt = tangential(crystal.index(mode, u) * u, m);

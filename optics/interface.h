@@ -5,9 +5,10 @@
 // (phase matching; Born & Wolf §1.5.1 for isotropic media, §15.3 for crystals). Write every
 // outgoing wave as p = p_t + q m, with p_t the incident wave vector's tangential part (p = n s
 // in units of k₀ = ω/c; |p| is the index the wave sees). Each mode satisfies its dispersion
-// relation pᵀ M p = 1 (docs/design.md §2: M_o = I/n_o², M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e², M = I/n² in an
-// isotropic medium), which is a quadratic in q:
-//     A q² + B q + C = 0,  A = mᵀMm,  B = 2 p_tᵀMm,  C = p_tᵀMp_t − 1      (docs/reference-cases.md §3).
+// relation pᵀ M p = 1 (docs/design.md §2: M_o = I/n_o², M_e = aaᵀ/n_o² + (I − aaᵀ)/n_e², M = I/n²
+// in an isotropic medium), which is a quadratic in q:
+//     A q² + B q + C = 0,  A = mᵀMm,  B = 2 p_tᵀMm,  C = p_tᵀMp_t − 1      (docs/reference-cases.md
+//     §3).
 // The ray (energy) velocity is M p (∝ εs for the e-mode, §8), and its normal component
 // (Mp)·m = ±½√(B² − 4AC) for the two roots. So the root that carries energy ACROSS the interface
 // (transmission) is q = (−B + √disc)/(2A) and the reflected one is q = (−B − √disc)/(2A) — the
@@ -25,7 +26,8 @@
 //     returns the same-mode reflected wave only (docs/design.md §2: a later refinement). Fresnel
 //     amplitudes are in fresnel.h.
 //
-// Worked example (docs/reference-cases.md §3: air → calcite at D, i = 30°, axis ∥ surface, in plane):
+// Worked example (docs/reference-cases.md §3: air → calcite at D, i = 30°, axis ∥ surface, in
+// plane):
 //   eikon::Uniaxial calcite(1.658344, 1.486130, {1, 0, 0});
 //   glm::dvec3 s_in{std::sin(pi/6), 0, std::cos(pi/6)};
 //   auto w = eikon::refractIntoUniaxial(s_in, {0, 0, 1}, 1.0, calcite);
@@ -48,11 +50,11 @@ namespace eikon {
 
 /// One outgoing plane wave of a given mode.
 struct ModeWave {
-  bool exists = false;   ///< false: evanescent (TIR for this mode); other fields then zero
-  glm::dvec3 s{0.0};     ///< unit wave normal
-  double n = 0.0;        ///< effective index |p| (n(θ) for an e-wave)
-  glm::dvec3 t{0.0};     ///< unit ray (Poynting) direction, t ∝ M p
-  double q = 0.0;        ///< normal component p·m, m oriented along the incident energy flow
+  bool exists = false;  ///< false: evanescent (TIR for this mode); other fields then zero
+  glm::dvec3 s{0.0};    ///< unit wave normal
+  double n = 0.0;       ///< effective index |p| (n(θ) for an e-wave)
+  glm::dvec3 t{0.0};    ///< unit ray (Poynting) direction, t ∝ M p
+  double q = 0.0;       ///< normal component p·m, m oriented along the incident energy flow
   glm::dvec3 p() const { return n * s; }  ///< wave vector in units of k₀
 };
 
@@ -68,19 +70,22 @@ struct ModePair {
 ModeWave solveInterfaceMode(glm::dvec3 p_t, glm::dvec3 m, const glm::dmat3& M, bool transmitted);
 
 /// Isotropic (index n1) → uniaxial crystal: the refracted o- and e-waves.
-ModePair refractIntoUniaxial(glm::dvec3 s_in, glm::dvec3 normal, double n1, const Uniaxial& crystal);
+ModePair refractIntoUniaxial(glm::dvec3 s_in, glm::dvec3 normal, double n1,
+                             const Uniaxial& crystal);
 
 /// Crystal → isotropic (index n2): the transmitted wave of an incident `mode` wave with wave
 /// normal `s_in` (energy direction decides which side it leaves through). exists = false on TIR.
-ModeWave refractOutOfUniaxial(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in, glm::dvec3 normal,
-                              double n2);
+ModeWave refractOutOfUniaxial(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in,
+                              glm::dvec3 normal, double n2);
 
 /// Reflection inside the crystal, same mode (o→o, e→e; mode conversion ignored).
-ModeWave reflectInsideUniaxial(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in, glm::dvec3 normal);
+ModeWave reflectInsideUniaxial(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in,
+                               glm::dvec3 normal);
 
 /// Both reflected modes inside the crystal for an incident `mode` wave (o→o, o→e or e→o, e→e):
 /// the directions exist even though fresnel.h decides how much power each gets.
-ModePair reflectInsideUniaxialBoth(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in, glm::dvec3 normal);
+ModePair reflectInsideUniaxialBoth(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in,
+                                   glm::dvec3 normal);
 
 /// Isotropic → isotropic Snell refraction (n1 → n2); exists = false on TIR.
 ModeWave refractIsotropic(glm::dvec3 s_in, glm::dvec3 normal, double n1, double n2);

@@ -49,19 +49,22 @@ PleochroismWeights pleochroismWeights(double theta_rad, double n_o, double n_e,
                                       PleochroismModel model = PleochroismModel::FirstOrder);
 
 /// e-wave intensity attenuation per unit length along the wave normal at angle θ.
-double extraordinaryAttenuation(double theta_rad, double n_o, double n_e, double sigma_o, double sigma_e,
+double extraordinaryAttenuation(double theta_rad, double n_o, double n_e, double sigma_o,
+                                double sigma_e,
                                 PleochroismModel model = PleochroismModel::FirstOrder);
 /// Per-band (RGB or any 3 bands) version.
 glm::dvec3 extraordinaryAttenuation(double theta_rad, double n_o, double n_e, glm::dvec3 sigma_o,
-                                    glm::dvec3 sigma_e, PleochroismModel model = PleochroismModel::FirstOrder);
+                                    glm::dvec3 sigma_e,
+                                    PleochroismModel model = PleochroismModel::FirstOrder);
 
 /// Attenuation of `mode` for wave normal s, per unit length along the wave normal.
-glm::dvec3 attenuationPerWaveNormalLength(const Uniaxial& c, Mode mode, glm::dvec3 s, glm::dvec3 sigma_o,
-                                          glm::dvec3 sigma_e,
+glm::dvec3 attenuationPerWaveNormalLength(const Uniaxial& c, Mode mode, glm::dvec3 s,
+                                          glm::dvec3 sigma_o, glm::dvec3 sigma_e,
                                           PleochroismModel model = PleochroismModel::FirstOrder);
 /// Same per unit length along the RAY: × cos ρ (what a ray-marching renderer should use).
 glm::dvec3 attenuationPerRayLength(const Uniaxial& c, Mode mode, glm::dvec3 s, glm::dvec3 sigma_o,
-                                   glm::dvec3 sigma_e, PleochroismModel model = PleochroismModel::FirstOrder);
+                                   glm::dvec3 sigma_e,
+                                   PleochroismModel model = PleochroismModel::FirstOrder);
 
 /// Beer–Lambert transmittance exp(−σL) per band.
 glm::dvec3 transmittance(glm::dvec3 sigma, double length);

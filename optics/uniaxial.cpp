@@ -67,7 +67,8 @@ double Uniaxial::walkOffAngle(glm::dvec3 s) const {
 }
 
 double Uniaxial::walkOffAngleAt(double theta_rad) const {
-  const double theta_r = std::atan2(n_o * n_o * std::sin(theta_rad), n_e * n_e * std::cos(theta_rad));
+  const double theta_r =
+      std::atan2(n_o * n_o * std::sin(theta_rad), n_e * n_e * std::cos(theta_rad));
   return theta_r - theta_rad;
 }
 
@@ -86,6 +87,8 @@ double Uniaxial::hamiltonian(Mode mode, glm::dvec3 p) const {
   return 0.5 * (glm::dot(p, hamiltonianMatrix(mode) * p) - 1.0);
 }
 
-glm::dvec3 Uniaxial::rayVelocity(Mode mode, glm::dvec3 p) const { return hamiltonianMatrix(mode) * p; }
+glm::dvec3 Uniaxial::rayVelocity(Mode mode, glm::dvec3 p) const {
+  return hamiltonianMatrix(mode) * p;
+}
 
 }  // namespace eikon

@@ -6,13 +6,13 @@
 // k = k₀ n s) splits into two modes:
 //   * o (ordinary):      index n_o for every s; D ⊥ the principal plane (s, a); ray ∥ s.
 //   * e (extraordinary): index n(θ), 1/n(θ)² = cos²θ/n_o² + sin²θ/n_e²   (Born & Wolf §15.3.3,
-//                        eq. (15.3.24); docs/reference-cases.md §1), θ = angle between the WAVE NORMAL
-//                        s and the optic axis a (NOT the ray); D in the principal plane.
+//                        eq. (15.3.24); docs/reference-cases.md §1), θ = angle between the WAVE
+//                        NORMAL s and the optic axis a (NOT the ray); D in the principal plane.
 // The e-ray (Poynting vector, energy direction) is t = εs/|εs| (Beyerle & McDermid 1998,
 // Appl. Opt. 37:7947, eq. for the ray vector; Tevs 2007 appendix A.2; docs/reference-cases.md §8).
 // It differs from s by the walk-off angle ρ, tan ρ = (n_o² − n_e²) sinθ cosθ /
-// (n_e² cos²θ + n_o² sin²θ) = −(1/n) dn/dθ (docs/reference-cases.md §2), and lies in the plane (s, a).
-// In a negative crystal (calcite, n_e < n_o) the e-ray bends AWAY from the optic axis; in a
+// (n_e² cos²θ + n_o² sin²θ) = −(1/n) dn/dθ (docs/reference-cases.md §2), and lies in the plane (s,
+// a). In a negative crystal (calcite, n_e < n_o) the e-ray bends AWAY from the optic axis; in a
 // positive one (quartz, rutile) TOWARDS it.
 //
 // Hamiltonian form (docs/design.md §2). With p = ∇S (|p| = the index the wave sees, p = n s), each
@@ -46,8 +46,8 @@ enum class Mode { Ordinary, Extraordinary };
 /// A homogeneous uniaxial crystal at one wavelength. Dimensionless indices; the axis is a unit
 /// vector after construction (the sign of the axis is irrelevant to every result).
 struct Uniaxial {
-  double n_o = 1.0;              ///< ordinary index (E ⊥ axis)
-  double n_e = 1.0;              ///< principal extraordinary index (E ∥ axis)
+  double n_o = 1.0;                ///< ordinary index (E ⊥ axis)
+  double n_e = 1.0;                ///< principal extraordinary index (E ∥ axis)
   glm::dvec3 axis{0.0, 0.0, 1.0};  ///< unit optic axis a
 
   /// Validates and normalises. Throws std::invalid_argument when n_o or n_e is not finite or

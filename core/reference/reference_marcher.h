@@ -28,7 +28,9 @@ class AnalyticField : public Field {
   using IndexFn = std::function<void(const glm::dvec3&, double&, glm::dvec3&)>;
   AnalyticField(IndexFn fn, glm::dvec3 bmin, glm::dvec3 bmax, double cell)
       : fn_(std::move(fn)), bmin_(bmin), bmax_(bmax), cell_(cell) {}
-  void index(const glm::dvec3& x, double, double, double& n, glm::dvec3& grad) const override { fn_(x, n, grad); }
+  void index(const glm::dvec3& x, double, double, double& n, glm::dvec3& grad) const override {
+    fn_(x, n, grad);
+  }
   glm::dvec4 medium(const glm::dvec3&) const override { return glm::dvec4(0.0); }
   glm::dvec3 emission(const glm::dvec3&) const override { return glm::dvec3(0.0); }
   double skipDistance(const glm::dvec3&) const override { return 0.0; }
@@ -53,8 +55,8 @@ class ReferenceMarcher {
 
  private:
   struct Result;
-  Result march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar, const MarchSettings& m,
-               int mode) const;
+  Result march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar,
+               const MarchSettings& m, int mode) const;
   const Field& field_;
   const Environment& env_;
 };

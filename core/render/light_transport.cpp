@@ -5,8 +5,8 @@
 
 namespace eikon {
 
-LightingSummary simulateLighting(vk::Context& ctx, const Scene& scene, VolumeSet& volume, const LightingOptions& options,
-                                 int steps_per_dispatch) {
+LightingSummary simulateLighting(vk::Context& ctx, const Scene& scene, VolumeSet& volume,
+                                 const LightingOptions& options, int steps_per_dispatch) {
   // The patch list is one storage buffer: the budget cannot exceed what the device holds in one
   // (lavapipe: 128 MiB = 838,860 patches of 160 B). Lowered, and said so, rather than failing a
   // render when the wavefront grows.
@@ -14,14 +14,16 @@ LightingSummary simulateLighting(vk::Context& ctx, const Scene& scene, VolumeSet
   std::vector<std::string> notes;
   const size_t fits = size_t(ctx.limits().max_storage_buffer_range / sizeof(gpu::WavePatch));
   if (size_t(o.wave.max_patches) > fits) {
-    notes.push_back("patch budget lowered from " + std::to_string(o.wave.max_patches) + " to " + std::to_string(fits) +
+    notes.push_back("patch budget lowered from " + std::to_string(o.wave.max_patches) + " to " +
+                    std::to_string(fits) +
                     ": the device's storage buffers hold at most that many patches");
     o.wave.max_patches = int(fits);
   }
   // The simulator reads the volume's medium fields only, so the light volumes are filled in place.
-  LightingSummary sum = simulateLightingWith(scene, volume, o, [&](const WavefrontSettings& s, const Light& light) {
-    return GpuWavefront(ctx, volume, s, steps_per_dispatch).run(light);
-  });
+  LightingSummary sum =
+      simulateLightingWith(scene, volume, o, [&](const WavefrontSettings& s, const Light& light) {
+        return GpuWavefront(ctx, volume, s, steps_per_dispatch).run(light);
+      });
   sum.notes.insert(sum.notes.begin(), notes.begin(), notes.end());
   return sum;
 }

@@ -18,7 +18,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 void validate(const MarchSettings& m) {
-  if (!(m.step_voxels > 0 && m.step_voxels <= 4)) throw std::invalid_argument("march step must be in (0, 4] voxels");
+  if (!(m.step_voxels > 0 && m.step_voxels <= 4))
+    throw std::invalid_argument("march step must be in (0, 4] voxels");
   if (m.max_steps < 1) throw std::invalid_argument("max_steps must be >= 1");
   if (!(m.interface_threshold > 0)) throw std::invalid_argument("interface threshold must be > 0");
 }
@@ -30,14 +31,16 @@ void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scen
   for (int a = 0; a < 3; ++a)
     if (uint32_t(grid.dims[size_t(a)]) > lim.max_image_dimension_3d)
       throw std::runtime_error(scene.file.string() + ": /volume/resolution: the volume needs " +
-                               std::to_string(grid.dims[0]) + "x" + std::to_string(grid.dims[1]) + "x" +
-                               std::to_string(grid.dims[2]) + " voxels but the device '" + ctx.deviceName() +
-                               "' allows at most " + std::to_string(lim.max_image_dimension_3d) + " per side");
+                               std::to_string(grid.dims[0]) + "x" + std::to_string(grid.dims[1]) +
+                               "x" + std::to_string(grid.dims[2]) + " voxels but the device '" +
+                               ctx.deviceName() + "' allows at most " +
+                               std::to_string(lim.max_image_dimension_3d) + " per side");
   // Images: 3 index fields + medium + emission (+ 3 e-index, medium e, axis when uniaxial)
   // (+ scatter when a material has an albedo, + 2 light volumes when the scene has lights).
   size_t images = scene.anyUniaxial() ? 10 : 5;
   bool scattering = false;
-  for (const auto& [name, m] : scene.materials) scattering = scattering || glm::length(m.albedo) > 0;
+  for (const auto& [name, m] : scene.materials)
+    scattering = scattering || glm::length(m.albedo) > 0;
   if (scattering) images += 1;
   if (!scene.lights.empty()) images += 2;
   double bytes = double(grid.count()) * 16.0 * double(images);
@@ -45,7 +48,8 @@ void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scen
   if (scene.interfaces == Scene::Interfaces::Sharp) bytes += double(grid.count()) * 8.0;
   if (bytes > 0.9 * double(lim.heap_size))
     throw std::runtime_error(scene.file.string() + ": /volume/resolution: the volume needs " +
-                             std::to_string(int64_t(bytes / (1 << 20))) + " MiB of device memory but the device heap has " +
+                             std::to_string(int64_t(bytes / (1 << 20))) +
+                             " MiB of device memory but the device heap has " +
                              std::to_string(lim.heap_size >> 20) + " MiB; lower the resolution");
 }
 
@@ -58,14 +62,16 @@ struct ViewRenderer::Impl {
   bool sharp = false;  // march region by region (shaders/sharp.glsl), as the CPU twin does
   // [oA, oB, oC, (eA, eB, eC), medO, (medE), emission, (axis), (scatter), (fluence, flux)]
   std::vector<vk::Image3D> images;
-  size_t scatterImage = 0, fluenceImage = 0, fluxImage = 0;  // 0: not present (index A bound instead)
+  size_t scatterImage = 0, fluenceImage = 0,
+         fluxImage = 0;  // 0: not present (index A bound instead)
   vk::Buffer params, env, tables;
   BoundaryDevice boundary;  // the sharp-boundary field (placeholders when smoothed)
   vk::ComputePipeline view, tracer;
   int skip_cap = 32;
   double ambient = 1.0;
 
-  Impl(vk::Context& context, const Scene& s, const VolumeSet& v) : ctx(context), scene(s), grid(v.grid) {
+  Impl(vk::Context& context, const Scene& s, const VolumeSet& v)
+      : ctx(context), scene(s), grid(v.grid) {
     checkVolumeFits(ctx, grid, scene);
     uniaxial = v.uniaxial;
     dispersive = v.dispersive;
@@ -76,7 +82,8 @@ struct ViewRenderer::Impl {
     lit = v.lit();
     skip_cap = v.skip_cap;
     ambient = v.ambient_index;
-    std::array<uint32_t, 3> ext{uint32_t(grid.dims[0]), uint32_t(grid.dims[1]), uint32_t(grid.dims[2])};
+    std::array<uint32_t, 3> ext{uint32_t(grid.dims[0]), uint32_t(grid.dims[1]),
+                                uint32_t(grid.dims[2])};
     auto upload = [&](const std::vector<glm::vec4>& data, const char* name) {
       vk::Image3D img(ctx, ext, VK_FORMAT_R32G32B32A32_SFLOAT, name);
       img.upload(ctx, data.data(), data.size() * sizeof(glm::vec4));
@@ -105,10 +112,12 @@ struct ViewRenderer::Impl {
 
     boundary = BoundaryDevice(ctx, v.boundary, v.media, scene.file.string());
     sharp = !v.boundary.empty() && !v.media.empty();
-    params = vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
+    params =
+        vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
     const auto& e = scene.environment;
     if (e.type == Environment::Type::LatLong) {
-      env = vk::Buffer(ctx, e.image_rgba.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "environment");
+      env = vk::Buffer(ctx, e.image_rgba.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                       "environment");
       env.write(e.image_rgba.data(), e.image_rgba.size() * sizeof(float));
     } else {
       env = vk::Buffer(ctx, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "environment (unused)");
@@ -116,34 +125,46 @@ struct ViewRenderer::Impl {
       env.write(zero, 16);
     }
     std::vector<glm::vec4> tab(EIKON_TABLE_COUNT, glm::vec4(0.0f));
-    for (int i = 0; i < EIKON_CMF_COUNT; ++i) tab[size_t(EIKON_CMF_OFFSET + i)] = glm::vec4(glm::vec3(spectrum::cmfTableRow(i)), 0.0f);
+    for (int i = 0; i < EIKON_CMF_COUNT; ++i)
+      tab[size_t(EIKON_CMF_OFFSET + i)] = glm::vec4(glm::vec3(spectrum::cmfTableRow(i)), 0.0f);
     const auto& basis = spectrum::basisTable();
     for (int i = 0; i < EIKON_BASIS_COUNT; ++i)
-      tab[size_t(EIKON_BASIS_OFFSET + i)] = glm::vec4(basis[size_t(3 * i)], basis[size_t(3 * i + 1)], basis[size_t(3 * i + 2)], 0.0f);
+      tab[size_t(EIKON_BASIS_OFFSET + i)] =
+          glm::vec4(basis[size_t(3 * i)], basis[size_t(3 * i + 1)], basis[size_t(3 * i + 2)], 0.0f);
     glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
-    for (int r = 0; r < 3; ++r) tab[size_t(EIKON_MATRIX_OFFSET + r)] = glm::vec4(float(M[0][r]), float(M[1][r]), float(M[2][r]), 0.0f);
-    tables = vk::Buffer(ctx, tab.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "spectral tables");
+    for (int r = 0; r < 3; ++r)
+      tab[size_t(EIKON_MATRIX_OFFSET + r)] =
+          glm::vec4(float(M[0][r]), float(M[1][r]), float(M[2][r]), 0.0f);
+    tables = vk::Buffer(ctx, tab.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                        "spectral tables");
     tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
 
     std::vector<vk::BindingSpec> common;
-    for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b) common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t b : {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
+    for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE), uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
+    for (uint32_t b :
+         {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
+                       uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
     for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
     // constant_id 0 (march.glsl kSharpMarch): the sharp or the smoothed march, not both.
     const std::vector<uint32_t> spec{sharp ? 1u : 0u};
-    view = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4), common, 0, "view", spec);
+    view = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4),
+                               common, 0, "view", spec);
     auto traceBindings = common;
     traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    tracer = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4), traceBindings, 0, "trace", spec);
+    tracer =
+        vk::ComputePipeline(ctx, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4),
+                            traceBindings, 0, "trace", spec);
     for (auto* p : {&view, &tracer}) bindCommon(*p);
   }
 
   void bindCommon(vk::ComputePipeline& p) {
     size_t oA = 0, eA = uniaxial ? 3 : 0;
-    size_t medO = uniaxial ? 6 : 3, medE = uniaxial ? 7 : 3, emi = uniaxial ? 8 : 4, axis = uniaxial ? 9 : 4;
+    size_t medO = uniaxial ? 6 : 3, medE = uniaxial ? 7 : 3, emi = uniaxial ? 8 : 4,
+           axis = uniaxial ? 9 : 4;
     p.bindImage(EIKON_B_INDEX_O_A, images[oA]);
     p.bindImage(EIKON_B_INDEX_O_B, images[oA + 1]);
     p.bindImage(EIKON_B_INDEX_O_C, images[oA + 2]);
@@ -169,7 +190,8 @@ struct ViewRenderer::Impl {
     glm::dvec3 fwd = glm::normalize(cam.look_at - cam.position);
     glm::dvec3 right = glm::normalize(glm::cross(fwd, cam.up));
     glm::dvec3 up = glm::cross(right, fwd);
-    p.cam_pos = glm::vec4(glm::vec3(cam.position), float(std::tan(0.5 * cam.fov_deg * kPi / 180.0)));
+    p.cam_pos =
+        glm::vec4(glm::vec3(cam.position), float(std::tan(0.5 * cam.fov_deg * kPi / 180.0)));
     p.cam_forward = glm::vec4(glm::vec3(fwd), float(double(cam.width) / cam.height));
     p.cam_right = glm::vec4(glm::vec3(right), 0.0f);
     p.cam_up = glm::vec4(glm::vec3(up), 0.0f);
@@ -187,13 +209,16 @@ struct ViewRenderer::Impl {
     if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
     if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
-    p.march = glm::vec4(float(m.step_voxels), float(m.interface_threshold), float(ambient), float(int(m.integrator)));
+    p.march = glm::vec4(float(m.step_voxels), float(m.interface_threshold), float(ambient),
+                        float(int(m.integrator)));
     p.limits = glm::ivec4(m.max_steps, 1, 1, skip_cap);
     const auto& e = scene.environment;
-    int type = e.type == Environment::Type::Checker ? EIKON_ENV_CHECKER
-               : e.type == Environment::Type::Constant ? EIKON_ENV_CONSTANT : EIKON_ENV_LATLONG;
+    int type = e.type == Environment::Type::Checker    ? EIKON_ENV_CHECKER
+               : e.type == Environment::Type::Constant ? EIKON_ENV_CONSTANT
+                                                       : EIKON_ENV_LATLONG;
     p.env = glm::vec4(float(type), float(e.squares), float(e.intensity), 0.0f);
-    p.env_a = glm::vec4(glm::vec3(e.type == Environment::Type::Constant ? e.radiance : e.color_a), 0.0f);
+    p.env_a =
+        glm::vec4(glm::vec3(e.type == Environment::Type::Constant ? e.radiance : e.color_a), 0.0f);
     p.env_b = glm::vec4(glm::vec3(e.color_b), 0.0f);
     p.env_size = glm::ivec4(e.image_width, e.image_height, 0, 0);
     return p;
@@ -210,9 +235,11 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   RenderImage img;
   img.width = s.width > 0 ? s.width : I.scene.camera.width;
   img.height = s.height > 0 ? s.height : I.scene.camera.height;
-  if (img.width > 16384 || img.height > 16384) throw std::invalid_argument("image larger than 16384 pixels per side");
+  if (img.width > 16384 || img.height > 16384)
+    throw std::invalid_argument("image larger than 16384 pixels per side");
   if (s.spp < 1 || s.spp > 4096) throw std::invalid_argument("spp must be in [1, 4096]");
-  if (s.wavelengths < 0 || s.wavelengths > 256) throw std::invalid_argument("wavelengths must be in [0, 256]");
+  if (s.wavelengths < 0 || s.wavelengths > 256)
+    throw std::invalid_argument("wavelengths must be in [0, 256]");
   gpu::ViewParams p = I.baseParams(s.march, s.wavelengths > 0 ? EIKON_F_SPECTRAL : 0);
   // Keep the camera's aspect from the requested image size.
   p.cam_forward.w = float(double(img.width) / img.height);
@@ -243,7 +270,8 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
     p.image = glm::ivec4(img.width, img.height, y0, n);
     I.params.write(&p, sizeof p);
     I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
-      I.view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X), uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
+      I.view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X),
+                      uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
     });
     out.read(band.data(), size_t(img.width) * size_t(n) * sizeof(glm::vec4));
     for (int y = 0; y < n; ++y)
@@ -267,35 +295,41 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   return img;
 }
 
-std::vector<TraceOutcome> ViewRenderer::trace(const std::vector<TraceRequest>& rays, const MarchSettings& m) {
+std::vector<TraceOutcome> ViewRenderer::trace(const std::vector<TraceRequest>& rays,
+                                              const MarchSettings& m) {
   std::vector<TraceOutcome> out;
   for (const auto& pair : traceModes(rays, m)) out.push_back(pair[0]);
   return out;
 }
 
-std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(const std::vector<TraceRequest>& rays,
-                                                                  const MarchSettings& m) {
+std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(
+    const std::vector<TraceRequest>& rays, const MarchSettings& m) {
   validate(m);
   Impl& I = *impl_;
   if (rays.empty()) return {};
   std::vector<gpu::TraceRay> in(rays.size());
   for (size_t i = 0; i < rays.size(); ++i) {
     double len = glm::length(rays[i].direction);
-    if (!(len > 0) || !std::isfinite(len)) throw std::invalid_argument("trace direction must be a non-zero finite vector");
-    if (!(rays[i].wavelength_nm > 0)) throw std::invalid_argument("trace wavelength must be > 0 nm");
+    if (!(len > 0) || !std::isfinite(len))
+      throw std::invalid_argument("trace direction must be a non-zero finite vector");
+    if (!(rays[i].wavelength_nm > 0))
+      throw std::invalid_argument("trace wavelength must be > 0 nm");
     in[i].origin = glm::vec4(glm::vec3(rays[i].origin), float(rays[i].wavelength_nm * 1e-3));
     in[i].direction = glm::vec4(glm::vec3(rays[i].direction / len), 0.0f);
   }
   gpu::ViewParams p = I.baseParams(m, 0);
   p.image = glm::ivec4(int(rays.size()), 1, 0, 1);
   I.params.write(&p, sizeof p);
-  vk::Buffer rb(I.ctx, in.size() * sizeof(gpu::TraceRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "trace rays");
+  vk::Buffer rb(I.ctx, in.size() * sizeof(gpu::TraceRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                "trace rays");
   rb.write(in.data(), in.size() * sizeof(gpu::TraceRay));
-  vk::Buffer ob(I.ctx, 2 * in.size() * sizeof(gpu::TraceResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "trace results");
+  vk::Buffer ob(I.ctx, 2 * in.size() * sizeof(gpu::TraceResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                "trace results");
   I.tracer.bindBuffer(EIKON_B_RAYS, rb);
   I.tracer.bindBuffer(EIKON_B_OUTPUT, ob);
   I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
-    I.tracer.dispatch(cmd, uint32_t((in.size() + EIKON_TRACE_WG - 1) / EIKON_TRACE_WG), 1, 1, nullptr);
+    I.tracer.dispatch(cmd, uint32_t((in.size() + EIKON_TRACE_WG - 1) / EIKON_TRACE_WG), 1, 1,
+                      nullptr);
   });
   std::vector<gpu::TraceResult> res(2 * in.size());
   ob.read(res.data(), res.size() * sizeof(gpu::TraceResult));

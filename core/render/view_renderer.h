@@ -4,10 +4,9 @@
 //
 //   auto ctx = eikon::vk::Context::create();
 //   eikon::Scene scene = eikon::loadScene("scenes/glass_sphere.json");
-//   eikon::checkVolumeFits(*ctx, eikon::makeGrid(scene.volume), scene);   // refuse before voxelising
-//   eikon::VolumeSet vol = eikon::voxelize(scene);
-//   eikon::ViewRenderer renderer(*ctx, scene, vol);
-//   eikon::RenderImage img = renderer.render({});
+//   eikon::checkVolumeFits(*ctx, eikon::makeGrid(scene.volume), scene);   // refuse before
+//   voxelising eikon::VolumeSet vol = eikon::voxelize(scene); eikon::ViewRenderer renderer(*ctx,
+//   scene, vol); eikon::RenderImage img = renderer.render({});
 //
 // Common mistakes: voxelising before checkVolumeFits (a 4096³ request would exhaust host memory
 // before the device refuses it); comparing timings across runs (lavapipe varies ±20%).
@@ -39,7 +38,8 @@ class ViewRenderer {
   /// Render the scene's camera view. Throws std::invalid_argument for bad settings.
   RenderImage render(const RenderSettings& settings);
   /// Trace individual rays at their wavelengths: the o-mode (isotropic scenes: the ray).
-  std::vector<TraceOutcome> trace(const std::vector<TraceRequest>& rays, const MarchSettings& settings);
+  std::vector<TraceOutcome> trace(const std::vector<TraceRequest>& rays,
+                                  const MarchSettings& settings);
   /// Trace both modes of each ray: {o, e}; identical where every material is isotropic.
   std::vector<std::array<TraceOutcome, 2>> traceModes(const std::vector<TraceRequest>& rays,
                                                       const MarchSettings& settings);

@@ -4,10 +4,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include "core/io/exr.h"
 #include "core/spectrum/illuminants.h"
@@ -47,7 +46,8 @@ std::string box(const VolumeSpec& v) {
 /// A JSON value with its location, for error messages that name file and path.
 class Node {
  public:
-  Node(const json& j, std::string path, const std::string& file) : j_(j), path_(std::move(path)), file_(file) {}
+  Node(const json& j, std::string path, const std::string& file)
+      : j_(j), path_(std::move(path)), file_(file) {}
 
   [[noreturn]] void fail(const std::string& msg) const {
     throw SceneError(file_ + ": " + (path_.empty() ? "/" : path_) + ": " + msg);
@@ -95,7 +95,8 @@ class Node {
   double number(double lo, double hi, bool lo_open = false) const {
     double v = number();
     if (v < lo || (lo_open && v == lo) || v > hi)
-      fail("must be in " + std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + "], got " + fmt(v));
+      fail("must be in " + std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + "], got " +
+           fmt(v));
     return v;
   }
   double positive() const {
@@ -109,7 +110,9 @@ class Node {
       fail("must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
            std::to_string(j_.get<unsigned long long>()));
     long long v = j_.get<long long>();
-    if (v < lo || v > hi) fail("must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + std::to_string(v));
+    if (v < lo || v > hi)
+      fail("must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+           std::to_string(v));
     return int(v);
   }
   std::string string() const {
@@ -161,11 +164,13 @@ class Node {
 
 // ------------------------------------------------------------------ materials
 void checkIndexAtLeastOne(const Node& at, const Dispersion& d) {
-  // An index below 1 (or a Sellmeier pole) anywhere in the visible window is an error (never clamped).
+  // An index below 1 (or a Sellmeier pole) anywhere in the visible window is an error (never
+  // clamped).
   for (double l = 380.0; l <= 780.0; l += 1.0) {
     double n = d.index(l);
-    if (!(n >= 1.0)) at.fail("refractive index " + (std::isfinite(n) ? fmt(n) : std::string("undefined")) +
-                             " at " + fmt(l) + " nm is below 1");
+    if (!(n >= 1.0))
+      at.fail("refractive index " + (std::isfinite(n) ? fmt(n) : std::string("undefined")) +
+              " at " + fmt(l) + " nm is below 1");
   }
 }
 
@@ -186,7 +191,8 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
   if (kinds != 1)
     n.fail("give exactly one of cauchy, sellmeier, conrady, linear, luneburg, maxwell_fisheye");
   if (n.has("linear") || n.has("luneburg") || n.has("maxwell_fisheye")) {
-    if (!grin) n.fail("gradient-index profiles are allowed only for isotropic materials (key \"n\")");
+    if (!grin)
+      n.fail("gradient-index profiles are allowed only for isotropic materials (key \"n\")");
     if (auto l = n.get("linear")) {
       l->allowKeys({"n0", "gradient_per_mm", "origin"});
       grin->type = GrinProfile::Type::Linear;
@@ -212,26 +218,30 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
   try {
     if (auto c = n.get("cauchy")) {
       auto v = c->numbers();
-      if (v.empty() || v.size() > 6) c->fail("cauchy needs 1 to 6 coefficients [A, B, C, ...] (λ in µm), got " + std::to_string(v.size()));
+      if (v.empty() || v.size() > 6)
+        c->fail("cauchy needs 1 to 6 coefficients [A, B, C, ...] (λ in µm), got " +
+                std::to_string(v.size()));
       d = Dispersion::cauchy(v);
     } else if (auto cr = n.get("conrady")) {
       // n = n0 + A/λ + B/λ^3.5 (λ in µm); the renderer carries its Cauchy approximation.
       auto v = cr->numbers();
       if (v.size() != 3)
         cr->fail("conrady needs [n0, A, B] (n = n0 + A/λ + B/λ^3.5, λ in µm), got " +
-                std::to_string(v.size()) + " numbers");
+                 std::to_string(v.size()) + " numbers");
       d = Dispersion::conrady(v[0], v[1], v[2]);
     } else {
       auto s = n.at("sellmeier");
       auto v = s.numbers();
       if (v.empty() || v.size() % 2 || v.size() > 12)
-        s.fail("sellmeier needs [B1..Bk, C1..Ck] (k = 1..6, C in µm²), got " + std::to_string(v.size()) + " numbers");
+        s.fail("sellmeier needs [B1..Bk, C1..Ck] (k = 1..6, C in µm²), got " +
+               std::to_string(v.size()) + " numbers");
       size_t k = v.size() / 2;
       d = Dispersion::sellmeier({v.begin(), v.begin() + long(k)}, {v.begin() + long(k), v.end()});
     }
     if (auto r = n.get("range_nm")) {
       auto v = r->numbers();
-      if (v.size() != 2 || !(v[0] > 0 && v[1] > v[0])) r->fail("range_nm must be [lo, hi] with 0 < lo < hi");
+      if (v.size() != 2 || !(v[0] > 0 && v[1] > v[0]))
+        r->fail("range_nm must be [lo, hi] with 0 < lo < hi");
       d.withRange(v[0], v[1]);
     }
   } catch (const std::invalid_argument& e) {
@@ -255,7 +265,8 @@ Attenuation parseAttenuation(const Node& n) {
             .index(i)
             .fail("wavelengths must be > 0 nm, got " + fmt(a.wavelengths_nm[i]));
       if (a.values[i] < 0) n.fail("attenuation must be >= 0");
-      if (i && !(a.wavelengths_nm[i] > a.wavelengths_nm[i - 1])) n.fail("wavelength_nm must be strictly increasing");
+      if (i && !(a.wavelengths_nm[i] > a.wavelengths_nm[i - 1]))
+        n.fail("wavelength_nm must be strictly increasing");
     }
     return a;
   }
@@ -265,24 +276,30 @@ Attenuation parseAttenuation(const Node& n) {
 
 Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
   if (is_file)
-    m.allowKeys({"name", "source", "notes", "fit", "n", "n_o", "n_e", "optic_axis", "attenuation_per_mm",
-                 "attenuation_o_per_mm", "attenuation_e_per_mm", "emission", "opacity", "albedo", "phase_g"});
+    m.allowKeys({"name", "source", "notes", "fit", "n", "n_o", "n_e", "optic_axis",
+                 "attenuation_per_mm", "attenuation_o_per_mm", "attenuation_e_per_mm", "emission",
+                 "opacity", "albedo", "phase_g"});
   else
     m.allowKeys({"n", "n_o", "n_e", "optic_axis", "attenuation_per_mm", "attenuation_o_per_mm",
-                 "attenuation_e_per_mm", "emission", "opacity", "albedo", "phase_g", "source", "notes"});
+                 "attenuation_e_per_mm", "emission", "opacity", "albedo", "phase_g", "source",
+                 "notes"});
   Material mat;
   mat.name = name;
   if (auto s = m.get("source")) mat.source = s->string();
   bool iso = m.has("n"), crystal = m.has("n_o") || m.has("n_e");
-  if (iso && crystal) m.fail("give either \"n\" (isotropic) or \"n_o\" and \"n_e\" (uniaxial), not both");
+  if (iso && crystal)
+    m.fail("give either \"n\" (isotropic) or \"n_o\" and \"n_e\" (uniaxial), not both");
   if (!iso && !crystal) m.fail("missing \"n\" (isotropic) or \"n_o\"/\"n_e\" (uniaxial)");
   if (iso) {
     mat.n_o = parseDispersion(m.at("n"), &mat.grin);
     mat.n_e = mat.n_o;
     if (m.has("optic_axis")) m.fail("optic_axis given for an isotropic material (use n_o and n_e)");
     if (m.has("attenuation_o_per_mm") || m.has("attenuation_e_per_mm"))
-      m.fail("attenuation_o_per_mm/attenuation_e_per_mm are for uniaxial materials; use attenuation_per_mm");
-    if (auto a = m.get("attenuation_per_mm")) mat.attenuation_o = mat.attenuation_e = parseAttenuation(*a);
+      m.fail(
+          "attenuation_o_per_mm/attenuation_e_per_mm are for uniaxial materials; use "
+          "attenuation_per_mm");
+    if (auto a = m.get("attenuation_per_mm"))
+      mat.attenuation_o = mat.attenuation_e = parseAttenuation(*a);
   } else {
     if (!m.has("n_o")) m.fail("uniaxial material is missing n_o");
     if (!m.has("n_e")) m.fail("uniaxial material is missing n_e (extraordinary index)");
@@ -290,7 +307,8 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
     mat.n_o = parseDispersion(m.at("n_o"), nullptr);
     mat.n_e = parseDispersion(m.at("n_e"), nullptr);
     if (auto a = m.get("optic_axis")) mat.optic_axis = a->unitVector();
-    if (m.has("attenuation_per_mm")) m.fail("uniaxial materials take attenuation_o_per_mm and attenuation_e_per_mm");
+    if (m.has("attenuation_per_mm"))
+      m.fail("uniaxial materials take attenuation_o_per_mm and attenuation_e_per_mm");
     if (auto a = m.get("attenuation_o_per_mm")) mat.attenuation_o = parseAttenuation(*a);
     if (auto a = m.get("attenuation_e_per_mm")) mat.attenuation_e = parseAttenuation(*a);
   }
@@ -298,16 +316,24 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
   if (auto o = m.get("opacity")) mat.opacity = o->number(0.0, 1.0);
   if (auto a = m.get("albedo")) {
     mat.albedo = a->color();
-    if (mat.albedo.x > 1 || mat.albedo.y > 1 || mat.albedo.z > 1) a->fail("albedo must be in [0, 1] per band");
+    if (mat.albedo.x > 1 || mat.albedo.y > 1 || mat.albedo.z > 1)
+      a->fail("albedo must be in [0, 1] per band");
     // Translucent scattering is albedo·σ_t: without attenuation there is nothing to scatter.
-    if (mat.opacity < 0.5 && glm::length(mat.albedo) > 0 && mat.attenuation_o.isZero() && mat.attenuation_e.isZero())
-      a->fail("a translucent material scatters albedo x attenuation; give attenuation_per_mm > 0 (or opacity 1 for a "
-              "diffuse surface)");
+    if (mat.opacity < 0.5 && glm::length(mat.albedo) > 0 && mat.attenuation_o.isZero() &&
+        mat.attenuation_e.isZero())
+      a->fail(
+          "a translucent material scatters albedo x attenuation; give attenuation_per_mm > 0 (or "
+          "opacity 1 for a "
+          "diffuse surface)");
   }
   if (auto g = m.get("phase_g")) {
     mat.phase_g = g->number(-1.0, 1.0);
-    if (std::abs(mat.phase_g) >= 1.0) g->fail("phase_g must be in (-1, 1), got " + fmt(mat.phase_g));
-    if (mat.opacity >= 0.5) g->fail("phase_g is the in-scatter asymmetry of a translucent material; an opaque one is diffuse");
+    if (std::abs(mat.phase_g) >= 1.0)
+      g->fail("phase_g must be in (-1, 1), got " + fmt(mat.phase_g));
+    if (mat.opacity >= 0.5)
+      g->fail(
+          "phase_g is the in-scatter asymmetry of a translucent material; an opaque one is "
+          "diffuse");
   }
   return mat;
 }
@@ -347,7 +373,8 @@ SceneObject parseObject(const Node& o) {
       auto s = o.at("size").position();
       if (!(s.x > 0 && s.y > 0 && s.z > 0)) o.at("size").fail("all sizes must be > 0");
       double r = o.at("radius").length();
-      if (2 * r > std::min(s.x, std::min(s.y, s.z))) o.at("radius").fail("corner radius exceeds half the smallest side");
+      if (2 * r > std::min(s.x, std::min(s.y, s.z)))
+        o.at("radius").fail("corner radius exceeds half the smallest side");
       g = RoundedBoxShape{s, r};
     } else if (shape == "prism") {
       allow({"apex_deg", "side", "height"});
@@ -397,10 +424,12 @@ SceneObject parseObject(const Node& o) {
   if (auto a = o.get("optic_axis")) obj.optic_axis = a->unitVector();
   if (auto f = o.get("optic_axis_field")) {
     std::string kind = f->string();
-    if (kind == "radial") obj.radial_axis = true;
+    if (kind == "radial")
+      obj.radial_axis = true;
     else if (kind != "uniform")
       f->fail("unknown optic_axis_field '" + excerpt(kind) + "' (uniform, radial)");
-    if (obj.radial_axis && obj.optic_axis) f->fail("give either optic_axis or optic_axis_field \"radial\", not both");
+    if (obj.radial_axis && obj.optic_axis)
+      f->fail("give either optic_axis or optic_axis_field \"radial\", not both");
   }
   return obj;
 }
@@ -482,8 +511,10 @@ json readJsonFile(const std::filesystem::path& path, const char* what) {
 // ------------------------------------------------------------------ small physics helpers
 double GrinProfile::index(const glm::dvec3& x) const {
   switch (type) {
-    case Type::None: return n0;
-    case Type::Linear: return n0 + glm::dot(gradient, x - origin);
+    case Type::None:
+      return n0;
+    case Type::Linear:
+      return n0 + glm::dot(gradient, x - origin);
     case Type::Luneburg: {
       double r2 = glm::dot(x - origin, x - origin) / (radius * radius);
       return std::sqrt(std::max(2.0 - r2, 1.0));
@@ -498,8 +529,10 @@ double GrinProfile::index(const glm::dvec3& x) const {
 
 glm::dvec3 GrinProfile::indexGradient(const glm::dvec3& x) const {
   switch (type) {
-    case Type::None: return glm::dvec3(0.0);
-    case Type::Linear: return gradient;
+    case Type::None:
+      return glm::dvec3(0.0);
+    case Type::Linear:
+      return gradient;
     case Type::Luneburg: {
       double r2 = glm::dot(x - origin, x - origin) / (radius * radius);
       if (2.0 - r2 <= 1.0) return glm::dvec3(0.0);
@@ -517,7 +550,8 @@ glm::dvec3 GrinProfile::indexGradient(const glm::dvec3& x) const {
 double Light::spectralPower(double lambda_nm) const {
   if (spectrum_nm.empty()) return spectrum::d65(lambda_nm);
   if (lambda_nm < spectrum_nm.front() || lambda_nm > spectrum_nm.back()) return 0.0;
-  size_t k = size_t(std::upper_bound(spectrum_nm.begin(), spectrum_nm.end(), lambda_nm) - spectrum_nm.begin());
+  size_t k = size_t(std::upper_bound(spectrum_nm.begin(), spectrum_nm.end(), lambda_nm) -
+                    spectrum_nm.begin());
   if (k >= spectrum_nm.size()) return spectrum_power.back();
   double t = (lambda_nm - spectrum_nm[k - 1]) / (spectrum_nm[k] - spectrum_nm[k - 1]);
   return spectrum_power[k - 1] + t * (spectrum_power[k] - spectrum_power[k - 1]);
@@ -540,7 +574,8 @@ double Attenuation::at(double lambda_nm) const {
 }
 
 bool Attenuation::isZero() const {
-  if (!values.empty()) return std::all_of(values.begin(), values.end(), [](double v) { return v == 0.0; });
+  if (!values.empty())
+    return std::all_of(values.begin(), values.end(), [](double v) { return v == 0.0; });
   return rgb == glm::dvec3(0.0);
 }
 
@@ -549,7 +584,8 @@ glm::dvec3 Environment::lookup(const glm::dvec3& d) const {
   double u = std::atan2(d.x, -d.z) / (2.0 * kPi) + 0.5;
   double v = std::acos(std::clamp(d.y, -1.0, 1.0)) / kPi;
   switch (type) {
-    case Type::Constant: return radiance * intensity;
+    case Type::Constant:
+      return radiance * intensity;
     case Type::Checker: {
       long iu = long(std::floor(u * 2.0 * squares)), iv = long(std::floor(v * squares));
       return ((iu + iv) & 1 ? color_b : color_a) * intensity;
@@ -574,7 +610,8 @@ glm::dvec3 Environment::lookup(const glm::dvec3& d) const {
 }
 
 bool Scene::anyUniaxial() const {
-  return std::any_of(materials.begin(), materials.end(), [](const auto& m) { return m.second.uniaxial; });
+  return std::any_of(materials.begin(), materials.end(),
+                     [](const auto& m) { return m.second.uniaxial; });
 }
 
 bool Scene::anyDispersive() const {
@@ -618,8 +655,11 @@ static Light parseLight(const Node& l) {
       light.position = c->position();
     }
   } else if (type == "point" || type == "spot") {
-    if (type == "point") l.allowKeys({"type", "position", "intensity", "spectrum"});
-    else l.allowKeys({"type", "position", "direction", "cone_half_angle_deg", "intensity", "spectrum"});
+    if (type == "point")
+      l.allowKeys({"type", "position", "intensity", "spectrum"});
+    else
+      l.allowKeys(
+          {"type", "position", "direction", "cone_half_angle_deg", "intensity", "spectrum"});
     light.type = type == "point" ? Light::Type::Point : Light::Type::Spot;
     light.position = l.at("position").position();
     if (auto v = l.get("intensity")) light.irradiance = v->number(0.0, 1e12);
@@ -840,11 +880,13 @@ static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::
     SceneObject obj = parseObject(o);
     if (!scene.materials.count(obj.material)) loadLibraryMaterial(o, obj, scene);
     const Material& mat = scene.materials[obj.material];
-    if (obj.radial_axis && !mat.uniaxial) o.at("optic_axis_field").fail("optic_axis_field given for an isotropic material");
+    if (obj.radial_axis && !mat.uniaxial)
+      o.at("optic_axis_field").fail("optic_axis_field given for an isotropic material");
     if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis && !obj.radial_axis)
       o.fail("uniaxial material '" + excerpt(obj.material) +
              "' needs an optic_axis (on the object or the material)");
-    if (!mat.uniaxial && obj.optic_axis) o.at("optic_axis").fail("optic_axis given for an isotropic material");
+    if (!mat.uniaxial && obj.optic_axis)
+      o.at("optic_axis").fail("optic_axis given for an isotropic material");
     if (checkObjectInVolume(o, obj, scene, file)) covering.insert(i);
     if (mat.grin.type != GrinProfile::Type::None) checkGrinIndex(o, obj, mat, scene.volume);
     scene.objects.push_back(std::move(obj));

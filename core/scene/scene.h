@@ -8,9 +8,8 @@
 // clamped. Lengths are millimetres, wavelengths nanometres, attenuation per millimetre.
 #pragma once
 
-#include <glm/glm.hpp>
-
 #include <filesystem>
+#include <glm/glm.hpp>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -31,10 +30,10 @@ struct SceneError : std::runtime_error {
 /// A gradient-index profile that replaces a constant index inside an object (world coordinates).
 struct GrinProfile {
   enum class Type { None, Linear, Luneburg, MaxwellFisheye } type = Type::None;
-  double n0 = 1.0;             ///< Linear: index at `origin`; Fisheye: n₀ of n₀/(1 + r²/R²)
-  glm::dvec3 gradient{0.0};    ///< Linear: ∇n per mm
-  glm::dvec3 origin{0.0};      ///< Linear origin / Luneburg and fisheye centre
-  double radius = 1.0;         ///< Luneburg: n = √(2 − r²/R²); fisheye R
+  double n0 = 1.0;           ///< Linear: index at `origin`; Fisheye: n₀ of n₀/(1 + r²/R²)
+  glm::dvec3 gradient{0.0};  ///< Linear: ∇n per mm
+  glm::dvec3 origin{0.0};    ///< Linear origin / Luneburg and fisheye centre
+  double radius = 1.0;       ///< Luneburg: n = √(2 − r²/R²); fisheye R
   /// Index at a world point (valid inside the object only).
   double index(const glm::dvec3& x) const;
   /// ∇n at a world point (per mm).
@@ -52,20 +51,20 @@ struct Attenuation {
 
 struct Material {
   std::string name;
-  std::string source;             ///< where the data came from (library files)
+  std::string source;  ///< where the data came from (library files)
   bool uniaxial = false;
-  Dispersion n_o;                 ///< the index of an isotropic material, or the ordinary index
-  Dispersion n_e;                 ///< extraordinary index (uniaxial only)
-  GrinProfile grin;               ///< isotropic gradient-index profile (replaces n_o if set)
+  Dispersion n_o;    ///< the index of an isotropic material, or the ordinary index
+  Dispersion n_e;    ///< extraordinary index (uniaxial only)
+  GrinProfile grin;  ///< isotropic gradient-index profile (replaces n_o if set)
   std::optional<glm::dvec3> optic_axis;  ///< unit vector, world space
   Attenuation attenuation_o, attenuation_e;
-  glm::dvec3 emission{0.0};       ///< radiance per mm (translucent) or surface radiance (opaque)
-  double opacity = 0.0;           ///< 1 = opaque: rays stop at the surface
+  glm::dvec3 emission{0.0};  ///< radiance per mm (translucent) or surface radiance (opaque)
+  double opacity = 0.0;      ///< 1 = opaque: rays stop at the surface
   /// Translucent: single-scattering albedo σ_s/σ_t per RGB band (σ_t = the attenuation), so the
   /// scattering coefficient is albedo·σ_t; opaque: the diffuse (Lambertian) reflectance of the
   /// surface, which then shows the simulated irradiance as albedo·E/π. Zero: no scattering.
   glm::dvec3 albedo{0.0};
-  double phase_g = 0.0;           ///< Henyey–Greenstein asymmetry g ∈ (−1, 1) of the in-scatter
+  double phase_g = 0.0;  ///< Henyey–Greenstein asymmetry g ∈ (−1, 1) of the in-scatter
 };
 
 struct Camera {
@@ -76,21 +75,22 @@ struct Camera {
 
 struct Environment {
   enum class Type { Checker, Constant, LatLong } type = Type::Checker;
-  int squares = 16;                           ///< checker squares per 180° of latitude
-  glm::dvec3 color_a{1.0}, color_b{0.05};     ///< checker colours (linear sRGB radiance)
-  glm::dvec3 radiance{1.0};                   ///< constant
-  double intensity = 1.0;                     ///< scale applied to every type
-  std::filesystem::path image_path;           ///< latlong EXR
+  int squares = 16;                        ///< checker squares per 180° of latitude
+  glm::dvec3 color_a{1.0}, color_b{0.05};  ///< checker colours (linear sRGB radiance)
+  glm::dvec3 radiance{1.0};                ///< constant
+  double intensity = 1.0;                  ///< scale applied to every type
+  std::filesystem::path image_path;        ///< latlong EXR
   int image_width = 0, image_height = 0;
-  std::vector<float> image_rgba;              ///< latlong texels, rows from the top (north)
+  std::vector<float> image_rgba;  ///< latlong texels, rows from the top (north)
   /// Radiance seen in a world direction (unit vector), linear sRGB. Same formula as the shader.
   glm::dvec3 lookup(const glm::dvec3& dir) const;
 };
 
 struct VolumeSpec {
   glm::dvec3 bounds_min{-12.0}, bounds_max{12.0};
-  int resolution = 128;            ///< voxels along the longest side; voxels are cubes
-  double smoothing_voxels = 0.75;  ///< σ of the pre-smoothing, in voxels (0 = none: sharp, anti-aliased)
+  int resolution = 128;  ///< voxels along the longest side; voxels are cubes
+  double smoothing_voxels =
+      0.75;  ///< σ of the pre-smoothing, in voxels (0 = none: sharp, anti-aliased)
   /// How the σ-smoothing is done: "analytic" (default) smooths each object's indicator through its
   /// signed distance with a compact kernel of variance σ² (exact normals for flat faces);
   /// "gaussian" supersamples coverage and convolves with a Gaussian (the seed's method).
@@ -99,23 +99,25 @@ struct VolumeSpec {
 
 struct SceneObject {
   Shape shape;
-  std::string material;              ///< key into Scene::materials
+  std::string material;                  ///< key into Scene::materials
   std::optional<glm::dvec3> optic_axis;  ///< per-object override (unit, world space)
   /// "optic_axis_field": "radial" — the axis points away from the object's centre everywhere
   /// (a spherulite); the e-ray equation then includes the axis' derivative.
   bool radial_axis = false;
 };
 
-/// A light of the light simulator (docs/light-simulator.md). Its power is `irradiance` (directional:
-/// E in W/mm² across the beam; point and spot: intensity I in W/sr), the integral over 380–780 nm
-/// of a spectral distribution of the given shape. Colours are normalised so that a light of any
-/// spectrum and power E lights a white diffuse surface at normal incidence to linear-sRGB
-/// luminance Y = E (D65: rgb ≈ (E, E, E)).
+/// A light of the light simulator (docs/light-simulator.md). Its power is `irradiance`
+/// (directional: E in W/mm² across the beam; point and spot: intensity I in W/sr), the integral
+/// over 380–780 nm of a spectral distribution of the given shape. Colours are normalised so that a
+/// light of any spectrum and power E lights a white diffuse surface at normal incidence to
+/// linear-sRGB luminance Y = E (D65: rgb ≈ (E, E, E)).
 struct Light {
   enum class Type { Directional, Point, Spot } type = Type::Directional;
-  glm::dvec3 direction{0, -1, 0};  ///< directional and spot: unit propagation direction (spot: cone axis)
-  glm::dvec3 position{0.0};        ///< point and spot: the source; directional with a beam: a point on the beam axis
-  double irradiance = 1.0;         ///< directional: E (W/mm²); point, spot: intensity I (W/sr)
+  glm::dvec3 direction{0, -1,
+                       0};  ///< directional and spot: unit propagation direction (spot: cone axis)
+  glm::dvec3 position{
+      0.0};  ///< point and spot: the source; directional with a beam: a point on the beam axis
+  double irradiance = 1.0;  ///< directional: E (W/mm²); point, spot: intensity I (W/sr)
   /// Directional only: radius (mm) of a collimated beam of circular cross-section about the axis
   /// through `position` (a laser or a slit-less collimator); 0 = the whole volume is lit.
   double beam_radius = 0.0;

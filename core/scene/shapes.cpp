@@ -22,13 +22,17 @@ glm::dmat3 rotationFromEuler(glm::dvec3 deg) {
 
 double boxDistance(const glm::dvec3& p, const glm::dvec3& half) {
   glm::dvec3 q = glm::abs(p) - half;
-  return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
+  return glm::length(glm::max(q, glm::dvec3(0.0))) +
+         std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
 }
 
 }  // namespace
 
 Shape::Shape(std::string kind, ShapeGeometry geometry, glm::dvec3 center, glm::dvec3 rotation_deg)
-    : kind_(std::move(kind)), geometry_(std::move(geometry)), center_(center), rotation_(rotationFromEuler(rotation_deg)) {}
+    : kind_(std::move(kind)),
+      geometry_(std::move(geometry)),
+      center_(center),
+      rotation_(rotationFromEuler(rotation_deg)) {}
 
 glm::dvec3 Shape::toLocal(const glm::dvec3& world) const {
   return glm::transpose(rotation_) * (world - center_);
@@ -101,10 +105,14 @@ std::pair<glm::dvec3, glm::dvec3> Shape::bounds() const {
   double r = std::visit(
       [](const auto& g) -> double {
         using T = std::decay_t<decltype(g)>;
-        if constexpr (std::is_same_v<T, SphereShape>) return g.radius;
-        else if constexpr (std::is_same_v<T, BoxShape>) return 0.5 * glm::length(g.size);
-        else if constexpr (std::is_same_v<T, RoundedBoxShape>) return 0.5 * glm::length(g.size);
-        else return g.bounding_radius;
+        if constexpr (std::is_same_v<T, SphereShape>)
+          return g.radius;
+        else if constexpr (std::is_same_v<T, BoxShape>)
+          return 0.5 * glm::length(g.size);
+        else if constexpr (std::is_same_v<T, RoundedBoxShape>)
+          return 0.5 * glm::length(g.size);
+        else
+          return g.bounding_radius;
       },
       geometry_);
   return {center_ - glm::dvec3(r), center_ + glm::dvec3(r)};
@@ -208,7 +216,8 @@ void finishConvex(ConvexShape& shape) {
 }
 
 ConvexShape makePrism(double apex_deg, double side, double height) {
-  if (!(apex_deg > 0 && apex_deg < 180)) throw std::invalid_argument("prism apex angle must be in (0, 180) degrees");
+  if (!(apex_deg > 0 && apex_deg < 180))
+    throw std::invalid_argument("prism apex angle must be in (0, 180) degrees");
   if (!(side > 0 && height > 0)) throw std::invalid_argument("prism side and height must be > 0");
   // Isosceles triangle: apex at top, the two refracting faces of length `side` meet at the apex.
   double half = 0.5 * apex_deg * kDeg;
@@ -230,7 +239,8 @@ ConvexShape makePrism(double apex_deg, double side, double height) {
 ConvexShape makeBrilliant(double diameter, double table_frac, double crown_deg, double pavilion_deg,
                           double girdle_frac, int facets) {
   if (!(diameter > 0)) throw std::invalid_argument("brilliant diameter must be > 0");
-  if (!(table_frac > 0 && table_frac < 1)) throw std::invalid_argument("brilliant table must be in (0, 1) of the diameter");
+  if (!(table_frac > 0 && table_frac < 1))
+    throw std::invalid_argument("brilliant table must be in (0, 1) of the diameter");
   if (!(crown_deg > 0 && crown_deg < 90 && pavilion_deg > 0 && pavilion_deg < 90))
     throw std::invalid_argument("brilliant crown and pavilion angles must be in (0, 90) degrees");
   if (facets < 3) throw std::invalid_argument("brilliant needs at least 3 facets around");
@@ -245,10 +255,12 @@ ConvexShape makeBrilliant(double diameter, double table_frac, double crown_deg, 
     // Girdle: a vertical facet at radius R.
     s.planes.push_back({radial, R});
     // Crown facet through the girdle top edge (R, +girdle_half), tilted by crown angle.
-    glm::dvec3 nc = glm::normalize(radial * std::sin(crown_deg * kDeg) + glm::dvec3(0, std::cos(crown_deg * kDeg), 0));
+    glm::dvec3 nc = glm::normalize(radial * std::sin(crown_deg * kDeg) +
+                                   glm::dvec3(0, std::cos(crown_deg * kDeg), 0));
     s.planes.push_back({nc, glm::dot(nc, radial * R + glm::dvec3(0, girdle_half, 0))});
     // Pavilion facet through the girdle bottom edge (R, −girdle_half), down to the culet.
-    glm::dvec3 np = glm::normalize(radial * std::sin(pavilion_deg * kDeg) - glm::dvec3(0, std::cos(pavilion_deg * kDeg), 0));
+    glm::dvec3 np = glm::normalize(radial * std::sin(pavilion_deg * kDeg) -
+                                   glm::dvec3(0, std::cos(pavilion_deg * kDeg), 0));
     s.planes.push_back({np, glm::dot(np, radial * R - glm::dvec3(0, girdle_half, 0))});
   }
   finishConvex(s);

@@ -8,7 +8,6 @@
 #pragma once
 
 #include <glm/glm.hpp>
-
 #include <string>
 #include <variant>
 #include <vector>
@@ -20,9 +19,16 @@ struct Plane {
   double d;           ///< inside where dot(normal, x) <= d
 };
 
-struct SphereShape { double radius; };
-struct BoxShape { glm::dvec3 size; };
-struct RoundedBoxShape { glm::dvec3 size; double radius; };
+struct SphereShape {
+  double radius;
+};
+struct BoxShape {
+  glm::dvec3 size;
+};
+struct RoundedBoxShape {
+  glm::dvec3 size;
+  double radius;
+};
 /// Convex polyhedron given by planes in the object's local frame (prism, brilliant, planes).
 struct ConvexShape {
   std::vector<Plane> planes;
@@ -69,7 +75,8 @@ class Shape {
 
 /// Convex polyhedron of a triangular prism: apex angle (deg) between the two refracting faces,
 /// side = length of the faces' edges in the triangle, height along the prism's local z axis.
-/// Local frame: the apex points to +y, the base is parallel to x, the centroid of the triangle at 0.
+/// Local frame: the apex points to +y, the base is parallel to x, the centroid of the triangle at
+/// 0.
 ConvexShape makePrism(double apex_deg, double side, double height);
 
 /// Standard round brilliant approximated by facets (Tolkowsky-like proportions, all relative to

@@ -2,9 +2,8 @@
 // core/reference), so that both are driven and compared through the same plain structs.
 #pragma once
 
-#include <glm/glm.hpp>
-
 #include <functional>
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
 
@@ -13,19 +12,19 @@ namespace eikon {
 enum class Integrator { Euler = 0, Midpoint = 1, RK4 = 2 };
 
 struct MarchSettings {
-  double step_voxels = 0.25;           ///< ds in voxels (the constant spatial step)
+  double step_voxels = 0.25;  ///< ds in voxels (the constant spatial step)
   Integrator integrator = Integrator::RK4;
-  bool skip_empty = true;              ///< straight steps across homogeneous regions
-  bool fresnel = true;                 ///< Fresnel losses/reflections at interfaces
-  double interface_threshold = 0.02;   ///< |∇n|·h peak that makes a layer an interface
-  int max_steps = 20000;               ///< per ray; a ray that runs out is reported as stopped
+  bool skip_empty = true;             ///< straight steps across homogeneous regions
+  bool fresnel = true;                ///< Fresnel losses/reflections at interfaces
+  double interface_threshold = 0.02;  ///< |∇n|·h peak that makes a layer an interface
+  int max_steps = 20000;              ///< per ray; a ray that runs out is reported as stopped
 };
 
 struct RenderSettings {
-  int width = 0, height = 0;           ///< 0 = the scene camera's
-  int spp = 1;                         ///< jittered samples per pixel
-  int wavelengths = 0;                 ///< spectral samples per pixel sample; 0 = RGB mode
-  double wavelength_nm = 587.5618;     ///< index wavelength of the RGB mode (He d line)
+  int width = 0, height = 0;        ///< 0 = the scene camera's
+  int spp = 1;                      ///< jittered samples per pixel
+  int wavelengths = 0;              ///< spectral samples per pixel sample; 0 = RGB mode
+  double wavelength_nm = 587.5618;  ///< index wavelength of the RGB mode (He d line)
   MarchSettings march;
   /// progress(fraction done); may be empty.
   std::function<void(double)> progress;
@@ -48,8 +47,8 @@ struct TraceOutcome {
   double transmittance = 1.0;      ///< Fresnel × attenuation at the ray's wavelength
   bool left_volume = true;         ///< false if stopped by an opaque object or the step limit
   int steps = 0;
-  double invariant_drift = 0.0;    ///< max | |w| − n | along the ray
-  int interfaces = 0;              ///< interfaces crossed (Fresnel applied)
+  double invariant_drift = 0.0;  ///< max | |w| − n | along the ray
+  int interfaces = 0;            ///< interfaces crossed (Fresnel applied)
   int total_internal_reflections = 0;
 };
 

@@ -1,5 +1,6 @@
 // Fixtures shared by the light-simulator tests (CPU reference and GPU twin): lights, the glass-
-// sphere scene, the exact unit Luneburg field (docs/reference-cases.md §7a), and a statistics printer.
+// sphere scene, the exact unit Luneburg field (docs/reference-cases.md §7a), and a statistics
+// printer.
 #pragma once
 
 #include <cmath>
@@ -44,11 +45,12 @@ inline void unitLuneburg(const glm::dvec3& x, double& n, glm::dvec3& g) {
 inline void printWavefrontStats(const char* name, const WavefrontStats& s) {
   std::printf(
       "[ measured ] %s: steps %d, seeded %zu, max live %zu, splits %zu (refused %zu), kills "
-      "left/caustic/energy/opaque %zu/%zu/%zu/%zu\n             flux emitted %.12g, left %.12g, caustic %.12g, "
+      "left/caustic/energy/opaque %zu/%zu/%zu/%zu\n             flux emitted %.12g, left %.12g, "
+      "caustic %.12g, "
       "energy %.12g, absorbed %.12g, probe %.12g, ended before probe %.12g\n",
-      name, s.steps, s.seeded, s.max_live, s.splits, s.splits_refused, s.kills_left, s.kills_caustic, s.kills_energy,
-      s.kills_opaque, s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_energy, s.flux_absorbed, s.flux_probe,
-      s.flux_ended_before_probe);
+      name, s.steps, s.seeded, s.max_live, s.splits, s.splits_refused, s.kills_left,
+      s.kills_caustic, s.kills_energy, s.kills_opaque, s.flux_emitted, s.flux_left, s.flux_caustic,
+      s.flux_energy, s.flux_absorbed, s.flux_probe, s.flux_ended_before_probe);
 }
 
 }  // namespace eikon::test

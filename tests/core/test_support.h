@@ -27,7 +27,8 @@ inline vk::Context& context() {
 /// Fails the current test if the validation layer said anything since the last call.
 inline void expectNoValidationMessages() {
   auto msgs = context().validationMessages();
-  EXPECT_TRUE(msgs.empty()) << msgs.size() << " validation message(s), first: " << (msgs.empty() ? "" : msgs.front());
+  EXPECT_TRUE(msgs.empty()) << msgs.size() << " validation message(s), first: "
+                            << (msgs.empty() ? "" : msgs.front());
   context().clearValidationMessages();
 }
 

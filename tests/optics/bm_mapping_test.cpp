@@ -10,7 +10,6 @@
 
 #include "optics/dispersion.h"
 #include "optics/interface.h"
-
 #include "tests/optics/crystal_fixtures.h"
 
 namespace {
@@ -20,9 +19,6 @@ using eikon::test::deg;
 using eikon::test::kPi;
 using eikon::test::randomUnit;
 using eikon::test::toDeg;
-
-
-
 
 // A random crystal: n_o, n_e in [1, 3], positive or negative, random axis.
 eikon::Uniaxial randomCrystal(std::mt19937_64& rng) {
@@ -50,7 +46,8 @@ TEST(BMMapping, GammaSquaredIsMeAndMatchesRotationForm) {
     // γ = O·diag(1/n_e, 1/n_e, 1/n_o)·Oᵀ with O's third column = a (any such rotation).
     const glm::dvec3 u = glm::normalize(glm::cross(c.axis, randomUnit(rng)));
     const glm::dmat3 O(u, glm::cross(c.axis, u), c.axis);  // columns
-    const glm::dmat3 diag(glm::dvec3(1 / c.n_e, 0, 0), glm::dvec3(0, 1 / c.n_e, 0), glm::dvec3(0, 0, 1 / c.n_o));
+    const glm::dmat3 diag(glm::dvec3(1 / c.n_e, 0, 0), glm::dvec3(0, 1 / c.n_e, 0),
+                          glm::dvec3(0, 0, 1 / c.n_o));
     EXPECT_LT(maxAbs(O * diag * glm::transpose(O) - g), 1e-15);
     EXPECT_LT(maxAbs(g * bm.gammaInverse() - glm::dmat3(1.0)), 1e-14);
     EXPECT_LT(maxAbs(g - glm::transpose(g)), 1e-16);
@@ -78,7 +75,8 @@ TEST(BMMapping, ESurfaceMapsToUnitSphereAndRayToWaveNormal) {
     EXPECT_NEAR(glm::dot(pm, bm.mapPoint(x)), glm::dot(p, x), 1e-13);
     const glm::dvec3 nh = randomUnit(rng);
     const double d = glm::dot(nh, x);
-    EXPECT_NEAR(glm::dot(bm.mapNormal(nh), bm.mapPoint(x)), d / glm::length(bm.gamma() * nh), 1e-13);
+    EXPECT_NEAR(glm::dot(bm.mapNormal(nh), bm.mapPoint(x)), d / glm::length(bm.gamma() * nh),
+                1e-13);
   }
 }
 
@@ -119,7 +117,8 @@ TEST(BMMapping, MappedRefractionEqualsDirectQuadraticRandom) {
     ++compared;
     worst_refract = std::max(worst_refract, glm::length(pe - direct.e.p()));
     // e→e reflection inside: mapped mirror law vs the other root of the quadratic.
-    const auto refl = eikon::reflectInsideUniaxial(c, eikon::Mode::Extraordinary, direct.e.s, normal);
+    const auto refl =
+        eikon::reflectInsideUniaxial(c, eikon::Mode::Extraordinary, direct.e.s, normal);
     const glm::dvec3 pr = bm.reflectE(direct.e.p(), normal);
     worst_reflect = std::max(worst_reflect, glm::length(pr - refl.p()));
   }
@@ -157,5 +156,6 @@ TEST(BMMapping, IsotropicCrystalIsScaledIdentity) {
   const glm::dvec3 s_in = glm::normalize(glm::dvec3(0.4, 0.1, 1));
   const glm::dvec3 pe = bm.refractE(s_in, {0, 0, 1});
   const double sin_i = glm::length(glm::cross(s_in, glm::dvec3(0, 0, 1)));
-  EXPECT_NEAR(glm::length(glm::cross(glm::normalize(pe), glm::dvec3(0, 0, 1))), sin_i / 1.5, 1e-15) << "Snell";
+  EXPECT_NEAR(glm::length(glm::cross(glm::normalize(pe), glm::dvec3(0, 0, 1))), sin_i / 1.5, 1e-15)
+      << "Snell";
 }

@@ -1,9 +1,9 @@
 // Shared fixtures for the uniaxial-optics tests: angle helpers, calcite at the sodium D line from
-// the Ghosh (1999) Sellmeier coefficients in tests/data/reference/materials.json, random unit vectors.
+// the Ghosh (1999) Sellmeier coefficients in tests/data/reference/materials.json, random unit
+// vectors.
 #pragma once
 
 #include <glm/glm.hpp>
-
 #include <random>
 
 #include "optics/dispersion.h"
@@ -17,7 +17,8 @@ inline double toDeg(double r) { return r * 180.0 / kPi; }
 
 /// Calcite at D (589.2938 nm): n_o = 1.658344, n_e = 1.486130 (docs/reference-cases.md), any axis.
 inline Uniaxial calciteD(glm::dvec3 axis = {0, 0, 1}) {
-  const auto o = Dispersion::sellmeier({0.73358749, 0.96464345, 1.82831454}, {0, 0.0194325203, 120});
+  const auto o =
+      Dispersion::sellmeier({0.73358749, 0.96464345, 1.82831454}, {0, 0.0194325203, 120});
   const auto e = Dispersion::sellmeier({0.35859695, 0.8242783, 0.14429128}, {0, 0.0106689543, 120});
   return Uniaxial(o.index(fraunhofer::D), e.index(fraunhofer::D), axis);
 }

@@ -11,7 +11,6 @@
 #include <stdexcept>
 
 #include "optics/dispersion.h"
-
 #include "tests/optics/crystal_fixtures.h"
 
 namespace {
@@ -22,9 +21,6 @@ using eikon::test::kPi;
 using eikon::test::randomUnit;
 using eikon::test::toDeg;
 
-
-
-
 glm::dvec3 incidence(double i_deg) { return {std::sin(deg(i_deg)), 0, std::cos(deg(i_deg))}; }
 
 }  // namespace
@@ -32,13 +28,14 @@ glm::dvec3 incidence(double i_deg) { return {std::sin(deg(i_deg)), 0, std::cos(d
 TEST(Fresnel, Section5CriticalBrewsterR0) {
   // §5 at d: N-BK7 (SCHOTT) and diamond (Peter 1923), indices from their Sellmeier formulas.
   const auto bk7 = eikon::Dispersion::sellmeier({1.03961212, 0.231792344, 1.01046945},
-                                               {0.00600069867, 0.0200179144, 103.560653});
+                                                {0.00600069867, 0.0200179144, 103.560653});
   const auto dia = eikon::Dispersion::sellmeier({0.3306, 4.3356}, {0.175 * 0.175, 0.106 * 0.106});
   struct Case {
     double n, nd, crit, b_ext, b_int, r0;
   };
-  const Case cases[] = {{bk7.index(eikon::fraunhofer::d), 1.516800, 41.2452, 56.6038, 33.3962, 0.042165},
-                        {dia.index(eikon::fraunhofer::d), 2.417486, 24.4345, 67.5274, 22.4726, 0.172038}};
+  const Case cases[] = {
+      {bk7.index(eikon::fraunhofer::d), 1.516800, 41.2452, 56.6038, 33.3962, 0.042165},
+      {dia.index(eikon::fraunhofer::d), 2.417486, 24.4345, 67.5274, 22.4726, 0.172038}};
   for (const Case& c : cases) {
     EXPECT_NEAR(c.n, c.nd, 1e-6);
     EXPECT_NEAR(toDeg(eikon::criticalAngle(c.n, 1.0)), c.crit, 1e-4);
@@ -50,9 +47,12 @@ TEST(Fresnel, Section5CriticalBrewsterR0) {
     EXPECT_NEAR(f.Rp, c.r0, 1e-6);
     EXPECT_NEAR(f.R, c.r0, 1e-6);
     // p vanishes at Brewster (both sides); TIR above critical; grazing → 1.
-    EXPECT_NEAR(eikon::fresnelReflectance(std::cos(eikon::brewsterAngle(1.0, c.n)), 1.0, c.n).Rp, 0.0, 1e-15);
-    EXPECT_NEAR(eikon::fresnelReflectance(std::cos(eikon::brewsterAngle(c.n, 1.0)), c.n, 1.0).Rp, 0.0, 1e-15);
-    const auto tir = eikon::fresnelReflectance(std::cos(eikon::criticalAngle(c.n, 1.0) + 1e-9), c.n, 1.0);
+    EXPECT_NEAR(eikon::fresnelReflectance(std::cos(eikon::brewsterAngle(1.0, c.n)), 1.0, c.n).Rp,
+                0.0, 1e-15);
+    EXPECT_NEAR(eikon::fresnelReflectance(std::cos(eikon::brewsterAngle(c.n, 1.0)), c.n, 1.0).Rp,
+                0.0, 1e-15);
+    const auto tir =
+        eikon::fresnelReflectance(std::cos(eikon::criticalAngle(c.n, 1.0) + 1e-9), c.n, 1.0);
     EXPECT_EQ(tir.R, 1.0);
     EXPECT_NEAR(eikon::fresnelReflectance(0.0, 1.0, c.n).R, 1.0, 1e-15);
   }
@@ -113,10 +113,13 @@ TEST(Fresnel, IsotropicLimitExactAndApproximate) {
       const auto iso = eikon::fresnelReflectance(std::cos(deg(id)), n1, 1.6);
       const auto ex = eikon::uniaxialEntryExact(incidence(id), {0, 0, 1}, n1, c);
       const auto ap = eikon::uniaxialEntryApprox(incidence(id), {0, 0, 1}, n1, c);
-      worst_exact = std::max({worst_exact, std::abs(ex.reflected - iso.R), std::abs(ex.o + ex.e - (1 - iso.R))});
+      worst_exact = std::max(
+          {worst_exact, std::abs(ex.reflected - iso.R), std::abs(ex.o + ex.e - (1 - iso.R))});
       worst_approx = std::max({worst_approx, std::abs(ap.reflected - iso.R)});
-      const auto out = eikon::uniaxialExitExact(c, eikon::Mode::Extraordinary, incidence(id), {0, 0, 1}, n1);
-      const auto out_ap = eikon::uniaxialExitApprox(c, eikon::Mode::Extraordinary, incidence(id), {0, 0, 1}, n1);
+      const auto out =
+          eikon::uniaxialExitExact(c, eikon::Mode::Extraordinary, incidence(id), {0, 0, 1}, n1);
+      const auto out_ap =
+          eikon::uniaxialExitApprox(c, eikon::Mode::Extraordinary, incidence(id), {0, 0, 1}, n1);
       // For a single polarised mode the exit reflectance depends on its s/p mix: compare the mix.
       const auto back = eikon::fresnelReflectance(std::cos(deg(id)), 1.6, n1);
       EXPECT_GE(out.transmitted, 1 - std::max(back.Rs, back.Rp) - 1e-12);
@@ -150,9 +153,12 @@ TEST(Fresnel, ExitTotalInternalReflectionPerMode) {
   const auto o = eikon::uniaxialExitExact(c, eikon::Mode::Ordinary, incidence(40), {0, 0, 1}, 1.0);
   EXPECT_NEAR(o.transmitted, 0.0, 1e-14);
   EXPECT_NEAR(o.o + o.e, 1.0, 1e-12);
-  const auto e = eikon::uniaxialExitExact(c, eikon::Mode::Extraordinary, incidence(40), {0, 0, 1}, 1.0);
+  const auto e =
+      eikon::uniaxialExitExact(c, eikon::Mode::Extraordinary, incidence(40), {0, 0, 1}, 1.0);
   EXPECT_GT(e.transmitted, 0.3);
-  EXPECT_EQ(eikon::uniaxialExitApprox(c, eikon::Mode::Ordinary, incidence(40), {0, 0, 1}, 1.0).transmitted, 0.0);
+  EXPECT_EQ(eikon::uniaxialExitApprox(c, eikon::Mode::Ordinary, incidence(40), {0, 0, 1}, 1.0)
+                .transmitted,
+            0.0);
 }
 
 TEST(Fresnel, ApproximationCostForCalcite) {
@@ -183,9 +189,9 @@ TEST(Fresnel, ApproximationCostForCalcite) {
     }
   }
   rms_mode = std::sqrt(rms_mode / count);
-  std::cout << "[ Fresnel approx cost, calcite D ] entry per-mode max " << d_mode << " rms " << rms_mode
-            << ", entry total-R max " << d_total << "; for i <= 60°: per-mode max " << d_mode60 << ", total-R max "
-            << d_total60 << "; exit (0–34°) max " << d_exit << "\n";
+  std::cout << "[ Fresnel approx cost, calcite D ] entry per-mode max " << d_mode << " rms "
+            << rms_mode << ", entry total-R max " << d_total << "; for i <= 60°: per-mode max "
+            << d_mode60 << ", total-R max " << d_total60 << "; exit (0–34°) max " << d_exit << "\n";
   RecordProperty("entry_mode_max", std::to_string(d_mode));
   RecordProperty("entry_total_max", std::to_string(d_total));
   RecordProperty("exit_max", std::to_string(d_exit));

@@ -1,6 +1,6 @@
 // Plane-interface refraction and reflection of o- and e-waves (interface.h) against
-// docs/reference-cases.md §3 and against invariants: tangential k conserved, both waves on their index
-// surfaces, energy on the correct side, isotropic Snell when n_o = n_e.
+// docs/reference-cases.md §3 and against invariants: tangential k conserved, both waves on their
+// index surfaces, energy on the correct side, isotropic Snell when n_o = n_e.
 #include "optics/interface.h"
 
 #include <gtest/gtest.h>
@@ -9,7 +9,6 @@
 #include <random>
 
 #include "optics/dispersion.h"
-
 #include "tests/optics/crystal_fixtures.h"
 
 namespace {
@@ -19,9 +18,6 @@ using eikon::test::deg;
 using eikon::test::kPi;
 using eikon::test::randomUnit;
 using eikon::test::toDeg;
-
-
-
 
 double angleFromZ(glm::dvec3 v) { return toDeg(std::atan2(std::hypot(v.x, v.y), v.z)); }
 
@@ -43,7 +39,8 @@ TEST(Interface, Section3WorkedCase) {
   const double si = 0.5;
   EXPECT_NEAR(w.e.q, c.n_e * std::sqrt(1 - si * si / (c.n_o * c.n_o)), 1e-15);
   EXPECT_NEAR(w.e.n, si / std::sin(deg(angleFromZ(w.e.s))), 1e-12);
-  EXPECT_NEAR(std::tan(deg(angleFromZ(w.e.t))), (c.n_e / c.n_o) * (c.n_e / c.n_o) * std::tan(deg(angleFromZ(w.e.s))), 1e-12);
+  EXPECT_NEAR(std::tan(deg(angleFromZ(w.e.t))),
+              (c.n_e / c.n_o) * (c.n_e / c.n_o) * std::tan(deg(angleFromZ(w.e.s))), 1e-12);
   // The fixed-point iteration of §3 converges to the same index.
   double n = c.n_o;
   for (int k = 0; k < 200; ++k) n = c.extraordinaryIndexAt(deg(90) - std::asin(si / n));
@@ -64,7 +61,8 @@ TEST(Interface, RandomGeometriesConserveTangentialKAndEnergySide) {
     const double n1 = u(rng);
     const auto w = eikon::refractIntoUniaxial(s_in, m, n1, c);
     const glm::dvec3 pt = n1 * s_in - glm::dot(n1 * s_in, m) * m;
-    for (auto [wave, mode] : {std::pair{w.o, eikon::Mode::Ordinary}, std::pair{w.e, eikon::Mode::Extraordinary}}) {
+    for (auto [wave, mode] :
+         {std::pair{w.o, eikon::Mode::Ordinary}, std::pair{w.e, eikon::Mode::Extraordinary}}) {
       if (!wave.exists) continue;
       const glm::dvec3 p = wave.p();
       EXPECT_LT(glm::length(p - glm::dot(p, m) * m - pt), 1e-14) << "tangential k conserved";
@@ -132,7 +130,8 @@ TEST(Interface, TotalInternalReflectionPerMode) {
   EXPECT_NEAR(toDeg(std::asin(1 / c.n_o)), 37.0859, 1e-4);
   // At 45° both are trapped.
   const glm::dvec3 s45{std::sin(deg(45)), 0, std::cos(deg(45))};
-  EXPECT_FALSE(eikon::refractOutOfUniaxial(c, eikon::Mode::Extraordinary, s45, {0, 0, 1}, 1.0).exists);
+  EXPECT_FALSE(
+      eikon::refractOutOfUniaxial(c, eikon::Mode::Extraordinary, s45, {0, 0, 1}, 1.0).exists);
   // Isotropic TIR.
   EXPECT_FALSE(eikon::refractIsotropic(s45, {0, 0, 1}, 1.5, 1.0).exists);
 }

@@ -42,7 +42,8 @@ eikon::Dispersion parseSpec(const json& j, const std::string& where) {
     d = eikon::Dispersion::conrady(c[0], c[1], c[2]);
   } else if (j.contains("sellmeier")) {
     const auto c = j.at("sellmeier").get<std::vector<double>>();
-    if (c.empty() || c.size() % 2 != 0) throw std::runtime_error(where + ": sellmeier needs 2k numbers");
+    if (c.empty() || c.size() % 2 != 0)
+      throw std::runtime_error(where + ": sellmeier needs 2k numbers");
     const std::ptrdiff_t k = std::ptrdiff_t(c.size() / 2);
     d = eikon::Dispersion::sellmeier({c.begin(), c.begin() + k}, {c.begin() + k, c.end()});
   } else {
@@ -69,13 +70,20 @@ void checkAgainst(const eikon::Dispersion& d, const json& ref, const std::string
 }
 
 const std::set<std::string> kIsotropicKeys{"name", "source", "notes", "n"};
-const std::set<std::string> kCrystalKeys{"name",     "source",     "notes", "n_o", "n_e", "optic_axis",
-                                         "attenuation_o_per_mm", "attenuation_e_per_mm"};
+const std::set<std::string> kCrystalKeys{"name",
+                                         "source",
+                                         "notes",
+                                         "n_o",
+                                         "n_e",
+                                         "optic_axis",
+                                         "attenuation_o_per_mm",
+                                         "attenuation_e_per_mm"};
 
 }  // namespace
 
 TEST(Materials, LibraryMatchesReference) {
-  const json ref = readJson(fs::path(EIKON_SOURCE_DIR) / "tests" / "data" / "reference" / "materials.json");
+  const json ref =
+      readJson(fs::path(EIKON_SOURCE_DIR) / "tests" / "data" / "reference" / "materials.json");
   const fs::path dir = fs::path(EIKON_SOURCE_DIR) / "materials";
   std::set<std::string> seen;
   int checked_against_reference = 0;
@@ -116,13 +124,15 @@ TEST(Materials, LibraryMatchesReference) {
     if (ref.contains(ref_key) && ref.at(ref_key).contains("o")) {
       checkAgainst(o, ref.at(ref_key).at("o"), stem + " o");
       checkAgainst(e, ref.at(ref_key).at("e"), stem + " e");
-      EXPECT_NEAR(o.abbeNumber() / ref.at(ref_key).at("Vd_computed").at("o").get<double>(), 1.0, 0.01);
-      EXPECT_NEAR(e.abbeNumber() / ref.at(ref_key).at("Vd_computed").at("e").get<double>(), 1.0, 0.01);
+      EXPECT_NEAR(o.abbeNumber() / ref.at(ref_key).at("Vd_computed").at("o").get<double>(), 1.0,
+                  0.01);
+      EXPECT_NEAR(e.abbeNumber() / ref.at(ref_key).at("Vd_computed").at("e").get<double>(), 1.0,
+                  0.01);
       ++checked_against_reference;
     }
   }
-  for (const char* name : {"N-BK7", "N-SF11", "fused-silica", "diamond", "water", "calcite", "quartz", "sapphire",
-                           "rutile", "tourmaline"})
+  for (const char* name : {"N-BK7", "N-SF11", "fused-silica", "diamond", "water", "calcite",
+                           "quartz", "sapphire", "rutile", "tourmaline"})
     EXPECT_TRUE(seen.count(name)) << "missing materials/" << name << ".json";
   EXPECT_EQ(checked_against_reference, 9) << "all but tourmaline (and ruby) have reference lines";
 }
@@ -135,7 +145,8 @@ TEST(Materials, TourmalineAndRubyAreDocumentedApproximations) {
   EXPECT_EQ(t.at("n_e").get<double>(), 1.6225);
   const auto ao = t.at("attenuation_o_per_mm").get<std::vector<double>>();
   const auto ae = t.at("attenuation_e_per_mm").get<std::vector<double>>();
-  for (int i = 0; i < 3; ++i) EXPECT_GT(ao[size_t(i)], 3.0 * ae[size_t(i)]) << "o absorbed much more than e";
+  for (int i = 0; i < 3; ++i)
+    EXPECT_GT(ao[size_t(i)], 3.0 * ae[size_t(i)]) << "o absorbed much more than e";
   EXPECT_NE(t.at("notes").get<std::string>().find("ILLUSTRATIVE"), std::string::npos);
   if (fs::exists(dir / "ruby.json")) {  // optional: sapphire indices
     const json r = readJson(dir / "ruby.json");

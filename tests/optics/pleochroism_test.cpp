@@ -7,7 +7,6 @@
 #include <complex>
 
 #include "optics/dispersion.h"
-
 #include "tests/optics/crystal_fixtures.h"
 
 namespace {
@@ -18,8 +17,6 @@ using eikon::test::kPi;
 using eikon::test::randomUnit;
 using eikon::test::toDeg;
 
-
-
 }  // namespace
 
 TEST(Pleochroism, EndpointsAreExact) {
@@ -29,9 +26,11 @@ TEST(Pleochroism, EndpointsAreExact) {
   EXPECT_DOUBLE_EQ(eikon::extraordinaryAttenuation(0.0, c.n_o, c.n_e, so, se), so);
   EXPECT_DOUBLE_EQ(eikon::extraordinaryAttenuation(deg(90), c.n_o, c.n_e, so, se), se);
   // Tevs' variant misses σ_e at 90° by (n_o/n_e)² = 1.2452 for calcite at D.
-  EXPECT_NEAR(eikon::extraordinaryAttenuation(deg(90), c.n_o, c.n_e, 0.0, 1.0, eikon::PleochroismModel::TevsThesis),
+  EXPECT_NEAR(eikon::extraordinaryAttenuation(deg(90), c.n_o, c.n_e, 0.0, 1.0,
+                                              eikon::PleochroismModel::TevsThesis),
               1.2452, 1e-4);
-  EXPECT_NEAR(eikon::extraordinaryAttenuation(deg(90), 1.642, 1.6225, 0.0, 1.0, eikon::PleochroismModel::TevsThesis),
+  EXPECT_NEAR(eikon::extraordinaryAttenuation(deg(90), 1.642, 1.6225, 0.0, 1.0,
+                                              eikon::PleochroismModel::TevsThesis),
               1.0242, 1e-4);
 }
 
@@ -41,7 +40,8 @@ TEST(Pleochroism, WeightsAt45Degrees) {
   const auto w = eikon::pleochroismWeights(deg(45), c.n_o, c.n_e);
   EXPECT_NEAR(w.o, 0.4204, 5e-5);
   EXPECT_NEAR(w.e, 0.5841, 5e-5);
-  const auto t = eikon::pleochroismWeights(deg(45), c.n_o, c.n_e, eikon::PleochroismModel::TevsThesis);
+  const auto t =
+      eikon::pleochroismWeights(deg(45), c.n_o, c.n_e, eikon::PleochroismModel::TevsThesis);
   EXPECT_NEAR(t.o, 0.5, 1e-15);
   EXPECT_NEAR(t.e, 0.6226, 5e-5);
 }
@@ -56,7 +56,8 @@ TEST(Pleochroism, FirstOrderMatchesComplexIndexRelation) {
   const double so = 2 * no.imag(), se = 2 * ne.imag();
   for (double td = 0; td <= 90; td += 7.5) {
     const double th = deg(td);
-    const cd n = 1.0 / std::sqrt(std::cos(th) * std::cos(th) / (no * no) + std::sin(th) * std::sin(th) / (ne * ne));
+    const cd n = 1.0 / std::sqrt(std::cos(th) * std::cos(th) / (no * no) +
+                                 std::sin(th) * std::sin(th) / (ne * ne));
     const double exact = 2 * n.imag();
     EXPECT_NEAR(eikon::extraordinaryAttenuation(th, c.n_o, c.n_e, so, se) / exact, 1.0, 1e-6) << td;
   }
@@ -66,11 +67,13 @@ TEST(Pleochroism, RayLengthCarriesCosRho) {
   const auto c = calciteD(glm::normalize(glm::dvec3(0.2, 0.1, 1)));
   const glm::dvec3 so{0.9, 0.5, 0.1}, se{0.1, 0.2, 0.3};
   const glm::dvec3 s = glm::normalize(glm::dvec3(1, 0.3, 1));
-  const glm::dvec3 wn = eikon::attenuationPerWaveNormalLength(c, eikon::Mode::Extraordinary, s, so, se);
+  const glm::dvec3 wn =
+      eikon::attenuationPerWaveNormalLength(c, eikon::Mode::Extraordinary, s, so, se);
   const glm::dvec3 ray = eikon::attenuationPerRayLength(c, eikon::Mode::Extraordinary, s, so, se);
   const double cos_rho = glm::dot(s, c.rayDirection(eikon::Mode::Extraordinary, s));
   EXPECT_LT(glm::length(ray - wn * cos_rho), 1e-15);
-  EXPECT_LT(glm::length(eikon::attenuationPerRayLength(c, eikon::Mode::Ordinary, s, so, se) - so), 1e-15);
+  EXPECT_LT(glm::length(eikon::attenuationPerRayLength(c, eikon::Mode::Ordinary, s, so, se) - so),
+            1e-15);
   const double th = std::acos(c.cosTheta(s));
   EXPECT_NEAR(wn.x, eikon::extraordinaryAttenuation(th, c.n_o, c.n_e, so.x, se.x), 1e-15);
 }
@@ -80,7 +83,8 @@ TEST(Pleochroism, UnpolarisedColourAveragesTransmittances) {
   // adding absorbances (exp(−½(σ_o+σ_e)L)) is darker (Jensen) — by a factor > 2 here.
   const glm::dvec3 so{2.5, 1.2, 2.2}, se{0.35, 0.12, 0.3};
   const double L = 5.0;
-  const glm::dvec3 right = eikon::unpolarisedTransmittance(eikon::transmittance(so, L), eikon::transmittance(se, L));
+  const glm::dvec3 right =
+      eikon::unpolarisedTransmittance(eikon::transmittance(so, L), eikon::transmittance(se, L));
   const glm::dvec3 wrong = glm::exp(-0.5 * (so + se) * L);
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(right[i], 0.5 * (std::exp(-so[i] * L) + std::exp(-se[i] * L)), 1e-15);

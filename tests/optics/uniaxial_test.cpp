@@ -1,6 +1,7 @@
 // Uniaxial index surface, ray direction and walk-off against docs/reference-cases.md
 // §1, §2 and §8. Indices come from the Ghosh (1999) Sellmeier formulas through eikon::Dispersion,
-// so the tolerances are those of docs/reference-cases.md (1e-6 on n, 1e-4° on angles), not the code's own.
+// so the tolerances are those of docs/reference-cases.md (1e-6 on n, 1e-4° on angles), not the
+// code's own.
 #include "optics/uniaxial.h"
 
 #include <gtest/gtest.h>
@@ -20,10 +21,18 @@ double deg(double d) { return d * kPi / 180.0; }
 double toDeg(double r) { return r * 180.0 / kPi; }
 
 // Ghosh 1999 calcite and quartz, refractiveindex.info formula 2 with C1 as a C = 0 term.
-eikon::Dispersion calciteO() { return eikon::Dispersion::sellmeier({0.73358749, 0.96464345, 1.82831454}, {0, 0.0194325203, 120}); }
-eikon::Dispersion calciteE() { return eikon::Dispersion::sellmeier({0.35859695, 0.8242783, 0.14429128}, {0, 0.0106689543, 120}); }
-eikon::Dispersion quartzO() { return eikon::Dispersion::sellmeier({0.28604141, 1.07044083, 1.10202242}, {0, 0.0100585997, 100}); }
-eikon::Dispersion quartzE() { return eikon::Dispersion::sellmeier({0.28851804, 1.09509924, 1.15662475}, {0, 0.0102101864, 100}); }
+eikon::Dispersion calciteO() {
+  return eikon::Dispersion::sellmeier({0.73358749, 0.96464345, 1.82831454}, {0, 0.0194325203, 120});
+}
+eikon::Dispersion calciteE() {
+  return eikon::Dispersion::sellmeier({0.35859695, 0.8242783, 0.14429128}, {0, 0.0106689543, 120});
+}
+eikon::Dispersion quartzO() {
+  return eikon::Dispersion::sellmeier({0.28604141, 1.07044083, 1.10202242}, {0, 0.0100585997, 100});
+}
+eikon::Dispersion quartzE() {
+  return eikon::Dispersion::sellmeier({0.28851804, 1.09509924, 1.15662475}, {0, 0.0102101864, 100});
+}
 
 eikon::Uniaxial calciteAt(double lambda_nm, glm::dvec3 axis = {0, 0, 1}) {
   return eikon::Uniaxial(calciteO().index(lambda_nm), calciteE().index(lambda_nm), axis);
@@ -75,10 +84,13 @@ TEST(Uniaxial, WalkOffThreeFormsAgree) {
   const double no2 = c.n_o * c.n_o, ne2 = c.n_e * c.n_e;
   for (double td = 1; td < 90; td += 7) {
     const double t = deg(td);
-    const double closed = std::atan((no2 - ne2) * std::sin(t) * std::cos(t) / (ne2 * std::cos(t) * std::cos(t) + no2 * std::sin(t) * std::sin(t)));
+    const double closed =
+        std::atan((no2 - ne2) * std::sin(t) * std::cos(t) /
+                  (ne2 * std::cos(t) * std::cos(t) + no2 * std::sin(t) * std::sin(t)));
     const double h = 1e-6;
     const double n = c.extraordinaryIndexAt(t);
-    const double fd = std::atan(-(c.extraordinaryIndexAt(t + h) - c.extraordinaryIndexAt(t - h)) / (2 * h) / n);
+    const double fd =
+        std::atan(-(c.extraordinaryIndexAt(t + h) - c.extraordinaryIndexAt(t - h)) / (2 * h) / n);
     const glm::dvec3 s{std::sin(t), 0, std::cos(t)};
     EXPECT_NEAR(c.walkOffAngleAt(t), closed, 1e-14) << td;
     EXPECT_NEAR(c.walkOffAngle(s), closed, 1e-14) << td;
@@ -113,7 +125,8 @@ TEST(Uniaxial, MaxWalkOff) {
 TEST(Uniaxial, CalciteAwayQuartzTowardsAxis) {
   // §2: negative crystal → ray farther from the axis than the wave normal; positive → closer.
   const auto cal = calciteAt(eikon::fraunhofer::D);
-  const eikon::Uniaxial qz(quartzO().index(eikon::fraunhofer::D), quartzE().index(eikon::fraunhofer::D), {0, 0, 1});
+  const eikon::Uniaxial qz(quartzO().index(eikon::fraunhofer::D),
+                           quartzE().index(eikon::fraunhofer::D), {0, 0, 1});
   EXPECT_FALSE(cal.isPositive());
   EXPECT_TRUE(qz.isPositive());
   for (double td = 5; td < 90; td += 10) {
@@ -130,12 +143,14 @@ TEST(Uniaxial, CalcitePlateDoubleImage) {
   // §2 plate: t = 10 mm, normal incidence, axis in the xz plane at 45° to the surface leaning
   // towards +x. The e image is displaced by 1.092 mm (1.09207) towards −x at D, 1.0924 at d; the
   // o-ray goes straight; both leave parallel to the incident beam.
-  for (auto [lambda, expected] : {std::pair{eikon::fraunhofer::D, 1.09207}, std::pair{eikon::fraunhofer::d, 1.0924}}) {
+  for (auto [lambda, expected] :
+       {std::pair{eikon::fraunhofer::D, 1.09207}, std::pair{eikon::fraunhofer::d, 1.0924}}) {
     const auto c = calciteAt(lambda, {1, 0, 1});
     const glm::dvec3 in{0, 0, 1}, normal{0, 0, 1};
     const auto w = eikon::refractIntoUniaxial(in, normal, 1.0, c);
     ASSERT_TRUE(w.o.exists && w.e.exists);
-    EXPECT_NEAR(glm::length(w.e.s - in), 0.0, 1e-15) << "wave normals stay along the surface normal";
+    EXPECT_NEAR(glm::length(w.e.s - in), 0.0, 1e-15)
+        << "wave normals stay along the surface normal";
     EXPECT_NEAR(glm::length(w.o.t - in), 0.0, 1e-15) << "o-ray goes straight";
     const double offset_x = 10.0 * w.e.t.x / w.e.t.z;
     EXPECT_NEAR(offset_x, -expected, 1e-4) << "e image moves away from the axis (towards −x)";
@@ -156,7 +171,8 @@ TEST(Uniaxial, RayIsEpsilonSNotInverseSection8) {
   const double th[] = {30, 45, 70}, wrong_by[] = {10.8, 12.5, 8.1};
   for (int i = 0; i < 3; ++i) {
     const glm::dvec3 s = std::cos(deg(th[i])) * a + std::sin(deg(th[i])) * perp;
-    const glm::dvec3 D = glm::normalize(glm::cross(s, glm::cross(s, a)));  // e-wave D: ⊥ s, in (s, a)
+    const glm::dvec3 D =
+        glm::normalize(glm::cross(s, glm::cross(s, a)));  // e-wave D: ⊥ s, in (s, a)
     const glm::dvec3 E = eps_inv * D;
     const glm::dvec3 H = glm::cross(s, E);
     const glm::dvec3 S = glm::normalize(glm::cross(E, H));
@@ -178,7 +194,8 @@ TEST(Uniaxial, HamiltonianVanishesOnBothIndexSurfaces) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) EXPECT_NEAR(Me[i][j], ratio[i][j], 1e-15) << "M_e = ε/(n_o² n_e²)";
   for (int k = 0; k < 50; ++k) {
-    const glm::dvec3 s = glm::normalize(glm::dvec3(std::sin(k * 1.3), std::cos(k * 0.7), std::sin(k * 2.1 + 0.3)));
+    const glm::dvec3 s =
+        glm::normalize(glm::dvec3(std::sin(k * 1.3), std::cos(k * 0.7), std::sin(k * 2.1 + 0.3)));
     EXPECT_NEAR(c.hamiltonian(eikon::Mode::Ordinary, c.n_o * s), 0.0, 1e-15);
     EXPECT_NEAR(c.hamiltonian(eikon::Mode::Extraordinary, c.extraordinaryIndex(s) * s), 0.0, 1e-15);
     EXPECT_LT(angleBetween(c.rayVelocity(eikon::Mode::Ordinary, s), s), 1e-15);
@@ -204,7 +221,8 @@ TEST(Uniaxial, IsotropicLimitAndAxisAlongWaveNormal) {
 TEST(Uniaxial, ValidatesAndNormalises) {
   const eikon::Uniaxial c(1.6, 1.5, {0, 0, 7});
   EXPECT_DOUBLE_EQ(glm::length(c.axis), 1.0);
-  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN(),
+               inf = std::numeric_limits<double>::infinity();
   EXPECT_THROW(eikon::Uniaxial(1.6, 1.5, {0, 0, 0}), std::invalid_argument);
   EXPECT_THROW(eikon::Uniaxial(1.6, 1.5, {nan, 0, 1}), std::invalid_argument);
   EXPECT_THROW(eikon::Uniaxial(1.6, 1.5, {inf, 0, 1}), std::invalid_argument);

@@ -1,6 +1,6 @@
-// Simulated light in the view renderer (issue 6, docs/design.md §2 image formation): the band/mode plan,
-// a diffuse floor under a directional light (Lambert's cosine law), single scattering in a slab of
-// haze against its closed form, and the two twins rendering the same lit volume. The light
+// Simulated light in the view renderer (issue 6, docs/design.md §2 image formation): the band/mode
+// plan, a diffuse floor under a directional light (Lambert's cosine law), single scattering in a
+// slab of haze against its closed form, and the two twins rendering the same lit volume. The light
 // volumes come from the simulator (GPU or CPU reference); both view twins then read the same ones.
 #include <gtest/gtest.h>
 
@@ -102,7 +102,8 @@ glm::dvec3 centreMean(const RenderImage& img, int half) {
 
 /// The lit volume rendered by the CPU reference (unless `cpu` is false) and the GPU view renderer,
 /// at half-voxel steps.
-std::pair<RenderImage, RenderImage> renderBothTwins(const Scene& scene, const VolumeSet& v, bool cpu = true) {
+std::pair<RenderImage, RenderImage> renderBothTwins(const Scene& scene, const VolumeSet& v,
+                                                    bool cpu = true) {
   RenderSettings rs;
   rs.march.step_voxels = 0.5;
   RenderImage c;
@@ -124,8 +125,8 @@ TEST(Lighting, DiffuseFloorFollowsLambertsCosineLaw) {
   const double expected = 0.6 * 2.0 * std::cos(30.0 * kDeg) / kPi;
   auto [ci, gi] = renderBothTwins(scene, v);
   glm::dvec3 c = centreMean(ci, 2), g = centreMean(gi, 2);
-  std::printf("floor radiance: CPU (%.6f %.6f %.6f), GPU (%.6f %.6f %.6f), Lambert %.6f\n", c.x, c.y, c.z, g.x, g.y, g.z,
-              expected);
+  std::printf("floor radiance: CPU (%.6f %.6f %.6f), GPU (%.6f %.6f %.6f), Lambert %.6f\n", c.x,
+              c.y, c.z, g.x, g.y, g.z, expected);
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(c[k], expected, 0.02 * expected);
     EXPECT_NEAR(g[k], expected, 0.02 * expected);
@@ -170,10 +171,12 @@ TEST(Lighting, InScatterMatchesSingleScatteringInASlab) {
   const double g = 0.5, sigma = 0.1;
   const double p = (1 - g * g) / (4 * kPi * std::pow(1 + g * g, 1.5));
   const double W = v.grid.extent.z;  // the grid's depth (≥ the 12 mm asked, by < 1 voxel)
-  const double expected = sigma * p * 10.0 * std::exp(-sigma * 5.0) * (1 - std::exp(-sigma * W)) / sigma;
+  const double expected =
+      sigma * p * 10.0 * std::exp(-sigma * 5.0) * (1 - std::exp(-sigma * W)) / sigma;
   auto [cImg, gImg] = renderBothTwins(scene, v);
   glm::dvec3 c = centreMean(cImg, 0), gg = centreMean(gImg, 0);
-  std::printf("in-scatter: CPU %.6f, GPU %.6f, closed form %.6f\n", luminance(c), luminance(gg), expected);
+  std::printf("in-scatter: CPU %.6f, GPU %.6f, closed form %.6f\n", luminance(c), luminance(gg),
+              expected);
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(c[k], expected, 0.005 * expected);
     EXPECT_NEAR(gg[k], expected, 0.005 * expected);
@@ -204,7 +207,8 @@ TEST(Lighting, LitRenderTwinsAgree) {
     diff += std::abs(double(ci.rgb[i]) - gi.rgb[i]);
     mean += ci.rgb[i];
   }
-  std::printf("lit twins: mean |d| %.3e, mean radiance %.3e\n", diff / double(ci.rgb.size()), mean / double(ci.rgb.size()));
+  std::printf("lit twins: mean |d| %.3e, mean radiance %.3e\n", diff / double(ci.rgb.size()),
+              mean / double(ci.rgb.size()));
   EXPECT_GT(mean, 0.0);
   EXPECT_LT(diff, 0.01 * mean);
   expectNoValidationMessages();

@@ -1,12 +1,13 @@
 // Light simulator, CPU reference (issue 6): energy bookkeeping, uniform beams, absorption, the
 // Luneburg focus, patch budget and termination. The GPU kernel will be tested against this.
+#include "core/reference/wavefront.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "core/reference/wavefront.h"
 #include "tests/core/light_fixtures.h"
 #include "tests/core/test_support.h"
 
@@ -39,7 +40,8 @@ TEST(Wavefront, HomogeneousBeamIsUniformAndConserved) {
         g = glm::dvec3(0.0);
       },
       grid.origin, grid.boundsMax(), h);
-  for (auto mode : {WavefrontSettings::Splat::Accumulate, WavefrontSettings::Splat::HighestEnergy}) {
+  for (auto mode :
+       {WavefrontSettings::Splat::Accumulate, WavefrontSettings::Splat::HighestEnergy}) {
     WavefrontSettings s;
     s.dt = 0.75 * h;
     s.splat = mode;
@@ -61,7 +63,8 @@ TEST(Wavefront, HomogeneousBeamIsUniformAndConserved) {
       dirErr = std::max(dirErr, glm::length(glm::dvec3(r.direction[v]) - glm::dvec3(1, 0, 0)));
     }
     std::printf("[ measured ] %s: irradiance min %.9g max %.9g (E = %g), direction error %.2e\n",
-                mode == WavefrontSettings::Splat::Accumulate ? "accumulate" : "highest", lo, hi, E, dirErr);
+                mode == WavefrontSettings::Splat::Accumulate ? "accumulate" : "highest", lo, hi, E,
+                dirErr);
     EXPECT_NEAR(lo, E, 1e-6 * E);
     EXPECT_NEAR(hi, E, 1e-6 * E);
     EXPECT_LT(dirErr, 1e-6);
@@ -96,12 +99,13 @@ TEST(Wavefront, GlassSphereConservesFlux) {
   EXPECT_EQ(st.flux_absorbed, 0.0);
   EXPECT_GT(st.kills_caustic, 0u);
   EXPECT_GT(st.splits, 0u);
-  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted, 1e-9 * st.flux_emitted);
+  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted,
+              1e-9 * st.flux_emitted);
   EXPECT_NEAR(st.flux_probe + st.flux_ended_before_probe, st.flux_emitted, 1e-9 * st.flux_emitted);
   const double h = vol.grid.h;
   EXPECT_GE(st.flux_probe, st.flux_emitted - E * kPi * (1 + 3 * h) * (1 + 3 * h));
-  std::printf("[ measured ] flux ended upstream of x = 1.1 mm: %.6f = E*pi*(%.4f mm)^2\n", st.flux_ended_before_probe,
-              std::sqrt(st.flux_ended_before_probe / (E * kPi)));
+  std::printf("[ measured ] flux ended upstream of x = 1.1 mm: %.6f = E*pi*(%.4f mm)^2\n",
+              st.flux_ended_before_probe, std::sqrt(st.flux_ended_before_probe / (E * kPi)));
   EXPECT_LE(st.flux_probe, st.flux_emitted * (1 + 1e-9));
 }
 
@@ -121,7 +125,8 @@ TEST(Wavefront, PassingCausticsKeepsTheLightBeyondTheFocus) {
   s.pass_caustics = true;
   WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0));
   s.pass_caustics = false;
-  const WavefrontStats killed = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0)).stats;
+  const WavefrontStats killed =
+      WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0)).stats;
   const WavefrontStats& st = r.stats;
   printWavefrontStats("glass sphere, caustics passed", st);
   std::printf("[ measured ] caustic crossings %zu\n", st.caustic_crossings);
@@ -164,11 +169,14 @@ TEST(Wavefront, StraightStepsMatchSingleSteps) {
               b.stats.straight_time_steps);
   double sumA = 0, sumB = 0, l1 = 0;
   for (size_t v = 0; v < vol.grid.count(); ++v) {
-    sumA += a.irradiance[v], sumB += b.irradiance[v], l1 += std::abs(double(b.irradiance[v]) - a.irradiance[v]);
+    sumA += a.irradiance[v], sumB += b.irradiance[v],
+        l1 += std::abs(double(b.irradiance[v]) - a.irradiance[v]);
   }
-  std::printf("[ measured ] volume: sum straight/single - 1 = %.2e, L1 = %.2e\n", sumB / sumA - 1, l1 / sumA);
+  std::printf("[ measured ] volume: sum straight/single - 1 = %.2e, L1 = %.2e\n", sumB / sumA - 1,
+              l1 / sumA);
   const WavefrontStats &sa = a.stats, &sb = b.stats;
-  EXPECT_GT(sb.straight_time_steps, sb.straight_steps);  // straight steps were taken, k > 1 on average
+  EXPECT_GT(sb.straight_time_steps,
+            sb.straight_steps);  // straight steps were taken, k > 1 on average
   EXPECT_EQ(sa.straight_steps, 0u);
   auto rel = [](double x, double y) { return std::abs(x - y) / std::max(1.0, std::abs(y)); };
   EXPECT_LE(rel(double(sb.splits), double(sa.splits)), 1e-3);
@@ -179,16 +187,17 @@ TEST(Wavefront, StraightStepsMatchSingleSteps) {
   EXPECT_NEAR(sb.flux_left, sa.flux_left, 1e-6 * sa.flux_emitted);
   EXPECT_NEAR(sb.flux_caustic, sa.flux_caustic, 1e-6 * sa.flux_emitted);
   EXPECT_NEAR(sb.flux_energy, sa.flux_energy, 1e-6 * sa.flux_emitted);
-  EXPECT_NEAR(sb.flux_left + sb.flux_caustic + sb.flux_energy, sb.flux_emitted, 1e-9 * sb.flux_emitted);
+  EXPECT_NEAR(sb.flux_left + sb.flux_caustic + sb.flux_energy, sb.flux_emitted,
+              1e-9 * sb.flux_emitted);
   EXPECT_LT(glm::length(sb.caustic_centroid - sa.caustic_centroid), 1e-6 * vol.grid.h);
   EXPECT_NEAR(sumB / sumA, 1.0, 1.0 / 64);
   EXPECT_LT(l1 / sumA, 0.05);
 }
 
-// 3. Luneburg lens n = √(2 − r²/R²), R = 1 (docs/reference-cases.md §7a), exact analytic field. Every ray
-// parallel to +x reaches (R, 0, 0) after the same optical path R(1 + π/2) from x = −R, and the
-// simulator's time is optical path (c = 1), so the part of the front inside the lens collapses
-// onto the focus in the same step: patches flip there and are killed. We check (a) the
+// 3. Luneburg lens n = √(2 − r²/R²), R = 1 (docs/reference-cases.md §7a), exact analytic field.
+// Every ray parallel to +x reaches (R, 0, 0) after the same optical path R(1 + π/2) from x = −R,
+// and the simulator's time is optical path (c = 1), so the part of the front inside the lens
+// collapses onto the focus in the same step: patches flip there and are killed. We check (a) the
 // flux-weighted centroid of the caustic kills is within one step (dt = h/2) of (R, 0, 0); (b) the
 // accumulated irradiance peaks in the voxel whose centre is the focus (the grid is placed so that
 // (R, 0, 0) is a voxel centre), i.e. within 1 voxel; (c) before any caustic, all the flux crosses
@@ -205,19 +214,23 @@ TEST(Wavefront, LuneburgLensFocusesOnTheFarSurface) {
   const WavefrontStats& st = r.stats;
   printWavefrontStats("Luneburg", st);
   const glm::dvec3 focus(1, 0, 0);
-  std::printf("[ measured ] caustic centroid (%.5f, %.5f, %.5f), %.3e mm from the focus\n", st.caustic_centroid.x,
-              st.caustic_centroid.y, st.caustic_centroid.z, glm::length(st.caustic_centroid - focus));
+  std::printf("[ measured ] caustic centroid (%.5f, %.5f, %.5f), %.3e mm from the focus\n",
+              st.caustic_centroid.x, st.caustic_centroid.y, st.caustic_centroid.z,
+              glm::length(st.caustic_centroid - focus));
   EXPECT_LT(glm::length(st.caustic_centroid - focus), s.dt > 0 ? s.dt : 0.5 * h);
   size_t best = 0;
   for (size_t v = 0; v < grid.count(); ++v)
     if (r.irradiance[v] > r.irradiance[best]) best = v;
   const int bi = int(best % 49), bj = int((best / 49) % 49), bk = int(best / (49 * 49));
   const glm::dvec3 c = grid.center(bi, bj, bk);
-  std::printf("[ measured ] irradiance peak %.4g (incident 1) in voxel (%d, %d, %d) centred (%.4f, %.4f, %.4f)\n",
-              double(r.irradiance[best]), bi, bj, bk, c.x, c.y, c.z);
+  std::printf(
+      "[ measured ] irradiance peak %.4g (incident 1) in voxel (%d, %d, %d) centred (%.4f, %.4f, "
+      "%.4f)\n",
+      double(r.irradiance[best]), bi, bj, bk, c.x, c.y, c.z);
   EXPECT_LE(glm::length(c - focus), 1.01 * h);
   EXPECT_NEAR(st.flux_probe, st.flux_emitted, 1e-9 * st.flux_emitted);
-  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted, 1e-9 * st.flux_emitted);
+  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted,
+              1e-9 * st.flux_emitted);
   EXPECT_EQ(st.live_at_end, 0u);
 }
 
@@ -242,7 +255,8 @@ TEST(Wavefront, PatchBudgetHoldsAndTheLoopEnds) {
   EXPECT_GT(st.splits_refused, 0u);
   EXPECT_LT(st.steps, s.max_steps);
   EXPECT_EQ(st.live_at_end, 0u);
-  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted, 1e-9 * st.flux_emitted);
+  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted,
+              1e-9 * st.flux_emitted);
 }
 
 // 4a. Threads (WavefrontSettings::threads): each step's patch list is cut into contiguous chunks,
@@ -309,11 +323,13 @@ TEST(Wavefront, ThreadsGiveTheSingleThreadedCounts) {
       EXPECT_EQ(a.flux_absorbed, 0.0);
       EXPECT_EQ(b.flux_absorbed, 0.0);
       const size_t crossings = a.seeded + 4 * a.splits;
-      const double seedFlux = a.flux_emitted / double(a.seeded);  // every seed carries the same flux
+      const double seedFlux =
+          a.flux_emitted / double(a.seeded);  // every seed carries the same flux
       EXPECT_NEAR(b.flux_probe, a.flux_probe, orders(crossings, double(crossings) * seedFlux));
       EXPECT_NEAR(b.flux_ended_before_probe, a.flux_ended_before_probe,
                   orders(crossings, double(crossings) * seedFlux));
-      const double centroidTol = orders(a.kills_caustic, 4.0 * std::sqrt(3.0) * a.flux_caustic) / a.flux_caustic;
+      const double centroidTol =
+          orders(a.kills_caustic, 4.0 * std::sqrt(3.0) * a.flux_caustic) / a.flux_caustic;
       EXPECT_LT(glm::length(b.caustic_centroid - a.caustic_centroid), centroidTol);
       const double probeTol = orders(crossings, double(crossings) * seedFlux) / a.flux_probe;
       EXPECT_LT(glm::length(b.probe_centroid - a.probe_centroid), 4.0 * std::sqrt(3.0) * probeTol);
@@ -322,16 +338,20 @@ TEST(Wavefront, ThreadsGiveTheSingleThreadedCounts) {
       double worst = 0;
       for (size_t v = 0; v < vol.grid.count(); ++v) {
         const float x = one.irradiance[v], y = r.irradiance[v];
-        if (x != y) ++differ, worst = std::max(worst, std::abs(double(y) - x) / std::abs(double(x)));
+        if (x != y)
+          ++differ, worst = std::max(worst, std::abs(double(y) - x) / std::abs(double(x)));
         bool ok = near1ulp(x, y, 0.0) && near1ulp(one.direction[v].w, r.direction[v].w, 0.0);
-        for (int c = 0; c < 3; ++c) ok = ok && near1ulp(one.direction[v][c], r.direction[v][c], 1e-12);
+        for (int c = 0; c < 3; ++c)
+          ok = ok && near1ulp(one.direction[v][c], r.direction[v][c], 1e-12);
         if (!ok) ++apart;
       }
-      std::printf("[ measured ] %d threads%s: %zu of %zu voxels differ from 1 thread (at most %.2e relative); flux "
-                  "left, caustic, energy differ by %.1e, %.1e, %.1e relative\n",
-                  threads, budget == 5000 ? ", budget 5000" : "", differ, vol.grid.count(), worst,
-                  std::abs(b.flux_left / a.flux_left - 1), std::abs(b.flux_caustic / a.flux_caustic - 1),
-                  std::abs(b.flux_energy / a.flux_energy - 1));
+      std::printf(
+          "[ measured ] %d threads%s: %zu of %zu voxels differ from 1 thread (at most %.2e "
+          "relative); flux "
+          "left, caustic, energy differ by %.1e, %.1e, %.1e relative\n",
+          threads, budget == 5000 ? ", budget 5000" : "", differ, vol.grid.count(), worst,
+          std::abs(b.flux_left / a.flux_left - 1), std::abs(b.flux_caustic / a.flux_caustic - 1),
+          std::abs(b.flux_energy / a.flux_energy - 1));
       EXPECT_EQ(apart, 0u);
       if (threads == 2) {
         const WavefrontResult again = WavefrontSimulator(field, vol.grid, s).run(light);
@@ -370,8 +390,8 @@ TEST(Wavefront, AbsorbingSlabTransmitsExpMinusHalf) {
   const WavefrontStats& st = r.stats;
   printWavefrontStats("slab", st);
   const double expected = st.flux_emitted * std::exp(-0.5);
-  std::printf("[ measured ] transmitted fraction %.12f vs exp(-0.5) = %.12f\n", st.flux_left / st.flux_emitted,
-              std::exp(-0.5));
+  std::printf("[ measured ] transmitted fraction %.12f vs exp(-0.5) = %.12f\n",
+              st.flux_left / st.flux_emitted, std::exp(-0.5));
   EXPECT_NEAR(st.flux_left, expected, 1e-6 * expected);
   EXPECT_NEAR(st.flux_left + st.flux_absorbed, st.flux_emitted, 1e-12 * st.flux_emitted);
   EXPECT_EQ(st.kills_caustic + st.kills_energy, 0u);
@@ -426,8 +446,10 @@ TEST(Wavefront, PointLightInverseSquare) {
         if (rr >= 0.75 && rr <= 1.75) shell += v * h * h * h;
         if (rr >= 1.4 && rr <= 1.6) ringSum += v, ringExpect += I / (rr * rr), ++ringN;
       }
-  std::printf("[ measured ] shell sum %.6f vs 4*pi*I*1 = %.6f (rel %.2e); mean over %d voxels at r~1.5: %.5f vs I/r^2 %.5f\n",
-              shell, 4 * kPi * I, shell / (4 * kPi * I) - 1, ringN, ringSum / ringN, ringExpect / ringN);
+  std::printf(
+      "[ measured ] shell sum %.6f vs 4*pi*I*1 = %.6f (rel %.2e); mean over %d voxels at r~1.5: "
+      "%.5f vs I/r^2 %.5f\n",
+      shell, 4 * kPi * I, shell / (4 * kPi * I) - 1, ringN, ringSum / ringN, ringExpect / ringN);
   EXPECT_NEAR(shell, 4 * kPi * I, 0.01 * 4 * kPi * I);
   EXPECT_NEAR(ringSum / ringN, ringExpect / ringN, 0.02 * ringExpect / ringN);
 }

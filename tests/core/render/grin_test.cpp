@@ -1,5 +1,5 @@
-// Gradient-index media: the integrator against closed forms (docs/reference-cases.md §7), first on the
-// exact analytic field (integrator error only), then voxelised on both twins.
+// Gradient-index media: the integrator against closed forms (docs/reference-cases.md §7), first on
+// the exact analytic field (integrator error only), then voxelised on both twins.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -40,7 +40,7 @@ TEST(Interface, SnellRefractionAngleMatchesSinRatio) {
   for (double deg : {0.0, 10.0, 30.0, 50.0, 70.0, 85.0}) {
     glm::dvec3 d(std::sin(deg * kDeg), 0, std::cos(deg * kDeg));
     TraceRequest req{glm::dvec3(0, 0, 0) - 20.0 * d, d, 587.5618};  // hits the face at the origin
-    double expected = std::sin(deg * kDeg) / 1.5;  // n1 sin θ1 = n2 sin θ2
+    double expected = std::sin(deg * kDeg) / 1.5;                   // n1 sin θ1 = n2 sin θ2
     TraceOutcome c = t.cpu->trace(req, ms);
     TraceOutcome g = t.gpu->trace({req}, ms).front();
     SCOPED_TRACE("incidence " + std::to_string(deg) + " deg");

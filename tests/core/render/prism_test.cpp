@@ -23,7 +23,8 @@ struct Line {
   double nm, n, dmin_deg;
 };
 // n from the SCHOTT Sellmeier and D_min from docs/reference-cases.md §4.
-const Line kLines[] = {{"F", 486.1327, 1.522376, 39.1381}, {"d", 587.5618, 1.516800, 38.6467},
+const Line kLines[] = {{"F", 486.1327, 1.522376, 39.1381},
+                       {"d", 587.5618, 1.516800, 38.6467},
                        {"C", 656.2725, 1.514322, 38.4291}};
 
 double traceDeviation(Twins& t, const Line& l, double height, bool gpu) {
@@ -32,7 +33,8 @@ double traceDeviation(Twins& t, const Line& l, double height, bool gpu) {
   // Inside at minimum deviation the ray runs parallel to the base (+x); outside it arrives at
   // (i − r) above the horizontal and leaves (i − r) below.
   glm::dvec3 d(std::cos(i - r), std::sin(i - r), 0);
-  glm::dvec3 target(-2.5 * (1.0 - height), height * 0.0 + (1.0 - height) * 0.0 + 0.0, 0);  // see below
+  glm::dvec3 target(-2.5 * (1.0 - height), height * 0.0 + (1.0 - height) * 0.0 + 0.0,
+                    0);  // see below
   // A point on the left face at fraction `height` between the base corner and the apex.
   const double H = 10.0 * std::cos(A / 2);
   glm::dvec3 apex(0, 2.0 / 3.0 * H, 0), corner(-5, -H / 3.0, 0);
@@ -57,8 +59,8 @@ TEST(Prism, MinimumDeviationAtFraunhoferLines) {
       double sum = 0.0;
       for (double hgt : {0.3, 0.4, 0.5, 0.6, 0.7}) sum += traceDeviation(t, kLines[k], hgt, g == 1);
       dev[k][g] = sum / 5.0;
-      std::printf("%s line: D = %.4f° (%s), analytic %.4f°, error %+.4f°\n", kLines[k].name, dev[k][g], g ? "GPU" : "CPU",
-                  kLines[k].dmin_deg, dev[k][g] - kLines[k].dmin_deg);
+      std::printf("%s line: D = %.4f° (%s), analytic %.4f°, error %+.4f°\n", kLines[k].name,
+                  dev[k][g], g ? "GPU" : "CPU", kLines[k].dmin_deg, dev[k][g] - kLines[k].dmin_deg);
       EXPECT_NEAR(dev[k][g], kLines[k].dmin_deg, 0.05) << kLines[k].name;
     }
   for (int g = 0; g < 2; ++g) {

@@ -41,8 +41,9 @@ TEST(RadialAxis, AngularMomentumIsConservedForBothModes) {
       TraceOutcome c = t.cpu->trace(req, ms, mode);
       glm::dvec3 L1 = glm::cross(c.exit_point, c.wave_normal);
       glm::dvec3 L1g = glm::cross(gpu[size_t(mode)].exit_point, gpu[size_t(mode)].wave_normal);
-      std::printf("b = %.1f mode %c: |ΔL| CPU %.2e, GPU %.2e mm; exit (%.4f, %.4f, %.4f)\n", b, mode ? 'e' : 'o',
-                  glm::length(L1 - L0), glm::length(L1g - L0), c.exit_point.x, c.exit_point.y, c.exit_point.z);
+      std::printf("b = %.1f mode %c: |ΔL| CPU %.2e, GPU %.2e mm; exit (%.4f, %.4f, %.4f)\n", b,
+                  mode ? 'e' : 'o', glm::length(L1 - L0), glm::length(L1g - L0), c.exit_point.x,
+                  c.exit_point.y, c.exit_point.z);
       if (mode == 0) {
         base = glm::length(L1 - L0);
         EXPECT_LT(base, 1e-2);  // sanity of the baseline: 0.02 h·|p| per crossing layer
@@ -64,16 +65,20 @@ TEST(RadialAxis, RayThroughTheCentreDoesNotSplit) {
   TraceRequest req{{-6.9, 0, 0}, {1, 0, 0}, 589.2938};
   auto gpu = t.gpu->traceModes({req}, ms).front();
   EXPECT_LT(glm::length(gpu[0].exit_point - gpu[1].exit_point), 1e-5);
-  EXPECT_LT(glm::length(t.cpu->trace(req, ms, 0).exit_point - t.cpu->trace(req, ms, 1).exit_point), 1e-9);
+  EXPECT_LT(glm::length(t.cpu->trace(req, ms, 0).exit_point - t.cpu->trace(req, ms, 1).exit_point),
+            1e-9);
 }
 
 TEST(RadialAxis, BadInput) {
   EXPECT_THROW(sceneFromJson(R"({"objects": [{"shape": "sphere", "radius": 1, "material": "calcite",
-      "optic_axis_field": "spiral"}]})"), SceneError);
+      "optic_axis_field": "spiral"}]})"),
+               SceneError);
   EXPECT_THROW(sceneFromJson(R"({"objects": [{"shape": "sphere", "radius": 1, "material": "N-BK7",
-      "optic_axis_field": "radial"}]})"), SceneError);
+      "optic_axis_field": "radial"}]})"),
+               SceneError);
   EXPECT_THROW(sceneFromJson(R"({"objects": [{"shape": "sphere", "radius": 1, "material": "calcite",
-      "optic_axis_field": "radial", "optic_axis": [0, 0, 1]}]})"), SceneError);
+      "optic_axis_field": "radial", "optic_axis": [0, 0, 1]}]})"),
+               SceneError);
 }
 
 }  // namespace

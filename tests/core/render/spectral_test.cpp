@@ -55,14 +55,17 @@ TEST(Spectral, NonDispersiveSphereHasNoColourShift) {
     glm::dvec3 c = px(img, i), w = flatWeight(uint32_t(i), 8), g = c / w;
     double mean = (g.x + g.y + g.z) / 3.0;
     double chroma = (std::max({g.x, g.y, g.z}) - std::min({g.x, g.y, g.z})) / mean;
-    double raw = (std::max({c.x, c.y, c.z}) - std::min({c.x, c.y, c.z})) / ((c.x + c.y + c.z) / 3.0);
+    double raw =
+        (std::max({c.x, c.y, c.z}) - std::min({c.x, c.y, c.z})) / ((c.x + c.y + c.z) / 3.0);
     int x = i % img.width, y = i / img.width;
     if (std::hypot(x - 15.5, y - 15.5) < 10) ++inside;  // sphere covers r ≈ 11.6 px
     worst = std::max(worst, chroma);
     worstRaw = std::max(worstRaw, raw);
   }
-  std::printf("non-dispersive sphere, N = 8: max chroma of RGB/W_p %.3g (raw per-pixel chroma up to %.3g), %d px on the sphere\n",
-              worst, worstRaw, inside);
+  std::printf(
+      "non-dispersive sphere, N = 8: max chroma of RGB/W_p %.3g (raw per-pixel chroma up to %.3g), "
+      "%d px on the sphere\n",
+      worst, worstRaw, inside);
   EXPECT_LT(worst, 1e-4);
   expectNoValidationMessages();
 }
@@ -98,9 +101,11 @@ TEST(Spectral, EqualEnergyEnvironmentIsWhite) {
     ++count;
   }
   glm::dvec3 mean = sum / double(count), sd = glm::sqrt(sum2 / double(count) - mean * mean);
-  std::printf("flat environment, N = 8, %d background px: max |RGB - W_p| %.3g; mean (%.5f %.5f %.5f), per-pixel sd "
-              "(%.3f %.3f %.3f)\n",
-              count, worst, mean.x, mean.y, mean.z, sd.x, sd.y, sd.z);
+  std::printf(
+      "flat environment, N = 8, %d background px: max |RGB - W_p| %.3g; mean (%.5f %.5f %.5f), "
+      "per-pixel sd "
+      "(%.3f %.3f %.3f)\n",
+      count, worst, mean.x, mean.y, mean.z, sd.x, sd.y, sd.z);
   EXPECT_LT(worst, 1e-3);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], 1.0, 5.0 * sd[c] / std::sqrt(double(count)));
   expectNoValidationMessages();
@@ -134,8 +139,8 @@ TEST(Spectral, FlatSpectrumMeanConvergesUnbiased) {
       glm::dvec3 mean = sum / double(P);
       if (spp == 1) sd1 = glm::sqrt(sum2 / double(P) - mean * mean);
       glm::dvec3 tol = 5.0 * sd1 / std::sqrt(double(P) * spp);
-      std::printf("N = %2d spp = %2d: mean (%.5f %.5f %.5f), 5σ/√(P·spp) (%.2g %.2g %.2g)\n", n, spp, mean.x, mean.y, mean.z,
-                  tol.x, tol.y, tol.z);
+      std::printf("N = %2d spp = %2d: mean (%.5f %.5f %.5f), 5σ/√(P·spp) (%.2g %.2g %.2g)\n", n,
+                  spp, mean.x, mean.y, mean.z, tol.x, tol.y, tol.z);
       for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], 1.0, tol[c]) << "N " << n << " spp " << spp;
     }
   }
@@ -160,10 +165,12 @@ double deviation(Twins& t, double nm, double n_ref, bool gpu) {
   const double H = 10.0 * std::cos(A / 2);
   const glm::dvec3 apex(0, 2.0 / 3.0 * H, 0), corner(-5, -H / 3.0, 0);
   std::vector<TraceRequest> reqs;
-  for (double h : {0.3, 0.4, 0.5, 0.6, 0.7}) reqs.push_back({corner + h * (apex - corner) - 12.0 * d, d, nm});
+  for (double h : {0.3, 0.4, 0.5, 0.6, 0.7})
+    reqs.push_back({corner + h * (apex - corner) - 12.0 * d, d, nm});
   double sum = 0.0;
   for (const auto& q : reqs) {
-    TraceOutcome o = gpu ? t.gpu->trace({q}, MarchSettings{}).front() : t.cpu->trace(q, MarchSettings{});
+    TraceOutcome o =
+        gpu ? t.gpu->trace({q}, MarchSettings{}).front() : t.cpu->trace(q, MarchSettings{});
     sum += (i - r - std::atan2(o.exit_direction.y, o.exit_direction.x)) / kDeg;
   }
   return sum / double(reqs.size());
@@ -172,11 +179,13 @@ double deviation(Twins& t, double nm, double n_ref, bool gpu) {
 TEST(Spectral, PrismSpectrumOrderAndAbbeNumber) {
   Twins t(kPrism);
   const Dispersion& bk7 = t.scene.materials.at("N-BK7").n_o;
-  // (d) Order: violet deviated most. Deviations at 450/550/650 nm (each at its own D_min incidence).
+  // (d) Order: violet deviated most. Deviations at 450/550/650 nm (each at its own D_min
+  // incidence).
   for (int g = 0; g < 2; ++g) {
     double d450 = deviation(t, 450, bk7.index(450), g), d550 = deviation(t, 550, bk7.index(550), g),
            d650 = deviation(t, 650, bk7.index(650), g);
-    std::printf("%s: D(450) %.4f° > D(550) %.4f° > D(650) %.4f°\n", g ? "GPU" : "CPU", d450, d550, d650);
+    std::printf("%s: D(450) %.4f° > D(550) %.4f° > D(650) %.4f°\n", g ? "GPU" : "CPU", d450, d550,
+                d650);
     EXPECT_GT(d450, d550);
     EXPECT_GT(d550, d650);
     // The steps are ~0.6° and ~0.35°; require each to be clearly resolved (≥ 0.2°).
@@ -194,11 +203,15 @@ TEST(Spectral, PrismSpectrumOrderAndAbbeNumber) {
   };
   double vFit = (cauchyN(dl) - 1) / (cauchyN(F) - cauchyN(C));
   for (int g = 0; g < 2; ++g) {
-    double nF = nFrom(deviation(t, F, bk7.index(F), g)), nd = nFrom(deviation(t, dl, bk7.index(dl), g)),
+    double nF = nFrom(deviation(t, F, bk7.index(F), g)),
+           nd = nFrom(deviation(t, dl, bk7.index(dl), g)),
            nC = nFrom(deviation(t, C, bk7.index(C), g));
     double V = (nd - 1) / (nF - nC);
-    std::printf("%s: n_F %.6f n_d %.6f n_C %.6f -> V_d %.3f (catalogue %.2f, %+.2f%%; Sellmeier %.3f, Cauchy fit %.3f)\n",
-                g ? "GPU" : "CPU", nF, nd, nC, V, catalogue, 100 * (V / catalogue - 1), bk7.abbeNumber(), vFit);
+    std::printf(
+        "%s: n_F %.6f n_d %.6f n_C %.6f -> V_d %.3f (catalogue %.2f, %+.2f%%; Sellmeier %.3f, "
+        "Cauchy fit %.3f)\n",
+        g ? "GPU" : "CPU", nF, nd, nC, V, catalogue, 100 * (V / catalogue - 1), bk7.abbeNumber(),
+        vFit);
     // What the renderer carries is the weighted least-squares Cauchy fit of the Sellmeier over
     // 380–780 nm (its V_d is 64.09, −0.12% from the catalogue): the traced V must reproduce the
     // fit's V within 0.1% (the march itself), and the catalogue 64.17 within 1% (issue 4).
@@ -234,8 +247,10 @@ TEST(Spectral, GpuMatchesCpuInSpectralMode) {
   }
   std::sort(diffs.begin(), diffs.end());
   double p95 = diffs[size_t(0.95 * double(diffs.size()))], rel = sumDiff / sumVal;
-  std::printf("GPU vs CPU spectral (24x18, N = 8): mean |Δ|/mean |RGB| %.3g, 95th percentile |Δ| %.3g, max %.3g\n", rel,
-              p95, diffs.back());
+  std::printf(
+      "GPU vs CPU spectral (24x18, N = 8): mean |Δ|/mean |RGB| %.3g, 95th percentile |Δ| %.3g, max "
+      "%.3g\n",
+      rel, p95, diffs.back());
   EXPECT_LT(rel, 0.01);
   EXPECT_LT(p95, 0.02);
   expectNoValidationMessages();

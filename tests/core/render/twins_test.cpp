@@ -52,8 +52,9 @@ TEST(Twins, TraceKernelAgreesWithReferenceOnRandomRays) {
       EXPECT_NEAR(c.optical_path_mm, gpu[i].optical_path_mm, 1e-3);
     }
   }
-  std::printf("GPU vs CPU: %d/%zu rays agree (1e-3 mm, 1e-4); worst transmittance difference %.2e\n", agree,
-              rays.size(), worst_t);
+  std::printf(
+      "GPU vs CPU: %d/%zu rays agree (1e-3 mm, 1e-4); worst transmittance difference %.2e\n", agree,
+      rays.size(), worst_t);
   EXPECT_GE(agree, int(0.97 * double(rays.size())));
   EXPECT_LT(worst_t, 1e-3);
   expectNoValidationMessages();
@@ -78,8 +79,8 @@ TEST(Twins, RenderedImageAgreesWithReference) {
       close += d < 1e-2;
     }
     double mean = sum / double(g.rgb.size());
-    std::printf("render (%s): mean |GPU − CPU| %.2e, %.1f%% of values within 1e-2\n", wl ? "spectral" : "RGB", mean,
-                100.0 * double(close) / double(g.rgb.size()));
+    std::printf("render (%s): mean |GPU − CPU| %.2e, %.1f%% of values within 1e-2\n",
+                wl ? "spectral" : "RGB", mean, 100.0 * double(close) / double(g.rgb.size()));
     EXPECT_LT(mean, 2e-3);
     EXPECT_GE(double(close), 0.98 * double(g.rgb.size()));
   }
@@ -89,7 +90,8 @@ TEST(Twins, RenderedImageAgreesWithReference) {
 TEST(Twins, ValidationLayersAreActiveInTests) {
   // ctest runs every test with EIKON_VALIDATION=1, so a silent validation layer would hide bugs.
   const char* env = std::getenv("EIKON_VALIDATION");
-  if (!env || std::string(env) != "1") GTEST_SKIP() << "EIKON_VALIDATION is not set (run through ctest)";
+  if (!env || std::string(env) != "1")
+    GTEST_SKIP() << "EIKON_VALIDATION is not set (run through ctest)";
   EXPECT_TRUE(context().validationEnabled());
 }
 

@@ -1,6 +1,6 @@
 // End-to-end checks of the e-ray march (issue 5): the voxelised, smoothed crystal marched by the
-// mode Hamiltonian H_e = ½(pᵀM_e p − 1) (docs/design.md §2; shaders/march.glsl, core/reference) against
-// the closed-form uniaxial library in optics/ (uniaxial.h, interface.h, fresnel.h,
+// mode Hamiltonian H_e = ½(pᵀM_e p − 1) (docs/design.md §2; shaders/march.glsl, core/reference)
+// against the closed-form uniaxial library in optics/ (uniaxial.h, interface.h, fresnel.h,
 // pleochroism.h), with the numbers of docs/reference-cases.md §1–3, §8, §9.
 //
 // How the expected values are built. Every test takes the crystal's indices from the volume
@@ -142,8 +142,8 @@ std::array<TraceOutcome, 2> cpuModes(const Twins& t, const TraceRequest& r,
 // --------------------------------------------------------------------------- 1. plate walk-off
 
 TEST(UniaxialMarch, CalcitePlateDoubleImageAtNormalIncidence) {
-  // docs/reference-cases.md §2: t = 10 mm, axis in the plane of incidence at 45° to the faces, normal
-  // incidence, D line: the o-ray goes straight, the e-ray leaves parallel, displaced by
+  // docs/reference-cases.md §2: t = 10 mm, axis in the plane of incidence at 45° to the faces,
+  // normal incidence, D line: the o-ray goes straight, the e-ray leaves parallel, displaced by
   // t·tan ρ = 1.092 mm towards −x (axis leaning to +x), ρ = 6.2324°.
   //
   // Tolerances. (a) Against the quadrature of the smoothed profile (same indices): the wave
@@ -201,8 +201,8 @@ TEST(UniaxialMarch, CalcitePlateDoubleImageAtNormalIncidence) {
       EXPECT_NEAR(m[1].exit_point.y, o.y, tol);
       EXPECT_NEAR(sep, quad, tol);
       double rho = deg(std::atan((sep - layerExcess) / 10.0));
-      // the reference cases' own tolerance (1e-4 mm, 1e-4°) widened by the fit's shift, plus the rounding
-      // of the published 1.092 (±5e-4 mm).
+      // the reference cases' own tolerance (1e-4 mm, 1e-4°) widened by the fit's shift, plus the
+      // rounding of the published 1.092 (±5e-4 mm).
       EXPECT_NEAR(sep - layerExcess, 1.092, std::abs(fitShift) + 6e-4);
       EXPECT_NEAR(
           rho, 6.2324,
@@ -222,9 +222,9 @@ TEST(UniaxialMarch, CalcitePlateDoubleImageAtNormalIncidence) {
 // --------------------------------------------------------------------------- 2. walk-off sign
 
 TEST(UniaxialMarch, WalkOffAwayFromAxisInCalciteTowardsItInQuartz) {
-  // docs/reference-cases.md §2: negative crystal (calcite) e-ray bends away from the optic axis, positive
-  // (quartz) towards it. Axis in x-z at 45°, leaning to +x; normal incidence into a half space.
-  // Inside, the ray t and wave normal s = ẑ: θ_r = angle(t, a) > θ = 45° for calcite, < for
+  // docs/reference-cases.md §2: negative crystal (calcite) e-ray bends away from the optic axis,
+  // positive (quartz) towards it. Axis in x-z at 45°, leaning to +x; normal incidence into a half
+  // space. Inside, the ray t and wave normal s = ẑ: θ_r = angle(t, a) > θ = 45° for calcite, < for
   // quartz, by the library's walk-off (|Δ| < 1e-5 rad: the wave normal is exactly ẑ, t ∝ M_e ẑ).
   MarchSettings ms;
   const glm::dvec3 axis = glm::normalize(glm::dvec3(1, 0, 1));
@@ -262,16 +262,17 @@ TEST(UniaxialMarch, WalkOffAwayFromAxisInCalciteTowardsItInQuartz) {
 // --------------------------------------------------------------------------- 3. oblique incidence
 
 TEST(UniaxialMarch, ObliqueRefractionMatchesClosedForm) {
-  // docs/reference-cases.md §3: air → calcite at D, i = 30°, axis in the plane of incidence and parallel
-  // to the surface: wave normal φ_e = 19.4362°, ray ψ = 15.8218°, o-wave 17.5481°. Plus a random
-  // axis, where the e-ray leaves the plane of incidence. The ray ends inside a half-space crystal.
-  // Tolerances: the face is parallel to the grid and ∇n ∥ ẑ, so the tangential p is conserved and
-  // the marcher puts p back on H_e = 0 when the layer closes: directions agree with the library
-  // to float32 storage, 2e-7 CPU (interface_test's Snell bound) and 1e-5 GPU. The exit point is
-  // compared with the quadrature of the smoothed profile: inside the layer the marcher bends p by
-  // the interpolated exact gradient, which is not exactly the derivative of the interpolated n
-  // (H drifts by ~1e-4 there), so the ray slope differs by ~1e-4 over ±0.225 mm: 0.01 h = 1e-3 mm.
-  // Against the reference cases' angles: the Cauchy fit (|Δn| ≲ 3e-5) moves them by < 1e-3°.
+  // docs/reference-cases.md §3: air → calcite at D, i = 30°, axis in the plane of incidence and
+  // parallel to the surface: wave normal φ_e = 19.4362°, ray ψ = 15.8218°, o-wave 17.5481°. Plus a
+  // random axis, where the e-ray leaves the plane of incidence. The ray ends inside a half-space
+  // crystal. Tolerances: the face is parallel to the grid and ∇n ∥ ẑ, so the tangential p is
+  // conserved and the marcher puts p back on H_e = 0 when the layer closes: directions agree with
+  // the library to float32 storage, 2e-7 CPU (interface_test's Snell bound) and 1e-5 GPU. The exit
+  // point is compared with the quadrature of the smoothed profile: inside the layer the marcher
+  // bends p by the interpolated exact gradient, which is not exactly the derivative of the
+  // interpolated n (H drifts by ~1e-4 there), so the ray slope differs by ~1e-4 over ±0.225 mm:
+  // 0.01 h = 1e-3 mm. Against the reference cases' angles: the Cauchy fit (|Δn| ≲ 3e-5) moves them
+  // by < 1e-3°.
   MarchSettings ms;
   std::mt19937 rng(2024);
   std::normal_distribution<double> gauss(0.0, 1.0);

@@ -1,8 +1,9 @@
-// Light simulator, GPU kernel (shaders/wavefront.comp via GpuWavefront) against the double-precision
-// CPU reference (core/reference/wavefront.h): same seeds, same kill/split statistics, flux
-// conservation, and the splatted volumes. Both twins read the same VolumeSet (the CPU through
-// VolumeField), so every difference is float32 arithmetic (the GPU also splits in float32) and
-// the fixed-point splat. The scan of the GPU list rebuild is tested in wavefront_scan_test.cpp.
+// Light simulator, GPU kernel (shaders/wavefront.comp via GpuWavefront) against the
+// double-precision CPU reference (core/reference/wavefront.h): same seeds, same kill/split
+// statistics, flux conservation, and the splatted volumes. Both twins read the same VolumeSet (the
+// CPU through VolumeField), so every difference is float32 arithmetic (the GPU also splits in
+// float32) and the fixed-point splat. The scan of the GPU list rebuild is tested in
+// wavefront_scan_test.cpp.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -48,28 +49,35 @@ TEST(WavefrontGpu, HomogeneousBeamMatchesReference) {
   const double h = 0.25, E = 2.0;
   const VolumeSet vol = uniformVolume(16, h, {-2, -2, -2}, 1.5);
   VolumeField field(vol);
-  for (auto mode : {WavefrontSettings::Splat::Accumulate, WavefrontSettings::Splat::HighestEnergy}) {
+  for (auto mode :
+       {WavefrontSettings::Splat::Accumulate, WavefrontSettings::Splat::HighestEnergy}) {
     WavefrontSettings s;
     s.dt = 0.75 * h;
     s.splat = mode;
-    const WavefrontResult c = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, E));
+    const WavefrontResult c =
+        WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, E));
     const WavefrontResult g = GpuWavefront(context(), vol, s).run(directionalLight({1, 0, 0}, E));
     printWavefrontStats("homogeneous gpu", g.stats);
     EXPECT_EQ(g.stats.seeded, c.stats.seeded);
     EXPECT_EQ(g.stats.seeded, size_t(32 * 32));
     EXPECT_EQ(g.stats.splits, 0u);
     EXPECT_EQ(g.stats.kills_left, g.stats.seeded);
-    EXPECT_EQ(g.stats.kills_caustic + g.stats.kills_energy + g.stats.kills_opaque + g.stats.live_at_end, 0u);
+    EXPECT_EQ(
+        g.stats.kills_caustic + g.stats.kills_energy + g.stats.kills_opaque + g.stats.live_at_end,
+        0u);
     EXPECT_NEAR(g.stats.flux_left, c.stats.flux_emitted, 1e-12 * c.stats.flux_emitted);
-    EXPECT_NEAR(g.stats.steps, c.stats.steps, 1);  // the exit may land one step apart on the far face
+    EXPECT_NEAR(g.stats.steps, c.stats.steps,
+                1);  // the exit may land one step apart on the far face
     double worst = 0, worstCpu = 0, dirErr = 0;
     for (size_t v = 0; v < vol.grid.count(); ++v) {
       worst = std::max(worst, std::abs(g.irradiance[v] / E - 1.0));
       worstCpu = std::max(worstCpu, std::abs(double(g.irradiance[v]) - c.irradiance[v]) / E);
       dirErr = std::max(dirErr, glm::length(glm::dvec3(g.direction[v]) - glm::dvec3(1, 0, 0)));
     }
-    std::printf("[ measured ] %s: max |gpu/E - 1| %.2e, max |gpu - cpu|/E %.2e, direction error %.2e\n",
-                mode == WavefrontSettings::Splat::Accumulate ? "accumulate" : "highest", worst, worstCpu, dirErr);
+    std::printf(
+        "[ measured ] %s: max |gpu/E - 1| %.2e, max |gpu - cpu|/E %.2e, direction error %.2e\n",
+        mode == WavefrontSettings::Splat::Accumulate ? "accumulate" : "highest", worst, worstCpu,
+        dirErr);
     EXPECT_LT(worst, 1e-5);
     EXPECT_LT(worstCpu, 1e-5);
     EXPECT_LT(dirErr, 1e-5);
@@ -79,17 +87,18 @@ TEST(WavefrontGpu, HomogeneousBeamMatchesReference) {
 
 // 2. Glass sphere: refraction, a caustic behind the sphere, splits, whispering-gallery patches
 // killed by the energy threshold. Seeds are identical (both twins seed with
-// core/light/seeding.h), so the emitted flux matches to the double sum's round-off. Conservation on the GPU: splits quarter
-// float flux exactly and nothing absorbs, so ended = emitted up to the float32 rounding of each
-// seed's flux (≤ 6e-8 relative); we allow 1e-6. The statistics are not bit-identical: a patch
-// whose edge or orientation test is borderline in double may go the other way in float32 and
-// then its whole subtree differs. Measured on lavapipe (K = 16 steps per dispatch): counts
-// differ by ≤ 2.5e-4 relative (e.g. caustic kills 120654 vs 120684), flux by reason by ≤ 1e-6 of
-// the emitted flux, the volume total Σ fluence·h³ (= Σ flux·Δs) by 3e-7 and the per-voxel L1
-// difference Σ|g − c| / Σ c is 2e-6 (the fixed-point splat contributes ≤ 2^-29 of the largest
-// splat per splat, negligible). We allow about ten times the measured values (2e-3 on counts,
-// 1e-5 of the emitted flux by reason), and 1e-5 / 1e-4 on the volume total / L1: a borderline
-// decision that flips a large subtree in a future compiler or device is what these would catch.
+// core/light/seeding.h), so the emitted flux matches to the double sum's round-off. Conservation on
+// the GPU: splits quarter float flux exactly and nothing absorbs, so ended = emitted up to the
+// float32 rounding of each seed's flux (≤ 6e-8 relative); we allow 1e-6. The statistics are not
+// bit-identical: a patch whose edge or orientation test is borderline in double may go the other
+// way in float32 and then its whole subtree differs. Measured on lavapipe (K = 16 steps per
+// dispatch): counts differ by ≤ 2.5e-4 relative (e.g. caustic kills 120654 vs 120684), flux by
+// reason by ≤ 1e-6 of the emitted flux, the volume total Σ fluence·h³ (= Σ flux·Δs) by 3e-7 and the
+// per-voxel L1 difference Σ|g − c| / Σ c is 2e-6 (the fixed-point splat contributes ≤ 2^-29 of the
+// largest splat per splat, negligible). We allow about ten times the measured values (2e-3 on
+// counts, 1e-5 of the emitted flux by reason), and 1e-5 / 1e-4 on the volume total / L1: a
+// borderline decision that flips a large subtree in a future compiler or device is what these would
+// catch.
 TEST(WavefrontGpu, GlassSphereAgreesWithReference) {
   const Scene scene = sceneFromJson(kGlassSphereLightScene);
   const VolumeSet vol = voxelize(scene);
@@ -102,11 +111,12 @@ TEST(WavefrontGpu, GlassSphereAgreesWithReference) {
   auto t1 = std::chrono::steady_clock::now();
   const WavefrontResult g = gpu.run(light);
   auto t2 = std::chrono::steady_clock::now();
-  const double tc = std::chrono::duration<double>(t1 - t0).count(), tg = std::chrono::duration<double>(t2 - t1).count();
+  const double tc = std::chrono::duration<double>(t1 - t0).count(),
+               tg = std::chrono::duration<double>(t2 - t1).count();
   printWavefrontStats("sphere cpu", c.stats);
   printWavefrontStats("sphere gpu", g.stats);
-  std::printf("[ measured ] sphere: cpu %.3f s, gpu (%s) %.3f s, cpu/gpu %.2f\n", tc, context().deviceName().c_str(), tg,
-              tc / tg);
+  std::printf("[ measured ] sphere: cpu %.3f s, gpu (%s) %.3f s, cpu/gpu %.2f\n", tc,
+              context().deviceName().c_str(), tg, tc / tg);
   const WavefrontStats &cs = c.stats, &gs = g.stats;
   EXPECT_EQ(gs.seeded, cs.seeded);
   EXPECT_NEAR(gs.flux_emitted, cs.flux_emitted, 1e-12 * cs.flux_emitted);
@@ -124,11 +134,14 @@ TEST(WavefrontGpu, GlassSphereAgreesWithReference) {
   EXPECT_LT(glm::length(gs.caustic_centroid - cs.caustic_centroid), vol.grid.h);
   double sumC = 0, sumG = 0, l1 = 0, maxC = 0;
   for (size_t v = 0; v < vol.grid.count(); ++v) {
-    sumC += c.irradiance[v], sumG += g.irradiance[v], l1 += std::abs(double(g.irradiance[v]) - c.irradiance[v]);
+    sumC += c.irradiance[v], sumG += g.irradiance[v],
+        l1 += std::abs(double(g.irradiance[v]) - c.irradiance[v]);
     maxC = std::max(maxC, double(c.irradiance[v]));
   }
-  std::printf("[ measured ] sphere volume: sum gpu/cpu - 1 = %.2e, L1 |g - c| / sum c = %.2e (peak cpu %.4g)\n",
-              sumG / sumC - 1, l1 / sumC, maxC);
+  std::printf(
+      "[ measured ] sphere volume: sum gpu/cpu - 1 = %.2e, L1 |g - c| / sum c = %.2e (peak cpu "
+      "%.4g)\n",
+      sumG / sumC - 1, l1 / sumC, maxC);
   EXPECT_NEAR(sumG / sumC, 1.0, 1e-5);
   EXPECT_LT(l1 / sumC, 1e-4);
   expectNoValidationMessages();
@@ -181,30 +194,34 @@ TEST(WavefrontGpu, AbsorbingSlabMatchesReference) {
   const VolumeSet vol = voxelize(scene);
   VolumeField field(vol);
   WavefrontSettings s;
-  const WavefrontResult c = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0));
+  const WavefrontResult c =
+      WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0));
   const WavefrontResult g = GpuWavefront(context(), vol, s).run(directionalLight({1, 0, 0}, 1.0));
   printWavefrontStats("slab gpu", g.stats);
-  std::printf("[ measured ] slab transmitted: gpu %.9f cpu %.9f exp(-0.5) %.9f\n", g.stats.flux_left / g.stats.flux_emitted,
-              c.stats.flux_left / c.stats.flux_emitted, std::exp(-0.5));
+  std::printf("[ measured ] slab transmitted: gpu %.9f cpu %.9f exp(-0.5) %.9f\n",
+              g.stats.flux_left / g.stats.flux_emitted, c.stats.flux_left / c.stats.flux_emitted,
+              std::exp(-0.5));
   EXPECT_EQ(g.stats.seeded, c.stats.seeded);
   EXPECT_EQ(g.stats.kills_left, c.stats.kills_left);
   EXPECT_EQ(g.stats.kills_caustic + g.stats.kills_energy, 0u);
   EXPECT_NEAR(g.stats.flux_left, c.stats.flux_left, 2e-5 * c.stats.flux_left);
-  EXPECT_NEAR(g.stats.flux_left + g.stats.flux_absorbed, g.stats.flux_emitted, 1e-6 * g.stats.flux_emitted);
+  EXPECT_NEAR(g.stats.flux_left + g.stats.flux_absorbed, g.stats.flux_emitted,
+              1e-6 * g.stats.flux_emitted);
   double worst = 0;
-  for (size_t v = 0; v < vol.grid.count(); ++v) worst = std::max(worst, std::abs(double(g.irradiance[v]) - c.irradiance[v]));
+  for (size_t v = 0; v < vol.grid.count(); ++v)
+    worst = std::max(worst, std::abs(double(g.irradiance[v]) - c.irradiance[v]));
   std::printf("[ measured ] slab volume: max |gpu - cpu| = %.2e (incident 1)\n", worst);
   EXPECT_LT(worst, 2e-5);
   expectNoValidationMessages();
 }
 
-
 // 4. Point light, n = 1 (the CPU test's 32³ box, h = 0.125): cube-sphere seeds, splits as the
 // front expands, everything leaves. Also the dispatch/rebuild split of the work: patches are
 // independent and the fixed-point splat is order independent, so running 1 or 16 steps per
 // dispatch must give the same kills, splits and a bit-identical volume (each patch does the same
-// float operations; only the list rebuilds between dispatches move). Against the CPU: 4πI leaves (float rounding of the seed
-// flux, 1e-6), split/kill counts as in test 2 (measured: identical), volume L1 ≤ 1e-4.
+// float operations; only the list rebuilds between dispatches move). Against the CPU: 4πI leaves
+// (float rounding of the seed flux, 1e-6), split/kill counts as in test 2 (measured: identical),
+// volume L1 ≤ 1e-4.
 TEST(WavefrontGpu, PointLightIsIndependentOfStepsPerDispatch) {
   const double h = 0.125, I = 3.0;
   const VolumeSet vol = uniformVolume(32, h, {-2, -2, -2}, 1.0);
@@ -223,13 +240,17 @@ TEST(WavefrontGpu, PointLightIsIndependentOfStepsPerDispatch) {
   auto t2 = std::chrono::steady_clock::now();
   printWavefrontStats("point cpu", c.stats);
   printWavefrontStats("point gpu K=16", g16.stats);
-  std::printf("[ measured ] point light: gpu K=1 %.3f s (incl. pipeline), K=16 %.3f s (incl. pipeline)\n",
-              std::chrono::duration<double>(t1 - t0).count(), std::chrono::duration<double>(t2 - t1).count());
+  std::printf(
+      "[ measured ] point light: gpu K=1 %.3f s (incl. pipeline), K=16 %.3f s (incl. pipeline)\n",
+      std::chrono::duration<double>(t1 - t0).count(),
+      std::chrono::duration<double>(t2 - t1).count());
   for (const WavefrontResult* g : {&g1, &g16}) {
     EXPECT_EQ(g->stats.seeded, size_t(6 * 64));
-    EXPECT_NEAR(g->stats.flux_left, 4 * 3.14159265358979323846 * I, 1e-6 * 4 * 3.14159265358979323846 * I);
+    EXPECT_NEAR(g->stats.flux_left, 4 * 3.14159265358979323846 * I,
+                1e-6 * 4 * 3.14159265358979323846 * I);
     EXPECT_EQ(g->stats.kills_caustic + g->stats.kills_energy, 0u);
-    EXPECT_LE(std::abs(double(g->stats.splits) - double(c.stats.splits)), 2e-3 * double(c.stats.splits));
+    EXPECT_LE(std::abs(double(g->stats.splits) - double(c.stats.splits)),
+              2e-3 * double(c.stats.splits));
   }
   EXPECT_EQ(g1.stats.splits, g16.stats.splits);
   EXPECT_EQ(g1.stats.kills_left, g16.stats.kills_left);
@@ -240,8 +261,10 @@ TEST(WavefrontGpu, PointLightIsIndependentOfStepsPerDispatch) {
     differ += g1.irradiance[v] != g16.irradiance[v] || g1.direction[v] != g16.direction[v];
     sumC += c.irradiance[v], l1 += std::abs(double(g16.irradiance[v]) - c.irradiance[v]);
   }
-  std::printf("[ measured ] point light: %zu voxels differ between K=1 and K=16; L1 |g - c| / sum c = %.2e\n", differ,
-              l1 / sumC);
+  std::printf(
+      "[ measured ] point light: %zu voxels differ between K=1 and K=16; L1 |g - c| / sum c = "
+      "%.2e\n",
+      differ, l1 / sumC);
   EXPECT_EQ(differ, 0u);
   EXPECT_LT(l1 / sumC, 1e-4);
   expectNoValidationMessages();

@@ -67,9 +67,9 @@ double plateSlope(double no, double ne, glm::dvec3 a) {
 }
 
 struct PlateExpectation {
-  double quad;          ///< displacement −x of the e-ray through the stored (smoothed) profile, mm
-  double bulk;          ///< t·tan ρ from the stored bulk indices, mm
-  double published;     ///< t·tan ρ from Ghosh's n_o, n_e at D (docs/reference-cases.md §2), mm
+  double quad;       ///< displacement −x of the e-ray through the stored (smoothed) profile, mm
+  double bulk;       ///< t·tan ρ from the stored bulk indices, mm
+  double published;  ///< t·tan ρ from Ghosh's n_o, n_e at D (docs/reference-cases.md §2), mm
 };
 
 /// Quadrature of the e-ray slope along the beam axis through the volume's own fields (n_o, n_e
@@ -90,7 +90,8 @@ PlateExpectation plateExpectation(const VolumeSet& vol) {
   };
   PlateExpectation e{};
   const double z0 = vol.grid.origin.z, z1 = vol.grid.boundsMax().z, dz = 1e-4;
-  for (double z = z0 + 0.5 * dz; z < z1; z += dz) e.quad -= slopeAt(z) * dz;  // −x for an axis leaning +x
+  for (double z = z0 + 0.5 * dz; z < z1; z += dz)
+    e.quad -= slopeAt(z) * dz;  // −x for an axis leaning +x
   e.bulk = -kPlateT * slopeAt(0.0);
   const glm::dvec3 a(std::sqrt(0.5), 0, std::sqrt(0.5));
   e.published = -kPlateT * plateSlope(1.658344, 1.486130, a);
@@ -99,19 +100,23 @@ PlateExpectation plateExpectation(const VolumeSet& vol) {
 
 void checkPlateRun(const char* name, const WavefrontStats& st, int mode, double spotTol) {
   printWavefrontStats(name, st);
-  std::printf("[ measured ] %s mode %d: probe centroid (%.7f, %.7f, %.4f), direction (%.2e, %.2e, %.9f), "
-              "probe flux / emitted %.9f\n",
-              name, mode, st.probe_centroid.x, st.probe_centroid.y, st.probe_centroid.z, st.probe_direction.x,
-              st.probe_direction.y, st.probe_direction.z, st.flux_probe / st.flux_emitted);
+  std::printf(
+      "[ measured ] %s mode %d: probe centroid (%.7f, %.7f, %.4f), direction (%.2e, %.2e, %.9f), "
+      "probe flux / emitted %.9f\n",
+      name, mode, st.probe_centroid.x, st.probe_centroid.y, st.probe_centroid.z,
+      st.probe_direction.x, st.probe_direction.y, st.probe_direction.z,
+      st.flux_probe / st.flux_emitted);
   // The disc of seed cells: cells of edge e whose centre lies within R. Every such cell lies inside
-  // R + e/√2 and every cell inside R − e/√2 is launched, so π(R − e/√2)² ≤ emitted/E ≤ π(R + e/√2)².
+  // R + e/√2 and every cell inside R − e/√2 is launched, so π(R − e/√2)² ≤ emitted/E ≤ π(R +
+  // e/√2)².
   const double e = 0.5 * 0.15, lo = kPi * std::pow(kBeamR - e / std::sqrt(2.0), 2),
                hi = kPi * std::pow(kBeamR + e / std::sqrt(2.0), 2);
   EXPECT_GE(st.flux_emitted, lo);
   EXPECT_LE(st.flux_emitted, hi);
   // No absorption and no Fresnel: each mode carries all of its beam's flux through the probe
   // plane (CPU: sums of the same numbers, 1e-9; GPU: float tallies, 1e-5).
-  EXPECT_NEAR(st.flux_probe, st.flux_emitted, spotTol > 1e-6 ? 1e-5 * st.flux_emitted : 1e-9 * st.flux_emitted);
+  EXPECT_NEAR(st.flux_probe, st.flux_emitted,
+              spotTol > 1e-6 ? 1e-5 * st.flux_emitted : 1e-9 * st.flux_emitted);
   EXPECT_EQ(st.kills_caustic + st.kills_energy + st.kills_opaque, 0u);
   // Both spots leave parallel to the incident beam (planar faces, tangential p = 0 conserved).
   EXPECT_NEAR(st.probe_direction.z, 1.0, spotTol);
@@ -140,9 +145,11 @@ TEST(WavefrontPhysics, CalcitePlateGivesTwoSpots) {
   ASSERT_TRUE(vol.uniaxial);
   VolumeField field(vol);
   const PlateExpectation ex = plateExpectation(vol);
-  std::printf("[ measured ] calcite plate: expected e displacement: quadrature %.7f mm, bulk t·tanρ %.7f mm "
-              "(smoothing excess %.3e), published %.7f mm (fit shift %.3e)\n",
-              ex.quad, ex.bulk, ex.quad - ex.bulk, ex.published, ex.bulk - ex.published);
+  std::printf(
+      "[ measured ] calcite plate: expected e displacement: quadrature %.7f mm, bulk t·tanρ %.7f "
+      "mm "
+      "(smoothing excess %.3e), published %.7f mm (fit shift %.3e)\n",
+      ex.quad, ex.bulk, ex.quad - ex.bulk, ex.published, ex.bulk - ex.published);
   const Light l = beam({kBeamX, 0, 0}, {0, 0, 1}, kBeamR, 1.0);
   double cpuX[2], gpuX[2];
   for (int mode = 0; mode < 2; ++mode) {
@@ -159,18 +166,19 @@ TEST(WavefrontPhysics, CalcitePlateGivesTwoSpots) {
     EXPECT_EQ(g.stats.seeded, c.stats.seeded);
     EXPECT_NEAR(g.stats.flux_emitted, c.stats.flux_emitted, 1e-12 * c.stats.flux_emitted);
     // Where the spot is in the fluence volume: the beam's flux crosses the layer z ≈ 5.9 mm.
-    std::printf("[ measured ] calcite mode %d: centroid x cpu %.7f, gpu %.7f (gpu − cpu %.2e mm)\n", mode,
-                cpuX[mode], gpuX[mode], gpuX[mode] - cpuX[mode]);
+    std::printf("[ measured ] calcite mode %d: centroid x cpu %.7f, gpu %.7f (gpu − cpu %.2e mm)\n",
+                mode, cpuX[mode], gpuX[mode], gpuX[mode] - cpuX[mode]);
   }
   // o: undisplaced (the x gradient is exactly 0, so every corner keeps its x: 1e-9 CPU; GPU
   // float32 x ≈ 0.55 keeps its value too, allow 1e-5).
   EXPECT_NEAR(cpuX[0], kBeamX, 1e-9);
   EXPECT_NEAR(gpuX[0], kBeamX, 1e-5);
   const double sepCpu = cpuX[0] - cpuX[1], sepGpu = gpuX[0] - gpuX[1];
-  std::printf("[ measured ] calcite: o − e separation cpu %.7f, gpu %.7f mm; vs quadrature %.2e / %.2e; "
-              "minus smoothing excess vs published 1.0920707: %.2e mm (%.1f s)\n",
-              sepCpu, sepGpu, sepCpu - ex.quad, sepGpu - ex.quad, sepCpu - (ex.quad - ex.bulk) - ex.published,
-              seconds(t0));
+  std::printf(
+      "[ measured ] calcite: o − e separation cpu %.7f, gpu %.7f mm; vs quadrature %.2e / %.2e; "
+      "minus smoothing excess vs published 1.0920707: %.2e mm (%.1f s)\n",
+      sepCpu, sepGpu, sepCpu - ex.quad, sepGpu - ex.quad,
+      sepCpu - (ex.quad - ex.bulk) - ex.published, seconds(t0));
   EXPECT_GT(sepCpu, 1.0);  // e displaced towards −x (away from the axis, calcite negative)
   EXPECT_NEAR(sepCpu, ex.quad, 2e-4);
   EXPECT_NEAR(sepGpu, ex.quad, 3e-4);
@@ -230,7 +238,9 @@ TEST(WavefrontPhysics, PrismPutsTheSpectrumInOrder) {
   const struct {
     const char* name;
     double lambda, nPub, dPub;
-  } lines[3] = {{"F", 486.13, 1.522376, 39.1381}, {"d", 587.56, 1.516800, 38.6467}, {"C", 656.27, 1.514322, 38.4291}};
+  } lines[3] = {{"F", 486.13, 1.522376, 39.1381},
+                {"d", 587.56, 1.516800, 38.6467},
+                {"C", 656.27, 1.514322, 38.4291}};
   double devCpu[3], devGpu[3];
   for (int k = 0; k < 3; ++k) {
     WavefrontSettings s;
@@ -252,10 +262,13 @@ TEST(WavefrontPhysics, PrismPutsTheSpectrumInOrder) {
     devCpu[k] = deviation(c.stats);
     devGpu[k] = deviation(gr.stats);
     printWavefrontStats("prism cpu", c.stats);
-    std::printf("[ measured ] prism %s %.2f nm: n stored %.6f (published %.6f); deviation cpu %.5f°, gpu %.5f°; "
-                "Snell (stored n) %.5f° (cpu − %.2e°, gpu − %.2e°); Snell (published n) %.5f° (§4 D_min %.4f°)\n",
-                lines[k].name, lines[k].lambda, nVol, lines[k].nPub, devCpu[k], devGpu[k], expVol,
-                devCpu[k] - expVol, devGpu[k] - expVol, expPub, lines[k].dPub);
+    std::printf(
+        "[ measured ] prism %s %.2f nm: n stored %.6f (published %.6f); deviation cpu %.5f°, gpu "
+        "%.5f°; "
+        "Snell (stored n) %.5f° (cpu − %.2e°, gpu − %.2e°); Snell (published n) %.5f° (§4 D_min "
+        "%.4f°)\n",
+        lines[k].name, lines[k].lambda, nVol, lines[k].nPub, devCpu[k], devGpu[k], expVol,
+        devCpu[k] - expVol, devGpu[k] - expVol, expPub, lines[k].dPub);
     // The whole beam leaves through the probe plane as one nearly collimated beam. |mean dir| is
     // 1 − ½⟨δθ²⟩ for a spread δθ of the patches' directions: 1e-5 allows δθ_rms ≤ 4.5e-3 rad
     // (0.26°, a third of the F–C spread). Measured 1.26e-6, i.e. δθ_rms ≈ 1.6e-3 rad: single
@@ -277,8 +290,8 @@ TEST(WavefrontPhysics, PrismPutsTheSpectrumInOrder) {
   EXPECT_GT(devCpu[1], devCpu[2]);
   EXPECT_GT(devGpu[0], devGpu[1]);
   EXPECT_GT(devGpu[1], devGpu[2]);
-  std::printf("[ measured ] prism: D_F − D_C cpu %.4f°, gpu %.4f° (published 0.7090°) (%.1f s)\n", devCpu[0] - devCpu[2],
-              devGpu[0] - devGpu[2], seconds(t0));
+  std::printf("[ measured ] prism: D_F − D_C cpu %.4f°, gpu %.4f° (published 0.7090°) (%.1f s)\n",
+              devCpu[0] - devCpu[2], devGpu[0] - devGpu[2], seconds(t0));
   expectNoValidationMessages();
 }
 

@@ -19,8 +19,8 @@ TEST(WavefrontScan, MatchesCpuPrefixSum) {
   GpuScan scan(context());
   std::mt19937 rng(6);
   const uint32_t choices[3] = {0, 1, 4};
-  for (size_t n : {size_t(1), size_t(7), size_t(255), size_t(511), size_t(512), size_t(513), size_t(1000),
-                   size_t(262143), size_t(262145), size_t(300001), size_t(1) << 20}) {
+  for (size_t n : {size_t(1), size_t(7), size_t(255), size_t(511), size_t(512), size_t(513),
+                   size_t(1000), size_t(262143), size_t(262145), size_t(300001), size_t(1) << 20}) {
     std::vector<uint32_t> v(n);
     for (uint32_t& x : v) x = choices[rng() % 3];
     std::vector<uint32_t> want(n);
@@ -29,12 +29,14 @@ TEST(WavefrontScan, MatchesCpuPrefixSum) {
     std::vector<uint32_t> got = v;
     const auto t0 = std::chrono::steady_clock::now();
     const uint32_t total = scan.exclusiveScan(got);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     size_t bad = 0;
     for (size_t i = 0; i < n; ++i) bad += got[i] != want[i];
     EXPECT_EQ(total, sum) << "n = " << n;
     EXPECT_EQ(bad, 0u) << "n = " << n;
-    if (n == (size_t(1) << 20)) std::printf("[ measured ] scan of 1M counts: %.1f ms incl. upload/readback\n", ms);
+    if (n == (size_t(1) << 20))
+      std::printf("[ measured ] scan of 1M counts: %.1f ms incl. upload/readback\n", ms);
   }
   // Larger values (carries across levels): random up to 2^11, 1M elements, total < 2^32.
   std::vector<uint32_t> v(1000003);

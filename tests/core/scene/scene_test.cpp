@@ -1,7 +1,10 @@
 // Scene JSON parser (core/scene/scene.cpp): every user error is a SceneError whose message names
 // the file and the JSON path of the offending value plus a phrase that tells the user what is
-// wrong (docs/design.md §3-4: unknown keys are errors, n < 1 is an error, nothing is clamped). Positive
-// cases: the docs/design.md §3 example, library materials (N-BK7, calcite) and every shipped scene.
+// wrong (docs/design.md §3-4: unknown keys are errors, n < 1 is an error, nothing is clamped).
+// Positive cases: the docs/design.md §3 example, library materials (N-BK7, calcite) and every
+// shipped scene.
+#include "core/scene/scene.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,7 +14,6 @@
 #include <fstream>
 #include <string>
 
-#include "core/scene/scene.h"
 #include "tests/core/scene_support.h"
 
 namespace eikon {
@@ -22,12 +24,14 @@ namespace fs = std::filesystem;
 constexpr const char* kOrigin = "scene-under-test.json";
 
 // A minimal valid scene; tests splice one faulty piece into it.
-std::string scene(const std::string& materials, const std::string& objects, const std::string& extra = "") {
-  return "{" + extra + (extra.empty() ? "" : ",") + "\"materials\": {" + materials + "}, \"objects\": [" + objects +
-         "]}";
+std::string scene(const std::string& materials, const std::string& objects,
+                  const std::string& extra = "") {
+  return "{" + extra + (extra.empty() ? "" : ",") + "\"materials\": {" + materials +
+         "}, \"objects\": [" + objects + "]}";
 }
 const std::string kGlass = R"("glass": {"n": 1.5})";
-const std::string kSphere = R"({"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "glass"})";
+const std::string kSphere =
+    R"({"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "glass"})";
 
 /// Parses `text`, expects a SceneError, returns its message (empty + test failure otherwise).
 std::string errorOf(const std::string& text, const fs::path& origin = kOrigin) {
@@ -35,13 +39,15 @@ std::string errorOf(const std::string& text, const fs::path& origin = kOrigin) {
 }
 
 // The message must read "FILE: /json/path: ..." and contain `phrase`.
-#define EXPECT_SCENE_ERROR(text, json_path, phrase)                                                          \
-  do {                                                                                                       \
-    const std::string msg_ = errorOf(text);                                                                  \
-    EXPECT_EQ(msg_.rfind(std::string(kOrigin) + ": ", 0), 0u) << "message does not start with the file: " << msg_; \
-    EXPECT_NE(msg_.find(std::string(": ") + (json_path) + ": "), std::string::npos)                            \
-        << "message lacks the JSON path " << (json_path) << ": " << msg_;                                      \
-    EXPECT_NE(msg_.find(phrase), std::string::npos) << "message lacks '" << (phrase) << "': " << msg_;       \
+#define EXPECT_SCENE_ERROR(text, json_path, phrase)                                 \
+  do {                                                                              \
+    const std::string msg_ = errorOf(text);                                         \
+    EXPECT_EQ(msg_.rfind(std::string(kOrigin) + ": ", 0), 0u)                       \
+        << "message does not start with the file: " << msg_;                        \
+    EXPECT_NE(msg_.find(std::string(": ") + (json_path) + ": "), std::string::npos) \
+        << "message lacks the JSON path " << (json_path) << ": " << msg_;           \
+    EXPECT_NE(msg_.find(phrase), std::string::npos)                                 \
+        << "message lacks '" << (phrase) << "': " << msg_;                          \
   } while (0)
 
 using test::TempDir;
@@ -75,35 +81,38 @@ TEST(SceneParse, UnknownTopLevelKey) {
 }
 
 TEST(SceneParse, UnknownCameraKey) {
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("camera": {"position": [0, 0, -60], "zoom": 2})"), "/camera/zoom",
-                     "unknown key");
+  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("camera": {"position": [0, 0, -60], "zoom": 2})"),
+                     "/camera/zoom", "unknown key");
 }
 
 TEST(SceneParse, UnknownVolumeKey) {
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"resolution": 32, "smoothing": 1})"), "/volume/smoothing",
-                     "unknown key");
+  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"resolution": 32, "smoothing": 1})"),
+                     "/volume/smoothing", "unknown key");
 }
 
 TEST(SceneParse, UnknownMaterialKey) {
-  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": 1.5, "abbe": 64})", kSphere), "/materials/glass/abbe", "unknown key");
+  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": 1.5, "abbe": 64})", kSphere), "/materials/glass/abbe",
+                     "unknown key");
 }
 
 // A sphere has a radius, not a size: the message names the key and the shape.
 TEST(SceneParse, UnknownKeyForShape) {
-  EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "sphere", "radius": 3, "size": [1, 1, 1], "material": "glass"})"),
-                     "/objects/0", "unknown key 'size'");
-  const std::string msg =
-      errorOf(scene(kGlass, R"({"shape": "sphere", "radius": 3, "size": [1, 1, 1], "material": "glass"})"));
+  EXPECT_SCENE_ERROR(
+      scene(kGlass, R"({"shape": "sphere", "radius": 3, "size": [1, 1, 1], "material": "glass"})"),
+      "/objects/0", "unknown key 'size'");
+  const std::string msg = errorOf(
+      scene(kGlass, R"({"shape": "sphere", "radius": 3, "size": [1, 1, 1], "material": "glass"})"));
   EXPECT_NE(msg.find("sphere"), std::string::npos) << msg;
 }
 
 TEST(SceneParse, UnknownShape) {
-  EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "torus", "radius": 3, "material": "glass"})"), "/objects/0/shape",
-                     "unknown shape 'torus'");
+  EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "torus", "radius": 3, "material": "glass"})"),
+                     "/objects/0/shape", "unknown shape 'torus'");
 }
 
 TEST(SceneParse, MissingObjects) {
-  EXPECT_SCENE_ERROR(R"({"materials": {"glass": {"n": 1.5}}})", "/", "missing required key 'objects'");
+  EXPECT_SCENE_ERROR(R"({"materials": {"glass": {"n": 1.5}}})", "/",
+                     "missing required key 'objects'");
 }
 
 TEST(SceneParse, ObjectsNotAnArray) {
@@ -113,44 +122,48 @@ TEST(SceneParse, ObjectsNotAnArray) {
 // ------------------------------------------------------------------ refractive indices
 
 TEST(SceneParse, IndexBelowOne) {
-  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": 0.9})", kSphere), "/materials/glass/n", "must be >= 1");
+  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": 0.9})", kSphere), "/materials/glass/n",
+                     "must be >= 1");
 }
 
 // n = 0.9 + 0.01/λ² (λ in µm) is 0.969 at 380 nm and 0.916 at 780 nm: below 1 everywhere visible.
 TEST(SceneParse, CauchyBelowOneInTheVisible) {
-  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": {"cauchy": [0.9, 0.01]}})", kSphere), "/materials/glass/n", "below 1");
+  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": {"cauchy": [0.9, 0.01]}})", kSphere),
+                     "/materials/glass/n", "below 1");
 }
 
 // Below 1 only at the red end: A = 0.99, B = 0.004 µm² gives n(380 nm) = 1.0177 but
 // n(780 nm) = 0.9966 — the whole 380–780 nm window must be checked, not one wavelength.
 TEST(SceneParse, CauchyBelowOneOnlyAtTheRedEnd) {
-  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": {"cauchy": [0.99, 0.004]}})", kSphere), "/materials/glass/n",
-                     "below 1");
+  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": {"cauchy": [0.99, 0.004]}})", kSphere),
+                     "/materials/glass/n", "below 1");
 }
 
 TEST(SceneParse, CauchyCoefficientCount) {
-  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": {"cauchy": []}})", kSphere), "/materials/glass/n/cauchy",
-                     "1 to 6 coefficients");
+  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": {"cauchy": []}})", kSphere),
+                     "/materials/glass/n/cauchy", "1 to 6 coefficients");
   EXPECT_SCENE_ERROR(scene(R"("glass": {"n": {"cauchy": [1.5, 0, 0, 0, 0, 0, 0]}})", kSphere),
                      "/materials/glass/n/cauchy", "got 7");
 }
 
 TEST(SceneParse, SellmeierOddCount) {
-  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": {"sellmeier": [1.03961212, 0.231792344, 1.01046945, 0.006, 0.02]}})",
-                           kSphere),
-                     "/materials/glass/n/sellmeier", "got 5 numbers");
+  EXPECT_SCENE_ERROR(
+      scene(R"("glass": {"n": {"sellmeier": [1.03961212, 0.231792344, 1.01046945, 0.006, 0.02]}})",
+            kSphere),
+      "/materials/glass/n/sellmeier", "got 5 numbers");
 }
 
 // A Sellmeier pole inside the visible window (C = 0.25 µm² ⇒ pole at 500 nm) gives n² < 0 just
 // below it: the index is undefined there and must be rejected.
 TEST(SceneParse, SellmeierPoleInTheVisible) {
-  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": {"sellmeier": [1.0, 0.25]}})", kSphere), "/materials/glass/n",
-                     "below 1");
+  EXPECT_SCENE_ERROR(scene(R"("glass": {"n": {"sellmeier": [1.0, 0.25]}})", kSphere),
+                     "/materials/glass/n", "below 1");
 }
 
 TEST(SceneParse, UnknownMaterialName) {
-  EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "sphere", "radius": 3, "material": "unobtainium"})"),
-                     "/objects/0/material", "unknown material 'unobtainium'");
+  EXPECT_SCENE_ERROR(
+      scene(kGlass, R"({"shape": "sphere", "radius": 3, "material": "unobtainium"})"),
+      "/objects/0/material", "unknown material 'unobtainium'");
 }
 
 TEST(SceneParse, UniaxialWithoutOpticAxis) {
@@ -163,9 +176,10 @@ TEST(SceneParse, ZeroOpticAxis) {
   EXPECT_SCENE_ERROR(scene(R"("xtal": {"n_o": 1.6, "n_e": 1.5, "optic_axis": [0, 0, 0]})",
                            R"({"shape": "sphere", "radius": 3, "material": "xtal"})"),
                      "/materials/xtal/optic_axis", "non-zero");
-  EXPECT_SCENE_ERROR(scene(R"("xtal": {"n_o": 1.6, "n_e": 1.5})",
-                           R"({"shape": "sphere", "radius": 3, "material": "xtal", "optic_axis": [0, 0, 0]})"),
-                     "/objects/0/optic_axis", "non-zero");
+  EXPECT_SCENE_ERROR(
+      scene(R"("xtal": {"n_o": 1.6, "n_e": 1.5})",
+            R"({"shape": "sphere", "radius": 3, "material": "xtal", "optic_axis": [0, 0, 0]})"),
+      "/objects/0/optic_axis", "non-zero");
 }
 
 TEST(SceneParse, BothNAndNo) {
@@ -200,15 +214,15 @@ TEST(SceneParse, LinearGrinBelowOneInsideTheObject) {
 // ------------------------------------------------------------------ shapes
 
 TEST(SceneParse, NonPositiveRadius) {
-  EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "sphere", "radius": -3, "material": "glass"})"), "/objects/0/radius",
-                     "must be > 0");
-  EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "sphere", "radius": 0, "material": "glass"})"), "/objects/0/radius",
-                     "must be > 0");
+  EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "sphere", "radius": -3, "material": "glass"})"),
+                     "/objects/0/radius", "must be > 0");
+  EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "sphere", "radius": 0, "material": "glass"})"),
+                     "/objects/0/radius", "must be > 0");
 }
 
 TEST(SceneParse, ZeroBoxSize) {
-  EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "box", "size": [2, 0, 2], "material": "glass"})"), "/objects/0/size",
-                     "must be > 0");
+  EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "box", "size": [2, 0, 2], "material": "glass"})"),
+                     "/objects/0/size", "must be > 0");
 }
 
 // Three planes cannot bound a solid; four planes that all face +x leave −x open.
@@ -230,28 +244,32 @@ TEST(SceneParse, PlanesWithZeroNormal) {
 // ------------------------------------------------------------------ volume, camera, environment
 
 TEST(SceneParse, BoundsMaxNotAboveBoundsMin) {
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, -5, 5]})"),
-                     "/volume", "bounds_max must exceed bounds_min");
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, -6]})"),
-                     "/volume", "bounds_max must exceed bounds_min");
+  EXPECT_SCENE_ERROR(
+      scene(kGlass, kSphere, R"("volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, -5, 5]})"),
+      "/volume", "bounds_max must exceed bounds_min");
+  EXPECT_SCENE_ERROR(
+      scene(kGlass, kSphere, R"("volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, -6]})"),
+      "/volume", "bounds_max must exceed bounds_min");
 }
 
 TEST(SceneParse, Resolution) {
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"resolution": 0})"), "/volume/resolution", "got 0");
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"resolution": 32.5})"), "/volume/resolution",
-                     "expected an integer");
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"resolution": "64"})"), "/volume/resolution",
-                     "expected an integer");
+  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"resolution": 0})"), "/volume/resolution",
+                     "got 0");
+  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"resolution": 32.5})"),
+                     "/volume/resolution", "expected an integer");
+  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"resolution": "64"})"),
+                     "/volume/resolution", "expected an integer");
 }
 
 TEST(SceneParse, NegativeSmoothing) {
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"smoothing_voxels": -0.5})"), "/volume/smoothing_voxels",
-                     "got -0.5");
+  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("volume": {"smoothing_voxels": -0.5})"),
+                     "/volume/smoothing_voxels", "got -0.5");
 }
 
 TEST(SceneParse, CameraPositionEqualsLookAt) {
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("camera": {"position": [1, 2, 3], "look_at": [1, 2, 3]})"), "/camera",
-                     "coincide");
+  EXPECT_SCENE_ERROR(
+      scene(kGlass, kSphere, R"("camera": {"position": [1, 2, 3], "look_at": [1, 2, 3]})"),
+      "/camera", "coincide");
 }
 
 TEST(SceneParse, CameraSizeZero) {
@@ -259,21 +277,24 @@ TEST(SceneParse, CameraSizeZero) {
 }
 
 TEST(SceneParse, UnknownEnvironmentType) {
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("environment": {"type": "skybox"})"), "/environment/type",
-                     "unknown environment type 'skybox'");
+  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("environment": {"type": "skybox"})"),
+                     "/environment/type", "unknown environment type 'skybox'");
 }
 
 TEST(SceneParse, LatlongFileMissing) {
   TempDir dir;
   const fs::path missing = dir.path() / "no_such_sky.exr";
-  EXPECT_SCENE_ERROR(scene(kGlass, kSphere, R"("environment": {"type": "latlong", "file": ")" + missing.string() + "\"}"),
-                     "/environment/file", missing.string());
+  EXPECT_SCENE_ERROR(
+      scene(kGlass, kSphere,
+            R"("environment": {"type": "latlong", "file": ")" + missing.string() + "\"}"),
+      "/environment/file", missing.string());
 }
 
 TEST(SceneParse, LatlongFileNotAnExr) {
   TempDir dir;
   const fs::path text = dir.write("sky.exr", "this is a text file, not an OpenEXR image\n");
-  const std::string json = scene(kGlass, kSphere, R"("environment": {"type": "latlong", "file": ")" + text.string() + "\"}");
+  const std::string json = scene(
+      kGlass, kSphere, R"("environment": {"type": "latlong", "file": ")" + text.string() + "\"}");
   EXPECT_SCENE_ERROR(json, "/environment/file", text.string());
   EXPECT_SCENE_ERROR(json, "/environment/file", "not an OpenEXR file");
 }
@@ -288,7 +309,8 @@ TEST(SceneParse, LatlongRelativePathResolvesAgainstTheSceneFile) {
   } catch (const SceneError& e) {
     const std::string msg = e.what();
     EXPECT_EQ(msg.rfind(scene_file.string() + ": /environment/file: ", 0), 0u) << msg;
-    EXPECT_NE(msg.find((scene_file.parent_path() / "not_an_exr.exr").string()), std::string::npos) << msg;
+    EXPECT_NE(msg.find((scene_file.parent_path() / "not_an_exr.exr").string()), std::string::npos)
+        << msg;
     EXPECT_NE(msg.find("not an OpenEXR file"), std::string::npos) << msg;
   }
 }
@@ -298,13 +320,15 @@ TEST(SceneParse, MissingSceneFile) {
     loadScene("/nonexistent/dir/scene.json");
     ADD_FAILURE() << "expected a SceneError";
   } catch (const SceneError& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/scene.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/scene.json"), std::string::npos)
+        << e.what();
   }
 }
 
 // ------------------------------------------------------------------ positive cases
 
-// The docs/design.md §3 example verbatim (N-BK7 comes from the material library, my-calcite is inline).
+// The docs/design.md §3 example verbatim (N-BK7 comes from the material library, my-calcite is
+// inline).
 TEST(SceneParse, DesignExampleParses) {
   const char* text = R"({
     "camera": {"position": [0, 0, -60], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 30,
@@ -413,7 +437,8 @@ TEST(SceneParse, TestDataScenesParse) {
 }  // namespace
 }  // namespace eikon
 
-// ------------------------------------------------------------------ lights and scattering (issue 6)
+// ------------------------------------------------------------------ lights and scattering (issue
+// 6)
 namespace eikon {
 namespace {
 
@@ -422,13 +447,14 @@ std::string withLight(const std::string& light) {
 }
 
 TEST(SceneParse, LightsParseBeamsSpotsAndSpectra) {
-  Scene s = parseScene(withLight(R"({"type": "directional", "direction": [0, -2, 0], "irradiance": 3,
+  Scene s =
+      parseScene(withLight(R"({"type": "directional", "direction": [0, -2, 0], "irradiance": 3,
                                      "beam_radius": 1.5, "beam_center": [1, 2, 3], "spectrum": "E"},
                                     {"type": "spot", "position": [0, 5, 0], "direction": [0, -1, 0],
                                      "cone_half_angle_deg": 20, "intensity": 2,
                                      "spectrum": {"wavelength_nm": [400, 700], "power": [1, 3]}},
                                     {"type": "point", "position": [0, 5, 0]})"),
-                       kOrigin);
+                 kOrigin);
   ASSERT_EQ(s.lights.size(), 3u);
   EXPECT_EQ(s.lights[0].direction, glm::dvec3(0, -1, 0));
   EXPECT_EQ(s.lights[0].beam_radius, 1.5);
@@ -437,27 +463,35 @@ TEST(SceneParse, LightsParseBeamsSpotsAndSpectra) {
   EXPECT_EQ(s.lights[1].type, Light::Type::Spot);
   EXPECT_EQ(s.lights[1].cone_half_angle_deg, 20.0);
   EXPECT_DOUBLE_EQ(s.lights[1].spectralPower(550.0), 2.0);  // linear between (400, 1) and (700, 3)
-  EXPECT_EQ(s.lights[1].spectralPower(720.0), 0.0);          // nothing outside the table
+  EXPECT_EQ(s.lights[1].spectralPower(720.0), 0.0);         // nothing outside the table
   EXPECT_DOUBLE_EQ(s.lights[2].spectralPower(560.0), 100.0);  // default D65, 100 at 560 nm
 }
 
 TEST(SceneParse, BadLights) {
-  EXPECT_SCENE_ERROR(withLight(R"({"type": "laser", "direction": [0, -1, 0]})"), "/lights/0/type", "unknown light type");
-  EXPECT_SCENE_ERROR(withLight(R"({"type": "directional", "direction": [0, 0, 0]})"), "/lights/0/direction", "non-zero");
-  EXPECT_SCENE_ERROR(withLight(R"({"type": "directional", "direction": [0, -1, 0], "beam_radius": -1})"),
-                     "/lights/0/beam_radius", "must be > 0");
-  EXPECT_SCENE_ERROR(withLight(R"({"type": "directional", "direction": [0, -1, 0], "beam_center": [0, 0, 0]})"),
-                     "/lights/0/beam_center", "needs beam_radius");
-  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0], "beam_radius": 1})"), "/lights/0/beam_radius",
-                     "unknown key");
-  EXPECT_SCENE_ERROR(withLight(R"({"type": "spot", "position": [0, 0, 0], "direction": [0, -1, 0], "cone_half_angle_deg": 95})"),
-                     "/lights/0/cone_half_angle_deg", "must be in");
-  EXPECT_SCENE_ERROR(withLight(R"({"type": "spot", "position": [0, 0, 0], "direction": [0, -1, 0]})"), "/lights/0",
-                     "cone_half_angle_deg");
-  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0], "intensity": -2})"), "/lights/0/intensity",
-                     "must be in");
-  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0], "spectrum": "tungsten"})"),
-                     "/lights/0/spectrum", "unknown spectrum");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "laser", "direction": [0, -1, 0]})"), "/lights/0/type",
+                     "unknown light type");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "directional", "direction": [0, 0, 0]})"),
+                     "/lights/0/direction", "non-zero");
+  EXPECT_SCENE_ERROR(
+      withLight(R"({"type": "directional", "direction": [0, -1, 0], "beam_radius": -1})"),
+      "/lights/0/beam_radius", "must be > 0");
+  EXPECT_SCENE_ERROR(
+      withLight(R"({"type": "directional", "direction": [0, -1, 0], "beam_center": [0, 0, 0]})"),
+      "/lights/0/beam_center", "needs beam_radius");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0], "beam_radius": 1})"),
+                     "/lights/0/beam_radius", "unknown key");
+  EXPECT_SCENE_ERROR(
+      withLight(
+          R"({"type": "spot", "position": [0, 0, 0], "direction": [0, -1, 0], "cone_half_angle_deg": 95})"),
+      "/lights/0/cone_half_angle_deg", "must be in");
+  EXPECT_SCENE_ERROR(
+      withLight(R"({"type": "spot", "position": [0, 0, 0], "direction": [0, -1, 0]})"), "/lights/0",
+      "cone_half_angle_deg");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0], "intensity": -2})"),
+                     "/lights/0/intensity", "must be in");
+  EXPECT_SCENE_ERROR(
+      withLight(R"({"type": "point", "position": [0, 0, 0], "spectrum": "tungsten"})"),
+      "/lights/0/spectrum", "unknown spectrum");
   EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0],
                                    "spectrum": {"wavelength_nm": [500, 400], "power": [1, 1]}})"),
                      "/lights/0/spectrum/wavelength_nm/1", "strictly increasing");
@@ -470,22 +504,26 @@ TEST(SceneParse, BadLights) {
 }
 
 TEST(SceneParse, ScatteringMaterials) {
-  Scene s = parseScene(scene(R"("smoke": {"n": 1, "attenuation_per_mm": 0.1, "albedo": [0.9, 0.8, 0.7], "phase_g": 0.4},
+  Scene s = parseScene(
+      scene(
+          R"("smoke": {"n": 1, "attenuation_per_mm": 0.1, "albedo": [0.9, 0.8, 0.7], "phase_g": 0.4},
                                  "floor": {"n": 1, "opacity": 1, "albedo": 0.5})",
-                             R"({"shape": "sphere", "radius": 3, "material": "smoke"},
+          R"({"shape": "sphere", "radius": 3, "material": "smoke"},
                                 {"shape": "sphere", "center": [5, 0, 0], "radius": 1, "material": "floor"})"),
-                       kOrigin);
+      kOrigin);
   EXPECT_EQ(s.materials.at("smoke").albedo, glm::dvec3(0.9, 0.8, 0.7));
   EXPECT_EQ(s.materials.at("smoke").phase_g, 0.4);
   EXPECT_EQ(s.materials.at("floor").albedo, glm::dvec3(0.5));
   const std::string obj = R"({"shape": "sphere", "radius": 3, "material": "m"})";
-  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "attenuation_per_mm": 0.1, "albedo": 1.2})", obj), "/materials/m/albedo",
-                     "[0, 1]");
-  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "albedo": 0.5})", obj), "/materials/m/albedo", "attenuation_per_mm > 0");
-  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "attenuation_per_mm": 0.1, "albedo": 0.5, "phase_g": 1})", obj),
-                     "/materials/m/phase_g", "(-1, 1)");
-  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "opacity": 1, "albedo": 0.5, "phase_g": 0.2})", obj), "/materials/m/phase_g",
-                     "diffuse");
+  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "attenuation_per_mm": 0.1, "albedo": 1.2})", obj),
+                     "/materials/m/albedo", "[0, 1]");
+  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "albedo": 0.5})", obj), "/materials/m/albedo",
+                     "attenuation_per_mm > 0");
+  EXPECT_SCENE_ERROR(
+      scene(R"("m": {"n": 1, "attenuation_per_mm": 0.1, "albedo": 0.5, "phase_g": 1})", obj),
+      "/materials/m/phase_g", "(-1, 1)");
+  EXPECT_SCENE_ERROR(scene(R"("m": {"n": 1, "opacity": 1, "albedo": 0.5, "phase_g": 0.2})", obj),
+                     "/materials/m/phase_g", "diffuse");
 }
 
 }  // namespace

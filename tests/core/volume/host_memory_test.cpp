@@ -1,6 +1,8 @@
 // Host memory is checked before voxelising (issue 11, item 3): a volume the process cannot hold
 // is refused with the numbers ("needs X GiB of host memory, Y available (LIMIT)") instead of
 // ending in std::bad_alloc. Nothing here allocates the volumes it asks for.
+#include "core/volume/host_memory.h"
+
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -10,7 +12,6 @@
 #include <string>
 
 #include "core/scene/scene.h"
-#include "core/volume/host_memory.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {

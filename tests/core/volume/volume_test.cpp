@@ -44,7 +44,8 @@ TEST(Voxelize, SphereVolumeFromCoverage) {
     "volume": {"bounds_min": [-1, -1, -1], "bounds_max": [1, 1, 1], "resolution": 64, "smoothing_voxels": 0},
     "materials": {"glass": {"n": 1.5}},
     "objects": [{"shape": "sphere", "center": [%.17g, %.17g, %.17g], "radius": %.17g, "material": "glass"}]
-  })", c0.x, c0.y, c0.z, r);
+  })",
+                c0.x, c0.y, c0.z, r);
   const Scene scene = parseScene(text, "sphere-volume.json");
   const VolumeSet vs = voxelize(scene);
   const Grid& g = vs.grid;
@@ -61,7 +62,8 @@ TEST(Voxelize, SphereVolumeFromCoverage) {
     for (int j = 0; j < g.dims[1]; ++j)
       for (int i = 0; i < g.dims[0]; ++i) {
         const double c = (double(A[g.index(i, j, k)].x) - 1.0) / 0.5;
-        // Coverage is a count of 64 sub-samples: k/64 up to float32 rounding of A (~1e-7 ⇒ 64c ± 2e-5).
+        // Coverage is a count of 64 sub-samples: k/64 up to float32 rounding of A (~1e-7 ⇒ 64c ±
+        // 2e-5).
         if (std::abs(c * 64.0 - std::round(c * 64.0)) > 1e-3) ++off_grid_fraction;
         if (c > 1e-6 && c < 1 - 1e-6) ++partial;
         sum += c;
@@ -70,8 +72,8 @@ TEST(Voxelize, SphereVolumeFromCoverage) {
   const double h3 = g.h * g.h * g.h;
   const double volume = sum * h3, exact = 4.0 / 3.0 * kPi * r * r * r;
   const double rel = volume / exact - 1.0;
-  std::printf("[ measured ] sphere volume %.8f mm^3 vs %.8f (rel %.3e), %d boundary voxels\n", volume, exact, rel,
-              partial);
+  std::printf("[ measured ] sphere volume %.8f mm^3 vs %.8f (rel %.3e), %d boundary voxels\n",
+              volume, exact, rel, partial);
   EXPECT_NEAR(rel, 0.0, 1e-3);
   EXPECT_EQ(off_grid_fraction, 0) << "coverage values that are not multiples of 1/64";
   // Boundary voxels: about 4πr²/h² ≈ 6300 surface-crossing voxel areas, times 1–2 layers.
@@ -116,7 +118,8 @@ TEST(GaussianSmooth, PreservesMassAwayFromTheEdges) {
   gaussianSmooth(f, dims, sigma, 2);
   double after = 0.0;
   for (float v : f) after += v;
-  std::printf("[ measured ] mass before %.9g after %.9g (rel %.2e)\n", before, after, after / before - 1);
+  std::printf("[ measured ] mass before %.9g after %.9g (rel %.2e)\n", before, after,
+              after / before - 1);
   EXPECT_NEAR(after / before, 1.0, 1e-5);
   // It did smooth (a random field loses variance), and σ = 0 is the identity.
   EXPECT_NE(f, orig);
@@ -160,8 +163,8 @@ TEST(GaussianSmooth, StepBecomesErrorFunction) {
           worst = std::max(worst, std::abs(v - Phi(x / sigma_eff)));
           worst_raw = std::max(worst_raw, std::abs(v - Phi(x / sigma)));
         }
-    std::printf("[ measured ] axis %d: max |out - Phi(x/sigma_eff)| = %.2e, vs Phi(x/sigma) %.2e\n", axis, worst,
-                worst_raw);
+    std::printf("[ measured ] axis %d: max |out - Phi(x/sigma_eff)| = %.2e, vs Phi(x/sigma) %.2e\n",
+                axis, worst, worst_raw);
     EXPECT_LT(worst, 1e-3) << "axis " << axis;
     // The raw comparison is bounded by Sheppard's term plus truncation: 4.5e-3 + 2.5e-4 (+ margin).
     EXPECT_LT(worst_raw, 6e-3) << "axis " << axis;
@@ -180,7 +183,8 @@ TEST(Voxelize, LinearGrinGradientIsExact) {
     "volume": {"bounds_min": [-4, -4, -4], "bounds_max": [4, 4, 4], "resolution": 16, "smoothing_voxels": 0},
     "materials": {"grin": {"n": {"linear": {"n0": 1.5, "gradient_per_mm": [0, 0.05, 0]}}}},
     "objects": [{"shape": "box", "center": [0, 0, 0], "size": [20, 20, 20], "material": "grin"}]
-  })", "grin.json");
+  })",
+                                 "grin.json");
   const VolumeSet vs = voxelize(scene);
   const Grid& g = vs.grid;
   ASSERT_EQ(g.dims[1], 16);
@@ -196,8 +200,8 @@ TEST(Voxelize, LinearGrinGradientIsExact) {
         // No dispersion: the B and C fields are zero with zero gradient.
         EXPECT_EQ(vs.index[0][1][g.index(i, j, k)], glm::vec4(0.0f));
       }
-  std::printf("[ measured ] GRIN gradient errors: x %.2e, y %.2e, z %.2e per mm; index %.2e\n", worst_gx, worst_gy,
-              worst_gz, worst_n);
+  std::printf("[ measured ] GRIN gradient errors: x %.2e, y %.2e, z %.2e per mm; index %.2e\n",
+              worst_gx, worst_gy, worst_gz, worst_n);
   EXPECT_LT(worst_gx, 1e-5);
   EXPECT_LT(worst_gy, 1e-5);
   EXPECT_LT(worst_gz, 1e-5);
@@ -217,7 +221,8 @@ TEST(Voxelize, SkipDistanceIsSafeAndTight) {
     "volume": {"bounds_min": [-6, -6, -6], "bounds_max": [6, 6, 6], "resolution": 48, "smoothing_voxels": 0.75},
     "materials": {"glass": {"n": 1.5, "attenuation_per_mm": [0.1, 0.2, 0.3]}},
     "objects": [{"shape": "sphere", "center": [0.3, -0.2, 0.1], "radius": 1.0, "material": "glass"}]
-  })", "skip.json");
+  })",
+                                 "skip.json");
   const VolumeSet vs = voxelize(scene);
   const Grid& g = vs.grid;
   const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
@@ -247,9 +252,9 @@ TEST(Voxelize, SkipDistanceIsSafeAndTight) {
             d = same(g.index(i, j, k), g.index(n[0], n[1], n[2])) ? 0 : 1;
           }
           auto& p = P[size_t(a)];
-          p[pidx(i + 1, j + 1, k + 1)] = d + p[pidx(i, j + 1, k + 1)] + p[pidx(i + 1, j, k + 1)] +
-                                         p[pidx(i + 1, j + 1, k)] - p[pidx(i, j, k + 1)] - p[pidx(i, j + 1, k)] -
-                                         p[pidx(i + 1, j, k)] + p[pidx(i, j, k)];
+          p[pidx(i + 1, j + 1, k + 1)] =
+              d + p[pidx(i, j + 1, k + 1)] + p[pidx(i + 1, j, k + 1)] + p[pidx(i + 1, j + 1, k)] -
+              p[pidx(i, j, k + 1)] - p[pidx(i, j + 1, k)] - p[pidx(i + 1, j, k)] + p[pidx(i, j, k)];
         }
   }
   // Number of differing pairs (u, u + e_a) with u in [lo, hi] (inclusive box).
@@ -296,8 +301,8 @@ TEST(Voxelize, SkipDistanceIsSafeAndTight) {
           ADD_FAILURE() << "voxel (" << i << "," << j << "," << k << ") has skip " << D
                         << " although nothing changes within " << D + 1 << " voxels";
       }
-  std::printf("[ measured ] %d voxels with skip >= 2 checked, max skip %d, unsafe %d, loose %d\n", checked, max_d,
-              unsafe, loose);
+  std::printf("[ measured ] %d voxels with skip >= 2 checked, max skip %d, unsafe %d, loose %d\n",
+              checked, max_d, unsafe, loose);
   EXPECT_EQ(unsafe, 0);
   EXPECT_EQ(loose, 0);
   // Far from the sphere (the corner, ≥ 20 voxels from it) the skip is large.
