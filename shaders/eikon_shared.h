@@ -1,7 +1,8 @@
 // Shared between C++ and GLSL (vk_mini_path_tracer style): binding numbers, workgroup sizes and
 // the parameter/record structs of the view and trace kernels, declared once. vec4/ivec4 members
 // only, so std430 (GLSL) and C++ agree without padding rules; the C++ side static_asserts sizes.
-// clang-format off: GLSL reads this file too, and its tables of offsets are aligned by hand.
+// GLSL reads this file too, and its tables of offsets are aligned by hand:
+// clang-format off
 #ifndef EIKON_SHARED_H
 #define EIKON_SHARED_H
 
