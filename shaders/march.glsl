@@ -493,6 +493,30 @@ bool clipToVolume(inout MarchState S, inout MarchResult R, StepEnd E) {
   return true;
 }
 
+// Both marches start here: R initialised, and the ray either misses the volume (R is the
+// environment seen along d; false) or enters it at o + t0·d, t0 ≥ 0 (true).
+bool enterVolume(vec3 o, vec3 d, out MarchResult R, out float t0) {
+  R.radiance = vec3(0.0);
+  R.throughput = vec3(1.0);
+  R.opl = 0.0;
+  R.left = true;
+  R.steps = 0;
+  R.drift = 0.0;
+  R.interfaces = 0;
+  R.tir = 0;
+  R.exit_point = o;
+  R.exit_dir = d;
+  R.wave_normal = d;
+  const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
+  float t1;
+  if (!boxHit(o, d, bmin, bmax, t0, t1)) {
+    R.radiance = environmentWeighted(vec3(1.0), d);
+    return false;
+  }
+  t0 = max(t0, 0.0);
+  return true;
+}
+
 #include "sharp.glsl"
 
 // The host specialises this constant (with EIKON_F_SHARP): the pipeline holds one of the two
@@ -502,24 +526,8 @@ layout(constant_id = 0) const bool kSharpMarch = false;
 MarchResult march(vec3 o, vec3 d, int mode) {
   if (kSharpMarch) return marchSharp(o, d, mode);
   MarchResult R;
-  R.radiance = vec3(0.0);
-  R.throughput = vec3(1.0);
-  R.opl = 0.0;
-  R.left = true;
-  R.steps = 0;
-  R.drift = 0.0;
-  R.interfaces = 0;
-  R.tir = 0;
-  const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
-  float t0, t1;
-  if (!boxHit(o, d, bmin, bmax, t0, t1)) {
-    R.radiance = environmentWeighted(vec3(1.0), d);
-    R.exit_point = o;
-    R.exit_dir = d;
-    R.wave_normal = d;
-    return R;
-  }
-  t0 = max(t0, 0.0);
+  float t0;
+  if (!enterVolume(o, d, R, t0)) return R;
   MarchState S;
   S.x = o + d * t0;
   R.opl = P.march.z * t0;  // the ambient index

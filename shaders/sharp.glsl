@@ -359,24 +359,8 @@ void crossInterface(inout MarchState S, inout MarchResult R, BoundaryCrossing c,
 
 MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   MarchResult R;
-  R.radiance = vec3(0.0);
-  R.throughput = vec3(1.0);
-  R.opl = 0.0;
-  R.left = true;
-  R.steps = 0;
-  R.drift = 0.0;
-  R.interfaces = 0;
-  R.tir = 0;
-  const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
-  float t0, t1;
-  if (!boxHit(o, d, bmin, bmax, t0, t1)) {
-    R.radiance = environmentWeighted(vec3(1.0), d);
-    R.exit_point = o;
-    R.exit_dir = d;
-    R.wave_normal = d;
-    return R;
-  }
-  t0 = max(t0, 0.0);
+  float t0;
+  if (!enterVolume(o, d, R, t0)) return R;
   MarchState S;
   S.nn = vec4(0.0);  // unused by the sharp march, but defined
   S.inLayer = false;

@@ -108,6 +108,9 @@ class RayMarch {
     il4_ = il2_ * il2_;
   }
   MarchResult march(const glm::dvec3& o, const glm::dvec3& d) const;
+  /// Both marches start here: false (R = the environment along d) if the ray misses the volume,
+  /// else true with the entry at o + t0·d, t0 ≥ 0.
+  bool enterVolume(const glm::dvec3& o, const glm::dvec3& d, MarchResult& R, double& t0) const;
 
  private:
   glm::dvec3 colourOf(const glm::dvec3& rgb) const {
@@ -427,18 +430,26 @@ bool RayMarch::clipToVolume(MarchState& S, MarchResult& R, const StepEnd& E) con
   return true;
 }
 
-MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
-  if (bf_ && media_) return marchSharp(o, d);
-  MarchResult R;
-  double t0, t1;
+bool RayMarch::enterVolume(const glm::dvec3& o, const glm::dvec3& d, MarchResult& R,
+                           double& t0) const {
+  R = MarchResult{};
+  double t1;
   if (!boxHit(o, d, bmin_, bmax_, t0, t1)) {
     R.radiance = environment(d);
     R.exit_point = o;
     R.exit_dir = d;
     R.wave_normal = d;
-    return R;
+    return false;
   }
   t0 = std::max(t0, 0.0);
+  return true;
+}
+
+MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
+  if (bf_ && media_) return marchSharp(o, d);
+  MarchResult R;
+  double t0;
+  if (!enterVolume(o, d, R, t0)) return R;
   MarchState S;
   S.x = o + d * t0;
   R.opl = f_.ambientIndex() * t0;
@@ -679,15 +690,8 @@ void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCross
 
 MarchResult RayMarch::marchSharp(const glm::dvec3& o, const glm::dvec3& d) const {
   MarchResult R;
-  double t0, t1;
-  if (!boxHit(o, d, bmin_, bmax_, t0, t1)) {
-    R.radiance = environment(d);
-    R.exit_point = o;
-    R.exit_dir = d;
-    R.wave_normal = d;
-    return R;
-  }
-  t0 = std::max(t0, 0.0);
+  double t0;
+  if (!enterVolume(o, d, R, t0)) return R;
   MarchState S;
   sharpEnter(S, o + d * t0, d);
   R.opl = f_.ambientIndex() * t0;
