@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Re-renders the README's pictures (docs/images/*.png) from the shipped scenes, at 800×600 or
+# more, with the sample and wavelength counts that make each one converge (no speckle). Run it
+# whenever the renderer changes what a picture shows; it takes long on a CPU-only machine (each
+# line prints its own progress). Usage:
+#   scripts/render_pictures.sh [NAME...]     (default: every picture; NAME = a scene's base name)
+# Environment: EIKON (default build/apps/eikon), EIKON_PICTURE_ARGS (extra arguments for every
+# render, e.g. "--reference" to use the CPU twin where it is the faster).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+EIKON="${EIKON:-build/apps/eikon}"
+[[ -x "$EIKON" ]] || { echo "render_pictures: error: $EIKON not built (run ./scripts/build.sh)" >&2; exit 1; }
+
+# name | width×height | extra arguments (the scene's own aspect ratio, at least 800×600).
+# Spectral scenes use 16 stratified wavelengths per sample (the default); the jittered samples
+# per pixel are what takes the colour noise of the wavelength sampling out.
+pictures=(
+  "glass_sphere|800x600|--spp 4"
+  "prism_bk7|800x600|--spp 8"
+  "diamond_brilliant|800x600|--spp 8"
+  "calcite_rhomb|800x600|--spp 8"
+  "tourmaline|800x600|--spp 4"
+  "caustic_sphere|800x600|--spp 4"
+  "prism_rainbow|960x600|--spp 8"
+  "smoke_sphere|960x600|--spp 4"
+)
+
+want=("$@")
+out="$(mktemp -d)"
+trap 'rm -rf "$out"' EXIT
+for entry in "${pictures[@]}"; do
+  IFS='|' read -r name size args <<<"$entry"
+  if ((${#want[@]})) && [[ ! " ${want[*]} " =~ " $name " ]]; then continue; fi
+  echo "== $name ($size, $args)"
+  # shellcheck disable=SC2086
+  "$EIKON" render "scenes/$name.json" -o "$out/$name.exr" --width "${size%x*}" \
+    --height "${size#*x}" $args \
+    ${EIKON_PICTURE_ARGS:-}
+  mv "$out/$name.png" "docs/images/$name.png"
+done
