@@ -204,7 +204,7 @@ void Tracer::run(const Branch& start, std::vector<Branch>& exits, bool& truncate
   while (!stack.empty()) {
     Branch b = stack.back();
     stack.pop_back();
-    if (b.events > s_.max_events || int(exits.size() + stack.size()) >= s_.max_branches) {
+    if (b.events > s_.max_events || int(exits.size() + stack.size()) + 1 > s_.max_branches) {
       truncated = true;
       continue;
     }

@@ -227,6 +227,19 @@ TEST(PolarisedTrace, WalkOffBeyondTheCoherenceWidthAddsStokes) {
   EXPECT_NEAR(small.totalPower(), (to * to + te * te) / 8, 1e-6);
 }
 
+// Pleochroism per mode: a 1 mm tourmaline plate (axis along x in its faces, immersed at n_o) at
+// 549 nm, where its band values are σ_o = 1.2, σ_e = 0.12 per mm: light polarised along the axis
+// is the e-wave and keeps e^{−σ_e d}, across it the o-wave keeps e^{−σ_o d}, and unpolarised light
+// keeps ½(e^{−σ_o d} + e^{−σ_e d}) — never e^{−½(σ_o + σ_e)d}.
+TEST(PolarisedTrace, PleochroicPlateKeepsEachModesOwnTransmittance) {
+  const Scenery s(plate("tourmaline", 1.0, "[1, 0, 0]"), 1.642);
+  const double nm = 549.0, To = std::exp(-1.2), Te = std::exp(-0.12);
+  const glm::dvec3 o(0.3, 0.2, -30), d(0, 0, 1);
+  EXPECT_NEAR(s.trace(o, d, nm, {1, 1, 0, 0}).totalPower(), Te, 1e-4);  // along x̂ = the axis
+  EXPECT_NEAR(s.trace(o, d, nm, {1, -1, 0, 0}).totalPower(), To, 1e-12);
+  EXPECT_NEAR(s.trace(o, d, nm).totalPower(), 0.5 * (To + Te), 1e-4);
+}
+
 TEST(PolarisedTrace, BadInputIsRefused) {
   const Scenery s(kAside);
   EXPECT_THROW(s.trace({0, 0, -30}, {0, 0, 0}, 550.0), std::invalid_argument);
