@@ -240,6 +240,50 @@ TEST(PolarisedTrace, PleochroicPlateKeepsEachModesOwnTransmittance) {
   EXPECT_NEAR(s.trace(o, d, nm).totalPower(), 0.5 * (To + Te), 1e-4);
 }
 
+// A Fresnel rhomb of N-BK7: two total internal reflections at the angle θ where each gives the
+// s−p phase δ = 45° (tan(δ/2) = cos θ √(sin²θ − 1/n²)/sin²θ, Born & Wolf §1.5.4) turn light
+// linear at 45° to the plane of incidence into RIGHT circular light (S3 = +1: δ = φ_s − φ_p > 0
+// in the right-handed frame (ŝ, p̂ = k̂ × ŝ, k̂)), with S0 = (4n/(1 + n)²)² (lossless TIR, normal
+// entry and exit).
+TEST(PolarisedTrace, FresnelRhombMakesRightCircularLight) {
+  const double nm = 587.5618;
+  const Material glass = loadMaterialFile(std::string(EIKON_SOURCE_DIR) + "/materials/N-BK7.json");
+  const double n = glass.n_o.index(nm), n2 = 1.0 / (n * n);
+  auto delta = [&](double th) {
+    const double si = std::sin(th), ci = std::cos(th);
+    return 2.0 * std::atan(ci * std::sqrt(si * si - n2) / (si * si));
+  };
+  // δ is largest at cos²θ = (1 − 1/n²)/(1 + 1/n²); the 45° root above it, by bisection.
+  double lo = std::acos(std::sqrt((1 - n2) / (1 + n2))), hi = rad(89.0);
+  for (int k = 0; k < 100; ++k) (delta(0.5 * (lo + hi)) > kPi / 4 ? lo : hi) = 0.5 * (lo + hi);
+  const double th = 0.5 * (lo + hi), c = std::cos(th), sn = std::sin(th);
+  // Faces y = ±1; the ray enters normally at E along u1, reflects at y = +1 and y = −1, and
+  // leaves normally through the face u1·x = c_exit.
+  const glm::dvec3 u1(0, c, sn), u2(0, -c, sn), E(0, -0.9, -3.5);
+  const glm::dvec3 P2 = E + (1.9 / c) * u1 + (2.0 / c) * u2;
+  const double c_in = glm::dot(u1, E), c_out = glm::dot(u1, P2) + 1.0 / c;
+  auto num = [](double v) { return std::to_string(v); };
+  const Scenery s(R"({"shape": "planes", "material": "N-BK7", "planes": [[0, 1, 0, 1],
+                     [0, -1, 0, 1], [1, 0, 0, 3], [-1, 0, 0, 3], [0, )" +
+                  num(c) + ", " + num(sn) + ", " + num(c_out) + "], [0, " + num(-c) + ", " +
+                  num(-sn) + ", " + num(-c_in) + "]]}");
+  // Input linear at +45° in the (ŝ, p̂) frame of the first reflection (ŝ = −x̂ there).
+  const glm::dvec3 s_hat(-1, 0, 0), p_hat = glm::cross(u1, s_hat),
+                                    e = glm::normalize(s_hat + p_hat);
+  const glm::dvec3 xin = stokesBasis(u1), yin = glm::cross(u1, xin);
+  const double psi = std::atan2(glm::dot(e, yin), glm::dot(e, xin));
+  const PolarisedTrace t =
+      s.trace(E - 20.0 * u1, u1, nm, {1, std::cos(2 * psi), std::sin(2 * psi), 0});
+  ASSERT_EQ(t.beams.size(), 1u);
+  const Stokes& o = t.beams[0].stokes;
+  const double T = 4 * n / ((1 + n) * (1 + n));
+  std::printf("Fresnel rhomb (N-BK7, θ = %.4f deg): S3/S0 = %.7f, S0 = %.9f (closed %.9f)\n",
+              th * 180 / kPi, o[3] / o[0], o[0], T * T);
+  EXPECT_NEAR(glm::length(t.beams[0].direction - u1), 0.0, 1e-9);
+  EXPECT_GE(o[3] / o[0], 0.999);
+  EXPECT_NEAR(o[0], T * T, 1e-6);
+}
+
 TEST(PolarisedTrace, BadInputIsRefused) {
   const Scenery s(kAside);
   EXPECT_THROW(s.trace({0, 0, -30}, {0, 0, 0}, 550.0), std::invalid_argument);
