@@ -10,6 +10,8 @@
 //  - conoscopic figure of a 1 mm c-cut calcite plate between crossed sheets: dark isogyres along
 //    the sheets' axes, and the m-th dark ring (m = 1, 2, 3) at the closed-form angle
 //    d[√(n_o² − sin²i) − (n_o/n_e)√(n_e² − sin²i)] = mλ within 1%;
+//  - a Fresnel rhomb of N-BK7 (two total internal reflections of δ = 45° each) makes right
+//    circular light; a tourmaline plate keeps each mode's own e^{−σd};
 //  - coherence: the o and e rays of a 4 mm calcite plate (axis at 45°, walk-off 0.44 mm) add
 //    incoherently, ⅛(τ_o² + τ_e²), unless the sample's bandwidth is narrow enough for their
 //    optical path difference and the coherence width covers the walk-off.
