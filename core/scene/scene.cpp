@@ -414,7 +414,7 @@ SceneObject parseObject(const Node& o) {
       o.at("shape").fail("shape 'mesh' is not supported yet (use planes for convex solids)");
     } else {
       o.at("shape").fail("unknown shape '" + excerpt(shape) +
-                         "' (sphere, box, rounded_box, prism, brilliant, planes)");
+                         "' (sphere, box, rounded_box, prism, brilliant, planes, polarizer)");
     }
   } catch (const std::invalid_argument& e) {
     o.fail(e.what());
@@ -640,12 +640,62 @@ Material loadMaterialFile(const std::filesystem::path& path) {
   return parseMaterial(root, name, true);
 }
 
+// ------------------------------------------------------------------ polarisation
+/// "polarization": "unpolarized" or {"stokes": [S0, S1, S2, S3], "reference": [x, y, z]}.
+static Polarization parsePolarization(const Node& p) {
+  Polarization pol;
+  if (p.isString()) {
+    const std::string v = p.string();
+    if (v != "unpolarized")
+      p.fail("unknown polarization '" + excerpt(v) +
+             "' (\"unpolarized\" or {\"stokes\": [S0, S1, S2, S3], \"reference\": [x, y, z]})");
+    return pol;
+  }
+  p.allowKeys({"stokes", "reference"});
+  const Node s = p.at("stokes");
+  const std::vector<double> v = s.numbers();
+  if (v.size() != 4)
+    s.fail("expected [S0, S1, S2, S3], got " + std::to_string(v.size()) + " numbers");
+  if (!(v[0] > 0)) s.index(0).fail("S0 must be > 0, got " + fmt(v[0]));
+  const double dop = std::sqrt(v[1] * v[1] + v[2] * v[2] + v[3] * v[3]) / v[0];
+  if (dop > 1.0 + 1e-9)
+    s.fail("the degree of polarisation sqrt(S1² + S2² + S3²)/S0 must be <= 1, got " + fmt(dop));
+  pol.stokes = glm::dvec4(1.0, v[1] / v[0], v[2] / v[0], v[3] / v[0]);
+  if (auto r = p.get("reference")) pol.reference = r->unitVector();
+  return pol;
+}
+
+/// {"shape": "polarizer", "center", "normal", "transmission_axis", "size": [w, h]}.
+static PolarizerSheet parsePolarizer(const Node& o) {
+  o.allowKeys({"shape", "center", "normal", "transmission_axis", "size"});
+  PolarizerSheet sheet;
+  sheet.center = o.at("center").position();
+  const Node n = o.at("normal");
+  const glm::dvec3 nv = n.vec3();
+  const double len = glm::length(nv);
+  if (!(len > 1e-12)) n.fail("must be a non-zero unit vector, got (0, 0, 0)");
+  if (std::abs(len - 1.0) > 1e-6) n.fail("must be a unit vector, got length " + fmt(len));
+  sheet.normal = nv / len;
+  const Node a = o.at("transmission_axis");
+  const glm::dvec3 av = a.unitVector();
+  if (std::abs(glm::dot(av, sheet.normal)) > 1e-6)
+    a.fail("must be perpendicular to the normal (it lies in the sheet), got a cosine of " +
+           fmt(glm::dot(av, sheet.normal)) + " with it");
+  sheet.axis = glm::normalize(av - glm::dot(av, sheet.normal) * sheet.normal);
+  const Node sz = o.at("size");
+  if (!sz.isArray() || sz.size() != 2) sz.fail("expected [width, height] in mm");
+  sheet.width = sz.index(0).length();
+  sheet.height = sz.index(1).length();
+  return sheet;
+}
+
 // ------------------------------------------------------------------ lights
 static Light parseLight(const Node& l) {
   Light light;
   std::string type = l.at("type").string();
   if (type == "directional") {
-    l.allowKeys({"type", "direction", "irradiance", "beam_radius", "beam_center", "spectrum"});
+    l.allowKeys({"type", "direction", "irradiance", "beam_radius", "beam_center", "spectrum",
+                 "polarization"});
     light.type = Light::Type::Directional;
     light.direction = l.at("direction").unitVector();
     if (auto v = l.get("irradiance")) light.irradiance = v->number(0.0, 1e12);
@@ -656,10 +706,10 @@ static Light parseLight(const Node& l) {
     }
   } else if (type == "point" || type == "spot") {
     if (type == "point")
-      l.allowKeys({"type", "position", "intensity", "spectrum"});
+      l.allowKeys({"type", "position", "intensity", "spectrum", "polarization"});
     else
-      l.allowKeys(
-          {"type", "position", "direction", "cone_half_angle_deg", "intensity", "spectrum"});
+      l.allowKeys({"type", "position", "direction", "cone_half_angle_deg", "intensity", "spectrum",
+                   "polarization"});
     light.type = type == "point" ? Light::Type::Point : Light::Type::Spot;
     light.position = l.at("position").position();
     if (auto v = l.get("intensity")) light.irradiance = v->number(0.0, 1e12);
@@ -670,6 +720,7 @@ static Light parseLight(const Node& l) {
   } else {
     l.at("type").fail("unknown light type '" + excerpt(type) + "' (directional, point, spot)");
   }
+  if (auto p = l.get("polarization")) light.polarization = parsePolarization(*p);
   if (auto sp = l.get("spectrum")) {
     if (sp->isString()) {
       std::string name = sp->string();
@@ -707,7 +758,7 @@ static Light parseLight(const Node& l) {
 // parseScene's stages, one per top-level key of the scene (and the checks of each object against
 // the volume); each fails with the JSON path of what it reads.
 static void parseCamera(const Node& c, Camera& cam) {
-  c.allowKeys({"position", "look_at", "up", "fov_deg", "width", "height"});
+  c.allowKeys({"position", "look_at", "up", "fov_deg", "width", "height", "analyzer"});
   if (auto v = c.get("position")) cam.position = v->position();
   if (auto v = c.get("look_at")) cam.look_at = v->position();
   if (auto v = c.get("up")) cam.up = v->unitVector();
@@ -718,22 +769,29 @@ static void parseCamera(const Node& c, Camera& cam) {
   if (glm::length(fwd) < 1e-9) c.fail("position and look_at coincide");
   if (glm::length(glm::cross(glm::normalize(fwd), cam.up)) < 1e-6)
     c.fail("up is parallel to the viewing direction");
+  if (auto a = c.get("analyzer")) {
+    cam.analyzer = a->unitVector();
+    if (glm::length(glm::cross(glm::normalize(fwd), *cam.analyzer)) < 1e-6)
+      a->fail(
+          "the analyzer's transmission axis is parallel to the viewing direction; it must have "
+          "a component in the image plane");
+  }
 }
 
 static void parseEnvironment(const Node& e, const std::filesystem::path& origin, Environment& env) {
   std::string type = e.at("type").string();
   if (type == "checker") {
-    e.allowKeys({"type", "squares", "color_a", "color_b", "intensity"});
+    e.allowKeys({"type", "squares", "color_a", "color_b", "intensity", "polarization"});
     env.type = Environment::Type::Checker;
     if (auto v = e.get("squares")) env.squares = v->integer(1, 4096);
     if (auto v = e.get("color_a")) env.color_a = v->color();
     if (auto v = e.get("color_b")) env.color_b = v->color();
   } else if (type == "constant") {
-    e.allowKeys({"type", "radiance", "intensity"});
+    e.allowKeys({"type", "radiance", "intensity", "polarization"});
     env.type = Environment::Type::Constant;
     if (auto v = e.get("radiance")) env.radiance = v->color();
   } else if (type == "latlong") {
-    e.allowKeys({"type", "file", "intensity"});
+    e.allowKeys({"type", "file", "intensity", "polarization"});
     env.type = Environment::Type::LatLong;
     std::filesystem::path p = e.at("file").string();
     if (p.is_relative()) p = origin.parent_path() / p;
@@ -754,6 +812,7 @@ static void parseEnvironment(const Node& e, const std::filesystem::path& origin,
                       "' (checker, constant, latlong)");
   }
   if (auto v = e.get("intensity")) env.intensity = v->number(0.0, 1e9);
+  if (auto p = e.get("polarization")) env.polarization = parsePolarization(*p);
 }
 
 static void parseVolume(const Node& v, VolumeSpec& vol) {
@@ -871,12 +930,19 @@ static void checkGrinIndex(const Node& o, const SceneObject& obj, const Material
 }
 
 /// /objects: each object, its material (from the library if not defined in the scene) and its
-/// checks against the volume. Returns the objects that cover the whole volume.
-static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::string& file) {
+/// checks against the volume; polariser sheets go to scene.polarizers. Returns the objects (index
+/// in scene.objects) that cover the whole volume; json_index[k] is object k's index in /objects.
+static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::string& file,
+                                     std::vector<size_t>& json_index) {
   if (!objs.isArray()) objs.fail("expected an array of objects");
   std::set<size_t> covering;  // objects that cover the whole volume (warned about once)
   for (size_t i = 0; i < objs.size(); ++i) {
     Node o = objs.index(i);
+    o.requireObject();
+    if (o.has("shape") && o.at("shape").isString() && o.at("shape").string() == "polarizer") {
+      scene.polarizers.push_back(parsePolarizer(o));
+      continue;
+    }
     SceneObject obj = parseObject(o);
     if (!scene.materials.count(obj.material)) loadLibraryMaterial(o, obj, scene);
     const Material& mat = scene.materials[obj.material];
@@ -887,9 +953,10 @@ static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::
              "' needs an optic_axis (on the object or the material)");
     if (!mat.uniaxial && obj.optic_axis)
       o.at("optic_axis").fail("optic_axis given for an isotropic material");
-    if (checkObjectInVolume(o, obj, scene, file)) covering.insert(i);
+    if (checkObjectInVolume(o, obj, scene, file)) covering.insert(scene.objects.size());
     if (mat.grin.type != GrinProfile::Type::None) checkGrinIndex(o, obj, mat, scene.volume);
     scene.objects.push_back(std::move(obj));
+    json_index.push_back(i);
   }
   return covering;
 }
@@ -897,7 +964,7 @@ static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::
 /// The volume's faces must lie in the ambient medium (rays leave straight from there): warn if an
 /// object comes within the smoothing reach (3σ + 1 voxel) of a face, sampled on each face.
 static void warnObjectsNearFaces(Scene& scene, const std::set<size_t>& covering,
-                                 const std::string& file) {
+                                 const std::vector<size_t>& json_index, const std::string& file) {
   const auto& v = scene.volume;
   glm::dvec3 ext = v.bounds_max - v.bounds_min;
   double h = std::max(ext.x, std::max(ext.y, ext.z)) / v.resolution;
@@ -921,10 +988,10 @@ static void warnObjectsNearFaces(Scene& scene, const std::set<size_t>& covering,
             closest = std::min(closest, scene.objects[i].shape.signedDistance(q));
           }
     if (closest < margin)
-      scene.warnings.push_back(
-          printable(file + ": /objects/" + std::to_string(i) + ": the object comes within " +
-                    fmt(std::max(closest, 0.0)) + " mm of the volume's boundary (smoothing reach " +
-                    fmt(margin) + " mm); rays leaving through it are not refracted there"));
+      scene.warnings.push_back(printable(
+          file + ": /objects/" + std::to_string(json_index[i]) + ": the object comes within " +
+          fmt(std::max(closest, 0.0)) + " mm of the volume's boundary (smoothing reach " +
+          fmt(margin) + " mm); rays leaving through it are not refracted there"));
   }
 }
 
@@ -955,8 +1022,9 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
       scene.materials[it.key()] = parseMaterial(
           Node(it.value(), ms->path() + "/" + excerpt(it.key()), file), it.key(), false);
   }
-  const std::set<size_t> covering = parseObjects(root.at("objects"), scene, file);
-  warnObjectsNearFaces(scene, covering, file);
+  std::vector<size_t> json_index;
+  const std::set<size_t> covering = parseObjects(root.at("objects"), scene, file, json_index);
+  warnObjectsNearFaces(scene, covering, json_index, file);
   if (auto ls = root.get("lights")) {
     if (!ls->isArray()) ls->fail("expected an array of lights");
     for (size_t i = 0; i < ls->size(); ++i) scene.lights.push_back(parseLight(ls->index(i)));

@@ -67,10 +67,34 @@ struct Material {
   double phase_g = 0.0;  ///< Henyey–Greenstein asymmetry g ∈ (−1, 1) of the in-scatter
 };
 
+/// The polarisation state of the environment or of a light (docs/polarisation.md): a Stokes
+/// vector normalised to S0 = 1 in the frame whose reference direction x̂ is `reference` projected
+/// ⊥ the propagation direction (Mitsuba 3's stokes_basis of that direction when unset; ŷ =
+/// k̂ × x̂). The default (1, 0, 0, 0) is unpolarised; the radiance itself is given elsewhere.
+struct Polarization {
+  glm::dvec4 stokes{1.0, 0.0, 0.0, 0.0};
+  std::optional<glm::dvec3> reference;  ///< unit, world space
+  bool unpolarized() const { return stokes.y == 0.0 && stokes.z == 0.0 && stokes.w == 0.0; }
+};
+
+/// An ideal linear polariser sheet, {"shape": "polarizer", ...} in /objects (docs/scene-format.md):
+/// a width × height rectangle centred on `center` in the plane ⊥ `normal`, transmitting the field
+/// along `axis`; width is measured along the axis, height along normal × axis. It is not part of
+/// the index volume and may lie outside it.
+struct PolarizerSheet {
+  glm::dvec3 center{0.0};
+  glm::dvec3 normal{0, 0, 1};  ///< unit
+  glm::dvec3 axis{1, 0, 0};    ///< unit, ⊥ normal: the transmission axis
+  double width = 1.0, height = 1.0;
+};
+
 struct Camera {
   glm::dvec3 position{0, 0, -60}, look_at{0.0}, up{0, 1, 0};
   double fov_deg = 30.0;  ///< vertical field of view
   int width = 800, height = 600;
+  /// An ideal linear analyser in front of the camera: its transmission axis (unit; the image
+  /// plane's component of it is used). Unset: no analyser.
+  std::optional<glm::dvec3> analyzer;
 };
 
 struct Environment {
@@ -82,6 +106,7 @@ struct Environment {
   std::filesystem::path image_path;        ///< latlong EXR
   int image_width = 0, image_height = 0;
   std::vector<float> image_rgba;  ///< latlong texels, rows from the top (north)
+  Polarization polarization;      ///< of the light arriving from the environment
   /// Radiance seen in a world direction (unit vector), linear sRGB. Same formula as the shader.
   glm::dvec3 lookup(const glm::dvec3& dir) const;
 };
@@ -125,6 +150,7 @@ struct Light {
   double cone_half_angle_deg = 0.0;
   /// Relative spectral power distribution (any scale); empty = D65 (CIE standard daylight).
   std::vector<double> spectrum_nm, spectrum_power;
+  Polarization polarization;  ///< of the emitted light (default unpolarised)
   /// Relative spectral power at λ (nm): the tabulated shape, linear in between, 0 outside; D65
   /// when no table is given.
   double spectralPower(double lambda_nm) const;
@@ -138,7 +164,8 @@ struct Scene {
   std::map<std::string, Material> materials;
   std::vector<SceneObject> objects;
   std::vector<Light> lights;
-  double ambient_index = 1.0;  ///< index of the medium around the objects (air)
+  std::vector<PolarizerSheet> polarizers;  ///< ideal sheets, not voxelised
+  double ambient_index = 1.0;              ///< index of the medium around the objects (air)
   /// "interfaces": how boundaries between media are marched. Sharp (default): located on the
   /// boundary field (core/volume/boundary.h) and crossed with exact Snell/Fresnel; Smoothed: the
   /// smoothed layer is integrated (the fields are built either way).

@@ -1,0 +1,344 @@
+#include "core/reference/polarised_trace.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "core/reference/field.h"
+#include "core/volume/boundary.h"
+#include "core/volume/media.h"
+
+namespace eikon {
+namespace {
+
+using maxwell::CV;
+constexpr double kPi = 3.14159265358979323846;
+/// As RayMarch::nextCrossing: a sliver where the trilinear region field and the exact surface
+/// disagree just past a crossing is skipped (voxels), and the search restarts this far past it.
+constexpr double kSliverVoxels = 0.25;
+constexpr double kNudgeVoxels = 1e-4;
+/// "To infinity": how far a ray leaving the volume is followed for polariser sheets (mm).
+constexpr double kFarMm = 1e9;
+
+bool boxHit(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& bmin,
+            const glm::dvec3& bmax, double& t0, double& t1) {
+  t0 = -1e300;
+  t1 = 1e300;
+  for (int a = 0; a < 3; ++a) {
+    const double inv = 1.0 / (d[a] == 0.0 ? 1e-30 : d[a]);
+    const double ta = (bmin[a] - o[a]) * inv, tb = (bmax[a] - o[a]) * inv;
+    t0 = std::max(t0, std::min(ta, tb));
+    t1 = std::min(t1, std::max(ta, tb));
+  }
+  return t1 >= std::max(t0, 0.0);
+}
+
+/// One path of the o/e ray tree: where it is, its wave vector and ray, and the power-normalised
+/// fields G[b] it carries for the input basis states b = x̂_in, ŷ_in (unit power each).
+struct Branch {
+  glm::dvec3 x{0.0}, p{0.0}, ray{0.0};
+  int region = 0;
+  Mode mode = Mode::Ordinary;
+  std::array<CV, 2> G{};
+  double opl = 0.0;  ///< ∫p·dx from the origin (mm)
+  std::string modes;
+  int events = 0;
+};
+
+double power(const Branch& b) {
+  return maxwell::norm(b.G[0]) * maxwell::norm(b.G[0]) +
+         maxwell::norm(b.G[1]) * maxwell::norm(b.G[1]);
+}
+
+class Tracer {
+ public:
+  Tracer(const Field& f, const std::vector<PolarizerSheet>& sheets, double lambda_nm,
+         const PolarisedTraceSettings& s)
+      : sheets_(sheets),
+        lambda_(lambda_nm),
+        s_(s),
+        bf_(f.boundary()),
+        media_(f.media()),
+        h_(f.cellSize()),
+        bmin_(f.boundsMin()),
+        bmax_(f.boundsMax()) {}
+  /// Follow `start` (inside the volume) to the exits of all its branches.
+  void run(const Branch& start, std::vector<Branch>& exits, bool& truncated) const;
+  /// Polariser sheets met on [x, x + dir·len] (nearest first), applied to b's fields.
+  void applySheets(Branch& b, const glm::dvec3& x, const glm::dvec3& dir, double len) const;
+
+ private:
+  const MediumRecord& rec(int region) const { return media_->regions[size_t(region)]; }
+  OpticalMedium mediumOf(int region, const glm::dvec3& x) const;
+  BoundaryCrossing nextCrossing(const glm::dvec3& a, const glm::dvec3& b, int region) const;
+  void segment(Branch& b, double len) const;
+  void cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branch>& stack) const;
+
+  const std::vector<PolarizerSheet>& sheets_;
+  double lambda_;
+  const PolarisedTraceSettings& s_;
+  const BoundaryField* bf_;
+  const MediaTable* media_;
+  double h_;
+  glm::dvec3 bmin_, bmax_;
+};
+
+OpticalMedium Tracer::mediumOf(int region, const glm::dvec3& x) const {
+  const MediumRecord& m = rec(region);
+  if (!m.homogeneous)
+    throw std::runtime_error("polarised trace: region " + std::to_string(region) +
+                             " is a gradient-index or radial-axis medium, which the polarised "
+                             "trace does not support yet");
+  const double n_o = mediumIndexAt(m, 0, lambda_, x);
+  if (!m.uniaxial) return OpticalMedium::isotropic(n_o);
+  return OpticalMedium::uniaxial(
+      Uniaxial(n_o, mediumIndexAt(m, 1, lambda_, x), glm::dvec3(mediumAxisField(m, x))));
+}
+
+// RayMarch::nextCrossing's search (the sliver rule).
+BoundaryCrossing Tracer::nextCrossing(const glm::dvec3& a, const glm::dvec3& b, int region) const {
+  const double total = glm::length(b - a);
+  if (!(total > 0.0)) return BoundaryCrossing{};
+  const glm::dvec3 dir = (b - a) / total;
+  glm::dvec3 start = a;
+  for (int k = 0; k < 4; ++k) {
+    BoundaryCrossing c = locateCrossing(*bf_, start, b);
+    if (!c.found) return c;
+    const double along = glm::dot(c.point - a, dir);
+    const bool sliver = c.from != region && c.to == region && along <= kSliverVoxels * h_;
+    if (!sliver) {
+      c.t = std::clamp(along / total, 0.0, 1.0);
+      c.from = region;
+      return c;
+    }
+    start = a + (along + kNudgeVoxels * h_) * dir;
+    if (along + kNudgeVoxels * h_ >= total) return BoundaryCrossing{};
+  }
+  return BoundaryCrossing{};
+}
+
+// An ideal dichroic sheet absorbs the field along its absorbing direction b = normal × axis
+// (projected ⊥ the wave normal) and transmits the rest.
+void Tracer::applySheets(Branch& b, const glm::dvec3& x, const glm::dvec3& dir, double len) const {
+  std::vector<std::pair<double, const PolarizerSheet*>> hits;
+  for (const PolarizerSheet& sh : sheets_) {
+    const double dn = glm::dot(dir, sh.normal);
+    if (std::abs(dn) < 1e-15) continue;
+    const double t = glm::dot(sh.center - x, sh.normal) / dn;
+    if (!(t > 0.0 && t <= len)) continue;
+    const glm::dvec3 r = x + t * dir - sh.center;
+    if (std::abs(glm::dot(r, sh.axis)) <= 0.5 * sh.width &&
+        std::abs(glm::dot(r, glm::cross(sh.normal, sh.axis))) <= 0.5 * sh.height)
+      hits.push_back({t, &sh});
+  }
+  std::sort(hits.begin(), hits.end(),
+            [](const auto& u, const auto& v) { return u.first < v.first; });
+  const glm::dvec3 k = glm::normalize(b.p);
+  for (const auto& [t, sh] : hits) {
+    glm::dvec3 a = glm::cross(sh->normal, sh->axis);
+    a -= glm::dot(a, k) * k;
+    if (glm::length(a) < 1e-12) continue;  // grazing: the absorbing direction is along k
+    a = glm::normalize(a);
+    for (CV& g : b.G) g = g - maxwell::dot(g, a) * maxwell::cv(a);
+  }
+}
+
+// A straight piece of length len along b.ray in b's region: sheets, the phase k₀∫p·dx (carried as
+// the optical path) and the pleochroic amplitude exp(−½σL), σ per unit ray length.
+void Tracer::segment(Branch& b, double len) const {
+  applySheets(b, b.x, b.ray, len);
+  b.opl += glm::dot(b.p, b.ray) * len;
+  const MediumRecord& m = rec(b.region);
+  double sigma = field::bandAt(m.sigma_o, lambda_);
+  if (m.uniaxial && b.mode == Mode::Extraordinary) {
+    const glm::dvec3 a = glm::dvec3(mediumAxisField(m, b.x));
+    sigma =
+        field::attenuationE(glm::dvec3(sigma), glm::dvec3(field::bandAt(m.sigma_e, lambda_)), b.p,
+                            a, mediumIndexAt(m, 0, lambda_, b.x), mediumIndexAt(m, 1, lambda_, b.x))
+            .x;
+  }
+  if (sigma > 0.0) {
+    const Complex f(std::exp(-0.5 * sigma * len));
+    for (CV& g : b.G) g = f * g;
+  }
+  b.x += b.ray * len;
+}
+
+// The exact interface map; the branch goes on as the transmitted beam(s) (the o and e modes
+// into a crystal), or the reflected one(s) on total internal reflection or where asked.
+void Tracer::cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branch>& stack) const {
+  const MediumRecord &A = rec(b.region), &B = rec(c.to);
+  if (B.opaque()) return;  // absorbed: nothing of this branch leaves
+  const OpticalMedium from = mediumOf(b.region, c.point), to = mediumOf(c.to, c.point);
+  if (A.medium == B.medium && (!from.crystal || from.crystal->axis == to.crystal->axis)) {
+    Branch same = b;
+    same.region = c.to;
+    stack.push_back(same);
+    return;
+  }
+  const InterfaceMap map = interfaceMap(from, b.mode, glm::normalize(b.p), c.normal, to);
+  const bool asked =
+      std::find(s_.reflect_at.begin(), s_.reflect_at.end(), b.events) != s_.reflect_at.end();
+  const bool reflect = asked || !(map.beams[2].exists || map.beams[3].exists);
+  const OpticalMedium& side = reflect ? from : to;
+  for (size_t slot = reflect ? 0 : 2; slot < (reflect ? 2u : 4u); ++slot) {
+    const OutgoingBeam& beam = map.beams[slot];
+    if (!beam.exists) continue;
+    Branch nb = b;
+    nb.G = {map.apply(b.G[0])[slot], map.apply(b.G[1])[slot]};
+    if (power(nb) < 1e-14) continue;
+    nb.p = beam.p;
+    nb.ray = beam.ray;
+    nb.mode = beam.mode;
+    nb.region = reflect ? b.region : c.to;
+    nb.x = c.point;
+    nb.events = b.events + 1;
+    if (side.crystal) nb.modes += beam.mode == Mode::Ordinary ? 'o' : 'e';
+    stack.push_back(nb);
+  }
+}
+
+void Tracer::run(const Branch& start, std::vector<Branch>& exits, bool& truncated) const {
+  std::vector<Branch> stack{start};
+  while (!stack.empty()) {
+    Branch b = stack.back();
+    stack.pop_back();
+    if (b.events > s_.max_events || int(exits.size() + stack.size()) + 1 > s_.max_branches) {
+      truncated = true;
+      continue;
+    }
+    if (rec(b.region).opaque()) continue;
+    mediumOf(b.region, b.x);  // refuses unsupported regions
+    double t0, t1;
+    boxHit(b.x, b.ray, bmin_, bmax_, t0, t1);
+    double len = std::max(t1, 0.0);
+    const BoundaryCrossing c = nextCrossing(b.x, b.x + b.ray * len, b.region);
+    if (c.found) len *= c.t;
+    segment(b, len);
+    if (!c.found) {  // out of the volume: straight on, through any sheets beyond it
+      Branch out = b;
+      applySheets(out, b.x, b.ray, kFarMm);
+      exits.push_back(out);
+      continue;
+    }
+    b.x = c.point;
+    cross(b, c, stack);
+  }
+}
+
+/// Branches leaving in one direction, recombined: coherent groups (Jones matrices added with their
+/// phases on a common wavefront) added as Stokes vectors.
+PolarisedBeam recombine(const std::vector<const Branch*>& group, const Stokes& input,
+                        double lambda_nm, const PolarisedTraceSettings& s) {
+  const Branch& first = *group.front();
+  PolarisedBeam beam;
+  beam.direction = glm::normalize(first.ray);
+  beam.exit_point = first.x;
+  beam.frame_x = stokesBasis(beam.direction);
+  const glm::dvec3 x = beam.frame_x, y = glm::cross(beam.direction, x);
+  const double k0 = 2.0 * kPi / (lambda_nm * 1e-6);
+  const double width = lambda_nm * 1e-6 / s.source_angle_rad,
+               length = lambda_nm * lambda_nm * 1e-6 / s.bandwidth_nm;
+  auto delta = [](const Branch& b) { return b.opl - glm::dot(b.p, b.x); };  // S on a wavefront
+  std::vector<bool> used(group.size(), false);
+  for (size_t r = 0; r < group.size(); ++r) {
+    if (used[r]) continue;
+    const Branch& ref = *group[r];
+    JonesMatrix J;
+    J.m = {};
+    for (size_t j = r; j < group.size(); ++j) {
+      const Branch& b = *group[j];
+      const glm::dvec3 sep = b.x - ref.x;
+      const double lateral = glm::length(sep - glm::dot(sep, beam.direction) * beam.direction);
+      const double opd = delta(b) - delta(ref);  // the o−e (or path) difference
+      if (used[j] || lateral > width || std::abs(opd) > length) continue;
+      used[j] = true;
+      const Complex ph = std::exp(Complex(0.0, k0 * opd));
+      for (size_t c = 0; c < 2; ++c) {
+        J.m[0][c] += ph * maxwell::dot(b.G[c], x);
+        J.m[1][c] += ph * maxwell::dot(b.G[c], y);
+      }
+      beam.modes += (beam.modes.empty() ? "" : ",") + (b.modes.empty() ? "-" : b.modes);
+      beam.branches++;
+    }
+    beam.stokes += muellerOf(J) * input;
+    beam.coherent_groups++;
+  }
+  return beam;
+}
+
+void validate(const TraceRequest& ray, const Stokes& in, const PolarisedTraceSettings& s) {
+  const double len = glm::length(ray.direction);
+  if (!(len > 0) || !std::isfinite(len))
+    throw std::invalid_argument("trace direction must be a non-zero finite vector");
+  if (!(ray.wavelength_nm > 0) || !std::isfinite(ray.wavelength_nm))
+    throw std::invalid_argument("trace wavelength must be > 0 nm");
+  if (!(in[0] > 0) || !std::isfinite(in[1] + in[2] + in[3]))
+    throw std::invalid_argument("input Stokes vector needs S0 > 0 and finite S1..S3");
+  if (degreeOfPolarisation(in) > 1.0 + 1e-9)
+    throw std::invalid_argument("input Stokes vector has sqrt(S1² + S2² + S3²) > S0");
+  if (!(s.bandwidth_nm > 0) || !(s.source_angle_rad > 0) || s.max_branches < 1 || s.max_events < 1)
+    throw std::invalid_argument("polarised trace settings must be positive");
+}
+
+}  // namespace
+
+double PolarisedTrace::totalPower() const {
+  double p = 0.0;
+  for (const PolarisedBeam& b : beams) p += b.stokes[0];
+  return p;
+}
+
+PolarisedTrace tracePolarised(const Field& field, const std::vector<PolarizerSheet>& sheets,
+                              const TraceRequest& ray, const Stokes& input,
+                              const PolarisedTraceSettings& settings) {
+  validate(ray, input, settings);
+  if (!field.boundary() || !field.media())
+    throw std::runtime_error(
+        "polarised trace: the field has no sharp boundaries (it needs "
+        "\"interfaces\": \"sharp\")");
+  const glm::dvec3 d = glm::normalize(ray.direction);
+  const Tracer tracer(field, sheets, ray.wavelength_nm, settings);
+  PolarisedTrace out;
+  out.frame_x_in = stokesBasis(d);
+  Branch b;
+  b.x = ray.origin;
+  b.ray = d;
+  b.p = field.ambientIndex() * d;
+  b.G = {maxwell::cv(out.frame_x_in), maxwell::cv(glm::cross(d, out.frame_x_in))};
+  std::vector<Branch> exits;
+  double t0, t1;
+  if (!boxHit(ray.origin, d, field.boundsMin(), field.boundsMax(), t0, t1)) {
+    tracer.applySheets(b, b.x, d, kFarMm);
+    exits.push_back(b);
+  } else {
+    t0 = std::max(t0, 0.0);
+    tracer.applySheets(b, b.x, d, t0);
+    b.x += d * t0;
+    b.opl = field.ambientIndex() * t0;
+    b.region = boundaryRegion(*field.boundary(), b.x);
+    if (b.region != 0)
+      throw std::runtime_error("polarised trace: the ray enters the volume inside an object");
+    tracer.run(b, exits, out.truncated);
+  }
+  std::vector<bool> used(exits.size(), false);
+  for (size_t i = 0; i < exits.size(); ++i) {  // one beam per direction
+    if (used[i]) continue;
+    std::vector<const Branch*> group;
+    for (size_t j = i; j < exits.size(); ++j) {
+      const double angle = std::acos(std::clamp(glm::dot(exits[i].ray, exits[j].ray), -1.0, 1.0));
+      if (!used[j] && angle <= settings.source_angle_rad) {
+        used[j] = true;
+        group.push_back(&exits[j]);
+      }
+    }
+    out.beams.push_back(recombine(group, input, ray.wavelength_nm, settings));
+  }
+  std::sort(out.beams.begin(), out.beams.end(), [](const PolarisedBeam& u, const PolarisedBeam& v) {
+    return u.stokes[0] > v.stokes[0];
+  });
+  return out;
+}
+
+}  // namespace eikon

@@ -1,0 +1,78 @@
+// The polarised trace of the CPU twin (issue 15; docs/polarisation.md): one ray of light followed
+// forwards through the sharp march's regions carrying its field coherently — a Jones vector per
+// input basis state, as a 3D complex field — and the Stokes vector of the light leaving along the
+// path for a given input Stokes vector.
+//
+// What happens along the path (optics/polarization.h does the optics):
+//   * at every interface the exact Maxwell amplitudes (isotropic: Born & Wolf's r/t with the TIR
+//     phase; crystal faces: the 4×4 solve of optics/maxwell_boundary.h, so no D-projection
+//     approximation): the path follows the transmitted beam(s), or the reflected one(s) on total
+//     internal reflection or where `reflect_at` asks; a wave entering a crystal splits into an o
+//     and an e branch, which are traced separately (a ray tree, at most max_branches leaves);
+//   * in a crystal each branch gains k₀∫p·dx (p the wave vector: walk-off is accounted for) and
+//     loses exp(−½σL) of its amplitude (pleochroic σ(θ)cos ρ per ray length, field::attenuationE);
+//   * a straight piece that crosses a polariser sheet's rectangle (scene "polarizer", outside or
+//     inside the volume) keeps only the field across the sheet's absorbing direction;
+//   * branches leaving in the same direction (within source_angle_rad) are recombined: coherently
+//     (Jones matrices added with their phases on a common wavefront) when their exit rays are
+//     within the coherence width λ/source_angle_rad of each other and their optical paths differ
+//     by less than the coherence length λ²/bandwidth_nm; otherwise their Stokes vectors add.
+//
+// Frames: the input Stokes vector is given in Mitsuba 3's stokesBasis of the ray direction, each
+// output beam's Stokes vector in the stokesBasis of its own direction (optics/polarization.h).
+//
+//   eikon::TraceRequest ray{{0, 0, -30}, {0, 0, 1}, 589.29};
+//   eikon::PolarisedTrace t = eikon::tracePolarised(field, scene.polarizers, ray, {1, 0, 0, 0});
+//   // t.beams[k].stokes: what leaves along direction t.beams[k].direction
+//
+// Only homogeneous regions are supported (a gradient-index or radial-axis region on the path is
+// a std::runtime_error naming it); an opaque region absorbs the branch.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/scene/scene.h"
+#include "core/volume/field.h"
+#include "core/volume/march_types.h"
+#include "optics/polarization.h"
+
+namespace eikon {
+
+struct PolarisedTraceSettings {
+  double bandwidth_nm = 10.0;      ///< spectral width of one sample: coherence length λ²/Δλ
+  double source_angle_rad = 1e-3;  ///< angular size of one light/environment sample
+  int max_branches = 64;           ///< o/e ray-tree leaves
+  int max_events = 256;            ///< interface events per branch
+  std::vector<int> reflect_at;     ///< interface events (0-based per branch) that take the
+                                   ///< reflected beam instead of the transmitted one
+};
+
+/// One beam leaving the scene.
+struct PolarisedBeam {
+  glm::dvec3 exit_point{0.0};  ///< last point in the volume (the origin's line if it missed it)
+  glm::dvec3 direction{0.0};   ///< unit energy direction
+  glm::dvec3 frame_x{0.0};     ///< the Stokes reference direction, stokesBasis(direction)
+  Stokes stokes{0.0};
+  int branches = 0;         ///< o/e paths added into it
+  int coherent_groups = 0;  ///< groups added incoherently (1: fully coherent sum)
+  std::string modes;        ///< the branches' mode sequences, e.g. "o,e"
+};
+
+struct PolarisedTrace {
+  std::vector<PolarisedBeam> beams;  ///< by decreasing S0
+  glm::dvec3 frame_x_in{0.0};        ///< the input Stokes reference direction
+  bool truncated = false;            ///< max_branches or max_events cut the ray tree
+  /// Σ S0 of the beams (what leaves the scene in all directions).
+  double totalPower() const;
+};
+
+/// Trace `ray` (forwards) through the field's sharp boundaries and the given sheets. Throws
+/// std::invalid_argument on a bad ray, input Stokes vector (S0 ≤ 0, DoP > 1) or settings, and
+/// std::runtime_error when the field has no sharp boundary field or the path meets a region the
+/// polarised trace does not support.
+PolarisedTrace tracePolarised(const Field& field, const std::vector<PolarizerSheet>& sheets,
+                              const TraceRequest& ray, const Stokes& input,
+                              const PolarisedTraceSettings& settings = {});
+
+}  // namespace eikon
