@@ -148,6 +148,13 @@ class Cutter {
  private:
   int normIndex(int i) const { return ((i % design_.gear) + design_.gear) % design_.gear; }
 
+  /// `name` if it names a table or culet tier, "" otherwise.
+  std::string tableName(const std::string& name) const {
+    for (const auto& t : design_.tiers)
+      if (t.name == name && (t.side == FacetSide::Table || t.side == FacetSide::Culet)) return name;
+    return {};
+  }
+
   /// Every vertex of the current stone.
   std::vector<glm::dvec3> vertices() const {
     std::vector<glm::dvec3> v;
@@ -236,11 +243,14 @@ class Cutter {
     glm::dvec3 b;
     for (int r = 0; r < 3; ++r) {
       const FacetRef& ref = tier.meet[size_t(r)];
-      auto it = where_.find({ref.tier, normIndex(ref.index + offset)});
+      // The table and a culet have no azimuth: they are met wherever the facet is.
+      const bool flat = ref.tier == tableName(ref.tier);
+      const int ri = flat ? 0 : normIndex(ref.index + offset);
+      auto it = where_.find({ref.tier, ri});
       if (it == where_.end())
         throw FacetError(at + "/" + std::to_string(r) + idx,
                          "cannot be met: no facet of an earlier tier '" + ref.tier + "' at index " +
-                             std::to_string(normIndex(ref.index + offset)));
+                             std::to_string(ri));
       const Plane& pl = planes_[it->second];
       A[0][r] = pl.normal.x;  // row r of A (glm is column-major)
       A[1][r] = pl.normal.y;

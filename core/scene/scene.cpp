@@ -446,7 +446,11 @@ FacetTier parseTier(const Node& t, int gear, const std::string& rel) {
           .fail("must divide the gear's " + std::to_string(gear) + " teeth, got " +
                 std::to_string(n));
     const int first = t.get("first_index") ? t.at("first_index").integer(0, gear) : gear / n;
-    for (int k = 0; k < n; ++k) tier.indices.push_back((first + k * (gear / n)) % gear);
+    // As a cutter counts: from the first index on, wrapping past the gear's top tooth.
+    for (int k = 0; k < n; ++k) {
+      const int v = first + k * (gear / n);
+      tier.indices.push_back(v > gear ? v - gear : v);
+    }
   }
   parsePlacement(t, tier);
   return tier;
