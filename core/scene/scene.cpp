@@ -4,11 +4,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
 #include "core/io/exr.h"
+#include "core/scene/faceted.h"
 #include "core/spectrum/illuminants.h"
 
 namespace eikon {
@@ -54,6 +56,7 @@ class Node {
   }
   const json& raw() const { return j_; }
   const std::string& path() const { return path_; }
+  const std::string& file() const { return file_; }
   bool isObject() const { return j_.is_object(); }
   bool isNumber() const { return j_.is_number(); }
   bool isArray() const { return j_.is_array(); }
@@ -339,6 +342,155 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
 }
 
 // ------------------------------------------------------------------ objects
+/// /girdle of a faceted object: {"outline": "round", "diameter"} | {"outline": "oval" |
+/// "rectangle", "length", "width"[, "corner"]}, "thickness".
+GirdleOutline parseGirdle(const Node& g) {
+  GirdleOutline out;
+  const std::string kind = g.at("outline").string();
+  if (kind == "round") {
+    g.allowKeys({"outline", "diameter", "thickness"});
+    out.kind = GirdleOutline::Kind::Round;
+    out.length = out.width = g.at("diameter").length();
+  } else if (kind == "oval" || kind == "rectangle") {
+    if (kind == "oval") g.allowKeys({"outline", "length", "width", "thickness"});
+    if (kind != "oval") g.allowKeys({"outline", "length", "width", "corner", "thickness"});
+    out.kind = kind == "oval" ? GirdleOutline::Kind::Oval : GirdleOutline::Kind::Rectangle;
+    out.length = g.at("length").length();
+    out.width = g.at("width").length();
+    if (auto c = g.get("corner"))
+      out.corner = c->number(0.0, 0.5 * std::min(out.length, out.width));
+  } else {
+    g.at("outline").fail("unknown outline '" + excerpt(kind) + "' (round, oval, rectangle)");
+  }
+  out.thickness = g.get("thickness") ? g.at("thickness").number(0.0, kMaxCoordinateMm) : 0.0;
+  return out;
+}
+
+/// Where a tier is cut to: exactly one of distance, to_center, meet.
+void parsePlacement(const Node& t, FacetTier& tier) {
+  const int given = int(t.has("distance")) + int(t.has("to_center")) + int(t.has("meet"));
+  if (given != 1)
+    t.fail("give exactly one of distance, to_center, meet (where the facets are cut to)");
+  if (auto d = t.get("distance")) {
+    tier.value = d->number(-kMaxCoordinateMm, kMaxCoordinateMm);
+  } else if (auto c = t.get("to_center")) {
+    if (tier.side != FacetSide::Crown && tier.side != FacetSide::Pavilion)
+      c->fail("to_center is for crown and pavilion tiers");
+    tier.place = FacetTier::Place::ToCenter;
+    tier.value = c->number(-kMaxCoordinateMm, kMaxCoordinateMm);
+  } else {
+    const Node m = t.at("meet");
+    if (m.isString()) {
+      if (m.string() != "girdle")
+        m.fail("expected \"girdle\", {\"tier\", \"height\"} or three [tier, index]");
+      tier.place = FacetTier::Place::MeetGirdle;
+    } else if (m.isObject()) {
+      m.allowKeys({"tier", "height"});
+      tier.place = FacetTier::Place::MeetLevel;
+      tier.level_tier = m.at("tier").string();
+      tier.value = m.at("height").number(-kMaxCoordinateMm, kMaxCoordinateMm);
+    } else {
+      if (!m.isArray() || m.size() != 3)
+        m.fail("expected \"girdle\", {\"tier\", \"height\"} or three [tier, index]");
+      tier.place = FacetTier::Place::MeetPoint;
+      for (size_t r = 0; r < 3; ++r) {
+        const Node ref = m.index(r);
+        if (!ref.isArray() || ref.size() != 2) ref.fail("expected [tier name, index]");
+        tier.meet[r] = {ref.index(0).string(), ref.index(1).integer(-100000, 100000)};
+      }
+    }
+  }
+}
+
+FacetTier parseTier(const Node& t, int gear, const std::string& rel) {
+  t.allowKeys({"name", "side", "angle_deg", "index", "symmetry", "first_index", "distance",
+               "to_center", "meet"});
+  FacetTier tier;
+  tier.path = rel;
+  tier.name = t.at("name").string();
+  const std::string side = t.at("side").string();
+  static const std::map<std::string, FacetSide> sides = {{"crown", FacetSide::Crown},
+                                                         {"pavilion", FacetSide::Pavilion},
+                                                         {"girdle", FacetSide::Girdle},
+                                                         {"table", FacetSide::Table},
+                                                         {"culet", FacetSide::Culet}};
+  auto it = sides.find(side);
+  if (it == sides.end())
+    t.at("side").fail("unknown side '" + excerpt(side) +
+                      "' (crown, pavilion, girdle, table, culet)");
+  tier.side = it->second;
+  const bool tilted = tier.side == FacetSide::Crown || tier.side == FacetSide::Pavilion;
+  if (tilted) {
+    tier.angle_deg = t.at("angle_deg").number();
+    if (!(tier.angle_deg > 0 && tier.angle_deg < 90))
+      t.at("angle_deg")
+          .fail("must be in (0, 90) degrees from the girdle plane, got " + fmt(tier.angle_deg));
+  } else if (t.has("angle_deg")) {
+    t.at("angle_deg").fail("a " + side + " tier has no angle");
+  }
+  if (tier.side == FacetSide::Table || tier.side == FacetSide::Culet) {
+    if (t.has("index") || t.has("symmetry") || t.has("first_index"))
+      t.fail("a " + side + " has no index");
+    tier.indices = {0};
+  } else if (auto ix = t.get("index")) {
+    if (t.has("symmetry") || t.has("first_index")) t.fail("give index or symmetry, not both");
+    if (!ix->isArray() || ix->size() == 0) ix->fail("expected a non-empty array of gear indices");
+    for (size_t k = 0; k < ix->size(); ++k) {
+      const Node v = ix->index(k);
+      tier.indices.push_back(v.integer(0, gear));
+    }
+  } else {
+    const int n = t.at("symmetry").integer(1, gear);
+    if (gear % n != 0)
+      t.at("symmetry")
+          .fail("must divide the gear's " + std::to_string(gear) + " teeth, got " +
+                std::to_string(n));
+    const int first = t.get("first_index") ? t.at("first_index").integer(0, gear) : gear / n;
+    // As a cutter counts: from the first index on, wrapping past the gear's top tooth.
+    for (int k = 0; k < n; ++k) {
+      const int v = first + k * (gear / n);
+      tier.indices.push_back(v > gear ? v - gear : v);
+    }
+  }
+  parsePlacement(t, tier);
+  return tier;
+}
+
+/// {"shape": "faceted", "gear", "girdle", "tiers"} or {"shape": "faceted", "file": "x.asc"}.
+ConvexShape parseFaceted(const Node& o) {
+  FacetedDesign design;
+  if (auto f = o.get("file")) {
+    if (o.has("tiers") || o.has("gear") || o.has("girdle"))
+      o.fail("give either file (a GemCad .asc) or gear, girdle and tiers, not both");
+    std::filesystem::path p = f->string();
+    if (p.is_relative()) p = std::filesystem::path(o.file()).parent_path() / p;
+    std::error_code ec;
+    if (std::filesystem::is_directory(p, ec))
+      f->fail("is a directory, expected a GemCad .asc file");
+    if (std::filesystem::exists(p, ec) && std::filesystem::file_size(p, ec) > (1u << 20))
+      f->fail("the .asc file is larger than 1 MiB");
+    std::ifstream in(p);
+    if (!in) f->fail("cannot open '" + excerpt(p.string()) + "'");
+    try {
+      design = readGemCadAsc(in, p.filename().string());
+    } catch (const FacetError& e) {
+      f->fail(printable(e.what(), 300));
+    }
+  } else {
+    design.gear = o.get("gear") ? o.at("gear").integer(3, 400) : 96;
+    if (auto g = o.get("girdle")) design.girdle = parseGirdle(*g);
+    const Node ts = o.at("tiers");
+    if (!ts.isArray() || ts.size() == 0) ts.fail("expected a non-empty array of tiers");
+    for (size_t k = 0; k < ts.size(); ++k)
+      design.tiers.push_back(parseTier(ts.index(k), design.gear, "/tiers/" + std::to_string(k)));
+  }
+  try {
+    return cutFaceted(design).shape;
+  } catch (const FacetError& e) {
+    throw SceneError(o.file() + ": " + o.path() + e.where() + ": " + printable(e.what(), 300));
+  }
+}
+
 SceneObject parseObject(const Node& o) {
   o.requireObject();
   std::string shape = o.at("shape").string();
@@ -388,6 +540,9 @@ SceneObject parseObject(const Node& o) {
                         o.get("pavilion_deg") ? o.at("pavilion_deg").number() : 40.75,
                         o.get("girdle") ? o.at("girdle").number(0.0, 0.5) : 0.02,
                         o.get("facets") ? o.at("facets").integer(3, 64) : 16);
+    } else if (shape == "faceted") {
+      allow({"gear", "girdle", "tiers", "file"});
+      g = parseFaceted(o);
     } else if (shape == "planes") {
       allow({"planes"});
       auto p = o.at("planes");
@@ -413,8 +568,9 @@ SceneObject parseObject(const Node& o) {
     } else if (shape == "mesh") {
       o.at("shape").fail("shape 'mesh' is not supported yet (use planes for convex solids)");
     } else {
-      o.at("shape").fail("unknown shape '" + excerpt(shape) +
-                         "' (sphere, box, rounded_box, prism, brilliant, planes, polarizer)");
+      o.at("shape").fail(
+          "unknown shape '" + excerpt(shape) +
+          "' (sphere, box, rounded_box, prism, brilliant, faceted, planes, polarizer)");
     }
   } catch (const std::invalid_argument& e) {
     o.fail(e.what());
