@@ -8,6 +8,7 @@
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
+#include "core/vk/timings.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/trace.spv.h"
 #include "shaders/view.spv.h"
@@ -138,6 +139,7 @@ struct ViewRenderer::Impl {
     tables = vk::Buffer(ctx, tab.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                         "spectral tables");
     tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
+    timings::mark("volume uploaded");
 
     std::vector<vk::BindingSpec> common;
     for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
@@ -159,6 +161,7 @@ struct ViewRenderer::Impl {
         vk::ComputePipeline(ctx, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4),
                             traceBindings, 0, "trace", spec);
     for (auto* p : {&view, &tracer}) bindCommon(*p);
+    timings::mark("pipelines built");
   }
 
   void bindCommon(vk::ComputePipeline& p) {
@@ -269,6 +272,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
     const auto band_start = std::chrono::steady_clock::now();
     p.image = glm::ivec4(img.width, img.height, y0, n);
     I.params.write(&p, sizeof p);
+    if (y0 == 0) timings::mark("first dispatch");
     I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
       I.view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X),
                       uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
