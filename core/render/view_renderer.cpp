@@ -161,6 +161,7 @@ struct ViewRenderer::Impl {
         vk::ComputePipeline(ctx, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4),
                             traceBindings, 0, "trace", spec);
     for (auto* p : {&view, &tracer}) bindCommon(*p);
+    ctx.savePipelineCache();  // core/vk/pipeline_cache.h: the next run skips the compilation
     timings::mark("pipelines built");
   }
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -128,6 +129,33 @@ TEST_F(StartupCli, TimingsOfTheCpuTwin) {
   const std::vector<std::string> expected = {"command line", "scene parsed", "voxelised",
                                              "rendered", "written"};
   EXPECT_EQ(stages, expected) << r.err;
+}
+
+// The pipeline cache (core/vk/pipeline_cache.h) is written to EIKON_CACHE_DIR by a GPU render; a
+// corrupt one there is ignored with one "eikon: note:" line, the render succeeds and replaces it.
+TEST_F(StartupCli, PipelineCacheIsWrittenAndACorruptOneIgnored) {
+  const Outcome first = render("-q");
+  ASSERT_EQ(first.code, 0) << first.err;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir_ / "cache"))
+    if (e.path().filename().string().rfind("pipelines-", 0) == 0) files.push_back(e.path());
+  ASSERT_EQ(files.size(), 1u);
+  const std::string good = eikon::test::slurp(files[0]);
+  EXPECT_EQ(good.substr(0, 8), "EIKPIPE1");
+  EXPECT_GE(good.size(), 24u + 32u);  // our header and at least the driver's (Vulkan spec)
+  std::ofstream(files[0], std::ios::binary | std::ios::trunc) << good.substr(0, good.size() / 2);
+  const Outcome second = render("-q");
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_EQ(second.err.rfind("eikon: note: pipeline cache '", 0), 0u) << second.err;
+  EXPECT_NE(second.err.find("ignored: truncated"), std::string::npos) << second.err;
+  EXPECT_EQ(std::count(second.err.begin(), second.err.end(), '\n'), 1) << second.err;
+  // Replaced by a whole one (the driver's data may differ from run to run on some drivers).
+  const std::string replaced = eikon::test::slurp(files[0]);
+  EXPECT_EQ(replaced.substr(0, 8), "EIKPIPE1");
+  EXPECT_GE(replaced.size(), 24u + 32u);
+  const Outcome third = render("-q");
+  ASSERT_EQ(third.code, 0) << third.err;
+  EXPECT_EQ(third.err, "");
 }
 
 }  // namespace
