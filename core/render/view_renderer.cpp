@@ -66,8 +66,9 @@ struct ViewRenderer::Impl {
   size_t scatterImage = 0, fluenceImage = 0,
          fluxImage = 0;  // 0: not present (index A bound instead)
   vk::Buffer params, env, tables;
-  BoundaryDevice boundary;  // the sharp-boundary field (placeholders when smoothed)
-  vk::ComputePipeline view, tracer;
+  BoundaryDevice boundary;              // the sharp-boundary field (placeholders when smoothed)
+  std::vector<vk::BindingSpec> common;  // the bindings both pipelines have
+  vk::ComputePipeline view, tracer;     // built on first use (ensureView, ensureTracer)
   int skip_cap = 32;
   double ambient = 1.0;
 
@@ -141,7 +142,6 @@ struct ViewRenderer::Impl {
     tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
     timings::mark("volume uploaded");
 
-    std::vector<vk::BindingSpec> common;
     for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     for (uint32_t b :
@@ -151,18 +151,29 @@ struct ViewRenderer::Impl {
                        uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
     for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
-    // constant_id 0 (march.glsl kSharpMarch): the sharp or the smoothed march, not both.
-    const std::vector<uint32_t> spec{sharp ? 1u : 0u};
-    view = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4),
-                               common, 0, "view", spec);
-    auto traceBindings = common;
-    traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    tracer =
-        vk::ComputePipeline(ctx, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4),
-                            traceBindings, 0, "trace", spec);
-    for (auto* p : {&view, &tracer}) bindCommon(*p);
+  }
+
+  // The pipelines are built on first use, each only when asked for (issue 14, start-up): a
+  // render never builds the tracer, a trace never builds the view pipeline; on lavapipe each
+  // takes seconds to compile. constant_id 0 (march.glsl kSharpMarch) picks the sharp or the
+  // smoothed march, so only the one the scene needs is compiled.
+  void buildPipeline(vk::ComputePipeline& p, std::span<const uint32_t> spirv, bool rays,
+                     const char* name) {
+    if (p.built()) return;
+    auto bindings = common;
+    if (rays) bindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    p = vk::ComputePipeline(ctx, spirv, bindings, 0, name, {sharp ? 1u : 0u});
+    bindCommon(p);
     ctx.savePipelineCache();  // core/vk/pipeline_cache.h: the next run skips the compilation
     timings::mark("pipelines built");
+  }
+  void ensureView() {
+    buildPipeline(view, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4), false,
+                  "view");
+  }
+  void ensureTracer() {
+    buildPipeline(tracer, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4), true,
+                  "trace");
   }
 
   void bindCommon(vk::ComputePipeline& p) {
@@ -236,6 +247,7 @@ ViewRenderer::~ViewRenderer() = default;
 RenderImage ViewRenderer::render(const RenderSettings& s) {
   validate(s.march);
   Impl& I = *impl_;
+  I.ensureView();
   RenderImage img;
   img.width = s.width > 0 ? s.width : I.scene.camera.width;
   img.height = s.height > 0 ? s.height : I.scene.camera.height;
@@ -312,6 +324,7 @@ std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(
   validate(m);
   Impl& I = *impl_;
   if (rays.empty()) return {};
+  I.ensureTracer();
   std::vector<gpu::TraceRay> in(rays.size());
   for (size_t i = 0; i < rays.size(); ++i) {
     double len = glm::length(rays[i].direction);
