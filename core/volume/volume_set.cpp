@@ -270,31 +270,44 @@ struct Composite {
   std::vector<glm::vec4> axis;
 };
 
-// The composited fields at their initial values (the ambient index, zeros). In an isotropic scene
-// the e-mode fields are not made: every material's n_e and attenuation_e are its n_o and
-// attenuation_o (core/scene), so they would be bitwise copies of the o-mode fields (painted with
-// the same values and coverages, and not smoothed: smoothFields leaves them), which add nothing to
-// the skip distances and are never packed; nor are their gradients. The Gaussian method keeps them:
-// there the o-mode fields are smoothed and the copies are not.
+// A field that starts at 0 and that no material paints with anything but +0 stays +0 in every
+// voxel, its exact gradient too (v(1 − c) + 0·c = +0, and the gradient's update ends by adding
+// +0, which turns a −0 into +0): it is not made, and reads as +0 (fieldAt).
+bool staysZero(int f, const std::map<std::string, MaterialValues>& values) {
+  if (f == kAo || f == kAe) return false;  // starts at the ambient index
+  for (const auto& [name, mv] : values)
+    if (mv.v[f] != 0.0f || std::signbit(mv.v[f])) return false;
+  return true;
+}
+
+// The composited fields at their initial values (the ambient index, zeros), all but those that
+// stay +0 (staysZero) and, in an isotropic scene, the e-mode fields: every material's n_e and
+// attenuation_e are its n_o and attenuation_o (core/scene), so they would be bitwise copies of
+// the o-mode fields (painted with the same values and coverages, and not smoothed: smoothFields
+// leaves them), which add nothing to the skip distances and are never packed; nor are their
+// gradients. The Gaussian method keeps them: there the o-mode fields are smoothed and the copies
+// are not. Fewer arrays: voxelising was mostly the kernel handing out their pages.
 Composite allocateComposite(const Scene& scene, const Grid& g, const CoverageRule& rule,
-                            bool uniaxial) {
+                            bool uniaxial, const std::map<std::string, MaterialValues>& values) {
   const bool e_copies =
       !uniaxial && (rule.analytic || scene.volume.smoothing_voxels <= 0.0);  // not made
   Composite cp;
   cp.fields.resize(kFieldCount);
+  if (rule.analytic) cp.gradients.resize(6);
   for (int f = 0; f < kFieldCount; ++f) {
     const bool e_field = (f >= kAe && f <= kCe) || (f >= kSer && f <= kSeb);
-    if (e_field && e_copies) continue;
+    if ((e_field && e_copies) || staysZero(f, values)) continue;
     cp.fields[size_t(f)].assign(g.count(),
                                 f == kAo || f == kAe ? float(scene.ambient_index) : 0.0f);
-  }
-  if (rule.analytic) {
-    cp.gradients.resize(6);
-    for (int f = 0; f < (uniaxial ? 6 : 3); ++f)
-      cp.gradients[size_t(f)].assign(g.count(), glm::vec3(0.0f));
+    if (rule.analytic && f < 6) cp.gradients[size_t(f)].assign(g.count(), glm::vec3(0.0f));
   }
   if (uniaxial) cp.axis.assign(g.count(), glm::vec4(0.0f));
   return cp;
+}
+
+float fieldAt(const Composite& cp, int f, size_t i) {
+  const auto& fld = cp.fields[size_t(f)];
+  return fld.empty() ? 0.0f : fld[i];
 }
 
 // One object's material painted over a voxel with coverage cov: v ← v(1 − c) + p c, and, with
@@ -379,8 +392,10 @@ void smoothFields(Composite& cp, const Grid& g, double sigma, bool uniaxial, Pro
     if (!uniaxial && (f == kAe || f == kBe || f == kCe || f == kSer || f == kSeg || f == kSeb))
       continue;
     auto& fld = cp.fields[size_t(f)];
-    auto [mn, mx] = std::minmax_element(fld.begin(), fld.end());
-    if (*mn != *mx) gaussianSmooth(fld, g.dims, sigma, threads);
+    if (!fld.empty()) {  // one that stays +0 is not made
+      auto [mn, mx] = std::minmax_element(fld.begin(), fld.end());
+      if (*mn != *mx) gaussianSmooth(fld, g.dims, sigma, threads);
+    }
     progress(0.4 + 0.3 * (f + 1) / double(kFieldCount), "smoothing");
   }
 }
@@ -417,7 +432,9 @@ void indexVolumes(const Composite& cp, const Grid& g, bool analytic, VolumeSet& 
   for (int m = 0; m < (vs.uniaxial ? 2 : 1); ++m)
     for (int c = 0; c < 3; ++c) {
       int f = m == 0 ? kAo + c : kAe + c;
-      if (analytic) {
+      if (cp.fields[size_t(f)].empty()) {  // stays +0, its gradient too
+        vs.index[size_t(m)][size_t(c)].assign(N, glm::vec4(0.0f));
+      } else if (analytic) {
         std::vector<glm::vec4> out(N);
         const auto& fld = cp.fields[size_t(f)];
         const auto& grad = cp.gradients[size_t(f)];
@@ -437,12 +454,11 @@ void indexVolumes(const Composite& cp, const Grid& g, bool analytic, VolumeSet& 
 // Four fields as vec4 texels (d < 0: w = 0).
 std::vector<glm::vec4> pack(const Composite& cp, const Grid& g, int a, int b, int c, int d,
                             int threads) {
-  const auto& F = cp.fields;
   std::vector<glm::vec4> out(g.count());
   parallelFor(g.dims[2], threads, [&](int k) {
     for (size_t i = g.index(0, 0, k), end = g.index(0, 0, k + 1); i < end; ++i)
-      out[i] = glm::vec4(F[size_t(a)][i], F[size_t(b)][i], F[size_t(c)][i],
-                         d >= 0 ? F[size_t(d)][i] : 0.0f);
+      out[i] = glm::vec4(fieldAt(cp, a, i), fieldAt(cp, b, i), fieldAt(cp, c, i),
+                         d >= 0 ? fieldAt(cp, d, i) : 0.0f);
   });
   return out;
 }
@@ -484,7 +500,7 @@ std::vector<uint8_t> skipSeeds(const Composite& cp, const Grid& g,
                                const std::vector<glm::vec4>& axis, int cap, int threads) {
   std::vector<const std::vector<float>*> used;  // a constant field makes no voxel active
   for (int f = 0; f < kFieldCount; ++f) {
-    if (cp.fields[size_t(f)].empty()) continue;  // a copy of the o-mode's (allocateComposite)
+    if (cp.fields[size_t(f)].empty()) continue;  // stays +0, or a copy (allocateComposite)
     auto [mn, mx] = std::minmax_element(cp.fields[size_t(f)].begin(), cp.fields[size_t(f)].end());
     if (*mn != *mx) used.push_back(&cp.fields[size_t(f)]);
   }
@@ -512,7 +528,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
   const std::map<std::string, MaterialValues> values = materialValues(scene, vs);
 
   const CoverageRule rule(scene.volume, g.h);
-  Composite cp = allocateComposite(scene, g, rule, vs.uniaxial);
+  Composite cp = allocateComposite(scene, g, rule, vs.uniaxial, values);
   // Analytic smoothing carries exact gradients of the index fields through the compositing
   // (∇ of the smoothed indicator = −F′·∇sd/3σ, along the face normal), so a flat face bends rays
   // exactly along its normal whatever its orientation to the grid. Central differences of the
