@@ -13,6 +13,7 @@
 #include "core/render/render_defaults.h"
 #include "core/session/session.h"
 #include "core/vk/context.h"
+#include "core/vk/timings.h"
 
 namespace eikon::cli {
 
@@ -28,6 +29,7 @@ struct RenderArgs {
   double light_step = 0.0, light_split = 1.0;
   std::string light_splat = "accumulate", light_cache, caustics = "pass", light_device = "auto";
   bool no_light = false, no_light_cache = false;
+  bool timings = false;
 };
 
 /// Refuse an output that is one of the render's own inputs (the same file by device and inode:
@@ -101,6 +103,9 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
                 "Simulate the light even if a cached result exists, and store none");
   sub->add_flag("--no-light", a.no_light,
                 "Do not simulate the scene's lights (no caustics, in-scatter or lit surfaces)");
+  sub->add_flag("--timings", a.timings,
+                "Print on stderr the seconds since the process started at the end of each "
+                "start-up stage (also EIKON_TIMINGS=1)");
 }
 
 /// The view settings as given: an option not given keeps the session's default (the scene
@@ -170,6 +175,8 @@ void printSummary(const RenderArgs& a, Session& session, const LightOutcome& lig
 }
 
 void runRender(const RenderArgs& a, const CLI::App& sub) {
+  if (a.timings) timings::enable(true);
+  timings::mark("command line");
   std::filesystem::path out(a.output),
       png = std::filesystem::path(a.output).replace_extension(".png");
   if (out.extension() != ".exr") throw CliError("output must end in .exr: " + a.output);
@@ -187,26 +194,37 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   checkWritable(png);
   const RenderSettings rs = renderSettings(*scene, view);
   for (const std::string& w : materialRangeWarnings(*scene, rs)) warn(w, a.strict);
+  timings::mark("scene parsed");
 
   Progress progress(progressMode(a.progress, a.quiet));
   Session session(scene);
   session.setThreads(a.threads);
   session.setProgress({[&](const char* what, double f) { progress.update(what, f); },
                        [&](const char* what) { progress.working(what); }});
+  if (!a.reference) {
+    session.context();  // what prepare() does first, marked apart from the voxelising
+    timings::mark("device created");
+    session.startViewPipeline();  // compiles while the scene is voxelised and uploaded
+  }
   session.prepare(!a.reference);
+  timings::mark("voxelised");
   LightOutcome light;
-  if (!scene->lights.empty() && !a.no_light)
+  if (!scene->lights.empty() && !a.no_light) {
     light = session.simulateLight(light_request, a.reference,
                                   a.no_light_cache ? std::filesystem::path() : lightCacheDir(a));
+    timings::mark(light.cached ? "light (from the cache)" : "light simulated");
+  }
   for (const std::string& w : light.warnings)
     std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
   RenderImage img = session.render(rs, !a.reference);
   progress.finish();
+  timings::mark("rendered");
   // The pair as a pair (core/io/atomic_write.h): both files or neither replace what is there,
   // and a concurrent render to the same -o cannot interleave its pair with this one. The
   // preview first: it is the smaller, so a full disk is usually met before the EXR is encoded.
   writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)},
                       {out, exrRgbContent(img.width, img.height, img.rgb)}});
+  timings::mark("written");
   printSummary(a, session, light, rs, img, out, png);
 }
 }  // namespace

@@ -12,6 +12,7 @@
 #include "apps/commands.h"
 #include "apps/progress.h"
 #include "core/session/session.h"
+#include "core/vk/timings.h"
 
 namespace eikon::cli {
 namespace {
@@ -119,6 +120,7 @@ void runTrace(const TraceArgs& a) {
   req.direction = glm::normalize(req.direction);
   const ProgressMode progress_mode = progressMode(a.progress, a.quiet);
   auto scene = std::make_shared<Scene>(loadScene(a.scene));
+  timings::mark("scene parsed");
   // Voxelising a 128³ scene takes seconds; the trace itself is instant.
   Progress progress(progress_mode);
   MarchSettings ms;
@@ -131,8 +133,10 @@ void runTrace(const TraceArgs& a) {
   session.setProgress({[&](const char* what, double f) { progress.update(what, f); },
                        [&](const char* what) { progress.working(what); }});
   session.prepare(!a.reference);
+  timings::mark("voxelised");
   const std::array<TraceOutcome, 2> modes = session.trace({req}, ms, !a.reference).front();
   progress.finish();
+  timings::mark("traced");
   const std::string device = session.deviceName(!a.reference);
   printTrace(a, *scene, modes, device);
 }

@@ -1,13 +1,13 @@
 #include "core/light/light_cache.h"
 
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <system_error>
 #include <vector>
 
 #include "core/io/atomic_write.h"
+#include "core/io/cache_dir.h"
 
 namespace eikon {
 namespace {
@@ -70,14 +70,7 @@ std::filesystem::path entryPath(const std::filesystem::path& dir, uint64_t key) 
 
 }  // namespace
 
-std::filesystem::path defaultLightCacheDir() {
-  if (const char* d = std::getenv("EIKON_CACHE_DIR"); d && *d) return d;
-  if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d)
-    return std::filesystem::path(d) / "eikon";
-  if (const char* d = std::getenv("HOME"); d && *d)
-    return std::filesystem::path(d) / ".cache" / "eikon";
-  return {};
-}
+std::filesystem::path defaultLightCacheDir() { return defaultCacheDir(); }
 
 uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOptions& o,
                        bool reference) {

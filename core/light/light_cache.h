@@ -21,7 +21,8 @@
 
 namespace eikon {
 
-/// $EIKON_CACHE_DIR, else $XDG_CACHE_HOME/eikon, else $HOME/.cache/eikon.
+/// defaultCacheDir() (core/io/cache_dir.h): $EIKON_CACHE_DIR, else $XDG_CACHE_HOME/eikon, else
+/// $HOME/.cache/eikon; the pipeline cache lives there too.
 std::filesystem::path defaultLightCacheDir();
 
 uint64_t lightCacheKey(const Scene& scene, const VolumeSet& volume, const LightingOptions& options,

@@ -2,12 +2,14 @@
 
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <stdexcept>
 
 #include "core/render/boundary_device.h"
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
+#include "core/vk/timings.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/trace.spv.h"
 #include "shaders/view.spv.h"
@@ -24,7 +26,56 @@ void validate(const MarchSettings& m) {
   if (!(m.interface_threshold > 0)) throw std::invalid_argument("interface threshold must be > 0");
 }
 
+// The bindings of the view and trace pipelines (the trace's adds EIKON_B_RAYS).
+std::vector<vk::BindingSpec> commonBindings() {
+  std::vector<vk::BindingSpec> common;
+  for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
+    common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  for (uint32_t b :
+       {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
+    common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
+                     uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
+    common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+  for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
+  return common;
+}
+
+// constant_id 0 (march.glsl kSharpMarch): the sharp or the smoothed march, so that only the one
+// the scene needs is compiled.
+vk::ComputePipeline makeViewPipeline(vk::Context& ctx, bool sharp) {
+  return vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4),
+                             commonBindings(), 0, "view", {sharp ? 1u : 0u});
+}
+
 }  // namespace
+
+class ViewPipelineBuild {
+ public:
+  ViewPipelineBuild(vk::Context& ctx, bool sharp)
+      : ctx_(&ctx), sharp_(sharp), pipe_(std::async(std::launch::async, [&ctx, sharp] {
+          return makeViewPipeline(ctx, sharp);
+        })) {}
+  ~ViewPipelineBuild() {
+    if (pipe_.valid()) pipe_.wait();  // the pipeline's device must outlive its compilation
+  }
+  /// The pipeline, once (waits for it); rethrows what the compilation threw.
+  vk::ComputePipeline take() { return pipe_.get(); }
+  bool matches(const vk::Context& ctx, bool sharp) const {
+    return &ctx == ctx_ && sharp == sharp_ && pipe_.valid();
+  }
+
+ private:
+  const vk::Context* ctx_;
+  bool sharp_;
+  std::future<vk::ComputePipeline> pipe_;
+};
+
+std::shared_ptr<ViewPipelineBuild> startViewPipelineBuild(vk::Context& ctx, const Scene& scene) {
+  // The voxeliser makes a boundary field and a medium table exactly for sharp scenes
+  // (volume_set.cpp), which is what makes the renderer march sharp.
+  return std::make_shared<ViewPipelineBuild>(ctx, scene.interfaces == Scene::Interfaces::Sharp);
+}
 
 void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scene) {
   const auto& lim = ctx.limits();
@@ -65,13 +116,17 @@ struct ViewRenderer::Impl {
   size_t scatterImage = 0, fluenceImage = 0,
          fluxImage = 0;  // 0: not present (index A bound instead)
   vk::Buffer params, env, tables;
-  BoundaryDevice boundary;  // the sharp-boundary field (placeholders when smoothed)
-  vk::ComputePipeline view, tracer;
+  BoundaryDevice boundary;              // the sharp-boundary field (placeholders when smoothed)
+  std::vector<vk::BindingSpec> common;  // the bindings both pipelines have
+  vk::ComputePipeline view, tracer;     // built on first use (ensureView, ensureTracer)
   int skip_cap = 32;
   double ambient = 1.0;
 
-  Impl(vk::Context& context, const Scene& s, const VolumeSet& v)
-      : ctx(context), scene(s), grid(v.grid) {
+  std::shared_ptr<ViewPipelineBuild> prebuilt;  // the view pipeline compiling beside us, if any
+
+  Impl(vk::Context& context, const Scene& s, const VolumeSet& v,
+       std::shared_ptr<ViewPipelineBuild> view_build)
+      : ctx(context), scene(s), grid(v.grid), prebuilt(std::move(view_build)) {
     checkVolumeFits(ctx, grid, scene);
     uniaxial = v.uniaxial;
     dispersive = v.dispersive;
@@ -138,27 +193,39 @@ struct ViewRenderer::Impl {
     tables = vk::Buffer(ctx, tab.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                         "spectral tables");
     tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
+    timings::mark("volume uploaded");
 
-    std::vector<vk::BindingSpec> common;
-    for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t b :
-         {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
-                       uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
-    // constant_id 0 (march.glsl kSharpMarch): the sharp or the smoothed march, not both.
-    const std::vector<uint32_t> spec{sharp ? 1u : 0u};
-    view = vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4),
-                               common, 0, "view", spec);
-    auto traceBindings = common;
-    traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    tracer =
-        vk::ComputePipeline(ctx, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4),
-                            traceBindings, 0, "trace", spec);
-    for (auto* p : {&view, &tracer}) bindCommon(*p);
+    common = commonBindings();
+  }
+
+  // The pipelines are built on first use, each only when asked for (issue 14, start-up): a
+  // render never builds the tracer, a trace never builds the view pipeline; on lavapipe each
+  // takes seconds to compile. constant_id 0 (march.glsl kSharpMarch) picks the sharp or the
+  // smoothed march, so only the one the scene needs is compiled.
+  void buildPipeline(vk::ComputePipeline& p, std::span<const uint32_t> spirv, bool rays,
+                     const char* name) {
+    if (p.built()) return;
+    auto bindings = common;
+    if (rays) bindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    p = vk::ComputePipeline(ctx, spirv, bindings, 0, name, {sharp ? 1u : 0u});
+    bindCommon(p);
+    ctx.savePipelineCache();  // core/vk/pipeline_cache.h: the next run skips the compilation
+    timings::mark("pipelines built");
+  }
+  void ensureView() {
+    if (!view.built() && prebuilt && prebuilt->matches(ctx, sharp)) {
+      view = prebuilt->take();
+      bindCommon(view);
+      ctx.savePipelineCache();
+      timings::mark("pipelines built");
+    }
+    prebuilt.reset();
+    buildPipeline(view, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4), false,
+                  "view");
+  }
+  void ensureTracer() {
+    buildPipeline(tracer, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4), true,
+                  "trace");
   }
 
   void bindCommon(vk::ComputePipeline& p) {
@@ -225,13 +292,15 @@ struct ViewRenderer::Impl {
   }
 };
 
-ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume)
-    : impl_(std::make_unique<Impl>(ctx, scene, volume)) {}
+ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume,
+                           std::shared_ptr<ViewPipelineBuild> view)
+    : impl_(std::make_unique<Impl>(ctx, scene, volume, std::move(view))) {}
 ViewRenderer::~ViewRenderer() = default;
 
 RenderImage ViewRenderer::render(const RenderSettings& s) {
   validate(s.march);
   Impl& I = *impl_;
+  I.ensureView();
   RenderImage img;
   img.width = s.width > 0 ? s.width : I.scene.camera.width;
   img.height = s.height > 0 ? s.height : I.scene.camera.height;
@@ -269,6 +338,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
     const auto band_start = std::chrono::steady_clock::now();
     p.image = glm::ivec4(img.width, img.height, y0, n);
     I.params.write(&p, sizeof p);
+    if (y0 == 0) timings::mark("first dispatch");
     I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
       I.view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X),
                       uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
@@ -307,6 +377,7 @@ std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(
   validate(m);
   Impl& I = *impl_;
   if (rays.empty()) return {};
+  I.ensureTracer();
   std::vector<gpu::TraceRay> in(rays.size());
   for (size_t i = 0; i < rays.size(); ++i) {
     double len = glm::length(rays[i].direction);

@@ -5,8 +5,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string_view>
 
 #include "core/vk/check.h"
+#include "core/vk/pipeline_cache.h"
 
 namespace eikon::vk {
 namespace {
@@ -205,12 +207,85 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
   VK_CHECK(vkCreateCommandPool(ctx->device_, &pci, nullptr, &ctx->pool_));
 
   ctx->limits_ = deviceLimits(chosen, ctx->props_, supported);
+  ctx->createPipelineCache(options);
   return ctx;
+}
+
+namespace {
+uint64_t dataHash(std::string_view bytes) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ULL;
+  return h;
+}
+}  // namespace
+
+void Context::createPipelineCache(const ContextOptions& options) {
+  cache_file_ = options.pipeline_cache ? *options.pipeline_cache : defaultPipelineCacheFile(props_);
+  std::string why;
+  const std::optional<std::string> data = loadPipelineCacheFile(cache_file_, props_, &why);
+  if (!why.empty()) note(why);
+  VkPipelineCacheCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
+  if (data) {
+    ci.initialDataSize = data->size();
+    ci.pInitialData = data->data();
+  }
+  VkResult r = vkCreatePipelineCache(device_, &ci, nullptr, &pipeline_cache_);
+  if (r != VK_SUCCESS && data) {  // the driver refused data that passed our checks: start empty
+    note("pipeline cache '" + cache_file_.string() + "' ignored: the driver refused it (" +
+         resultName(r) + ")");
+    ci.initialDataSize = 0;
+    ci.pInitialData = nullptr;
+    r = vkCreatePipelineCache(device_, &ci, nullptr, &pipeline_cache_);
+  } else if (data) {
+    cache_loaded_bytes_ = data->size();
+    cache_saved_hash_ = dataHash(*data);
+  }
+  VK_CHECK(r);
+}
+
+void Context::note(const std::string& line) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  cache_notes_.push_back(line);
+  if (echo_) std::fprintf(stderr, "eikon: note: %s\n", line.c_str());
+}
+
+std::vector<std::string> Context::pipelineCacheNotes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return cache_notes_;
+}
+
+std::string Context::savePipelineCache() {
+  if (cache_file_.empty() || !cache_dirty_.exchange(false)) return {};
+  size_t size = 0;
+  std::string data;
+  VkResult r = vkGetPipelineCacheData(device_, pipeline_cache_, &size, nullptr);
+  if (r == VK_SUCCESS) {
+    data.resize(size);
+    r = vkGetPipelineCacheData(device_, pipeline_cache_, &size, data.data());
+    data.resize(size);
+  }
+  std::string err;
+  if (r != VK_SUCCESS)
+    err = std::string("vkGetPipelineCacheData: ") + resultName(r);
+  else if (dataHash(data) == cache_saved_hash_)
+    return {};  // every pipeline came from the file: nothing new to write
+  else
+    err = savePipelineCacheFile(cache_file_, data);
+  if (err.empty()) {
+    cache_saved_hash_ = dataHash(data);
+    return {};
+  }
+  note("pipeline cache not saved: " + err);
+  return err;
 }
 
 Context::~Context() {
   if (device_) {
     vkDeviceWaitIdle(device_);
+    if (pipeline_cache_) {
+      savePipelineCache();
+      vkDestroyPipelineCache(device_, pipeline_cache_, nullptr);
+    }
     if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
     vkDestroyDevice(device_, nullptr);
   }

@@ -9,14 +9,22 @@
 //
 // Device choice: a discrete GPU if there is one, else integrated, else CPU (Mesa lavapipe).
 // EIKON_DEVICE=<index or case-insensitive name substring> overrides. Knows nothing about scenes.
+//
+// Pipeline cache: every pipeline is built through one VkPipelineCache, loaded from disk when the
+// device is created and saved (atomically) by savePipelineCache() after pipelines are built and
+// on destruction, so that a repeated run skips the driver's shader compilation where the driver
+// caches it (core/vk/pipeline_cache.h: the file, its checks, where it lives).
 #pragma once
 
 #include <vulkan/vulkan.h>
 
+#include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,8 +36,11 @@ struct ContextOptions {
   bool validation_from_env = true;
   /// Device selector (index or name substring); empty = use EIKON_DEVICE or the default choice.
   std::string device;
-  /// Print validation messages to stderr as they arrive.
+  /// Print validation messages (and pipeline-cache notes) to stderr as they arrive.
   bool echo_messages = true;
+  /// The pipeline cache file. Unset: defaultPipelineCacheFile() (core/vk/pipeline_cache.h, in
+  /// $EIKON_CACHE_DIR, $XDG_CACHE_HOME/eikon or ~/.cache/eikon); empty: an in-memory cache only.
+  std::optional<std::filesystem::path> pipeline_cache;
 };
 
 /// Device facts that callers check before allocating (they refuse clearly, never clamp).
@@ -66,6 +77,20 @@ class Context {
   /// Record commands into a fresh primary command buffer, submit, and wait (fence).
   void submitAndWait(const std::function<void(VkCommandBuffer)>& record) const;
 
+  /// The cache every pipeline is built through (never VK_NULL_HANDLE).
+  VkPipelineCache pipelineCache() const { return pipeline_cache_; }
+  /// The file it is loaded from and saved to (empty: none).
+  const std::filesystem::path& pipelineCacheFile() const { return cache_file_; }
+  /// Bytes of driver data taken from the file at creation (0: none, or the file was ignored).
+  size_t pipelineCacheLoadedBytes() const { return cache_loaded_bytes_; }
+  /// One line per file ignored or not saved ("pipeline cache '…' ignored: truncated: …").
+  std::vector<std::string> pipelineCacheNotes() const;
+  /// Called by ComputePipeline after building one: the next save has something to write.
+  void pipelineBuilt() const { cache_dirty_ = true; }
+  /// Write the cache file if pipelines were built since the last save and the driver's data
+  /// changed; "" when saved or nothing to do, else why not (also noted). Never throws.
+  std::string savePipelineCache();
+
   /// Validation-layer messages (warnings and errors) received so far.
   size_t validationMessageCount() const;
   std::vector<std::string> validationMessages() const;
@@ -76,6 +101,8 @@ class Context {
 
  private:
   Context() = default;
+  void createPipelineCache(const ContextOptions& options);
+  void note(const std::string& line);
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;
@@ -83,6 +110,12 @@ class Context {
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
   VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkPipelineCache pipeline_cache_ = VK_NULL_HANDLE;
+  std::filesystem::path cache_file_;
+  size_t cache_loaded_bytes_ = 0;
+  uint64_t cache_saved_hash_ = 0;  // of the driver data last loaded or saved
+  mutable std::atomic<bool> cache_dirty_{false};
+  std::vector<std::string> cache_notes_;
   VkPhysicalDeviceProperties props_{};
   DeviceLimits limits_{};
   bool validation_ = false;

@@ -225,7 +225,8 @@ ComputePipeline::ComputePipeline(const Context& ctx, std::span<const uint32_t> s
                             specialization.size() * sizeof(uint32_t), specialization.data()};
   if (!specialization.empty()) ci.stage.pSpecializationInfo = &spec;
   ci.layout = layout_;
-  VK_CHECK(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline_));
+  VK_CHECK(vkCreateComputePipelines(device_, ctx.pipelineCache(), 1, &ci, nullptr, &pipeline_));
+  ctx.pipelineBuilt();
 
   std::vector<VkDescriptorPoolSize> sizes;
   if (n_images) sizes.push_back({VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, n_images});

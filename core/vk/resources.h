@@ -102,6 +102,8 @@ class ComputePipeline {
   ComputePipeline(const ComputePipeline&) = delete;
   ComputePipeline& operator=(const ComputePipeline&) = delete;
 
+  /// False for a default-constructed (or moved-from) pipeline: nothing built yet.
+  bool built() const { return pipeline_ != VK_NULL_HANDLE; }
   void bindBuffer(uint32_t binding, const Buffer& buffer);
   void bindImage(uint32_t binding, const Image3D& image);
   /// Record bind + push constants + dispatch into `cmd`.

@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "core/volume/host_memory.h"
+#include "core/volume/skip_distance.h"
 
 namespace eikon {
 namespace {
@@ -269,6 +270,46 @@ struct Composite {
   std::vector<glm::vec4> axis;
 };
 
+// A field that starts at 0 and that no material paints with anything but +0 stays +0 in every
+// voxel, its exact gradient too (v(1 − c) + 0·c = +0, and the gradient's update ends by adding
+// +0, which turns a −0 into +0): it is not made, and reads as +0 (fieldAt).
+bool staysZero(int f, const std::map<std::string, MaterialValues>& values) {
+  if (f == kAo || f == kAe) return false;  // starts at the ambient index
+  for (const auto& [name, mv] : values)
+    if (mv.v[f] != 0.0f || std::signbit(mv.v[f])) return false;
+  return true;
+}
+
+// The composited fields at their initial values (the ambient index, zeros), all but those that
+// stay +0 (staysZero) and, in an isotropic scene, the e-mode fields: every material's n_e and
+// attenuation_e are its n_o and attenuation_o (core/scene), so they would be bitwise copies of
+// the o-mode fields (painted with the same values and coverages, and not smoothed: smoothFields
+// leaves them), which add nothing to the skip distances and are never packed; nor are their
+// gradients. The Gaussian method keeps them: there the o-mode fields are smoothed and the copies
+// are not. Fewer arrays: voxelising was mostly the kernel handing out their pages.
+Composite allocateComposite(const Scene& scene, const Grid& g, const CoverageRule& rule,
+                            bool uniaxial, const std::map<std::string, MaterialValues>& values) {
+  const bool e_copies =
+      !uniaxial && (rule.analytic || scene.volume.smoothing_voxels <= 0.0);  // not made
+  Composite cp;
+  cp.fields.resize(kFieldCount);
+  if (rule.analytic) cp.gradients.resize(6);
+  for (int f = 0; f < kFieldCount; ++f) {
+    const bool e_field = (f >= kAe && f <= kCe) || (f >= kSer && f <= kSeb);
+    if ((e_field && e_copies) || staysZero(f, values)) continue;
+    cp.fields[size_t(f)].assign(g.count(),
+                                f == kAo || f == kAe ? float(scene.ambient_index) : 0.0f);
+    if (rule.analytic && f < 6) cp.gradients[size_t(f)].assign(g.count(), glm::vec3(0.0f));
+  }
+  if (uniaxial) cp.axis.assign(g.count(), glm::vec4(0.0f));
+  return cp;
+}
+
+float fieldAt(const Composite& cp, int f, size_t i) {
+  const auto& fld = cp.fields[size_t(f)];
+  return fld.empty() ? 0.0f : fld[i];
+}
+
 // One object's material painted over a voxel with coverage cov: v ← v(1 − c) + p c, and, with
 // exact gradients, ∇[v(1 − c) + p c] = ∇v (1 − c) + (p − v)∇c + c∇p.
 void paintVoxel(Composite& cp, size_t idx, const glm::dvec3& c, double cov, const glm::dvec3& gcov,
@@ -284,13 +325,15 @@ void paintVoxel(Composite& cp, size_t idx, const glm::dvec3& c, double cov, cons
   }
   if (!cp.gradients.empty())
     for (int f = 0; f < 6; ++f) {
+      if (cp.gradients[size_t(f)].empty()) continue;  // the e-mode's, in an isotropic scene
       glm::dvec3 gv = glm::dvec3(cp.gradients[size_t(f)][idx]) * (1.0 - cov) +
                       (double(prop[f]) - cp.fields[size_t(f)][idx]) * gcov +
                       ((f == kAo || f == kAe) ? cov * gprop : glm::dvec3(0.0));
       cp.gradients[size_t(f)][idx] = glm::vec3(gv);
     }
   for (int f = 0; f < kFieldCount; ++f)
-    cp.fields[size_t(f)][idx] = cp.fields[size_t(f)][idx] * (1 - fc) + prop[f] * fc;
+    if (!cp.fields[size_t(f)].empty())
+      cp.fields[size_t(f)][idx] = cp.fields[size_t(f)][idx] * (1 - fc) + prop[f] * fc;
 }
 
 // Axis texel of an object: (a, 0) for a uniform axis; (centre, −1) for a radial field, evaluated
@@ -349,8 +392,10 @@ void smoothFields(Composite& cp, const Grid& g, double sigma, bool uniaxial, Pro
     if (!uniaxial && (f == kAe || f == kBe || f == kCe || f == kSer || f == kSeg || f == kSeb))
       continue;
     auto& fld = cp.fields[size_t(f)];
-    auto [mn, mx] = std::minmax_element(fld.begin(), fld.end());
-    if (*mn != *mx) gaussianSmooth(fld, g.dims, sigma, threads);
+    if (!fld.empty()) {  // one that stays +0 is not made
+      auto [mn, mx] = std::minmax_element(fld.begin(), fld.end());
+      if (*mn != *mx) gaussianSmooth(fld, g.dims, sigma, threads);
+    }
     progress(0.4 + 0.3 * (f + 1) / double(kFieldCount), "smoothing");
   }
 }
@@ -387,10 +432,16 @@ void indexVolumes(const Composite& cp, const Grid& g, bool analytic, VolumeSet& 
   for (int m = 0; m < (vs.uniaxial ? 2 : 1); ++m)
     for (int c = 0; c < 3; ++c) {
       int f = m == 0 ? kAo + c : kAe + c;
-      if (analytic) {
+      if (cp.fields[size_t(f)].empty()) {  // stays +0, its gradient too
+        vs.index[size_t(m)][size_t(c)].assign(N, glm::vec4(0.0f));
+      } else if (analytic) {
         std::vector<glm::vec4> out(N);
-        for (size_t i = 0; i < N; ++i)
-          out[i] = glm::vec4(cp.fields[size_t(f)][i], cp.gradients[size_t(f)][i]);
+        const auto& fld = cp.fields[size_t(f)];
+        const auto& grad = cp.gradients[size_t(f)];
+        parallelFor(g.dims[2], threads, [&](int k) {
+          for (size_t i = g.index(0, 0, k), end = g.index(0, 0, k + 1); i < end; ++i)
+            out[i] = glm::vec4(fld[i], grad[i]);
+        });
         vs.index[size_t(m)][size_t(c)] = std::move(out);
       } else {
         vs.index[size_t(m)][size_t(c)] = withCentralDifferences(cp.fields[size_t(f)], g, threads);
@@ -401,12 +452,14 @@ void indexVolumes(const Composite& cp, const Grid& g, bool analytic, VolumeSet& 
 }
 
 // Four fields as vec4 texels (d < 0: w = 0).
-std::vector<glm::vec4> pack(const Composite& cp, int a, int b, int c, int d) {
-  const auto& F = cp.fields;
-  std::vector<glm::vec4> out(F[0].size());
-  for (size_t i = 0; i < out.size(); ++i)
-    out[i] = glm::vec4(F[size_t(a)][i], F[size_t(b)][i], F[size_t(c)][i],
-                       d >= 0 ? F[size_t(d)][i] : 0.0f);
+std::vector<glm::vec4> pack(const Composite& cp, const Grid& g, int a, int b, int c, int d,
+                            int threads) {
+  std::vector<glm::vec4> out(g.count());
+  parallelFor(g.dims[2], threads, [&](int k) {
+    for (size_t i = g.index(0, 0, k), end = g.index(0, 0, k + 1); i < end; ++i)
+      out[i] = glm::vec4(fieldAt(cp, a, i), fieldAt(cp, b, i), fieldAt(cp, c, i),
+                         d >= 0 ? fieldAt(cp, d, i) : 0.0f);
+  });
   return out;
 }
 
@@ -440,68 +493,26 @@ void dilateAxis(std::vector<glm::vec4>& axis, const Grid& g, double sigma, Progr
   }
 }
 
-// Active voxels (distance 0): any field differs from a 26-neighbour, or a radial axis field (it
-// varies everywhere inside its crystal: never straight-step there). Others get `cap`.
-std::vector<uint8_t> activeVoxels(const Composite& cp, const Grid& g,
-                                  const std::vector<glm::vec4>& axis, int cap, int threads) {
-  std::vector<int> used;
+// Active voxels (distance 0): any field differs from a 26-neighbour (core/volume/skip_distance.h),
+// or a radial axis field (it varies everywhere inside its crystal: never straight-step there).
+// Others get `cap`.
+std::vector<uint8_t> skipSeeds(const Composite& cp, const Grid& g,
+                               const std::vector<glm::vec4>& axis, int cap, int threads) {
+  std::vector<const std::vector<float>*> used;  // a constant field makes no voxel active
   for (int f = 0; f < kFieldCount; ++f) {
+    if (cp.fields[size_t(f)].empty()) continue;  // stays +0, or a copy (allocateComposite)
     auto [mn, mx] = std::minmax_element(cp.fields[size_t(f)].begin(), cp.fields[size_t(f)].end());
-    if (*mn != *mx) used.push_back(f);
+    if (*mn != *mx) used.push_back(&cp.fields[size_t(f)]);
   }
-  std::vector<uint8_t> dist(g.count(), uint8_t(cap));
+  std::vector<uint8_t> dist = activeVoxels(used, g, threads);
   parallelFor(g.dims[2], threads, [&](int k) {
-    for (int j = 0; j < g.dims[1]; ++j)
-      for (int i = 0; i < g.dims[0]; ++i) {
-        size_t idx = g.index(i, j, k);
-        bool active = false;
-        for (int dz = -1; dz <= 1 && !active; ++dz)
-          for (int dy = -1; dy <= 1 && !active; ++dy)
-            for (int dx = -1; dx <= 1 && !active; ++dx) {
-              int x = std::clamp(i + dx, 0, g.dims[0] - 1),
-                  y = std::clamp(j + dy, 0, g.dims[1] - 1),
-                  z = std::clamp(k + dz, 0, g.dims[2] - 1);
-              size_t n = g.index(x, y, z);
-              for (int f : used)
-                if (cp.fields[size_t(f)][n] != cp.fields[size_t(f)][idx]) {
-                  active = true;
-                  break;
-                }
-            }
-        if (!axis.empty() && axis[idx].w < -0.5f) active = true;
-        if (active) dist[idx] = 0;
-      }
+    const size_t begin = g.index(0, 0, k), end = begin + size_t(g.dims[0]) * g.dims[1];
+    for (size_t i = begin; i < end; ++i) {
+      const bool active = dist[i] || (!axis.empty() && axis[i].w < -0.5f);
+      dist[i] = active ? 0 : uint8_t(cap);
+    }
   });
   return dist;
-}
-
-// Separable L∞ distance transform in place: D_a(v) = min_j max(|v_a − j|, D_{a−1}(…j…))
-// (progress 0.9 to 0.99).
-void chebyshevTransform(std::vector<uint8_t>& dist, const Grid& g, ProgressSink& progress,
-                        int threads) {
-  for (int a = 0; a < 3; ++a) {
-    std::vector<uint8_t> out(dist.size());
-    const size_t stride = a == 0   ? 1
-                          : a == 1 ? size_t(g.dims[0])
-                                   : size_t(g.dims[0]) * size_t(g.dims[1]);
-    parallelFor(g.dims[2], threads, [&](int k) {
-      for (int j = 0; j < g.dims[1]; ++j)
-        for (int i = 0; i < g.dims[0]; ++i) {
-          int c[3] = {i, j, k};
-          size_t idx = g.index(i, j, k);
-          int best = dist[idx];
-          for (int d = 1; d < best; ++d) {
-            int lo_i = c[a] - d, hi_i = c[a] + d;
-            if (lo_i >= 0) best = std::min(best, std::max(d, int(dist[idx - size_t(d) * stride])));
-            if (hi_i < g.dims[a])
-              best = std::min(best, std::max(d, int(dist[idx + size_t(d) * stride])));
-          }
-          out[idx] = uint8_t(best);
-        }
-    });
-    dist.swap(out);
-    progress(0.9 + 0.03 * (a + 1), "skip distances");
-  }
 }
 
 }  // namespace
@@ -516,18 +527,13 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
   vs.ambient_index = scene.ambient_index;
   const std::map<std::string, MaterialValues> values = materialValues(scene, vs);
 
-  Composite cp;
-  cp.fields.assign(kFieldCount, std::vector<float>(N, 0.0f));
-  std::fill(cp.fields[kAo].begin(), cp.fields[kAo].end(), float(scene.ambient_index));
-  std::fill(cp.fields[kAe].begin(), cp.fields[kAe].end(), float(scene.ambient_index));
-  if (vs.uniaxial) cp.axis.assign(N, glm::vec4(0.0f));
+  const CoverageRule rule(scene.volume, g.h);
+  Composite cp = allocateComposite(scene, g, rule, vs.uniaxial, values);
   // Analytic smoothing carries exact gradients of the index fields through the compositing
   // (∇ of the smoothed indicator = −F′·∇sd/3σ, along the face normal), so a flat face bends rays
   // exactly along its normal whatever its orientation to the grid. Central differences of the
   // sampled profile would not: their components are attenuated unequally for oblique faces, which
   // biased the prism deviation by −0.15° independently of resolution (docs/view-renderer.md).
-  const CoverageRule rule(scene.volume, g.h);
-  if (rule.analytic) cp.gradients.assign(6, std::vector<glm::vec3>(N, glm::vec3(0.0f)));
   compositeObjects(scene, g, values, rule, vs.uniaxial, cp, progress, opt.threads);
 
   const double sigma = scene.volume.smoothing_voxels;
@@ -535,17 +541,19 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
   indexVolumes(cp, g, rule.analytic, vs, progress, opt.threads);
   cp.gradients.clear();
 
-  vs.medium[0] = pack(cp, kSor, kSog, kSob, kOpacity);
+  vs.medium[0] = pack(cp, g, kSor, kSog, kSob, kOpacity, opt.threads);
   if (vs.uniaxial) {
-    vs.medium[1] = pack(cp, kSer, kSeg, kSeb, kOpacity);
+    vs.medium[1] = pack(cp, g, kSer, kSeg, kSeb, kOpacity, opt.threads);
     dilateAxis(cp.axis, g, sigma, progress, opt.threads);
     vs.axis = std::move(cp.axis);
   }
-  vs.emission = pack(cp, kEr, kEg, kEb, -1);
-  if (vs.scattering) vs.scatter = pack(cp, kAlr, kAlg, kAlb, kPhaseG);
+  vs.emission = pack(cp, g, kEr, kEg, kEb, -1, opt.threads);
+  if (vs.scattering) vs.scatter = pack(cp, g, kAlr, kAlg, kAlb, kPhaseG, opt.threads);
 
-  std::vector<uint8_t> dist = activeVoxels(cp, g, vs.axis, vs.skip_cap, opt.threads);
-  chebyshevTransform(dist, g, progress, opt.threads);
+  std::vector<uint8_t> dist = skipSeeds(cp, g, vs.axis, vs.skip_cap, opt.threads);
+  // The separable L∞ distance transform (progress 0.9 to 0.99).
+  chebyshevTransform(dist, g, opt.threads,
+                     [&](int a) { progress(0.9 + 0.03 * (a + 1), "skip distances"); });
   for (size_t i = 0; i < N; ++i) vs.emission[i].w = float(dist[i]);
   // The sharp-boundary field (core/volume/boundary.h), unless the scene asks for smoothed
   // interfaces only.

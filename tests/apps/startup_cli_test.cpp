@@ -1,0 +1,161 @@
+// Start-up of `eikon render` (issue 14, item 2 "start-up"): the --timings lines that show where
+// the time before the first dispatch goes. Only what the lines say and their order are tested,
+// never how long a stage took (timings vary ±30% on shared machines).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/apps/cli_support.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using eikon::test::Outcome;
+using eikon::test::quote;
+
+// A glass sphere in a 24³ volume and a 16x12 camera: a GPU render that starts in seconds.
+constexpr const char* kScene = R"({
+  "camera": {"position": [0, 0, -30], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 20, "width": 16, "height": 12},
+  "environment": {"type": "checker", "squares": 8},
+  "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "resolution": 24},
+  "materials": {"glass": {"n": 1.5}},
+  "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "glass"}]
+})";
+
+struct Mark {
+  double seconds = 0.0, delta = 0.0;
+  std::string stage;
+};
+
+/// The "eikon: timing: T s  +D s  STAGE" lines of `err`, in order.
+std::vector<Mark> timingLines(const std::string& err) {
+  std::vector<Mark> marks;
+  std::istringstream in(err);
+  std::string line;
+  const std::string prefix = "eikon: timing: ";
+  while (std::getline(in, line)) {
+    if (line.rfind(prefix, 0) != 0) continue;
+    std::istringstream f(line.substr(prefix.size()));
+    Mark m;
+    std::string s_unit, d_unit;
+    char plus = 0;
+    f >> m.seconds >> s_unit >> plus >> m.delta >> d_unit;
+    std::getline(f >> std::ws, m.stage);
+    EXPECT_FALSE(m.stage.empty()) << line;
+    EXPECT_EQ(s_unit, "s") << line;
+    EXPECT_EQ(plus, '+') << line;
+    EXPECT_EQ(d_unit, "s") << line;
+    marks.push_back(m);
+  }
+  return marks;
+}
+
+class StartupCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "eikon_startup_cli_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
+    dir_ = tmpl;
+    fs::create_directories(dir_ / "io");
+    std::ofstream(dir_ / "scene.json") << kScene;
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  /// `eikon render` of the scene, with validation and the caches in the test's own folder.
+  Outcome render(const std::string& extra, const std::string& env = "") const {
+    const std::string e = "EIKON_VALIDATION=1 EIKON_CACHE_DIR=" + quote((dir_ / "cache").string()) +
+                          (env.empty() ? "" : " " + env);
+    const Outcome o =
+        eikon::test::runEikon("render " + quote((dir_ / "scene.json").string()) + " -o " +
+                                  quote((dir_ / "out.exr").string()) + " " + extra,
+                              dir_ / "io", e);
+    EXPECT_EQ(o.err.find("[vulkan validation]"), std::string::npos) << o.err;
+    return o;
+  }
+  fs::path dir_;
+};
+
+// Every stage up to the written output, once each, in the order they run, with the seconds since
+// the process started non-decreasing and each "+delta" the difference to the line before.
+TEST_F(StartupCli, TimingsListEveryStageInOrder) {
+  const Outcome r = render("--timings");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<Mark> marks = timingLines(r.err);
+  const std::vector<std::string> expected = {"command line",   "scene parsed",    "device created",
+                                             "voxelised",      "volume uploaded", "pipelines built",
+                                             "first dispatch", "rendered",        "written"};
+  std::vector<std::string> stages;
+  for (const Mark& m : marks) stages.push_back(m.stage);
+  EXPECT_EQ(stages, expected) << r.err;
+  for (size_t i = 0; i < marks.size(); ++i) {
+    EXPECT_GE(marks[i].seconds, 0.0) << marks[i].stage;
+    // The process has run for at least as long as the stages it reports.
+    EXPECT_LT(marks[i].seconds, 600.0) << marks[i].stage;
+    if (i == 0) continue;
+    EXPECT_GE(marks[i].seconds, marks[i - 1].seconds) << marks[i].stage;
+    // Printed to the millisecond: the delta is the difference of the rounded times ± 1 ms.
+    EXPECT_NEAR(marks[i].delta, marks[i].seconds - marks[i - 1].seconds, 1.5e-3) << marks[i].stage;
+  }
+  // The render's own summary still goes to stdout, untouched.
+  EXPECT_NE(r.out.find("eikon: rendered"), std::string::npos) << r.out;
+}
+
+// EIKON_TIMINGS=1 does what --timings does (for the Python module and the benchmarks); neither
+// given, stderr stays empty.
+TEST_F(StartupCli, TimingsFromTheEnvironmentAndOffByDefault) {
+  const Outcome env = render("-q", "EIKON_TIMINGS=1");
+  ASSERT_EQ(env.code, 0) << env.err;
+  EXPECT_EQ(timingLines(env.err).size(), 9u) << env.err;
+  const Outcome off = render("-q");
+  ASSERT_EQ(off.code, 0) << off.err;
+  EXPECT_EQ(off.err, "");
+}
+
+// The CPU twin has no device and no pipelines: only its own stages are listed.
+TEST_F(StartupCli, TimingsOfTheCpuTwin) {
+  const Outcome r = render("--reference --timings");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::vector<std::string> stages;
+  for (const Mark& m : timingLines(r.err)) stages.push_back(m.stage);
+  const std::vector<std::string> expected = {"command line", "scene parsed", "voxelised",
+                                             "rendered", "written"};
+  EXPECT_EQ(stages, expected) << r.err;
+}
+
+// The pipeline cache (core/vk/pipeline_cache.h) is written to EIKON_CACHE_DIR by a GPU render; a
+// corrupt one there is ignored with one "eikon: note:" line, the render succeeds and replaces it.
+TEST_F(StartupCli, PipelineCacheIsWrittenAndACorruptOneIgnored) {
+  const Outcome first = render("-q");
+  ASSERT_EQ(first.code, 0) << first.err;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir_ / "cache"))
+    if (e.path().filename().string().rfind("pipelines-", 0) == 0) files.push_back(e.path());
+  ASSERT_EQ(files.size(), 1u);
+  const std::string good = eikon::test::slurp(files[0]);
+  EXPECT_EQ(good.substr(0, 8), "EIKPIPE1");
+  EXPECT_GE(good.size(), 24u + 32u);  // our header and at least the driver's (Vulkan spec)
+  std::ofstream(files[0], std::ios::binary | std::ios::trunc) << good.substr(0, good.size() / 2);
+  const Outcome second = render("-q");
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_EQ(second.err.rfind("eikon: note: pipeline cache '", 0), 0u) << second.err;
+  EXPECT_NE(second.err.find("ignored: truncated"), std::string::npos) << second.err;
+  EXPECT_EQ(std::count(second.err.begin(), second.err.end(), '\n'), 1) << second.err;
+  // Replaced by a whole one (the driver's data may differ from run to run on some drivers).
+  const std::string replaced = eikon::test::slurp(files[0]);
+  EXPECT_EQ(replaced.substr(0, 8), "EIKPIPE1");
+  EXPECT_GE(replaced.size(), 24u + 32u);
+  const Outcome third = render("-q");
+  ASSERT_EQ(third.code, 0) << third.err;
+  EXPECT_EQ(third.err, "");
+}
+
+}  // namespace
