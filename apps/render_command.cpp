@@ -204,7 +204,6 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   if (!a.reference) {
     session.context();  // what prepare() does first, marked apart from the voxelising
     timings::mark("device created");
-    session.startViewPipeline();  // compiles while the scene is voxelised and uploaded
   }
   session.prepare(!a.reference);
   timings::mark("voxelised");

@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <future>
 #include <stdexcept>
 
 #include "core/render/boundary_device.h"
@@ -26,56 +25,7 @@ void validate(const MarchSettings& m) {
   if (!(m.interface_threshold > 0)) throw std::invalid_argument("interface threshold must be > 0");
 }
 
-// The bindings of the view and trace pipelines (the trace's adds EIKON_B_RAYS).
-std::vector<vk::BindingSpec> commonBindings() {
-  std::vector<vk::BindingSpec> common;
-  for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
-    common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-  for (uint32_t b :
-       {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
-    common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-  for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
-                     uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
-    common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-  for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
-  return common;
-}
-
-// constant_id 0 (march.glsl kSharpMarch): the sharp or the smoothed march, so that only the one
-// the scene needs is compiled.
-vk::ComputePipeline makeViewPipeline(vk::Context& ctx, bool sharp) {
-  return vk::ComputePipeline(ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4),
-                             commonBindings(), 0, "view", {sharp ? 1u : 0u});
-}
-
 }  // namespace
-
-class ViewPipelineBuild {
- public:
-  ViewPipelineBuild(vk::Context& ctx, bool sharp)
-      : ctx_(&ctx), sharp_(sharp), pipe_(std::async(std::launch::async, [&ctx, sharp] {
-          return makeViewPipeline(ctx, sharp);
-        })) {}
-  ~ViewPipelineBuild() {
-    if (pipe_.valid()) pipe_.wait();  // the pipeline's device must outlive its compilation
-  }
-  /// The pipeline, once (waits for it); rethrows what the compilation threw.
-  vk::ComputePipeline take() { return pipe_.get(); }
-  bool matches(const vk::Context& ctx, bool sharp) const {
-    return &ctx == ctx_ && sharp == sharp_ && pipe_.valid();
-  }
-
- private:
-  const vk::Context* ctx_;
-  bool sharp_;
-  std::future<vk::ComputePipeline> pipe_;
-};
-
-std::shared_ptr<ViewPipelineBuild> startViewPipelineBuild(vk::Context& ctx, const Scene& scene) {
-  // The voxeliser makes a boundary field and a medium table exactly for sharp scenes
-  // (volume_set.cpp), which is what makes the renderer march sharp.
-  return std::make_shared<ViewPipelineBuild>(ctx, scene.interfaces == Scene::Interfaces::Sharp);
-}
 
 void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scene) {
   const auto& lim = ctx.limits();
@@ -122,11 +72,8 @@ struct ViewRenderer::Impl {
   int skip_cap = 32;
   double ambient = 1.0;
 
-  std::shared_ptr<ViewPipelineBuild> prebuilt;  // the view pipeline compiling beside us, if any
-
-  Impl(vk::Context& context, const Scene& s, const VolumeSet& v,
-       std::shared_ptr<ViewPipelineBuild> view_build)
-      : ctx(context), scene(s), grid(v.grid), prebuilt(std::move(view_build)) {
+  Impl(vk::Context& context, const Scene& s, const VolumeSet& v)
+      : ctx(context), scene(s), grid(v.grid) {
     checkVolumeFits(ctx, grid, scene);
     uniaxial = v.uniaxial;
     dispersive = v.dispersive;
@@ -195,7 +142,15 @@ struct ViewRenderer::Impl {
     tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
     timings::mark("volume uploaded");
 
-    common = commonBindings();
+    for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    for (uint32_t b :
+         {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
+                       uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
   }
 
   // The pipelines are built on first use, each only when asked for (issue 14, start-up): a
@@ -213,13 +168,6 @@ struct ViewRenderer::Impl {
     timings::mark("pipelines built");
   }
   void ensureView() {
-    if (!view.built() && prebuilt && prebuilt->matches(ctx, sharp)) {
-      view = prebuilt->take();
-      bindCommon(view);
-      ctx.savePipelineCache();
-      timings::mark("pipelines built");
-    }
-    prebuilt.reset();
     buildPipeline(view, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4), false,
                   "view");
   }
@@ -292,9 +240,8 @@ struct ViewRenderer::Impl {
   }
 };
 
-ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume,
-                           std::shared_ptr<ViewPipelineBuild> view)
-    : impl_(std::make_unique<Impl>(ctx, scene, volume, std::move(view))) {}
+ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume)
+    : impl_(std::make_unique<Impl>(ctx, scene, volume)) {}
 ViewRenderer::~ViewRenderer() = default;
 
 RenderImage ViewRenderer::render(const RenderSettings& s) {

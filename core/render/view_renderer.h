@@ -28,20 +28,9 @@ namespace eikon {
 /// (3D image side limit, heap size). Call before voxelising.
 void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scene);
 
-/// The view pipeline being compiled on a thread of its own (issue 14, start-up): on lavapipe the
-/// compilation takes seconds, and it needs only the scene, not its voxels, so it can run while
-/// the scene is voxelised and uploaded. Hand it to the ViewRenderer of the same scene and
-/// context; it waits for the compilation on its first render. Destroying it waits too.
-class ViewPipelineBuild;
-std::shared_ptr<ViewPipelineBuild> startViewPipelineBuild(vk::Context& ctx, const Scene& scene);
-
 class ViewRenderer {
  public:
-  /// `view`: a pipeline started by startViewPipelineBuild for this scene and context (else the
-  /// view pipeline is compiled on the first render; one built for the other march, smoothed or
-  /// sharp, is not used).
-  ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume,
-               std::shared_ptr<ViewPipelineBuild> view = nullptr);
+  ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume);
   ~ViewRenderer();
   ViewRenderer(const ViewRenderer&) = delete;
   ViewRenderer& operator=(const ViewRenderer&) = delete;

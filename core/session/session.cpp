@@ -126,10 +126,6 @@ vk::Context& Session::context() {
   return *ctx_;
 }
 
-void Session::startViewPipeline() {
-  if (!view_build_ && !gpu_) view_build_ = startViewPipelineBuild(context(), *scene_);
-}
-
 VolumeSet& Session::prepare(bool gpu) {
   if (gpu) context();
   if (!volume_) {
@@ -185,8 +181,7 @@ ViewRenderer& Session::gpuRenderer() {
   prepare(true);
   if (!gpu_) {
     if (progress_.working) progress_.working("preparing the GPU (pipelines, volume upload)");
-    gpu_ = std::make_unique<ViewRenderer>(*ctx_, *scene_, *volume_, std::move(view_build_));
-    view_build_.reset();
+    gpu_ = std::make_unique<ViewRenderer>(*ctx_, *scene_, *volume_);
   }
   return *gpu_;
 }

@@ -40,7 +40,6 @@ namespace vk {
 class Context;
 }
 class ViewRenderer;
-class ViewPipelineBuild;
 class ReferenceMarcher;
 class VolumeField;
 
@@ -132,11 +131,6 @@ class Session {
   /// then (checkVolumeFits), before anything is voxelised.
   vk::Context& context();
   bool hasContext() const { return ctx_ != nullptr; }
-  /// Start compiling the GPU view pipeline on a thread of its own, to run beside the voxelising
-  /// and the upload (core/render/view_renderer.h: startViewPipelineBuild); the GPU renderer takes
-  /// it on its first render. For callers that will render on the GPU (eikon render): a trace
-  /// never uses it.
-  void startViewPipeline();
   /// The context (gpu) and the voxelised volume, each made once.
   VolumeSet& prepare(bool gpu);
   bool voxelized() const { return volume_ != nullptr; }
@@ -171,7 +165,6 @@ class Session {
   std::unique_ptr<ViewRenderer> gpu_;
   std::unique_ptr<VolumeField> field_;
   std::unique_ptr<ReferenceMarcher> cpu_;
-  std::shared_ptr<ViewPipelineBuild> view_build_;  // last: its thread uses ctx_
 };
 
 }  // namespace eikon
