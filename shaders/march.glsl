@@ -59,6 +59,18 @@ bool gRecordOverflow = false;
 int gNumRecorded = 0;
 vec4 gRecorded[6];
 
+// Specialization constants (core/render/view_renderer.cpp: one pipeline per feature set). llvmpipe
+// (lavapipe) executes both sides of every branch with a lane mask and every loop body at least
+// once, so a step costs all the code in the march loop whatever the scene uses; constants fold
+// the features away instead (docs/performance.md). −1: read the value from P at run time.
+//   kSharpMarch: the sharp march (EIKON_F_SHARP) instead of the smoothed one;
+//   kViewFlags: the EIKON_F_* flags of the scene and the render (P.grid_dims.w);
+//   kIntegrator: EIKON_INT_* (P.march.w).
+layout(constant_id = 0) const bool kSharpMarch = false;
+layout(constant_id = 1) const int kViewFlags = -1;
+layout(constant_id = 2) const int kIntegrator = -1;
+
+#define EIKON_FIELD_FLAGS (kViewFlags == -1 ? P.grid_dims.w : kViewFlags)
 #define EIKON_FIELD_INV_H P.grid_extent.w
 #define EIKON_FIELD_LAMBDA_UM gLambdaUm
 #define EIKON_FIELD_IL2 gIl2
@@ -99,7 +111,7 @@ vec3 environment(vec3 d);
 
 // Environment radiance times a throughput weight, recorded for wavelength sharing.
 vec3 environmentWeighted(vec3 weight, vec3 d) {
-  if (gRecord) {
+  if (hasFlag(EIKON_F_SPECTRAL) && gRecord) {  // only view.comp's spectral mode records
     if (gNumRecorded < 6) gRecorded[gNumRecorded++] = vec4(d, weight.x);
     else gRecordOverflow = true;
   }
@@ -348,7 +360,7 @@ int straightStep(inout MarchState S, inout MarchResult R, int mode) {
 // the optical path and (o-mode) the drift of the invariant |w| = n.
 StepEnd integrateStep(inout MarchState S, inout MarchResult R, int mode) {
   const float ds = P.march.x * P.grid_origin.w;
-  const int integrator = int(P.march.w);
+  const int integrator = kIntegrator == -1 ? int(P.march.w) : kIntegrator;
   StepEnd E;
   E.x0 = S.x;
   E.w0 = S.w;
@@ -519,11 +531,10 @@ bool enterVolume(vec3 o, vec3 d, out MarchResult R, out float t0) {
 
 #include "sharp.glsl"
 
-// The host specialises this constant (with EIKON_F_SHARP): the pipeline holds one of the two
-// marches, which halves what lavapipe compiles.
-layout(constant_id = 0) const bool kSharpMarch = false;
-
+// kSharpMarch (with EIKON_F_SHARP): the pipeline holds one of the two marches, which halves what
+// lavapipe compiles.
 MarchResult march(vec3 o, vec3 d, int mode) {
+  if (!hasFlag(EIKON_F_UNIAXIAL)) mode = 0;  // always so; as a constant it folds the e-mode away
   if (kSharpMarch) return marchSharp(o, d, mode);
   MarchResult R;
   float t0;
