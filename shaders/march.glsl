@@ -12,7 +12,14 @@
 #ifndef EIKON_MARCH_GLSL
 #define EIKON_MARCH_GLSL
 
-layout(std430, binding = EIKON_B_PARAMS) readonly buffer ParamsBuf { ViewParams P; };
+layout(std430, binding = EIKON_B_PARAMS) readonly buffer ParamsBuf { ViewParams params; };
+// A private copy of the parameter block, made once by loadParams() at the top of main(). llvmpipe
+// reads a storage buffer lane by lane in a scalar loop wherever a lane mask is active (inside any
+// branch or loop), so P.x read from the buffer in the march loop cost a loop per component; the
+// copy is a register (or stack) read (docs/performance.md).
+ViewParams P;
+
+void loadParams() { P = params; }
 layout(binding = EIKON_B_INDEX_O_A, rgba32f) readonly uniform image3D idxOA;
 layout(binding = EIKON_B_INDEX_O_B, rgba32f) readonly uniform image3D idxOB;
 layout(binding = EIKON_B_INDEX_O_C, rgba32f) readonly uniform image3D idxOC;

@@ -27,6 +27,7 @@ vec3 cmf(float lambda_nm) {
 }
 
 void main() {
+  loadParams();
   uvec2 gid = gl_GlobalInvocationID.xy;
   int W = P.image.x, H = P.image.y;
   int px = int(gid.x), py = P.image.z + int(gid.y);
