@@ -473,12 +473,33 @@ void fresnelAtLayer(inout MarchState S, inout MarchResult R, vec3 N, int mode) {
   }
 }
 
+// |∇n|·h at the step's end, the quantity that opens and closes layers.
+float layerGradient(MarchState S, StepEnd E) {
+  return max(length(S.nn.yzw), length(E.ne.yzw)) * P.grid_origin.w;
+}
+
+const float kLayerOpen = 1e-6;  // |∇n|·h above which a layer opens
+
+// Whether layerStep would open or close a layer here (otherwise it only accumulates, as
+// layerAccumulate does).
+bool layerEvent(MarchState S, StepEnd E) {
+  float g = layerGradient(S, E);
+  return S.inLayer ? g <= kLayerOpen : g > kLayerOpen;
+}
+
+// layerStep where it neither opens nor closes a layer.
+void layerAccumulate(inout MarchState S, StepEnd E) {
+  if (!S.inLayer) return;
+  S.gAcc += E.gradN * (P.march.x * P.grid_origin.w);
+  S.peak = max(S.peak, layerGradient(S, E));
+}
+
 // Interface bookkeeping: a layer opens where |∇n|·h rises above 1e-6 and closes where it falls
 // back; a closed layer whose peak exceeded march.y was an interface (projectOnShell, fresnelAtLayer).
 void layerStep(inout MarchState S, inout MarchResult R, StepEnd E, int mode) {
   const float h = P.grid_origin.w, ds = P.march.x * h;
-  const float thrLow = 1e-6, thrIface = P.march.y;
-  float g = max(length(S.nn.yzw), length(E.ne.yzw)) * h;
+  const float thrLow = kLayerOpen, thrIface = P.march.y;
+  float g = layerGradient(S, E);
   if (!S.inLayer && g > thrLow) {
     S.inLayer = true;
     S.wBefore = E.w0;
@@ -494,6 +515,12 @@ void layerStep(inout MarchState S, inout MarchResult R, StepEnd E, int mode) {
   vec3 N = dot(S.gAcc, S.gAcc) > 0.0 ? normalize(S.gAcc) : vec3(0.0);
   if (dot(N, N) > 0.0 && abs(dot(S.x - S.xOpen, N)) <= 12.0 * h) projectOnShell(S, E, N);
   if (S.peak > thrIface && !hasFlag(EIKON_F_NO_FRESNEL) && dot(N, N) > 0.0) fresnelAtLayer(S, R, N, mode);
+}
+
+// Whether x is outside the volume box (clipToVolume's test).
+bool outsideVolume(vec3 x) {
+  return any(lessThan(x, P.grid_origin.xyz)) ||
+         any(greaterThan(x, P.grid_origin.xyz + P.grid_extent.xyz));
 }
 
 // Left the volume? The ray is straight outside (fields clamp to the uniform edge voxels): cut the
@@ -562,14 +589,29 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   S.xOpen = S.x;
   const int maxSteps = P.limits.x;
   int steps = 0;
-  for (; steps < maxSteps; ++steps) {
-    const int straight = straightStep(S, R, mode);
-    if (straight == kStepStop) break;
-    if (straight == kStepTaken) continue;
-    StepEnd E = integrateStep(S, R, mode);
-    if (mediumAlongStep(S, E, mode)) break;
+  // Per step: straightStep, integrateStep, mediumAlongStep, layerStep, clipToVolume. lavapipe runs
+  // a loop's whole body for all lanes while any lane goes on, so the steps where layerStep only
+  // accumulates and clipToVolume does nothing run in an inner loop, and the rare events (a layer
+  // opens or closes, the ray leaves the volume) leave it for the full stages, once per event.
+  while (steps < maxSteps) {
+    StepEnd E;
+    bool event = false;
+    for (; steps < maxSteps; ++steps) {
+      const int straight = straightStep(S, R, mode);
+      if (straight == kStepStop) break;
+      if (straight == kStepTaken) continue;
+      E = integrateStep(S, R, mode);
+      if (mediumAlongStep(S, E, mode)) break;
+      if (layerEvent(S, E) || outsideVolume(S.x)) {
+        event = true;
+        break;
+      }
+      layerAccumulate(S, E);
+    }
+    if (!event) break;
     layerStep(S, R, E, mode);
     if (clipToVolume(S, R, E)) break;
+    ++steps;
   }
   R.steps = steps;
   R.exit_point = S.x;
