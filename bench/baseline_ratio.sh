@@ -55,7 +55,7 @@ trap 'rm -rf "$work"' EXIT
 now() { date +%s.%N; }
 # Field $2 (awk column) of the view_bench row whose variant name starts with $1.
 row() { awk -v n="$1" -v c="$2" 'index($0, n) == 1 { print $c }'; }
-ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.2f", a / b; else print "-" }'; }
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.3g", a / b; else print "-" }'; }
 
 # 1. The baseline (whole process, and its own dispatch statistics).
 base_steps="" base_rays="" base_whole=""
