@@ -13,6 +13,7 @@
 // turning points, same bisections, same tie rules), so the two differ by float rounding only.
 #ifndef EIKON_BOUNDARY_GLSL
 #define EIKON_BOUNDARY_GLSL
+#extension GL_EXT_control_flow_attributes : require
 
 // ---- Analytic shapes (core/scene/shapes.cpp) ----
 
@@ -42,6 +43,29 @@ vec3 boxGradient(vec3 p, vec3 half_size) {
   return g;
 }
 
+// lavapipe's loop budget (gallivm, LP_MAX_TGSI_LOOP_ITERATIONS in lp_bld_limits.h): one counter
+// per SIMD group of invocations (8 lanes), set to 65535 when the shader starts and decremented at
+// the end of every pass of every loop, whichever loop and whichever lanes are active; at zero,
+// every loop stops after its current pass, silently. A group runs each loop until its last lane
+// is done, so divergent neighbours spend the budget together. The sharp march of a 49-plane
+// brilliant spent ~1800 passes per crossing, ~1500 of them one plane per pass in the ~40 signed
+// distances of the refinement below: rays of 12–30 total internal reflections had their plane
+// loops cut and left through a wrong facet (docs/view-renderer.md). Hence:
+//  - the plane loops take kShapePlanesPerPass planes per pass (an unrolled inner loop; the index
+//    clamped to the last plane, which a max repeats harmlessly and a strict `>` never picks
+//    twice: the values and the plane chosen are those of one plane per pass) and test at the end
+//    of a pass (a for loop's failing test costs a pass of its own);
+//  - the 8-corner "seen before" loops have a constant count, so that they unroll;
+// ~280 passes per crossing; and marchSharp reports a ray whose loops may have been cut as one
+// that ran out of steps (loopLimitReached, sharp.glsl).
+const int kShapePlanesPerPass = 32;
+
+// Plane k of a convex shape at local point p (k clamped to the last plane).
+float shapePlaneValue(int first, int count, int k, vec3 p) {
+  vec4 pl = shapeTable[first + min(k, count - 1)];
+  return dot(pl.xyz, p) - pl.w;
+}
+
 // Signed distance (mm, negative inside) of shape s at world point x: Shape::signedDistance.
 float shapeSignedDistance(int s, vec3 x) {
   int o = EIKON_SHAPE_STRIDE * s;
@@ -52,9 +76,12 @@ float shapeSignedDistance(int s, vec3 x) {
   if (kind == EIKON_SHAPE_BOX) return boxDistance(p, par.xyz);
   if (kind == EIKON_SHAPE_ROUNDED_BOX) return boxDistance(p, par.xyz) - par.w;
   float m = -3.0e38;
-  for (int k = 0; k < int(head.z); ++k) {
-    vec4 pl = shapeTable[int(head.y) + k];
-    m = max(m, dot(pl.xyz, p) - pl.w);
+  int first = int(head.y), count = int(head.z);
+  for (int k = 0; count > 0;) {  // the test at the end: no pass is spent on a failing test
+    [[unroll]] for (int j = 0; j < kShapePlanesPerPass; ++j)
+      m = max(m, shapePlaneValue(first, count, k + j, p));
+    k += kShapePlanesPerPass;
+    if (k >= count) break;
   }
   return m;
 }
@@ -74,14 +101,18 @@ vec3 shapeDistanceGradient(int s, vec3 x) {
     g = boxGradient(p, par.xyz);
   } else {
     float m = -3.0e38;
+    int first = int(head.y), count = int(head.z);
     g = vec3(0.0);
-    for (int k = 0; k < int(head.z); ++k) {
-      vec4 pl = shapeTable[int(head.y) + k];
-      float v = dot(pl.xyz, p) - pl.w;
-      if (v > m) {
-        m = v;
-        g = pl.xyz;
+    for (int k = 0; count > 0;) {
+      [[unroll]] for (int j = 0; j < kShapePlanesPerPass; ++j) {
+        float v = shapePlaneValue(first, count, k + j, p);
+        if (v > m) {
+          m = v;
+          g = shapeTable[first + min(k + j, count - 1)].xyz;
+        }
       }
+      k += kShapePlanesPerPass;
+      if (k >= count) break;
     }
   }
   return g.x * shapeTable[o + 2].xyz + g.y * shapeTable[o + 3].xyz + g.z * shapeTable[o + 4].xyz;
@@ -247,8 +278,9 @@ int boundaryRegionOfCell(BoundaryCell c) {
   float bestPhi = -3.0e38;
   vec3 g;
   for (int k = 0; k < 8; ++k) {
+    // j < 8, not j < k: a constant count, so that both loops unroll (kShapePlanesPerPass).
     bool seen = false;
-    for (int j = 0; j < k; ++j) seen = seen || c.reg[j] == c.reg[k];
+    for (int j = 0; j < 8; ++j) seen = seen || (j < k && c.reg[j] == c.reg[k]);
     if (seen) continue;
     float phi = boundaryCellPhi(c, c.reg[k], g);
     if (phi > bestPhi) {
@@ -309,7 +341,7 @@ bool boundaryCrossCell(int from, vec3 ua, vec3 du, float t0, float t1, float tol
   vec3 g;
   for (int k = 0; k < 8; ++k) {
     bool seen = c.reg[k] == from;
-    for (int j = 0; j < k; ++j) seen = seen || c.reg[j] == c.reg[k];
+    for (int j = 0; j < 8; ++j) seen = seen || (j < k && c.reg[j] == c.reg[k]);
     if (seen) continue;
     float phi = boundaryCellPhi(past, c.reg[k], g);
     if (phi > best) {

@@ -361,6 +361,16 @@ void crossInterface(inout MarchState S, inout MarchResult R, BoundaryCrossing c,
   S.region = B;
 }
 
+// Whether lavapipe's loop budget is spent (boundary.glsl, before kShapePlanesPerPass): past it
+// every loop stops after one pass, so a loop of two passes makes one. The march asks after each
+// step and reports a ray whose loops may have been cut as one that ran out of steps (not left),
+// never as a wrong exit. A driver without the budget always makes both passes.
+bool loopLimitReached() {
+  int passes = 0;
+  for (int k = 0; k < 1 + int(P.limits.x > 0); ++k) ++passes;
+  return passes < 2;
+}
+
 MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   MarchResult R;
   float t0;
@@ -379,6 +389,7 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   R.opl = P.march.z * t0;
   const int maxSteps = P.limits.x;
   int steps = 0;
+  bool cut = false;
   for (; steps < maxSteps; ++steps) {
     if (hasFlag(EIKON_F_OPACITY) && mediumOpaque(S.region)) {  // surface emission over the coverage, as the smoothed path
       S.L += S.T * (colourOf(mediumRow(S.region, 10).xyz) / mediumRow(S.region, 8).w +
@@ -388,14 +399,18 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
     }
     BoundaryCrossing c;
     int ev = sharpAdvance(S, R, c, mode);
-    if (ev == kSharpLeave) break;
     if (ev == kSharpCross) crossInterface(S, R, c, mode);
+    if (loopLimitReached()) {
+      cut = true;
+      break;
+    }
+    if (ev == kSharpLeave) break;
   }
   R.steps = steps;
   R.exit_point = S.x;
   R.exit_dir = sharpDirection(S, mode);
   R.wave_normal = normalize(S.w);
-  R.left = !S.stopped && steps < maxSteps;
+  R.left = !S.stopped && !cut && steps < maxSteps;
   if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
   R.radiance = S.L;
   R.throughput = S.T;
