@@ -5,6 +5,13 @@
 // the CPU reference at RK4 with a 0.05-voxel step.
 //
 //   build/bench/view_bench [scene.json] [--width W --height H] [--no-cpu] [--interfaces]
+//                          [--march sharp|smoothed] [--only SUBSTRING] [--no-accuracy] [--repeat N]
+//
+// --march: voxelise with that kind of interface whatever the scene says (the variants' integrator
+// and step only matter where the march integrates: every layer when smoothed, varying regions when
+// sharp). --only: the variants whose name contains SUBSTRING. --no-accuracy: no CPU truth rays
+// (timing only). --repeat: render each variant N times after the warm-up and report the median.
+// Steps/s is the rendered steps (the `w` of every pixel) per second of the render.
 //
 // --interfaces: only the sharp vs smoothed comparison (issue 13): the scene voxelised both ways
 // ("interfaces": "sharp" / "smoothed"), rendered at the default settings; time and steps per ray
@@ -72,8 +79,19 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-cpu", cpu, "Skip the CPU reference");
   bool interfaces = false;
   app.add_flag("--interfaces", interfaces, "Only compare sharp and smoothed interfaces");
+  std::string march_kind, only;
+  app.add_option("--march", march_kind, "Voxelise with sharp or smoothed interfaces")
+      ->check(CLI::IsMember({"sharp", "smoothed"}));
+  app.add_option("--only", only, "Only the variants whose name contains this text");
+  bool accuracy = true;
+  app.add_flag("!--no-accuracy", accuracy, "Skip the accuracy rays (CPU truth and GPU traces)");
+  int repeat = 1;
+  app.add_option("--repeat", repeat, "Timed renders per variant (median)")
+      ->check(CLI::Range(1, 50));
   CLI11_PARSE(app, argc, argv);
   Scene scene = loadScene(scene_path);
+  if (march_kind == "sharp") scene.interfaces = Scene::Interfaces::Sharp;
+  if (march_kind == "smoothed") scene.interfaces = Scene::Interfaces::Smoothed;
   auto ctx = vk::Context::create();
   if (interfaces) return compareInterfaces(*ctx, scene, width, height, cpu);
   auto t0 = std::chrono::steady_clock::now();
@@ -100,7 +118,8 @@ int main(int argc, char** argv) {
   truth.step_voxels = 0.05;
   truth.max_steps = 200000;
   std::vector<glm::dvec3> exact;
-  for (const auto& r : rays) exact.push_back(ref.trace(r, truth).exit_direction);
+  if (accuracy)
+    for (const auto& r : rays) exact.push_back(ref.trace(r, truth).exit_direction);
 
   struct Variant {
     const char* name;
@@ -122,30 +141,37 @@ int main(int argc, char** argv) {
       {"RK4, 0.5 voxel, skip", mk(Integrator::RK4, 0.5, true, true)},
       {"RK4, 0.25 voxel, skip (default)", mk(Integrator::RK4, 0.25, true, true)},
   };
-  std::printf("\n%-34s %10s %10s %11s %12s %12s\n", "GPU variant", "time [s]", "rays/s",
-              "steps/ray", "mean err", "max err");
+  std::printf("\n%-34s %10s %10s %11s %10s %12s %12s\n", "GPU variant", "time [s]", "rays/s",
+              "steps/ray", "steps/s", "mean err", "max err");
   double naive_s = 0, default_s = 0;
   for (const auto& v : variants) {
+    if (!only.empty() && std::string(v.name).find(only) == std::string::npos) continue;
     RenderSettings rs;
     rs.width = width;
     rs.height = height;
     rs.march = v.m;
     gpu.render(rs);  // warm-up (pipeline compile, caches)
-    RenderImage img = gpu.render(rs);
-    auto tr = gpu.trace(rays, v.m);
+    std::vector<RenderImage> runs;
+    for (int k = 0; k < repeat; ++k) runs.push_back(gpu.render(rs));
+    std::sort(runs.begin(), runs.end(),
+              [](const RenderImage& a, const RenderImage& b) { return a.seconds < b.seconds; });
+    const RenderImage& img = runs[runs.size() / 2];
+    auto tr = accuracy ? gpu.trace(rays, v.m) : std::vector<TraceOutcome>();
     double mean = 0, mx = 0;
-    for (size_t i = 0; i < rays.size(); ++i) {
+    for (size_t i = 0; i < tr.size(); ++i) {
       double e = std::acos(std::clamp(glm::dot(tr[i].exit_direction, exact[i]), -1.0, 1.0));
       mean += e / double(rays.size());
       mx = std::max(mx, e);
     }
-    std::printf("%-34s %10.3f %10.3g %11.1f %11.2e° %11.2e°\n", v.name, img.seconds,
-                width * height / img.seconds, img.mean_steps, mean * 180 / 3.14159265358979,
+    std::printf("%-34s %10.3f %10.3g %11.1f %10.3g %11.2e° %11.2e°\n", v.name, img.seconds,
+                width * height / img.seconds, img.mean_steps,
+                img.mean_steps * width * height / img.seconds, mean * 180 / 3.14159265358979,
                 mx * 180 / 3.14159265358979);
     if (v.name[0] == 'n') naive_s = img.seconds;
-    default_s = img.seconds;
+    if (std::string(v.name).find("(default)") != std::string::npos) default_s = img.seconds;
   }
-  std::printf("\nratio default / naive Euler time: %.2f\n", default_s / naive_s);
+  if (naive_s > 0 && default_s > 0)
+    std::printf("\nratio default / naive Euler time: %.2f\n", default_s / naive_s);
   if (cpu) {
     RenderSettings rs;
     rs.width = width;
@@ -153,8 +179,9 @@ int main(int argc, char** argv) {
     RenderImage c = ref.render(scene.camera, rs);
     std::printf("CPU reference (double, %u threads, default settings): %.3f s, %.3g rays/s\n",
                 std::thread::hardware_concurrency(), c.seconds, width * height / c.seconds);
-    std::printf("ratio GPU / CPU reference speed (default settings): %.2f\n",
-                c.seconds / default_s);
+    if (default_s > 0)
+      std::printf("ratio GPU / CPU reference speed (default settings): %.2f\n",
+                  c.seconds / default_s);
   }
   return 0;
 }

@@ -17,7 +17,11 @@
 //   EIKON_FIELD_LAMBDA_UM  the wavelength (µm), EIKON_FIELD_IL2 / EIKON_FIELD_IL4 its 1/λ², 1/λ⁴;
 //   EIKON_FIELD_HAS_AXIS   an expression, false where the kernel binds no optic axis;
 //   EIKON_FIELD_ON_DISPERSION(b, c)  optional: called with the B, C samples (march.glsl notes
-//                          whether any ray saw dispersion, for wavelength sharing).
+//                          whether any ray saw dispersion, for wavelength sharing);
+//   EIKON_FIELD_FLAGS      optional: the EIKON_F_* flags hasFlag tests (default P.grid_dims.w).
+//                          march.glsl makes them a specialization constant: lavapipe runs both
+//                          sides of every branch (masked SIMD), so only code that a constant
+//                          removes costs nothing (docs/performance.md).
 #ifndef EIKON_FIELD_GLSL
 #define EIKON_FIELD_GLSL
 
@@ -25,7 +29,11 @@
 #define EIKON_FIELD_ON_DISPERSION(b, c)
 #endif
 
-bool hasFlag(int f) { return (P.grid_dims.w & f) != 0; }
+#ifndef EIKON_FIELD_FLAGS
+#define EIKON_FIELD_FLAGS P.grid_dims.w
+#endif
+
+bool hasFlag(int f) { return (EIKON_FIELD_FLAGS & f) != 0; }
 
 // ---- Sampling: cell-centred trilinear stencil, clamped to the edge voxels ----
 
@@ -63,10 +71,12 @@ ivec3 voxelAt(vec3 x) {
 
 // (n, ∂n/∂x, ∂n/∂y, ∂n/∂z) of mode 0 (o) or 1 (e) at x and the kernel's wavelength:
 // A + B/λ² + C/λ⁴ (docs/design.md §2, Dispersion).
+// Where the kernel binds no optic axis the e-mode images are the o-mode's, so mode 1 reads
+// those (one branch fewer for a kernel specialised without crystals).
 vec4 sampleIndex(vec3 x, int mode) {
   Stencil s = stencilAt(x);
   vec4 a;
-  if (mode == 0) {
+  if (mode == 0 || !(EIKON_FIELD_HAS_AXIS)) {
     a = TRI(idxOA, s);
     if (hasFlag(EIKON_F_DISPERSIVE)) {
       vec4 b = TRI(idxOB, s), c = TRI(idxOC, s);
@@ -87,7 +97,8 @@ vec4 sampleIndex(vec3 x, int mode) {
 // (σ_r, σ_g, σ_b band values per mm, opacity) of mode 0 (o) or 1 (e) at x.
 vec4 sampleMedium(vec3 x, int mode) {
   Stencil s = stencilAt(x);
-  return mode == 0 ? TRI(mediumO, s) : TRI(mediumE, s);
+  if (mode == 0 || !(EIKON_FIELD_HAS_AXIS)) return TRI(mediumO, s);
+  return TRI(mediumE, s);
 }
 
 // Band values (σ at 612, 549, 465 nm) → value at the wavelength, linear between, constant beyond.

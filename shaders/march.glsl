@@ -12,7 +12,14 @@
 #ifndef EIKON_MARCH_GLSL
 #define EIKON_MARCH_GLSL
 
-layout(std430, binding = EIKON_B_PARAMS) readonly buffer ParamsBuf { ViewParams P; };
+layout(std430, binding = EIKON_B_PARAMS) readonly buffer ParamsBuf { ViewParams params; };
+// A private copy of the parameter block, made once by loadParams() at the top of main(). llvmpipe
+// reads a storage buffer lane by lane in a scalar loop wherever a lane mask is active (inside any
+// branch or loop), so P.x read from the buffer in the march loop cost a loop per component; the
+// copy is a register (or stack) read (docs/performance.md).
+ViewParams P;
+
+void loadParams() { P = params; }
 layout(binding = EIKON_B_INDEX_O_A, rgba32f) readonly uniform image3D idxOA;
 layout(binding = EIKON_B_INDEX_O_B, rgba32f) readonly uniform image3D idxOB;
 layout(binding = EIKON_B_INDEX_O_C, rgba32f) readonly uniform image3D idxOC;
@@ -59,6 +66,18 @@ bool gRecordOverflow = false;
 int gNumRecorded = 0;
 vec4 gRecorded[6];
 
+// Specialization constants (core/render/view_renderer.cpp: one pipeline per feature set). llvmpipe
+// (lavapipe) executes both sides of every branch with a lane mask and every loop body at least
+// once, so a step costs all the code in the march loop whatever the scene uses; constants fold
+// the features away instead (docs/performance.md). −1: read the value from P at run time.
+//   kSharpMarch: the sharp march (EIKON_F_SHARP) instead of the smoothed one;
+//   kViewFlags: the EIKON_F_* flags of the scene and the render (P.grid_dims.w);
+//   kIntegrator: EIKON_INT_* (P.march.w).
+layout(constant_id = 0) const bool kSharpMarch = false;
+layout(constant_id = 1) const int kViewFlags = -1;
+layout(constant_id = 2) const int kIntegrator = -1;
+
+#define EIKON_FIELD_FLAGS (kViewFlags == -1 ? P.grid_dims.w : kViewFlags)
 #define EIKON_FIELD_INV_H P.grid_extent.w
 #define EIKON_FIELD_LAMBDA_UM gLambdaUm
 #define EIKON_FIELD_IL2 gIl2
@@ -99,7 +118,7 @@ vec3 environment(vec3 d);
 
 // Environment radiance times a throughput weight, recorded for wavelength sharing.
 vec3 environmentWeighted(vec3 weight, vec3 d) {
-  if (gRecord) {
+  if (hasFlag(EIKON_F_SPECTRAL) && gRecord) {  // only view.comp's spectral mode records
     if (gNumRecorded < 6) gRecorded[gNumRecorded++] = vec4(d, weight.x);
     else gRecordOverflow = true;
   }
@@ -348,7 +367,7 @@ int straightStep(inout MarchState S, inout MarchResult R, int mode) {
 // the optical path and (o-mode) the drift of the invariant |w| = n.
 StepEnd integrateStep(inout MarchState S, inout MarchResult R, int mode) {
   const float ds = P.march.x * P.grid_origin.w;
-  const int integrator = int(P.march.w);
+  const int integrator = kIntegrator == -1 ? int(P.march.w) : kIntegrator;
   StepEnd E;
   E.x0 = S.x;
   E.w0 = S.w;
@@ -454,12 +473,33 @@ void fresnelAtLayer(inout MarchState S, inout MarchResult R, vec3 N, int mode) {
   }
 }
 
+// |∇n|·h at the step's end, the quantity that opens and closes layers.
+float layerGradient(MarchState S, StepEnd E) {
+  return max(length(S.nn.yzw), length(E.ne.yzw)) * P.grid_origin.w;
+}
+
+const float kLayerOpen = 1e-6;  // |∇n|·h above which a layer opens
+
+// Whether layerStep would open or close a layer here (otherwise it only accumulates, as
+// layerAccumulate does).
+bool layerEvent(MarchState S, StepEnd E) {
+  float g = layerGradient(S, E);
+  return S.inLayer ? g <= kLayerOpen : g > kLayerOpen;
+}
+
+// layerStep where it neither opens nor closes a layer.
+void layerAccumulate(inout MarchState S, StepEnd E) {
+  if (!S.inLayer) return;
+  S.gAcc += E.gradN * (P.march.x * P.grid_origin.w);
+  S.peak = max(S.peak, layerGradient(S, E));
+}
+
 // Interface bookkeeping: a layer opens where |∇n|·h rises above 1e-6 and closes where it falls
 // back; a closed layer whose peak exceeded march.y was an interface (projectOnShell, fresnelAtLayer).
 void layerStep(inout MarchState S, inout MarchResult R, StepEnd E, int mode) {
   const float h = P.grid_origin.w, ds = P.march.x * h;
-  const float thrLow = 1e-6, thrIface = P.march.y;
-  float g = max(length(S.nn.yzw), length(E.ne.yzw)) * h;
+  const float thrLow = kLayerOpen, thrIface = P.march.y;
+  float g = layerGradient(S, E);
   if (!S.inLayer && g > thrLow) {
     S.inLayer = true;
     S.wBefore = E.w0;
@@ -475,6 +515,12 @@ void layerStep(inout MarchState S, inout MarchResult R, StepEnd E, int mode) {
   vec3 N = dot(S.gAcc, S.gAcc) > 0.0 ? normalize(S.gAcc) : vec3(0.0);
   if (dot(N, N) > 0.0 && abs(dot(S.x - S.xOpen, N)) <= 12.0 * h) projectOnShell(S, E, N);
   if (S.peak > thrIface && !hasFlag(EIKON_F_NO_FRESNEL) && dot(N, N) > 0.0) fresnelAtLayer(S, R, N, mode);
+}
+
+// Whether x is outside the volume box (clipToVolume's test).
+bool outsideVolume(vec3 x) {
+  return any(lessThan(x, P.grid_origin.xyz)) ||
+         any(greaterThan(x, P.grid_origin.xyz + P.grid_extent.xyz));
 }
 
 // Left the volume? The ray is straight outside (fields clamp to the uniform edge voxels): cut the
@@ -519,11 +565,10 @@ bool enterVolume(vec3 o, vec3 d, out MarchResult R, out float t0) {
 
 #include "sharp.glsl"
 
-// The host specialises this constant (with EIKON_F_SHARP): the pipeline holds one of the two
-// marches, which halves what lavapipe compiles.
-layout(constant_id = 0) const bool kSharpMarch = false;
-
+// kSharpMarch (with EIKON_F_SHARP): the pipeline holds one of the two marches, which halves what
+// lavapipe compiles.
 MarchResult march(vec3 o, vec3 d, int mode) {
+  if (!hasFlag(EIKON_F_UNIAXIAL)) mode = 0;  // always so; as a constant it folds the e-mode away
   if (kSharpMarch) return marchSharp(o, d, mode);
   MarchResult R;
   float t0;
@@ -544,14 +589,29 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   S.xOpen = S.x;
   const int maxSteps = P.limits.x;
   int steps = 0;
-  for (; steps < maxSteps; ++steps) {
-    const int straight = straightStep(S, R, mode);
-    if (straight == kStepStop) break;
-    if (straight == kStepTaken) continue;
-    StepEnd E = integrateStep(S, R, mode);
-    if (mediumAlongStep(S, E, mode)) break;
+  // Per step: straightStep, integrateStep, mediumAlongStep, layerStep, clipToVolume. lavapipe runs
+  // a loop's whole body for all lanes while any lane goes on, so the steps where layerStep only
+  // accumulates and clipToVolume does nothing run in an inner loop, and the rare events (a layer
+  // opens or closes, the ray leaves the volume) leave it for the full stages, once per event.
+  while (steps < maxSteps) {
+    StepEnd E;
+    bool event = false;
+    for (; steps < maxSteps; ++steps) {
+      const int straight = straightStep(S, R, mode);
+      if (straight == kStepStop) break;
+      if (straight == kStepTaken) continue;
+      E = integrateStep(S, R, mode);
+      if (mediumAlongStep(S, E, mode)) break;
+      if (layerEvent(S, E) || outsideVolume(S.x)) {
+        event = true;
+        break;
+      }
+      layerAccumulate(S, E);
+    }
+    if (!event) break;
     layerStep(S, R, E, mode);
     if (clipToVolume(S, R, E)) break;
+    ++steps;
   }
   R.steps = steps;
   R.exit_point = S.x;

@@ -85,6 +85,7 @@ float regionIndex(int r, int mode, vec3 x) {
 // The optic axis field of a region at x: (unit axis, 1/r of a radial field or 0); zero where
 // isotropic (mediumAxisField).
 vec4 regionAxisField(int r, vec3 x) {
+  if (!hasFlag(EIKON_F_UNIAXIAL)) return vec4(0.0);  // no crystal in the scene
   int f = mediumFlags(r);
   if ((f & EIKON_MEDIUM_UNIAXIAL) == 0) return vec4(0.0);
   if ((f & EIKON_MEDIUM_RADIAL_AXIS) == 0) return vec4(mediumRow(r, 7).xyz, 0.0);
@@ -186,6 +187,8 @@ BoundaryCrossing nextCrossing(vec3 a, vec3 b, int region) {
 // Emission, attenuation (exact: e^{−σ len}) and in-scatter along a straight piece in the ray's
 // region.
 void absorbAlong(inout MarchState S, vec3 dir, float len, int mode) {
+  // Nothing to add where no medium attenuates, emits or scatters light (S.L += 0, S.T *= 1).
+  if (!hasFlag(EIKON_F_ATTENUATION) && !hasFlag(EIKON_F_EMISSION) && !hasFlag(EIKON_F_LIT)) return;
   int r = S.region;
   vec3 sig = sigmaOf(mediumRow(r, 8).xyz);
   vec4 af = regionAxisField(r, S.x);
@@ -251,7 +254,7 @@ void sharpRk4(int region, float ds, int mode, inout vec3 x, inout vec3 w) {
 int sharpAdvance(inout MarchState S, inout MarchResult R, out BoundaryCrossing c, int mode) {
   const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
   const float h = P.grid_origin.w;
-  bool straight = mediumHomogeneous(S.region);
+  bool straight = !hasFlag(EIKON_F_VARYING) || mediumHomogeneous(S.region);
   vec3 x0 = S.x, w0 = S.w, x1 = x0, w1 = w0, dir;
   float len = 0.0, ds = P.march.x * h, keep = 1.0;
   bool leaving = true;
@@ -310,8 +313,9 @@ void crossInterface(inout MarchState S, inout MarchResult R, BoundaryCrossing c,
   int A = S.region, B = c.to;
   vec3 x = S.x, N = c.normal, s = normalize(S.w);
   vec4 afA = regionAxisField(A, x), afB = regionAxisField(B, x);
-  bool uA = mediumUniaxial(A), uB = mediumUniaxial(B);
-  if (mediumOpaque(B) || (mediumRow(A, 10).w == mediumRow(B, 10).w && int(mediumRow(A, 11).w) == 0 &&
+  bool uA = hasFlag(EIKON_F_UNIAXIAL) && mediumUniaxial(A);
+  bool uB = hasFlag(EIKON_F_UNIAXIAL) && mediumUniaxial(B);
+  if ((hasFlag(EIKON_F_OPACITY) && mediumOpaque(B)) || (mediumRow(A, 10).w == mediumRow(B, 10).w && int(mediumRow(A, 11).w) == 0 &&
                           afA.xyz == afB.xyz)) {
     S.region = B;  // equal media: nothing changes (an opaque one stops the ray next)
     return;
@@ -387,7 +391,7 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   int steps = 0;
   bool cut = false;
   for (; steps < maxSteps; ++steps) {
-    if (mediumOpaque(S.region)) {  // surface emission over the coverage, as the smoothed path
+    if (hasFlag(EIKON_F_OPACITY) && mediumOpaque(S.region)) {  // surface emission over the coverage, as the smoothed path
       S.L += S.T * (colourOf(mediumRow(S.region, 10).xyz) / mediumRow(S.region, 8).w +
                     diffuseSurface(S.x, mode));
       S.stopped = true;

@@ -22,6 +22,7 @@ TraceResult pack(MarchResult r) {
 
 // results[2i] is the o-mode of ray i, results[2i + 1] its e-mode (identical where isotropic).
 void main() {
+  loadParams();
   uint i = gl_GlobalInvocationID.x;
   if (i >= uint(P.image.x)) return;
   TraceRay ray = rays[i];

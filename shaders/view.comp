@@ -27,6 +27,7 @@ vec3 cmf(float lambda_nm) {
 }
 
 void main() {
+  loadParams();
   uvec2 gid = gl_GlobalInvocationID.xy;
   int W = P.image.x, H = P.image.y;
   int px = int(gid.x), py = P.image.z + int(gid.y);
@@ -53,7 +54,7 @@ void main() {
     vec3 xyz = vec3(0.0);
     // Wavelength sharing (march.glsl): only where nothing but the index can depend on λ.
     const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
-    bool share = spectral && (P.grid_dims.w & lambdaDependent) == 0;
+    bool share = spectral && !hasFlag(lambdaDependent);
     bool reuse = false;
     for (int k = 0; k < N; ++k) {
       float lambda = 0.0;

@@ -2,7 +2,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <stdexcept>
+#include <tuple>
 
 #include "core/render/boundary_device.h"
 #include "core/spectrum/cie1931.h"
@@ -60,15 +62,20 @@ struct ViewRenderer::Impl {
   Grid grid;
   bool uniaxial = false, dispersive = false, attenuating = false, emissive = false, opaque = false;
   bool scattering = false, lit = false;
-  bool sharp = false;  // march region by region (shaders/sharp.glsl), as the CPU twin does
+  bool sharp = false;    // march region by region (shaders/sharp.glsl), as the CPU twin does
+  bool varying = false;  // sharp: some region's medium varies in space (GRIN, radial axis)
   // [oA, oB, oC, (eA, eB, eC), medO, (medE), emission, (axis), (scatter), (fluence, flux)]
   std::vector<vk::Image3D> images;
   size_t scatterImage = 0, fluenceImage = 0,
          fluxImage = 0;  // 0: not present (index A bound instead)
   vk::Buffer params, env, tables;
-  BoundaryDevice boundary;              // the sharp-boundary field (placeholders when smoothed)
-  std::vector<vk::BindingSpec> common;  // the bindings both pipelines have
-  vk::ComputePipeline view, tracer;     // built on first use (ensureView, ensureTracer)
+  BoundaryDevice boundary;  // the sharp-boundary field (placeholders when smoothed)
+  // One pipeline per kernel and feature set, made on first use (specialization constants 0–2 of
+  // march.glsl: the march kind, the EIKON_F_* flags, the integrator). lavapipe executes every
+  // branch of a kernel masked, so a kernel with the scene's and the settings' features folded in
+  // marches many times faster than one that tests them at run time (docs/performance.md).
+  std::vector<vk::BindingSpec> viewBindings, traceBindings;
+  std::map<std::tuple<bool, int, int, int>, vk::ComputePipeline> pipelines;
   int skip_cap = 32;
   double ambient = 1.0;
 
@@ -114,6 +121,7 @@ struct ViewRenderer::Impl {
 
     boundary = BoundaryDevice(ctx, v.boundary, v.media, scene.file.string());
     sharp = !v.boundary.empty() && !v.media.empty();
+    for (const MediumRecord& r : v.media.regions) varying = varying || !r.homogeneous;
     params =
         vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
     const auto& e = scene.environment;
@@ -151,29 +159,30 @@ struct ViewRenderer::Impl {
                        uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
     for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
+    viewBindings = common;
+    traceBindings = common;
+    traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
   }
 
-  // The pipelines are built on first use, each only when asked for (issue 14, start-up): a
-  // render never builds the tracer, a trace never builds the view pipeline; on lavapipe each
-  // takes seconds to compile. constant_id 0 (march.glsl kSharpMarch) picks the sharp or the
-  // smoothed march, so only the one the scene needs is compiled.
-  void buildPipeline(vk::ComputePipeline& p, std::span<const uint32_t> spirv, bool rays,
-                     const char* name) {
-    if (p.built()) return;
-    auto bindings = common;
-    if (rays) bindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    p = vk::ComputePipeline(ctx, spirv, bindings, 0, name, {sharp ? 1u : 0u});
-    bindCommon(p);
-    ctx.savePipelineCache();  // core/vk/pipeline_cache.h: the next run skips the compilation
+  // The view (trace = false) or trace kernel specialised for the flags and integrator of p.
+  vk::ComputePipeline& pipeline(bool trace, const gpu::ViewParams& p) {
+    const int flags = p.grid_dims.w, integrator = int(p.march.w);
+    auto key = std::make_tuple(trace, flags, integrator, sharp ? 1 : 0);
+    auto it = pipelines.find(key);
+    if (it != pipelines.end()) return it->second;
+    // constant_id 0: kSharpMarch, 1: kViewFlags, 2: kIntegrator (march.glsl).
+    const std::vector<uint32_t> spec{sharp ? 1u : 0u, uint32_t(flags), uint32_t(integrator)};
+    vk::ComputePipeline pl =
+        trace ? vk::ComputePipeline(ctx,
+                                    std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4),
+                                    traceBindings, 0, "trace", spec)
+              : vk::ComputePipeline(ctx,
+                                    std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4),
+                                    viewBindings, 0, "view", spec);
+    bindCommon(pl);
+    ctx.savePipelineCache();  // core/vk/pipeline_cache.h: the next run may skip the compilation
     timings::mark("pipelines built");
-  }
-  void ensureView() {
-    buildPipeline(view, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4), false,
-                  "view");
-  }
-  void ensureTracer() {
-    buildPipeline(tracer, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4), true,
-                  "trace");
+    return pipelines.emplace(key, std::move(pl)).first->second;
   }
 
   void bindCommon(vk::ComputePipeline& p) {
@@ -221,6 +230,7 @@ struct ViewRenderer::Impl {
     if (scattering) flags |= EIKON_F_SCATTER;
     if (lit) flags |= EIKON_F_LIT;
     if (sharp) flags |= EIKON_F_SHARP;
+    if (sharp && varying) flags |= EIKON_F_VARYING;
     if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
     if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
@@ -247,7 +257,6 @@ ViewRenderer::~ViewRenderer() = default;
 RenderImage ViewRenderer::render(const RenderSettings& s) {
   validate(s.march);
   Impl& I = *impl_;
-  I.ensureView();
   RenderImage img;
   img.width = s.width > 0 ? s.width : I.scene.camera.width;
   img.height = s.height > 0 ? s.height : I.scene.camera.height;
@@ -275,7 +284,8 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   int rows = EIKON_WG_Y;
   vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * sizeof(glm::vec4),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
-  I.view.bindBuffer(EIKON_B_OUTPUT, out);
+  vk::ComputePipeline& view = I.pipeline(false, p);
+  view.bindBuffer(EIKON_B_OUTPUT, out);
   img.rgb.resize(size_t(img.width) * size_t(img.height) * 3);
   std::vector<glm::vec4> band(size_t(img.width) * size_t(max_rows));
   double steps = 0.0;
@@ -287,8 +297,8 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
     I.params.write(&p, sizeof p);
     if (y0 == 0) timings::mark("first dispatch");
     I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
-      I.view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X),
-                      uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
+      view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X),
+                    uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
     });
     out.read(band.data(), size_t(img.width) * size_t(n) * sizeof(glm::vec4));
     for (int y = 0; y < n; ++y)
@@ -324,7 +334,6 @@ std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(
   validate(m);
   Impl& I = *impl_;
   if (rays.empty()) return {};
-  I.ensureTracer();
   std::vector<gpu::TraceRay> in(rays.size());
   for (size_t i = 0; i < rays.size(); ++i) {
     double len = glm::length(rays[i].direction);
@@ -343,11 +352,12 @@ std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(
   rb.write(in.data(), in.size() * sizeof(gpu::TraceRay));
   vk::Buffer ob(I.ctx, 2 * in.size() * sizeof(gpu::TraceResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                 "trace results");
-  I.tracer.bindBuffer(EIKON_B_RAYS, rb);
-  I.tracer.bindBuffer(EIKON_B_OUTPUT, ob);
+  vk::ComputePipeline& tracer = I.pipeline(true, p);
+  tracer.bindBuffer(EIKON_B_RAYS, rb);
+  tracer.bindBuffer(EIKON_B_OUTPUT, ob);
   I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
-    I.tracer.dispatch(cmd, uint32_t((in.size() + EIKON_TRACE_WG - 1) / EIKON_TRACE_WG), 1, 1,
-                      nullptr);
+    tracer.dispatch(cmd, uint32_t((in.size() + EIKON_TRACE_WG - 1) / EIKON_TRACE_WG), 1, 1,
+                    nullptr);
   });
   std::vector<gpu::TraceResult> res(2 * in.size());
   ob.read(res.data(), res.size() * sizeof(gpu::TraceResult));

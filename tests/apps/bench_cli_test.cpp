@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -66,5 +67,58 @@ INSTANTIATE_TEST_SUITE_P(Benchmarks, BenchHelp,
                                            Bench{"spectral_bench", EIKON_SPECTRAL_BENCH},
                                            Bench{"light_bench", EIKON_LIGHT_BENCH}),
                          [](const auto& param_info) { return std::string(param_info.param.name); });
+
+// bench/baseline_ratio.sh (docs/performance.md): its arguments are checked before anything runs,
+// each mistake one line naming the argument and a non-zero exit.
+class BaselineRatio : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "eikon_baseline_ratio_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
+    dir_ = tmpl;
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  eikon::test::Outcome run(const std::string& args, const std::string& env = "") {
+    return eikon::test::runProgram(std::string(EIKON_SOURCE_DIR) + "/bench/baseline_ratio.sh", args,
+                                   dir_, env);
+  }
+  static int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+  fs::path dir_;
+};
+
+TEST_F(BaselineRatio, MissingBaselineBinaryIsOneErrorLine) {
+  const auto r = run("--baseline " + (dir_ / "no_such_program").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("--baseline"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no_such_program"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+TEST_F(BaselineRatio, BaselineFromTheEnvironmentIsCheckedToo) {
+  const auto r = run("", "EIKON_BASELINE=" + (dir_ / "absent").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("absent"), std::string::npos) << r.err;
+}
+
+TEST_F(BaselineRatio, BadArgumentsAreOneErrorLine) {
+  for (const char* args : {"--reps 0", "--reps x", "--no-such-option"}) {
+    const auto r = run(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(lines(r.err), 1) << args << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
+  }
+}
+
+TEST_F(BaselineRatio, MissingBuildIsOneErrorLine) {
+  const auto r = run("--build " + (dir_ / "no_build").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("not built"), std::string::npos) << r.err;
+}
 
 }  // namespace
