@@ -15,7 +15,10 @@
 //
 // --interfaces: only the sharp vs smoothed comparison (issue 13): the scene voxelised both ways
 // ("interfaces": "sharp" / "smoothed"), rendered at the default settings; time and steps per ray
-// (sharp: one step per straight segment or RK4 step; smoothed: per integration step) and the ratio.
+// (sharp: one step per straight segment or RK4 step; smoothed: per integration step) and the ratio;
+// for the CPU twin also the volume-field reads per ray (every trilinear sample of the index,
+// medium and other volumes, and every boundary-field cell locateCrossing evaluates; the GPU's are
+// not counted, to keep counters out of the shader's inner loops).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -36,7 +39,7 @@ int compareInterfaces(vk::Context& ctx, const Scene& scene, int width, int heigh
   RenderSettings rs;
   rs.width = width;
   rs.height = height;
-  double t[2][2] = {{0, 0}, {0, 0}}, steps[2][2] = {{0, 0}, {0, 0}};
+  double t[2][2] = {{0, 0}, {0, 0}}, steps[2][2] = {{0, 0}, {0, 0}}, fetches[2] = {0, 0};
   const Scene::Interfaces kinds[2] = {Scene::Interfaces::Sharp, Scene::Interfaces::Smoothed};
   for (int k = 0; k < 2; ++k) {
     Scene s = scene;
@@ -55,14 +58,16 @@ int compareInterfaces(vk::Context& ctx, const Scene& scene, int width, int heigh
     const RenderImage c = ref.render(s.camera, rs);
     t[k][1] = c.seconds;
     steps[k][1] = c.mean_steps;
-    std::printf("%-9s CPU: %8.3f s, %8.1f steps/ray\n", k ? "smoothed" : "sharp", c.seconds,
-                c.mean_steps);
+    fetches[k] = c.mean_fetches;
+    std::printf("%-9s CPU: %8.3f s, %8.1f steps/ray, %8.1f field fetches/ray\n",
+                k ? "smoothed" : "sharp", c.seconds, c.mean_steps, c.mean_fetches);
   }
   std::printf("ratio smoothed / sharp, GPU: time %.2f, steps %.2f\n", t[1][0] / t[0][0],
               steps[1][0] / std::max(steps[0][0], 1e-9));
   if (cpu)
-    std::printf("ratio smoothed / sharp, CPU: time %.2f, steps %.2f\n", t[1][1] / t[0][1],
-                steps[1][1] / std::max(steps[0][1], 1e-9));
+    std::printf("ratio smoothed / sharp, CPU: time %.2f, steps %.2f, field fetches %.2f\n",
+                t[1][1] / t[0][1], steps[1][1] / std::max(steps[0][1], 1e-9),
+                fetches[1] / std::max(fetches[0], 1e-9));
   return 0;
 }
 

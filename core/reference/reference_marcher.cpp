@@ -55,6 +55,7 @@ struct MarchResult {
   double opl = 0.0, drift = 0.0;
   bool left = true;
   int steps = 0, interfaces = 0, tir = 0;
+  long long fetches = 0;  ///< volume-field reads (CountedField)
 };
 
 /// The state of one march between its stages (march.glsl's MarchState).
@@ -84,6 +85,34 @@ enum class Straight { None, Taken, Stop };
 /// out of the volume.
 enum class SharpEvent { Go, Cross, Leave };
 
+/// The field as one march reads it, every read of the volumes counted (bench/view_bench.cpp
+/// reports fetches per ray): a trilinear sample of the index, medium, emission, axis, scatter or
+/// light volume, a nearest-voxel read (skipDistance), and (RayMarch::nextCrossing) each
+/// boundary-field cell locateCrossing evaluates. A counter per ray, no atomics.
+class CountedField {
+ public:
+  explicit CountedField(const Field& f) : f_(f) {}
+  const Field& read() const {  // a read of the volumes through the returned field
+    ++fetches;
+    return f_;
+  }
+  glm::dvec4 medium(const glm::dvec3& x) const { return read().medium(x); }
+  glm::dvec4 mediumE(const glm::dvec3& x) const { return read().mediumE(x); }
+  glm::dvec3 emission(const glm::dvec3& x) const { return read().emission(x); }
+  glm::dvec4 scatter(const glm::dvec3& x) const { return read().scatter(x); }
+  glm::dvec4 lightFluence(const glm::dvec3& x) const { return read().lightFluence(x); }
+  glm::dvec3 lightFlux(const glm::dvec3& x) const { return read().lightFlux(x); }
+  glm::dvec3 axis(const glm::dvec3& x) const { return read().axis(x); }
+  glm::dvec4 axisField(const glm::dvec3& x) const { return read().axisField(x); }
+  double skipDistance(const glm::dvec3& x) const { return read().skipDistance(x); }
+  double ambientIndex() const { return f_.ambientIndex(); }
+  bool uniaxial() const { return f_.uniaxial(); }
+  mutable long long fetches = 0;
+
+ private:
+  const Field& f_;
+};
+
 /// One march of ReferenceMarcher: the ray's constants and the functions and stages of
 /// shaders/march.glsl under the same names, in double precision (docs/twins.md).
 class RayMarch {
@@ -108,6 +137,8 @@ class RayMarch {
     il4_ = il2_ * il2_;
   }
   MarchResult march(const glm::dvec3& o, const glm::dvec3& d) const;
+  /// The volume-field reads of this march so far (CountedField).
+  long long fetches() const { return f_.fetches; }
   /// Both marches start here: false (R = the environment along d) if the ray misses the volume,
   /// else true with the entry at o + t0·d, t0 ≥ 0.
   bool enterVolume(const glm::dvec3& o, const glm::dvec3& d, MarchResult& R, double& t0) const;
@@ -121,7 +152,7 @@ class RayMarch {
   }
   glm::dvec3 environment(const glm::dvec3& dir) const { return colourOf(env_.lookup(dir)); }
   glm::dvec4 sampleIndex(const glm::dvec3& x, int mode) const {
-    return field::sampleIndex(f_, x, il2_, il4_, mode);
+    return field::sampleIndex(f_.read(), x, il2_, il4_, mode);
   }
   glm::dvec3 axisAt(const glm::dvec3& x) const { return mode_ == 1 ? f_.axis(x) : glm::dvec3(0.0); }
   void deriv(const glm::dvec3& x, const glm::dvec3& w, glm::dvec3& dx, glm::dvec3& dw) const;
@@ -146,6 +177,7 @@ class RayMarch {
   void sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& d) const;
   glm::dvec3 sharpDirection(const MarchState& S) const;
   BoundaryCrossing nextCrossing(const glm::dvec3& a, const glm::dvec3& b, int region) const;
+  long long cellsOn(const glm::dvec3& a, const glm::dvec3& b) const;
   void absorbAlong(MarchState& S, const glm::dvec3& dir, double len) const;
   SharpEvent sharpSegment(MarchState& S, MarchResult& R, BoundaryCrossing& c) const;
   void sharpDeriv(int region, const glm::dvec3& x, const glm::dvec3& w, glm::dvec3& dx,
@@ -154,7 +186,7 @@ class RayMarch {
   SharpEvent sharpStep(MarchState& S, MarchResult& R, BoundaryCrossing& c) const;
   void crossInterface(MarchState& S, MarchResult& R, const BoundaryCrossing& c) const;
 
-  const Field& f_;
+  CountedField f_;
   const Environment& env_;
   double lambda_nm_, il2_ = 0.0, il4_ = 0.0;
   bool scalar_;
@@ -223,7 +255,7 @@ glm::dvec3 RayMarch::inScatter(const glm::dvec3& x, const glm::dvec3& dir,
 glm::dvec3 RayMarch::diffuseSurface(const glm::dvec3& x) const {
   // Albedo and opacity are both composited with the coverage: their ratio is the surface's albedo.
   if (!lit_) return glm::dvec3(0.0);
-  auto opacity = [&](const glm::dvec3& y) { return field::sampleMedium(f_, y, mode_).w; };
+  auto opacity = [&](const glm::dvec3& y) { return field::sampleMedium(f_.read(), y, mode_).w; };
   const glm::dvec4 sc = f_.scatter(x) / std::max(opacity(x), 0.5);
   if (sc.x + sc.y + sc.z <= 0.0) return glm::dvec3(0.0);
   glm::dvec3 g;
@@ -494,6 +526,7 @@ constexpr double kNudgeVoxels = 1e-4;
 void RayMarch::sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& d) const {
   S.x = x;
   S.region = boundaryRegion(*bf_, x);
+  ++f_.fetches;  // the cell around x
   const MediumRecord& m = rec(S.region);
   double n = regionIndex(S.region, 0, x);
   const glm::dvec4 af = mediumAxisField(m, x);
@@ -521,6 +554,9 @@ BoundaryCrossing RayMarch::nextCrossing(const glm::dvec3& a, const glm::dvec3& b
   glm::dvec3 start = a;
   for (int k = 0; k < 4; ++k) {
     BoundaryCrossing c = locateCrossing(*bf_, start, b);
+    // Its cell reads: the region at start, the cells walked to the crossing, and (found) the
+    // cells past it and at it (the region entered, the field's normal).
+    f_.fetches += 1 + cellsOn(start, c.found ? c.point : b) + (c.found ? 2 : 0);
     if (!c.found) return c;
     const double along = glm::dot(c.point - a, dir);
     const bool sliver = c.from != region && c.to == region && along <= kSliverVoxels * h_;
@@ -533,6 +569,20 @@ BoundaryCrossing RayMarch::nextCrossing(const glm::dvec3& a, const glm::dvec3& b
     if (along + kNudgeVoxels * h_ >= total) return BoundaryCrossing{};
   }
   return BoundaryCrossing{};
+}
+
+// The trilinear cells of the boundary field that [a, b] passes through, which locateCrossing
+// walks in order: 1 + the voxel-centre planes crossed (boundary.cpp cellBreaks).
+long long RayMarch::cellsOn(const glm::dvec3& a, const glm::dvec3& b) const {
+  const Grid& g = bf_->grid;
+  const glm::dvec3 ua = (a - g.origin) / g.h - 0.5, ub = (b - g.origin) / g.h - 0.5;
+  long long n = 1;
+  for (int k = 0; k < 3; ++k) {
+    const double m0 = std::max(std::ceil(std::min(ua[k], ub[k])), 0.0);
+    const double m1 = std::min(std::floor(std::max(ua[k], ub[k])), double(g.dims[size_t(k)] - 1));
+    if (m1 >= m0) n += (long long)(m1 - m0) + 1;
+  }
+  return n;
 }
 
 // Emission, attenuation (exact: e^{−σ len}) and in-scatter along a straight piece in the ray's
@@ -727,7 +777,9 @@ ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm:
                                                  double lambda_nm, bool scalar,
                                                  const MarchSettings& m, int mode) const {
   Result r;
-  static_cast<MarchResult&>(r) = RayMarch(field_, env_, lambda_nm, scalar, m, mode).march(o, d);
+  const RayMarch rm(field_, env_, lambda_nm, scalar, m, mode);
+  static_cast<MarchResult&>(r) = rm.march(o, d);
+  r.fetches = rm.fetches();
   return r;
 }
 
@@ -769,10 +821,10 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
                aspect = double(img.width) / img.height;
   const glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
   std::atomic<int> next{0}, rows_done{0};
-  std::atomic<long long> total_steps{0};
+  std::atomic<long long> total_steps{0}, total_fetches{0};
   std::mutex progress_mutex;  // progress per row, one report at a time (skipped when busy)
   auto worker = [&] {
-    long long local_steps = 0;
+    long long local_steps = 0, local_fetches = 0;
     for (int y = next++; y < img.height; y = next++) {
       if (y > 0 && s.progress) {
         std::unique_lock<std::mutex> lock(progress_mutex, std::try_to_lock);
@@ -781,7 +833,7 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
       for (int x = 0; x < img.width; ++x) {
         uint32_t pixel = uint32_t(y * img.width + x);
         glm::dvec3 sum(0.0);
-        double steps = 0;
+        double steps = 0, fetches = 0;
         for (int sidx = 0; sidx < s.spp; ++sidx) {
           double jx = 0.5, jy = 0.5;
           if (s.spp > 1) {
@@ -800,10 +852,12 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
               Result r = march(cam.position, d, l, true, s.march, 0);
               double rad = r.radiance.x;
               steps += double(r.steps) / s.wavelengths;
+              fetches += double(r.fetches) / s.wavelengths;
               if (field_.uniaxial()) {  // unpolarised: each mode carries half
                 Result re = march(cam.position, d, l, true, s.march, 1);
                 rad = 0.5 * (rad + re.radiance.x);
                 steps += double(re.steps) / s.wavelengths;
+                fetches += double(re.fetches) / s.wavelengths;
               }
               xyz += rad * spectrum::sampleWeightXyz(l, uint32_t(s.wavelengths));
             }
@@ -812,10 +866,12 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
             Result r = march(cam.position, d, s.wavelength_nm, false, s.march, 0);
             glm::dvec3 rad = r.radiance;
             steps += r.steps;
+            fetches += double(r.fetches);
             if (field_.uniaxial()) {
               Result re = march(cam.position, d, s.wavelength_nm, false, s.march, 1);
               rad = 0.5 * (rad + re.radiance);
               steps += re.steps;
+              fetches += double(re.fetches);
             }
             sum += rad;
           }
@@ -823,10 +879,12 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
         size_t o = (size_t(y) * size_t(img.width) + size_t(x)) * 3;
         for (int c = 0; c < 3; ++c) img.rgb[o + size_t(c)] = float(sum[c] / s.spp);
         local_steps += (long long)(steps / s.spp);
+        local_fetches += (long long)(fetches / s.spp);
       }
       ++rows_done;
     }
     total_steps += local_steps;
+    total_fetches += local_fetches;
   };
   int t = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
   auto t0 = std::chrono::steady_clock::now();
@@ -836,6 +894,7 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
   if (s.progress) s.progress(1.0);
   img.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   img.mean_steps = double(total_steps) / (double(img.width) * img.height);
+  img.mean_fetches = double(total_fetches) / (double(img.width) * img.height);
   return img;
 }
 

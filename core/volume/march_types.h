@@ -35,7 +35,10 @@ struct RenderImage {
   int width = 0, height = 0;
   std::vector<float> rgb;
   double mean_steps = 0.0;  ///< integration steps per ray (mean over pixels)
-  double seconds = 0.0;     ///< wall time of the march itself
+  /// Volume-field reads per ray (trilinear samples, boundary cells); the CPU twin's only, 0 on
+  /// the GPU (core/reference/reference_marcher.cpp CountedField).
+  double mean_fetches = 0.0;
+  double seconds = 0.0;  ///< wall time of the march itself
 };
 
 /// One traced ray (one mode) as both twins report it. Directions are unit, world space.
