@@ -21,8 +21,8 @@
 // Common mistakes: expecting bit-identical stats — float32 may move a borderline kill or split by
 // a step; expecting identical stats when splits are refused (the budget is applied per rebuild
 // against that rebuild's survivors, so which splits are refused depends on steps_per_dispatch);
-// forgetting the buffer limits — live patches take 160 B each (two lists) and the splat 36 B per
-// voxel, each buffer within the device's storage-buffer range (lavapipe: 128 MiB ≈ 838k live
+// forgetting the buffer limits — live patches take 176 B each (two lists) and the splat 36 B per
+// voxel, each buffer within the device's storage-buffer range (lavapipe: 128 MiB ≈ 762k live
 // patches, 3.7M voxels; run() and the constructor throw with a message beyond that, so lower
 // max_patches or the resolution).
 #pragma once
