@@ -159,9 +159,8 @@ void printSummary(const RenderArgs& a, Session& session, const LightOutcome& lig
         light.summary.seconds, light.summary.patches,
         double(light.summary.patches) / std::max(light.summary.seconds, 1e-9),
         light.summary.conservationError(),
-        light.summary.flux_emitted > 0
-            ? light.summary.flux_reflected / light.summary.flux_emitted
-            : 0.0);
+        light.summary.flux_emitted > 0 ? light.summary.flux_reflected / light.summary.flux_emitted
+                                       : 0.0);
   double rays = double(img.width) * img.height * a.spp * std::max(1, rs.wavelengths);
   std::printf(
       "eikon: rendered %s (%dx%d, %s, %d spp) on %s in %.2f s: %.3g rays/s, %.1f steps/ray -> %s, "

@@ -50,17 +50,16 @@ struct Run {
 
 void print(const char* name, const Run& r) {
   const WavefrontStats& s = r.st;
-  const double ended =
-      s.flux_left + s.flux_caustic + s.flux_energy + s.flux_absorbed + s.flux_reflected +
-      s.flux_live_at_end;
+  const double ended = s.flux_left + s.flux_caustic + s.flux_energy + s.flux_absorbed +
+                       s.flux_reflected + s.flux_live_at_end;
   std::printf(
       "  %-6s %8.2f s  %10.0f patches  %9.3g patches/s  steps %5d  splits %zu (refused %zu)\n",
       name, r.s, r.patches(), r.patches() / r.s, s.steps, s.splits, s.splits_refused);
   std::printf(
       "       flux emitted %.9g = left %.9g + caustic %.9g + energy %.9g + absorbed %.9g + "
       "reflected %.9g + live %.9g  (balance %+.2e relative)\n",
-      s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_energy, s.flux_absorbed,
-      s.flux_reflected, s.flux_live_at_end, (ended - s.flux_emitted) / s.flux_emitted);
+      s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_energy, s.flux_absorbed, s.flux_reflected,
+      s.flux_live_at_end, (ended - s.flux_emitted) / s.flux_emitted);
   if (s.straight_steps > 0)
     std::printf("       straight steps %zu covering %zu time steps (%.1f each)\n", s.straight_steps,
                 s.straight_time_steps, double(s.straight_time_steps) / double(s.straight_steps));
@@ -73,7 +72,7 @@ struct Pair {
 };
 
 int gStepsPerDispatch = 16;
-bool gSharp = false;  ///< --sharp
+bool gSharp = false;              ///< --sharp
 std::vector<int> gThreads = {0};  ///< CPU reference thread counts (0: hardware concurrency)
 
 Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu) {

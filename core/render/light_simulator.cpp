@@ -11,8 +11,8 @@
 #include "core/light/lighting.h"
 #include "core/light/seeding.h"
 #include "core/render/boundary_device.h"
-#include "core/volume/media.h"
 #include "core/vk/resources.h"
+#include "core/volume/media.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/scan.spv.h"
 #include "shaders/wavefront.spv.h"
@@ -445,8 +445,7 @@ struct GpuWavefront::Impl {
       if (s.progress)
         s.progress(wavefrontRunFraction(
             dispatches * steps_per_dispatch, s.dt, g.extent,
-            st.flux_left + st.flux_caustic + st.flux_energy + st.flux_absorbed +
-                st.flux_reflected,
+            st.flux_left + st.flux_caustic + st.flux_energy + st.flux_absorbed + st.flux_reflected,
             st.flux_emitted));
       if (total == 0) break;
       const int dst = 1 - src;

@@ -208,9 +208,10 @@ TEST(SharpWavefrontTwins, PrismAtMinimumDeviation) {
   std::printf(
       "[ measured ] gpu sharp prism: deviation %.9f° (closed form %.9f°, error %.2e°, bound "
       "%.1e°; cpu %.2e°), 1 − |dir| %.2e, T relative error %.2e\n",
-      deviation(g.probe_direction) / kDeg, dMin / kDeg, (deviation(g.probe_direction) - dMin) / kDeg,
-      dirTol / kDeg, (deviation(c.probe_direction) - dMin) / kDeg,
-      1.0 - glm::length(g.probe_direction), g.flux_probe / g.flux_emitted / T - 1.0);
+      deviation(g.probe_direction) / kDeg, dMin / kDeg,
+      (deviation(g.probe_direction) - dMin) / kDeg, dirTol / kDeg,
+      (deviation(c.probe_direction) - dMin) / kDeg, 1.0 - glm::length(g.probe_direction),
+      g.flux_probe / g.flux_emitted / T - 1.0);
   EXPECT_NEAR(deviation(g.probe_direction), dMin, dirTol);
   EXPECT_NEAR(glm::length(g.probe_direction), 1.0, dirTol);
   EXPECT_NEAR(g.flux_probe / g.flux_emitted, T, 1e-5 * T);
@@ -346,9 +347,8 @@ TEST(SharpWavefrontTwins, LightingDriversFollowTheInterfaces) {
   std::printf(
       "[ measured ] lighting drivers, sharp sphere: reflected gpu %.6f, cpu %.6f of emitted "
       "(bounds %.4f, %.4f), balance gpu %.1e cpu %.1e; smoothed reflected %.1e\n",
-      gpu.flux_reflected / gpu.flux_emitted, cpu.flux_reflected / cpu.flux_emitted,
-      0.0784 * disc, disc, gpu.conservationError(), cpu.conservationError(),
-      off.flux_reflected);
+      gpu.flux_reflected / gpu.flux_emitted, cpu.flux_reflected / cpu.flux_emitted, 0.0784 * disc,
+      disc, gpu.conservationError(), cpu.conservationError(), off.flux_reflected);
   for (const LightingSummary* sum : {&gpu, &cpu}) {
     EXPECT_GT(sum->flux_reflected, 0.0784 * disc * sum->flux_emitted * 0.99);
     EXPECT_LT(sum->flux_reflected, disc * sum->flux_emitted);
