@@ -712,9 +712,9 @@ TEST_F(Cli, LightSummaryReportsTheFluxReflectedAtSharpInterfaces) {
   "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 2}]
 })";
   auto reflected = [&](const std::string& interfaces, const std::string& device) {
-    std::string json = scene;
-    json.replace(json.find("INTERFACES"), 10, "\"interfaces\": \"" + interfaces + "\",");
-    const Outcome o = render(json, "-q --caustics kill --no-light-cache --light-device " + device);
+    std::string text = scene;
+    text.replace(text.find("INTERFACES"), 10, "\"interfaces\": \"" + interfaces + "\",");
+    const Outcome o = render(text, "-q --caustics kill --no-light-cache --light-device " + device);
     EXPECT_EQ(o.code, 0) << o.err;
     const size_t at = o.out.find("reflected ");
     EXPECT_NE(at, std::string::npos) << o.out;
