@@ -158,12 +158,14 @@ void printSummary(const RenderArgs& a, Session& session, const LightOutcome& lig
   else if (light.summary.runs > 0)
     std::printf(
         "eikon: simulated %zu light runs on %s in %.2f s: %zu patches (%.3g patches/s), flux "
-        "balance %.1e\n",
+        "balance %.1e, reflected %.3g of emitted\n",
         light.summary.runs,
         light.on_cpu ? "the CPU reference" : session.context().deviceName().c_str(),
         light.summary.seconds, light.summary.patches,
         double(light.summary.patches) / std::max(light.summary.seconds, 1e-9),
-        light.summary.conservationError());
+        light.summary.conservationError(),
+        light.summary.flux_emitted > 0 ? light.summary.flux_reflected / light.summary.flux_emitted
+                                       : 0.0);
   double rays = double(img.width) * img.height * a.spp * std::max(1, rs.wavelengths);
   std::printf(
       "eikon: rendered %s (%dx%d, %s, %d spp) on %s in %.2f s: %.3g rays/s, %.1f steps/ray -> %s, "

@@ -9,12 +9,15 @@
 // minutes per twin on a 2-core lavapipe machine), and the speed-up of skipping at that resolution.
 // Timings are not asserted anywhere (they vary ±20% on a shared machine).
 //
+// --sharp: every run at the scene's sharp interfaces (issue 13; WavefrontSettings::
+// sharp_interfaces on the GPU, sharpInterfacesFor on the CPU), where they apply.
+//
 // --threads T1,T2,…: run the CPU reference once per listed thread count
 // (WavefrontSettings::threads; default 0 = hardware concurrency) and print each one's speed-up
 // over the first; --no-gpu: skip the GPU twin (and Vulkan).
 //
 //   light_bench [--resolution N] [--no-skip-resolution M] [--steps-per-dispatch K] [--no-cpu]
-//               [--no-gpu] [--threads T1,T2,…]
+//               [--no-gpu] [--threads T1,T2,…] [--sharp]
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -47,16 +50,15 @@ struct Run {
 
 void print(const char* name, const Run& r) {
   const WavefrontStats& s = r.st;
-  const double ended =
-      s.flux_left + s.flux_caustic + s.flux_energy + s.flux_absorbed + s.flux_live_at_end;
+  const double ended = s.flux_left + s.flux_caustic + s.flux_energy + s.flux_absorbed +
+                       s.flux_reflected + s.flux_live_at_end;
   std::printf(
       "  %-6s %8.2f s  %10.0f patches  %9.3g patches/s  steps %5d  splits %zu (refused %zu)\n",
       name, r.s, r.patches(), r.patches() / r.s, s.steps, s.splits, s.splits_refused);
   std::printf(
-      "       flux emitted %.9g = left %.9g + caustic %.9g + energy %.9g + absorbed %.9g + live "
-      "%.9g"
-      "  (balance %+.2e relative)\n",
-      s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_energy, s.flux_absorbed,
+      "       flux emitted %.9g = left %.9g + caustic %.9g + energy %.9g + absorbed %.9g + "
+      "reflected %.9g + live %.9g  (balance %+.2e relative)\n",
+      s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_energy, s.flux_absorbed, s.flux_reflected,
       s.flux_live_at_end, (ended - s.flux_emitted) / s.flux_emitted);
   if (s.straight_steps > 0)
     std::printf("       straight steps %zu covering %zu time steps (%.1f each)\n", s.straight_steps,
@@ -70,6 +72,7 @@ struct Pair {
 };
 
 int gStepsPerDispatch = 16;
+bool gSharp = false;              ///< --sharp
 std::vector<int> gThreads = {0};  ///< CPU reference thread counts (0: hardware concurrency)
 
 Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu) {
@@ -77,9 +80,13 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
   const VolumeSet vol = voxelize(scene);
   WavefrontSettings s;
   s.skip_empty = skip;
-  std::printf("\nvolume %dx%dx%d (h = %.4g mm), straight steps %s\n", vol.grid.dims[0],
-              vol.grid.dims[1], vol.grid.dims[2], vol.grid.h,
-              skip ? "on (skip_empty = true)" : "off (skip_empty = false)");
+  s.sharp_interfaces = gSharp;
+  const SharpInterfaces sharp =
+      gSharp ? sharpInterfacesFor(vol, s.wavelength_nm) : SharpInterfaces{};
+  std::printf("\nvolume %dx%dx%d (h = %.4g mm), straight steps %s, interfaces %s\n",
+              vol.grid.dims[0], vol.grid.dims[1], vol.grid.dims[2], vol.grid.h,
+              skip ? "on (skip_empty = true)" : "off (skip_empty = false)",
+              sharp.active() ? "sharp" : "smoothed");
   Pair p;
   if (ctx) {
     GpuWavefront gpu(*ctx, vol, s, gStepsPerDispatch);
@@ -94,7 +101,7 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
     VolumeField field(vol);
     for (int threads : gThreads) {
       s.threads = threads;
-      WavefrontSimulator sim(field, vol.grid, s);
+      WavefrontSimulator sim(field, vol.grid, s, sharp);
       auto t0 = std::chrono::steady_clock::now();
       WavefrontResult r = sim.run(scene.lights[0]);
       Run run;
@@ -135,6 +142,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_flag("!--no-cpu", cpu, "Skip the CPU reference");
   app.add_flag("!--no-gpu", gpu, "Skip the GPU simulator");
+  app.add_flag("--sharp", gSharp, "Simulate at the scene's sharp interfaces (both twins)");
   app.add_option("--threads", gThreads,
                  "CPU thread counts to compare, comma separated (0: all cores)")
       ->delimiter(',')

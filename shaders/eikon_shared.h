@@ -224,18 +224,24 @@ struct WaveTally {
   uvec4 count_a;  // kills: left, caustic, energy, opaque
   uvec4 count_b;  // x: live at max_steps; y: patches asking for a split; z: survivors (count ≥ 1); w: max steps
   vec4 probe_pos;  // probe plane crossings in the last dispatch: xyz: Σ ±flux·crossing point; w: Σ ±flux
-  vec4 probe_dir;  // xyz: Σ ±flux·unit direction of the centre's motion at the crossing
+  vec4 probe_dir;  // xyz: Σ ±flux·unit direction of the centre's motion at the crossing;
+                   // w: sharp interfaces: Σ flux lost to Fresnel reflection in the last dispatch
 };
 
 // One patch: four corners in bilinear order (0,0), (1,0), (1,1), (0,1).
 // x[k].w, w[k].w: the probe sums of the last propagation (x[0..2].w: Σ ±flux·crossing point,
-// x[3].w: Σ ±flux, w[0..2].w: Σ ±flux·direction; w[3].w unused), read by the COUNT pass.
+// x[3].w: Σ ±flux, w[0..2].w: Σ ±flux·direction) and w[3].w the flux lost to Fresnel reflection
+// in it (sharp interfaces), read by the COUNT pass.
 struct WavePatch {
   vec4 x[4];    // xyz: corner position (mm)
   vec4 w[4];    // xyz: corner wave vector w = p (o-mode |w| = n; e-mode wᵀM_e w = 1)
   vec4 flux;    // x: flux (W); y: area0 (mm²); z: seed flux (W); w: flux absorbed in this dispatch
   ivec4 state;  // x: EIKON_PATCH_*; y: launch orientation (±1, 0); z: entered (0/1); w: steps done
+  ivec4 region; // sharp interfaces: corner k's region (bits 0–15; −1: not located yet) and its
+                // mirror bit EIKON_CORNER_MIRRORED (odd number of total internal reflections)
 };
+#define EIKON_CORNER_REGION 0xFFFF
+#define EIKON_CORNER_MIRRORED 0x10000
 
 #ifdef __cplusplus
 static_assert(sizeof(ViewParams) == 15 * 16, "ViewParams must be vec4-packed");
@@ -244,7 +250,7 @@ static_assert(sizeof(BoundaryQuery) == 48 && sizeof(BoundaryAnswer) == 80,
               "boundary probe records must be vec4-packed");
 static_assert(sizeof(WavePush) == 16 && sizeof(ScanPush) == 16 && sizeof(WaveTally) == 7 * 16,
               "wavefront push/tally records must be vec4-packed");
-static_assert(sizeof(WaveParams) == 8 * 16 && sizeof(WavePatch) == 10 * 16, "wavefront records must be vec4-packed");
+static_assert(sizeof(WaveParams) == 8 * 16 && sizeof(WavePatch) == 11 * 16, "wavefront records must be vec4-packed");
 }  // namespace eikon::gpu
 #endif
 

@@ -149,17 +149,7 @@ vec3 environment(vec3 d) {
   return colourOf(c * P.env.z);
 }
 
-// Fresnel amplitude reflectances squared (Rs, Rp) for a wave going from index n1 into n2 with
-// cos θ_i = ci ≥ 0 (Born & Wolf §1.5.2); (1, 1) beyond the critical angle.
-vec2 fresnelRsRp(float ci, float n1, float n2) {
-  float eta = n1 / n2;
-  float st2 = eta * eta * max(0.0, 1.0 - ci * ci);
-  if (st2 >= 1.0) return vec2(1.0);
-  float ct = sqrt(1.0 - st2);
-  float rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
-  float rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
-  return vec2(rs * rs, rp * rp);
-}
+#include "fresnel.glsl"
 
 // Light from the light simulator (docs/design.md §2 image formation, Tevs eq. 5.10; docs/light-simulator.md).
 // φ (fluence rate, W/mm², linear sRGB) and the net flux vector F of its luminance φ_Y, trilinear.
@@ -276,20 +266,6 @@ vec3 attenuationAt(vec3 x, vec3 w, int mode) {
   if (!hasAxis(a)) return so;
   vec3 se = sigmaOf(sampleMedium(x, 1).xyz);
   return attenuationE(so, se, w, a, sampleIndex(x, 0).x, sampleIndex(x, 1).x);
-}
-
-// Fresnel (Rs, Rp) weights of a mode at an interface: the share of its D field along the
-// s-polarisation direction (normal to the plane of incidence). Isotropic or degenerate: ½/½,
-// which makes ½(T_o + T_e) the unpolarised transmittance.
-float sWeight(vec3 s_crystal, vec3 a, vec3 N, vec3 dIn, int mode) {
-  vec3 es = cross(N, dIn);
-  if (dot(a, a) < 0.25 || dot(es, es) < 1e-12) return 0.5;
-  vec3 Do = cross(s_crystal, a);
-  if (dot(Do, Do) < 1e-12) return 0.5;  // wave normal along the axis: no split
-  Do = normalize(Do);
-  es = normalize(es);
-  float wo = dot(Do, es) * dot(Do, es);
-  return mode == 0 ? wo : 1.0 - wo;
 }
 
 // ---- The march, stage by stage (the same stages, under the same names, as ReferenceMarcher's in

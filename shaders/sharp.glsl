@@ -8,6 +8,9 @@
 // one (GRIN, radial optic axis) is integrated with RK4 on the region's own analytic medium; each
 // segment or step chord is tested with locateCrossing, and at a crossing the exact interface laws
 // (optics/interface.h, optics/fresnel.h) are applied.
+//
+// The light simulator (wavefront.comp) defines EIKON_SHARP_NO_MARCH before including this file: it
+// takes the medium table, the interface laws and nextCrossing, not the march's stages.
 #ifndef EIKON_SHARP_GLSL
 #define EIKON_SHARP_GLSL
 
@@ -134,6 +137,7 @@ ModeWave solveInterfaceMode(vec3 pt, vec3 m, bool eMat, vec3 a, float no, float 
 vec3 orientNormal(vec3 N, vec3 flow) { return dot(N, flow) < 0.0 ? -N : N; }
 
 // ---- The stages (RayMarch::sharp*) ----
+#ifndef EIKON_SHARP_NO_MARCH
 
 // Box entry: the region there, and the wave vector of the mode in its medium along d.
 void sharpEnter(inout MarchState S, vec3 x, vec3 d, int mode) {
@@ -152,6 +156,8 @@ vec3 sharpDirection(MarchState S, int mode) {
   if (mode == 0 || !hasAxis(af.xyz)) return normalize(S.w);
   return normalize(applyM(S.w, af.xyz, regionIndex(S.region, 0, S.x), regionIndex(S.region, 1, S.x)));
 }
+
+#endif  // EIKON_SHARP_NO_MARCH
 
 // The first crossing on [a, b] out of the ray's region, skipping slivers (a crossing back into the
 // ray's own region within kSliverVoxels of a).
@@ -184,6 +190,7 @@ BoundaryCrossing nextCrossing(vec3 a, vec3 b, int region) {
   return none;
 }
 
+#ifndef EIKON_SHARP_NO_MARCH
 // Emission, attenuation (exact: e^{−σ len}) and in-scatter along a straight piece in the ray's
 // region.
 void absorbAlong(inout MarchState S, vec3 dir, float len, int mode) {
@@ -416,5 +423,6 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   R.throughput = S.T;
   return R;
 }
+#endif  // EIKON_SHARP_NO_MARCH
 
 #endif  // EIKON_SHARP_GLSL

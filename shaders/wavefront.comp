@@ -31,6 +31,15 @@
 //     their offset; a child whose edge still exceeds the split span is written as SPLIT and is
 //     split again by the next rebuild without propagating (the reference's recursive split).
 //
+// Sharp interfaces (issue 13; specialisation constant kSharpLight, set by the host only when the
+// scene's boundary field applies, as the view renderer's kSharpMarch): every corner crosses its
+// region's homogeneous medium on a straight line in constant time, is stopped at the first
+// boundary (nextCrossing of sharp.glsl, locateCrossing of boundary.glsl), refracted or totally
+// reflected there (solveInterfaceMode) and goes on for the rest of the step; the patch takes the
+// product of its corners' Fresnel transmissions T^¼ (fresnel.glsl). The stages are
+// PatchStepper's sharp ones in core/reference/wavefront.cpp under the same names: sharpCorner,
+// crossInterface, mediumShell, mediumVelocity, mediumSigma, straddles.
+//
 // Splat: GLSL float atomics (GL_EXT_shader_atomic_float) are not available everywhere (lavapipe),
 // so the Accumulate sums are signed 64-bit fixed point held as (lo, hi) uint pairs: lo by
 // atomicAdd, hi by the carry and the sign extension (exact, order independent). One splat is
@@ -86,6 +95,47 @@ void storeOther(uint i, WavePatch p) {
 #include "field.glsl"
 
 bool eMode() { return P.control.w == 1; }
+
+// ---- Sharp interfaces: the boundary field (boundary.glsl), the medium table and the interface
+// laws (sharp.glsl, without the view march's stages), the Fresnel factors (fresnel.glsl) ----
+layout(constant_id = 0) const bool kSharpLight = false;
+layout(binding = EIKON_B_REGION, r32ui) readonly uniform uimage3D regionImg;
+layout(binding = EIKON_B_BOUNDARY_DIST, r32f) readonly uniform image3D boundaryDist;
+layout(std430, binding = EIKON_B_SHAPES) readonly buffer ShapeBuf { vec4 shapeTable[]; };
+layout(std430, binding = EIKON_B_MEDIA) readonly buffer MediaBuf { vec4 mediaTable[]; };
+float gLambdaUm = 0.5876;      // sharp.glsl's mediumIndex: set to P.wavelength.x in main()
+bool gDispersiveHit = false;  // written by mediumIndex, unused here
+#include "boundary.glsl"
+#include "fresnel.glsl"
+#define EIKON_SHARP_NO_MARCH
+#include "sharp.glsl"
+
+int regionOf(int corner) { return corner & EIKON_CORNER_REGION; }
+
+// The constant-time velocity dx/dt in region r's medium (deriv in a constant field): w/n², or in a
+// crystal of the e-mode M_e w.
+vec3 mediumVelocity(int r, vec3 w) {
+  float no = mediumIndex(r, 0);
+  if (eMode() && mediumUniaxial(r)) return applyM(w, mediumRow(r, 7).xyz, no, mediumIndex(r, 1));
+  return w / (no * no);
+}
+
+// The wave vector along the unit direction s on region r's shell: n·s, or in a crystal of the
+// e-mode s/√(sᵀM_e s).
+vec3 mediumShell(int r, vec3 s) {
+  if (eMode() && mediumUniaxial(r)) return s * inversesqrt(dot(s, mediumVelocity(r, s)));
+  return mediumIndex(r, 0) * s;
+}
+
+// Attenuation per unit ray length in region r for wave vector w: σ_o at the wavelength, or in a
+// crystal of the e-mode the pleochroic σ(θ)·cos ρ (attenuationE).
+float mediumSigma(int r, vec3 w) {
+  float so = bandAt(mediumRow(r, 8).xyz);
+  if (!eMode() || !mediumUniaxial(r)) return so;
+  float se = bandAt(mediumRow(r, 9).xyz);
+  if (so == 0.0 && se == 0.0) return so;
+  return attenuationE(vec3(so), vec3(se), w, mediumRow(r, 7).xyz, mediumIndex(r, 0), mediumIndex(r, 1)).x;
+}
 
 // Wave vector along the unit direction s at x on the simulated mode's shell (onModeShell in
 // core/light/seeding.cpp, which PatchStepper::onShell calls).
@@ -269,7 +319,7 @@ void splatSegment(vec3 c0, vec3 u, float L, float E0, float sigma, vec3 dir, flo
 // caustic or leave.
 int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, out vec3 v[4]) {
   for (int k = 0; k < 4; ++k) v[k] = vec3(0.0);
-  if (P.options.x == 0) return 0;
+  if (P.options.x == 0 || kSharpLight) return 0;  // sharp: the skip distance describes the smoothed field
   const vec3 c0 = centreOf(x);
   const float Dc = skipAt(c0);
   if (Dc < 2.0) return 0;
@@ -339,7 +389,113 @@ struct PatchStep {
   float sigma;    // attenuation at the step's midpoint
   float E0;       // flux before the step
   float fluxMid;  // flux at the step's middle
+  // Sharp interfaces: the factors of the corners' crossings over the step, each the product over
+  // the four corners of a fourth root (Fresnel transmission; attenuation exp(−σ·length)).
+  float fresnel;
+  float attenuation;
 };
+
+// ---- Sharp interfaces: the stages of PatchStepper (core/reference/wavefront.cpp) ----
+
+// Corner at the crossing c (x the crossing point, w the incident wave vector, its region A = from):
+// the exact laws between the media of A and c.to. Isotropic ↔ isotropic: Snell and T = 1 − ½(Rs +
+// Rp); into a crystal: the run's mode (solveInterfaceMode on its shell) with T = 1 − (w_s Rs +
+// (1 − w_s) Rp), the D-projection share of fresnel.glsl (the CPU twin takes the exact Maxwell
+// share, uniaxialEntryExact: equal at normal incidence, a few 1e-3 apart at oblique incidence on
+// calcite, docs/uniaxial-optics.md); out of a crystal: the same with the incident mode's index;
+// crystal → crystal: the phase-matched wave of the same mode, no loss. Where the outgoing wave does
+// not exist: total internal reflection, the mirror wave of the same mode, no loss; the corner's
+// mirror bit flips and it stays in A. Equal media, or an opaque one entered: only the region
+// changes. Multiplies `transmission` by T; true if the corner was turned.
+bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, inout float transmission) {
+  const int B = c.to;
+  const vec3 N = c.normal;
+  const bool uA = mediumUniaxial(A), uB = mediumUniaxial(B), e = eMode();
+  const float noA = mediumIndex(A, 0), noB = mediumIndex(B, 0);
+  const float neA = uA ? mediumIndex(A, 1) : 0.0, neB = uB ? mediumIndex(B, 1) : 0.0;
+  const vec3 aA = mediumRow(A, 7).xyz, aB = mediumRow(B, 7).xyz;
+  const bool same = noA == noB && neA == neB && (!uA || aA == aB);
+  if (same || mediumOpaque(B) || !(length(N) > 0.0)) {
+    corner = (corner & ~EIKON_CORNER_REGION) | B;
+    return false;
+  }
+  const vec3 s = normalize(w);
+  const int mode = e ? 1 : 0;
+  // The incident wave's tangential part: along the energy flow of A's mode (a crystal's ray M_e w).
+  const vec3 m = uA && !uB ? orientNormal(N, normalize(mediumVelocity(A, s))) : orientNormal(N, s);
+  const float nIn = uA && e ? inversesqrt(dot(s, applyM(s, aA, noA, neA))) : noA;
+  const vec3 pt = nIn * s - dot(nIn * s, m) * m;
+  ModeWave o;
+  float T = 1.0;
+  bool mirror = false;
+  if (!uB || !uA) {  // isotropic → isotropic, into a crystal, out of a crystal
+    o = solveInterfaceMode(pt, m, uB && e, aB, noB, uB ? neB : noB, true);
+    if (o.exists) {
+      const vec2 rsp = fresnelRsRp(min(1.0, abs(dot(s, N))), nIn, o.n);
+      const float ws = uA || uB ? sWeight(uB ? o.s : s, uB ? aB : aA, N, s, mode) : 0.5;
+      T = 1.0 - (ws * rsp.x + (1.0 - ws) * rsp.y);
+    }
+  } else {  // crystal → crystal
+    const vec3 mc = dot(mediumVelocity(A, w), N) >= 0.0 ? N : -N;
+    const vec3 ptc = w - dot(w, mc) * mc;
+    o = solveInterfaceMode(ptc, mc, e, aB, noB, neB, true);
+    if (!o.exists) {
+      o = solveInterfaceMode(ptc, mc, e, aA, noA, neA, false);
+      mirror = true;
+    }
+  }
+  if (!o.exists && !mirror) {  // total internal reflection (or a crystal mode that cannot enter)
+    o = solveInterfaceMode(pt, m, uA && e, aA, noA, uA ? neA : noA, false);
+    mirror = true;
+  }
+  if (!o.exists) {  // degenerate (grazing): go on unturned
+    corner = (corner & ~EIKON_CORNER_REGION) | B;
+    return false;
+  }
+  w = o.n * o.s;
+  if (mirror) {
+    corner ^= EIKON_CORNER_MIRRORED;
+  } else {
+    corner = (corner & ~EIKON_CORNER_REGION) | B;
+    transmission *= T;
+  }
+  return true;
+}
+
+// A corner moves for the step's time dt through homogeneous media: straight in its region's medium
+// up to the first boundary, turned there (crossInterface) and on for the rest of dt (at most 16
+// crossings). Its share of the patch's factors: T^¼ of each transmission, exp(−σ·length/4).
+void sharpCorner(inout vec3 x, inout vec3 w, inout int corner, inout PatchStep st) {
+  float T = P.step.x, absorb = 0.0, trans = 1.0;
+  for (int guard = 0; T > 0.0; ++guard) {
+    const int r = regionOf(corner);
+    const vec3 d = T * mediumVelocity(r, w);
+    const float len = length(d);
+    BoundaryCrossing c;
+    c.found = false;
+    if (guard < 16) c = nextCrossing(x, x + d, r);
+    if (!c.found) {
+      absorb += mediumSigma(r, w) * len;
+      x += d;
+      break;
+    }
+    absorb += mediumSigma(r, w) * c.t * len;
+    x = c.point;
+    T *= 1.0 - c.t;
+    crossInterface(c, r, w, corner, trans);
+  }
+  st.fresnel *= pow(trans, 0.25);
+  st.attenuation *= exp(-0.25 * absorb);
+}
+
+// The corners lie in different regions, or only some have been mirrored: the patch is being torn
+// by a boundary; it is not split and not tested for a caustic until all four are on one side.
+bool straddles(ivec4 region) {
+  const ivec4 r = region & EIKON_CORNER_REGION, mir = region & EIKON_CORNER_MIRRORED;
+  return r.y != r.x || r.z != r.x || r.w != r.x || mir.y != mir.x || mir.z != mir.x || mir.w != mir.x;
+}
+
+bool anyMirrored(ivec4 region) { return any(notEqual(region & EIKON_CORNER_MIRRORED, ivec4(0))); }
 
 vec3 meanOf(vec3 w[4]) { return 0.25 * (w[0] + w[1] + w[2] + w[3]); }
 
@@ -353,7 +509,12 @@ PatchStep moveStep(inout vec3 x[4], inout vec3 w[4], inout WavePatch p) {
   vec3 vel[4];
   st.kStraight = straightSteps(x, w, p.flux, p.state, vel);
   st.dA = vec3(0.0), st.dB = vec3(0.0), st.dC = vec3(0.0), st.dD = vec3(0.0);
-  if (st.kStraight > 0) {
+  st.fresnel = 1.0;
+  st.attenuation = 1.0;
+  if (kSharpLight) {
+    for (int k = 0; k < 4; ++k) sharpCorner(x[k], w[k], p.region[k], st);
+    ++p.state.w;
+  } else if (st.kStraight > 0) {
     st.dA = x[2] - x[0], st.dB = dt * (vel[2] - vel[0]), st.dC = x[3] - x[1], st.dD = dt * (vel[3] - vel[1]);
     const float T = float(st.kStraight) * dt;
     for (int k = 0; k < 4; ++k) x[k] += T * vel[k];
@@ -368,13 +529,24 @@ PatchStep moveStep(inout vec3 x[4], inout vec3 w[4], inout WavePatch p) {
 }
 
 // flux ← flux·exp(−σΔs), σ at the midpoint of the centre's path; returns the medium there.
-vec4 attenuateStep(inout WavePatch p, inout PatchStep st, vec3 w[4]) {
+// Sharp interfaces: first the corners' Fresnel losses (added to `reflected`), then their
+// attenuation; σ is the mean over the centre's path.
+vec4 attenuateStep(inout WavePatch p, inout PatchStep st, vec3 w[4], inout float reflected) {
   const vec3 m = 0.5 * (st.c0 + st.c1);
   const vec4 med = mediumAt(m);
-  st.sigma = eMode() ? sigmaE(m, 0.5 * (st.wm0 + meanOf(w))) : bandAt(med.xyz);
+  float att;
+  if (kSharpLight) {
+    reflected += p.flux.x * (1.0 - st.fresnel);
+    p.flux.x *= st.fresnel;
+    st.sigma = st.ds > 0.0 ? -log(st.attenuation) / st.ds : 0.0;
+    att = st.attenuation;
+    st.fluxMid = p.flux.x * sqrt(att);
+  } else {
+    st.sigma = eMode() ? sigmaE(m, 0.5 * (st.wm0 + meanOf(w))) : bandAt(med.xyz);
+    att = exp(-st.sigma * st.ds);
+    st.fluxMid = p.flux.x * exp(-0.5 * st.sigma * st.ds);
+  }
   st.E0 = p.flux.x;
-  float att = exp(-st.sigma * st.ds);
-  st.fluxMid = p.flux.x * exp(-0.5 * st.sigma * st.ds);
   p.flux.w += p.flux.x * (1.0 - att);
   p.flux.x *= att;
   return med;
@@ -430,7 +602,10 @@ bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) 
     return true;
   }
   const float o = dot(0.5 * cross(x[2] - x[0], x[3] - x[1]), wm);
-  if ((o > 0.0 && p.state.y < 0) || (o < 0.0 && p.state.y > 0)) {
+  // Sharp interfaces: a mirror reverses the orientation; a patch torn by a boundary is not tested.
+  const int orient = kSharpLight && anyMirrored(p.region) ? -p.state.y : p.state.y;
+  const bool torn = kSharpLight && straddles(p.region);
+  if (!torn && ((o > 0.0 && orient < 0) || (o < 0.0 && orient > 0))) {
     if (P.options.y == 0) {
       p.state.x = EIKON_PATCH_CAUSTIC;
       return true;
@@ -441,7 +616,7 @@ bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) 
     p.state.x = EIKON_PATCH_ENERGY;
     return true;
   }
-  if (maxEdgeOf(x) > P.step.y) {
+  if (maxEdgeOf(x) > P.step.y && !torn) {
     p.state.x = EIKON_PATCH_SPLIT;
     return true;
   }
@@ -462,14 +637,20 @@ void propagate(uint id) {
   }
   vec4 probePos = vec4(0.0);
   vec3 probeDir = vec3(0.0);
+  float reflected = 0.0;
   vec3 x[4], w[4];
   for (int k = 0; k < 4; ++k) {
     x[k] = p.x[k].xyz;
     w[k] = p.w[k].xyz;
   }
+  if (kSharpLight && p.region.x < 0)  // a seed: each corner in its region, on its medium's shell
+    for (int k = 0; k < 4; ++k) {
+      p.region[k] = boundaryRegion(x[k]);
+      w[k] = mediumShell(p.region[k], normalize(w[k]));
+    }
   for (int it = 0; it < P.control.y && p.state.w < P.control.z; ++it) {
     PatchStep st = moveStep(x, w, p);
-    const vec4 med = attenuateStep(p, st, w);
+    const vec4 med = attenuateStep(p, st, w, reflected);
     splatStep(st, x, w);
     probeStep(st, probePos, probeDir);
     if (endOfStep(p, st, med, x, w)) break;
@@ -481,7 +662,7 @@ void propagate(uint id) {
   p.w[0] = vec4(w[0], probeDir.x);
   p.w[1] = vec4(w[1], probeDir.y);
   p.w[2] = vec4(w[2], probeDir.z);
-  p.w[3] = vec4(w[3], 0.0);
+  p.w[3] = vec4(w[3], reflected);
   storePatch(id, p);
 }
 
@@ -511,7 +692,10 @@ void scatter(uint id) {
       const float w0 = (1.0 - fa) * (1.0 - fb), w1 = fa * (1.0 - fb), w2 = fa * fb, w3 = (1.0 - fa) * fb;
       X[b * 3 + a] = w0 * p.x[0].xyz + w1 * p.x[1].xyz + w2 * p.x[2].xyz + w3 * p.x[3].xyz;
       vec3 ww = w0 * p.w[0].xyz + w1 * p.w[1].xyz + w2 * p.w[2].xyz + w3 * p.w[3].xyz;
-      if (a == 1 || b == 1) ww = onShell(X[b * 3 + a], normalize(ww));  // back onto the mode's shell
+      if ((a == 1 || b == 1) && kSharpLight)
+        ww = mediumShell(regionOf(p.region.x), normalize(ww));  // the region's medium's shell
+      else if (a == 1 || b == 1)
+        ww = onShell(X[b * 3 + a], normalize(ww));  // back onto the mode's shell
       W[b * 3 + a] = ww;
     }
   X[0] = p.x[0].xyz, X[2] = p.x[1].xyz, X[8] = p.x[2].xyz, X[6] = p.x[3].xyz;
@@ -536,6 +720,7 @@ void scatter(uint id) {
 
 void main() {
   const uint id = gl_GlobalInvocationID.x, mode = pc.control.y;
+  gLambdaUm = P.wavelength.x;
   if (mode == EIKON_WM_PROPAGATE)
     propagate(id);
   else if (mode == EIKON_WM_SCATTER)

@@ -66,7 +66,7 @@ void countPass(uint id, uint lid, uint mode) {
     }
     fb.x = p.flux.w;
     ppos = vec4(p.x[0].w, p.x[1].w, p.x[2].w, p.x[3].w);  // probe sums of the last propagation
-    pdir = vec4(p.w[0].w, p.w[1].w, p.w[2].w, 0.0);
+    pdir = vec4(p.w[0].w, p.w[1].w, p.w[2].w, p.w[3].w);  // w: flux reflected (sharp interfaces)
     cb.y = wantSplit ? 1u : 0u;
     cb.z = keep;
     cb.w = uint(max(p.state.w, 0));

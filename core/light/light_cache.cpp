@@ -8,6 +8,8 @@
 
 #include "core/io/atomic_write.h"
 #include "core/io/cache_dir.h"
+#include "core/light/lighting.h"
+#include "core/volume/media.h"
 
 namespace eikon {
 namespace {
@@ -112,6 +114,15 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOpt
   h.value(s.skip_empty);
   h.value(s.pass_caustics);
   h.value(s.beam_min_cells);
+  // Sharp interfaces (issue 13): which path the light took, and what it refracted at (the
+  // boundary field and the media); a smoothed entry must not serve a sharp scene.
+  const bool sharp = o.sharp_interfaces && sharpLightApplies(v);
+  h.value(sharp);
+  if (sharp) {
+    h.vec(v.boundary.region);
+    h.vec(v.boundary.distance);
+    h.vec(packMediaTable(v.media));
+  }
   return h.digest();
 }
 

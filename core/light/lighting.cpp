@@ -117,6 +117,13 @@ void smoothLighting(VolumeSet& volume, double sigma_voxels, int threads) {
     }
 }
 
+bool sharpLightApplies(const VolumeSet& volume) {
+  const BoundaryField& b = volume.boundary;
+  const std::vector<MediumRecord>& m = volume.media.regions;
+  if (b.empty() || m.size() < b.shapes.size() + 1) return false;
+  return std::all_of(m.begin(), m.end(), [](const MediumRecord& r) { return r.homogeneous; });
+}
+
 std::string describeLighting(const std::vector<LightingRun>& runs, const Scene& scene) {
   size_t modes = 1;
   for (const auto& r : runs) modes = std::max(modes, size_t(r.mode + 1));

@@ -76,6 +76,13 @@ void addLightingRun(VolumeSet& volume, const LightingRun& run, const std::vector
 /// normalised) and blurs caustics by no more than the voxel size that already limits them.
 void smoothLighting(VolumeSet& volume, double sigma_voxels = 1.0, int threads = 0);
 
+/// Whether the light simulators (both twins) refract at the volume's sharp boundaries: it was
+/// voxelised with "interfaces": "sharp" (a boundary field), and the media table has a homogeneous
+/// medium for every region (core/volume/media.h). Otherwise (GRIN, a radial optic axis, a
+/// smoothed scene) they run the smoothed field throughout, as SharpInterfaces::active
+/// (core/reference/wavefront.h) decides for the CPU twin.
+bool sharpLightApplies(const VolumeSet& volume);
+
 /// One-line description of a plan for progress output ("2 lights x 12 bands x 2 modes").
 std::string describeLighting(const std::vector<LightingRun>& runs, const Scene& scene);
 

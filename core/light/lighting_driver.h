@@ -28,6 +28,11 @@ struct LightingOptions {
   int bands = 0;  ///< wavelength bands (≤ 0: defaultLightBands)
   double smoothing_voxels =
       1.0;  ///< σ of the final smoothing of the light volumes (smoothLighting)
+  /// Follow the scene's interfaces: refract at its sharp boundaries where they apply
+  /// (sharpLightApplies; both twins: WavefrontSettings::sharp_interfaces on the GPU,
+  /// sharpInterfacesFor on the CPU); false: the smoothed field throughout. Sets
+  /// wave.sharp_interfaces for every run.
+  bool sharp_interfaces = true;
   /// progress(fraction done, what) now and then; may be empty.
   std::function<void(double, const std::string&)> progress;
 };

@@ -80,6 +80,13 @@ struct WavefrontSettings {
   /// order (a sum of m terms by up to ~2m·2⁻⁵³ relative; glass-sphere test: ≤ 5e-12). The Field
   /// must allow concurrent calls (VolumeField does; an AnalyticField's function must too).
   int threads = 0;
+  /// Sharp interfaces (issue 13; docs/light-simulator.md, "Sharp interfaces"): GpuWavefront
+  /// refracts at the volume's exact boundaries where they apply (a boundary field, i.e.
+  /// "interfaces": "sharp", and a homogeneous medium in every region: sharpLightApplies,
+  /// core/light/lighting.h) instead of bending through the smoothed field. The CPU twin takes its
+  /// SharpInterfaces explicitly (WavefrontSimulator's constructor) and ignores this flag; the
+  /// lighting drivers of both twins set it from LightingOptions::sharp_interfaces.
+  bool sharp_interfaces = false;
   /// Called after every time step (CPU) or dispatch of steps (GPU) with an estimate of the run's
   /// fraction done (wavefrontRunFraction), from the thread that called run(); may be empty.
   /// Not part of the physics (not in the light cache key).
@@ -112,8 +119,8 @@ struct Patch {
   bool entered = false;        ///< the centre has been inside the field's bounds
   int probe_side = 0;          ///< −1 / +1: side of the probe plane the centre is on
   int steps = 0;               ///< time steps taken (a straight step of k counts k)
-  /// Sharp interfaces (CPU twin): each corner's region of the boundary field, and a bit per corner
-  /// set after an odd number of total internal reflections (a mirror reverses the orientation).
+  /// Sharp interfaces: each corner's region of the boundary field, and a bit per corner set after
+  /// an odd number of total internal reflections (a mirror reverses the orientation).
   std::array<int, 4> region{};
   unsigned mirrored = 0;
 };

@@ -1044,8 +1044,8 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     if (s_.progress) {
       double flux_ended = 0.0;
       for (const Chunk& ch : chunks)
-        flux_ended +=
-            ch.st.flux_left + ch.st.flux_caustic + ch.st.flux_energy + ch.st.flux_absorbed;
+        flux_ended += ch.st.flux_left + ch.st.flux_caustic + ch.st.flux_energy +
+                      ch.st.flux_absorbed + ch.st.flux_reflected;
       s_.progress(
           wavefrontRunFraction(step_count, s_.dt, grid_.extent, flux_ended, st.flux_emitted));
     }

@@ -8,8 +8,11 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/light/lighting.h"
 #include "core/light/seeding.h"
+#include "core/render/boundary_device.h"
 #include "core/vk/resources.h"
+#include "core/volume/media.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/scan.spv.h"
 #include "shaders/wavefront.spv.h"
@@ -110,6 +113,11 @@ struct GpuWavefront::Impl {
   std::vector<vk::Image3D>
       images;          // o: A, B, C (B, C only when dispersive), medium; e: the same, axis
   bool eMode = false;  // settings.mode == 1 and the volume is uniaxial
+  // Sharp interfaces (settings.sharp_interfaces and sharpLightApplies): the pipeline is
+  // specialised with kSharpLight and the boundary field and media table are uploaded; otherwise
+  // 1-voxel placeholders keep those bindings valid.
+  bool sharp = false;
+  BoundaryDevice boundary;
   vk::Buffer params, splat, patches[2], scan, tally;
   vk::ComputePipeline pipe, countPipe;  // wavefront.comp (propagate, scatter), wavefront_count.comp
   ScanKernel scanner;
@@ -143,6 +151,11 @@ struct GpuWavefront::Impl {
           n += vol.index[size_t(md)][1][i].x * il2 + vol.index[size_t(md)][2][i].x * il4;
         n_min = std::min(n_min, n);
       }
+    sharp = s.sharp_interfaces && sharpLightApplies(vol);
+    if (sharp)  // the media's own indices: a corner moves dt/n in its region's medium
+      for (const MediumRecord& r : vol.media.regions)
+        for (const MediumDispersion* d : {&r.n_o, &r.n_e})
+          n_min = std::min(n_min, mediumIndex(*d, s.wavelength_nm));
     if (!(n_min > 0)) throw std::invalid_argument("wavefront: the index volume has n <= 0");
 
     std::array<uint32_t, 3> ext{uint32_t(g.dims[0]), uint32_t(g.dims[1]), uint32_t(g.dims[2])};
@@ -186,9 +199,16 @@ struct GpuWavefront::Impl {
          {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_SPLAT),
           uint32_t(EIKON_WB_PATCHES_B), uint32_t(EIKON_WB_SCAN), uint32_t(EIKON_WB_TALLY)})
       b.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    for (const vk::BindingSpec& bs : boundaryBindings()) b.push_back(bs);
+    boundary = sharp ? BoundaryDevice(ctx, vol.boundary, vol.media)
+                     : BoundaryDevice(ctx, BoundaryField{}, MediaTable{});
+    // constant_id 0 (wavefront.comp kSharpLight): the sharp stages only where they apply, as the
+    // view renderer's kSharpMarch.
     pipe = vk::ComputePipeline(
         ctx, std::span<const uint32_t>(k_wavefront_spv, sizeof(k_wavefront_spv) / 4), b,
-        sizeof(gpu::WavePush), "wavefront");
+        sizeof(gpu::WavePush), sharp ? "wavefront sharp" : "wavefront",
+        std::vector<uint32_t>{sharp ? 1u : 0u});
+    boundary.bind(pipe);
     const size_t med = vol.dispersive ? 3 : 1;
     pipe.bindImage(EIKON_WB_INDEX_A, images[0]);
     pipe.bindImage(EIKON_WB_INDEX_B, images[vol.dispersive ? 1 : 0]);
@@ -259,6 +279,7 @@ struct GpuWavefront::Impl {
     }
     g.flux = glm::vec4(float(p.energy), float(p.area0), float(p.seed_energy), 0.0f);
     g.state = glm::ivec4(EIKON_PATCH_ALIVE, p.orientation, p.entered ? 1 : 0, 0);
+    g.region = glm::ivec4(-1);  // sharp interfaces: located by the first propagation
     return g;
   }
 
@@ -367,6 +388,7 @@ struct GpuWavefront::Impl {
       st.probe_centroid += glm::dvec3(glm::vec3(t.probe_pos));
       st.flux_probe += t.probe_pos.w;
       st.probe_direction += glm::dvec3(glm::vec3(t.probe_dir));
+      st.flux_reflected += t.probe_dir.w;
     }
   }
 
@@ -423,7 +445,8 @@ struct GpuWavefront::Impl {
       if (s.progress)
         s.progress(wavefrontRunFraction(
             dispatches * steps_per_dispatch, s.dt, g.extent,
-            st.flux_left + st.flux_caustic + st.flux_energy + st.flux_absorbed, st.flux_emitted));
+            st.flux_left + st.flux_caustic + st.flux_energy + st.flux_absorbed + st.flux_reflected,
+            st.flux_emitted));
       if (total == 0) break;
       const int dst = 1 - src;
       ensurePatchCapacity(dst, total);

@@ -9,6 +9,11 @@
 //   eikon::GpuWavefront gpu(ctx, vol, settings);
 //   eikon::WavefrontResult r = gpu.run(scene.lights[0]);   // r.irradiance in W/mm², r.stats
 //
+// Sharp interfaces (issue 13; WavefrontSettings::sharp_interfaces, where sharpLightApplies): the
+// corners refract at the scene's exact boundaries as the CPU twin's do given sharpInterfacesFor
+// (the pipeline is specialised with kSharpLight; docs/light-simulator.md, "Sharp interfaces"),
+// with one difference: a crystal face takes the D-projection Fresnel split (the CPU: exact).
+//
 // What differs from the reference: the kernel runs in float32, the splits included; the patch
 // list stays on the GPU and is rebuilt between dispatches by a count / exclusive scan / scatter
 // into a second buffer (each dispatch advances every live patch by up to `steps_per_dispatch`
@@ -21,8 +26,8 @@
 // Common mistakes: expecting bit-identical stats — float32 may move a borderline kill or split by
 // a step; expecting identical stats when splits are refused (the budget is applied per rebuild
 // against that rebuild's survivors, so which splits are refused depends on steps_per_dispatch);
-// forgetting the buffer limits — live patches take 160 B each (two lists) and the splat 36 B per
-// voxel, each buffer within the device's storage-buffer range (lavapipe: 128 MiB ≈ 838k live
+// forgetting the buffer limits — live patches take 176 B each (two lists) and the splat 36 B per
+// voxel, each buffer within the device's storage-buffer range (lavapipe: 128 MiB ≈ 762k live
 // patches, 3.7M voxels; run() and the constructor throw with a message beyond that, so lower
 // max_patches or the resolution).
 #pragma once
@@ -57,7 +62,8 @@ class GpuWavefront {
  public:
   /// The volume is uploaded (o-mode index A/B/C and medium; for settings.mode = 1 in a uniaxial
   /// volume also the e-mode index A/B/C, medium and the optic axis — the e-mode of an isotropic
-  /// volume is the o-mode); it is referenced for seeding and
+  /// volume is the o-mode; with settings.sharp_interfaces, where sharpLightApplies(volume), the
+  /// boundary field and the media table); it is referenced for seeding and
   /// splitting and must outlive this object. Throws std::invalid_argument for bad settings,
   /// std::runtime_error if the splat buffer exceeds the device's storage-buffer range.
   GpuWavefront(vk::Context& ctx, const VolumeSet& volume, WavefrontSettings settings,

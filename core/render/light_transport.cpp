@@ -8,7 +8,7 @@ namespace eikon {
 LightingSummary simulateLighting(vk::Context& ctx, const Scene& scene, VolumeSet& volume,
                                  const LightingOptions& options, int steps_per_dispatch) {
   // The patch list is one storage buffer: the budget cannot exceed what the device holds in one
-  // (lavapipe: 128 MiB = 838,860 patches of 160 B). Lowered, and said so, rather than failing a
+  // (lavapipe: 128 MiB = 762,600 patches of 176 B). Lowered, and said so, rather than failing a
   // render when the wavefront grows.
   LightingOptions o = options;
   std::vector<std::string> notes;

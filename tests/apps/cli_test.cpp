@@ -695,6 +695,40 @@ TEST_F(Cli, TraceGpuAgreesWithReference) {
 
 // ------------------------------------------------------------------ lights (issue 6)
 
+// Sharp interfaces (issue 13): the light follows the scene's "interfaces" on both twins. A sharp
+// scene loses flux to Fresnel reflection, which the summary reports as a share of the emitted
+// flux: at least the normal-incidence loss of the lit disc's two passes, 1 − (1 − R₀)² = 0.0784
+// times the disc's share πR²/(10 mm)² = 0.196 of the light over the box, and at most that share;
+// a smoothed scene reflects nothing.
+TEST_F(Cli, LightSummaryReportsTheFluxReflectedAtSharpInterfaces) {
+  const std::string scene = R"({
+  "camera": {"position": [0, 20, -20], "look_at": [0, -2, 0], "up": [0, 1, 0], "fov_deg": 30, "width": 16, "height": 12},
+  "environment": {"type": "constant", "radiance": 0.1},
+  "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "resolution": 24},
+  INTERFACES
+  "materials": {"glass": {"n": 1.5}, "floor": {"n": 1, "opacity": 1, "albedo": 0.8}},
+  "objects": [{"shape": "box", "center": [0, -3.5, 0], "size": [8, 1, 8], "material": "floor"},
+              {"shape": "sphere", "center": [0, 0.5, 0], "radius": 2.5, "material": "glass"}],
+  "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 2}]
+})";
+  auto reflected = [&](const std::string& interfaces, const std::string& device) {
+    std::string text = scene;
+    text.replace(text.find("INTERFACES"), 10, "\"interfaces\": \"" + interfaces + "\",");
+    const Outcome o = render(text, "-q --caustics kill --no-light-cache --light-device " + device);
+    EXPECT_EQ(o.code, 0) << o.err;
+    const size_t at = o.out.find("reflected ");
+    EXPECT_NE(at, std::string::npos) << o.out;
+    return at == std::string::npos ? -1.0 : std::strtod(o.out.c_str() + at + 10, nullptr);
+  };
+  const double disc = 3.14159265358979 * 2.5 * 2.5 / 100.0;
+  for (const char* device : {"cpu", "gpu"}) {
+    const double r = reflected("sharp", device);
+    EXPECT_GT(r, 0.0784 * disc * 0.99) << device;
+    EXPECT_LT(r, disc) << device;
+  }
+  EXPECT_EQ(reflected("smoothed", "cpu"), 0.0);
+}
+
 // A lit floor under the tiny glass sphere: the light is simulated once and then read back from
 // the cache (keyed by the medium, the lights and the simulator settings, never the camera), and
 // the cached render is the same picture.

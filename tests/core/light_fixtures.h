@@ -30,6 +30,42 @@ inline const char* kGlassSphereLightScene = R"({
   "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 1.0, "material": "glass"}]
 })";
 
+// The scenes of the sharp-interface tests, shared by the CPU twin's (tests/core/light/
+// sharp_wavefront_test.cpp, which describes their closed forms) and the GPU twin's
+// (tests/core/render/sharp_wavefront_twins_test.cpp). kSharpSlabScene's "RES" is replaced by the
+// resolution along x.
+inline const char* kSharpSlabScene = R"({
+  "camera": {"width": 8, "height": 8},
+  "environment": {"type": "constant", "radiance": 1},
+  "volume": {"bounds_min": [-6.0, -0.5, -1.0], "bounds_max": [6.5, 0.5, 1.2], "resolution": RES},
+  "objects": [{"shape": "box", "center": [0, 0, 0], "size": [60, 60, 1], "material": "glass"}],
+  "materials": {"glass": {"n": 1.5}}
+})";
+
+inline const char* kSharpRightPrismScene = R"({
+  "camera": {"width": 8, "height": 8},
+  "environment": {"type": "constant", "radiance": 1},
+  "volume": {"bounds_min": [-5.0, -2.0, -1.0], "bounds_max": [4.6, 4.4, 1.0], "resolution": 96},
+  "objects": [{"shape": "prism", "apex_deg": 90, "side": 6, "height": 20, "material": "glass"}],
+  "materials": {"glass": {"n": 1.5}}
+})";
+
+inline const char* kSharpPrismScene = R"({
+  "camera": {"width": 8, "height": 8},
+  "environment": {"type": "constant", "radiance": 1},
+  "volume": {"bounds_min": [-4.4, -2.4, -1.2], "bounds_max": [4.2, 3.0, 1.2], "resolution": 86},
+  "objects": [{"shape": "prism", "apex_deg": 60, "side": 6, "height": 20, "material": "glass"}],
+  "materials": {"glass": {"n": 1.5168}}
+})";
+
+inline const char* kSharpCalcitePlateScene = R"({
+  "camera": {"width": 8, "height": 8},
+  "environment": {"type": "constant", "radiance": 1},
+  "volume": {"bounds_min": [-2.4, -1.5, -5.7], "bounds_max": [2.4, 1.5, 6.3], "resolution": 80},
+  "objects": [{"shape": "box", "center": [0, 0, 0], "size": [60, 60, 10], "material": "calcite",
+               "optic_axis": [0.70710678118654752, 0, 0.70710678118654752]}]
+})";
+
 /// Luneburg lens of radius 1 about the origin: n = √(2 − r²) inside, 1 outside, exact ∇n.
 inline void unitLuneburg(const glm::dvec3& x, double& n, glm::dvec3& g) {
   double r2 = glm::dot(x, x);

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 
+#include "core/light/lighting.h"
 #include "core/volume/volume_set.h"
 #include "tests/core/scene_support.h"
 
@@ -81,6 +82,35 @@ TEST(LightCache, KeyFollowsWhatTheSimulationReads) {
   elsewhere.camera.position = glm::dvec3(5, 6, 7);
   elsewhere.camera.width = 17;
   EXPECT_EQ(lightCacheKey(elsewhere, v, o, false), key);
+}
+
+// Sharp interfaces (issue 13): a scene voxelised with "interfaces": "sharp" is lit through its
+// exact boundaries, with "smoothed" through the smoothed field (the index volumes the key hashes
+// may be the same), so a cached smoothed light must not serve the sharp scene, nor a light
+// simulated with LightingOptions::sharp_interfaces = false the default.
+TEST(LightCache, KeyFollowsTheInterfaces) {
+  const Scene sharp = litScene();
+  const Scene smoothed = parseScene(R"({
+    "volume": {"bounds_min": [-2, -2, -2], "bounds_max": [2, 2, 2], "resolution": 6},
+    "interfaces": "smoothed",
+    "materials": {"g": {"n": 1.5}},
+    "objects": [{"shape": "sphere", "radius": 1, "material": "g"}],
+    "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 2}]})",
+                                    "cache-test.json");
+  const VolumeSet vSharp = voxelize(sharp), vSmoothed = voxelize(smoothed);
+  ASSERT_TRUE(sharpLightApplies(vSharp));
+  ASSERT_FALSE(sharpLightApplies(vSmoothed));
+  const LightingOptions o;
+  for (bool reference : {false, true}) {
+    const uint64_t key = lightCacheKey(sharp, vSharp, o, reference);
+    EXPECT_NE(lightCacheKey(smoothed, vSmoothed, o, reference), key);
+    LightingOptions off = o;
+    off.sharp_interfaces = false;
+    EXPECT_NE(lightCacheKey(sharp, vSharp, off, reference), key);
+    // Off, or a smoothed scene: the light takes the smoothed path either way.
+    EXPECT_EQ(lightCacheKey(smoothed, vSmoothed, off, reference),
+              lightCacheKey(smoothed, vSmoothed, o, reference));
+  }
 }
 
 TEST(LightCache, ACorruptedEntryIsRefusedWithANotice) {

@@ -61,13 +61,7 @@ SharpInterfaces oneGlass(const VolumeSet& vol, double n) {
 // plane at incidence i whose axis meets the entry face at the origin's (0, 0, −0.5). Behind the
 // slab (probe z = 1.0) the axis is displaced by t·(tan i − tan r) along −x against the straight
 // line and leaves along the incident direction.
-const char* kSlab = R"({
-  "camera": {"width": 8, "height": 8},
-  "environment": {"type": "constant", "radiance": 1},
-  "volume": {"bounds_min": [-6.0, -0.5, -1.0], "bounds_max": [6.5, 0.5, 1.2], "resolution": RES},
-  "objects": [{"shape": "box", "center": [0, 0, 0], "size": [60, 60, 1], "material": "glass"}],
-  "materials": {"glass": {"n": 1.5}}
-})";
+const char* const kSlab = kSharpSlabScene;  // tests/core/light_fixtures.h
 
 void slabAtEachIncidence(const VolumeSet& vol);
 
@@ -139,13 +133,7 @@ void slabAtEachIncidence(const VolumeSet& vol) {
 // the hypotenuse at 45° beyond the critical angle (41.81°), is totally reflected and leaves the
 // right leg at normal incidence at (H/2, H/6) along (1, 1)/√2. Only the two normal-incidence
 // faces take power: T = (1 − R₀)², R₀ = ((n − 1)/(n + 1))² = 0.04; the reflection returns all.
-const char* kRightPrism = R"({
-  "camera": {"width": 8, "height": 8},
-  "environment": {"type": "constant", "radiance": 1},
-  "volume": {"bounds_min": [-5.0, -2.0, -1.0], "bounds_max": [4.6, 4.4, 1.0], "resolution": 96},
-  "objects": [{"shape": "prism", "apex_deg": 90, "side": 6, "height": 20, "material": "glass"}],
-  "materials": {"glass": {"n": 1.5}}
-})";
+const char* const kRightPrism = kSharpRightPrismScene;  // tests/core/light_fixtures.h
 
 TEST(SharpWavefront, TotalInternalReflectionReturnsAllThePower) {
   const Scene scene = sceneFromJson(kRightPrism);
@@ -184,13 +172,7 @@ TEST(SharpWavefront, TotalInternalReflectionReturnsAllThePower) {
 // minimum-deviation incidence i = (A + D)/2, sin i = n sin(A/2): D_min = 2 asin(n sin 30°) − 60° =
 // 38.6470°, the geometry of tests/core/wavefront_physics_test.cpp. Exact Snell: D to round-off
 // (the smoothed path: +1.7e-3°); the transmission (1 − R(i))², both faces at the same angles.
-const char* kPrism = R"({
-  "camera": {"width": 8, "height": 8},
-  "environment": {"type": "constant", "radiance": 1},
-  "volume": {"bounds_min": [-4.4, -2.4, -1.2], "bounds_max": [4.2, 3.0, 1.2], "resolution": 86},
-  "objects": [{"shape": "prism", "apex_deg": 60, "side": 6, "height": 20, "material": "glass"}],
-  "materials": {"glass": {"n": 1.5168}}
-})";
+const char* const kPrism = kSharpPrismScene;  // tests/core/light_fixtures.h
 
 TEST(SharpWavefront, PrismAtMinimumDeviation) {
   const Scene scene = sceneFromJson(kPrism);
@@ -233,13 +215,7 @@ TEST(SharpWavefront, PrismAtMinimumDeviation) {
 // light is ½(1 − R_o), and a mode's run carries half the light), the e-mode the same with n(45°).
 // The smoothed layers add 7.26e-3 mm to the separation at this h (docs/light-simulator.md,
 // CalcitePlateGivesTwoSpots).
-const char* kCalcitePlate = R"({
-  "camera": {"width": 8, "height": 8},
-  "environment": {"type": "constant", "radiance": 1},
-  "volume": {"bounds_min": [-2.4, -1.5, -5.7], "bounds_max": [2.4, 1.5, 6.3], "resolution": 80},
-  "objects": [{"shape": "box", "center": [0, 0, 0], "size": [60, 60, 10], "material": "calcite",
-               "optic_axis": [0.70710678118654752, 0, 0.70710678118654752]}]
-})";
+const char* const kCalcitePlate = kSharpCalcitePlateScene;  // tests/core/light_fixtures.h
 
 TEST(SharpWavefront, CalcitePlateSeparatesTheSpotsByTheWalkOff) {
   const Scene scene = sceneFromJson(kCalcitePlate);
