@@ -1,5 +1,6 @@
 // eikon render SCENE.json -o OUT.exr [options]: voxelise, march on the GPU (or --reference on the
 // CPU), write the linear-sRGB EXR and a tone-mapped PNG preview beside it.
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -176,6 +177,21 @@ void printSummary(const RenderArgs& a, Session& session, const LightOutcome& lig
       rays / img.seconds, img.mean_steps, out.c_str(), png.c_str());
 }
 
+/// Progressive output: the PNG preview rewritten (atomically) as pixel samples finish, at most
+/// once a second, so a long render shows the picture forming; the final pair replaces it.
+RenderSettings withPreview(RenderSettings rs, const std::filesystem::path& png, double exposure) {
+  auto last =
+      std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
+  rs.on_pass = [png, exposure, last](const RenderImage& so_far, int, int) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - *last < std::chrono::seconds(1)) return;
+    writeFilesTogether(
+        {{png, pngPreviewContent(so_far.width, so_far.height, so_far.rgb, exposure)}});
+    *last = now;
+  };
+  return rs;
+}
+
 void runRender(const RenderArgs& a, const CLI::App& sub) {
   if (a.timings) timings::enable(true);
   timings::mark("command line");
@@ -217,9 +233,14 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   }
   for (const std::string& w : light.warnings)
     std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
-  RenderImage img = session.render(rs, !a.reference);
+  RenderImage img = session.render(withPreview(rs, png, a.exposure), !a.reference);
   progress.finish();
   timings::mark("rendered");
+  if (img.cut_samples > 0)
+    warn(std::to_string(img.cut_samples) +
+             " pixel samples were cut short by the Vulkan driver's loop limit and lack the light "
+             "they would have reached (docs/view-renderer.md); render them with --reference",
+         a.strict);
   // The pair as a pair (core/io/atomic_write.h): both files or neither replace what is there,
   // and a concurrent render to the same -o cannot interleave its pair with this one. The
   // preview first: it is the smaller, so a full disk is usually met before the EXR is encoded.

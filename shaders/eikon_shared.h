@@ -117,6 +117,7 @@ struct ViewParams {
   ivec4 env_size;    // latlong width, height
   ivec4 image;       // x: width; y: height; z: first row of this dispatch; w: rows in this dispatch
   vec4 wavelength;   // x: λ (µm) of the non-spectral mode; y: 1/λ²; z: 1/λ⁴
+  ivec4 pass;        // x: the pixel sample of this dispatch; y: its first wavelength; z: wavelengths
 };
 
 // One ray for the trace kernel: origin and unit direction in world space, λ in µm.
@@ -244,7 +245,7 @@ struct WavePatch {
 #define EIKON_CORNER_MIRRORED 0x10000
 
 #ifdef __cplusplus
-static_assert(sizeof(ViewParams) == 15 * 16, "ViewParams must be vec4-packed");
+static_assert(sizeof(ViewParams) == 16 * 16, "ViewParams must be vec4-packed");
 static_assert(sizeof(TraceRay) == 32 && sizeof(TraceResult) == 64, "trace records must be vec4-packed");
 static_assert(sizeof(BoundaryQuery) == 48 && sizeof(BoundaryAnswer) == 80,
               "boundary probe records must be vec4-packed");

@@ -218,6 +218,7 @@ struct MarchResult {
   vec3 throughput;
   float opl;
   bool left;
+  bool cut;  // the driver's loop budget ran out on the way (sharp.glsl loopLimitReached)
   int steps;
   float drift;
   int interfaces;
@@ -522,6 +523,7 @@ bool enterVolume(vec3 o, vec3 d, out MarchResult R, out float t0) {
   R.throughput = vec3(1.0);
   R.opl = 0.0;
   R.left = true;
+  R.cut = false;
   R.steps = 0;
   R.drift = 0.0;
   R.interfaces = 0;

@@ -417,6 +417,7 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   R.exit_point = S.x;
   R.exit_dir = sharpDirection(S, mode);
   R.wave_normal = normalize(S.w);
+  R.cut = cut;
   R.left = !S.stopped && !cut && steps < maxSteps;
   if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
   R.radiance = S.L;

@@ -1,8 +1,16 @@
 #version 450
-// View renderer: one thread per pixel; spp jittered sub-pixel samples; RGB mode (one march at a
-// fixed wavelength, RGB attenuation) or spectral mode (N stratified wavelengths per sample,
-// CIE 1931 → linear sRGB). Uniaxial scenes march the o- and e-modes, each carrying half of the
-// unpolarised radiance. Output: linear sRGB radiance per pixel, w = mean steps.
+// View renderer: one thread per pixel and one pass per dispatch: pixel sample P.pass.x (jittered
+// when spp > 1) at wavelengths [P.pass.y, P.pass.y + P.pass.z) of its N stratified ones (spectral
+// mode, CIE 1931 → linear sRGB) or at the fixed wavelength (RGB mode, RGB attenuation). Uniaxial
+// scenes march the o- and e-modes, each carrying half of the unpolarised radiance. Output: this
+// pass's share of the pixel's linear sRGB radiance (the host sums the passes and divides by spp),
+// w = its steps, or −(steps + 1) when a march of the pass ran out of the driver's loop budget.
+//
+// Why passes: lavapipe gives each SIMD group of invocations one budget of 65535 loop passes, all
+// loops together, and silently ends every loop when it is spent (docs/view-renderer.md). A pixel
+// that marched every sample and wavelength in one invocation spent it 16–32 times over in a
+// spectral crystal; one pass marches one wavelength (both modes), or all N where wavelength
+// sharing replaces the marches of the others by table lookups.
 #extension GL_GOOGLE_include_directive : require
 #include "eikon_shared.h"
 
@@ -36,7 +44,9 @@ void main() {
   int spp = P.limits.y;
   vec3 sum = vec3(0.0);
   float steps = 0.0;
-  for (int s = 0; s < spp; ++s) {
+  bool cut = false;
+  {
+    int s = P.pass.x;
     vec2 jitter = vec2(0.5);
     if (spp > 1) {
       uint hs = pcg_hash(pixelIndex * 9781u + uint(s) * 6271u + 17u);
@@ -49,14 +59,16 @@ void main() {
     // is one "wavelength" of radiance triplets, and the modes of a crystal are a loop.
     bool spectral = hasFlag(EIKON_F_SPECTRAL);
     int N = spectral ? P.limits.z : 1;
+    int k0 = spectral ? P.pass.y : 0, k1 = spectral ? min(P.pass.y + P.pass.z, N) : 1;
     int modes = hasFlag(EIKON_F_UNIAXIAL) ? 2 : 1;  // unpolarised: each mode carries 1/modes
     uint seed = pcg_hash(pixelIndex + pcg_hash(uint(s)));
     vec3 xyz = vec3(0.0);
-    // Wavelength sharing (march.glsl): only where nothing but the index can depend on λ.
+    // Wavelength sharing (march.glsl): only where nothing but the index can depend on λ, and only
+    // within one pass (the host makes a pass all N wavelengths when the scene allows sharing).
     const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
     bool share = spectral && !hasFlag(lambdaDependent);
     bool reuse = false;
-    for (int k = 0; k < N; ++k) {
+    for (int k = k0; k < k1; ++k) {
       float lambda = 0.0;
       if (spectral) {
         float uk = float(pcg_hash(seed + uint(k)) >> 8u) * (1.0 / 16777216.0);
@@ -74,7 +86,7 @@ void main() {
       vec3 rad = vec3(0.0);
       for (int mode = 0; mode < modes; ++mode) {
         if (mode == 0) {
-          gRecord = share && k == 0;
+          gRecord = share && k == k0;
           gNumRecorded = 0;
           gRecordOverflow = false;
           gDispersiveHit = false;
@@ -86,6 +98,7 @@ void main() {
         }
         rad += modes == 2 ? 0.5 * r.radiance : r.radiance;
         steps += float(r.steps) / float(N);
+        cut = cut || r.cut;
       }
       if (spectral) xyz += rad.x * cmf(lambda) * (400.0 / float(N));
       else sum += rad;
@@ -96,5 +109,5 @@ void main() {
       sum += xyz * M;  // rows stored: rgb_i = dot(row_i, xyz)
     }
   }
-  pixels[int(gid.y) * W + px] = vec4(sum / float(spp), steps / float(spp));
+  pixels[int(gid.y) * W + px] = vec4(sum, cut ? -(steps + 1.0) : steps);
 }

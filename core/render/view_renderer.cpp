@@ -273,52 +273,75 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   double l = s.wavelength_nm * 1e-3;
   p.wavelength = glm::vec4(float(l), float(1.0 / (l * l)), float(1.0 / (l * l * l * l)), 0.0f);
 
-  // Bands of rows so that progress can be reported and no single dispatch runs for long. The band
-  // buffer holds up to ~2e5 rays' worth of rows; the first band is one workgroup row, and each
-  // next band is sized from the last one's time to take ~0.25 s, so even a small image that is
-  // slow per ray (many wavelengths, a dense volume) reports progress several times a second.
-  const double work = double(img.width) * img.height * s.spp * std::max(1, s.wavelengths);
-  int max_rows = std::clamp(int(std::ceil(double(img.height) * 2.0e5 / std::max(work, 1.0))),
-                            EIKON_WG_Y, img.height);
+  // Passes: one pixel sample at one wavelength (both modes) per dispatch, or at all N where no
+  // march depends on λ (view.comp's wavelength sharing: one march serves every wavelength, the
+  // others are table lookups) — lavapipe's loop budget is per invocation, all loops together
+  // (view.comp's header, docs/view-renderer.md). Passes are outermost so that every finished pass
+  // is a whole (noisier) image: RenderSettings::on_pass shows the picture forming.
+  const int N = std::max(1, s.wavelengths);
+  const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY |
+                              EIKON_F_UNIAXIAL | EIKON_F_DISPERSIVE;
+  const bool share = s.wavelengths > 0 && (p.grid_dims.w & lambdaDependent) == 0;
+  const int perPass = share ? N : 1;
+  const int passesPerSample = (N + perPass - 1) / perPass;
+  const int passes = s.spp * passesPerSample;
+  // Bands of rows within a pass so that progress is reported and no dispatch runs for long: the
+  // band buffer holds up to ~2e5 rays' worth of rows; the first band is one workgroup row, each
+  // next one is sized from the last one's time to take ~0.25 s.
+  const double rowWork = double(img.width) * perPass;
+  int max_rows = std::clamp(int(std::ceil(2.0e5 / std::max(rowWork, 1.0))), EIKON_WG_Y, img.height);
   max_rows = (max_rows + EIKON_WG_Y - 1) / EIKON_WG_Y * EIKON_WG_Y;
   int rows = EIKON_WG_Y;
   vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * sizeof(glm::vec4),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
   vk::ComputePipeline& view = I.pipeline(false, p);
   view.bindBuffer(EIKON_B_OUTPUT, out);
-  img.rgb.resize(size_t(img.width) * size_t(img.height) * 3);
+  const size_t pixels = size_t(img.width) * size_t(img.height);
+  std::vector<double> acc(pixels * 3, 0.0);
+  img.rgb.assign(pixels * 3, 0.0f);
   std::vector<glm::vec4> band(size_t(img.width) * size_t(max_rows));
   double steps = 0.0;
   auto t0 = std::chrono::steady_clock::now();
-  for (int y0 = 0, n = 0; y0 < img.height; y0 += n) {
-    n = std::min(rows, img.height - y0);
-    const auto band_start = std::chrono::steady_clock::now();
-    p.image = glm::ivec4(img.width, img.height, y0, n);
-    I.params.write(&p, sizeof p);
-    if (y0 == 0) timings::mark("first dispatch");
-    I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
-      view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X),
-                    uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
-    });
-    out.read(band.data(), size_t(img.width) * size_t(n) * sizeof(glm::vec4));
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < img.width; ++x) {
-        const glm::vec4& v = band[size_t(y) * size_t(img.width) + size_t(x)];
-        size_t o = (size_t(y0 + y) * size_t(img.width) + size_t(x)) * 3;
-        img.rgb[o] = v.x;
-        img.rgb[o + 1] = v.y;
-        img.rgb[o + 2] = v.z;
-        steps += v.w;
+  for (int pass = 0; pass < passes; ++pass) {
+    p.pass = glm::ivec4(pass / passesPerSample, (pass % passesPerSample) * perPass, perPass, 0);
+    for (int y0 = 0, n = 0; y0 < img.height; y0 += n) {
+      n = std::min(rows, img.height - y0);
+      const auto band_start = std::chrono::steady_clock::now();
+      p.image = glm::ivec4(img.width, img.height, y0, n);
+      I.params.write(&p, sizeof p);
+      if (pass == 0 && y0 == 0) timings::mark("first dispatch");
+      I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
+        view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X),
+                      uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
+      });
+      out.read(band.data(), size_t(img.width) * size_t(n) * sizeof(glm::vec4));
+      for (size_t i = 0; i < size_t(img.width) * size_t(n); ++i) {
+        const glm::vec4& v = band[i];
+        const size_t o = (size_t(y0) * size_t(img.width) + i) * 3;
+        acc[o] += v.x;
+        acc[o + 1] += v.y;
+        acc[o + 2] += v.z;
+        if (v.w < 0.0f) ++img.cut_samples;
+        steps += v.w < 0.0f ? -double(v.w) - 1.0 : double(v.w);
       }
-    if (s.progress) s.progress(double(y0 + n) / img.height);
-    const double band_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - band_start).count();
-    const double next =
-        double(n) * 0.25 / std::max(band_s, 1e-3);  // rows for ~0.25 s, at most 8x the last
-    rows = std::clamp(int(std::min(next, 8.0 * n)) / EIKON_WG_Y * EIKON_WG_Y, EIKON_WG_Y, max_rows);
+      if (s.progress) s.progress((pass + double(y0 + n) / img.height) / passes);
+      const double band_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - band_start).count();
+      const double next =
+          double(n) * 0.25 / std::max(band_s, 1e-3);  // rows for ~0.25 s, at most 8x the last
+      rows =
+          std::clamp(int(std::min(next, 8.0 * n)) / EIKON_WG_Y * EIKON_WG_Y, EIKON_WG_Y, max_rows);
+    }
+    // The image so far: the finished samples' mean (a sample's wavelengths all done).
+    const bool sampleDone = (pass + 1) % passesPerSample == 0;
+    if (sampleDone && (s.on_pass || pass + 1 == passes)) {
+      const double scale = 1.0 / double((pass + 1) / passesPerSample);
+      for (size_t i = 0; i < acc.size(); ++i) img.rgb[i] = float(acc[i] * scale);
+      if (s.on_pass && pass + 1 < passes) s.on_pass(img, (pass + 1) / passesPerSample, s.spp);
+    }
   }
   img.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  img.mean_steps = steps / (double(img.width) * img.height);
+  img.mean_steps = steps / (double(pixels) * s.spp);
   return img;
 }
 

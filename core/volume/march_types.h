@@ -20,6 +20,8 @@ struct MarchSettings {
   int max_steps = 20000;              ///< per ray; a ray that runs out is reported as stopped
 };
 
+struct RenderImage;
+
 struct RenderSettings {
   int width = 0, height = 0;        ///< 0 = the scene camera's
   int spp = 1;                      ///< jittered samples per pixel
@@ -28,6 +30,9 @@ struct RenderSettings {
   MarchSettings march;
   /// progress(fraction done); may be empty.
   std::function<void(double)> progress;
+  /// Called with the image so far each time a pixel sample is finished (all its wavelengths),
+  /// before the last (which render() returns): the mean of `done` of `spp` samples. May be empty.
+  std::function<void(const RenderImage& so_far, int done, int spp)> on_pass;
 };
 
 /// A rendered image: linear sRGB, rows from the top, 3 floats per pixel.
@@ -39,6 +44,9 @@ struct RenderImage {
   /// the GPU (core/reference/reference_marcher.cpp CountedField).
   double mean_fetches = 0.0;
   double seconds = 0.0;  ///< wall time of the march itself
+  /// Pixel samples (passes of a pixel) in which a march was stopped by the device's loop budget
+  /// (lavapipe; docs/view-renderer.md) and so lacks the light it would have reached; 0 on the CPU.
+  long long cut_samples = 0;
 };
 
 /// One traced ray (one mode) as both twins report it. Directions are unit, world space.
