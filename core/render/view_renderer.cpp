@@ -150,6 +150,7 @@ struct ViewRenderer::Impl {
     tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
     timings::mark("volume uploaded");
 
+    std::vector<vk::BindingSpec> common;  // the bindings of both kernels (the trace's adds rays)
     for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     for (uint32_t b :
