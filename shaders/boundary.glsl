@@ -17,6 +17,13 @@
 
 // ---- Analytic shapes (core/scene/shapes.cpp) ----
 
+// Whether any shape may be a convex polyhedron: march.glsl makes it a specialization constant
+// (EIKON_F_CONVEX), so that a scene without one compiles the plane loops out (lavapipe runs them,
+// masked, on every signed distance otherwise: docs/performance.md).
+#ifndef EIKON_BOUNDARY_HAS_CONVEX
+#define EIKON_BOUNDARY_HAS_CONVEX true
+#endif
+
 int shapeKind(int s) { return int(shapeTable[EIKON_SHAPE_STRIDE * s].x); }
 
 // Local coordinates p = Rᵀ(x − c) of world point x in shape s (s = region − 1).
@@ -76,6 +83,7 @@ float shapeSignedDistance(int s, vec3 x) {
   if (kind == EIKON_SHAPE_BOX) return boxDistance(p, par.xyz);
   if (kind == EIKON_SHAPE_ROUNDED_BOX) return boxDistance(p, par.xyz) - par.w;
   float m = -3.0e38;
+  if (!(EIKON_BOUNDARY_HAS_CONVEX)) return m;  // unreachable then: no shape has planes
   int first = int(head.y), count = int(head.z);
   for (int k = 0; count > 0;) {  // the test at the end: no pass is spent on a failing test
     [[unroll]] for (int j = 0; j < kShapePlanesPerPass; ++j)
@@ -93,13 +101,13 @@ vec3 shapeDistanceGradient(int s, vec3 x) {
   vec4 head = shapeTable[o], par = shapeTable[o + 5];
   vec3 p = shapeLocal(s, x);
   int kind = int(head.x);
-  vec3 g;
+  vec3 g = vec3(0.0);
   if (kind == EIKON_SHAPE_SPHERE) {
     float l = length(p);
     g = l > 0.0 ? p / l : vec3(0.0, 0.0, 1.0);
   } else if (kind == EIKON_SHAPE_BOX || kind == EIKON_SHAPE_ROUNDED_BOX) {
     g = boxGradient(p, par.xyz);
-  } else {
+  } else if (EIKON_BOUNDARY_HAS_CONVEX) {  // (else unreachable: no shape has planes)
     float m = -3.0e38;
     int first = int(head.y), count = int(head.z);
     g = vec3(0.0);

@@ -68,6 +68,7 @@ using uvec4 = glm::uvec4;
 #define EIKON_F_LIT 512         // light volumes from the light simulator are bound
 #define EIKON_F_SHARP 1024      // sharp interfaces: march region by region (shaders/sharp.glsl)
 #define EIKON_F_VARYING 2048    // sharp: some region's medium varies in space (GRIN, radial axis)
+#define EIKON_F_CONVEX 4096     // sharp: some region's shape is a convex polyhedron (plane loops)
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0

@@ -5,6 +5,7 @@
 #include <map>
 #include <stdexcept>
 #include <tuple>
+#include <variant>
 
 #include "core/render/boundary_device.h"
 #include "core/spectrum/cie1931.h"
@@ -64,6 +65,7 @@ struct ViewRenderer::Impl {
   bool scattering = false, lit = false;
   bool sharp = false;    // march region by region (shaders/sharp.glsl), as the CPU twin does
   bool varying = false;  // sharp: some region's medium varies in space (GRIN, radial axis)
+  bool convex = false;   // sharp: some region's shape is a convex polyhedron
   // [oA, oB, oC, (eA, eB, eC), medO, (medE), emission, (axis), (scatter), (fluence, flux)]
   std::vector<vk::Image3D> images;
   size_t scatterImage = 0, fluenceImage = 0,
@@ -122,6 +124,8 @@ struct ViewRenderer::Impl {
     boundary = BoundaryDevice(ctx, v.boundary, v.media, scene.file.string());
     sharp = !v.boundary.empty() && !v.media.empty();
     for (const MediumRecord& r : v.media.regions) varying = varying || !r.homogeneous;
+    for (const Shape& shape : v.boundary.shapes)
+      convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());
     params =
         vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
     const auto& e = scene.environment;
@@ -232,6 +236,7 @@ struct ViewRenderer::Impl {
     if (lit) flags |= EIKON_F_LIT;
     if (sharp) flags |= EIKON_F_SHARP;
     if (sharp && varying) flags |= EIKON_F_VARYING;
+    if (sharp && convex) flags |= EIKON_F_CONVEX;
     if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
     if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
