@@ -14,10 +14,6 @@ namespace {
 
 using maxwell::CV;
 constexpr double kPi = 3.14159265358979323846;
-/// As RayMarch::nextCrossing: a sliver where the trilinear region field and the exact surface
-/// disagree just past a crossing is skipped (voxels), and the search restarts this far past it.
-constexpr double kSliverVoxels = 0.25;
-constexpr double kNudgeVoxels = 1e-4;
 /// "To infinity": how far a ray leaving the volume is followed for polariser sheets (mm).
 constexpr double kFarMm = 1e9;
 
@@ -60,7 +56,6 @@ class Tracer {
         s_(s),
         bf_(f.boundary()),
         media_(f.media()),
-        h_(f.cellSize()),
         bmin_(f.boundsMin()),
         bmax_(f.boundsMax()) {}
   /// Follow `start` (inside the volume) to the exits of all its branches.
@@ -80,7 +75,6 @@ class Tracer {
   const PolarisedTraceSettings& s_;
   const BoundaryField* bf_;
   const MediaTable* media_;
-  double h_;
   glm::dvec3 bmin_, bmax_;
 };
 
@@ -96,26 +90,9 @@ OpticalMedium Tracer::mediumOf(int region, const glm::dvec3& x) const {
       Uniaxial(n_o, mediumIndexAt(m, 1, lambda_, x), glm::dvec3(mediumAxisField(m, x))));
 }
 
-// RayMarch::nextCrossing's search (the sliver rule).
+// The sharp marches' search (core/volume/boundary.h nextCrossingOutOf: the sliver rule).
 BoundaryCrossing Tracer::nextCrossing(const glm::dvec3& a, const glm::dvec3& b, int region) const {
-  const double total = glm::length(b - a);
-  if (!(total > 0.0)) return BoundaryCrossing{};
-  const glm::dvec3 dir = (b - a) / total;
-  glm::dvec3 start = a;
-  for (int k = 0; k < 4; ++k) {
-    BoundaryCrossing c = locateCrossing(*bf_, start, b);
-    if (!c.found) return c;
-    const double along = glm::dot(c.point - a, dir);
-    const bool sliver = c.from != region && c.to == region && along <= kSliverVoxels * h_;
-    if (!sliver) {
-      c.t = std::clamp(along / total, 0.0, 1.0);
-      c.from = region;
-      return c;
-    }
-    start = a + (along + kNudgeVoxels * h_) * dir;
-    if (along + kNudgeVoxels * h_ >= total) return BoundaryCrossing{};
-  }
-  return BoundaryCrossing{};
+  return nextCrossingOutOf(*bf_, a, b, region);
 }
 
 // An ideal dichroic sheet absorbs the field along its absorbing direction b = normal × axis

@@ -516,12 +516,6 @@ MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
 // integrated with RK4 on the region's own analytic medium; every segment or step chord is tested
 // with locateCrossing, and at a crossing the exact interface laws of optics/ are applied.
 
-/// How far past a crossing (voxels) a search may skip a sliver where the trilinear region field
-/// and the exact surface disagree (≤ 3h²/(8r) for a sphere of radius r voxels; 0 on planes).
-constexpr double kSliverVoxels = 0.25;
-/// The step past a sliver's end at which the search restarts (voxels).
-constexpr double kNudgeVoxels = 1e-4;
-
 // Box entry: the region there, and the wave vector of the mode in its medium along d.
 void RayMarch::sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& d) const {
   S.x = x;
@@ -543,32 +537,15 @@ glm::dvec3 RayMarch::sharpDirection(const MarchState& S) const {
                                       regionIndex(S.region, 1, S.x)));
 }
 
-// The first crossing on [a, b] out of the ray's region. Just past a crossing of a curved surface
-// the trilinear field may still place the ray on the side it came from; such a sliver (a crossing
-// into the ray's own region within kSliverVoxels) is skipped, not crossed twice.
+// The first crossing on [a, b] out of the ray's region (nextCrossingOutOf: the sliver rule),
+// counting the cells each search reads: the region at its start, the cells walked to the
+// crossing, and (found) the cells past it and at it (the region entered, the field's normal).
 BoundaryCrossing RayMarch::nextCrossing(const glm::dvec3& a, const glm::dvec3& b,
                                         int region) const {
-  const double total = glm::length(b - a);
-  if (!(total > 0.0)) return BoundaryCrossing{};
-  const glm::dvec3 dir = (b - a) / total;
-  glm::dvec3 start = a;
-  for (int k = 0; k < 4; ++k) {
-    BoundaryCrossing c = locateCrossing(*bf_, start, b);
-    // Its cell reads: the region at start, the cells walked to the crossing, and (found) the
-    // cells past it and at it (the region entered, the field's normal).
-    f_.fetches += 1 + cellsOn(start, c.found ? c.point : b) + (c.found ? 2 : 0);
-    if (!c.found) return c;
-    const double along = glm::dot(c.point - a, dir);
-    const bool sliver = c.from != region && c.to == region && along <= kSliverVoxels * h_;
-    if (!sliver) {
-      c.t = std::clamp(along / total, 0.0, 1.0);
-      c.from = region;
-      return c;
-    }
-    start = a + (along + kNudgeVoxels * h_) * dir;
-    if (along + kNudgeVoxels * h_ >= total) return BoundaryCrossing{};
-  }
-  return BoundaryCrossing{};
+  return nextCrossingOutOf(
+      *bf_, a, b, region, [&](const glm::dvec3& start, const BoundaryCrossing& c) {
+        f_.fetches += 1 + cellsOn(start, c.found ? c.point : b) + (c.found ? 2 : 0);
+      });
 }
 
 // The trilinear cells of the boundary field that [a, b] passes through, which locateCrossing

@@ -290,4 +290,28 @@ BoundaryCrossing locateCrossing(const BoundaryField& bf, const glm::dvec3& a, co
   return out;
 }
 
+BoundaryCrossing nextCrossingOutOf(
+    const BoundaryField& field, const glm::dvec3& a, const glm::dvec3& b, int region,
+    const std::function<void(const glm::dvec3&, const BoundaryCrossing&)>& on_locate) {
+  const double total = glm::length(b - a), h = field.grid.h;
+  if (!(total > 0.0)) return BoundaryCrossing{};
+  const glm::dvec3 dir = (b - a) / total;
+  glm::dvec3 start = a;
+  for (int k = 0; k < 4; ++k) {
+    BoundaryCrossing c = locateCrossing(field, start, b);
+    if (on_locate) on_locate(start, c);
+    if (!c.found) return c;
+    const double along = glm::dot(c.point - a, dir);
+    const bool sliver = c.from != region && c.to == region && along <= kSliverVoxels * h;
+    if (!sliver) {
+      c.t = std::clamp(along / total, 0.0, 1.0);
+      c.from = region;
+      return c;
+    }
+    start = a + (along + kNudgeVoxels * h) * dir;
+    if (along + kNudgeVoxels * h >= total) return BoundaryCrossing{};
+  }
+  return BoundaryCrossing{};
+}
+
 }  // namespace eikon

@@ -24,6 +24,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <glm/glm.hpp>
 #include <string>
 #include <vector>
@@ -89,5 +90,22 @@ struct BoundaryCrossing {
 /// sign change is bisected to `tolerance_voxels`. found = false when [a, b] stays in one region.
 BoundaryCrossing locateCrossing(const BoundaryField& field, const glm::dvec3& a,
                                 const glm::dvec3& b, const LocateOptions& options = {});
+
+/// How far past a crossing (voxels) a search may skip a sliver where the trilinear region field
+/// and the exact surface disagree (≤ 3h²/(8r) for a sphere of radius r voxels; 0 on planes), and
+/// the step past a sliver's end at which the search restarts (voxels). shaders/sharp.glsl has
+/// the same constants.
+constexpr double kSliverVoxels = 0.25;
+constexpr double kNudgeVoxels = 1e-4;
+
+/// The first crossing on [a, b] out of `region` (the region a ray carries), as the sharp marches
+/// and the polarised trace search: just past a crossing of a curved surface the trilinear field
+/// may still place the ray on the side it came from; such a sliver (a crossing into `region`
+/// within kSliverVoxels of a) is skipped, not crossed twice. The crossing's t is along [a, b] and
+/// its `from` is `region`. `on_locate(start, c)`, when given, sees every locateCrossing made (the
+/// CPU twin counts the cells it reads).
+BoundaryCrossing nextCrossingOutOf(
+    const BoundaryField& field, const glm::dvec3& a, const glm::dvec3& b, int region,
+    const std::function<void(const glm::dvec3&, const BoundaryCrossing&)>& on_locate = {});
 
 }  // namespace eikon

@@ -19,6 +19,25 @@ inline Light directionalLight(glm::dvec3 d, double irradiance) {
   return l;
 }
 
+// A directional beam of radius `radius` (mm) about the line through axis_point along dir.
+inline Light beam(glm::dvec3 axis_point, glm::dvec3 dir, double radius, double E) {
+  Light l = directionalLight(dir, E);
+  l.position = axis_point;
+  l.beam_radius = radius;
+  return l;
+}
+
+/// Unpolarised Fresnel reflectance n1 → n2 at incidence i (Born & Wolf eq. 1.5.21), written out
+/// here rather than taken from optics/ (the code under test calls that).
+inline double fresnelR(double n1, double n2, double i) {
+  const double si = std::sin(i), st = n1 * si / n2;
+  if (st >= 1.0) return 1.0;
+  const double ci = std::cos(i), ct = std::sqrt(1.0 - st * st);
+  const double rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
+  const double rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
 // A glass sphere (n = 1.5, R = 1 mm, smoothing 1 voxel) in a 40 × 32 × 32 grid, h = 0.1 mm; the
 // paraxial focus f = nR/(2(n − 1)) = 1.5 mm from the centre lies inside the box.
 inline const char* kGlassSphereLightScene = R"({

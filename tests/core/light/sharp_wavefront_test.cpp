@@ -28,24 +28,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
-Light beam(glm::dvec3 axis_point, glm::dvec3 dir, double radius, double E) {
-  Light l = directionalLight(dir, E);
-  l.position = axis_point;
-  l.beam_radius = radius;
-  return l;
-}
-
-/// Unpolarised Fresnel reflectance n1 → n2 at incidence i (Born & Wolf eq. 1.5.21), written out
-/// here rather than taken from optics/ (the code under test calls that).
-double fresnelR(double n1, double n2, double i) {
-  const double si = std::sin(i), st = n1 * si / n2;
-  if (st >= 1.0) return 1.0;
-  const double ci = std::cos(i), ct = std::sqrt(1.0 - st * st);
-  const double rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
-  const double rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
-  return 0.5 * (rs * rs + rp * rp);
-}
-
 /// The sharp media of a one-object scene: the ambient (n = 1) and the object's glass.
 SharpInterfaces oneGlass(const VolumeSet& vol, double n) {
   SharpInterfaces si;

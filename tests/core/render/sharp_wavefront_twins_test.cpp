@@ -46,23 +46,6 @@ constexpr double kEps32 = 5.960464477539063e-08;  // 2⁻²⁴
 /// ulp of a float32 of magnitude ≤ X (mm): 2ε·X rounded up to the binade, as a bound.
 double ulp32(double X) { return 2.0 * kEps32 * std::exp2(std::ceil(std::log2(X))); }
 
-Light beam(glm::dvec3 axis_point, glm::dvec3 dir, double radius, double E) {
-  Light l = directionalLight(dir, E);
-  l.position = axis_point;
-  l.beam_radius = radius;
-  return l;
-}
-
-/// Unpolarised Fresnel reflectance n1 → n2 at incidence i (Born & Wolf eq. 1.5.21).
-double fresnelR(double n1, double n2, double i) {
-  const double si = std::sin(i), st = n1 * si / n2;
-  if (st >= 1.0) return 1.0;
-  const double ci = std::cos(i), ct = std::sqrt(1.0 - st * st);
-  const double rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
-  const double rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
-  return 0.5 * (rs * rs + rp * rp);
-}
-
 double fluxEnded(const WavefrontStats& s) {
   return s.flux_left + s.flux_caustic + s.flux_energy + s.flux_absorbed + s.flux_reflected +
          s.flux_live_at_end;

@@ -26,13 +26,6 @@ double seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-Light beam(glm::dvec3 axis_point, glm::dvec3 dir, double radius, double E) {
-  Light l = directionalLight(dir, E);
-  l.position = axis_point;
-  l.beam_radius = radius;
-  return l;
-}
-
 // ---------------------------------------------------------------- calcite plate
 // A 10 mm calcite plate (faces z = ±5, 60 mm wide: no side faces in the volume), optic axis in the
 // x–z plane at 45° to the faces, leaning to +x; h = 0.15 mm (80 voxels along z), smoothing σ =
