@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -178,19 +179,29 @@ void printSummary(const RenderArgs& a, Session& session, const LightOutcome& lig
 }
 
 /// Progressive output: the PNG preview rewritten (atomically) as pixel samples finish, at most
-/// once a second, so a long render shows the picture forming; the final pair replaces it.
-RenderSettings withPreview(RenderSettings rs, const std::filesystem::path& png, double exposure) {
-  auto last =
-      std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
-  rs.on_pass = [png, exposure, last](const RenderImage& so_far, int, int) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now - *last < std::chrono::seconds(1)) return;
-    writeFilesTogether(
-        {{png, pngPreviewContent(so_far.width, so_far.height, so_far.rgb, exposure)}});
-    *last = now;
-  };
-  return rs;
-}
+/// once a second, so a long render shows the picture forming; the final pair replaces it. A render
+/// that fails after a preview was written removes it (~Preview): no partial output is left.
+struct Preview {
+  std::filesystem::path png;
+  double exposure = 0.0;
+  std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+  bool written = false, finished = false;
+  ~Preview() {
+    std::error_code ec;
+    if (written && !finished) std::filesystem::remove(png, ec);
+  }
+  RenderSettings attach(RenderSettings rs) {
+    rs.on_pass = [this](const RenderImage& so_far, int, int) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last < std::chrono::seconds(1)) return;
+      writeFilesTogether(
+          {{png, pngPreviewContent(so_far.width, so_far.height, so_far.rgb, exposure)}});
+      last = now;
+      written = true;
+    };
+    return rs;
+  }
+};
 
 void runRender(const RenderArgs& a, const CLI::App& sub) {
   if (a.timings) timings::enable(true);
@@ -233,7 +244,8 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   }
   for (const std::string& w : light.warnings)
     std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
-  RenderImage img = session.render(withPreview(rs, png, a.exposure), !a.reference);
+  Preview preview{png, a.exposure};
+  RenderImage img = session.render(preview.attach(rs), !a.reference);
   progress.finish();
   timings::mark("rendered");
   if (img.cut_samples > 0)
@@ -246,6 +258,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   // preview first: it is the smaller, so a full disk is usually met before the EXR is encoded.
   writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)},
                       {out, exrRgbContent(img.width, img.height, img.rgb)}});
+  preview.finished = true;
   timings::mark("written");
   printSummary(a, session, light, rs, img, out, png);
 }
