@@ -251,6 +251,46 @@ TEST(PolarisedTraceGpu, WalkOffBeyondTheCoherenceWidthAddsStokes) {
   expectNoValidationMessages();
 }
 
+// A Fresnel rhomb of N-BK7 (the CPU test's geometry): two total internal reflections of δ = 45°
+// each turn light linear at 45° to the plane of incidence right circular, S0 = (4n/(1 + n)²)².
+// Exercises the GPU's complex TIR amplitudes (cos t = +i√((n₁/n₂)² sin²i − 1)).
+TEST(PolarisedTraceGpu, FresnelRhombMakesRightCircularLight) {
+  const double nm = 587.5618;
+  const Material glass = loadMaterialFile(std::string(EIKON_SOURCE_DIR) + "/materials/N-BK7.json");
+  const double n = glass.n_o.index(nm), n2 = 1.0 / (n * n);
+  auto delta = [&](double th) {
+    const double si = std::sin(th), ci = std::cos(th);
+    return 2.0 * std::atan(ci * std::sqrt(si * si - n2) / (si * si));
+  };
+  double lo = std::acos(std::sqrt((1 - n2) / (1 + n2))), hi = rad(89.0);
+  for (int k = 0; k < 100; ++k) (delta(0.5 * (lo + hi)) > kPi / 4 ? lo : hi) = 0.5 * (lo + hi);
+  const double th = 0.5 * (lo + hi), c = std::cos(th), sn = std::sin(th);
+  const glm::dvec3 u1(0, c, sn), u2(0, -c, sn), E(0, -0.9, -3.5);
+  const glm::dvec3 P2 = E + (1.9 / c) * u1 + (2.0 / c) * u2;
+  const double c_in = glm::dot(u1, E), c_out = glm::dot(u1, P2) + 1.0 / c;
+  auto num = [](double v) { return std::to_string(v); };
+  PolTwins t(R"({"shape": "planes", "material": "N-BK7", "planes": [[0, 1, 0, 1],
+               [0, -1, 0, 1], [1, 0, 0, 3], [-1, 0, 0, 3], [0, )" +
+             num(c) + ", " + num(sn) + ", " + num(c_out) + "], [0, " + num(-c) + ", " + num(-sn) +
+             ", " + num(-c_in) + "]]}");
+  const glm::dvec3 s_hat(-1, 0, 0), p_hat = glm::cross(u1, s_hat),
+                                    e = glm::normalize(s_hat + p_hat);
+  const glm::dvec3 xin = stokesBasis(u1), yin = glm::cross(u1, xin);
+  const double psi = std::atan2(glm::dot(e, yin), glm::dot(e, xin));
+  const Stokes in(1, std::cos(2 * psi), std::sin(2 * psi), 0);
+  const TraceRequest r{E - 20.0 * u1, u1, nm};
+  const PolarisedTrace g = t.gpu.tracePolarised({}, {r}, {in}).front();
+  ASSERT_EQ(g.beams.size(), 1u);
+  const Stokes& o = g.beams[0].stokes;
+  const double T = 4 * n / ((1 + n) * (1 + n));
+  std::printf("GPU Fresnel rhomb: S3/S0 = %.7f, S0 = %.7f (closed %.7f)\n", o[3] / o[0], o[0],
+              T * T);
+  EXPECT_GE(o[3] / o[0], 0.999);
+  EXPECT_NEAR(o[0], T * T, 1e-5);
+  expectStokesNear(o, t.cpu({}, r, in).beams[0].stokes, 1e-4, "rhomb vs CPU");
+  expectNoValidationMessages();
+}
+
 TEST(PolarisedTraceGpu, BadInputIsRefused) {
   PolTwins t(kAside);
   const TraceRequest r{{0, 0, -30}, {0, 0, 1}, 550.0};
