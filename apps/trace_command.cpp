@@ -4,9 +4,17 @@
 // steps (docs/design.md §3). Isotropic scenes print one mode, marked "o=e" (--json gives both,
 // identical). Transmittance is the mode's own (Fresnel for its polarisation × attenuation);
 // unpolarised light gives each mode half of the incident power.
+//
+// Polarisation (docs/polarisation.md): in a scene with sharp interfaces the ray is also followed
+// with its field (the polarised trace of the chosen twin) for the input Stokes vector --stokes
+// S0,S1,S2,S3 (default 1,0,0,0, unpolarised; in Mitsuba 3's stokesBasis of --dir), and the Stokes
+// vector of the light leaving along the traced path is printed: "stokes_out" (the strongest
+// beam, in the stokesBasis of its direction) and "polarised_beams" (every exit direction).
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "apps/commands.h"
@@ -36,16 +44,80 @@ glm::dvec3 parseVec(const std::string& s, const char* what) {
   return {v[0], v[1], v[2]};
 }
 
+/// --stokes: four finite numbers with S0 > 0 and a degree of polarisation ≤ 1.
+Stokes parseStokes(const std::string& s) {
+  std::stringstream ss(s);
+  std::string part;
+  std::vector<double> v;
+  auto bad = [&](const std::string& why) {
+    return CliError("--stokes " + why + ", got '" + s + "'");
+  };
+  while (std::getline(ss, part, ',')) {
+    try {
+      size_t used = 0;
+      double x = std::stod(part, &used);
+      if (used != part.size() || !std::isfinite(x)) throw std::invalid_argument("");
+      v.push_back(x);
+    } catch (...) {
+      throw bad("must be four finite numbers S0,S1,S2,S3");
+    }
+  }
+  if (v.size() != 4) throw bad("must be four numbers S0,S1,S2,S3");
+  const Stokes st(v[0], v[1], v[2], v[3]);
+  if (!(st[0] > 0)) throw bad("needs S0 > 0");
+  if (degreeOfPolarisation(st) > 1.0 + 1e-9)
+    throw bad("has a degree of polarisation sqrt(S1² + S2² + S3²)/S0 above 1");
+  return st;
+}
+
 struct TraceArgs {
-  std::string scene, origin, dir;
+  std::string scene, origin, dir, stokes;
   double wavelength = 587.5618, step = 0.25;
   bool json = false, reference = false, quiet = false, strict = false;
   std::string integrator = "rk4", progress = "auto";
 };
 
 /// The trace as JSON (--json) or as text: per mode, where and how the ray left.
+/// The polarised trace's beams as JSON: direction, exit point, frame, Stokes vector, branches.
+nlohmann::json beamsJson(const PolarisedTrace& t) {
+  auto vec = [](const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+  nlohmann::json beams = nlohmann::json::array();
+  for (const PolarisedBeam& b : t.beams)
+    beams.push_back({{"direction", vec(b.direction)},
+                     {"exit_point", vec(b.exit_point)},
+                     {"frame_x", vec(b.frame_x)},
+                     {"stokes", {b.stokes[0], b.stokes[1], b.stokes[2], b.stokes[3]}},
+                     {"branches", b.branches},
+                     {"coherent_groups", b.coherent_groups},
+                     {"modes", b.modes}});
+  return beams;
+}
+
+/// stokes_out in the text output: the strongest beam, then the others.
+void printPolarised(const Stokes& in, const std::optional<PolarisedTrace>& pol,
+                    const std::string& why_not) {
+  if (!pol) {
+    std::printf("  stokes_out: not traced (%s)\n", why_not.c_str());
+    return;
+  }
+  std::printf("  stokes in (%g, %g, %g, %g)%s\n", in[0], in[1], in[2], in[3],
+              pol->truncated ? " (ray tree cut: max branches or events)" : "");
+  if (pol->beams.empty()) std::printf("  stokes_out: nothing leaves (absorbed)\n");
+  for (size_t k = 0; k < pol->beams.size(); ++k) {
+    const PolarisedBeam& b = pol->beams[k];
+    std::printf(
+        "  %s (%.9f, %.9f, %.9f, %.9f) dir (%.6f, %.6f, %.6f) frame x (%.6f, %.6f, %.6f), "
+        "%d branch%s (%s), %d coherent group%s\n",
+        k == 0 ? "stokes_out" : "     other", b.stokes[0], b.stokes[1], b.stokes[2], b.stokes[3],
+        b.direction.x, b.direction.y, b.direction.z, b.frame_x.x, b.frame_x.y, b.frame_x.z,
+        b.branches, b.branches == 1 ? "" : "es", b.modes.c_str(), b.coherent_groups,
+        b.coherent_groups == 1 ? "" : "s");
+  }
+}
+
 void printTrace(const TraceArgs& a, const Scene& scene, const std::array<TraceOutcome, 2>& modes,
-                const std::string& device) {
+                const std::string& device, const Stokes& in,
+                const std::optional<PolarisedTrace>& pol, const std::string& why_not) {
   auto vec = [](const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
   if (a.json) {
     nlohmann::json j;
@@ -63,6 +135,16 @@ void printTrace(const TraceArgs& a, const Scene& scene, const std::array<TraceOu
                             {"steps", t.steps},
                             {"interfaces", t.interfaces},
                             {"total_internal_reflections", t.total_internal_reflections}});
+    }
+    j["stokes_in"] = {in[0], in[1], in[2], in[3]};
+    if (pol) {
+      const Stokes o = pol->beams.empty() ? Stokes(0.0) : pol->beams[0].stokes;
+      j["stokes_out"] = {o[0], o[1], o[2], o[3]};
+      j["polarised_beams"] = beamsJson(*pol);
+      j["polarised_truncated"] = pol->truncated;
+    } else {
+      j["stokes_out"] = nullptr;
+      j["stokes_out_note"] = why_not;
     }
     j["device"] = device;
     std::printf("%s\n", j.dump(2).c_str());
@@ -87,6 +169,7 @@ void printTrace(const TraceArgs& a, const Scene& scene, const std::array<TraceOu
     std::printf("  %*s  %d interfaces crossed, %d total internal reflections, %d steps\n",
                 isotropic ? 3 : 1, "", t.interfaces, t.total_internal_reflections, t.steps);
   }
+  printPolarised(in, pol, why_not);
 }
 void runTrace(const TraceArgs& a);
 }  // namespace
@@ -100,6 +183,9 @@ void addTraceCommand(CLI::App& app) {
   sub->add_option("--dir", a->dir, "Ray direction x,y,z (any non-zero length)")->required();
   sub->add_option("--wavelength", a->wavelength, "Wavelength in nm (default 587.5618, the d line)");
   sub->add_option("--step", a->step, "Integration step in voxels (default 0.25)");
+  sub->add_option("--stokes", a->stokes,
+                  "Input Stokes vector S0,S1,S2,S3 of the polarised trace, in Mitsuba 3's "
+                  "stokesBasis of --dir (default 1,0,0,0: unpolarised); needs sharp interfaces");
   sub->add_flag("--json", a->json, "Print JSON");
   sub->add_flag("--reference", a->reference,
                 "Use the double-precision CPU reference instead of the GPU");
@@ -112,15 +198,20 @@ void addTraceCommand(CLI::App& app) {
 }
 
 namespace {
+constexpr const char* kNeedsSharp = "the polarised trace needs \"interfaces\": \"sharp\"";
+
 void runTrace(const TraceArgs& a) {
   TraceRequest req{parseVec(a.origin, "--origin"), parseVec(a.dir, "--dir"), a.wavelength};
   // The range checks are the session's, as Python's (core/session/session.h).
   checkTraceRequest(req);
   checkMarchStep(a.step);
+  const Stokes stokes_in = a.stokes.empty() ? Stokes(1, 0, 0, 0) : parseStokes(a.stokes);
   req.direction = glm::normalize(req.direction);
   const ProgressMode progress_mode = progressMode(a.progress, a.quiet);
   auto scene = std::make_shared<Scene>(loadScene(a.scene));
   timings::mark("scene parsed");
+  if (!a.stokes.empty() && scene->interfaces != Scene::Interfaces::Sharp)
+    throw CliError(std::string("--stokes: ") + kNeedsSharp);  // before any voxelising or warning
   // Voxelising a 128³ scene takes seconds; the trace itself is instant.
   Progress progress(progress_mode);
   MarchSettings ms;
@@ -135,10 +226,24 @@ void runTrace(const TraceArgs& a) {
   session.prepare(!a.reference);
   timings::mark("voxelised");
   const std::array<TraceOutcome, 2> modes = session.trace({req}, ms, !a.reference).front();
+  // The polarised trace: an explicit --stokes must be honoured (its failure is the error); by
+  // default a scene it does not support prints why instead of stokes_out.
+  std::optional<PolarisedTrace> pol;
+  std::string why_not;
+  if (scene->interfaces != Scene::Interfaces::Sharp) {
+    why_not = kNeedsSharp;
+  } else {
+    try {
+      pol = session.tracePolarised(req, stokes_in, {}, !a.reference);
+    } catch (const std::runtime_error& e) {
+      if (!a.stokes.empty()) throw CliError(std::string("--stokes: ") + e.what());
+      why_not = e.what();
+    }
+  }
   progress.finish();
   timings::mark("traced");
   const std::string device = session.deviceName(!a.reference);
-  printTrace(a, *scene, modes, device);
+  printTrace(a, *scene, modes, device, stokes_in, pol, why_not);
 }
 }  // namespace
 

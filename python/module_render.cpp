@@ -227,6 +227,53 @@ py::dict traceOne(Prepared& p, const py::handle& origin, const py::handle& direc
   return d;
 }
 
+py::array_t<double> stokesArray(const Stokes& s) {
+  py::array_t<double> a(4);
+  for (int k = 0; k < 4; ++k) a.mutable_at(k) = s[k];
+  return a;
+}
+
+// The polarised trace of one ray (Session::tracePolarised, as `eikon trace --stokes`):
+// {'stokes_out': (4,) of the strongest beam, 'beams': [{'direction', 'exit_point', 'frame_x',
+// 'stokes', 'branches', 'coherent_groups', 'modes'}], 'frame_x_in', 'truncated', 'device'}.
+py::dict tracePolarisedOne(Prepared& p, const py::handle& origin, const py::handle& direction,
+                           double wavelength_nm, const py::handle& stokes,
+                           const std::string& device, double bandwidth_nm, double source_angle_rad,
+                           const std::vector<int>& reflect_at) {
+  const bool gpu = isGpu(device);
+  TraceRequest q{toVec3(origin), toVec3(direction), wavelength_nm};
+  const auto in = py::cast<std::vector<double>>(stokes);
+  if (in.size() != 4)
+    throw std::invalid_argument("stokes must be four numbers S0, S1, S2, S3, got " +
+                                std::to_string(in.size()));
+  PolarisedTraceSettings set;
+  set.bandwidth_nm = bandwidth_nm;
+  set.source_angle_rad = source_angle_rad;
+  set.reflect_at = reflect_at;
+  checkSetting([&] { checkTraceRequest(q); });
+  const Stokes s_in(in[0], in[1], in[2], in[3]);
+  const PolarisedTrace t = p.run([&](Session& s) { return s.tracePolarised(q, s_in, set, gpu); });
+  py::list beams;
+  for (const PolarisedBeam& b : t.beams) {
+    py::dict d;
+    d["direction"] = fromVec3(b.direction);
+    d["exit_point"] = fromVec3(b.exit_point);
+    d["frame_x"] = fromVec3(b.frame_x);
+    d["stokes"] = stokesArray(b.stokes);
+    d["branches"] = b.branches;
+    d["coherent_groups"] = b.coherent_groups;
+    d["modes"] = b.modes;
+    beams.append(d);
+  }
+  py::dict d;
+  d["stokes_out"] = stokesArray(t.beams.empty() ? Stokes(0.0) : t.beams[0].stokes);
+  d["beams"] = beams;
+  d["frame_x_in"] = fromVec3(t.frame_x_in);
+  d["truncated"] = t.truncated;
+  d["device"] = device;
+  return d;
+}
+
 py::array_t<float> readExr(const std::string& path) {
   RgbaImage im = readExrRgba(path, 16384, 16384);
   py::array_t<float> a({py::ssize_t(im.height), py::ssize_t(im.width), py::ssize_t(3)});
@@ -257,6 +304,15 @@ void bindModuleCalls(py::module_& m) {
       },
       py::arg("scene"),
       "trace(scene, origin, direction, wavelength_nm=, march=, device=) — see Renderer.trace");
+  m.def(
+      "trace_polarised",
+      [](std::shared_ptr<Scene> s, py::args a, py::kwargs kw) {
+        auto p = py::cast(cachedPrepared(s));
+        return p.attr("trace_polarised")(*a, **kw);
+      },
+      py::arg("scene"),
+      "trace_polarised(scene, origin, direction, wavelength_nm=, stokes=, device=, ...) — see "
+      "Renderer.trace_polarised");
   m.def(
       "clear_cache",
       [] {
@@ -317,7 +373,16 @@ void bindRenderer(py::module_& m) {
            py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(),
            py::arg("device") = "gpu",
            "one ray, the CLI JSON shape: {'wavelength_nm', 'device', 'modes': [{'mode': 'o', ...}, "
-           "...]}");
+           "...]}")
+      .def("trace_polarised", &tracePolarisedOne, py::arg("origin"), py::arg("direction"),
+           py::arg("wavelength_nm") = 587.5618, py::arg("stokes") = std::vector<double>{1, 0, 0, 0},
+           py::arg("device") = "gpu", py::arg("bandwidth_nm") = 10.0,
+           py::arg("source_angle_rad") = 1e-3, py::arg("reflect_at") = std::vector<int>{},
+           "the polarised trace of one ray (`eikon trace --stokes`; docs/polarisation.md) for the "
+           "input Stokes vector `stokes` in Mitsuba 3's stokes_basis of `direction`: "
+           "{'stokes_out': (4,), 'beams': [{'direction', 'exit_point', 'frame_x', 'stokes', "
+           "'branches', 'coherent_groups', 'modes'}], 'frame_x_in', 'truncated', 'device'}; each "
+           "beam's Stokes vector is in the stokes_basis of its direction (frame_x)");
 
   bindModuleCalls(m);
 }

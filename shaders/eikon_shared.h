@@ -152,6 +152,43 @@ struct BoundaryAnswer {
   vec4 shape;     // x: signed distance of shape s at a (mm); yzw: its gradient (world)
 };
 
+// ---- The polarised trace (polarised_trace.comp; CPU twin core/reference/polarised_trace.h) ----
+// Its own bindings on top of the trace kernel's: the polariser sheets and the trace settings.
+#define EIKON_B_SHEETS 23
+#define EIKON_POL_MAX_SHEETS 8    // polariser sheets a scene may hold for the GPU twin
+#define EIKON_POL_MAX_LEAVES 8    // o/e ray-tree leaves (exit branches) per ray
+#define EIKON_POL_MAX_STACK 8     // branches waiting to be followed
+#define EIKON_POL_MAX_EVENTS 48   // interface events per branch
+#define EIKON_POL_MAX_PIECES 96   // straight pieces per ray, all branches together (loop budget)
+#define EIKON_POL_MAX_BEAMS 4     // output beams per ray (exit directions)
+#define EIKON_POL_MAX_GROUPED 4   // branch mode codes reported per beam
+// Sheets buffer: [0] = (sheet count, bandwidth_nm, source_angle_rad, reflect_at bit mask), then
+// per sheet (center, width), (unit normal, height), (unit transmission axis, 0).
+
+// One ray of the polarised trace: origin, unit direction, λ and the input Stokes vector (in
+// stokesBasis(direction)).
+struct PolarisedRay {
+  vec4 origin;     // xyz (mm), w: λ (µm)
+  vec4 direction;  // xyz unit
+  vec4 stokes;     // S0..S3
+};
+
+// One beam leaving the scene (the CPU's PolarisedBeam).
+struct PolarisedBeamOut {
+  vec4 exit_point;  // xyz (mm); w: branches added into it
+  vec4 direction;   // xyz unit energy direction; w: coherent groups
+  vec4 frame_x;     // xyz the Stokes reference direction stokesBasis(direction)
+  vec4 stokes;      // S0..S3
+  ivec4 modes;      // per branch (up to EIKON_POL_MAX_GROUPED): (length << 16) | o/e bits (e = 1,
+                    // first crystal first), −1 where none
+};
+
+struct PolarisedResult {
+  ivec4 head;  // x: beams; y: 1 if the ray tree was cut (branches, events, loop budget);
+               // z: an unsupported (varying) region + 1, or 0; w: 1 if it entered inside an object
+  PolarisedBeamOut beams[EIKON_POL_MAX_BEAMS];
+};
+
 // ---- Light simulator (wavefront.comp; CPU twin core/reference/wavefront.h) ----
 #define EIKON_WAVE_WG 64
 // Descriptor bindings of the wavefront pipeline (its own set 0).
@@ -248,6 +285,9 @@ struct WavePatch {
 #ifdef __cplusplus
 static_assert(sizeof(ViewParams) == 16 * 16, "ViewParams must be vec4-packed");
 static_assert(sizeof(TraceRay) == 32 && sizeof(TraceResult) == 64, "trace records must be vec4-packed");
+static_assert(sizeof(PolarisedRay) == 48 && sizeof(PolarisedBeamOut) == 80 &&
+                  sizeof(PolarisedResult) == 16 + 80 * EIKON_POL_MAX_BEAMS,
+              "polarised trace records must be vec4-packed");
 static_assert(sizeof(BoundaryQuery) == 48 && sizeof(BoundaryAnswer) == 80,
               "boundary probe records must be vec4-packed");
 static_assert(sizeof(WavePush) == 16 && sizeof(ScanPush) == 16 && sizeof(WaveTally) == 7 * 16,

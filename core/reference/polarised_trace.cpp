@@ -245,32 +245,12 @@ PolarisedBeam recombine(const std::vector<const Branch*>& group, const Stokes& i
   return beam;
 }
 
-void validate(const TraceRequest& ray, const Stokes& in, const PolarisedTraceSettings& s) {
-  const double len = glm::length(ray.direction);
-  if (!(len > 0) || !std::isfinite(len))
-    throw std::invalid_argument("trace direction must be a non-zero finite vector");
-  if (!(ray.wavelength_nm > 0) || !std::isfinite(ray.wavelength_nm))
-    throw std::invalid_argument("trace wavelength must be > 0 nm");
-  if (!(in[0] > 0) || !std::isfinite(in[1] + in[2] + in[3]))
-    throw std::invalid_argument("input Stokes vector needs S0 > 0 and finite S1..S3");
-  if (degreeOfPolarisation(in) > 1.0 + 1e-9)
-    throw std::invalid_argument("input Stokes vector has sqrt(S1² + S2² + S3²) > S0");
-  if (!(s.bandwidth_nm > 0) || !(s.source_angle_rad > 0) || s.max_branches < 1 || s.max_events < 1)
-    throw std::invalid_argument("polarised trace settings must be positive");
-}
-
 }  // namespace
-
-double PolarisedTrace::totalPower() const {
-  double p = 0.0;
-  for (const PolarisedBeam& b : beams) p += b.stokes[0];
-  return p;
-}
 
 PolarisedTrace tracePolarised(const Field& field, const std::vector<PolarizerSheet>& sheets,
                               const TraceRequest& ray, const Stokes& input,
                               const PolarisedTraceSettings& settings) {
-  validate(ray, input, settings);
+  checkPolarisedTrace(ray, input, settings);
   if (!field.boundary() || !field.media())
     throw std::runtime_error(
         "polarised trace: the field has no sharp boundaries (it needs "

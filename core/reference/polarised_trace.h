@@ -25,47 +25,22 @@
 //   eikon::PolarisedTrace t = eikon::tracePolarised(field, scene.polarizers, ray, {1, 0, 0, 0});
 //   // t.beams[k].stokes: what leaves along direction t.beams[k].direction
 //
+// The settings and beams are the neutral ones of core/volume/polarised.h, shared with the GPU twin
+// (ViewRenderer::tracePolarised, shaders/polarised_trace.comp).
+//
 // Only homogeneous regions are supported (a gradient-index or radial-axis region on the path is
 // a std::runtime_error naming it); an opaque region absorbs the branch.
 #pragma once
 
-#include <string>
 #include <vector>
 
 #include "core/scene/scene.h"
 #include "core/volume/field.h"
 #include "core/volume/march_types.h"
+#include "core/volume/polarised.h"
 #include "optics/polarization.h"
 
 namespace eikon {
-
-struct PolarisedTraceSettings {
-  double bandwidth_nm = 10.0;      ///< spectral width of one sample: coherence length λ²/Δλ
-  double source_angle_rad = 1e-3;  ///< angular size of one light/environment sample
-  int max_branches = 64;           ///< o/e ray-tree leaves
-  int max_events = 256;            ///< interface events per branch
-  std::vector<int> reflect_at;     ///< interface events (0-based per branch) that take the
-                                   ///< reflected beam instead of the transmitted one
-};
-
-/// One beam leaving the scene.
-struct PolarisedBeam {
-  glm::dvec3 exit_point{0.0};  ///< last point in the volume (the origin's line if it missed it)
-  glm::dvec3 direction{0.0};   ///< unit energy direction
-  glm::dvec3 frame_x{0.0};     ///< the Stokes reference direction, stokesBasis(direction)
-  Stokes stokes{0.0};
-  int branches = 0;         ///< o/e paths added into it
-  int coherent_groups = 0;  ///< groups added incoherently (1: fully coherent sum)
-  std::string modes;        ///< the branches' mode sequences, e.g. "o,e"
-};
-
-struct PolarisedTrace {
-  std::vector<PolarisedBeam> beams;  ///< by decreasing S0
-  glm::dvec3 frame_x_in{0.0};        ///< the input Stokes reference direction
-  bool truncated = false;            ///< max_branches or max_events cut the ray tree
-  /// Σ S0 of the beams (what leaves the scene in all directions).
-  double totalPower() const;
-};
 
 /// Trace `ray` (forwards) through the field's sharp boundaries and the given sheets. Throws
 /// std::invalid_argument on a bad ray, input Stokes vector (S0 ≤ 0, DoP > 1) or settings, and

@@ -1,5 +1,6 @@
 #include "core/render/view_renderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -13,6 +14,7 @@
 #include "core/spectrum/rgb_to_spectrum.h"
 #include "core/vk/timings.h"
 #include "shaders/eikon_shared.h"
+#include "shaders/polarised_trace.spv.h"
 #include "shaders/trace.spv.h"
 #include "shaders/view.spv.h"
 
@@ -26,6 +28,63 @@ void validate(const MarchSettings& m) {
     throw std::invalid_argument("march step must be in (0, 4] voxels");
   if (m.max_steps < 1) throw std::invalid_argument("max_steps must be >= 1");
   if (!(m.interface_threshold > 0)) throw std::invalid_argument("interface threshold must be > 0");
+}
+
+/// The sheets buffer of polarised_trace.comp: a header (count, bandwidth, source angle, reflect_at
+/// bit mask), then three vec4s per sheet (eikon_shared.h).
+std::vector<glm::vec4> packSheets(const std::vector<PolarizerSheet>& sheets,
+                                  const PolarisedTraceSettings& s) {
+  if (sheets.size() > size_t(EIKON_POL_MAX_SHEETS))
+    throw std::invalid_argument("the GPU polarised trace takes at most " +
+                                std::to_string(EIKON_POL_MAX_SHEETS) + " polariser sheets, got " +
+                                std::to_string(sheets.size()));
+  int mask = 0;
+  for (int e : s.reflect_at) {
+    if (e < 0 || e >= 24)
+      throw std::invalid_argument("the GPU polarised trace's reflect_at events must be in [0, 23]");
+    mask |= 1 << e;
+  }
+  std::vector<glm::vec4> out{glm::vec4(float(sheets.size()), float(s.bandwidth_nm),
+                                       float(s.source_angle_rad), float(mask))};
+  for (const PolarizerSheet& sh : sheets) {
+    out.push_back(glm::vec4(glm::vec3(sh.center), float(sh.width)));
+    out.push_back(glm::vec4(glm::vec3(sh.normal), float(sh.height)));
+    out.push_back(glm::vec4(glm::vec3(sh.axis), 0.0f));
+  }
+  return out;
+}
+
+/// One ray's result of polarised_trace.comp as the CPU twin's PolarisedTrace (beams by S0).
+PolarisedTrace unpackPolarised(const gpu::PolarisedResult& r, const glm::dvec3& dir) {
+  if (r.head.z > 0)
+    throw std::runtime_error("polarised trace: region " + std::to_string(r.head.z - 1) +
+                             " is a gradient-index or radial-axis medium, which the polarised "
+                             "trace does not support yet");
+  if (r.head.w > 0)
+    throw std::runtime_error("polarised trace: the ray enters the volume inside an object");
+  PolarisedTrace t;
+  t.frame_x_in = stokesBasis(dir);
+  t.truncated = r.head.y != 0;
+  for (int k = 0; k < std::min(r.head.x, EIKON_POL_MAX_BEAMS); ++k) {
+    const gpu::PolarisedBeamOut& o = r.beams[k];
+    PolarisedBeam b;
+    b.exit_point = glm::dvec3(o.exit_point);
+    b.direction = glm::dvec3(o.direction);
+    b.frame_x = glm::dvec3(o.frame_x);
+    b.stokes = Stokes(o.stokes);
+    b.branches = int(o.exit_point.w);
+    b.coherent_groups = int(o.direction.w);
+    for (int j = 0; j < std::min(b.branches, EIKON_POL_MAX_GROUPED); ++j) {
+      std::string m;
+      for (int c = 0; c < (o.modes[j] >> 16); ++c) m += ((o.modes[j] >> c) & 1) ? 'e' : 'o';
+      b.modes += (j ? "," : "") + (m.empty() ? std::string("-") : m);
+    }
+    t.beams.push_back(b);
+  }
+  std::sort(t.beams.begin(), t.beams.end(), [](const PolarisedBeam& u, const PolarisedBeam& v) {
+    return u.stokes[0] > v.stokes[0];
+  });
+  return t;
 }
 
 }  // namespace
@@ -76,8 +135,9 @@ struct ViewRenderer::Impl {
   // march.glsl: the march kind, the EIKON_F_* flags, the integrator). lavapipe executes every
   // branch of a kernel masked, so a kernel with the scene's and the settings' features folded in
   // marches many times faster than one that tests them at run time (docs/performance.md).
-  std::vector<vk::BindingSpec> viewBindings, traceBindings;
-  std::map<std::tuple<bool, int, int, int>, vk::ComputePipeline> pipelines;
+  std::vector<vk::BindingSpec> viewBindings, traceBindings, polarisedBindings;
+  enum Kernel { kView = 0, kTrace = 1, kPolarised = 2 };
+  std::map<std::tuple<int, int, int, int>, vk::ComputePipeline> pipelines;
   int skip_cap = 32;
   double ambient = 1.0;
 
@@ -167,23 +227,25 @@ struct ViewRenderer::Impl {
     viewBindings = common;
     traceBindings = common;
     traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    polarisedBindings = traceBindings;
+    polarisedBindings.push_back({EIKON_B_SHEETS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
   }
 
-  // The view (trace = false) or trace kernel specialised for the flags and integrator of p.
-  vk::ComputePipeline& pipeline(bool trace, const gpu::ViewParams& p) {
+  // The view, trace or polarised-trace kernel specialised for the flags and integrator of p.
+  vk::ComputePipeline& pipeline(Kernel kernel, const gpu::ViewParams& p) {
     const int flags = p.grid_dims.w, integrator = int(p.march.w);
-    auto key = std::make_tuple(trace, flags, integrator, sharp ? 1 : 0);
+    auto key = std::make_tuple(int(kernel), flags, integrator, sharp ? 1 : 0);
     auto it = pipelines.find(key);
     if (it != pipelines.end()) return it->second;
     // constant_id 0: kSharpMarch, 1: kViewFlags, 2: kIntegrator (march.glsl).
     const std::vector<uint32_t> spec{sharp ? 1u : 0u, uint32_t(flags), uint32_t(integrator)};
+    auto make = [&](std::span<const uint32_t> code, const std::vector<vk::BindingSpec>& b,
+                    const char* name) { return vk::ComputePipeline(ctx, code, b, 0, name, spec); };
     vk::ComputePipeline pl =
-        trace ? vk::ComputePipeline(ctx,
-                                    std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4),
-                                    traceBindings, 0, "trace", spec)
-              : vk::ComputePipeline(ctx,
-                                    std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4),
-                                    viewBindings, 0, "view", spec);
+        kernel == kTrace  ? make({k_trace_spv, sizeof(k_trace_spv) / 4}, traceBindings, "trace")
+        : kernel == kView ? make({k_view_spv, sizeof(k_view_spv) / 4}, viewBindings, "view")
+                          : make({k_polarised_trace_spv, sizeof(k_polarised_trace_spv) / 4},
+                                 polarisedBindings, "polarised trace");
     bindCommon(pl);
     ctx.savePipelineCache();  // core/vk/pipeline_cache.h: the next run may skip the compilation
     timings::mark("pipelines built");
@@ -300,7 +362,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   int rows = EIKON_WG_Y;
   vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * sizeof(glm::vec4),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
-  vk::ComputePipeline& view = I.pipeline(false, p);
+  vk::ComputePipeline& view = I.pipeline(Impl::kView, p);
   view.bindBuffer(EIKON_B_OUTPUT, out);
   const size_t pixels = size_t(img.width) * size_t(img.height);
   std::vector<double> acc(pixels * 3, 0.0);
@@ -381,7 +443,7 @@ std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(
   rb.write(in.data(), in.size() * sizeof(gpu::TraceRay));
   vk::Buffer ob(I.ctx, 2 * in.size() * sizeof(gpu::TraceResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                 "trace results");
-  vk::ComputePipeline& tracer = I.pipeline(true, p);
+  vk::ComputePipeline& tracer = I.pipeline(Impl::kTrace, p);
   tracer.bindBuffer(EIKON_B_RAYS, rb);
   tracer.bindBuffer(EIKON_B_OUTPUT, ob);
   I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
@@ -405,6 +467,54 @@ std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(
     o.interfaces = int(r.stats.z);
     o.total_internal_reflections = int(r.stats.w);
   }
+  return out;
+}
+
+std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<PolarizerSheet>& sheets,
+                                                         const std::vector<TraceRequest>& rays,
+                                                         const std::vector<Stokes>& inputs,
+                                                         const PolarisedTraceSettings& settings) {
+  Impl& I = *impl_;
+  if (inputs.size() != rays.size())
+    throw std::invalid_argument("polarised trace: one input Stokes vector per ray");
+  for (size_t i = 0; i < rays.size(); ++i) checkPolarisedTrace(rays[i], inputs[i], settings);
+  if (!I.sharp)
+    throw std::runtime_error(
+        "polarised trace: the field has no sharp boundaries (it needs "
+        "\"interfaces\": \"sharp\")");
+  if (rays.empty()) return {};
+  const std::vector<glm::vec4> sheetData = packSheets(sheets, settings);
+  std::vector<gpu::PolarisedRay> in(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) {
+    in[i].origin = glm::vec4(glm::vec3(rays[i].origin), float(rays[i].wavelength_nm * 1e-3));
+    in[i].direction = glm::vec4(glm::vec3(glm::normalize(rays[i].direction)), 0.0f);
+    in[i].stokes = glm::vec4(inputs[i]);
+  }
+  gpu::ViewParams p = I.baseParams(MarchSettings{}, 0);
+  p.image = glm::ivec4(int(rays.size()), 1, 0, 1);
+  p.pass = glm::ivec4(std::min(settings.max_events, EIKON_POL_MAX_EVENTS),
+                      std::min(settings.max_branches, EIKON_POL_MAX_LEAVES), 0, 0);
+  I.params.write(&p, sizeof p);
+  vk::Buffer rb(I.ctx, in.size() * sizeof(gpu::PolarisedRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                "polarised rays");
+  rb.write(in.data(), in.size() * sizeof(gpu::PolarisedRay));
+  vk::Buffer sb(I.ctx, sheetData.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                "polariser sheets");
+  sb.write(sheetData.data(), sheetData.size() * sizeof(glm::vec4));
+  vk::Buffer ob(I.ctx, in.size() * sizeof(gpu::PolarisedResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                "polarised results");
+  vk::ComputePipeline& tracer = I.pipeline(Impl::kPolarised, p);
+  tracer.bindBuffer(EIKON_B_RAYS, rb);
+  tracer.bindBuffer(EIKON_B_SHEETS, sb);
+  tracer.bindBuffer(EIKON_B_OUTPUT, ob);
+  // One ray per workgroup (the kernel's local size is 1: its loop budget is its own).
+  I.ctx.submitAndWait(
+      [&](VkCommandBuffer cmd) { tracer.dispatch(cmd, uint32_t(in.size()), 1, 1, nullptr); });
+  std::vector<gpu::PolarisedResult> res(in.size());
+  ob.read(res.data(), res.size() * sizeof(gpu::PolarisedResult));
+  std::vector<PolarisedTrace> out;
+  for (size_t i = 0; i < res.size(); ++i)
+    out.push_back(unpackPolarised(res[i], glm::normalize(rays[i].direction)));
   return out;
 }
 

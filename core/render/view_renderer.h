@@ -20,6 +20,7 @@
 #include "core/vk/context.h"
 #include "core/vk/resources.h"
 #include "core/volume/march_types.h"
+#include "core/volume/polarised.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {
@@ -43,6 +44,15 @@ class ViewRenderer {
   /// Trace both modes of each ray: {o, e}; identical where every material is isotropic.
   std::vector<std::array<TraceOutcome, 2>> traceModes(const std::vector<TraceRequest>& rays,
                                                       const MarchSettings& settings);
+  /// The polarised trace of each ray through the scene's sharp boundaries and `sheets` (the GPU
+  /// twin of core/reference/polarised_trace.h's tracePolarised; shaders/polarised_trace.comp):
+  /// inputs[i] is ray i's input Stokes vector. Throws std::invalid_argument as the CPU twin does
+  /// (and for more than 8 sheets or a ray/input count mismatch), std::runtime_error for a scene
+  /// without sharp interfaces or a path through a region the trace does not support.
+  std::vector<PolarisedTrace> tracePolarised(const std::vector<PolarizerSheet>& sheets,
+                                             const std::vector<TraceRequest>& rays,
+                                             const std::vector<Stokes>& inputs,
+                                             const PolarisedTraceSettings& settings = {});
 
  private:
   struct Impl;

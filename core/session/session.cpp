@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/light/light_cache.h"
+#include "core/reference/polarised_trace.h"
 #include "core/reference/reference_lighting.h"
 #include "core/reference/reference_marcher.h"
 #include "core/render/light_transport.h"
@@ -230,6 +231,15 @@ std::vector<std::array<TraceOutcome, 2>> Session::trace(const std::vector<TraceR
   if (out.size() != rays.size())
     throw std::runtime_error("trace: outcome count differs from the ray count");
   return out;
+}
+
+PolarisedTrace Session::tracePolarised(const TraceRequest& ray, const Stokes& input,
+                                       const PolarisedTraceSettings& settings, bool gpu) {
+  checkPolarisedTrace(ray, input, settings);
+  if (gpu)
+    return gpuRenderer().tracePolarised(scene_->polarizers, {ray}, {input}, settings).front();
+  cpuMarcher();  // the volume and its field
+  return eikon::tracePolarised(*field_, scene_->polarizers, ray, input, settings);
 }
 
 }  // namespace eikon

@@ -33,6 +33,7 @@
 #include "core/light/lighting_driver.h"
 #include "core/scene/scene.h"
 #include "core/volume/march_types.h"
+#include "core/volume/polarised.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {
@@ -149,6 +150,13 @@ class Session {
   /// the o-mode by definition).
   std::vector<std::array<TraceOutcome, 2>> trace(const std::vector<TraceRequest>& rays,
                                                  const MarchSettings& march, bool gpu);
+  /// The polarised trace of one ray for the input Stokes vector `input` through the scene's sharp
+  /// interfaces and polariser sheets (docs/polarisation.md): the GPU twin
+  /// (ViewRenderer::tracePolarised) or the CPU twin (tracePolarised). Throws
+  /// std::invalid_argument for a bad input, std::runtime_error for a scene the trace does not
+  /// support (no sharp interfaces, a varying region on the path).
+  PolarisedTrace tracePolarised(const TraceRequest& ray, const Stokes& input,
+                                const PolarisedTraceSettings& settings, bool gpu);
 
  private:
   void dropRenderers();

@@ -1,0 +1,23 @@
+#include "core/volume/polarised.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace eikon {
+
+void checkPolarisedTrace(const TraceRequest& ray, const Stokes& in,
+                         const PolarisedTraceSettings& s) {
+  const double len = glm::length(ray.direction);
+  if (!(len > 0) || !std::isfinite(len))
+    throw std::invalid_argument("trace direction must be a non-zero finite vector");
+  if (!(ray.wavelength_nm > 0) || !std::isfinite(ray.wavelength_nm))
+    throw std::invalid_argument("trace wavelength must be > 0 nm");
+  if (!(in[0] > 0) || !std::isfinite(in[0] + in[1] + in[2] + in[3]))
+    throw std::invalid_argument("input Stokes vector needs S0 > 0 and finite S1..S3");
+  if (degreeOfPolarisation(in) > 1.0 + 1e-9)
+    throw std::invalid_argument("input Stokes vector has sqrt(S1² + S2² + S3²) > S0");
+  if (!(s.bandwidth_nm > 0) || !(s.source_angle_rad > 0) || s.max_branches < 1 || s.max_events < 1)
+    throw std::invalid_argument("polarised trace settings must be positive");
+}
+
+}  // namespace eikon
