@@ -57,8 +57,9 @@
 //
 // Worked example (tested): crossed polarisers with a quartz plate (axis in its faces, at 45°),
 // immersed in a liquid of index n_o so that the faces reflect nothing: the transmitted fraction
-// of unpolarised light is ½ sin²(π (n_e − n_o) d / λ); 16.0 µm of quartz at 589.29 nm
-// (n_e − n_o = 0.009172) is a quarter-wave plate and turns 45° linear light circular.
+// of unpolarised light is ½ sin²(π (n_e − n_o) d / λ); 16.19 µm of quartz at 589.29 nm
+// (materials/quartz.json: n_e − n_o = 0.009100) is a quarter-wave plate and turns 45° linear
+// light circular.
 //
 // Common mistakes: taking |t|² for the transmitted power (the factor n₂ cos t/(n₁ cos i) is
 // missing); reusing one s/p frame for the reflected wave without flipping p̂ (p̂ = k̂ × ŝ changes
