@@ -62,7 +62,7 @@ void addViewOptions(CLI::App* sub, ViewArgs& a) {
                   "for dispersive scenes, else 0; the R key toggles)");
   sub->add_option("--coarse", a.coarse,
                   "The first frame after a change has 1/N of the resolution per side, N in [1, "
-                  "16] (default 4)");
+                  "16] (default 4); N doubles while a coarse frame takes over 0.1 s");
   sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4; I cycles)");
   sub->add_option("--exposure", a.exposure, "Exposure in stops, as eikon render's PNG (default 0)");
   sub->add_flag("--no-light", a.no_light, "Do not simulate the scene's lights");
@@ -199,14 +199,15 @@ class Viewer {
                                coarse_seconds_.end());
     std::sort(coarse.begin(), coarse.end());
     const double median = coarse.empty() ? 0.0 : coarse[coarse.size() / 2];
-    char buf[400];
-    std::snprintf(buf, sizeof buf,
-                  "eikon view: %lld frames, the first %.2f s after the window was ready; %zu more "
-                  "coarse frames, %.3f s each (median: %.1f frames/s); the last view: full quality "
-                  "(1 sample, eikon render's default) after %.2f s, %d samples after %.2f s",
-                  frames_, first_frame_seconds_, coarse.size(), median,
-                  median > 0 ? 1.0 / median : 0.0, full_quality_seconds_, refined_spp_,
-                  refined_seconds_);
+    char buf[480];
+    std::snprintf(
+        buf, sizeof buf,
+        "eikon view: %lld frames, the first %.2f s after the window was ready; %zu more "
+        "coarse frames, %.3f s each (median: %.1f frames/s; 1/%d size per side at the end); "
+        "the last view: full quality "
+        "(1 sample, eikon render's default) after %.2f s, %d samples after %.2f s",
+        frames_, first_frame_seconds_, coarse.size(), median, median > 0 ? 1.0 / median : 0.0,
+        coarse_, full_quality_seconds_, refined_spp_, refined_seconds_);
     return buf;
   }
 
@@ -227,7 +228,7 @@ class Viewer {
     glfwGetFramebufferSize(window_, &w, &h);
     const int full = spectral_ ? full_wavelengths_ : 0;
     const int few = std::min(full, 4);
-    const int c = args_.coarse;
+    const int c = coarse_;
     std::vector<Stage> s;
     if (c > 1) s.push_back({std::max(1, w / c), std::max(1, h / c), 1, few});
     if (few != full) s.push_back({w, h, 1, few});
@@ -279,7 +280,11 @@ class Viewer {
     if (frames_ == 0) first_frame_seconds_ = std::chrono::duration<double>(now - opened_).count();
     if (samples == 1 && wavelengths == (spectral_ ? full_wavelengths_ : 0) && !coarse)
       full_quality_seconds_ = std::chrono::duration<double>(now - change_time_).count();
-    if (coarse) coarse_seconds_.push_back(std::chrono::duration<double>(now - start).count());
+    if (coarse) {
+      const double seconds = std::chrono::duration<double>(now - start).count();
+      if (frames_ > 0) adaptCoarse(seconds);  // the first frame waited for the compilation too
+      coarse_seconds_.push_back(seconds);
+    }
     shown_ = img;
     shown_spp_ = samples;
     shown_wavelengths_ = wavelengths;
@@ -294,6 +299,16 @@ class Viewer {
       throw Interrupted{};
     }
     poll();
+  }
+
+  /// Aim at >= 10 coarse frames/s while the view changes: a coarse frame slower than 0.1 s halves
+  /// the next one's size per side (down to 1/16), one faster than 0.025 s doubles it (up to
+  /// 1/--coarse).
+  void adaptCoarse(double seconds) {
+    if (seconds > 0.1 && coarse_ < 16)
+      coarse_ *= 2;
+    else if (seconds < 0.025 && coarse_ / 2 >= args_.coarse)
+      coarse_ /= 2;
   }
 
   void updateTitle(Clock::time_point now) {
@@ -472,6 +487,7 @@ class Viewer {
   int full_wavelengths_ = 0;
   bool changed_ = false, resized_ = false, quit_ = false, save_requested_ = false;
   bool finish_stage_ = false;  ///< poll() does not interrupt the stage (the coarse frame)
+  int coarse_ = args_.coarse;  ///< the coarse frame's 1/size per side (adaptCoarse)
   int drag_button_ = -1, drag_mods_ = 0;
   double last_x_ = 0, last_y_ = 0;
   bool have_cursor_ = false;
