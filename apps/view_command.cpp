@@ -176,6 +176,7 @@ class Viewer {
       if (resized_) resize();
       if (light_ready_) applyLight();
       changed_ = false;
+      refined_ = false;
       frames_since_change_ = 0;
       change_time_ = Clock::now();
       try {
@@ -262,6 +263,8 @@ class Viewer {
     }
     refined_spp_ = shown_spp_;
     refined_seconds_ = std::chrono::duration<double>(Clock::now() - change_time_).count();
+    refined_ = true;
+    updateTitle(Clock::now());
   }
 
   int fullWidth() const {
@@ -317,13 +320,13 @@ class Viewer {
       fps = double(frame_times_.size() - 1) /
             std::max(1e-6, std::chrono::duration<double>(now - frame_times_.front()).count());
     char buf[512];
-    std::snprintf(buf, sizeof buf, "eikon view: %s | %.1f frames/s | %dx%d, %d/%d samples, %s | %s",
-                  session_.scene()->file.filename().c_str(), fps, shown_.width, shown_.height,
-                  shown_spp_, args_.spp,
-                  shown_wavelengths_ > 0
-                      ? (std::to_string(shown_wavelengths_) + " wavelengths").c_str()
-                      : "RGB",
-                  integratorName(integrator_));
+    std::snprintf(
+        buf, sizeof buf, "eikon view: %s | %.1f frames/s | %dx%d, %d/%d samples, %s | %s%s",
+        session_.scene()->file.filename().c_str(), fps, shown_.width, shown_.height, shown_spp_,
+        args_.spp,
+        shown_wavelengths_ > 0 ? (std::to_string(shown_wavelengths_) + " wavelengths").c_str()
+                               : "RGB",
+        integratorName(integrator_), refined_ ? " | refined" : "");
     glfwSetWindowTitle(window_, buf);
   }
 
@@ -486,6 +489,7 @@ class Viewer {
   bool spectral_ = false;
   int full_wavelengths_ = 0;
   bool changed_ = false, resized_ = false, quit_ = false, save_requested_ = false;
+  bool refined_ = false;       ///< the view is fully refined (the title says so)
   bool finish_stage_ = false;  ///< poll() does not interrupt the stage (the coarse frame)
   int coarse_ = args_.coarse;  ///< the coarse frame's 1/size per side (adaptCoarse)
   int drag_button_ = -1, drag_mods_ = 0;

@@ -31,8 +31,8 @@ for i in $(seq "$STEPS"); do
   sleep 0.25
 done
 xdotool mouseup 1
-sleep 1  # the last move's coarse frame, then the refinement: quit once it is done
-for _ in $(seq 1200); do xdotool getwindowname "$wid" | grep -q " $SPP/$SPP samples" && break; sleep 0.25; done
+sleep 1  # the last move's coarse frame, then the refinement: quit once it is done (or 300 s)
+for _ in $(seq 1200); do xdotool getwindowname "$wid" | grep -q " | refined" && break; sleep 0.25; done
 xdotool windowfocus "$wid" key q
 wait $viewer
 cat "$tmp/out"
