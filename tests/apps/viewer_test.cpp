@@ -153,6 +153,16 @@ TEST_F(ViewerTest, DisplayUnsetIsOneLinePointingAtRender) {
   EXPECT_TRUE(o.out.empty()) << o.out;
 }
 
+TEST_F(ViewerTest, UnreachableDisplayIsOneLinePointingAtRender) {
+  // A display number no X server listens on (TCP is not tried for a local ":N").
+  const Outcome o = eikon::test::runEikon("view " + quote(kGlassSphere), dir_ / "io",
+                                          "EIKON_VALIDATION=1 DISPLAY=:65531");
+  EXPECT_NE(o.code, 0);
+  EXPECT_EQ(o.err.find("eikon: error: cannot open the display ':65531'"), 0u) << o.err;
+  EXPECT_NE(o.err.find("eikon render"), std::string::npos) << o.err;
+  EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+}
+
 TEST_F(ViewerTest, BadOptionsAreOneLineBeforeAnyWindow) {
   for (const std::string& bad : {std::string("--screenshot x.jpg"), std::string("--coarse 0"),
                                  std::string("--spp 0"), std::string("--exit-after-frames -1")}) {
