@@ -21,5 +21,6 @@ void addRenderCommand(CLI::App& app);
 void addTraceCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addFitCommand(CLI::App& app);
+void addViewCommand(CLI::App& app);
 
 }  // namespace eikon::cli

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   eikon::cli::addTraceCommand(app);
   eikon::cli::addInfoCommand(app);
   eikon::cli::addFitCommand(app);
+  eikon::cli::addViewCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

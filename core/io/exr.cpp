@@ -155,11 +155,11 @@ void writeExrRgb(const std::filesystem::path& path, int width, int height,
   writeFileAtomically(path, exrRgbContent(width, height, rgb));
 }
 
-FileContent pngPreviewContent(int width, int height, const std::vector<float>& rgb,
-                              double exposure) {
+std::vector<unsigned char> previewPixels(int width, int height, const std::vector<float>& rgb,
+                                         double exposure) {
   size_t n = size_t(width) * size_t(height);
-  if (rgb.size() != 3 * n) throw std::invalid_argument("pngPreviewContent: pixel count mismatch");
-  auto px = std::make_shared<std::vector<unsigned char>>(3 * n);
+  if (rgb.size() != 3 * n) throw std::invalid_argument("previewPixels: pixel count mismatch");
+  std::vector<unsigned char> px(3 * n);
   const double scale = std::pow(2.0, exposure);
   auto encode = [](double v) {
     v = std::clamp(v, 0.0, 1.0);
@@ -170,10 +170,19 @@ FileContent pngPreviewContent(int width, int height, const std::vector<float>& r
     double r = rgb[3 * i] * scale, g = rgb[3 * i + 1] * scale, b = rgb[3 * i + 2] * scale;
     double lum = 0.2126 * r + 0.7152 * g + 0.0722 * b;
     double k = lum > 0 ? (lum / (1.0 + lum / 4.0)) / lum : 1.0;  // soft shoulder above ~1
-    (*px)[3 * i] = encode(r * k);
-    (*px)[3 * i + 1] = encode(g * k);
-    (*px)[3 * i + 2] = encode(b * k);
+    px[3 * i] = encode(r * k);
+    px[3 * i + 1] = encode(g * k);
+    px[3 * i + 2] = encode(b * k);
   }
+  return px;
+}
+
+FileContent pngPreviewContent(int width, int height, const std::vector<float>& rgb,
+                              double exposure) {
+  size_t n = size_t(width) * size_t(height);
+  if (rgb.size() != 3 * n) throw std::invalid_argument("pngPreviewContent: pixel count mismatch");
+  auto px =
+      std::make_shared<std::vector<unsigned char>>(previewPixels(width, height, rgb, exposure));
   return
       [px, width, height](const std::filesystem::path& tmp) { encodePng(tmp, width, height, *px); };
 }

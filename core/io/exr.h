@@ -44,6 +44,11 @@ FileContent exrRgbContent(int width, int height, const std::vector<float>& rgb);
 void writeExrRgb(const std::filesystem::path& path, int width, int height,
                  const std::vector<float>& rgb);
 
+/// The tone-mapped 8-bit sRGB pixels (3 per pixel, rows from the top) of the PNG preview: what
+/// `eikon view` shows on screen, byte for byte the preview `eikon render` writes.
+std::vector<unsigned char> previewPixels(int width, int height, const std::vector<float>& rgb,
+                                         double exposure = 0.0);
+
 /// The 8-bit sRGB PNG preview of writePngPreview, for writeFilesTogether (pixels copied).
 FileContent pngPreviewContent(int width, int height, const std::vector<float>& rgb,
                               double exposure = 0.0);

@@ -107,6 +107,15 @@ uint32_t computeQueueFamily(VkPhysicalDevice chosen, const char* device_name) {
   throw std::runtime_error(std::string("device '") + device_name + "' has no compute queue");
 }
 
+bool hasDeviceExtension(VkPhysicalDevice device, const char* name) {
+  uint32_t n = 0;
+  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &n, nullptr));
+  std::vector<VkExtensionProperties> props(n);
+  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &n, props.data()));
+  return std::any_of(props.begin(), props.end(),
+                     [&](const auto& p) { return std::strcmp(p.extensionName, name) == 0; });
+}
+
 DeviceLimits deviceLimits(VkPhysicalDevice chosen, const VkPhysicalDeviceProperties& props,
                           const VkPhysicalDeviceFeatures& supported) {
   DeviceLimits limits{};
@@ -140,6 +149,7 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
     layers.push_back(kValidationLayer);
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   }
+  for (const std::string& e : options.surface_extensions) extensions.push_back(e.c_str());
 
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "eikon";
@@ -163,6 +173,10 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
     throw VulkanError(
         r, "no Vulkan driver found: install mesa-vulkan-drivers (lavapipe) or a GPU driver");
+  if (r == VK_ERROR_EXTENSION_NOT_PRESENT && !options.surface_extensions.empty())
+    throw VulkanError(r,
+                      "the Vulkan driver cannot present to this window system (no surface "
+                      "extension); use 'eikon render'");
   VK_CHECK(r);
   if (validation) {
     auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
@@ -198,6 +212,14 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
   dci2.queueCreateInfoCount = 1;
   dci2.pQueueCreateInfos = &qci;
   dci2.pEnabledFeatures = &enabled;
+  const char* swapchain_ext = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
+  if (options.swapchain) {
+    if (!hasDeviceExtension(chosen, swapchain_ext))
+      throw std::runtime_error(std::string("device '") + ctx->props_.deviceName +
+                               "' cannot present to a window (no " + swapchain_ext + ")");
+    dci2.enabledExtensionCount = 1;
+    dci2.ppEnabledExtensionNames = &swapchain_ext;
+  }
   VK_CHECK(vkCreateDevice(chosen, &dci2, nullptr, &ctx->device_));
   vkGetDeviceQueue(ctx->device_, ctx->queue_family_, 0, &ctx->queue_);
 

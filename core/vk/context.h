@@ -41,6 +41,11 @@ struct ContextOptions {
   /// The pipeline cache file. Unset: defaultPipelineCacheFile() (core/vk/pipeline_cache.h, in
   /// $EIKON_CACHE_DIR, $XDG_CACHE_HOME/eikon or ~/.cache/eikon); empty: an in-memory cache only.
   std::optional<std::filesystem::path> pipeline_cache;
+  /// Instance extensions a window system needs (VK_KHR_surface and VK_KHR_xlib_surface or
+  /// VK_KHR_xcb_surface, as GLFW reports them) and the device's VK_KHR_swapchain: only the viewer
+  /// (`eikon view`) asks; renders and tests without a display create a plain compute context.
+  std::vector<std::string> surface_extensions;
+  bool swapchain = false;
 };
 
 /// Device facts that callers check before allocating (they refuse clearly, never clamp).

@@ -1,0 +1,627 @@
+// eikon view SCENE.json [--width W --height H]: an interactive window on the scene, rendered by the
+// GPU twin exactly as `eikon render` renders it (ViewRenderer through the session), shown through
+// a Vulkan swapchain (core/vk/swapchain.h) in a GLFW window (X11). docs/viewer.md.
+//
+// Progressive refinement: after any change the view restarts with a coarse frame (a quarter of
+// the resolution, one sample, few wavelengths), then the full resolution at few wavelengths
+// (spectral scenes), then the full render (--spp samples at the scene's wavelengths), one frame
+// per finished sample (RenderSettings::on_pass). Events are polled between bands of rows
+// (RenderSettings::progress) and between samples; an event that changes the view throws
+// Interrupted out of the render, which ends it (the renderer's resources are RAII) and restarts.
+// The refined image is the mean of the same samples `eikon render --spp N` takes, so the two agree
+// within the renderer's own noise (tests/apps/viewer_test.cpp).
+#define GLFW_INCLUDE_VULKAN
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <deque>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "apps/commands.h"
+#include "apps/view_camera.h"
+#include "core/io/exr.h"
+#include "core/light/light_cache.h"
+#include "core/render/render_defaults.h"
+#include "core/session/session.h"
+#include "core/vk/context.h"
+#include "core/vk/swapchain.h"
+
+namespace eikon::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct ViewArgs {
+  std::string scene, screenshot;
+  int width = 0, height = 0, spp = 16, wavelengths = -1, coarse = 4, exit_after_frames = 0;
+  double exposure = 0.0;
+  std::string integrator = "rk4";
+  bool no_light = false;
+};
+
+void addViewOptions(CLI::App* sub, ViewArgs& a) {
+  sub->add_option("scene", a.scene, "Scene JSON file")->required();
+  sub->add_option("--width", a.width, "Window width in [1, 16384] (default: the scene camera's)");
+  sub->add_option("--height", a.height,
+                  "Window height in [1, 16384] (default: the scene camera's)");
+  sub->add_option("--spp", a.spp,
+                  "Samples per pixel the view is refined to while nothing changes, in [1, 4096] "
+                  "(default 16)");
+  sub->add_option("--wavelengths", a.wavelengths,
+                  "Spectral samples of the refined view in [1, 256], or 0 for RGB (default: 16 "
+                  "for dispersive scenes, else 0; the R key toggles)");
+  sub->add_option("--coarse", a.coarse,
+                  "The first frame after a change has 1/N of the resolution per side, N in [1, "
+                  "16] (default 4); N doubles while a coarse frame takes over 0.1 s");
+  sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4; I cycles)");
+  sub->add_option("--exposure", a.exposure, "Exposure in stops, as eikon render's PNG (default 0)");
+  sub->add_flag("--no-light", a.no_light, "Do not simulate the scene's lights");
+  sub->add_option("--exit-after-frames", a.exit_after_frames,
+                  "Exit after N frames of an unchanged view (or once it is fully refined, if that "
+                  "takes fewer), for tests and scripts");
+  sub->add_option("--screenshot", a.screenshot,
+                  "On exit, write the image on screen (at its rendered size) to this PNG and print "
+                  "the camera");
+}
+
+/// The first light moved by a drag, simulated again in the background: a Session of its own (a
+/// copy of the scene with the moved light, voxelised again) fills the light cache on a thread of
+/// its own, while the viewer keeps showing the last light volumes; the viewer's session then
+/// loads the new volumes from the cache (the key covers the medium, the lights and the simulator
+/// settings, never the camera) and restarts the view.
+class LightMover {
+ public:
+  LightMover(bool on_cpu, std::filesystem::path cache)
+      : on_cpu_(on_cpu), cache_(std::move(cache)) {}
+  ~LightMover() {
+    if (worker_.joinable()) worker_.join();
+  }
+  bool busy() const { return worker_.joinable() && !done_; }
+  /// A simulation has finished and finished() has not reported it yet.
+  bool done() const { return worker_.joinable() && done_; }
+  /// Simulate `scene`'s light (its lights[0] moved) unless a simulation is running.
+  bool start(const Scene& scene) {
+    if (busy()) return false;
+    if (worker_.joinable()) worker_.join();
+    done_ = false;
+    simulated_ = scene.lights.front();
+    worker_ = std::thread([this, copy = std::make_shared<Scene>(scene)] {
+      try {
+        Session session(copy);  // its own Vulkan device, made only if the GPU twin simulates
+        session.simulateLight(LightRequest{}, on_cpu_, cache_);
+      } catch (const std::exception& e) {
+        error_ = e.what();
+      }
+      done_ = true;
+    });
+    return true;
+  }
+  /// True once, when a simulation has finished: `light` is the light it simulated.
+  bool finished(Light& light, std::string& error) {
+    if (!worker_.joinable() || !done_) return false;
+    worker_.join();
+    light = simulated_;
+    error = error_;
+    error_.clear();
+    return true;
+  }
+
+ private:
+  const bool on_cpu_;
+  const std::filesystem::path cache_;
+  std::thread worker_;
+  std::atomic<bool> done_{false};
+  Light simulated_;
+  std::string error_;
+};
+
+/// Thrown out of a render by its callbacks when the view changed (restart) or the window closes.
+struct Interrupted {};
+
+/// One stage of the refinement.
+struct Stage {
+  int width, height, spp, wavelengths;
+};
+
+const char* integratorName(Integrator i) {
+  return i == Integrator::Euler ? "euler" : i == Integrator::Midpoint ? "midpoint" : "rk4";
+}
+
+/// The interactive window: input, refinement, frames.
+class Viewer {
+ public:
+  Viewer(const ViewArgs& a, Session& session, GLFWwindow* window, vk::Swapchain& chain,
+         RenderSettings base, LightMover* mover)
+      : args_(a),
+        session_(session),
+        window_(window),
+        chain_(chain),
+        base_(std::move(base)),
+        mover_(mover),
+        integrator_(base_.march.integrator) {
+    if (mover_) wanted_light_ = session_.scene()->lights.front();
+    full_wavelengths_ = base_.wavelengths > 0 ? base_.wavelengths : defaultSpectral();
+    spectral_ = base_.wavelengths > 0;
+    glfwSetWindowUserPointer(window_, this);
+    glfwSetCursorPosCallback(window_, [](GLFWwindow* w, double x, double y) {
+      static_cast<Viewer*>(glfwGetWindowUserPointer(w))->onCursor(x, y);
+    });
+    glfwSetMouseButtonCallback(window_, [](GLFWwindow* w, int button, int action, int mods) {
+      static_cast<Viewer*>(glfwGetWindowUserPointer(w))->onButton(button, action, mods);
+    });
+    glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double dy) {
+      static_cast<Viewer*>(glfwGetWindowUserPointer(w))->onScroll(dy);
+    });
+    glfwSetKeyCallback(window_, [](GLFWwindow* w, int key, int, int action, int) {
+      if (action == GLFW_PRESS) static_cast<Viewer*>(glfwGetWindowUserPointer(w))->onKey(key);
+    });
+    glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* w, int, int) {
+      static_cast<Viewer*>(glfwGetWindowUserPointer(w))->resized_ = true;
+    });
+  }
+
+  /// Until the window closes or --exit-after-frames is reached.
+  void run() {
+    while (!glfwWindowShouldClose(window_) && !quit_) {
+      if (resized_) resize();
+      if (light_ready_) applyLight();
+      changed_ = false;
+      refined_ = false;
+      frames_since_change_ = 0;
+      change_time_ = Clock::now();
+      try {
+        refine();
+      } catch (const Interrupted&) {
+        continue;  // a change: start again with a coarse frame
+      }
+      // Fully refined in fewer frames; a light still being simulated is waited for.
+      if (args_.exit_after_frames > 0 && !lightPending()) break;
+      while (!changed_ && !resized_ && !quit_ && !glfwWindowShouldClose(window_)) {
+        glfwWaitEventsTimeout(0.25);
+        handleRequests();
+      }
+    }
+  }
+
+  /// "N frames; the first after X s; K coarse frames, T s each (median; F frames/s); the last
+  /// view refined to S samples in T s". The first frame waits for the pipeline's compilation.
+  std::string summary() const {
+    std::vector<double> coarse(coarse_seconds_.begin() + (coarse_seconds_.empty() ? 0 : 1),
+                               coarse_seconds_.end());
+    std::sort(coarse.begin(), coarse.end());
+    const double median = coarse.empty() ? 0.0 : coarse[coarse.size() / 2];
+    char buf[480];
+    std::snprintf(
+        buf, sizeof buf,
+        "eikon view: %lld frames, the first %.2f s after the window was ready; %zu more "
+        "coarse frames, %.3f s each (median: %.1f frames/s; 1/%d size per side at the end); "
+        "the last view: full quality "
+        "(1 sample, eikon render's default) after %.2f s, %d samples after %.2f s",
+        frames_, first_frame_seconds_, coarse.size(), median, median > 0 ? 1.0 / median : 0.0,
+        coarse_, full_quality_seconds_, refined_spp_, refined_seconds_);
+    return buf;
+  }
+
+  const RenderImage& shown() const { return shown_; }
+  int shownSamples() const { return shown_spp_; }
+  int shownWavelengths() const { return shown_wavelengths_; }
+
+ private:
+  int defaultSpectral() const {
+    const int d = defaultWavelengths(*session_.scene());
+    return d > 0 ? d : kDefaultDispersiveWavelengths;
+  }
+
+  /// Coarse (1/--coarse of the size, one sample, few wavelengths), then the full size at few
+  /// wavelengths (spectral only), then the full render; stages the settings make equal are one.
+  std::vector<Stage> stages() const {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window_, &w, &h);
+    const int full = spectral_ ? full_wavelengths_ : 0;
+    const int few = std::min(full, 4);
+    const int c = coarse_;
+    std::vector<Stage> s;
+    if (c > 1) s.push_back({std::max(1, w / c), std::max(1, h / c), 1, few});
+    if (few != full) s.push_back({w, h, 1, few});
+    s.push_back({w, h, args_.spp, full});
+    return s;
+  }
+
+  void refine() {
+    const int full_width = fullWidth();
+    for (const Stage& st : stages()) {
+      // The coarse frame is short: it is finished even when the view changes meanwhile, so that a
+      // continuous drag still shows a frame per coarse render (a restart at every motion event
+      // would show none).
+      finish_stage_ = st.width < full_width;
+      RenderSettings rs = base_;
+      rs.width = st.width;
+      rs.height = st.height;
+      rs.spp = st.spp;
+      rs.wavelengths = st.wavelengths;
+      rs.march.integrator = integrator_;
+      const auto start = Clock::now();
+      rs.progress = [this](double) { poll(); };
+      rs.on_pass = [&](const RenderImage& so_far, int done, int) {
+        show(so_far, done, st.wavelengths, start, st.width < full_width);
+      };
+      if (st.width <= 0 || st.height <= 0) return;
+      RenderImage img = session_.render(rs, true);
+      show(img, st.spp, st.wavelengths, start, st.width < full_width);
+      finish_stage_ = false;
+      poll();  // a change during the coarse frame restarts here
+    }
+    refined_spp_ = shown_spp_;
+    refined_seconds_ = std::chrono::duration<double>(Clock::now() - change_time_).count();
+    refined_ = true;
+    updateTitle(Clock::now());
+  }
+
+  int fullWidth() const {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window_, &w, &h);
+    return w;
+  }
+
+  /// One frame: the image on screen, the title, the frame counters.
+  void show(const RenderImage& img, int samples, int wavelengths, Clock::time_point start,
+            bool coarse) {
+    const std::vector<unsigned char> px =
+        previewPixels(img.width, img.height, img.rgb, args_.exposure);
+    if (!chain_.present(px.data(), img.width, img.height)) resized_ = true;
+    const auto now = Clock::now();
+    if (frames_ == 0) first_frame_seconds_ = std::chrono::duration<double>(now - opened_).count();
+    if (samples == 1 && wavelengths == (spectral_ ? full_wavelengths_ : 0) && !coarse)
+      full_quality_seconds_ = std::chrono::duration<double>(now - change_time_).count();
+    if (coarse) {
+      const double seconds = std::chrono::duration<double>(now - start).count();
+      if (frames_ > 0) adaptCoarse(seconds);  // the first frame waited for the compilation too
+      coarse_seconds_.push_back(seconds);
+    }
+    shown_ = img;
+    shown_spp_ = samples;
+    shown_wavelengths_ = wavelengths;
+    ++frames_;
+    ++frames_since_change_;
+    frame_times_.push_back(now);
+    while (frame_times_.size() > 2 && now - frame_times_.front() > std::chrono::seconds(2))
+      frame_times_.pop_front();
+    updateTitle(now);
+    if (args_.exit_after_frames > 0 && frames_since_change_ >= args_.exit_after_frames) {
+      quit_ = true;
+      throw Interrupted{};
+    }
+    poll();
+  }
+
+  /// Aim at >= 10 coarse frames/s while the view changes: a coarse frame slower than 0.1 s halves
+  /// the next one's size per side (down to 1/16), one faster than 0.025 s doubles it (up to
+  /// 1/--coarse).
+  void adaptCoarse(double seconds) {
+    if (seconds > 0.1 && coarse_ < 16)
+      coarse_ *= 2;
+    else if (seconds < 0.025 && coarse_ / 2 >= args_.coarse)
+      coarse_ /= 2;
+  }
+
+  void updateTitle(Clock::time_point now) {
+    double fps = 0;
+    if (frame_times_.size() > 1)
+      fps = double(frame_times_.size() - 1) /
+            std::max(1e-6, std::chrono::duration<double>(now - frame_times_.front()).count());
+    char buf[512];
+    std::snprintf(
+        buf, sizeof buf, "eikon view: %s | %.1f frames/s | %dx%d, %d/%d samples, %s | %s%s",
+        session_.scene()->file.filename().c_str(), fps, shown_.width, shown_.height, shown_spp_,
+        args_.spp,
+        shown_wavelengths_ > 0 ? (std::to_string(shown_wavelengths_) + " wavelengths").c_str()
+                               : "RGB",
+        integratorName(integrator_), refined_ ? " | refined" : "");
+    glfwSetWindowTitle(window_, buf);
+  }
+
+  /// Handle pending events; a change (or closing) ends the render in progress.
+  void poll() {
+    glfwPollEvents();
+    handleRequests();
+    if (finish_stage_ && !quit_ && !glfwWindowShouldClose(window_)) return;
+    if (changed_ || resized_ || quit_ || glfwWindowShouldClose(window_)) throw Interrupted{};
+  }
+
+  void handleRequests() {
+    if (save_requested_) {
+      save_requested_ = false;
+      save();
+    }
+    if (!mover_) return;
+    std::string error;
+    if (mover_->finished(ready_light_, error)) {
+      if (error.empty()) {
+        light_ready_ = changed_ = true;  // applied between renders (it replaces the renderer)
+      } else {
+        std::fprintf(stderr, "eikon: warning: the moved light was not simulated: %s\n",
+                     error.c_str());
+      }
+    }
+    if (light_moved_ && !mover_->busy()) {
+      Scene moved = *session_.scene();
+      moved.lights.front() = wanted_light_;
+      light_moved_ = !mover_->start(moved);
+    }
+  }
+
+  bool lightPending() const {
+    return mover_ && (light_moved_ || light_ready_ || mover_->busy() || mover_->done());
+  }
+
+  /// The light volumes simulated in the background, from the light cache, into the view.
+  void applyLight() {
+    light_ready_ = false;
+    session_.scene()->lights.front() = ready_light_;
+    const LightOutcome o = session_.simulateLight(LightRequest{}, false, defaultLightCacheDir());
+    for (const std::string& w : o.warnings) std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+    std::printf("eikon view: light 0 simulated again (%s): position %s, direction %s\n",
+                o.cached ? "from the light cache" : "in the foreground",
+                vectorJson(ready_light_.position).c_str(),
+                vectorJson(ready_light_.direction).c_str());
+    std::fflush(stdout);
+  }
+
+  void resize() {
+    resized_ = false;
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window_, &w, &h);
+    while ((w == 0 || h == 0) && !glfwWindowShouldClose(window_)) {  // minimised
+      glfwWaitEvents();
+      glfwGetFramebufferSize(window_, &w, &h);
+    }
+    chain_.resize(uint32_t(w), uint32_t(h));
+  }
+
+  // Positions come from the motion events themselves, never from glfwGetCursorPos: events
+  // queued while a render ran (a whole drag, from a script) are handled later, when the pointer
+  // has moved on, and each must see the position it was sent with.
+  void onButton(int button, int action, int mods) {
+    if (action == GLFW_PRESS) {
+      drag_button_ = button;
+      drag_mods_ = mods;
+    } else if (button == drag_button_) {
+      drag_button_ = -1;
+    }
+  }
+
+  void onCursor(double x, double y) {
+    const double px = last_x_, py = last_y_;
+    last_x_ = x;
+    last_y_ = y;
+    if (drag_button_ < 0 || !have_cursor_) {
+      have_cursor_ = true;
+      return;
+    }
+    int w = 0, h = 0;
+    glfwGetWindowSize(window_, &w, &h);
+    const double dx = (x - px) / std::max(h, 1), dy = (y - py) / std::max(h, 1);
+    if (dx == 0 && dy == 0) return;
+    Camera& cam = session_.scene()->camera;
+    if (mover_ && drag_button_ == GLFW_MOUSE_BUTTON_LEFT && (drag_mods_ & GLFW_MOD_CONTROL)) {
+      moveLight(wanted_light_, cam, dx, -dy);  // the view stays until the new light is simulated
+      light_moved_ = true;
+      return;
+    }
+    const bool pan = drag_button_ != GLFW_MOUSE_BUTTON_LEFT || (drag_mods_ & GLFW_MOD_SHIFT);
+    if (pan)
+      panCamera(cam, -dx, dy);
+    else
+      orbitCamera(cam, -3.0 * dx, 3.0 * dy);  // a window height of drag: about 170°
+    changed_ = true;
+  }
+
+  void onScroll(double dy) {
+    zoomCamera(session_.scene()->camera, std::pow(0.9, dy));
+    changed_ = true;
+  }
+
+  void onKey(int key) {
+    switch (key) {
+      case GLFW_KEY_R:  // RGB ↔ spectral
+        spectral_ = !spectral_;
+        changed_ = true;
+        break;
+      case GLFW_KEY_I:  // euler → midpoint → rk4 → euler
+        integrator_ = Integrator((int(integrator_) + 1) % 3);
+        changed_ = true;
+        break;
+      case GLFW_KEY_S:
+        save_requested_ = true;
+        break;
+      case GLFW_KEY_Q:
+      case GLFW_KEY_ESCAPE:
+        glfwSetWindowShouldClose(window_, GLFW_TRUE);
+        break;
+      default:
+        break;
+    }
+  }
+
+  /// The view as a render's pair (EXR + PNG, `eikon render`'s formats) beside the scene's name in
+  /// the current folder, and the camera as the scene file spells it.
+  void save() {
+    if (shown_.rgb.empty()) return;
+    const std::string stem = session_.scene()->file.stem().string() + "-view-";
+    std::filesystem::path exr;
+    for (int k = 1;; ++k) {
+      exr = stem + std::to_string(k) + ".exr";
+      std::error_code ec;
+      if (!std::filesystem::exists(exr, ec)) break;
+    }
+    std::filesystem::path png = std::filesystem::path(exr).replace_extension(".png");
+    writeFilesTogether(
+        {{png, pngPreviewContent(shown_.width, shown_.height, shown_.rgb, args_.exposure)},
+         {exr, exrRgbContent(shown_.width, shown_.height, shown_.rgb)}});
+    std::printf("eikon view: saved %s and %s (%dx%d, %d samples, %s)\n\"camera\": %s\n",
+                exr.c_str(), png.c_str(), shown_.width, shown_.height, shown_spp_,
+                shown_wavelengths_ > 0
+                    ? (std::to_string(shown_wavelengths_) + " wavelengths").c_str()
+                    : "RGB",
+                cameraJson(session_.scene()->camera, shown_.width, shown_.height).c_str());
+    std::fflush(stdout);
+  }
+
+  const ViewArgs& args_;
+  Session& session_;
+  GLFWwindow* window_;
+  vk::Swapchain& chain_;
+  RenderSettings base_;
+  LightMover* mover_;
+  Light wanted_light_, ready_light_;
+  bool light_moved_ = false, light_ready_ = false;
+  Integrator integrator_;
+  bool spectral_ = false;
+  int full_wavelengths_ = 0;
+  bool changed_ = false, resized_ = false, quit_ = false, save_requested_ = false;
+  bool refined_ = false;       ///< the view is fully refined (the title says so)
+  bool finish_stage_ = false;  ///< poll() does not interrupt the stage (the coarse frame)
+  int coarse_ = args_.coarse;  ///< the coarse frame's 1/size per side (adaptCoarse)
+  int drag_button_ = -1, drag_mods_ = 0;
+  double last_x_ = 0, last_y_ = 0;
+  bool have_cursor_ = false;
+  long long frames_ = 0;
+  int frames_since_change_ = 0;
+  Clock::time_point change_time_ = Clock::now();
+  std::deque<Clock::time_point> frame_times_;
+  std::vector<double> coarse_seconds_;
+  RenderImage shown_;
+  int shown_spp_ = 0, shown_wavelengths_ = 0, refined_spp_ = 0;
+  double refined_seconds_ = 0, first_frame_seconds_ = 0, full_quality_seconds_ = 0;
+  const Clock::time_point opened_ = Clock::now();
+};
+
+/// GLFW's errors, kept for the one line that reports a failure.
+std::string& glfwLastError() {
+  static std::string last;
+  return last;
+}
+
+/// The window system, or one line saying why there is none.
+struct Glfw {
+  Glfw() {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display)
+      throw CliError(
+          "no display: DISPLAY is not set, so 'eikon view' cannot open a window; render without "
+          "one with 'eikon render SCENE.json -o OUT.exr'");
+    glfwSetErrorCallback([](int, const char* what) { glfwLastError() = what ? what : ""; });
+    if (!glfwInit())
+      throw CliError("cannot open the display '" + std::string(display) + "' (" + glfwLastError() +
+                     "); render without one with 'eikon render SCENE.json -o "
+                     "OUT.exr'");
+    if (!glfwVulkanSupported()) {
+      glfwTerminate();
+      throw CliError("the Vulkan loader cannot present to the display '" + std::string(display) +
+                     "'; render without a window with 'eikon render SCENE.json -o OUT.exr'");
+    }
+  }
+  ~Glfw() { glfwTerminate(); }
+};
+
+struct Window {
+  GLFWwindow* handle = nullptr;
+  Window(int width, int height, const std::string& title) {
+    glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
+    handle = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+    if (!handle) throw CliError("cannot open a window (" + glfwLastError() + ")");
+  }
+  ~Window() { glfwDestroyWindow(handle); }
+};
+
+void runView(const ViewArgs& a, const CLI::App& sub) {
+  ViewRequest view;
+  if (sub.count("--width")) view.width = a.width;
+  if (sub.count("--height")) view.height = a.height;
+  view.spp = a.spp;
+  if (sub.count("--wavelengths")) view.wavelengths = a.wavelengths;
+  checkViewRequest(view);
+  if (a.coarse < 1 || a.coarse > 16)
+    throw CliError("--coarse must be in [1, 16], got " + std::to_string(a.coarse));
+  if (a.exit_after_frames < 0)
+    throw CliError("--exit-after-frames must be >= 0, got " + std::to_string(a.exit_after_frames));
+  const Integrator integrator = parseIntegrator(a.integrator);
+  if (!a.screenshot.empty()) {
+    if (std::filesystem::path(a.screenshot).extension() != ".png")
+      throw CliError("--screenshot must end in .png: " + a.screenshot);
+    checkWritable(a.screenshot);
+  }
+  auto scene = std::make_shared<Scene>(loadScene(a.scene));
+  for (const std::string& w : scene->warnings)
+    std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+  RenderSettings base = renderSettings(*scene, view);
+  base.march.integrator = integrator;
+  const int width = view.width.value_or(scene->camera.width),
+            height = view.height.value_or(scene->camera.height);
+
+  Glfw glfw;
+  uint32_t n_ext = 0;
+  const char** ext = glfwGetRequiredInstanceExtensions(&n_ext);
+  vk::ContextOptions options;
+  for (uint32_t i = 0; i < n_ext; ++i) options.surface_extensions.push_back(ext[i]);
+  options.swapchain = true;
+  Window window(width, height, "eikon view: " + scene->file.filename().string() + " (preparing)");
+  Session session(scene,
+                  [&] { return std::shared_ptr<vk::Context>(vk::Context::create(options)); });
+  session.setProgress(
+      {[&](const char*, double) { glfwPollEvents(); }, [&](const char*) { glfwPollEvents(); }});
+  vk::Context& ctx = session.context();
+  VkSurfaceKHR surface = VK_NULL_HANDLE;
+  if (glfwCreateWindowSurface(ctx.instance(), window.handle, nullptr, &surface) != VK_SUCCESS)
+    throw CliError("cannot create a Vulkan surface for the window (" + glfwLastError() + ")");
+  int fw = 0, fh = 0;
+  glfwGetFramebufferSize(window.handle, &fw, &fh);
+  vk::Swapchain chain(ctx, surface, uint32_t(fw), uint32_t(fh));
+  std::unique_ptr<LightMover> mover;
+  if (!scene->lights.empty() && !a.no_light)
+    mover = std::make_unique<LightMover>(lightOnCpu("auto", &ctx), defaultLightCacheDir());
+  // Input is handled from here on: events that arrive while the scene is voxelised (polled by
+  // the progress callbacks) already move the camera of the first frame.
+  Viewer viewer(a, session, window.handle, chain, base, mover.get());
+  session.prepare(true);
+  if (mover) {
+    LightOutcome light = session.simulateLight(LightRequest{}, false, defaultLightCacheDir());
+    for (const std::string& w : light.warnings)
+      std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+  }
+  viewer.run();
+  std::printf("%s\n", viewer.summary().c_str());
+  const RenderImage& img = viewer.shown();
+  if (!a.screenshot.empty() && !img.rgb.empty()) {
+    writeFilesTogether(
+        {{a.screenshot, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)}});
+    std::printf("eikon view: screenshot %s (%dx%d, %d samples, %s)\n\"camera\": %s\n",
+                a.screenshot.c_str(), img.width, img.height, viewer.shownSamples(),
+                viewer.shownWavelengths() > 0
+                    ? (std::to_string(viewer.shownWavelengths()) + " wavelengths").c_str()
+                    : "RGB",
+                cameraJson(scene->camera, img.width, img.height).c_str());
+  }
+}
+
+}  // namespace
+
+void addViewCommand(CLI::App& app) {
+  auto args = std::make_shared<ViewArgs>();
+  auto* sub = app.add_subcommand(
+      "view", "Open a window on a scene: progressive GPU rendering, orbit/zoom/pan with the mouse");
+  addViewOptions(sub, *args);
+  sub->callback([args, sub] { runView(*args, *sub); });
+}
+
+}  // namespace eikon::cli

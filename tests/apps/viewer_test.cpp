@@ -1,0 +1,320 @@
+// `eikon view` (issue 17) as a user runs it: the real binary in a virtual X server (Xvfb, started
+// here on a display number it picks itself, -displayfd), a mouse drag sent with xdotool, the
+// screenshot it writes on exit compared with `eikon render` of the camera it prints. The
+// tolerance comes from the renderer's own sample noise, measured from two renders with different
+// sample counts, never from the viewer's output. Skipped only when the Xvfb binary is missing (CI
+// installs it: scripts/install_deps.sh).
+#include <gtest/gtest.h>
+#include <png.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/apps/cli_support.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using eikon::test::Outcome;
+using eikon::test::quote;
+
+/// The first executable `name` on PATH (or the usual Debian folders); "" if none.
+std::string findProgram(const std::string& name) {
+  std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  path += ":/usr/bin:/usr/local/bin";
+  std::istringstream dirs(path);
+  for (std::string d; std::getline(dirs, d, ':');)
+    if (!d.empty() && ::access((fs::path(d) / name).c_str(), X_OK) == 0)
+      return (fs::path(d) / name).string();
+  return "";
+}
+
+struct Png {
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgb;
+};
+
+Png readPng(const fs::path& p) {
+  png_image img{};
+  img.version = PNG_IMAGE_VERSION;
+  Png out;
+  if (!png_image_begin_read_from_file(&img, p.c_str())) return out;
+  img.format = PNG_FORMAT_RGB;
+  out.rgb.resize(PNG_IMAGE_SIZE(img));
+  if (!png_image_finish_read(&img, nullptr, out.rgb.data(), 0, nullptr)) {
+    png_image_free(&img);
+    return {};
+  }
+  out.width = int(img.width);
+  out.height = int(img.height);
+  return out;
+}
+
+/// Root mean square of the channel differences, in units of full scale (255).
+double rmsDifference(const Png& a, const Png& b) {
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  if (a.rgb.size() != b.rgb.size() || a.rgb.empty()) return 1e9;
+  double s = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    const double d = (double(a.rgb[i]) - double(b.rgb[i])) / 255.0;
+    s += d * d;
+  }
+  return std::sqrt(s / double(a.rgb.size()));
+}
+
+/// A virtual X server on a free display (Xvfb -displayfd picks it), killed by the destructor.
+class Xvfb {
+ public:
+  explicit Xvfb(const std::string& binary) {
+    int fds[2];
+    if (::pipe(fds) != 0) return;
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::close(fds[0]);
+      const std::string fd = std::to_string(fds[1]);
+      std::freopen("/dev/null", "w", stderr);
+      ::execl(binary.c_str(), "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", "640x480x24",
+              "-nolisten", "tcp", static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    ::close(fds[1]);
+    std::string number;
+    char c = 0;
+    while (::read(fds[0], &c, 1) == 1 && c != '\n') number += c;  // written once it is ready
+    ::close(fds[0]);
+    if (!number.empty()) display_ = ":" + number;
+  }
+  ~Xvfb() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGTERM);
+      int st = 0;
+      ::waitpid(pid_, &st, 0);
+    }
+  }
+  const std::string& display() const { return display_; }
+
+ private:
+  pid_t pid_ = -1;
+  std::string display_;
+};
+
+class ViewerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "eikon_viewer_test_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
+    dir_ = tmpl;
+    fs::create_directories(dir_ / "io");
+    fs::create_directories(dir_ / "render_io");
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  std::string env(const std::string& display) const {
+    return "EIKON_VALIDATION=1 DISPLAY=" + quote(display);
+  }
+  /// `eikon render` of `scene` at the viewer's size, `spp` samples: its PNG.
+  Png render(const fs::path& scene, int spp, const std::string& name) const {
+    const fs::path out = dir_ / (name + ".exr");
+    const Outcome o =
+        eikon::test::runEikon("render " + quote(scene.string()) + " -o " + quote(out.string()) +
+                                  " --width 160 --height 120 -q --spp " + std::to_string(spp),
+                              dir_ / "render_io", "EIKON_VALIDATION=1");
+    EXPECT_EQ(o.code, 0) << o.err;
+    EXPECT_EQ(o.err.find("validation"), std::string::npos) << o.err;
+    return readPng(fs::path(out).replace_extension(".png"));
+  }
+  fs::path dir_;
+};
+
+const std::string kGlassSphere = std::string(EIKON_SOURCE_DIR) + "/scenes/glass_sphere.json";
+
+TEST_F(ViewerTest, DisplayUnsetIsOneLinePointingAtRender) {
+  const Outcome o = eikon::test::runEikon("view " + quote(kGlassSphere), dir_ / "io",
+                                          "env -u DISPLAY EIKON_VALIDATION=1");
+  EXPECT_NE(o.code, 0);
+  EXPECT_EQ(o.err.find("eikon: error: "), 0u) << o.err;
+  EXPECT_NE(o.err.find("DISPLAY is not set"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("eikon render"), std::string::npos) << o.err;
+  EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+  EXPECT_TRUE(o.out.empty()) << o.out;
+}
+
+TEST_F(ViewerTest, UnreachableDisplayIsOneLinePointingAtRender) {
+  // A display number no X server listens on (TCP is not tried for a local ":N").
+  const Outcome o = eikon::test::runEikon("view " + quote(kGlassSphere), dir_ / "io",
+                                          "EIKON_VALIDATION=1 DISPLAY=:65531");
+  EXPECT_NE(o.code, 0);
+  EXPECT_EQ(o.err.find("eikon: error: cannot open the display ':65531'"), 0u) << o.err;
+  EXPECT_NE(o.err.find("eikon render"), std::string::npos) << o.err;
+  EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+}
+
+TEST_F(ViewerTest, BadOptionsAreOneLineBeforeAnyWindow) {
+  for (const std::string& bad : {std::string("--screenshot x.jpg"), std::string("--coarse 0"),
+                                 std::string("--spp 0"), std::string("--exit-after-frames -1")}) {
+    const Outcome o = eikon::test::runEikon("view " + quote(kGlassSphere) + " " + bad, dir_ / "io",
+                                            "env -u DISPLAY");
+    EXPECT_NE(o.code, 0) << bad;
+    EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << bad << ": " << o.err;
+    EXPECT_EQ(o.err.find("DISPLAY"), std::string::npos) << bad << ": " << o.err;
+  }
+}
+
+/// The drag changes the view, and the refined view is `eikon render` of the camera printed.
+TEST_F(ViewerTest, DragOrbitsAndRefinedViewMatchesRender) {
+  const std::string xvfb = findProgram("Xvfb"), xdotool = findProgram("xdotool");
+  if (xvfb.empty()) GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb)";
+  ASSERT_FALSE(xdotool.empty()) << "xdotool is not installed (Debian package xdotool)";
+  Xvfb server(xvfb);
+  ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
+  const fs::path shot = dir_ / "shot.png";
+  // The viewer in the background; it exits once its last view is refined to 4 samples.
+  const std::string cmd = env(server.display()) + " " + quote(EIKON_BINARY) + " view " +
+                          quote(kGlassSphere) +
+                          " --width 160 --height 120 --spp 4 --exit-after-frames 100 "
+                          "--screenshot " +
+                          quote(shot.string()) + " >" + quote((dir_ / "view.out").string()) +
+                          " 2>" + quote((dir_ / "view.err").string()) + " </dev/null";
+  const pid_t viewer = ::fork();
+  if (viewer == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Wait for the window, then drag across it with the left button: an orbit about look_at.
+  const std::string drag =
+      "DISPLAY=" + quote(server.display()) + " timeout 300 " + quote(xdotool) +
+      " search --sync --onlyvisible --name 'eikon view'"
+      " mousemove --window %1 60 60 sleep 0.1 mousedown 1 sleep 0.1"
+      " mousemove --window %1 75 64 sleep 0.1 mousemove --window %1 90 68 sleep 0.1"
+      " mousemove --window %1 105 72 sleep 0.1 mouseup 1 >/dev/null 2>&1";
+  EXPECT_EQ(std::system(drag.c_str()), 0) << drag;
+  int st = 0;
+  ASSERT_EQ(::waitpid(viewer, &st, 0), viewer);
+  const std::string out = eikon::test::slurp(dir_ / "view.out"),
+                    err = eikon::test::slurp(dir_ / "view.err");
+  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << err;
+  EXPECT_EQ(err.find("validation"), std::string::npos) << err;
+  EXPECT_NE(out.find("4 samples"), std::string::npos) << out;
+
+  // The camera it printed, in a copy of the scene.
+  const size_t at = out.find("\"camera\": ");
+  ASSERT_NE(at, std::string::npos) << out;
+  const nlohmann::json camera =
+      nlohmann::json::parse(out.substr(at + 10, out.find('\n', at) - at - 10));
+  nlohmann::json scene = nlohmann::json::parse(std::ifstream(kGlassSphere));
+  const nlohmann::json original = scene["camera"];
+  EXPECT_GT(std::abs(camera["position"][0].get<double>() - original["position"][0].get<double>()),
+            1.0)
+      << "the drag did not orbit the camera: " << camera.dump();
+  scene["camera"] = camera;
+  std::ofstream(dir_ / "moved.json") << scene.dump();
+
+  const Png viewed = readPng(shot), moved4 = render(dir_ / "moved.json", 4, "moved4"),
+            moved8 = render(dir_ / "moved.json", 8, "moved8"),
+            original4 = render(kGlassSphere, 4, "original4");
+  ASSERT_EQ(viewed.width, 160);
+  ASSERT_EQ(viewed.height, 120);
+  // Noise of a 4-sample image: R4 − R8 = (A − B)/2 for the two 4-sample halves A, B of R8, so
+  // two independent 4-sample images differ by 2·rms(R4 − R8); 3 of that plus the 8-bit rounding
+  // of both images (at most 1/255) bounds an honest difference.
+  const double noise = 2.0 * rmsDifference(moved4, moved8), tolerance = 3.0 * noise + 1.0 / 255;
+  const double same = rmsDifference(viewed, moved4), before = rmsDifference(viewed, original4);
+  std::printf(
+      "rms: viewer vs render of its camera %.5f, vs the scene's camera %.5f, tolerance "
+      "%.5f (noise %.5f)\n",
+      same, before, tolerance, noise);
+  EXPECT_LE(same, tolerance);
+  EXPECT_GT(before, tolerance) << "the screenshot did not change with the drag";
+}
+
+// A glass ball over a diffuse floor lit by a point light, small enough to simulate in seconds.
+constexpr const char* kLitScene = R"({
+  "camera": {"position": [0, 12, -30], "look_at": [0, -2, 0], "up": [0, 1, 0], "fov_deg": 40, "width": 80, "height": 60},
+  "environment": {"type": "constant", "radiance": [0.02, 0.02, 0.02]},
+  "volume": {"bounds_min": [-8, -5, -8], "bounds_max": [8, 9, 8], "resolution": 32},
+  "materials": {"glass": {"n": 1.5}, "floor": {"n": 1.0, "opacity": 1, "albedo": 0.8}},
+  "objects": [{"shape": "box", "center": [0, -4, 0], "size": [15, 1, 15], "material": "floor"},
+              {"shape": "sphere", "center": [0, 1, 0], "radius": 3, "material": "glass"}],
+  "lights": [{"type": "point", "position": [0, 7, 0], "intensity": 40}]
+})";
+
+/// Ctrl + drag moves the first light; it is simulated again in the background and the view then
+/// shows what `eikon render` shows with the light where the viewer says it put it.
+TEST_F(ViewerTest, CtrlDragMovesTheLightAndSimulatesItAgain) {
+  const std::string xvfb = findProgram("Xvfb"), xdotool = findProgram("xdotool");
+  if (xvfb.empty()) GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb)";
+  ASSERT_FALSE(xdotool.empty()) << "xdotool is not installed (Debian package xdotool)";
+  Xvfb server(xvfb);
+  ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
+  std::ofstream(dir_ / "lit.json") << kLitScene;
+  const fs::path shot = dir_ / "lit.png";
+  const std::string cmd = env(server.display()) + " " + quote(EIKON_BINARY) + " view " +
+                          quote((dir_ / "lit.json").string()) +
+                          " --width 80 --height 60 --spp 1 --exit-after-frames 100 "
+                          "--screenshot " +
+                          quote(shot.string()) + " >" + quote((dir_ / "view.out").string()) +
+                          " 2>" + quote((dir_ / "view.err").string()) + " </dev/null";
+  const pid_t viewer = ::fork();
+  if (viewer == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const std::string drag =
+      "DISPLAY=" + quote(server.display()) + " timeout 300 " + quote(xdotool) +
+      " search --sync --onlyvisible --name 'eikon view'"
+      " mousemove --window %1 40 30 sleep 0.1 keydown ctrl sleep 0.1 mousedown 1 sleep 0.1"
+      " mousemove --window %1 46 30 sleep 0.1 mousemove --window %1 52 30 sleep 0.1"
+      " mouseup 1 sleep 0.1 keyup ctrl >/dev/null 2>&1";
+  EXPECT_EQ(std::system(drag.c_str()), 0) << drag;
+  int st = 0;
+  ASSERT_EQ(::waitpid(viewer, &st, 0), viewer);
+  const std::string out = eikon::test::slurp(dir_ / "view.out"),
+                    err = eikon::test::slurp(dir_ / "view.err");
+  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << err;
+  EXPECT_EQ(err.find("validation"), std::string::npos) << err;
+  const std::string said = "light 0 simulated again (from the light cache): position ";
+  const size_t at = out.find(said);
+  ASSERT_NE(at, std::string::npos) << out;
+  const size_t open = at + said.size();
+  const nlohmann::json position =
+      nlohmann::json::parse(out.substr(open, out.find(']', open) + 1 - open));
+  // 12 pixels of a 60-pixel window to the right: 0.2 of the image height at the light's depth.
+  EXPECT_LT(position[0].get<double>(), -1.0) << position.dump();  // the image's right is -x
+  nlohmann::json scene = nlohmann::json::parse(kLitScene);
+  scene["camera"]["width"] = 80;
+  scene["lights"][0]["position"] = position;
+  std::ofstream(dir_ / "moved.json") << scene.dump();
+  const auto render80 = [&](const fs::path& s, const std::string& name) {
+    const fs::path out_exr = dir_ / (name + ".exr");
+    const Outcome o = eikon::test::runEikon(
+        "render " + quote(s.string()) + " -o " + quote(out_exr.string()) + " -q",
+        dir_ / "render_io", "EIKON_VALIDATION=1");
+    EXPECT_EQ(o.code, 0) << o.err;
+    return readPng(fs::path(out_exr).replace_extension(".png"));
+  };
+  const Png viewed = readPng(shot), moved = render80(dir_ / "moved.json", "moved"),
+            before = render80(dir_ / "lit.json", "before");
+  // One sample, no jitter: no sample noise; only the 8-bit rounding of the two images and the
+  // light position's 9 printed digits separate the view from the render of the moved light.
+  const double same = rmsDifference(viewed, moved), unmoved = rmsDifference(viewed, before);
+  std::printf("rms: viewer vs render with the moved light %.5f, with the scene's light %.5f\n",
+              same, unmoved);
+  EXPECT_LE(same, 2.0 / 255);
+  EXPECT_GT(unmoved, 2.0 / 255) << "the moved light did not change the view";
+}
+
+}  // namespace
