@@ -13,6 +13,11 @@ it writes next to itself. Every file is generated here, none is downloaded.
   inward_box.obj     box.obj with every face wound clockwise (consistent, but facing inward)
   notched_box.obj    a closed L-shaped prism (non-convex)
   lines.obj          a triangle and a line element (not a surface)
+
+and the meshes of the shipped scenes:
+
+  scenes/meshes/icosphere2.obj   the unit icosphere of level 2 (320 triangles)
+  scenes/meshes/torus.obj        a ring torus about the y axis, radii 1 and 0.4, 48 × 24 quads
 """
 import math
 import os
@@ -97,6 +102,19 @@ def icosphere(level):
     return v, f
 
 
+def torus(big, small, nu, nv):
+    v = []
+    for i in range(nu):
+        u = 2 * math.pi * i / nu
+        for j in range(nv):
+            w = 2 * math.pi * j / nv
+            rr = big + small * math.cos(w)
+            v.append((rr * math.cos(u), small * math.sin(w), rr * math.sin(u)))
+    q = [(i * nv + j, i * nv + (j + 1) % nv, ((i + 1) % nu) * nv + (j + 1) % nv, ((i + 1) % nu) * nv + j)
+         for i in range(nu) for j in range(nv)]
+    return v, q
+
+
 def main():
     write_obj("box.obj", CUBE_V, CUBE_Q)
     write_stl("box.stl", CUBE_V, tris_of(CUBE_Q))
@@ -114,6 +132,12 @@ def main():
     sides = [(k, (k + 1) % 6, (k + 1) % 6 + 6, k + 6) for k in range(6)]
     write_obj("notched_box.obj", lv, caps + sides)
     write_obj("lines.obj", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)], "l 1 2\n")
+    scenes = os.path.join(HERE, "..", "..", "..", "scenes", "meshes")
+    os.makedirs(scenes, exist_ok=True)
+    v, f = icosphere(2)
+    write_obj(os.path.join(scenes, "icosphere2.obj"), v, f)
+    v, q = torus(1.0, 0.4, 48, 24)
+    write_obj(os.path.join(scenes, "torus.obj"), v, q)
 
 
 if __name__ == "__main__":
