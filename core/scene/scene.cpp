@@ -343,7 +343,7 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
 }
 
 // ------------------------------------------------------------------ objects
-/// /girdle of a faceted object: {"outline": "round", "diameter"} | {"outline": "oval" |
+/// /girdle of a faceted object: {"outline": "round", "diameter"} | {"outline": "oval" | "pear" |
 /// "rectangle", "length", "width"[, "corner"]}, "thickness".
 GirdleOutline parseGirdle(const Node& g) {
   GirdleOutline out;
@@ -360,8 +360,18 @@ GirdleOutline parseGirdle(const Node& g) {
     out.width = g.at("width").length();
     if (auto c = g.get("corner"))
       out.corner = c->number(0.0, 0.5 * std::min(out.length, out.width));
+  } else if (kind == "pear") {
+    g.allowKeys({"outline", "length", "width", "thickness"});
+    out.kind = GirdleOutline::Kind::Pear;
+    out.length = g.at("length").length();
+    out.width = g.at("width").length();
+    if (!(out.width < out.length))
+      g.at("width").fail(
+          "a pear must be longer than wide (the point lies outside the round "
+          "end), got width " +
+          fmt(out.width) + " >= length " + fmt(out.length));
   } else {
-    g.at("outline").fail("unknown outline '" + excerpt(kind) + "' (round, oval, rectangle)");
+    g.at("outline").fail("unknown outline '" + excerpt(kind) + "' (round, oval, rectangle, pear)");
   }
   out.thickness = g.get("thickness") ? g.at("thickness").number(0.0, kMaxCoordinateMm) : 0.0;
   return out;
