@@ -28,6 +28,9 @@ void packShape(const Shape& shape, int first_plane, std::vector<glm::vec4>& out,
         } else if constexpr (std::is_same_v<T, RoundedBoxShape>) {
           head.x = EIKON_SHAPE_ROUNDED_BOX;
           par = glm::vec4(glm::vec3(0.5 * g.size - glm::dvec3(g.radius)), float(g.radius));
+        } else if constexpr (std::is_same_v<T, MeshShape>) {
+          // core/scene refuses sharp interfaces for non-convex meshes (mesh.h).
+          throw std::logic_error("a non-convex mesh has no sharp boundary");
         } else {
           head = glm::vec4(float(EIKON_SHAPE_CONVEX), float(first_plane + int(planes.size())),
                            float(g.planes.size()), 0.0f);

@@ -69,6 +69,8 @@ double outlineSupport(const GirdleOutline& g, double ux, double uz) {
       const double x = std::abs(ux), z = std::abs(uz);
       return std::max(x * a + z * (b - c), x * (a - c) + z * b);
     }
+    case GirdleOutline::Kind::Pear:  // the round end's circle (centre −a + b) or the point a
+      return std::max(ux * (b - a) + b * std::hypot(ux, uz), ux * a);
     case GirdleOutline::Kind::None:
       break;
   }

@@ -37,10 +37,12 @@ class FacetError : public std::invalid_argument {
 enum class FacetSide { Crown, Pavilion, Girdle, Table, Culet };
 
 /// The girdle outline that "meet": "girdle" cuts to: round (diameter = length), oval (an ellipse of
-/// axes length along x and width along z) or rectangle (length × width, corners cut by `corner`
-/// mm along both edges), at heights ±thickness/2.
+/// axes length along x and width along z), rectangle (length × width, corners cut by `corner`
+/// mm along both edges) or pear (a teardrop: the convex hull of the circle of diameter width
+/// whose far side is at x = −length/2 and the point (length/2, 0), length > width), at heights
+/// ±thickness/2.
 struct GirdleOutline {
-  enum class Kind { None, Round, Oval, Rectangle } kind = Kind::None;
+  enum class Kind { None, Round, Oval, Rectangle, Pear } kind = Kind::None;
   double length = 0, width = 0, corner = 0, thickness = 0;
 };
 

@@ -11,6 +11,7 @@
 
 #include "core/io/exr.h"
 #include "core/scene/faceted.h"
+#include "core/scene/mesh.h"
 #include "core/spectrum/illuminants.h"
 
 namespace eikon {
@@ -342,7 +343,7 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
 }
 
 // ------------------------------------------------------------------ objects
-/// /girdle of a faceted object: {"outline": "round", "diameter"} | {"outline": "oval" |
+/// /girdle of a faceted object: {"outline": "round", "diameter"} | {"outline": "oval" | "pear" |
 /// "rectangle", "length", "width"[, "corner"]}, "thickness".
 GirdleOutline parseGirdle(const Node& g) {
   GirdleOutline out;
@@ -359,8 +360,18 @@ GirdleOutline parseGirdle(const Node& g) {
     out.width = g.at("width").length();
     if (auto c = g.get("corner"))
       out.corner = c->number(0.0, 0.5 * std::min(out.length, out.width));
+  } else if (kind == "pear") {
+    g.allowKeys({"outline", "length", "width", "thickness"});
+    out.kind = GirdleOutline::Kind::Pear;
+    out.length = g.at("length").length();
+    out.width = g.at("width").length();
+    if (!(out.width < out.length))
+      g.at("width").fail(
+          "a pear must be longer than wide (the point lies outside the round "
+          "end), got width " +
+          fmt(out.width) + " >= length " + fmt(out.length));
   } else {
-    g.at("outline").fail("unknown outline '" + excerpt(kind) + "' (round, oval, rectangle)");
+    g.at("outline").fail("unknown outline '" + excerpt(kind) + "' (round, oval, rectangle, pear)");
   }
   out.thickness = g.get("thickness") ? g.at("thickness").number(0.0, kMaxCoordinateMm) : 0.0;
   return out;
@@ -491,6 +502,53 @@ ConvexShape parseFaceted(const Node& o) {
   }
 }
 
+/// {"shape": "mesh", "file": "x.obj", "scale": s | [sx, sy, sz]}: a closed triangle mesh, read and
+/// checked by core/scene/mesh.h. A convex one becomes its exact polyhedron (one plane per face),
+/// any other an exact-distance MeshShape (smoothed interfaces only: parseObjects checks).
+ShapeGeometry parseMesh(const Node& o) {
+  const Node f = o.at("file");
+  std::filesystem::path p = f.string();
+  if (p.empty()) f.fail("expected the path of an .obj, .ply or .stl file, got an empty string");
+  if (p.is_relative()) p = std::filesystem::path(o.file()).parent_path() / p;
+  glm::dvec3 scale(1.0);
+  const std::optional<Node> s = o.get("scale");
+  if (s) {
+    scale = s->isNumber() ? glm::dvec3(s->number()) : s->vec3();
+    if (!(scale.x > 0 && scale.y > 0 && scale.z > 0))
+      s->fail("every scale factor must be > 0, got " + fmt(std::min({scale.x, scale.y, scale.z})));
+  }
+  TriangleMesh mesh;
+  try {
+    mesh = readMesh(p);
+    checkClosedMesh(mesh, p.filename().string());
+  } catch (const std::invalid_argument& e) {
+    f.fail(printable(e.what(), 400));
+  }
+  std::vector<Plane> planes;
+  std::string why_not_convex;
+  try {
+    planes = meshFacePlanes(mesh, p.filename().string(), kMaxPlanes);
+  } catch (const std::invalid_argument& e) {
+    why_not_convex = printable(e.what(), 400);
+  }
+  auto far = [&](double r) {
+    if (!(r <= kMaxCoordinateMm))
+      (s ? *s : f)
+          .fail("the scaled mesh must lie within " + fmt(kMaxCoordinateMm) +
+                " mm of its centre, got a point at " + fmt(r) + " mm");
+  };
+  if (planes.empty()) {
+    for (glm::dvec3& v : mesh.vertices) {
+      v *= scale;
+      far(glm::length(v));
+    }
+    return makeMeshShape(mesh, why_not_convex);
+  }
+  ConvexShape c = scaledConvex(planes, scale);
+  for (const Plane& pl : c.planes) far(std::abs(pl.d));
+  return c;
+}
+
 SceneObject parseObject(const Node& o) {
   o.requireObject();
   std::string shape = o.at("shape").string();
@@ -566,11 +624,12 @@ SceneObject parseObject(const Node& o) {
       finishConvex(c);
       g = c;
     } else if (shape == "mesh") {
-      o.at("shape").fail("shape 'mesh' is not supported yet (use planes for convex solids)");
+      allow({"file", "scale"});
+      g = parseMesh(o);
     } else {
       o.at("shape").fail(
           "unknown shape '" + excerpt(shape) +
-          "' (sphere, box, rounded_box, prism, brilliant, faceted, planes, polarizer)");
+          "' (sphere, box, rounded_box, prism, brilliant, faceted, planes, mesh, polarizer)");
     }
   } catch (const std::invalid_argument& e) {
     o.fail(e.what());
@@ -1100,6 +1159,12 @@ static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::
       continue;
     }
     SceneObject obj = parseObject(o);
+    if (const auto* m = std::get_if<MeshShape>(&obj.shape.geometry()))
+      if (scene.interfaces == Scene::Interfaces::Sharp)
+        o.at("file").fail(m->why_not_convex +
+                          "; such a mesh needs \"interfaces\": \"smoothed\" (sharp interfaces "
+                          "take convex meshes of at most " +
+                          std::to_string(kMaxPlanes) + " faces)");
     if (!scene.materials.count(obj.material)) loadLibraryMaterial(o, obj, scene);
     const Material& mat = scene.materials[obj.material];
     if (obj.radial_axis && !mat.uniaxial)

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "core/scene/mesh.h"
+
 namespace eikon {
 namespace {
 
@@ -49,6 +51,8 @@ double Shape::signedDistance(const glm::dvec3& world) const {
           return boxDistance(p, 0.5 * g.size);
         } else if constexpr (std::is_same_v<T, RoundedBoxShape>) {
           return boxDistance(p, 0.5 * g.size - glm::dvec3(g.radius)) - g.radius;
+        } else if constexpr (std::is_same_v<T, MeshShape>) {
+          return g.distance->signedDistance(p);
         } else {
           double m = -std::numeric_limits<double>::infinity();
           for (const auto& pl : g.planes) m = std::max(m, glm::dot(pl.normal, p) - pl.d);
@@ -83,6 +87,10 @@ glm::dvec3 Shape::distanceGradient(const glm::dvec3& world) const {
           return boxGradient(p, 0.5 * geo.size);
         } else if constexpr (std::is_same_v<T, RoundedBoxShape>) {
           return boxGradient(p, 0.5 * geo.size - glm::dvec3(geo.radius));
+        } else if constexpr (std::is_same_v<T, MeshShape>) {
+          glm::dvec3 n;
+          geo.distance->signedDistance(p, &n);
+          return n;
         } else {
           double m = -std::numeric_limits<double>::infinity();
           glm::dvec3 n(0.0);

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <glm/glm.hpp>
+#include <memory>
 #include <string>
 #include <variant>
 #include <vector>
@@ -41,7 +42,16 @@ struct ConvexShape {
 /// of non-zero volume.
 void finishConvex(ConvexShape& shape);
 
-using ShapeGeometry = std::variant<SphereShape, BoxShape, RoundedBoxShape, ConvexShape>;
+class MeshDistance;  // core/scene/mesh.h
+/// A closed triangle mesh that is not convex (a convex one becomes a ConvexShape), in the object's
+/// local frame with its scale applied: exact signed distance; smoothed interfaces only.
+struct MeshShape {
+  std::shared_ptr<const MeshDistance> distance;
+  double bounding_radius = 0.0;
+  std::string why_not_convex;  ///< for the error when sharp interfaces are asked for
+};
+
+using ShapeGeometry = std::variant<SphereShape, BoxShape, RoundedBoxShape, ConvexShape, MeshShape>;
 
 class Shape {
  public:
@@ -50,7 +60,7 @@ class Shape {
 
   const std::string& kind() const { return kind_; }
   glm::dvec3 center() const { return center_; }
-  /// Signed distance (negative inside). Exact for sphere, box and rounded box; for convex
+  /// Signed distance (negative inside). Exact for sphere, box, rounded box and mesh; for convex
   /// polyhedra the max over planes, exact inside and a lower bound of the distance outside.
   double signedDistance(const glm::dvec3& world) const;
   bool contains(const glm::dvec3& world) const { return signedDistance(world) <= 0.0; }

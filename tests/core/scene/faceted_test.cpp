@@ -158,7 +158,8 @@ TEST_P(ShippedDesign, FacetsMatchTheDiagramAndCloseAConvexStone) {
 
 INSTANTIATE_TEST_SUITE_P(Faceted, ShippedDesign,
                          ::testing::Values("faceted_round_brilliant.json",
-                                           "faceted_emerald_cut.json", "faceted_oval.json"));
+                                           "faceted_emerald_cut.json", "faceted_oval.json",
+                                           "faceted_pear.json"));
 
 /// Plane sets equal up to order: every plane of `a` has one in `b` with normal and d within tol.
 double planeSetDistance(const std::vector<Plane>& a, const std::vector<Plane>& b) {
@@ -248,6 +249,37 @@ TEST(Faceted, StarFacetThroughAMeetPointOfThreeFacets) {
   ASSERT_EQ(c.planes.size(), 33u);
   EXPECT_NEAR(glm::length(c.planes[25].normal - ns), 0.0, 1e-12);
   EXPECT_NEAR(c.planes[25].d, glm::dot(ns, p), 1e-12);
+}
+
+TEST(Faceted, PearGirdleFacetsTouchTheTeardropOutline) {
+  // The pear outline of length 2a along x and width 2b: the circle of radius b centred at
+  // x = b − a and the point (a, 0). A girdle facet at azimuth φ touches it at distance
+  // max((b − a) cos φ + b, a cos φ): the circle's far side, or the point; at φ = ±60° (indices
+  // 16, 80 of 96) both, since the sides from the point touch the circle there (sin 30° = b/(2a −
+  // b)).
+  const double a = 6, b = 4;
+  const Scene s = parseScene(sceneWith(R"({"shape": "faceted", "material": "g", "gear": 96,
+    "girdle": {"outline": "pear", "length": 12, "width": 8},
+    "tiers": [{"name": "G", "side": "girdle", "index": [16, 24, 32, 40, 48, 56, 64, 72, 80], "meet": "girdle"},
+              {"name": "T", "side": "table", "distance": 1}, {"name": "K", "side": "culet", "distance": 1}]})"),
+                             "t.json");
+  const ConvexShape& c = convexOf(s);
+  ASSERT_EQ(c.planes.size(), 11u);
+  for (size_t k = 0; k < 9; ++k) {
+    const double phi = (16 + 8 * double(k)) * 3.75 * kDeg;
+    EXPECT_NEAR(c.planes[k].d, std::max((b - a) * std::cos(phi) + b, a * std::cos(phi)), 1e-12)
+        << k;
+  }
+  EXPECT_NEAR(c.planes[0].d, a * 0.5, 1e-12);  // through the point
+  EXPECT_NEAR(c.planes[4].d, a, 1e-12);        // the round end's far side, φ = 180°
+  // The point (a, 0, 0) lies on the stone: the two side facets meet there.
+  EXPECT_NEAR(s.objects[0].shape.signedDistance(glm::dvec3(a, 0, 0)), 0.0, 1e-12);
+  EXPECT_TRUE(test::isOneLineSceneError(
+      test::sceneErrorOf(sceneWith(R"({"shape": "faceted", "material": "g",
+        "girdle": {"outline": "pear", "length": 8, "width": 8}, "tiers": [
+        {"name": "G", "side": "girdle", "symmetry": 8, "meet": "girdle"}]})"),
+                         "t.json"),
+      "t.json", "/objects/0/girdle/width", "a pear must be longer than wide"));
 }
 
 // ------------------------------------------------------------------ refusals
