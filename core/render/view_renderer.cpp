@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <map>
 #include <stdexcept>
 #include <tuple>
@@ -77,11 +78,16 @@ struct ViewRenderer::Impl {
   // branch of a kernel masked, so a kernel with the scene's and the settings' features folded in
   // marches many times faster than one that tests them at run time (docs/performance.md).
   std::vector<vk::BindingSpec> viewBindings, traceBindings;
-  std::map<std::tuple<bool, int, int, int>, vk::ComputePipeline> pipelines;
+  using Key = std::tuple<bool, int, int, int>;  // trace, flags, integrator, sharp
+  std::map<Key, vk::ComputePipeline> pipelines;
+  // The expected render's view pipeline, compiled while the volume is uploaded (the compile runs
+  // on one core, the upload mostly on the other); adopted by pipeline() when its key comes up.
+  Key prefetchedKey{};
+  std::future<vk::ComputePipeline> prefetched;
   int skip_cap = 32;
   double ambient = 1.0;
 
-  Impl(vk::Context& context, const Scene& s, const VolumeSet& v)
+  Impl(vk::Context& context, const Scene& s, const VolumeSet& v, const RenderSettings* expected)
       : ctx(context), scene(s), grid(v.grid) {
     checkVolumeFits(ctx, grid, scene);
     uniaxial = v.uniaxial;
@@ -93,6 +99,24 @@ struct ViewRenderer::Impl {
     lit = v.lit();
     skip_cap = v.skip_cap;
     ambient = v.ambient_index;
+    sharp = !v.boundary.empty() && !v.media.empty();
+    for (const MediumRecord& r : v.media.regions) varying = varying || !r.homogeneous;
+    for (const Shape& shape : v.boundary.shapes)
+      convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());
+    std::vector<vk::BindingSpec> common;  // the bindings of both kernels (the trace's adds rays)
+    for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    for (uint32_t b :
+         {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
+                       uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
+    viewBindings = common;
+    traceBindings = common;
+    traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    if (expected) prefetch(*expected);
     std::array<uint32_t, 3> ext{uint32_t(grid.dims[0]), uint32_t(grid.dims[1]),
                                 uint32_t(grid.dims[2])};
     auto upload = [&](const std::vector<glm::vec4>& data, const char* name) {
@@ -122,10 +146,6 @@ struct ViewRenderer::Impl {
     }
 
     boundary = BoundaryDevice(ctx, v.boundary, v.media, scene.file.string());
-    sharp = !v.boundary.empty() && !v.media.empty();
-    for (const MediumRecord& r : v.media.regions) varying = varying || !r.homogeneous;
-    for (const Shape& shape : v.boundary.shapes)
-      convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());
     params =
         vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
     const auto& e = scene.environment;
@@ -153,41 +173,63 @@ struct ViewRenderer::Impl {
                         "spectral tables");
     tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
     timings::mark("volume uploaded");
-
-    std::vector<vk::BindingSpec> common;  // the bindings of both kernels (the trace's adds rays)
-    for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t b :
-         {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
-                       uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
-    viewBindings = common;
-    traceBindings = common;
-    traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
   }
 
-  // The view (trace = false) or trace kernel specialised for the flags and integrator of p.
+  static Key keyOf(bool trace, const gpu::ViewParams& p, bool sharp) {
+    return std::make_tuple(trace, p.grid_dims.w, int(p.march.w), sharp ? 1 : 0);
+  }
+
+  // The view (trace = false) or trace kernel specialised for the flags and integrator of a key.
+  vk::ComputePipeline build(const Key& key) const {
+    const auto [trace, flags, integrator, sharpMarch] = key;
+    // constant_id 0: kSharpMarch, 1: kViewFlags, 2: kIntegrator (march.glsl).
+    const std::vector<uint32_t> spec{uint32_t(sharpMarch), uint32_t(flags), uint32_t(integrator)};
+    return trace ? vk::ComputePipeline(
+                       ctx, std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4),
+                       traceBindings, 0, "trace", spec)
+                 : vk::ComputePipeline(
+                       ctx, std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4),
+                       viewBindings, 0, "view", spec);
+  }
+
+  // Starts compiling the view pipeline of a render with settings `s` on a thread of its own.
+  // Settings render() would refuse start nothing (it reports them).
+  void prefetch(const RenderSettings& s) {
+    try {
+      validate(s.march);
+    } catch (const std::invalid_argument&) {
+      return;
+    }
+    prefetchedKey = keyOf(false, baseParams(s.march, renderFlags(s)), sharp);
+    prefetched = std::async(std::launch::async, [this, key = prefetchedKey] { return build(key); });
+  }
+
+  // The pipeline for a dispatch with parameters p, built (or adopted from prefetch()) on first use.
   vk::ComputePipeline& pipeline(bool trace, const gpu::ViewParams& p) {
-    const int flags = p.grid_dims.w, integrator = int(p.march.w);
-    auto key = std::make_tuple(trace, flags, integrator, sharp ? 1 : 0);
+    const Key key = keyOf(trace, p, sharp);
     auto it = pipelines.find(key);
     if (it != pipelines.end()) return it->second;
-    // constant_id 0: kSharpMarch, 1: kViewFlags, 2: kIntegrator (march.glsl).
-    const std::vector<uint32_t> spec{sharp ? 1u : 0u, uint32_t(flags), uint32_t(integrator)};
-    vk::ComputePipeline pl =
-        trace ? vk::ComputePipeline(ctx,
-                                    std::span<const uint32_t>(k_trace_spv, sizeof(k_trace_spv) / 4),
-                                    traceBindings, 0, "trace", spec)
-              : vk::ComputePipeline(ctx,
-                                    std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4),
-                                    viewBindings, 0, "view", spec);
+    vk::ComputePipeline pl;
+    if (prefetched.valid()) {
+      vk::ComputePipeline ready = prefetched.get();  // rethrows what the build threw
+      if (prefetchedKey == key)
+        pl = std::move(ready);
+      else
+        adopt(prefetchedKey, std::move(ready));
+    }
+    if (!pl.built()) pl = build(key);
+    return adopt(key, std::move(pl));
+  }
+
+  vk::ComputePipeline& adopt(const Key& key, vk::ComputePipeline pl) {
     bindCommon(pl);
     ctx.savePipelineCache();  // core/vk/pipeline_cache.h: the next run may skip the compilation
     timings::mark("pipelines built");
     return pipelines.emplace(key, std::move(pl)).first->second;
+  }
+
+  static int renderFlags(const RenderSettings& s) {
+    return s.wavelengths > 0 ? EIKON_F_SPECTRAL : 0;
   }
 
   void bindCommon(vk::ComputePipeline& p) {
@@ -256,8 +298,9 @@ struct ViewRenderer::Impl {
   }
 };
 
-ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume)
-    : impl_(std::make_unique<Impl>(ctx, scene, volume)) {}
+ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume,
+                           const RenderSettings* expected)
+    : impl_(std::make_unique<Impl>(ctx, scene, volume, expected)) {}
 ViewRenderer::~ViewRenderer() = default;
 
 RenderImage ViewRenderer::render(const RenderSettings& s) {
@@ -271,7 +314,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   if (s.spp < 1 || s.spp > 4096) throw std::invalid_argument("spp must be in [1, 4096]");
   if (s.wavelengths < 0 || s.wavelengths > 256)
     throw std::invalid_argument("wavelengths must be in [0, 256]");
-  gpu::ViewParams p = I.baseParams(s.march, s.wavelengths > 0 ? EIKON_F_SPECTRAL : 0);
+  gpu::ViewParams p = I.baseParams(s.march, Impl::renderFlags(s));
   // Keep the camera's aspect from the requested image size.
   p.cam_forward.w = float(double(img.width) / img.height);
   p.limits.y = s.spp;
