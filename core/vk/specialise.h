@@ -23,7 +23,8 @@ namespace eikon::vk {
 /// VkSpecializationInfo would give it; a bool is true iff non-zero) and frozen, and the code
 /// that this makes unreachable removed. Constants beyond `values` keep their defaults (frozen
 /// too: the pipeline is built without specialisation info). Throws std::runtime_error with the
-/// optimiser's message when the module is not valid SPIR-V.
+/// optimiser's message when the module cannot be read as SPIR-V (it is not validated here: the
+/// kernels are eikon's own, validated by glslang when built and by the layer under validation).
 std::vector<uint32_t> specialiseSpirv(std::span<const uint32_t> spirv,
                                       std::span<const uint32_t> values);
 
