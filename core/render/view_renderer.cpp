@@ -29,6 +29,18 @@ void validate(const MarchSettings& m) {
   if (!(m.interface_threshold > 0)) throw std::invalid_argument("interface threshold must be > 0");
 }
 
+/// What render() refuses, checked before anything is compiled for it.
+void validateRender(const RenderSettings& s, const Scene& scene) {
+  validate(s.march);
+  const int width = s.width > 0 ? s.width : scene.camera.width;
+  const int height = s.height > 0 ? s.height : scene.camera.height;
+  if (width > 16384 || height > 16384)
+    throw std::invalid_argument("image larger than 16384 pixels per side");
+  if (s.spp < 1 || s.spp > 4096) throw std::invalid_argument("spp must be in [1, 4096]");
+  if (s.wavelengths < 0 || s.wavelengths > 256)
+    throw std::invalid_argument("wavelengths must be in [0, 256]");
+}
+
 }  // namespace
 
 void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scene) {
@@ -193,10 +205,10 @@ struct ViewRenderer::Impl {
   }
 
   // Starts compiling the view pipeline of a render with settings `s` on a thread of its own.
-  // Settings render() would refuse start nothing (it reports them).
+  // Settings render() would refuse start nothing (it reports them, without waiting for a build).
   void prefetch(const RenderSettings& s) {
     try {
-      validate(s.march);
+      validateRender(s, scene);
     } catch (const std::invalid_argument&) {
       return;
     }
@@ -304,16 +316,11 @@ ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet
 ViewRenderer::~ViewRenderer() = default;
 
 RenderImage ViewRenderer::render(const RenderSettings& s) {
-  validate(s.march);
   Impl& I = *impl_;
+  validateRender(s, I.scene);
   RenderImage img;
   img.width = s.width > 0 ? s.width : I.scene.camera.width;
   img.height = s.height > 0 ? s.height : I.scene.camera.height;
-  if (img.width > 16384 || img.height > 16384)
-    throw std::invalid_argument("image larger than 16384 pixels per side");
-  if (s.spp < 1 || s.spp > 4096) throw std::invalid_argument("spp must be in [1, 4096]");
-  if (s.wavelengths < 0 || s.wavelengths > 256)
-    throw std::invalid_argument("wavelengths must be in [0, 256]");
   gpu::ViewParams p = I.baseParams(s.march, Impl::renderFlags(s));
   // Keep the camera's aspect from the requested image size.
   p.cam_forward.w = float(double(img.width) / img.height);
