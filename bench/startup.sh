@@ -43,9 +43,11 @@ run() {  # run SCENE LOG: one render, its --timings lines and "cpu T" in LOG
   fi
   awk '{printf "eikon: timing: %.3f s  +0 s  process cpu (user+sys)\n", $2 + $3}' "$tmp/time" >>"$2"
 }
-echo "eikon: $("$eikon" --version 2>/dev/null | head -1 || true)  load: $(cut -d' ' -f1-3 /proc/loadavg)"
 for scene in "${scenes[@]}"; do
   [[ -f "$scene" ]] || { echo "startup.sh: error: no such scene file, got '$scene'" >&2; exit 2; }
+done
+echo "eikon: $("$eikon" --version 2>/dev/null | head -1 || true)  load: $(cut -d' ' -f1-3 /proc/loadavg)"
+for scene in "${scenes[@]}"; do
   run "$scene" "$tmp/warm.log"
   for ((i = 0; i < reps; ++i)); do run "$scene" "$tmp/run$i.log"; done
   echo "$(basename "$scene") (64x48, median of $reps repeated runs, seconds since process start):"
