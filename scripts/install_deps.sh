@@ -4,7 +4,7 @@
 set -euo pipefail
 PKGS=(
   build-essential cmake pkg-config git
-  libvulkan-dev mesa-vulkan-drivers vulkan-tools glslang-tools vulkan-validationlayers
+  libvulkan-dev mesa-vulkan-drivers vulkan-tools glslang-tools spirv-tools vulkan-validationlayers
   libglm-dev libceres-dev libopenexr-dev libpng-dev
   nlohmann-json3-dev libcli11-dev libyaml-cpp-dev libassimp-dev
   googletest libgtest-dev libbenchmark-dev universal-ctags clang-format

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <map>
 #include <stdexcept>
 #include <tuple>
@@ -87,6 +88,18 @@ PolarisedTrace unpackPolarised(const gpu::PolarisedResult& r, const glm::dvec3& 
   return t;
 }
 
+/// What render() refuses, checked before anything is compiled for it.
+void validateRender(const RenderSettings& s, const Scene& scene) {
+  validate(s.march);
+  const int width = s.width > 0 ? s.width : scene.camera.width;
+  const int height = s.height > 0 ? s.height : scene.camera.height;
+  if (width > 16384 || height > 16384)
+    throw std::invalid_argument("image larger than 16384 pixels per side");
+  if (s.spp < 1 || s.spp > 4096) throw std::invalid_argument("spp must be in [1, 4096]");
+  if (s.wavelengths < 0 || s.wavelengths > 256)
+    throw std::invalid_argument("wavelengths must be in [0, 256]");
+}
+
 }  // namespace
 
 void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scene) {
@@ -137,11 +150,16 @@ struct ViewRenderer::Impl {
   // marches many times faster than one that tests them at run time (docs/performance.md).
   std::vector<vk::BindingSpec> viewBindings, traceBindings, polarisedBindings;
   enum Kernel { kView = 0, kTrace = 1, kPolarised = 2 };
-  std::map<std::tuple<int, int, int, int>, vk::ComputePipeline> pipelines;
+  using Key = std::tuple<int, int, int, int>;  // kernel, flags, integrator, sharp
+  std::map<Key, vk::ComputePipeline> pipelines;
+  // The expected render's view pipeline, compiled while the volume is uploaded (the compile runs
+  // on one core, the upload mostly on the other); adopted by pipeline() when its key comes up.
+  Key prefetchedKey{};
+  std::future<vk::ComputePipeline> prefetched;
   int skip_cap = 32;
   double ambient = 1.0;
 
-  Impl(vk::Context& context, const Scene& s, const VolumeSet& v)
+  Impl(vk::Context& context, const Scene& s, const VolumeSet& v, const RenderSettings* expected)
       : ctx(context), scene(s), grid(v.grid) {
     checkVolumeFits(ctx, grid, scene);
     uniaxial = v.uniaxial;
@@ -153,6 +171,26 @@ struct ViewRenderer::Impl {
     lit = v.lit();
     skip_cap = v.skip_cap;
     ambient = v.ambient_index;
+    sharp = !v.boundary.empty() && !v.media.empty();
+    for (const MediumRecord& r : v.media.regions) varying = varying || !r.homogeneous;
+    for (const Shape& shape : v.boundary.shapes)
+      convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());
+    std::vector<vk::BindingSpec> common;  // the bindings of both kernels (the trace's adds rays)
+    for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    for (uint32_t b :
+         {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
+                       uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
+      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
+    viewBindings = common;
+    traceBindings = common;
+    traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    polarisedBindings = traceBindings;
+    polarisedBindings.push_back({EIKON_B_SHEETS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    if (expected) prefetch(*expected);
     std::array<uint32_t, 3> ext{uint32_t(grid.dims[0]), uint32_t(grid.dims[1]),
                                 uint32_t(grid.dims[2])};
     auto upload = [&](const std::vector<glm::vec4>& data, const char* name) {
@@ -182,10 +220,6 @@ struct ViewRenderer::Impl {
     }
 
     boundary = BoundaryDevice(ctx, v.boundary, v.media, scene.file.string());
-    sharp = !v.boundary.empty() && !v.media.empty();
-    for (const MediumRecord& r : v.media.regions) varying = varying || !r.homogeneous;
-    for (const Shape& shape : v.boundary.shapes)
-      convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());
     params =
         vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
     const auto& e = scene.environment;
@@ -213,43 +247,63 @@ struct ViewRenderer::Impl {
                         "spectral tables");
     tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
     timings::mark("volume uploaded");
-
-    std::vector<vk::BindingSpec> common;  // the bindings of both kernels (the trace's adds rays)
-    for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t b :
-         {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
-                       uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
-    viewBindings = common;
-    traceBindings = common;
-    traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    polarisedBindings = traceBindings;
-    polarisedBindings.push_back({EIKON_B_SHEETS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
   }
 
-  // The view, trace or polarised-trace kernel specialised for the flags and integrator of p.
-  vk::ComputePipeline& pipeline(Kernel kernel, const gpu::ViewParams& p) {
-    const int flags = p.grid_dims.w, integrator = int(p.march.w);
-    auto key = std::make_tuple(int(kernel), flags, integrator, sharp ? 1 : 0);
-    auto it = pipelines.find(key);
-    if (it != pipelines.end()) return it->second;
+  static Key keyOf(Kernel kernel, const gpu::ViewParams& p, bool sharp) {
+    return std::make_tuple(int(kernel), p.grid_dims.w, int(p.march.w), sharp ? 1 : 0);
+  }
+
+  // The view, trace or polarised-trace kernel specialised for the flags and integrator of a key.
+  vk::ComputePipeline build(const Key& key) const {
+    const auto [kernel, flags, integrator, sharpMarch] = key;
     // constant_id 0: kSharpMarch, 1: kViewFlags, 2: kIntegrator (march.glsl).
-    const std::vector<uint32_t> spec{sharp ? 1u : 0u, uint32_t(flags), uint32_t(integrator)};
+    const std::vector<uint32_t> spec{uint32_t(sharpMarch), uint32_t(flags), uint32_t(integrator)};
     auto make = [&](std::span<const uint32_t> code, const std::vector<vk::BindingSpec>& b,
                     const char* name) { return vk::ComputePipeline(ctx, code, b, 0, name, spec); };
-    vk::ComputePipeline pl =
-        kernel == kTrace  ? make({k_trace_spv, sizeof(k_trace_spv) / 4}, traceBindings, "trace")
-        : kernel == kView ? make({k_view_spv, sizeof(k_view_spv) / 4}, viewBindings, "view")
-                          : make({k_polarised_trace_spv, sizeof(k_polarised_trace_spv) / 4},
-                                 polarisedBindings, "polarised trace");
+    return kernel == kTrace  ? make({k_trace_spv, sizeof(k_trace_spv) / 4}, traceBindings, "trace")
+           : kernel == kView ? make({k_view_spv, sizeof(k_view_spv) / 4}, viewBindings, "view")
+                             : make({k_polarised_trace_spv, sizeof(k_polarised_trace_spv) / 4},
+                                    polarisedBindings, "polarised trace");
+  }
+
+  // Starts compiling the view pipeline of a render with settings `s` on a thread of its own.
+  // Settings render() would refuse start nothing (it reports them, without waiting for a build).
+  void prefetch(const RenderSettings& s) {
+    try {
+      validateRender(s, scene);
+    } catch (const std::invalid_argument&) {
+      return;
+    }
+    prefetchedKey = keyOf(kView, baseParams(s.march, renderFlags(s)), sharp);
+    prefetched = std::async(std::launch::async, [this, key = prefetchedKey] { return build(key); });
+  }
+
+  // The pipeline for a dispatch with parameters p, built (or adopted from prefetch()) on first use.
+  vk::ComputePipeline& pipeline(Kernel kernel, const gpu::ViewParams& p) {
+    const Key key = keyOf(kernel, p, sharp);
+    auto it = pipelines.find(key);
+    if (it != pipelines.end()) return it->second;
+    vk::ComputePipeline pl;
+    if (prefetched.valid()) {
+      vk::ComputePipeline ready = prefetched.get();  // rethrows what the build threw
+      if (prefetchedKey == key)
+        pl = std::move(ready);
+      else
+        adopt(prefetchedKey, std::move(ready));
+    }
+    if (!pl.built()) pl = build(key);
+    return adopt(key, std::move(pl));
+  }
+
+  vk::ComputePipeline& adopt(const Key& key, vk::ComputePipeline pl) {
     bindCommon(pl);
     ctx.savePipelineCache();  // core/vk/pipeline_cache.h: the next run may skip the compilation
     timings::mark("pipelines built");
     return pipelines.emplace(key, std::move(pl)).first->second;
+  }
+
+  static int renderFlags(const RenderSettings& s) {
+    return s.wavelengths > 0 ? EIKON_F_SPECTRAL : 0;
   }
 
   void bindCommon(vk::ComputePipeline& p) {
@@ -318,22 +372,18 @@ struct ViewRenderer::Impl {
   }
 };
 
-ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume)
-    : impl_(std::make_unique<Impl>(ctx, scene, volume)) {}
+ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume,
+                           const RenderSettings* expected)
+    : impl_(std::make_unique<Impl>(ctx, scene, volume, expected)) {}
 ViewRenderer::~ViewRenderer() = default;
 
 RenderImage ViewRenderer::render(const RenderSettings& s) {
-  validate(s.march);
   Impl& I = *impl_;
+  validateRender(s, I.scene);
   RenderImage img;
   img.width = s.width > 0 ? s.width : I.scene.camera.width;
   img.height = s.height > 0 ? s.height : I.scene.camera.height;
-  if (img.width > 16384 || img.height > 16384)
-    throw std::invalid_argument("image larger than 16384 pixels per side");
-  if (s.spp < 1 || s.spp > 4096) throw std::invalid_argument("spp must be in [1, 4096]");
-  if (s.wavelengths < 0 || s.wavelengths > 256)
-    throw std::invalid_argument("wavelengths must be in [0, 256]");
-  gpu::ViewParams p = I.baseParams(s.march, s.wavelengths > 0 ? EIKON_F_SPECTRAL : 0);
+  gpu::ViewParams p = I.baseParams(s.march, Impl::renderFlags(s));
   // Keep the camera's aspect from the requested image size.
   p.cam_forward.w = float(double(img.width) / img.height);
   p.limits.y = s.spp;

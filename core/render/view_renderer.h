@@ -31,7 +31,10 @@ void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scen
 
 class ViewRenderer {
  public:
-  ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume);
+  /// `expected`: the settings of the render that will follow, if known; its view pipeline is then
+  /// compiled on a thread of its own while the volume is uploaded (start-up, docs/performance.md).
+  ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet& volume,
+               const RenderSettings* expected = nullptr);
   ~ViewRenderer();
   ViewRenderer(const ViewRenderer&) = delete;
   ViewRenderer& operator=(const ViewRenderer&) = delete;

@@ -178,11 +178,11 @@ LightOutcome Session::simulateLight(const LightRequest& light, bool cpu_render,
   return out;
 }
 
-ViewRenderer& Session::gpuRenderer() {
+ViewRenderer& Session::gpuRenderer(const RenderSettings* expected) {
   prepare(true);
   if (!gpu_) {
     if (progress_.working) progress_.working("preparing the GPU (pipelines, volume upload)");
-    gpu_ = std::make_unique<ViewRenderer>(*ctx_, *scene_, *volume_);
+    gpu_ = std::make_unique<ViewRenderer>(*ctx_, *scene_, *volume_, expected);
   }
   return *gpu_;
 }
@@ -200,7 +200,7 @@ RenderImage Session::render(const RenderSettings& settings, bool gpu) {
   RenderSettings rs = settings;
   if (progress_.update && !rs.progress)
     rs.progress = [this](double f) { progress_.update("rendering", f); };
-  if (gpu) return gpuRenderer().render(rs);
+  if (gpu) return gpuRenderer(&rs).render(rs);
   Camera cam = scene_->camera;
   if (rs.width > 0) cam.width = rs.width;
   if (rs.height > 0) cam.height = rs.height;

@@ -160,7 +160,8 @@ class Session {
 
  private:
   void dropRenderers();
-  ViewRenderer& gpuRenderer();
+  /// `expected`: the render about to run, whose pipeline then compiles during the upload.
+  ViewRenderer& gpuRenderer(const RenderSettings* expected = nullptr);
   ReferenceMarcher& cpuMarcher();
 
   std::shared_ptr<Scene> scene_;

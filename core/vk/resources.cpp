@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "core/vk/check.h"
+#include "core/vk/specialise.h"
 
 namespace eikon::vk {
 
@@ -184,6 +185,13 @@ ComputePipeline::ComputePipeline(const Context& ctx, std::span<const uint32_t> s
       push_bytes_(push_constant_bytes),
       bindings_(std::move(bindings)),
       name_(std::move(name)) {
+  // Specialised on the host (core/vk/specialise.h): the driver gets the module without the code
+  // the constants disable, and no specialisation info.
+  std::vector<uint32_t> specialised;
+  if (!specialization.empty()) {
+    specialised = specialiseSpirv(spirv, specialization);
+    spirv = specialised;
+  }
   VkShaderModuleCreateInfo si{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   si.codeSize = spirv.size_bytes();
   si.pCode = spirv.data();
@@ -218,12 +226,6 @@ ComputePipeline::ComputePipeline(const Context& ctx, std::span<const uint32_t> s
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = module_;
   ci.stage.pName = "main";
-  std::vector<VkSpecializationMapEntry> entries;
-  for (uint32_t i = 0; i < uint32_t(specialization.size()); ++i)
-    entries.push_back({i, i * uint32_t(sizeof(uint32_t)), sizeof(uint32_t)});
-  VkSpecializationInfo spec{uint32_t(entries.size()), entries.data(),
-                            specialization.size() * sizeof(uint32_t), specialization.data()};
-  if (!specialization.empty()) ci.stage.pSpecializationInfo = &spec;
   ci.layout = layout_;
   VK_CHECK(vkCreateComputePipelines(device_, ctx.pipelineCache(), 1, &ci, nullptr, &pipeline_));
   ctx.pipelineBuilt();

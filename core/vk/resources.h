@@ -88,8 +88,9 @@ struct BindingSpec {
 };
 
 /// A compute pipeline with one descriptor set and an optional push-constant block.
-/// `specialization[i]` is the 32-bit value of the shader's `layout(constant_id = i)` constant
-/// (the driver folds it and drops the code it disables: a smaller, faster-to-compile pipeline).
+/// `specialization[i]` is the 32-bit value of the shader's `layout(constant_id = i)` constant,
+/// folded in on the host before the driver sees the module (core/vk/specialise.h: the code the
+/// constants disable never reaches the driver's compiler).
 class ComputePipeline {
  public:
   ComputePipeline() = default;

@@ -121,4 +121,19 @@ TEST_F(BaselineRatio, MissingBuildIsOneErrorLine) {
   EXPECT_NE(r.err.find("not built"), std::string::npos) << r.err;
 }
 
+// bench/startup.sh (docs/performance.md "Start-up"): the same for its arguments, checked before
+// any render runs (so nothing is printed on stdout).
+TEST_F(BaselineRatio, StartupBenchBadArgumentsAreOneErrorLine) {
+  const std::string script = std::string(EIKON_SOURCE_DIR) + "/bench/startup.sh";
+  for (const std::string args :
+       {std::string("--reps 0"), std::string("--reps x"), std::string("--no-such-option"),
+        "--eikon " + (dir_ / "no_eikon").string(), (dir_ / "no_scene.json").string()}) {
+    const auto r = eikon::test::runProgram(script, args, dir_, "");
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(lines(r.err), 1) << args << ": " << r.err;
+    EXPECT_NE(r.err.find("startup.sh: error:"), std::string::npos) << args << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
+  }
+}
+
 }  // namespace

@@ -109,6 +109,25 @@ TEST_F(StartupCli, TimingsListEveryStageInOrder) {
   EXPECT_NE(r.out.find("eikon: rendered"), std::string::npos) << r.out;
 }
 
+// The view pipeline compiled during the upload (ViewRenderer's `expected` settings) is the one the
+// render uses: with settings other than the defaults (spectral, Euler, no Fresnel, no skipping:
+// other specialisation constants) exactly one pipeline is built, after the upload and before the
+// first dispatch. A second one would mean the render compiled its own beside the prefetched one.
+TEST_F(StartupCli, TheRendersPipelineIsBuiltOnceWithNonDefaultSettings) {
+  const Outcome r =
+      render("--timings -q --wavelengths 4 --integrator euler --no-fresnel --no-skip --spp 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::vector<std::string> stages;
+  for (const Mark& m : timingLines(r.err)) stages.push_back(m.stage);
+  EXPECT_EQ(std::count(stages.begin(), stages.end(), "pipelines built"), 1) << r.err;
+  const auto at = [&](const char* stage) {
+    return std::find(stages.begin(), stages.end(), stage) - stages.begin();
+  };
+  EXPECT_LT(at("volume uploaded"), at("pipelines built")) << r.err;
+  EXPECT_LT(at("pipelines built"), at("first dispatch")) << r.err;
+  EXPECT_LT(at("first dispatch"), std::ptrdiff_t(stages.size())) << r.err;
+}
+
 // EIKON_TIMINGS=1 does what --timings does (for the Python module and the benchmarks); neither
 // given, stderr stays empty.
 TEST_F(StartupCli, TimingsFromTheEnvironmentAndOffByDefault) {

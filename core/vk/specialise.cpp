@@ -1,0 +1,39 @@
+#include "core/vk/specialise.h"
+
+#include <spirv-tools/optimizer.hpp>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace eikon::vk {
+
+std::vector<uint32_t> specialiseSpirv(std::span<const uint32_t> spirv,
+                                      std::span<const uint32_t> values) {
+  std::unordered_map<uint32_t, std::vector<uint32_t>> bits;
+  for (uint32_t i = 0; i < uint32_t(values.size()); ++i) bits[i] = {values[i]};
+  spvtools::Optimizer opt(SPV_ENV_VULKAN_1_2);
+  std::string error;
+  opt.SetMessageConsumer(
+      [&](spv_message_level_t level, const char*, const spv_position_t& pos, const char* message) {
+        if (level <= SPV_MSG_ERROR && error.empty())
+          error = "word " + std::to_string(pos.index) + ": " + message;
+      });
+  // The passes spirv-opt runs for --set-spec-const-default-value --freeze-spec-const
+  // --fold-spec-const-op-composite --eliminate-dead-branches --eliminate-dead-functions (measured
+  // against the alternatives in docs/performance.md: adding constant propagation or dead-code
+  // elimination saved the driver nothing more; inlining made its work larger).
+  opt.RegisterPass(spvtools::CreateSetSpecConstantDefaultValuePass(bits))
+      .RegisterPass(spvtools::CreateFreezeSpecConstantValuePass())
+      .RegisterPass(spvtools::CreateFoldSpecConstantOpAndCompositePass())
+      .RegisterPass(spvtools::CreateDeadBranchElimPass())
+      .RegisterPass(spvtools::CreateEliminateDeadFunctionsPass());
+  std::vector<uint32_t> out;
+  spvtools::OptimizerOptions options;
+  options.set_run_validator(false);  // the module is eikon's own, validated when it was built
+  if (!opt.Run(spirv.data(), spirv.size(), &out, options))
+    throw std::runtime_error("cannot specialise the SPIR-V module: " +
+                             (error.empty() ? std::string("the optimiser failed") : error));
+  return out;
+}
+
+}  // namespace eikon::vk
