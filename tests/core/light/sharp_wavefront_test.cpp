@@ -136,7 +136,9 @@ TEST(SharpWavefront, TotalInternalReflectionReturnsAllThePower) {
   const glm::dvec3 dout = glm::normalize(glm::dvec3(1, 1, 0));
   const double yExp = xProbe - H / 3;  // the exit line y = x − H/3
   const glm::dvec3 dir = st.probe_direction;
-  const double angle = std::acos(std::min(1.0, glm::dot(dir, dout) / glm::length(dir)));
+  // atan2(|d × d_out|, d·d_out), not acos(d̂·d_out): acos of a cosine one ulp below 1 is already
+  // 2.1e-8 rad, above the tolerance, so acos could not resolve the angle asserted here.
+  const double angle = std::atan2(glm::length(glm::cross(dir, dout)), glm::dot(dir, dout));
   std::printf(
       "[ measured ] sharp TIR: probe y %.12f (closed form %.12f, error %.2e mm), direction "
       "error %.2e rad, T %.12f (closed form %.12f, relative %.2e)\n",
