@@ -43,15 +43,13 @@ SharpInterfaces oneGlass(const VolumeSet& vol, double n) {
 // plane at incidence i whose axis meets the entry face at the origin's (0, 0, −0.5). Behind the
 // slab (probe z = 1.0) the axis is displaced by t·(tan i − tan r) along −x against the straight
 // line and leaves along the incident direction.
-const char* const kSlab = kSharpSlabScene;  // tests/core/light_fixtures.h
+// The scene: kSharpSlabScene (sharpSlabScene(res), tests/core/light_fixtures.h).
 
 void slabAtEachIncidence(const VolumeSet& vol);
 
 TEST(SharpWavefront, SlabDisplacesTheBeamAndTransmitsTheFresnelPower) {
   for (const char* res : {"64", "128"}) {
-    std::string json = kSlab;
-    json.replace(json.find("RES"), 3, res);
-    const Scene scene = sceneFromJson(json);
+    const Scene scene = sceneFromJson(sharpSlabScene(res));
     const VolumeSet vol = voxelize(scene);
     ASSERT_FALSE(vol.boundary.empty());
     std::printf("[ measured ] sharp slab at resolution %s (h = %.4f mm)\n", res, vol.grid.h);
