@@ -12,12 +12,16 @@
 // --sharp: every run at the scene's sharp interfaces (issue 13; WavefrontSettings::
 // sharp_interfaces on the GPU, sharpInterfacesFor on the CPU), where they apply.
 //
+// --interfaces smoothed,sharp: run the full resolution once per listed kind (e.g. both in one
+// run, for the ratios of docs/performance.md's "Light simulator" table); --no-low: skip the runs
+// without straight steps at the lower resolution.
+//
 // --threads T1,T2,…: run the CPU reference once per listed thread count
 // (WavefrontSettings::threads; default 0 = hardware concurrency) and print each one's speed-up
 // over the first; --no-gpu: skip the GPU twin (and Vulkan).
 //
 //   light_bench [--resolution N] [--no-skip-resolution M] [--steps-per-dispatch K] [--no-cpu]
-//               [--no-gpu] [--threads T1,T2,…] [--sharp]
+//               [--no-gpu] [--threads T1,T2,…] [--sharp] [--interfaces smoothed,sharp] [--no-low]
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -69,6 +73,7 @@ struct Pair {
   Run gpu;
   std::vector<Run> cpu;  ///< one per entry of gThreads
   bool haveGpu = false;
+  double gpuSetup = 0;  ///< seconds to construct the GpuWavefront
 };
 
 int gStepsPerDispatch = 16;
@@ -89,13 +94,17 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
               sharp.active() ? "sharp" : "smoothed");
   Pair p;
   if (ctx) {
-    GpuWavefront gpu(*ctx, vol, s, gStepsPerDispatch);
+    // Set-up (uploads, the pipelines' compilation) apart: a render pays it once per scene.
     auto t0 = std::chrono::steady_clock::now();
+    GpuWavefront gpu(*ctx, vol, s, gStepsPerDispatch);
+    p.gpuSetup = seconds(t0);
+    t0 = std::chrono::steady_clock::now();
     WavefrontResult r = gpu.run(scene.lights[0]);
     p.gpu.s = seconds(t0);
     p.gpu.st = r.stats;
     p.haveGpu = true;
     print("GPU", p.gpu);
+    std::printf("       set-up (upload, pipeline compilation) %.2f s\n", p.gpuSetup);
   }
   if (cpu) {
     VolumeField field(vol);
@@ -143,6 +152,14 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-cpu", cpu, "Skip the CPU reference");
   app.add_flag("!--no-gpu", gpu, "Skip the GPU simulator");
   app.add_flag("--sharp", gSharp, "Simulate at the scene's sharp interfaces (both twins)");
+  std::vector<std::string> interfaces;
+  app.add_option("--interfaces", interfaces,
+                 "Full-resolution runs, comma separated: smoothed, sharp (default: --sharp's)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"smoothed", "sharp"}));
+  bool lowRuns = true;
+  app.add_flag("!--no-low", lowRuns,
+               "Skip the runs without straight steps at the lower resolution");
   app.add_option("--threads", gThreads,
                  "CPU thread counts to compare, comma separated (0: all cores)")
       ->delimiter(',')
@@ -161,7 +178,23 @@ int main(int argc, char** argv) {
       "scene %s, light 0, WavefrontSettings defaults, GPU steps per dispatch %d, device %s\n",
       scene_path.c_str(), gStepsPerDispatch, ctx ? ctx->deviceName().c_str() : "(no GPU)");
 
-  const Pair full = simulate(ctx.get(), scene, resolution, true, cpu);
+  if (interfaces.empty()) interfaces = {gSharp ? "sharp" : "smoothed"};
+  std::vector<std::string> rows;
+  for (const std::string& kind : interfaces) {
+    gSharp = kind == "sharp";
+    const Pair full = simulate(ctx.get(), scene, resolution, true, cpu);
+    char row[256];
+    const double c = full.cpu.empty() ? 0.0 : full.cpu.back().s,
+                 g = full.haveGpu ? full.gpu.s : 0.0;
+    std::snprintf(row, sizeof row, "| %s | %d | %s | %.2f | %.2f (+%.2f set-up) | %.2f |",
+                  scene_path.c_str(), resolution, kind.c_str(), c, g, full.gpuSetup,
+                  c > 0 && g > 0 ? c / g : 0.0);
+    rows.push_back(row);
+  }
+  std::printf(
+      "\n| scene | resolution | interfaces | CPU s (last thread count) | GPU s | CPU/GPU |\n");
+  for (const std::string& r : rows) std::printf("%s\n", r.c_str());
+  if (!lowRuns) return 0;
   std::printf(
       "\nWithout straight steps at resolution %d (lower than %d: without skipping the full "
       "resolution "
@@ -176,6 +209,5 @@ int main(int argc, char** argv) {
   for (size_t i = 0; i < low.cpu.size(); ++i)
     std::printf(" CPU/%d %.2fx", gThreads[i], low.cpu[i].s / lowSkip.cpu[i].s);
   std::printf("\n");
-  (void)full;
   return 0;
 }

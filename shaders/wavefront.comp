@@ -51,7 +51,32 @@
 
 layout(local_size_x = EIKON_WAVE_WG) in;
 
-layout(std430, binding = EIKON_WB_PARAMS) readonly buffer ParamsBuf { WaveParams P; };
+layout(std430, binding = EIKON_WB_PARAMS) readonly buffer ParamsBuf { WaveParams params; };
+// A private copy of the parameter block, made once at the top of main(): llvmpipe reads a storage
+// buffer lane by lane in a scalar loop wherever a lane mask is active (inside any branch or loop),
+// so every P.x read in the step loop was a loop per component (docs/performance.md).
+WaveParams P;
+
+// Specialisation constants (docs/performance.md, "Light simulator"): llvmpipe runs both sides of
+// every branch under masks, so what a run does not use is compiled out. GpuWavefront makes one
+// pipeline per set of constants on first use.
+//   kSharpLight: the scene's boundary field applies (sharp interfaces);
+//   kWaveFlags:  EIKON_F_DISPERSIVE | _ATTENUATION | _OPACITY of the volume, _UNIAXIAL for an
+//                e-mode run in a uniaxial volume, _CONVEX when some shape is a convex polyhedron
+//                (sharp: boundary.glsl's plane loops); −1: read from P.grid_dims.w;
+//   kWaveOptions: EIKON_WO_* bits (straight steps, pass caustics, probe plane); −1: from P.
+layout(constant_id = 0) const bool kSharpLight = false;
+layout(constant_id = 1) const int kWaveFlags = -1;
+layout(constant_id = 2) const int kWaveOptions = -1;
+#define EIKON_WO_SKIP 1
+#define EIKON_WO_PASS_CAUSTICS 2
+#define EIKON_WO_PROBE 4
+bool hasOption(int o) {
+  if (kWaveOptions != -1) return (kWaveOptions & o) != 0;
+  if (o == EIKON_WO_SKIP) return P.options.x != 0;
+  if (o == EIKON_WO_PASS_CAUSTICS) return P.options.y != 0;
+  return P.control.x >= 0;
+}
 layout(binding = EIKON_WB_INDEX_A, rgba32f) readonly uniform image3D idxOA;
 layout(binding = EIKON_WB_INDEX_B, rgba32f) readonly uniform image3D idxOB;
 layout(binding = EIKON_WB_INDEX_C, rgba32f) readonly uniform image3D idxOC;
@@ -91,20 +116,22 @@ void storeOther(uint i, WavePatch p) {
 #define EIKON_FIELD_LAMBDA_UM P.wavelength.x
 #define EIKON_FIELD_IL2 P.wavelength.y
 #define EIKON_FIELD_IL4 P.wavelength.z
-#define EIKON_FIELD_HAS_AXIS true
+#define EIKON_FIELD_FLAGS (kWaveFlags == -1 ? P.grid_dims.w : kWaveFlags)
+#define EIKON_FIELD_HAS_AXIS hasFlag(EIKON_F_UNIAXIAL)
 #include "field.glsl"
 
-bool eMode() { return P.control.w == 1; }
+// The e-mode of a uniaxial volume (the host sets EIKON_F_UNIAXIAL only for such a run).
+bool eMode() { return hasFlag(EIKON_F_UNIAXIAL); }
 
 // ---- Sharp interfaces: the boundary field (boundary.glsl), the medium table and the interface
 // laws (sharp.glsl, without the view march's stages), the Fresnel factors (fresnel.glsl) ----
-layout(constant_id = 0) const bool kSharpLight = false;
 layout(binding = EIKON_B_REGION, r32ui) readonly uniform uimage3D regionImg;
 layout(binding = EIKON_B_BOUNDARY_DIST, r32f) readonly uniform image3D boundaryDist;
 layout(std430, binding = EIKON_B_SHAPES) readonly buffer ShapeBuf { vec4 shapeTable[]; };
 layout(std430, binding = EIKON_B_MEDIA) readonly buffer MediaBuf { vec4 mediaTable[]; };
 float gLambdaUm = 0.5876;      // sharp.glsl's mediumIndex: set to P.wavelength.x in main()
 bool gDispersiveHit = false;  // written by mediumIndex, unused here
+#define EIKON_BOUNDARY_HAS_CONVEX hasFlag(EIKON_F_CONVEX)
 #include "boundary.glsl"
 #include "fresnel.glsl"
 #define EIKON_SHARP_NO_MARCH
@@ -310,6 +337,15 @@ void splatSegment(vec3 c0, vec3 u, float L, float E0, float sigma, vec3 dir, flo
   }
 }
 
+// The corners lie in different regions, or only some have been mirrored: the patch is being torn
+// by a boundary; it is not split and not tested for a caustic until all four are on one side.
+bool straddles(ivec4 region) {
+  const ivec4 r = region & EIKON_CORNER_REGION, mir = region & EIKON_CORNER_MIRRORED;
+  return r.y != r.x || r.z != r.x || r.w != r.x || mir.y != mir.x || mir.z != mir.x || mir.w != mir.x;
+}
+
+bool anyMirrored(ivec4 region) { return any(notEqual(region & EIKON_CORNER_MIRRORED, ivec4(0))); }
+
 // How many time steps the patch (corners x, w) may take at once along straight lines (0: take
 // an RK4 step), and the corners' constant velocities v = dx/dt; the rules of straightSteps in
 // wavefront.cpp: centre and corners in voxels of skip distance D ≥ 2, the centre's voxel not
@@ -317,9 +353,14 @@ void splatSegment(vec3 c0, vec3 u, float L, float E0, float sigma, vec3 dir, flo
 // within (D − 1.5)·h of its start, within max_steps, ends at the first step below the energy
 // threshold (σ > 0), and is cut at the first step j at which single steps would split, meet a
 // caustic or leave.
-int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, out vec3 v[4]) {
+int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, ivec4 region, out vec3 v[4], out float sigma1) {
   for (int k = 0; k < 4; ++k) v[k] = vec3(0.0);
-  if (P.options.x == 0 || kSharpLight) return 0;  // sharp: the skip distance describes the smoothed field
+  sigma1 = 0.0;
+  if (!hasOption(EIKON_WO_SKIP)) return 0;
+  // Sharp interfaces: all four corners in one region on one side of every mirror (a torn patch
+  // takes single steps), moving at that medium's constant velocity.
+  const int r0 = regionOf(region.x);
+  if (kSharpLight && (straddles(region) || mediumOpaque(r0))) return 0;
   const vec3 c0 = centreOf(x);
   const float Dc = skipAt(c0);
   if (Dc < 2.0) return 0;
@@ -335,10 +376,16 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, out vec3 v[4]) {
   const bool in0 = insideBounds(c0);
   if (!in0 && (state.z != 0 || !rayHitsBox(c0, wm / wl))) return 0;
   vec3 vc = vec3(0.0);
+  float absorb1 = 0.0;  // sharp: Σ σ·length of the corners over one time step
   for (int k = 0; k < 4; ++k) {
-    if (eMode() && axisField(x[k]).w > 0.0) return 0;  // radial axis: a varies
-    vec3 dw;
-    deriv(x[k], w[k], v[k], dw);
+    if (kSharpLight) {
+      v[k] = mediumVelocity(r0, w[k]);
+      absorb1 += mediumSigma(r0, w[k]) * length(v[k]) * P.step.x;
+    } else {
+      if (eMode() && axisField(x[k]).w > 0.0) return 0;  // radial axis: a varies
+      vec3 dw;
+      deriv(x[k], w[k], v[k], dw);
+    }
     vc += 0.25 * v[k];
   }
   const float dt = P.step.x, h = P.grid_origin.w, maxEdge = P.step.y;
@@ -350,23 +397,28 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, out vec3 v[4]) {
     if (sp > 0.0) kmax = min(kmax, floor((D[k] - 1.5) * h / sp));
   }
   // Energy: below the threshold already (a split's child): one step; else the first step below it.
+  // Sharp: a single step's factor is exp(−¼ Σ σ·length) over the corners (sharpCorner), the same
+  // each step; sigma1 = −log of it per unit of the centre's path.
   const float ds1 = length(vc) * dt, thr = P.step.z * flux.z;
+  if (kSharpLight && ds1 > 0.0) sigma1 = 0.25 * absorb1 / ds1;
   if (flux.x < thr) {
     kmax = min(kmax, 1.0);
   } else if (ds1 > 0.0) {
     const vec3 m = c0 + 0.5 * dt * vc;
-    const float sigma = eMode() ? sigmaE(m, wm) : bandAt(mediumAt(m).xyz);
+    const float sigma = kSharpLight ? sigma1 : eMode() ? sigmaE(m, wm) : bandAt(mediumAt(m).xyz);
     if (sigma > 0.0 && thr > 0.0) kmax = min(kmax, floor(log(flux.x / thr) / (sigma * ds1)) + 1.0);
   }
   if (kmax < 1.0) return 0;
   const int K = int(kmax);
+  // A mirror reverses the orientation (endOfStep).
+  const int orient = kSharpLight && anyMirrored(region) ? -state.y : state.y;
   bool entered = state.z != 0 || in0;
   for (int j = 1; j <= K; ++j) {
     vec3 xj[4];
     for (int k = 0; k < 4; ++k) xj[k] = x[k] + (float(j) * dt) * v[k];
     const float o = dot(0.5 * cross(xj[2] - xj[0], xj[3] - xj[1]), wm);
     const vec3 c = centreOf(xj);
-    bool stop = maxEdgeOf(xj) > maxEdge || (o > 0.0 && state.y < 0) || (o < 0.0 && state.y > 0);
+    bool stop = maxEdgeOf(xj) > maxEdge || (o > 0.0 && orient < 0) || (o < 0.0 && orient > 0);
     if (insideBounds(c))
       entered = true;
     else if (entered || !rayHitsBox(c, wm / wl))
@@ -488,14 +540,6 @@ void sharpCorner(inout vec3 x, inout vec3 w, inout int corner, inout PatchStep s
   st.attenuation *= exp(-0.25 * absorb);
 }
 
-// The corners lie in different regions, or only some have been mirrored: the patch is being torn
-// by a boundary; it is not split and not tested for a caustic until all four are on one side.
-bool straddles(ivec4 region) {
-  const ivec4 r = region & EIKON_CORNER_REGION, mir = region & EIKON_CORNER_MIRRORED;
-  return r.y != r.x || r.z != r.x || r.w != r.x || mir.y != mir.x || mir.z != mir.x || mir.w != mir.x;
-}
-
-bool anyMirrored(ivec4 region) { return any(notEqual(region & EIKON_CORNER_MIRRORED, ivec4(0))); }
 
 vec3 meanOf(vec3 w[4]) { return 0.25 * (w[0] + w[1] + w[2] + w[3]); }
 
@@ -507,11 +551,12 @@ PatchStep moveStep(inout vec3 x[4], inout vec3 w[4], inout WavePatch p) {
   st.c0 = centreOf(x);
   st.wm0 = meanOf(w);
   vec3 vel[4];
-  st.kStraight = straightSteps(x, w, p.flux, p.state, vel);
+  float sigma1;
+  st.kStraight = straightSteps(x, w, p.flux, p.state, p.region, vel, sigma1);
   st.dA = vec3(0.0), st.dB = vec3(0.0), st.dC = vec3(0.0), st.dD = vec3(0.0);
   st.fresnel = 1.0;
   st.attenuation = 1.0;
-  if (kSharpLight) {
+  if (kSharpLight && st.kStraight == 0) {
     for (int k = 0; k < 4; ++k) sharpCorner(x[k], w[k], p.region[k], st);
     ++p.state.w;
   } else if (st.kStraight > 0) {
@@ -519,6 +564,8 @@ PatchStep moveStep(inout vec3 x[4], inout vec3 w[4], inout WavePatch p) {
     const float T = float(st.kStraight) * dt;
     for (int k = 0; k < 4; ++k) x[k] += T * vel[k];
     p.state.w += st.kStraight;
+    // Sharp: no boundary on the way (no Fresnel), the corners' attenuation over the path.
+    if (kSharpLight) st.attenuation = exp(-sigma1 * length(centreOf(x) - st.c0));
   } else {
     for (int k = 0; k < 4; ++k) rk4(x[k], w[k], dt);
     ++p.state.w;
@@ -573,8 +620,8 @@ vec3 splatStep(PatchStep st, vec3 x[4], vec3 w[4]) {
 // the reference keeps the side through splits, which differs only for a child whose centre
 // lies across the plane from its parent's).
 void probeStep(PatchStep st, inout vec4 probePos, inout vec3 probeDir) {
+  if (!hasOption(EIKON_WO_PROBE)) return;
   const int probeAxis = P.control.x;
-  if (probeAxis < 0) return;
   const float pp = P.probe.x;
   const bool before = st.c0[probeAxis] >= pp, after = st.c1[probeAxis] >= pp;
   if (before == after) return;
@@ -606,7 +653,7 @@ bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) 
   const int orient = kSharpLight && anyMirrored(p.region) ? -p.state.y : p.state.y;
   const bool torn = kSharpLight && straddles(p.region);
   if (!torn && ((o > 0.0 && orient < 0) || (o < 0.0 && orient > 0))) {
-    if (P.options.y == 0) {
+    if (!hasOption(EIKON_WO_PASS_CAUSTICS)) {
       p.state.x = EIKON_PATCH_CAUSTIC;
       return true;
     }
@@ -720,6 +767,7 @@ void scatter(uint id) {
 
 void main() {
   const uint id = gl_GlobalInvocationID.x, mode = pc.control.y;
+  P = params;
   gLambdaUm = P.wavelength.x;
   if (mode == EIKON_WM_PROPAGATE)
     propagate(id);

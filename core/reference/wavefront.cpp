@@ -199,7 +199,7 @@ class PatchStepper {
   void splatSegment(Chunk& ch, const glm::dvec3& c0, const glm::dvec3& u, double L, double E0,
                     double sigma, const glm::dvec3& dir, double ds1,
                     const glm::dvec3 diag[4]) const;
-  int straightSteps(const Patch& p, glm::dvec3 v[4]) const;
+  int straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1) const;
   // The stages of a step.
   PatchStep moveStep(Chunk& ch, Patch& p) const;
   glm::dvec4 attenuateStep(Chunk& ch, Patch& p, PatchStep& st) const;
@@ -493,9 +493,15 @@ void PatchStepper::splatSegment(Chunk& ch, const glm::dvec3& c0, const glm::dvec
 // solution there), stays within max_steps − steps and, when σ > 0, ends at the first step whose
 // flux is below the energy threshold; finally it is cut at the first step j at which single
 // steps would act: an edge longer than the split span (split), an orientation flip (caustic), the
-// centre leaving (after having been inside, or its ray missing the bounds).
-int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4]) const {
-  if (!s_.skip_empty || sharp_) return 0;
+// centre leaving (after having been inside, or its ray missing the bounds). Sharp interfaces
+// (docs/light-simulator.md, "Sharp interfaces"): also for a patch that is not torn and whose
+// region is not opaque, at its medium's velocities; sigma1 is then the step's attenuation per
+// unit of the centre's path (its corners' exp(−¼ Σ σ·length), as sharpCorner takes it).
+int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1) const {
+  if (!s_.skip_empty) return 0;
+  // Sharp interfaces: all four corners in one region on one side of every mirror (a torn patch
+  // takes single steps), moving at that medium's constant velocity.
+  if (sharp_ && (straddles(p) || mediumOf(p.region[0]).opaque)) return 0;
   const glm::dvec3 c0 = centre(p);
   double Dmin = f_.skipDistance(c0);
   if (Dmin < 2.0) return 0;
@@ -511,10 +517,16 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4]) const {
   const bool in0 = inside(c0, lo_, hi_);
   if (!in0 && (p.entered || !rayHitsBox(c0, wm / wl, lo_, hi_))) return 0;
   glm::dvec3 vc(0.0);
+  double absorb1 = 0.0;  // sharp: Σ σ·length of the corners over one time step
   for (int k = 0; k < 4; ++k) {
-    if (eMode_ && f_.axisField(p.x[size_t(k)]).w > 0.0) return 0;  // radial axis: a varies
-    glm::dvec3 dw;
-    deriv(p.x[size_t(k)], p.w[size_t(k)], v[k], dw);
+    if (sharp_) {
+      v[k] = mediumVelocity(p.region[0], p.w[size_t(k)]);
+      absorb1 += mediumSigma(p.region[0], p.w[size_t(k)]) * glm::length(v[k]) * dt_;
+    } else {
+      if (eMode_ && f_.axisField(p.x[size_t(k)]).w > 0.0) return 0;  // radial axis: a varies
+      glm::dvec3 dw;
+      deriv(p.x[size_t(k)], p.w[size_t(k)], v[k], dw);
+    }
     vc += 0.25 * v[k];
   }
   double kmax = double(s_.max_steps - p.steps);
@@ -526,17 +538,25 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4]) const {
   for (int k = 0; k < 4; ++k) capBy(D[k], v[k]);
   // Energy: a patch already below the threshold (a child of a split) is killed after its next
   // step; otherwise the first step at which exp(−σ·j·ds1) takes it below.
+  // Sharp interfaces: a single step's factor is exp(−¼ Σ σ·length) over the corners (sharpCorner),
+  // the same each step; sigma1 = −log of it per unit of the centre's path.
   const double ds1 = glm::length(vc) * dt_, thr = s_.min_energy_fraction * p.seed_energy;
+  sigma1 = 0.0;
   if (p.energy < thr) {
     kmax = std::min(kmax, 1.0);
   } else if (ds1 > 0) {
     const glm::dvec3 m = c0 + 0.5 * dt_ * vc;
-    const double sigma = eMode_ ? sigmaE(m, wm) : bandAt(glm::dvec3(f_.medium(m)));
+    const double sigma = sharp_   ? 0.25 * absorb1 / ds1
+                         : eMode_ ? sigmaE(m, wm)
+                                  : bandAt(glm::dvec3(f_.medium(m)));
     if (sigma > 0 && thr > 0)
       kmax = std::min(kmax, std::floor(std::log(p.energy / thr) / (sigma * ds1)) + 1.0);
   }
+  if (sharp_ && ds1 > 0) sigma1 = 0.25 * absorb1 / ds1;
   if (kmax < 1.0) return 0;
   const int K = int(kmax);
+  // A mirror reverses the orientation (endOfStep).
+  const int orientation = sharp_ && p.mirrored != 0u ? -p.orientation : p.orientation;
   bool entered = p.entered || in0;
   for (int j = 1; j <= K; ++j) {
     glm::dvec3 x[4];
@@ -545,7 +565,7 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4]) const {
     for (int k = 0; k < 4; ++k) e = std::max(e, glm::length(x[(k + 1) % 4] - x[k]));
     const double o = glm::dot(0.5 * glm::cross(x[2] - x[0], x[3] - x[1]), wm);
     const glm::dvec3 c = 0.25 * (x[0] + x[1] + x[2] + x[3]);
-    bool stop = e > maxEdge_ || (o > 0 && p.orientation < 0) || (o < 0 && p.orientation > 0);
+    bool stop = e > maxEdge_ || (o > 0 && orientation < 0) || (o < 0 && orientation > 0);
     if (inside(c, lo_, hi_))
       entered = true;
     else if (entered || !rayHitsBox(c, wm / wl, lo_, hi_))
@@ -618,8 +638,9 @@ PatchStep PatchStepper::moveStep(Chunk& ch, Patch& p) const {
   st.c0 = centre(p);
   st.wm0 = eMode_ ? meanW(p) : glm::dvec3(0.0);
   glm::dvec3 vel[4];
-  st.kStraight = straightSteps(p, vel);
-  if (sharp_) {
+  double sigma1 = 0.0;
+  st.kStraight = straightSteps(p, vel, sigma1);
+  if (sharp_ && st.kStraight == 0) {
     for (int k = 0; k < 4; ++k) sharpCorner(ch, p, k, dt_, st);
     ++p.steps;
   } else if (st.kStraight > 0) {
@@ -628,6 +649,8 @@ PatchStep PatchStepper::moveStep(Chunk& ch, Patch& p) const {
     st.diag[2] = p.x[3] - p.x[1], st.diag[3] = dt_ * (vel[3] - vel[1]);
     const double T = double(st.kStraight) * dt_;
     for (int k = 0; k < 4; ++k) p.x[size_t(k)] += T * vel[k];
+    // Sharp: no boundary on the way (no Fresnel), the corners' attenuation over the path.
+    if (sharp_) st.attenuation = std::exp(-sigma1 * glm::length(centre(p) - st.c0));
     p.steps += st.kStraight;
     ++ch.st.straight_steps;
     ch.st.straight_time_steps += size_t(st.kStraight);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <variant>
 #include <vector>
 
 #include "core/light/lighting.h"
@@ -202,12 +203,14 @@ struct GpuWavefront::Impl {
     for (const vk::BindingSpec& bs : boundaryBindings()) b.push_back(bs);
     boundary = sharp ? BoundaryDevice(ctx, vol.boundary, vol.media)
                      : BoundaryDevice(ctx, BoundaryField{}, MediaTable{});
-    // constant_id 0 (wavefront.comp kSharpLight): the sharp stages only where they apply, as the
-    // view renderer's kSharpMarch.
+    // The run's feature set as specialisation constants (wavefront.comp: kSharpLight, kWaveFlags,
+    // kWaveOptions), so that llvmpipe, which runs every branch under masks, compiles out what
+    // this run never does (docs/performance.md, "Light simulator"). The settings are fixed for
+    // the object's life, so its one pipeline is the one for its feature set.
     pipe = vk::ComputePipeline(
         ctx, std::span<const uint32_t>(k_wavefront_spv, sizeof(k_wavefront_spv) / 4), b,
         sizeof(gpu::WavePush), sharp ? "wavefront sharp" : "wavefront",
-        std::vector<uint32_t>{sharp ? 1u : 0u});
+        std::vector<uint32_t>{sharp ? 1u : 0u, uint32_t(featureFlags()), uint32_t(options())});
     boundary.bind(pipe);
     const size_t med = vol.dispersive ? 3 : 1;
     pipe.bindImage(EIKON_WB_INDEX_A, images[0]);
@@ -234,6 +237,26 @@ struct GpuWavefront::Impl {
         ctx, std::span<const uint32_t>(k_wavefront_count_spv, sizeof(k_wavefront_count_spv) / 4),
         cb, sizeof(gpu::WavePush), "wavefront count");
     countPipe.bindBuffer(EIKON_WB_PARAMS, params);
+  }
+
+  /// The EIKON_F_* flags of the run (wavefront.comp's kWaveFlags and WaveParams.grid_dims.w):
+  /// what the volume holds, EIKON_F_UNIAXIAL for an e-mode run in a uniaxial volume, and
+  /// EIKON_F_CONVEX when the sharp path's boundary has a convex polyhedron (its plane loops).
+  int featureFlags() const {
+    int flags = 0;
+    if (vol.dispersive) flags |= EIKON_F_DISPERSIVE;
+    if (vol.attenuating) flags |= EIKON_F_ATTENUATION;
+    if (vol.opaque) flags |= EIKON_F_OPACITY;
+    if (eMode) flags |= EIKON_F_UNIAXIAL;
+    if (sharp)
+      for (const Shape& shape : vol.boundary.shapes)
+        if (std::holds_alternative<ConvexShape>(shape.geometry())) flags |= EIKON_F_CONVEX;
+    return flags;
+  }
+  /// wavefront.comp's kWaveOptions: bit 0 straight steps, bit 1 pass caustics, bit 2 probe plane.
+  int options() const {
+    return (s.skip_empty ? 1 : 0) | (s.pass_caustics ? 2 : 0) |
+           (s.probe_axis >= 0 && s.probe_axis < 3 ? 4 : 0);
   }
 
   // Patch list `which` (0: EIKON_WB_PATCHES, 1: _B) holds at least n patches. Only called between
@@ -349,11 +372,7 @@ struct GpuWavefront::Impl {
     gpu::WaveParams P{};
     P.grid_origin = glm::vec4(glm::vec3(g.origin), float(g.h));
     P.grid_max = glm::vec4(glm::vec3(g.boundsMax()), float(1.0 / g.h));
-    int flags = 0;
-    if (vol.dispersive) flags |= EIKON_F_DISPERSIVE;
-    if (vol.attenuating) flags |= EIKON_F_ATTENUATION;
-    if (vol.opaque) flags |= EIKON_F_OPACITY;
-    P.grid_dims = glm::ivec4(g.dims[0], g.dims[1], g.dims[2], flags);
+    P.grid_dims = glm::ivec4(g.dims[0], g.dims[1], g.dims[2], featureFlags());
     P.step = glm::vec4(float(s.dt), float(s.split_span_voxels * g.h), float(s.min_energy_fraction),
                        float(1.0 / h3));
     const double l = s.wavelength_nm * 1e-3;

@@ -39,9 +39,11 @@ RenderSettings defaultRenderSettings(const Scene& scene);
 LightingOptions defaultLightingOptions();
 
 /// Whether the light is simulated by the CPU twin: device "cpu", or "auto" when there is no GPU
-/// context or its Vulkan device is a CPU (lavapipe, where the threaded double-precision twin is
-/// several times faster; docs/light-simulator.md). "gpu" uses the GPU twin. Throws
-/// std::invalid_argument for any other device name.
+/// context or its Vulkan device is a CPU (lavapipe, where light_bench measures the threaded
+/// double-precision twin faster than the GPU twin at every size and kind of interface once the
+/// GPU twin's pipeline compilation is counted, and within 5% of it without; docs/performance.md,
+/// "Light simulator"). "gpu" uses the GPU twin. Throws std::invalid_argument for any other
+/// device name.
 bool lightOnCpu(const std::string& device, const vk::Context* ctx);
 
 }  // namespace eikon

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "core/reference/wavefront.h"
 #include "core/scene/scene.h"
@@ -60,6 +61,13 @@ inline const char* kSharpSlabScene = R"({
   "objects": [{"shape": "box", "center": [0, 0, 0], "size": [60, 60, 1], "material": "glass"}],
   "materials": {"glass": {"n": 1.5}}
 })";
+
+/// kSharpSlabScene at `resolution` voxels along x (its "RES" replaced).
+inline std::string sharpSlabScene(const char* resolution) {
+  std::string json = kSharpSlabScene;
+  json.replace(json.find("RES"), 3, resolution);
+  return json;
+}
 
 inline const char* kSharpRightPrismScene = R"({
   "camera": {"width": 8, "height": 8},

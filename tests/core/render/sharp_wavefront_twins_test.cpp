@@ -94,9 +94,7 @@ double angleBetween(glm::dvec3 a, glm::dvec3 b) {
 // steps of ≥ dt/n = h/3, N ≤ 11.5/(h/3) steps; so |δx| ≤ N·ulp(X) + 11.5 mm·1e-6 rad.
 TEST(SharpWavefrontTwins, SlabDisplacementFrom0To80Degrees) {
   for (const char* res : {"64", "128"}) {
-    std::string json = kSharpSlabScene;
-    json.replace(json.find("RES"), 3, res);
-    const Scene scene = sceneFromJson(json);
+    const Scene scene = sceneFromJson(sharpSlabScene(res));
     const VolumeSet vol = voxelize(scene);
     const double n = 1.5, t = 1.0, zIn = -0.5, zProbe = 1.0, h = vol.grid.h;
     const double N = 11.5 / (h / 3.0), posTol = N * ulp32(6.5) + 11.5 * 1e-6;
