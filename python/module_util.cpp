@@ -58,6 +58,7 @@ void rethrowSetting(const SettingError& e) {
                                                              {"light-split", "split_voxels"},
                                                              {"max-patches", "max_patches"},
                                                              {"wavelength", "wavelength_nm"},
+                                                             {"spectral-sampling", "sampling"},
                                                              {"dir", "direction"}};
   auto it = keyword.find(e.setting());
   throw std::invalid_argument((it == keyword.end() ? e.setting() : it->second) + " " +

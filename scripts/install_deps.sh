@@ -10,6 +10,7 @@ PKGS=(
   googletest libgtest-dev libbenchmark-dev universal-ctags clang-format
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-scipy python3-matplotlib
   jupyter-nbconvert python3-nbformat python3-ipykernel
+  openimageio-tools
 )
 missing=()
 for p in "${PKGS[@]}"; do
