@@ -80,8 +80,7 @@ void encodeExr(const std::filesystem::path& file, int width, int height,
                const std::vector<std::pair<std::string, std::string>>& attributes = {}) {
   Imf::Header header(width, height);
   header.compression() = Imf::ZIP_COMPRESSION;
-  for (const auto& [name, value] : attributes)
-    header.insert(name, Imf::StringAttribute(value));
+  for (const auto& [name, value] : attributes) header.insert(name, Imf::StringAttribute(value));
   for (const auto& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
   Imf::FrameBuffer fb;
   for (const auto& c : channels)
@@ -175,14 +174,15 @@ FileContent exrLayersContent(int width, int height, const std::vector<float>& rg
   if (!modes.empty())
     for (const char* m : {"o.", "e."})
       for (const char* c : {"R", "G", "B"}) names.push_back(std::string(m) + c);
-  auto planes = std::make_shared<std::vector<std::vector<float>>>(names.size(),
-                                                                  std::vector<float>(n));
+  auto planes =
+      std::make_shared<std::vector<std::vector<float>>>(names.size(), std::vector<float>(n));
   for (size_t i = 0; i < n; ++i) {
     for (size_t c = 0; c < 3; ++c) (*planes)[c][i] = rgb[3 * i + c];
     for (size_t k = 0; k < size_t(std::max(bins, 0)); ++k)
       (*planes)[3 + k][i] = spectral[i * size_t(bins) + k];
     if (!modes.empty())
-      for (size_t c = 0; c < 6; ++c) (*planes)[3 + size_t(std::max(bins, 0)) + c][i] = modes[6 * i + c];
+      for (size_t c = 0; c < 6; ++c)
+        (*planes)[3 + size_t(std::max(bins, 0)) + c][i] = modes[6 * i + c];
   }
   std::vector<std::pair<std::string, std::string>> attributes;
   if (bins > 0) {

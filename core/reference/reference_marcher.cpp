@@ -59,7 +59,6 @@ struct HeroRecord {
   std::array<glm::dvec4, kMax> entries{};
 };
 
-
 // ------------------------------------------------------------------ ReferenceMarcher
 namespace {
 
@@ -827,9 +826,8 @@ TraceOutcome ReferenceMarcher::trace(const TraceRequest& ray, const MarchSetting
   return t;
 }
 
-glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d,
-                                           uint32_t pixel, uint32_t sample,
-                                           const RenderSettings& s, double& steps,
+glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
+                                           uint32_t sample, const RenderSettings& s, double& steps,
                                            double& fetches, LayerSums* layers) const {
   // view.comp's hero branch: one march (per mode) at λ_0, its lookups before the path's first
   // dispersive event recorded for all N wavelengths, the rest the hero's alone, counted N times.

@@ -46,7 +46,7 @@ class AnalyticField : public Field {
 };
 
 struct HeroRecord;  // hero wavelength sampling's record of one pixel sample (the .cpp)
-class LayerSums;   // core/volume/render_layers.h
+class LayerSums;    // core/volume/render_layers.h
 
 class ReferenceMarcher {
  public:
@@ -64,8 +64,8 @@ class ReferenceMarcher {
   /// CIE XYZ (unnormalised, as Σ L·sampleWeightXyz) of one pixel sample by hero wavelength
   /// sampling (docs/spectra.md); adds its steps and field reads, and its bins to `layers`.
   glm::dvec3 heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
-                           uint32_t sample, const RenderSettings& s, double& steps,
-                           double& fetches, LayerSums* layers) const;
+                           uint32_t sample, const RenderSettings& s, double& steps, double& fetches,
+                           LayerSums* layers) const;
   const Field& field_;
   const Environment& env_;
 };

@@ -321,9 +321,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   // channel values per mode (view.comp layerWrite); the pass's bins are added on the host.
   LayerSums layers(s, size_t(img.width) * size_t(img.height), I.uniaxial);
   const int layerBits = layers.active() ? (2 | (layers.modes() == 2 ? 4 : 0)) : 0;
-  const size_t stride = layers.active()
-                            ? size_t((layers.channels() * layers.modes() + 3) / 4)
-                            : 0;
+  const size_t stride = layers.active() ? size_t((layers.channels() * layers.modes() + 3) / 4) : 0;
   const double rowWork = double(img.width) * perPass;
   int max_rows = std::clamp(int(std::ceil(2.0e5 / std::max(rowWork, 1.0))), EIKON_WG_Y, img.height);
   max_rows = (max_rows + EIKON_WG_Y - 1) / EIKON_WG_Y * EIKON_WG_Y;

@@ -1,7 +1,6 @@
 #include "core/session/session.h"
 
 #include <algorithm>
-
 #include <cmath>
 
 #include "core/light/light_cache.h"

@@ -86,9 +86,7 @@ class VolumeField : public Field {
   glm::dvec4 lightFluence(const glm::dvec3& x) const override;
   glm::dvec3 lightFlux(const glm::dvec3& x) const override;
   bool lit() const override { return v_.lit(); }
-  bool weightsDependOnLambda() const override {
-    return v_.attenuating || v_.emissive || v_.opaque;
-  }
+  bool weightsDependOnLambda() const override { return v_.attenuating || v_.emissive || v_.opaque; }
   const BoundaryField* boundary() const override {
     return v_.boundary.empty() || v_.media.empty() ? nullptr : &v_.boundary;
   }

@@ -60,8 +60,8 @@ void LayerSums::finish(RenderImage& img, int spp) const {
       // From the float channels as written, so that integrating the file reproduces it.
       glm::dvec3 xyz(0.0);
       for (int k = 0; k < channels_; ++k)
-        xyz += double(spectral[p * std::size_t(channels_) + std::size_t(k)]) *
-               binCmf[std::size_t(k)];
+        xyz +=
+            double(spectral[p * std::size_t(channels_) + std::size_t(k)]) * binCmf[std::size_t(k)];
       total = M * xyz;
       for (int c = 0; c < 3; ++c) img.rgb[p * 3 + std::size_t(c)] = float(total[c]);
     }

@@ -3,10 +3,10 @@
 //
 // Each pixel sample delivers, per mode kept apart, one value per channel: in spectral mode the
 // radiance found at the sample's wavelength in bin k (every one of the N stratified or hero
-// wavelengths lies in its own bin [380 + k·400/N, 380 + (k + 1)·400/N) nm; the hero's radiance after
-// its path dispersed counts N times in the hero's bin), in RGB mode the mode's radiance triplet.
-// finish() divides by the sample count: a spectral channel is then an unbiased estimate of the
-// bin's mean spectral radiance S_k, and the RGB written with the layers is
+// wavelengths lies in its own bin [380 + k·400/N, 380 + (k + 1)·400/N) nm; the hero's radiance
+// after its path dispersed counts N times in the hero's bin), in RGB mode the mode's radiance
+// triplet. finish() divides by the sample count: a spectral channel is then an unbiased estimate of
+// the bin's mean spectral radiance S_k, and the RGB written with the layers is
 //     rgb = M · Σ_k S_k · ∫_bin k cmf(λ) dλ        (M = spectralToLinearSrgbMatrix())
 // so that integrating the written channels with the CIE 1931 functions, bin by bin, gives the RGB
 // exactly (float rounding only). The price: within a bin the product S·cmf is replaced by
