@@ -208,9 +208,12 @@ class RayMarch {
     const MediumRecord& m = rec(region);
     if (hero_ && m.grin_type == 0) {  // shaders/sharp.glsl mediumIndex: anything but a constant
       const MediumDispersion& d = mode == 1 ? m.n_e : m.n_o;
-      if (d.kind != MediumDispersion::Kind::Constant &&
-          !(d.kind == MediumDispersion::Kind::Cauchy && d.terms <= 1))
-        hero_->diverged = true;
+      bool dispersive =
+          d.kind != MediumDispersion::Kind::Constant && d.kind != MediumDispersion::Kind::Cauchy;
+      for (int k = 1; k < std::min(d.terms, 6); ++k)  // Cauchy: any λ term
+        dispersive =
+            dispersive || (d.kind == MediumDispersion::Kind::Cauchy && d.coeff[size_t(k)] != 0.0);
+      if (dispersive) hero_->diverged = true;
     }
     return mediumIndexAt(m, mode, lambda_nm_, x, grad);
   }
