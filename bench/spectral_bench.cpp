@@ -49,6 +49,35 @@ double colourError(const RenderImage& img, const RenderImage& ref, const std::ve
   return std::sqrt(s2 / double(std::max<size_t>(mask.size(), 1))) / lumMean;
 }
 
+// Section 0: how well the Cauchy fields carry each library material.
+void printCauchyFits(const std::filesystem::path& src) {
+  // How well the Cauchy fields carry each library material (least-squares A + B/λ² + C/λ⁴ over
+  //    380–780 nm, 1 nm samples): max |n_fit − n| and the Abbe number of the fit vs the model.
+  std::printf(
+      "0. Cauchy fit of the library materials over 380-780 nm (what the renderer carries)\n"
+      "   material          index   model          max|dn|   rms|dn|   V_d model  V_d fit\n");
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(src / "materials"))
+    files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) {
+    Material m = loadMaterialFile(f);
+    for (int k = 0; k < (m.uniaxial ? 2 : 1); ++k) {
+      const Dispersion& d = k ? m.n_e : m.n_o;
+      auto fit = d.cauchyApproximation(380.0, 780.0);
+      auto n = [&](double nm) {
+        double il2 = 1e6 / (nm * nm);
+        return fit.coeffs[0] + fit.coeffs[1] * il2 + fit.coeffs[2] * il2 * il2;
+      };
+      double vFit = (n(587.5618) - 1) / (n(486.1327) - n(656.2725));
+      std::printf("   %-16s  %-5s  %-13.13s  %9.2e %9.2e  %9.2f  %7.2f\n", m.name.c_str(),
+                  m.uniaxial ? (k ? "n_e" : "n_o") : "n", d.describe().c_str(), fit.max_error,
+                  fit.rms_error, d.abbeNumber(), vFit);
+    }
+  }
+  std::printf("\n");
+}
+
 // Section 4: hero wavelength sampling against stratified sampling and RGB on the brilliant.
 int heroSection(vk::Context& ctx, int W, int H, int res, int timeSpp, int refSpp, int eW, int eH) {
   const std::filesystem::path src(EIKON_SOURCE_DIR);
@@ -139,31 +168,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (onlyHero) return heroSection(*vk::Context::create(), dW, dH, dRes, timeSpp, refSpp, eW, eH);
   const std::filesystem::path src(EIKON_SOURCE_DIR);
-  // 0. How well the Cauchy fields carry each library material (least-squares A + B/λ² + C/λ⁴ over
-  //    380–780 nm, 1 nm samples): max |n_fit − n| and the Abbe number of the fit vs the model.
-  std::printf(
-      "0. Cauchy fit of the library materials over 380-780 nm (what the renderer carries)\n"
-      "   material          index   model          max|dn|   rms|dn|   V_d model  V_d fit\n");
-  std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(src / "materials"))
-    files.push_back(e.path());
-  std::sort(files.begin(), files.end());
-  for (const auto& f : files) {
-    Material m = loadMaterialFile(f);
-    for (int k = 0; k < (m.uniaxial ? 2 : 1); ++k) {
-      const Dispersion& d = k ? m.n_e : m.n_o;
-      auto fit = d.cauchyApproximation(380.0, 780.0);
-      auto n = [&](double nm) {
-        double il2 = 1e6 / (nm * nm);
-        return fit.coeffs[0] + fit.coeffs[1] * il2 + fit.coeffs[2] * il2 * il2;
-      };
-      double vFit = (n(587.5618) - 1) / (n(486.1327) - n(656.2725));
-      std::printf("   %-16s  %-5s  %-13.13s  %9.2e %9.2e  %9.2f  %7.2f\n", m.name.c_str(),
-                  m.uniaxial ? (k ? "n_e" : "n_o") : "n", d.describe().c_str(), fit.max_error,
-                  fit.rms_error, d.abbeNumber(), vFit);
-    }
-  }
-  std::printf("\n");
+  printCauchyFits(src);
 
   Scene scene = loadScene(src / "scenes/prism_bk7.json");
   auto ctx = vk::Context::create();
