@@ -24,7 +24,7 @@ struct RenderArgs {
   std::string scene, output;
   int width = 0, height = 0, spp = 1, wavelengths = -1, threads = 0;
   double step = kDefaultRenderStepVoxels, exposure = 0.0;
-  std::string integrator = "rk4", progress = "auto";
+  std::string integrator = "rk4", progress = "auto", spectral_sampling = "auto", layers;
   bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
   // Light simulator (scenes with "lights").
   int light_bands = 0, max_patches = 1 << 20;
@@ -63,6 +63,14 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
   sub->add_option("--wavelengths", a.wavelengths,
                   "Spectral samples per pixel sample in [1, 256], or 0 for RGB mode (default: 16 "
                   "for dispersive scenes, else 0)");
+  sub->add_option("--spectral-sampling", a.spectral_sampling,
+                  "Spectral renders: hero (one march per pixel sample, the other wavelengths "
+                  "share its path until it disperses), stratified (one march per wavelength) or "
+                  "auto (hero unless the scene attenuates, emits or has opaque objects; default)");
+  sub->add_option("--layers", a.layers,
+                  "Extra EXR layers, comma-separated: spectral (one S0.<nm> channel per "
+                  "wavelength bin; needs --wavelengths > 0) and modes (o.R..B, e.R..B: the o- and "
+                  "e-mode radiance); R, G, B are always written");
   sub->add_option("--step", a.step,
                   "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4)");
@@ -123,6 +131,8 @@ ViewRequest viewRequest(const RenderArgs& a, const CLI::App& sub) {
   ms.skip_empty = !a.no_skip;
   ms.fresnel = !a.no_fresnel;
   v.march = ms;
+  v.sampling = parseSpectralSampling(a.spectral_sampling);
+  parseLayers(a.layers, v);
   return v;
 }
 
@@ -257,7 +267,10 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   // and a concurrent render to the same -o cannot interleave its pair with this one. The
   // preview first: it is the smaller, so a full disk is usually met before the EXR is encoded.
   writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)},
-                      {out, exrRgbContent(img.width, img.height, img.rgb)}});
+                      {out, rs.spectral_layer || rs.mode_layers
+                                ? exrLayersContent(img.width, img.height, img.rgb, img.bins,
+                                                   img.spectral, img.modes)
+                                : exrRgbContent(img.width, img.height, img.rgb)}});
   preview.finished = true;
   timings::mark("written");
   printSummary(a, session, light, rs, img, out, png);

@@ -5,8 +5,14 @@
 //  3. eikon vs POV-Ray 3.7 (bench/povray/prism_bk7.pov, dispersion_samples 16) at the same
 //     resolution, skipped with a message when `povray` is not on PATH (CI does not install it).
 //
+//  4. hero wavelength sampling on scenes/diamond_brilliant.json: the march time of a 16-wavelength
+//     hero render and of a 16-wavelength stratified render against the RGB render (same size and
+//     spp), and (at --error-width x --error-height) the colour error of both methods against N and
+//     spp, against a converged stratified reference (N = 32, --reference-spp samples).
+//
 //   spectral_bench [WIDTH HEIGHT]     # default 800 600 (the scene camera); lavapipe on few cores
 //                                     # needs minutes there: pass e.g. 160 120 and say so.
+//   spectral_bench --only-hero --diamond-size 200 150 --diamond-resolution 128 --reference-spp 32
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -15,6 +21,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/render/view_renderer.h"
@@ -29,19 +36,22 @@ double seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
-}  // namespace
 
-int main(int argc, char** argv) {
-  int W = 800, H = 600;
-  CLI::App app{
-      "Spectral rendering cost and accuracy on scenes/prism_bk7.json (and POV-Ray when on PATH)",
-      "spectral_bench"};
-  app.add_option("width", W, "Image width (default 800, the scene camera's)")
-      ->check(CLI::Range(1, 16384));
-  app.add_option("height", H, "Image height (default 600)")->check(CLI::Range(1, 16384));
-  CLI11_PARSE(app, argc, argv);
-  const std::filesystem::path src(EIKON_SOURCE_DIR);
-  // 0. How well the Cauchy fields carry each library material (least-squares A + B/λ² + C/λ⁴ over
+// RMS |ΔRGB| over the pixels of `mask`, relative to their mean reference luminance.
+double colourError(const RenderImage& img, const RenderImage& ref, const std::vector<size_t>& mask,
+                   double lumMean) {
+  double s2 = 0.0;
+  for (size_t i : mask)
+    for (int c = 0; c < 3; ++c) {
+      const double d = double(img.rgb[3 * i + c]) - ref.rgb[3 * i + c];
+      s2 += d * d;
+    }
+  return std::sqrt(s2 / double(std::max<size_t>(mask.size(), 1))) / lumMean;
+}
+
+// Section 0: how well the Cauchy fields carry each library material.
+void printCauchyFits(const std::filesystem::path& src) {
+  // How well the Cauchy fields carry each library material (least-squares A + B/λ² + C/λ⁴ over
   //    380–780 nm, 1 nm samples): max |n_fit − n| and the Abbe number of the fit vs the model.
   std::printf(
       "0. Cauchy fit of the library materials over 380-780 nm (what the renderer carries)\n"
@@ -66,6 +76,99 @@ int main(int argc, char** argv) {
     }
   }
   std::printf("\n");
+}
+
+// Section 4: hero wavelength sampling against stratified sampling and RGB on the brilliant.
+int heroSection(vk::Context& ctx, int W, int H, int res, int timeSpp, int refSpp, int eW, int eH) {
+  const std::filesystem::path src(EIKON_SOURCE_DIR);
+  Scene scene = loadScene(src / "scenes/diamond_brilliant.json");
+  scene.volume.resolution = res;
+  checkVolumeFits(ctx, makeGrid(scene.volume), scene);
+  const VolumeSet vol = voxelize(scene);
+  ViewRenderer renderer(ctx, scene, vol);
+  auto render = [&](int n, int spp, SpectralSampling sampling, bool small = false) {
+    RenderSettings rs;
+    rs.width = small ? eW : W;
+    rs.height = small ? eH : H;
+    rs.spp = spp;
+    rs.wavelengths = n;
+    rs.sampling = sampling;
+    return renderer.render(rs);
+  };
+  // Warm-up: each pipeline (RGB, spectral) is compiled on its first render.
+  render(0, 1, SpectralSampling::Auto);
+  render(16, 1, SpectralSampling::Hero);
+  std::printf(
+      "\n4. Hero wavelength sampling: scenes/diamond_brilliant.json, %dx%d, %d^3, on %s\n"
+      "   march time, %d spp          seconds   ratio to RGB   cut samples\n",
+      W, H, res, ctx.deviceName().c_str(), timeSpp);
+  const RenderImage rgb = render(0, timeSpp, SpectralSampling::Auto);
+  const RenderImage hero = render(16, timeSpp, SpectralSampling::Hero);
+  const RenderImage strat = render(16, timeSpp, SpectralSampling::Stratified);
+  for (const auto& [name, img] : {std::pair<const char*, const RenderImage*>{"RGB", &rgb},
+                                  {"16 wavelengths, hero", &hero},
+                                  {"16 wavelengths, stratified", &strat}})
+    std::printf("   %-27s %8.3f   %12.2f   %lld\n", name, img->seconds, img->seconds / rgb.seconds,
+                img->cut_samples);
+
+  // The error study at eW x eH: the reference is stratified with N = 32 (other wavelengths than
+  // any N = 16 render's, the same camera jitter as all of them).
+  const RenderImage ref = render(32, refSpp, SpectralSampling::Stratified, true);
+  std::vector<size_t> mask;
+  double lumSum = 0.0;
+  for (size_t i = 0; i < size_t(eW) * eH; ++i)
+    if (luminance(&ref.rgb[3 * i]) > 0.02) {
+      mask.push_back(i);
+      lumSum += luminance(&ref.rgb[3 * i]);
+    }
+  const double lumMean = lumSum / double(std::max<size_t>(mask.size(), 1));
+  std::printf(
+      "   colour error (RMS |dRGB| / mean luminance) at %dx%d vs the reference (stratified, N = "
+      "32, "
+      "%d spp, %.1f s; %zu pixels of luminance > 0.02, mean %.3f); time in s\n"
+      "   N   spp   hero error   time   stratified error   time\n",
+      eW, eH, refSpp, ref.seconds, mask.size(), lumMean);
+  for (int n : {4, 16})
+    for (int spp : {1, 4, 16}) {
+      const RenderImage h = render(n, spp, SpectralSampling::Hero, true);
+      const RenderImage st = render(n, spp, SpectralSampling::Stratified, true);
+      std::printf("  %3d  %4d  %10.4f  %6.2f  %17.4f  %6.2f\n", n, spp,
+                  colourError(h, ref, mask, lumMean), h.seconds,
+                  colourError(st, ref, mask, lumMean), st.seconds);
+    }
+  return 0;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  int W = 800, H = 600;
+  CLI::App app{
+      "Spectral rendering cost and accuracy on scenes/prism_bk7.json (and POV-Ray when on PATH)",
+      "spectral_bench"};
+  app.add_option("width", W, "Image width (default 800, the scene camera's)")
+      ->check(CLI::Range(1, 16384));
+  app.add_option("height", H, "Image height (default 600)")->check(CLI::Range(1, 16384));
+  int dW = 200, dH = 150, dRes = 128, refSpp = 32, timeSpp = 4, eW = 64, eH = 48;
+  bool onlyHero = false;
+  app.add_option("--diamond-width", dW, "Section 4 image width (default 200)")
+      ->check(CLI::Range(8, 4096));
+  app.add_option("--diamond-height", dH, "Section 4 image height (default 150)")
+      ->check(CLI::Range(8, 4096));
+  app.add_option("--diamond-resolution", dRes, "Section 4 volume resolution (default 128)")
+      ->check(CLI::Range(16, 512));
+  app.add_option("--reference-spp", refSpp, "Section 4 reference samples per pixel (default 32)")
+      ->check(CLI::Range(1, 4096));
+  app.add_option("--time-spp", timeSpp, "Section 4 samples per pixel of the timed renders (4)")
+      ->check(CLI::Range(1, 4096));
+  app.add_option("--error-width", eW, "Section 4 error study width (default 64)")
+      ->check(CLI::Range(8, 4096));
+  app.add_option("--error-height", eH, "Section 4 error study height (default 48)")
+      ->check(CLI::Range(8, 4096));
+  app.add_flag("--only-hero", onlyHero, "Run section 4 only");
+  CLI11_PARSE(app, argc, argv);
+  if (onlyHero) return heroSection(*vk::Context::create(), dW, dH, dRes, timeSpp, refSpp, eW, eH);
+  const std::filesystem::path src(EIKON_SOURCE_DIR);
+  printCauchyFits(src);
 
   Scene scene = loadScene(src / "scenes/prism_bk7.json");
   auto ctx = vk::Context::create();
@@ -86,6 +189,7 @@ int main(int argc, char** argv) {
     rs.width = W;
     rs.height = H;
     rs.wavelengths = n;
+    rs.sampling = SpectralSampling::Stratified;  // sections 1-2 as before hero sampling; see 4
     return renderer.render(rs);
   };
   render(1);  // warm-up: the first render pays pipeline creation / shader JIT (13 s at 160x120 on
@@ -133,6 +237,8 @@ int main(int argc, char** argv) {
     std::printf("  %3d  %14.4f  %16.4f\n", ns[k], std::sqrt(s2 / double(mask.size())) / lumMean,
                 s1 / double(mask.size()) / lumMean);
   }
+
+  if (int rc = heroSection(*ctx, dW, dH, dRes, timeSpp, refSpp, eW, eH); rc != 0) return rc;
 
   std::printf("\n3. eikon vs POV-Ray 3.7 (same view, %dx%d, 1 sample per pixel, 16 wavelengths)\n",
               W, H);

@@ -105,10 +105,34 @@ py::dict grid(Prepared& p) {
 // first render (unless simulate_light() already did), by the twin the session picks (the CPU
 // reference for CPU renders, as --reference), through the CLI's light cache when `light_cache`
 // names one.
-py::array_t<float> render(Prepared& p, int width, int height, int spp,
-                          std::optional<int> wavelengths, double wavelength_nm,
-                          std::optional<MarchSettings> march, const std::string& device,
-                          int threads, bool light, const py::object& light_cache) {
+// The render with its layers (`layers` as `eikon render --layers`): a dict of numpy arrays.
+py::dict layerArrays(const RenderImage& img) {
+  py::dict d;
+  d["rgb"] = imageArray(img);
+  if (img.bins > 0) {
+    py::array_t<float> sp({py::ssize_t(img.height), py::ssize_t(img.width), py::ssize_t(img.bins)});
+    std::copy(img.spectral.begin(), img.spectral.end(), sp.mutable_data());
+    d["spectral"] = sp;
+    py::array_t<double> centres(py::ssize_t(img.bins));
+    for (int k = 0; k < img.bins; ++k)
+      centres.mutable_data()[k] = 380.0 + (k + 0.5) * 400.0 / img.bins;
+    d["wavelengths_nm"] = centres;
+  }
+  if (!img.modes.empty()) {
+    for (int m = 0; m < 2; ++m) {
+      py::array_t<float> a({py::ssize_t(img.height), py::ssize_t(img.width), py::ssize_t(3)});
+      for (size_t i = 0; i < size_t(img.width) * size_t(img.height); ++i)
+        for (size_t c = 0; c < 3; ++c) a.mutable_data()[3 * i + c] = img.modes[6 * i + 3 * m + c];
+      d[m == 0 ? "o" : "e"] = a;
+    }
+  }
+  return d;
+}
+
+py::object render(Prepared& p, int width, int height, int spp, std::optional<int> wavelengths,
+                  double wavelength_nm, std::optional<MarchSettings> march,
+                  const std::string& device, int threads, bool light, const py::object& light_cache,
+                  const std::string& sampling, const std::string& layers) {
   const bool gpu = isGpu(device);
   ViewRequest view;  // the CLI's defaults (core/session/session.h), then what the caller chose
   if (width != 0) view.width = width;
@@ -117,8 +141,13 @@ py::array_t<float> render(Prepared& p, int width, int height, int spp,
   view.wavelengths = wavelengths;
   view.wavelength_nm = wavelength_nm;
   view.march = march;
-  checkSetting([&] { checkViewRequest(view); });
-  const RenderSettings settings = renderSettings(*p.scene, view);
+  checkSetting([&] {
+    checkViewRequest(view);
+    view.sampling = parseSpectralSampling(sampling);
+    parseLayers(layers, view);
+  });
+  RenderSettings settings;
+  checkSetting([&] { settings = renderSettings(*p.scene, view); });
   const std::string cache_dir = light ? lightCacheDir(light_cache) : std::string();
   const RenderImage img = p.run([&](Session& s) {
     s.setThreads(threads);
@@ -129,6 +158,7 @@ py::array_t<float> render(Prepared& p, int width, int height, int spp,
     }
     return s.render(settings, gpu);
   });
+  if (settings.spectral_layer || settings.mode_layers) return layerArrays(img);
   return imageArray(img);
 }
 
@@ -342,7 +372,8 @@ void bindRenderer(py::module_& m) {
       .def("render", &render, py::arg("width") = 0, py::arg("height") = 0, py::arg("spp") = 1,
            py::arg("wavelengths") = py::none(), py::arg("wavelength_nm") = 587.5618,
            py::arg("march") = py::none(), py::arg("device") = "gpu", py::arg("threads") = 0,
-           py::arg("light") = true, py::arg("light_cache") = true,
+           py::arg("light") = true, py::arg("light_cache") = true, py::arg("sampling") = "auto",
+           py::arg("layers") = "",
            "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: wavelengths=None "
            "is 16 for a "
            "dispersive scene, else 0 (RGB; > 0 = spectral with that many samples); march=None is "
@@ -352,7 +383,9 @@ void bindRenderer(py::module_& m) {
            "did), on the twin the CLI picks, through the CLI's light cache (light_cache=True: the "
            "default "
            "folder, a path: that folder, False: none); light=False leaves an unsimulated scene "
-           "unlit (--no-light)")
+           "unlit (--no-light); sampling='auto'|'hero'|'stratified' (--spectral-sampling); "
+           "layers='spectral,modes' (--layers) returns a dict: rgb, spectral (H, W, N bins) with "
+           "wavelengths_nm (the bin centres), o and e (H, W, 3 each)")
       .def(
           "simulate_light", &simulateLight, py::arg("bands") = 0, py::arg("splat") = "accumulate",
           py::arg("step_voxels") = 0.5, py::arg("smoothing_voxels") = 1.0,

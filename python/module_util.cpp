@@ -50,15 +50,12 @@ std::string integratorName(Integrator i) {
 }
 // Python's keyword for each setting the session checks (its SettingError::setting()).
 void rethrowSetting(const SettingError& e) {
-  static const std::map<std::string, std::string> keyword = {{"step", "march.step_voxels"},
-                                                             {"light-bands", "bands"},
-                                                             {"light-splat", "splat"},
-                                                             {"light-step", "step_voxels"},
-                                                             {"light-device", "device"},
-                                                             {"light-split", "split_voxels"},
-                                                             {"max-patches", "max_patches"},
-                                                             {"wavelength", "wavelength_nm"},
-                                                             {"dir", "direction"}};
+  static const std::map<std::string, std::string> keyword = {
+      {"step", "march.step_voxels"},     {"light-bands", "bands"},
+      {"light-splat", "splat"},          {"light-step", "step_voxels"},
+      {"light-device", "device"},        {"light-split", "split_voxels"},
+      {"max-patches", "max_patches"},    {"wavelength", "wavelength_nm"},
+      {"spectral-sampling", "sampling"}, {"dir", "direction"}};
   auto it = keyword.find(e.setting());
   throw std::invalid_argument((it == keyword.end() ? e.setting() : it->second) + " " +
                               e.complaint());

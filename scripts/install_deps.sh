@@ -11,6 +11,7 @@ PKGS=(
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-scipy python3-matplotlib
   jupyter-nbconvert python3-nbformat python3-ipykernel
   libglfw3-dev xvfb xdotool
+  openimageio-tools
 )
 missing=()
 for p in "${PKGS[@]}"; do

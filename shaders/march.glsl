@@ -60,9 +60,18 @@ void setWavelength(float lambda_um, bool scalar) {
 // as (direction, weight). If none did, and nothing else depends on λ (no attenuation, emission,
 // opacity or crystal), the path and every weight are the same at all wavelengths: the others are
 // Σ weight·S_env(λ, direction), without marching.
+//
+// Hero wavelength sampling (view.comp, docs/spectra.md) uses the same record differently: while
+// gHero is set and the hero's path has met nothing dispersive (gDispersiveHit false), every
+// environment lookup is recorded as (linear sRGB radiance, weight × gRecordWeight) and left out of
+// the march's radiance — view.comp evaluates it at all N wavelengths, which share the path up to
+// there. From the path's first dispersive event on (or a 7th lookup, which the record cannot hold:
+// the cut depends on the path alone, not on λ) lookups are the hero's alone.
 bool gDispersiveHit = false;
 bool gRecord = false;
 bool gRecordOverflow = false;
+bool gHero = false;
+float gRecordWeight = 1.0;
 int gNumRecorded = 0;
 vec4 gRecorded[6];
 
@@ -116,9 +125,18 @@ vec3 colourOf(vec3 rgb) { return gScalar ? vec3(rgbToSpectrum(rgb)) : rgb; }
 
 // Environment radiance in direction d (unit). Same formulas as Environment::lookup (scene.cpp).
 vec3 environment(vec3 d);
+// The same in linear sRGB (before colourOf).
+vec3 environmentRgb(vec3 d);
 
 // Environment radiance times a throughput weight, recorded for wavelength sharing.
 vec3 environmentWeighted(vec3 weight, vec3 d) {
+  if (hasFlag(EIKON_F_SPECTRAL) && gHero && !gDispersiveHit) {
+    if (gNumRecorded < 6) {
+      gRecorded[gNumRecorded++] = vec4(environmentRgb(d), weight.x * gRecordWeight);
+      return vec3(0.0);
+    }
+    gDispersiveHit = true;  // the record is full: from here on the hero's alone
+  }
   if (hasFlag(EIKON_F_SPECTRAL) && gRecord) {  // only view.comp's spectral mode records
     if (gNumRecorded < 6) gRecorded[gNumRecorded++] = vec4(d, weight.x);
     else gRecordOverflow = true;
@@ -126,7 +144,9 @@ vec3 environmentWeighted(vec3 weight, vec3 d) {
   return weight * environment(d);
 }
 
-vec3 environment(vec3 d) {
+vec3 environment(vec3 d) { return colourOf(environmentRgb(d)); }
+
+vec3 environmentRgb(vec3 d) {
   float u = atan(d.x, -d.z) / (2.0 * kPi) + 0.5;
   float v = acos(clamp(d.y, -1.0, 1.0)) / kPi;
   int type = int(P.env.x);
@@ -147,7 +167,7 @@ vec3 environment(vec3 d) {
     c = mix(mix(envTexels[ya * W + xa].xyz, envTexels[ya * W + xb].xyz, tx),
             mix(envTexels[yb * W + xa].xyz, envTexels[yb * W + xb].xyz, tx), ty);
   }
-  return colourOf(c * P.env.z);
+  return c * P.env.z;
 }
 
 #include "fresnel.glsl"

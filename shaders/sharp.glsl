@@ -38,7 +38,11 @@ float mediumIndex(int r, int mode) {
   float coeff[6] = float[6](c0.x, c0.y, c0.z, c0.w, c1.x, c1.y);
   float sc[6] = float[6](c1.z, c1.w, c2.x, c2.y, c2.z, c2.w);
   if (kind == 0) return coeff[0];
-  if (kind != 1 || terms > 1) gDispersiveHit = true;
+  // Dispersive unless a Cauchy formula without λ terms (its B, C, ... all zero).
+  bool dispersive = kind != 1;
+  for (int k = 1; k < 6; ++k)  // a constant count: unrolled (the loop budget)
+    if (k < terms && coeff[k] != 0.0) dispersive = true;
+  if (dispersive) gDispersiveHit = true;
   float l = gLambdaUm, l2 = l * l;
   if (kind == 1) {
     float n = 0.0, p = 1.0;

@@ -1,7 +1,7 @@
 #version 450
 // View renderer: one thread per pixel and one pass per dispatch: pixel sample P.pass.x (jittered
 // when spp > 1) at wavelengths [P.pass.y, P.pass.y + P.pass.z) of its N stratified ones (spectral
-// mode, CIE 1931 → linear sRGB) or at the fixed wavelength (RGB mode, RGB attenuation). Uniaxial
+// mode, CIE 1931 → linear sRGB), or at all N by hero wavelength sampling (P.pass.w & 1) or at the fixed wavelength (RGB mode, RGB attenuation). Uniaxial
 // scenes march the o- and e-modes, each carrying half of the unpolarised radiance. Output: this
 // pass's share of the pixel's linear sRGB radiance (the host sums the passes and divides by spp),
 // w = its steps, or −(steps + 1) when a march of the pass ran out of the driver's loop budget.
@@ -34,6 +34,58 @@ vec3 cmf(float lambda_nm) {
   return mix(tables[EIKON_CMF_OFFSET + i].xyz, tables[EIKON_CMF_OFFSET + i + 1].xyz, f);
 }
 
+// Layers (P.pass.w & 2; core/volume/render_layers.h): after the band's pixels, per pixel
+// `layerStride` vec4s hold, per mode kept apart (2 where P.pass.w & 4, else 1), one value per
+// channel (the N wavelength bins in spectral mode, r, g, b in RGB mode). A pass writes the bins it
+// marches; the host reads those.
+int layerChannels() { return hasFlag(EIKON_F_SPECTRAL) ? P.limits.z : 3; }
+int layerModes() { return (P.pass.w & 4) != 0 ? 2 : 1; }
+int layerStride() { return (layerChannels() * layerModes() + 3) / 4; }
+void layerWrite(int bandPixel, int mode, int channel, float v) {
+  int i = min(mode, layerModes() - 1) * layerChannels() + channel;
+  pixels[P.image.x * P.image.w + bandPixel * layerStride() + i / 4][i % 4] = v;
+}
+
+// Hero wavelength sampling after the march (main): the lookups recorded before the path's first
+// dispersive event at all N wavelengths λ_j = 380 + ((k_h + j) mod N + u)·400/N, as CIE XYZ; with
+// layers, each λ_j's radiance per mode in its bin, the hero's own (after divergence) N times.
+vec3 heroWavelengthsXyz(int N, int kh, float uh, int heroCount0, float heroMode[2], bool layers,
+                        int bandPixel) {
+  const float width = 400.0 / float(N);
+  vec3 xyz = vec3(0.0);
+  for (int j = 0; j < N && (gNumRecorded > 0 || layers); ++j) {
+    float lj = 380.0 + (float((kh + j) % N) + uh) * width;
+    setWavelength(lj * 1e-3, true);
+    vec2 rad = vec2(0.0);  // per mode (records before heroCount0 are the o-mode's)
+    for (int i = 0; i < 6; ++i)  // a constant count: unrolled (the loop budget)
+      if (i < gNumRecorded) rad[i < heroCount0 ? 0 : 1] += gRecorded[i].w * rgbToSpectrum(gRecorded[i].xyz);
+    xyz += (rad.x + rad.y) * cmf(lj) * width;
+    if (layers) {
+      if (j == 0) rad += float(N) * vec2(heroMode[0], heroMode[1]);
+      int bin = (kh + j) % N;
+      if (layerModes() == 2) {
+        layerWrite(bandPixel, 0, bin, rad.x);
+        layerWrite(bandPixel, 1, bin, rad.y);
+      } else {
+        layerWrite(bandPixel, 0, bin, rad.x + rad.y);
+      }
+    }
+  }
+  return xyz;
+}
+
+// The camera ray of pixel (px, py), sample s (jittered when spp > 1).
+vec3 cameraRay(int px, int py, int s, uint pixelIndex) {
+  vec2 jitter = vec2(0.5);
+  if (P.limits.y > 1) {
+    uint hs = pcg_hash(pixelIndex * 9781u + uint(s) * 6271u + 17u);
+    jitter = vec2(float(hs & 0xffffu), float(hs >> 16u)) / 65536.0;
+  }
+  float u = ((float(px) + jitter.x) / float(P.image.x) * 2.0 - 1.0) * P.cam_pos.w * P.cam_forward.w;
+  float v = (1.0 - (float(py) + jitter.y) / float(P.image.y) * 2.0) * P.cam_pos.w;
+  return normalize(P.cam_forward.xyz + u * P.cam_right.xyz + v * P.cam_up.xyz);
+}
+
 void main() {
   loadParams();
   uvec2 gid = gl_GlobalInvocationID.xy;
@@ -47,14 +99,7 @@ void main() {
   bool cut = false;
   {
     int s = P.pass.x;
-    vec2 jitter = vec2(0.5);
-    if (spp > 1) {
-      uint hs = pcg_hash(pixelIndex * 9781u + uint(s) * 6271u + 17u);
-      jitter = vec2(float(hs & 0xffffu), float(hs >> 16u)) / 65536.0;
-    }
-    float u = ((float(px) + jitter.x) / float(W) * 2.0 - 1.0) * P.cam_pos.w * P.cam_forward.w;
-    float v = (1.0 - (float(py) + jitter.y) / float(H) * 2.0) * P.cam_pos.w;
-    vec3 d = normalize(P.cam_forward.xyz + u * P.cam_right.xyz + v * P.cam_up.xyz);
+    vec3 d = cameraRay(px, py, s, pixelIndex);
     // One call site of march() (lavapipe compiles every inlined copy of the march): the RGB mode
     // is one "wavelength" of radiance triplets, and the modes of a crystal are a loop.
     bool spectral = hasFlag(EIKON_F_SPECTRAL);
@@ -68,11 +113,38 @@ void main() {
     const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
     bool share = spectral && !hasFlag(lambdaDependent);
     bool reuse = false;
+    // Hero wavelength sampling (P.pass.w & 1; docs/spectra.md, Wilkie et al. 2014): λ_j = 380 +
+    // ((k_h + j) mod N + u)·400/N, one shared jitter u, the hero's stratum k_h cycling over the
+    // samples (core/spectrum/wavelength_sampling.h heroWavelengths). One march at the hero (both
+    // modes) in the loop below; its lookups before the path's first dispersive event are recorded
+    // (march.glsl) and valid at every λ_j (the stratified estimator, evaluated after the loop);
+    // after it only the hero can have made the path, so the hero's own radiance counts N times.
+    // With λ-dependent weights on the path (attenuation, emission, opaque surfaces) the hero
+    // carries everything from the start.
+    const bool hero = spectral && (P.pass.w & 1) != 0;
+    const bool layers = (P.pass.w & 2) != 0;
+    const int bandPixel = int(gid.y) * W + px;
+    int heroCount0 = 0;                // hero: records made by the o-mode's march
+    float heroMode[2] = float[2](0.0, 0.0);  // hero: each mode's own radiance (after divergence)
+    const float width = 400.0 / float(N);
+    const int weightDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY;
+    int kh = 0;
+    float uh = 0.0;
+    if (hero) {
+      uint offset = ((pcg_hash(pixelIndex ^ 0xa511e9b3u) >> 8u) * uint(N)) >> 24u;
+      kh = int((offset + uint(s)) % uint(N));
+      uh = float(pcg_hash(seed) >> 8u) * (1.0 / 16777216.0);
+      k0 = kh;
+      k1 = kh + 1;
+      gHero = true;
+      gNumRecorded = 0;
+      gRecordWeight = modes == 2 ? 0.5 : 1.0;
+    }
     for (int k = k0; k < k1; ++k) {
       float lambda = 0.0;
       if (spectral) {
-        float uk = float(pcg_hash(seed + uint(k)) >> 8u) * (1.0 / 16777216.0);
-        lambda = 380.0 + (float(k) + uk) * (400.0 / float(N));
+        float uk = hero ? uh : float(pcg_hash(seed + uint(k)) >> 8u) * (1.0 / 16777216.0);
+        lambda = 380.0 + (float(k) + uk) * width;
         setWavelength(lambda * 1e-3, true);
       } else {
         setWavelength(P.wavelength.x, false);
@@ -80,28 +152,49 @@ void main() {
       if (reuse) {
         float rad = 0.0;
         for (int j = 0; j < gNumRecorded; ++j) rad += gRecorded[j].w * environment(gRecorded[j].xyz).x;
-        xyz += rad * cmf(lambda) * (400.0 / float(N));
+        xyz += rad * cmf(lambda) * width;
+        if (layers) layerWrite(bandPixel, 0, k, rad);
         continue;
       }
       vec3 rad = vec3(0.0);
+      vec3 radMode[2] = vec3[2](vec3(0.0), vec3(0.0));
       for (int mode = 0; mode < modes; ++mode) {
-        if (mode == 0) {
+        if (mode == 0 && !hero) {
           gRecord = share && k == k0;
           gNumRecorded = 0;
           gRecordOverflow = false;
           gDispersiveHit = false;
         }
+        if (hero) gDispersiveHit = hasFlag(weightDependent);
         MarchResult r = march(P.cam_pos.xyz, d, mode);
-        if (mode == 0) {
+        if (mode == 0 && !hero) {
           reuse = gRecord && !gDispersiveHit && !gRecordOverflow;
           gRecord = false;
         }
-        rad += modes == 2 ? 0.5 * r.radiance : r.radiance;
-        steps += float(r.steps) / float(N);
+        vec3 part = modes == 2 ? 0.5 * r.radiance : r.radiance;
+        rad += part;
+        radMode[mode] = part;
+        if (hero && mode == 0) heroCount0 = gNumRecorded;
+        steps += float(r.steps) / float(hero ? 1 : N);
         cut = cut || r.cut;
       }
-      if (spectral) xyz += rad.x * cmf(lambda) * (400.0 / float(N));
+      if (spectral) xyz += (hero ? float(N) : 1.0) * rad.x * cmf(lambda) * width;
       else sum += rad;
+      if (hero) {
+        heroMode[0] = radMode[0].x;
+        heroMode[1] = radMode[1].x;
+      } else if (layers) {
+        for (int m = 0; m < 2; ++m) {
+          if (m >= layerModes()) break;
+          vec3 v = layerModes() == 2 ? radMode[m] : rad;
+          if (spectral) layerWrite(bandPixel, m, k, v.x);
+          else for (int c = 0; c < 3; ++c) layerWrite(bandPixel, m, c, v[c]);
+        }
+      }
+    }
+    if (hero) {
+      gHero = false;
+      xyz += heroWavelengthsXyz(N, kh, uh, heroCount0, heroMode, layers, bandPixel);
     }
     if (spectral) {
       mat3 M = mat3(tables[EIKON_MATRIX_OFFSET].xyz, tables[EIKON_MATRIX_OFFSET + 1].xyz,

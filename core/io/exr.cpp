@@ -6,6 +6,7 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <ImfTestFile.h>
 #include <png.h>
 #include <unistd.h>
@@ -19,6 +20,8 @@
 #include <fstream>
 #include <memory>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace eikon {
 
@@ -73,9 +76,11 @@ RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_
 namespace {
 
 void encodeExr(const std::filesystem::path& file, int width, int height,
-               const std::vector<ExrChannel>& channels) {
+               const std::vector<ExrChannel>& channels,
+               const std::vector<std::pair<std::string, std::string>>& attributes = {}) {
   Imf::Header header(width, height);
   header.compression() = Imf::ZIP_COMPRESSION;
+  for (const auto& [name, value] : attributes) header.insert(name, Imf::StringAttribute(value));
   for (const auto& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
   Imf::FrameBuffer fb;
   for (const auto& c : channels)
@@ -147,6 +152,51 @@ FileContent exrRgbContent(int width, int height, const std::vector<float>& rgb) 
   return [planes, width, height](const std::filesystem::path& tmp) {
     encodeExr(tmp, width, height,
               {{"R", (*planes)[0].data()}, {"G", (*planes)[1].data()}, {"B", (*planes)[2].data()}});
+  };
+}
+
+std::string spectralChannelName(double centreNm) {
+  std::string v = std::to_string(centreNm);  // "%f": 6 decimals, '.' in the C locale
+  std::replace(v.begin(), v.end(), '.', ',');
+  return "S0." + v + "nm";
+}
+
+FileContent exrLayersContent(int width, int height, const std::vector<float>& rgb, int bins,
+                             const std::vector<float>& spectral, const std::vector<float>& modes) {
+  const size_t n = size_t(width) * size_t(height);
+  if (rgb.size() != 3 * n || spectral.size() != size_t(std::max(bins, 0)) * n ||
+      (!modes.empty() && modes.size() != 6 * n))
+    throw std::invalid_argument("exrLayersContent: pixel count mismatch");
+  // One plane per channel: R, G, B, then the bins, then o.R … e.B.
+  std::vector<std::string> names = {"R", "G", "B"};
+  const double width_nm = bins > 0 ? 400.0 / bins : 0.0;
+  for (int k = 0; k < bins; ++k) names.push_back(spectralChannelName(380.0 + (k + 0.5) * width_nm));
+  if (!modes.empty())
+    for (const char* m : {"o.", "e."})
+      for (const char* c : {"R", "G", "B"}) names.push_back(std::string(m) + c);
+  auto planes =
+      std::make_shared<std::vector<std::vector<float>>>(names.size(), std::vector<float>(n));
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t c = 0; c < 3; ++c) (*planes)[c][i] = rgb[3 * i + c];
+    for (size_t k = 0; k < size_t(std::max(bins, 0)); ++k)
+      (*planes)[3 + k][i] = spectral[i * size_t(bins) + k];
+    if (!modes.empty())
+      for (size_t c = 0; c < 6; ++c)
+        (*planes)[3 + size_t(std::max(bins, 0)) + c][i] = modes[6 * i + c];
+  }
+  std::vector<std::pair<std::string, std::string>> attributes;
+  if (bins > 0) {
+    // Fichet et al. 2021's emissive spectral layout: S0 channels in ascending wavelength, their
+    // unit in a string attribute; each channel is the bin's mean spectral radiance.
+    attributes.push_back({"emissiveUnits", "W.m^-2.sr^-1.nm^-1"});
+    attributes.push_back({"spectralBins", std::to_string(bins) + " bins of " +
+                                              std::to_string(width_nm) +
+                                              " nm over 380-780 nm, named by their centres"});
+  }
+  return [planes, names, attributes, width, height](const std::filesystem::path& tmp) {
+    std::vector<ExrChannel> channels;
+    for (size_t c = 0; c < names.size(); ++c) channels.push_back({names[c], (*planes)[c].data()});
+    encodeExr(tmp, width, height, channels, attributes);
   };
 }
 

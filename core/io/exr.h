@@ -40,6 +40,20 @@ void writeExr(const std::filesystem::path& path, int width, int height,
 /// The pixels are copied: `rgb` need not outlive the result.
 FileContent exrRgbContent(int width, int height, const std::vector<float>& rgb);
 
+/// The spectral channel name of a bin centred at `centreNm`, after Fichet, Pacanowski & Wilkie,
+/// "An OpenEXR Layout for Spectral Images" (JCGT 10(3), 2021) and their reference code
+/// (github.com/afichet/spectral-exr, EXRSpectralImage::getStokesChannelName): "S0." + the value
+/// printed with 6 decimals and ',' as the decimal separator ('.' separates layers) + "nm", e.g.
+/// 392.5 nm → "S0.392,500000nm".
+std::string spectralChannelName(double centreNm);
+
+/// A render's EXR with its layers (ZIP, float): R, G, B (linear sRGB); `bins` channels
+/// spectralChannelName(bin centre) of [380, 780] nm cut in `bins` equal bins (spectral: bins per
+/// pixel, pixel-major) with the string attribute emissiveUnits = "W.m^-2.sr^-1.nm^-1"; and, if
+/// `modes` is not empty (6 floats per pixel), o.R, o.G, o.B, e.R, e.G, e.B. For writeFilesTogether.
+FileContent exrLayersContent(int width, int height, const std::vector<float>& rgb, int bins,
+                             const std::vector<float>& spectral, const std::vector<float>& modes);
+
 /// Write linear RGB floats (3 per pixel) as an EXR with R, G, B channels, atomically.
 void writeExrRgb(const std::filesystem::path& path, int width, int height,
                  const std::vector<float>& rgb);

@@ -1,6 +1,7 @@
 #include "core/reference/reference_marcher.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include "core/spectrum/wavelength_sampling.h"
 #include "core/volume/boundary.h"
 #include "core/volume/media.h"
+#include "core/volume/render_layers.h"
 #include "optics/fresnel.h"
 #include "optics/interface.h"
 
@@ -45,6 +47,17 @@ void validate(const MarchSettings& m) {
 }
 
 }  // namespace
+
+/// Hero wavelength sampling (view.comp, march.glsl gHero): the environment lookups of a hero march
+/// made before its path met anything dispersive, as (linear sRGB radiance, weight), valid at every
+/// wavelength of the pixel sample; after that (or once full) lookups are the hero's alone.
+struct HeroRecord {
+  static constexpr int kMax = 6;
+  bool diverged = false;
+  int count = 0;
+  double weight = 1.0;  ///< the mode's share (½ each in a crystal)
+  std::array<glm::dvec4, kMax> entries{};
+};
 
 // ------------------------------------------------------------------ ReferenceMarcher
 namespace {
@@ -92,6 +105,8 @@ enum class SharpEvent { Go, Cross, Leave };
 class CountedField {
  public:
   explicit CountedField(const Field& f) : f_(f) {}
+  /// The field without counting a read (hero sampling's dispersion test, not a march's read).
+  const Field& uncounted() const { return f_; }
   const Field& read() const {  // a read of the volumes through the returned field
     ++fetches;
     return f_;
@@ -118,8 +133,9 @@ class CountedField {
 class RayMarch {
  public:
   RayMarch(const Field& f, const Environment& env, double lambda_nm, bool scalar,
-           const MarchSettings& m, int mode)
-      : f_(f),
+           const MarchSettings& m, int mode, HeroRecord* hero = nullptr)
+      : hero_(hero),
+        f_(f),
         env_(env),
         lambda_nm_(lambda_nm),
         scalar_(scalar),
@@ -151,8 +167,25 @@ class RayMarch {
     return scalar_ ? glm::dvec3(field::bandAt(b, lambda_nm_)) : b;
   }
   glm::dvec3 environment(const glm::dvec3& dir) const { return colourOf(env_.lookup(dir)); }
+  /// weight × environment(dir), or, while a hero march has met nothing dispersive, recorded for
+  /// all wavelengths and left out of the radiance (march.glsl environmentWeighted).
+  glm::dvec3 environmentWeighted(const glm::dvec3& weight, const glm::dvec3& dir) const {
+    if (hero_ && !hero_->diverged) {
+      if (hero_->count < HeroRecord::kMax) {
+        hero_->entries[size_t(hero_->count++)] =
+            glm::dvec4(env_.lookup(dir), weight.x * hero_->weight);
+        return glm::dvec3(0.0);
+      }
+      hero_->diverged = true;  // the record is full: from here on the hero's alone
+    }
+    return weight * environment(dir);
+  }
   glm::dvec4 sampleIndex(const glm::dvec3& x, int mode) const {
-    return field::sampleIndex(f_.read(), x, il2_, il4_, mode);
+    const glm::dvec4 n = field::sampleIndex(f_.read(), x, il2_, il4_, mode);
+    // The GPU twin notes dispersion where the sampled B or C is non-zero: n differs from A.
+    if (hero_ && !hero_->diverged && n != field::sampleIndex(f_.uncounted(), x, 0.0, 0.0, mode))
+      hero_->diverged = true;
+    return n;
   }
   glm::dvec3 axisAt(const glm::dvec3& x) const { return mode_ == 1 ? f_.axis(x) : glm::dvec3(0.0); }
   void deriv(const glm::dvec3& x, const glm::dvec3& w, glm::dvec3& dx, glm::dvec3& dw) const;
@@ -172,7 +205,17 @@ class RayMarch {
   MarchResult marchSharp(const glm::dvec3& o, const glm::dvec3& d) const;
   const MediumRecord& rec(int region) const { return media_->regions[size_t(region)]; }
   double regionIndex(int region, int mode, const glm::dvec3& x, glm::dvec3* grad = nullptr) const {
-    return mediumIndexAt(rec(region), mode, lambda_nm_, x, grad);
+    const MediumRecord& m = rec(region);
+    if (hero_ && m.grin_type == 0) {  // shaders/sharp.glsl mediumIndex: anything but a constant
+      const MediumDispersion& d = mode == 1 ? m.n_e : m.n_o;
+      bool dispersive =
+          d.kind != MediumDispersion::Kind::Constant && d.kind != MediumDispersion::Kind::Cauchy;
+      for (int k = 1; k < std::min(d.terms, 6); ++k)  // Cauchy: any λ term
+        dispersive =
+            dispersive || (d.kind == MediumDispersion::Kind::Cauchy && d.coeff[size_t(k)] != 0.0);
+      if (dispersive) hero_->diverged = true;
+    }
+    return mediumIndexAt(m, mode, lambda_nm_, x, grad);
   }
   void sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& d) const;
   glm::dvec3 sharpDirection(const MarchState& S) const;
@@ -186,6 +229,7 @@ class RayMarch {
   SharpEvent sharpStep(MarchState& S, MarchResult& R, BoundaryCrossing& c) const;
   void crossInterface(MarchState& S, MarchResult& R, const BoundaryCrossing& c) const;
 
+  HeroRecord* hero_;
   CountedField f_;
   const Environment& env_;
   double lambda_nm_, il2_ = 0.0, il4_ = 0.0;
@@ -416,7 +460,7 @@ void RayMarch::fresnelAtLayer(MarchState& S, MarchResult& R, const glm::dvec3& N
   if (!(n1 > 0.0 && n2 > 0.0) || !std::isfinite(n1 + n2)) return;  // fresnelReflectance's domain
   const FresnelReflectance rsp = fresnelReflectance(std::abs(ci), n1, n2);
   const double Rf = f_.uniaxial() ? wsw * rsp.Rs + (1.0 - wsw) * rsp.Rp : 0.5 * (rsp.Rs + rsp.Rp);
-  if (n2 > n1) S.L += S.T * Rf * environment(glm::reflect(dIn, N));
+  if (n2 > n1) S.L += environmentWeighted(S.T * Rf, glm::reflect(dIn, N));
   S.T *= 1.0 - Rf;
   R.interfaces++;
 }
@@ -467,7 +511,7 @@ bool RayMarch::enterVolume(const glm::dvec3& o, const glm::dvec3& d, MarchResult
   R = MarchResult{};
   double t1;
   if (!boxHit(o, d, bmin_, bmax_, t0, t1)) {
-    R.radiance = environment(d);
+    R.radiance = environmentWeighted(glm::dvec3(1.0), d);
     R.exit_point = o;
     R.exit_dir = d;
     R.wave_normal = d;
@@ -504,7 +548,7 @@ MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
   R.exit_dir = rayDirection(S.x, S.w);
   R.wave_normal = glm::normalize(S.w);
   R.left = !S.stopped && steps < m_.max_steps;
-  if (R.left) S.L += S.T * environment(R.exit_dir);
+  if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
   R.radiance = S.L;
   R.throughput = S.T;
   return R;
@@ -707,7 +751,7 @@ void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCross
           sWeight(intoCrystal ? out.s : s, glm::dvec3(intoCrystal ? afB : afA), N, s, mode_);
       Rf = wsw * rsp.Rs + (1.0 - wsw) * rsp.Rp;
     }
-    if (out.n > n1) S.L += S.T * Rf * environment(glm::reflect(s, N));
+    if (out.n > n1) S.L += environmentWeighted(S.T * Rf, glm::reflect(s, N));
     S.T *= 1.0 - Rf;
   }
   R.interfaces++;
@@ -740,7 +784,7 @@ MarchResult RayMarch::marchSharp(const glm::dvec3& o, const glm::dvec3& d) const
   R.exit_dir = sharpDirection(S);
   R.wave_normal = glm::normalize(S.w);
   R.left = !S.stopped && steps < m_.max_steps;
-  if (R.left) S.L += S.T * environment(R.exit_dir);
+  if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
   R.radiance = S.L;
   R.throughput = S.T;
   return R;
@@ -752,9 +796,10 @@ struct ReferenceMarcher::Result : MarchResult {};
 
 ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm::dvec3& d,
                                                  double lambda_nm, bool scalar,
-                                                 const MarchSettings& m, int mode) const {
+                                                 const MarchSettings& m, int mode,
+                                                 HeroRecord* hero) const {
   Result r;
-  const RayMarch rm(field_, env_, lambda_nm, scalar, m, mode);
+  const RayMarch rm(field_, env_, lambda_nm, scalar, m, mode, hero);
   static_cast<MarchResult&>(r) = rm.march(o, d);
   r.fetches = rm.fetches();
   return r;
@@ -784,6 +829,49 @@ TraceOutcome ReferenceMarcher::trace(const TraceRequest& ray, const MarchSetting
   return t;
 }
 
+glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
+                                           uint32_t sample, const RenderSettings& s, double& steps,
+                                           double& fetches, LayerSums* layers) const {
+  // view.comp's hero branch: one march (per mode) at λ_0, its lookups before the path's first
+  // dispersive event recorded for all N wavelengths, the rest the hero's alone, counted N times.
+  const auto n = uint32_t(s.wavelengths);
+  const std::vector<double> lambdas = spectrum::heroWavelengths(pixel, sample, n);
+  const int modes = field_.uniaxial() ? 2 : 1;
+  HeroRecord rec;
+  rec.weight = modes == 2 ? 0.5 : 1.0;
+  double heroMode[2] = {0.0, 0.0};  // each mode's own radiance after its path dispersed
+  int count0 = 0;                   // records made by the o-mode's march
+  for (int mode = 0; mode < modes; ++mode) {
+    rec.diverged = field_.weightsDependOnLambda();
+    Result r = march(o, d, lambdas[0], true, s.march, mode, &rec);
+    heroMode[mode] = rec.weight * r.radiance.x;
+    if (mode == 0) count0 = rec.count;
+    steps += double(r.steps);
+    fetches += double(r.fetches);
+  }
+  glm::dvec3 xyz =
+      double(n) * (heroMode[0] + heroMode[1]) * spectrum::sampleWeightXyz(lambdas[0], n);
+  // The hero's bin (layers): λ_j lies in bin (k_h + j) mod N, k_h the hero's.
+  const auto heroBin = uint32_t((lambdas[0] - spectrum::kVisibleMinNm) * n /
+                                (spectrum::kVisibleMaxNm - spectrum::kVisibleMinNm));
+  for (uint32_t j = 0; j < n; ++j) {
+    const double l = lambdas[j];
+    double rad[2] = {0.0, 0.0};
+    for (int i = 0; i < rec.count; ++i) {
+      const glm::dvec4& e = rec.entries[size_t(i)];
+      rad[i < count0 ? 0 : 1] += e.w * spectrum::rgbToSpectrum(glm::dvec3(e), l);
+    }
+    if (rec.count > 0) xyz += (rad[0] + rad[1]) * spectrum::sampleWeightXyz(l, n);
+    if (layers) {
+      if (j == 0)
+        for (int m = 0; m < 2; ++m) rad[m] += double(n) * heroMode[m];
+      const int bin = int(std::min((heroBin + j) % n, n - 1));
+      for (int m = 0; m < modes; ++m) layers->at(pixel, m)[bin] += rad[m];
+    }
+  }
+  return xyz;
+}
+
 RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
                                      int threads) const {
   validate(s.march);
@@ -797,6 +885,8 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
   const double tanh = std::tan(0.5 * cam.fov_deg * kPi / 180.0),
                aspect = double(img.width) / img.height;
   const glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
+  const bool hero = useHeroSampling(s.sampling, field_.weightsDependOnLambda());
+  LayerSums layers(s, size_t(img.width) * size_t(img.height), field_.uniaxial());
   std::atomic<int> next{0}, rows_done{0};
   std::atomic<long long> total_steps{0}, total_fetches{0};
   std::mutex progress_mutex;  // progress per row, one report at a time (skipped when busy)
@@ -821,11 +911,15 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
           double u = ((x + jx) / img.width * 2.0 - 1.0) * tanh * aspect;
           double v = (1.0 - (y + jy) / img.height * 2.0) * tanh;
           glm::dvec3 d = glm::normalize(fwd + u * right + v * up);
-          if (s.wavelengths > 0) {
+          if (s.wavelengths > 0 && hero) {
+            sum += M * heroSampleXyz(cam.position, d, pixel, uint32_t(sidx), s, steps, fetches,
+                                     layers.active() ? &layers : nullptr);
+          } else if (s.wavelengths > 0) {
             auto lambdas =
                 spectrum::stratifiedWavelengths(pixel, uint32_t(sidx), uint32_t(s.wavelengths));
             glm::dvec3 xyz(0.0);
-            for (double l : lambdas) {
+            for (size_t k = 0; k < lambdas.size(); ++k) {
+              const double l = lambdas[k];
               Result r = march(cam.position, d, l, true, s.march, 0);
               double rad = r.radiance.x;
               steps += double(r.steps) / s.wavelengths;
@@ -835,6 +929,12 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
                 rad = 0.5 * (rad + re.radiance.x);
                 steps += double(re.steps) / s.wavelengths;
                 fetches += double(re.fetches) / s.wavelengths;
+                if (layers.active()) {
+                  layers.at(pixel, 0)[k] += 0.5 * r.radiance.x;
+                  layers.at(pixel, 1)[k] += 0.5 * re.radiance.x;
+                }
+              } else if (layers.active()) {
+                layers.at(pixel, 0)[k] += rad;
               }
               xyz += rad * spectrum::sampleWeightXyz(l, uint32_t(s.wavelengths));
             }
@@ -844,12 +944,18 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
             glm::dvec3 rad = r.radiance;
             steps += r.steps;
             fetches += double(r.fetches);
+            glm::dvec3 modeRad[2] = {rad, glm::dvec3(0.0)};
             if (field_.uniaxial()) {
               Result re = march(cam.position, d, s.wavelength_nm, false, s.march, 1);
               rad = 0.5 * (rad + re.radiance);
+              modeRad[0] = 0.5 * r.radiance;
+              modeRad[1] = 0.5 * re.radiance;
               steps += re.steps;
               fetches += double(re.fetches);
             }
+            if (layers.active())
+              for (int m = 0; m < 2; ++m)
+                for (int c = 0; c < 3; ++c) layers.at(pixel, m)[c] += modeRad[m][c];
             sum += rad;
           }
         }
@@ -869,6 +975,7 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
   for (int i = 0; i < t; ++i) pool.emplace_back(worker);
   for (auto& th : pool) th.join();
   if (s.progress) s.progress(1.0);
+  layers.finish(img, s.spp);
   img.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   img.mean_steps = double(total_steps) / (double(img.width) * img.height);
   img.mean_fetches = double(total_fetches) / (double(img.width) * img.height);

@@ -12,6 +12,7 @@
 //   eikon::RenderImage img = ref.render(scene.camera, settings);
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 
@@ -44,6 +45,9 @@ class AnalyticField : public Field {
   double cell_;
 };
 
+struct HeroRecord;  // hero wavelength sampling's record of one pixel sample (the .cpp)
+class LayerSums;    // core/volume/render_layers.h
+
 class ReferenceMarcher {
  public:
   ReferenceMarcher(const Field& field, const Environment& env) : field_(field), env_(env) {}
@@ -56,7 +60,12 @@ class ReferenceMarcher {
  private:
   struct Result;
   Result march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar,
-               const MarchSettings& m, int mode) const;
+               const MarchSettings& m, int mode, HeroRecord* hero = nullptr) const;
+  /// CIE XYZ (unnormalised, as Σ L·sampleWeightXyz) of one pixel sample by hero wavelength
+  /// sampling (docs/spectra.md); adds its steps and field reads, and its bins to `layers`.
+  glm::dvec3 heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
+                           uint32_t sample, const RenderSettings& s, double& steps, double& fetches,
+                           LayerSums* layers) const;
   const Field& field_;
   const Environment& env_;
 };

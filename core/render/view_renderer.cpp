@@ -14,6 +14,7 @@
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
 #include "core/vk/timings.h"
+#include "core/volume/render_layers.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/polarised_trace.spv.h"
 #include "shaders/trace.spv.h"
@@ -377,6 +378,24 @@ ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet
     : impl_(std::make_unique<Impl>(ctx, scene, volume, expected)) {}
 ViewRenderer::~ViewRenderer() = default;
 
+namespace {
+// Adds one band's layer values (view.comp layerWrite) to the sums: channels [c0, c1) of each mode
+// kept apart (the pass's wavelength bins, all N for a hero pass; r, g, b in RGB mode).
+void addLayers(LayerSums& layers, const std::vector<glm::vec4>& band, int width, int rows, int y0,
+               int c0, int c1, size_t stride) {
+  const int C = layers.channels(), M = layers.modes();
+  const size_t base = size_t(width) * size_t(rows);
+  const float* all = reinterpret_cast<const float*>(band.data());  // tightly packed vec4s
+  for (size_t i = 0; i < size_t(width) * size_t(rows); ++i) {
+    const float* v = all + (base + i * stride) * 4;
+    for (int m = 0; m < M; ++m) {
+      double* sum = layers.at(size_t(y0) * size_t(width) + i, m);
+      for (int c = c0; c < c1; ++c) sum[c] += v[m * C + c];
+    }
+  }
+}
+}  // namespace
+
 RenderImage ViewRenderer::render(const RenderSettings& s) {
   Impl& I = *impl_;
   validateRender(s, I.scene);
@@ -396,32 +415,42 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   // others are table lookups) — lavapipe's loop budget is per invocation, all loops together
   // (view.comp's header, docs/view-renderer.md). Passes are outermost so that every finished pass
   // is a whole (noisier) image: RenderSettings::on_pass shows the picture forming.
+  // Hero wavelength sampling (docs/spectra.md): one pass per pixel sample, all N wavelengths.
   const int N = std::max(1, s.wavelengths);
+  const bool weightsDependOnLambda =
+      (p.grid_dims.w & (EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY)) != 0;
+  const bool hero = s.wavelengths > 0 && useHeroSampling(s.sampling, weightsDependOnLambda);
   const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY |
                               EIKON_F_UNIAXIAL | EIKON_F_DISPERSIVE;
-  const bool share = s.wavelengths > 0 && (p.grid_dims.w & lambdaDependent) == 0;
+  const bool share = s.wavelengths > 0 && (hero || (p.grid_dims.w & lambdaDependent) == 0);
   const int perPass = share ? N : 1;
   const int passesPerSample = (N + perPass - 1) / perPass;
   const int passes = s.spp * passesPerSample;
   // Bands of rows within a pass so that progress is reported and no dispatch runs for long: the
   // band buffer holds up to ~2e5 rays' worth of rows; the first band is one workgroup row, each
   // next one is sized from the last one's time to take ~0.25 s.
+  // Layers (core/volume/render_layers.h): per pixel, after the band's RGB, `stride` vec4s of
+  // channel values per mode (view.comp layerWrite); the pass's bins are added on the host.
+  LayerSums layers(s, size_t(img.width) * size_t(img.height), I.uniaxial);
+  const int layerBits = layers.active() ? (2 | (layers.modes() == 2 ? 4 : 0)) : 0;
+  const size_t stride = layers.active() ? size_t((layers.channels() * layers.modes() + 3) / 4) : 0;
   const double rowWork = double(img.width) * perPass;
   int max_rows = std::clamp(int(std::ceil(2.0e5 / std::max(rowWork, 1.0))), EIKON_WG_Y, img.height);
   max_rows = (max_rows + EIKON_WG_Y - 1) / EIKON_WG_Y * EIKON_WG_Y;
   int rows = EIKON_WG_Y;
-  vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * sizeof(glm::vec4),
+  vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * (1 + stride) * sizeof(glm::vec4),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
   vk::ComputePipeline& view = I.pipeline(Impl::kView, p);
   view.bindBuffer(EIKON_B_OUTPUT, out);
   const size_t pixels = size_t(img.width) * size_t(img.height);
   std::vector<double> acc(pixels * 3, 0.0);
   img.rgb.assign(pixels * 3, 0.0f);
-  std::vector<glm::vec4> band(size_t(img.width) * size_t(max_rows));
+  std::vector<glm::vec4> band(size_t(img.width) * size_t(max_rows) * (1 + stride));
   double steps = 0.0;
   auto t0 = std::chrono::steady_clock::now();
   for (int pass = 0; pass < passes; ++pass) {
-    p.pass = glm::ivec4(pass / passesPerSample, (pass % passesPerSample) * perPass, perPass, 0);
+    p.pass = glm::ivec4(pass / passesPerSample, (pass % passesPerSample) * perPass, perPass,
+                        (hero ? 1 : 0) | layerBits);
     for (int y0 = 0, n = 0; y0 < img.height; y0 += n) {
       n = std::min(rows, img.height - y0);
       const auto band_start = std::chrono::steady_clock::now();
@@ -432,7 +461,12 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
         view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X),
                       uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
       });
-      out.read(band.data(), size_t(img.width) * size_t(n) * sizeof(glm::vec4));
+      out.read(band.data(), size_t(img.width) * size_t(n) * (1 + stride) * sizeof(glm::vec4));
+      if (layers.active()) {
+        const int c0 = s.wavelengths == 0 || hero ? 0 : p.pass.y;
+        const int c1 = s.wavelengths == 0 ? 3 : hero ? N : std::min(p.pass.y + p.pass.z, N);
+        addLayers(layers, band, img.width, n, y0, c0, c1, stride);
+      }
       for (size_t i = 0; i < size_t(img.width) * size_t(n); ++i) {
         const glm::vec4& v = band[i];
         const size_t o = (size_t(y0) * size_t(img.width) + i) * 3;
@@ -458,6 +492,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
       if (s.on_pass && pass + 1 < passes) s.on_pass(img, (pass + 1) / passesPerSample, s.spp);
     }
   }
+  layers.finish(img, s.spp);
   img.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   img.mean_steps = steps / (double(pixels) * s.spp);
   return img;

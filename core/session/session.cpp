@@ -1,5 +1,6 @@
 #include "core/session/session.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/light/light_cache.h"
@@ -30,6 +31,30 @@ Integrator parseIntegrator(const std::string& s) {
   throw SettingError("integrator", "must be euler, midpoint or rk4");
 }
 
+SpectralSampling parseSpectralSampling(const std::string& s) {
+  if (s == "auto") return SpectralSampling::Auto;
+  if (s == "hero") return SpectralSampling::Hero;
+  if (s == "stratified") return SpectralSampling::Stratified;
+  throw SettingError("spectral-sampling", "must be auto, hero or stratified, got '" + s + "'");
+}
+
+void parseLayers(const std::string& list, ViewRequest& view) {
+  view.spectral_layer = view.mode_layers = false;
+  size_t start = 0;
+  while (start <= list.size() && !list.empty()) {
+    const size_t end = std::min(list.find(',', start), list.size());
+    const std::string name = list.substr(start, end - start);
+    if (name == "spectral")
+      view.spectral_layer = true;
+    else if (name == "modes")
+      view.mode_layers = true;
+    else
+      throw SettingError("layers", "must be a comma-separated list of spectral and modes, got '" +
+                                       name + "' in '" + list + "'");
+    start = end + 1;
+  }
+}
+
 void checkMarchStep(double step_voxels) {
   if (!(step_voxels > 0 && step_voxels <= 4))
     throw SettingError("step", "must be in (0, 4] voxels");
@@ -53,6 +78,12 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
   if (v.wavelengths) rs.wavelengths = *v.wavelengths;
   rs.wavelength_nm = v.wavelength_nm;
   if (v.march) rs.march = *v.march;
+  rs.sampling = v.sampling;
+  rs.spectral_layer = v.spectral_layer;
+  rs.mode_layers = v.mode_layers;
+  if (rs.spectral_layer && rs.wavelengths <= 0)
+    throw SettingError("layers", "spectral needs a spectral render (wavelengths > 0), got " +
+                                     std::to_string(rs.wavelengths) + " wavelengths");
   return rs;
 }
 

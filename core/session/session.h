@@ -65,10 +65,17 @@ struct ViewRequest {
   std::optional<int> wavelengths;      ///< [0, 256] (0 = RGB); unset: defaultWavelengths(scene)
   double wavelength_nm = 587.5618;     ///< the index wavelength of the RGB mode
   std::optional<MarchSettings> march;  ///< step in (0, 4] voxels; unset: the render defaults
+  SpectralSampling sampling = SpectralSampling::Auto;  ///< spectral renders (docs/spectra.md)
+  bool spectral_layer = false, mode_layers = false;    ///< parseLayers; RenderSettings's
 };
 
 /// "euler", "midpoint" or "rk4"; else SettingError("integrator", ...).
 Integrator parseIntegrator(const std::string& name);
+/// A comma-separated list of "spectral" and "modes" (the extra image layers) into the request;
+/// else SettingError("layers", ...). An empty list asks for none.
+void parseLayers(const std::string& list, ViewRequest& view);
+/// "auto", "hero" or "stratified"; else SettingError("spectral-sampling", ...).
+SpectralSampling parseSpectralSampling(const std::string& name);
 /// March step in (0, 4] voxels; else SettingError("step", ...).
 void checkMarchStep(double step_voxels);
 /// Every range of a ViewRequest (SettingError for the first one out of range).

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
@@ -28,6 +29,19 @@ std::vector<double> stratifiedWavelengths(std::uint32_t pixelIndex, std::uint32_
   const double width = (kVisibleMaxNm - kVisibleMinNm) / n;
   for (std::uint32_t k = 0; k < n; ++k)
     out[k] = kVisibleMinNm + (k + wavelengthJitter(pixelIndex, sampleIndex, k)) * width;
+  return out;
+}
+
+std::vector<double> heroWavelengths(std::uint32_t pixelIndex, std::uint32_t sampleIndex,
+                                    std::uint32_t n) {
+  if (n == 0 || n > 256)
+    throw std::invalid_argument("heroWavelengths: N must be in [1, 256], got " + std::to_string(n));
+  const double u = wavelengthJitter(pixelIndex, sampleIndex, 0);
+  const std::uint32_t offset = ((pcgHash(pixelIndex ^ 0xa511e9b3u) >> 8u) * n) >> 24u;
+  const std::uint32_t hero = (offset + sampleIndex) % n;
+  const double width = (kVisibleMaxNm - kVisibleMinNm) / n;
+  std::vector<double> out(n);
+  for (std::uint32_t j = 0; j < n; ++j) out[j] = kVisibleMinNm + ((hero + j) % n + u) * width;
   return out;
 }
 

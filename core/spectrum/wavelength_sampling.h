@@ -57,6 +57,17 @@ double wavelengthJitter(std::uint32_t pixelIndex, std::uint32_t sampleIndex, std
 std::vector<double> stratifiedWavelengths(std::uint32_t pixelIndex, std::uint32_t sampleIndex,
                                           std::uint32_t n);
 
+/// Hero wavelength sampling (Wilkie et al., "Hero Wavelength Spectral Sampling", EGSR 2014;
+/// docs/spectra.md): the N wavelengths of one pixel sample share ONE jitter u (k = 0's above),
+///     λ_j = 380 + ((k_h + j) mod N + u) · 400/N,   j = 0..N−1,
+/// i.e. the hero λ_0 and its rotations by multiples of 400/N wrapped into [380, 780): still one
+/// wavelength per stratum, each uniform in it. The hero's stratum k_h = (o + sampleIndex) mod N
+/// cycles through the strata over the samples of a pixel, from a per-pixel offset
+///     o = ((pcg_hash(pixelIndex ^ 0xa511e9b3u) >> 8) · N) >> 24   (uint arithmetic, N ≤ 256).
+/// Returns {λ_0 (the hero), λ_1, ..., λ_{N−1}} in nm. Throws std::invalid_argument for N = 0 or
+/// N > 256.
+std::vector<double> heroWavelengths(std::uint32_t pixelIndex, std::uint32_t sampleIndex,
+                                    std::uint32_t n);
 /// Monte Carlo weight of one of N stratified samples at λ (nm): cmf(λ)·(kVisibleMaxNm −
 /// kVisibleMinNm)/N, in nm. Σ radiance_k·weight_k estimates ∫ S cmf dλ. Throws
 /// std::invalid_argument for N = 0, λ ≤ 0 or NaN.

@@ -54,6 +54,9 @@ class Field {
   virtual glm::dvec3 lightFlux(const glm::dvec3&) const { return glm::dvec3(0.0); }
   /// True once light volumes are present (in-scatter and diffuse surfaces are then lit).
   virtual bool lit() const { return false; }
+  /// True if some attenuation, emission or opacity is non-zero: a path's weights then depend on λ
+  /// even where the path does not (hero wavelength sampling, docs/spectra.md).
+  virtual bool weightsDependOnLambda() const { return false; }
   /// The sharp boundaries and their media (core/volume/boundary.h, media.h), or null where the
   /// medium has none (an analytic field, a scene with "interfaces": "smoothed"): marchers then
   /// integrate through the smoothed layers.
@@ -83,6 +86,7 @@ class VolumeField : public Field {
   glm::dvec4 lightFluence(const glm::dvec3& x) const override;
   glm::dvec3 lightFlux(const glm::dvec3& x) const override;
   bool lit() const override { return v_.lit(); }
+  bool weightsDependOnLambda() const override { return v_.attenuating || v_.emissive || v_.opaque; }
   const BoundaryField* boundary() const override {
     return v_.boundary.empty() || v_.media.empty() ? nullptr : &v_.boundary;
   }

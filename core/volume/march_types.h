@@ -22,11 +22,39 @@ struct MarchSettings {
 
 struct RenderImage;
 
+/// How a spectral render (RenderSettings::wavelengths = N > 0) samples its N wavelengths per pixel
+/// sample (docs/spectra.md "Hero wavelength sampling").
+enum class SpectralSampling {
+  /// Hero where every weight of a path is the same at all wavelengths until the path itself
+  /// depends on λ (no attenuation, emission or opaque objects in the scene), else Stratified.
+  Auto,
+  /// One march per pixel sample at a hero wavelength; the other N − 1 (rotated by multiples of
+  /// 400/N nm) share its path until a dispersive event, after which the hero carries the whole
+  /// estimate (Wilkie et al. 2014).
+  Hero,
+  /// One march per wavelength, each jittered in its own stratum (one pass per wavelength, or one
+  /// for all N where the scene has no dispersion and no λ-dependent weight).
+  Stratified,
+};
+
+/// Whether a spectral render samples by hero wavelengths: `weights_depend_on_lambda` is true for a
+/// scene with attenuation, emission or opaque objects (a path's weights then differ per λ before
+/// the path does; Auto keeps the stratified passes there). Both twins decide by this.
+inline bool useHeroSampling(SpectralSampling s, bool weights_depend_on_lambda) {
+  return s == SpectralSampling::Hero || (s == SpectralSampling::Auto && !weights_depend_on_lambda);
+}
+
 struct RenderSettings {
   int width = 0, height = 0;        ///< 0 = the scene camera's
   int spp = 1;                      ///< jittered samples per pixel
   int wavelengths = 0;              ///< spectral samples per pixel sample; 0 = RGB mode
   double wavelength_nm = 587.5618;  ///< index wavelength of the RGB mode (He d line)
+  SpectralSampling sampling = SpectralSampling::Auto;  ///< spectral mode only
+  /// Extra layers of the image (RenderImage::spectral, ::modes; `eikon render --layers`). With
+  /// either in spectral mode the RGB is computed from the wavelength bins (docs/spectra.md
+  /// "Spectral layers"), so that the layers integrate to it exactly.
+  bool spectral_layer = false;  ///< one channel per wavelength bin (spectral mode only)
+  bool mode_layers = false;     ///< o- and e-mode radiance as separate RGB layers
   MarchSettings march;
   /// progress(fraction done); may be empty.
   std::function<void(double)> progress;
@@ -47,6 +75,14 @@ struct RenderImage {
   /// Pixel samples (passes of a pixel) in which a march was stopped by the device's loop budget
   /// (lavapipe; docs/view-renderer.md) and so lacks the light it would have reached; 0 on the CPU.
   long long cut_samples = 0;
+  /// RenderSettings::spectral_layer: spectral radiance per wavelength bin k = [380 + k·400/N,
+  /// 380 + (k + 1)·400/N) nm (its mean over the bin, W·m⁻²·sr⁻¹·nm⁻¹ in the environment's units),
+  /// `bins` = N floats per pixel, rows from the top; empty otherwise.
+  int bins = 0;
+  std::vector<float> spectral;
+  /// RenderSettings::mode_layers: 6 floats per pixel, the o-mode's and the e-mode's share of the
+  /// linear sRGB (o + e = rgb; e = 0 in a scene without crystals); empty otherwise.
+  std::vector<float> modes;
 };
 
 /// One traced ray (one mode) as both twins report it. Directions are unit, world space.

@@ -46,7 +46,8 @@ ImageDiff compare(const RenderImage& g, const RenderImage& c) {
   return {sumDiff / sumVal, diffs[size_t(0.95 * double(diffs.size()))], diffs.back()};
 }
 
-void expectTwinsAgree(const char* name, int resolution, int width, int height) {
+void expectTwinsAgree(const char* name, int resolution, int width, int height,
+                      SpectralSampling sampling) {
   Scene scene =
       loadScene(std::filesystem::path(EIKON_SOURCE_DIR) / "scenes" / (std::string(name) + ".json"));
   scene.volume.resolution = resolution;
@@ -59,6 +60,7 @@ void expectTwinsAgree(const char* name, int resolution, int width, int height) {
   const ReferenceMarcher cpu(field, scene.environment);
   RenderSettings rs;
   rs.wavelengths = 16;
+  rs.sampling = sampling;
   int passesSeen = 0;
   rs.on_pass = [&](const RenderImage&, int, int) { ++passesSeen; };
   const RenderImage g = gpu.render(rs), c = cpu.render(scene.camera, rs);
@@ -74,10 +76,24 @@ void expectTwinsAgree(const char* name, int resolution, int width, int height) {
   expectNoValidationMessages();
 }
 
-TEST(SpectralPasses, CalciteRhombTwinsAgree) { expectTwinsAgree("calcite_rhomb", 224, 48, 36); }
+TEST(SpectralPasses, CalciteRhombTwinsAgree) {
+  expectTwinsAgree("calcite_rhomb", 224, 48, 36, SpectralSampling::Stratified);
+}
 
 TEST(SpectralPasses, DiamondBrilliantTwinsAgree) {
-  expectTwinsAgree("diamond_brilliant", 64, 40, 30);
+  expectTwinsAgree("diamond_brilliant", 64, 40, 30, SpectralSampling::Stratified);
+}
+
+// Hero wavelength sampling (docs/spectra.md): one march per pixel sample carries all 16
+// wavelengths. The rhomb attenuates (its weights depend on λ, so the hero carries everything from
+// the first step) and has two modes; the brilliant disperses at its first facet. The twins share
+// the hero, its rotations and the point where the others stop (the first dispersive event).
+TEST(SpectralPasses, CalciteRhombHeroTwinsAgree) {
+  expectTwinsAgree("calcite_rhomb", 224, 48, 36, SpectralSampling::Hero);
+}
+
+TEST(SpectralPasses, DiamondBrilliantHeroTwinsAgree) {
+  expectTwinsAgree("diamond_brilliant", 64, 40, 30, SpectralSampling::Hero);
 }
 
 // Progressive output: with 3 samples per pixel the image so far is handed out after the first and

@@ -21,9 +21,13 @@ namespace eikon::test {
 namespace {
 
 // Per-pixel flat-spectrum weight W_p (sample 0, spp = 1), in linear sRGB.
-glm::dvec3 flatWeight(uint32_t pixel, uint32_t n) {
+// The pixel's own estimate of white at its N wavelengths of sample 0: the stratified set, or
+// the hero's (heroWavelengths) where the render samples by hero wavelengths.
+glm::dvec3 flatWeight(uint32_t pixel, uint32_t n, bool hero = false) {
   std::vector<spectrum::SpectralSample> s;
-  for (double l : spectrum::stratifiedWavelengths(pixel, 0, n)) s.push_back({l, 1.0});
+  for (double l :
+       hero ? spectrum::heroWavelengths(pixel, 0, n) : spectrum::stratifiedWavelengths(pixel, 0, n))
+    s.push_back({l, 1.0});
   return spectrum::spectralToLinearSrgb(s);
 }
 
@@ -46,27 +50,30 @@ TEST(Spectral, NonDispersiveSphereHasNoColourShift) {
   // relative, gives ~2e-6 relative), while W_p is computed in double. Chroma is then a few 1e-6;
   // 1e-4 leaves margin yet is ~3000× below the raw per-pixel chroma of the N = 8 estimate (0.3–1).
   Twins t(kGreySphere);
-  RenderSettings rs;
-  rs.wavelengths = 8;
-  RenderImage img = t.gpu->render(rs);
-  double worst = 0.0, worstRaw = 0.0;
-  int inside = 0;
-  for (int i = 0; i < img.width * img.height; ++i) {
-    glm::dvec3 c = px(img, i), w = flatWeight(uint32_t(i), 8), g = c / w;
-    double mean = (g.x + g.y + g.z) / 3.0;
-    double chroma = (std::max({g.x, g.y, g.z}) - std::min({g.x, g.y, g.z})) / mean;
-    double raw =
-        (std::max({c.x, c.y, c.z}) - std::min({c.x, c.y, c.z})) / ((c.x + c.y + c.z) / 3.0);
-    int x = i % img.width, y = i / img.width;
-    if (std::hypot(x - 15.5, y - 15.5) < 10) ++inside;  // sphere covers r ≈ 11.6 px
-    worst = std::max(worst, chroma);
-    worstRaw = std::max(worstRaw, raw);
+  for (bool hero : {false, true}) {
+    RenderSettings rs;
+    rs.wavelengths = 8;
+    rs.sampling = hero ? SpectralSampling::Hero : SpectralSampling::Stratified;
+    RenderImage img = t.gpu->render(rs);
+    double worst = 0.0, worstRaw = 0.0;
+    int inside = 0;
+    for (int i = 0; i < img.width * img.height; ++i) {
+      glm::dvec3 c = px(img, i), w = flatWeight(uint32_t(i), 8, hero), g = c / w;
+      double mean = (g.x + g.y + g.z) / 3.0;
+      double chroma = (std::max({g.x, g.y, g.z}) - std::min({g.x, g.y, g.z})) / mean;
+      double raw =
+          (std::max({c.x, c.y, c.z}) - std::min({c.x, c.y, c.z})) / ((c.x + c.y + c.z) / 3.0);
+      int x = i % img.width, y = i / img.width;
+      if (std::hypot(x - 15.5, y - 15.5) < 10) ++inside;  // sphere covers r ≈ 11.6 px
+      worst = std::max(worst, chroma);
+      worstRaw = std::max(worstRaw, raw);
+    }
+    std::printf(
+        "non-dispersive sphere, N = 8 (%s): max chroma of RGB/W_p %.3g (raw per-pixel chroma up to "
+        "%.3g), %d px on the sphere\n",
+        hero ? "hero" : "stratified", worst, worstRaw, inside);
+    EXPECT_LT(worst, 1e-4);
   }
-  std::printf(
-      "non-dispersive sphere, N = 8: max chroma of RGB/W_p %.3g (raw per-pixel chroma up to %.3g), "
-      "%d px on the sphere\n",
-      worst, worstRaw, inside);
-  EXPECT_LT(worst, 1e-4);
   expectNoValidationMessages();
 }
 
@@ -85,29 +92,33 @@ TEST(Spectral, EqualEnergyEnvironmentIsWhite) {
   // differences, not ratios.) Their mean over the image must be (1,1,1) within 5σ/√P
   // (σ the per-pixel sample standard deviation), and the same estimator's bias is checked below.
   Twins t(kFlatEnv);
-  RenderSettings rs;
-  rs.wavelengths = 8;
-  RenderImage img = t.gpu->render(rs);
-  double worst = 0.0;
-  glm::dvec3 sum(0.0), sum2(0.0);
-  int count = 0;
-  for (int i = 0; i < img.width * img.height; ++i) {
-    int x = i % img.width, y = i / img.width;
-    if (std::hypot(x - 127.5, y - 127.5) < 50) continue;  // sphere r = 3 mm at 40 mm: 36 px; margin
-    glm::dvec3 c = px(img, i), w = flatWeight(uint32_t(i), 8);
-    worst = std::max({worst, std::abs(c.x - w.x), std::abs(c.y - w.y), std::abs(c.z - w.z)});
-    sum += c;
-    sum2 += c * c;
-    ++count;
+  for (bool hero : {false, true}) {
+    RenderSettings rs;
+    rs.wavelengths = 8;
+    rs.sampling = hero ? SpectralSampling::Hero : SpectralSampling::Stratified;
+    RenderImage img = t.gpu->render(rs);
+    double worst = 0.0;
+    glm::dvec3 sum(0.0), sum2(0.0);
+    int count = 0;
+    for (int i = 0; i < img.width * img.height; ++i) {
+      int x = i % img.width, y = i / img.width;
+      if (std::hypot(x - 127.5, y - 127.5) < 50)
+        continue;  // sphere r = 3 mm at 40 mm: 36 px; margin
+      glm::dvec3 c = px(img, i), w = flatWeight(uint32_t(i), 8, hero);
+      worst = std::max({worst, std::abs(c.x - w.x), std::abs(c.y - w.y), std::abs(c.z - w.z)});
+      sum += c;
+      sum2 += c * c;
+      ++count;
+    }
+    glm::dvec3 mean = sum / double(count), sd = glm::sqrt(sum2 / double(count) - mean * mean);
+    std::printf(
+        "flat environment, N = 8, %d background px: max |RGB - W_p| %.3g; mean (%.5f %.5f %.5f), "
+        "per-pixel sd "
+        "(%.3f %.3f %.3f)\n",
+        count, worst, mean.x, mean.y, mean.z, sd.x, sd.y, sd.z);
+    EXPECT_LT(worst, 1e-3);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], 1.0, 5.0 * sd[c] / std::sqrt(double(count)));
   }
-  glm::dvec3 mean = sum / double(count), sd = glm::sqrt(sum2 / double(count) - mean * mean);
-  std::printf(
-      "flat environment, N = 8, %d background px: max |RGB - W_p| %.3g; mean (%.5f %.5f %.5f), "
-      "per-pixel sd "
-      "(%.3f %.3f %.3f)\n",
-      count, worst, mean.x, mean.y, mean.z, sd.x, sd.y, sd.z);
-  EXPECT_LT(worst, 1e-3);
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], 1.0, 5.0 * sd[c] / std::sqrt(double(count)));
   expectNoValidationMessages();
 }
 
