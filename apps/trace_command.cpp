@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <vector>
 
 #include "apps/commands.h"
 #include "apps/progress.h"
@@ -25,7 +26,8 @@
 namespace eikon::cli {
 namespace {
 
-glm::dvec3 parseVec(const std::string& s, const char* what) {
+/// The comma-separated numbers of `s`, or nothing when a part is not one finite number.
+std::optional<std::vector<double>> parseNumbers(const std::string& s) {
   std::stringstream ss(s);
   std::string part;
   std::vector<double> v;
@@ -33,37 +35,33 @@ glm::dvec3 parseVec(const std::string& s, const char* what) {
     try {
       size_t used = 0;
       double x = std::stod(part, &used);
-      if (used != part.size() || !std::isfinite(x)) throw std::invalid_argument("");
+      if (used != part.size() || !std::isfinite(x)) return std::nullopt;
       v.push_back(x);
     } catch (...) {
-      throw CliError(std::string(what) + " must be three finite numbers x,y,z, got '" + s + "'");
+      return std::nullopt;
     }
   }
-  if (v.size() != 3)
+  return v;
+}
+
+glm::dvec3 parseVec(const std::string& s, const char* what) {
+  const std::optional<std::vector<double>> v = parseNumbers(s);
+  if (!v)
+    throw CliError(std::string(what) + " must be three finite numbers x,y,z, got '" + s + "'");
+  if (v->size() != 3)
     throw CliError(std::string(what) + " must be three numbers x,y,z, got '" + s + "'");
-  return {v[0], v[1], v[2]};
+  return {(*v)[0], (*v)[1], (*v)[2]};
 }
 
 /// --stokes: four finite numbers with S0 > 0 and a degree of polarisation ≤ 1.
 Stokes parseStokes(const std::string& s) {
-  std::stringstream ss(s);
-  std::string part;
-  std::vector<double> v;
   auto bad = [&](const std::string& why) {
     return CliError("--stokes " + why + ", got '" + s + "'");
   };
-  while (std::getline(ss, part, ',')) {
-    try {
-      size_t used = 0;
-      double x = std::stod(part, &used);
-      if (used != part.size() || !std::isfinite(x)) throw std::invalid_argument("");
-      v.push_back(x);
-    } catch (...) {
-      throw bad("must be four finite numbers S0,S1,S2,S3");
-    }
-  }
-  if (v.size() != 4) throw bad("must be four numbers S0,S1,S2,S3");
-  const Stokes st(v[0], v[1], v[2], v[3]);
+  const std::optional<std::vector<double>> v = parseNumbers(s);
+  if (!v) throw bad("must be four finite numbers S0,S1,S2,S3");
+  if (v->size() != 4) throw bad("must be four numbers S0,S1,S2,S3");
+  const Stokes st((*v)[0], (*v)[1], (*v)[2], (*v)[3]);
   if (!(st[0] > 0)) throw bad("needs S0 > 0");
   if (degreeOfPolarisation(st) > 1.0 + 1e-9)
     throw bad("has a degree of polarisation sqrt(S1² + S2² + S3²)/S0 above 1");

@@ -125,7 +125,7 @@ TEST_F(BaselineRatio, MissingBuildIsOneErrorLine) {
 // any render runs (so nothing is printed on stdout).
 TEST_F(BaselineRatio, StartupBenchBadArgumentsAreOneErrorLine) {
   const std::string script = std::string(EIKON_SOURCE_DIR) + "/bench/startup.sh";
-  for (const std::string args :
+  for (const std::string& args :
        {std::string("--reps 0"), std::string("--reps x"), std::string("--no-such-option"),
         "--eikon " + (dir_ / "no_eikon").string(), (dir_ / "no_scene.json").string()}) {
     const auto r = eikon::test::runProgram(script, args, dir_, "");

@@ -10,7 +10,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
+#include <system_error>
 
 namespace eikon::test {
 
@@ -68,5 +70,28 @@ inline Outcome runEikon(const std::string& args, const std::filesystem::path& io
                         const std::string& env = "") {
   return runProgram(EIKON_BINARY, args, io_dir, env);
 }
+
+/// A fresh folder under the system's temporary directory, named `stem_XXXXXX`, with an `io`
+/// subfolder for the runners' captured output; removed with everything in it when it goes.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& stem) {
+    std::string tmpl = (std::filesystem::temp_directory_path() / (stem + "_XXXXXX")).string();
+    if (::mkdtemp(tmpl.data()) == nullptr)
+      throw std::runtime_error("cannot create a temporary folder " + tmpl);
+    path_ = tmpl;
+    std::filesystem::create_directories(path_ / "io");
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
 
 }  // namespace eikon::test

@@ -29,14 +29,6 @@ const fs::path kMeshes = fs::path(EIKON_SOURCE_DIR) / "tests" / "data" / "meshes
 
 class MeshCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_mesh_cli_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-    dir_ = tmpl;
-    fs::create_directories(dir_ / "io");
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   fs::path scene(const std::string& name, const std::string& object,
                  const std::string& interfaces = "sharp") {
     const fs::path p = dir_ / name;
@@ -52,7 +44,8 @@ class MeshCli : public ::testing::Test {
   }
   Outcome eikon(const std::string& args) { return eikon::test::runEikon(args, dir_ / "io"); }
 
-  fs::path dir_;
+  eikon::test::TempDir tmp_{"eikon_mesh_cli"};
+  const fs::path dir_ = tmp_.path();
 };
 
 const char* kPlace = R"("center": [0.3, -0.2, 0.1], "rotation_deg": [20, -35, 50])";

@@ -31,18 +31,11 @@ constexpr const char* kScene = R"({
   "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 5, "material": "glass"}]
 })";
 
+/// A temporary folder holding kScene as scene.json.
 struct Dir {
-  fs::path path;
-  Dir() {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_layers_cli_XXXXXX").string();
-    if (::mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path = tmpl;
-    std::ofstream(path / "scene.json") << kScene;
-  }
-  ~Dir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
+  eikon::test::TempDir tmp{"eikon_layers_cli"};
+  const fs::path path = tmp.path();
+  Dir() { std::ofstream(path / "scene.json") << kScene; }
 };
 
 size_t lineCount(const std::string& s) {

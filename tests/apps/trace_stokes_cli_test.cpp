@@ -27,16 +27,6 @@ using eikon::test::quote;
 
 class TraceStokesCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_stokes_cli_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-    dir_ = tmpl;
-    fs::create_directories(dir_ / "io");
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
   std::string write(const std::string& name, const std::string& text) const {
     std::ofstream(dir_ / name) << text;
     return (dir_ / name).string();
@@ -53,7 +43,8 @@ class TraceStokesCli : public ::testing::Test {
     EXPECT_NE(r.err.find(phrase), std::string::npos) << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;  // no partial output
   }
-  fs::path dir_;
+  eikon::test::TempDir tmp_{"eikon_stokes_cli"};
+  const fs::path dir_ = tmp_.path();
 };
 
 std::string sheetJson(double z, double deg) {

@@ -112,17 +112,7 @@ class Xvfb {
 
 class ViewerTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_viewer_test_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-    dir_ = tmpl;
-    fs::create_directories(dir_ / "io");
-    fs::create_directories(dir_ / "render_io");
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
+  void SetUp() override { fs::create_directories(dir_ / "render_io"); }
   std::string env(const std::string& display) const {
     return "EIKON_VALIDATION=1 DISPLAY=" + quote(display);
   }
@@ -137,7 +127,8 @@ class ViewerTest : public ::testing::Test {
     EXPECT_EQ(o.err.find("validation"), std::string::npos) << o.err;
     return readPng(fs::path(out).replace_extension(".png"));
   }
-  fs::path dir_;
+  eikon::test::TempDir tmp_{"eikon_viewer_test"};
+  const fs::path dir_ = tmp_.path();
 };
 
 const std::string kGlassSphere = std::string(EIKON_SOURCE_DIR) + "/scenes/glass_sphere.json";
