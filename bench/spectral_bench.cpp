@@ -140,6 +140,39 @@ int heroSection(vk::Context& ctx, int W, int H, int res, int timeSpp, int refSpp
 }
 }  // namespace
 
+/// Section 2: colour error against the reference over the pixels where it shows the spectrum.
+void printColourError(const std::vector<RenderImage>& imgs, const std::vector<int>& ns,
+                      const RenderImage& ref, int W, int H) {
+  // Colour error over the pixels where the reference shows the spectrum (luminance > 0.1; the
+  // sky is 0.02): RMS of |ΔRGB| / mean reference luminance there, and the RMS chromaticity error.
+  std::printf(
+      "\n2. Colour error vs N (reference N = 128, spp 1, same pixel positions)\n"
+      "   N   rel. RMS |dRGB|   mean |dRGB|/lum   (pixels in the spectrum: ");
+  std::vector<size_t> mask;
+  double lumSum = 0.0;
+  for (size_t i = 0; i < size_t(W) * H; ++i)
+    if (luminance(&ref.rgb[3 * i]) > 0.1) {
+      mask.push_back(i);
+      lumSum += luminance(&ref.rgb[3 * i]);
+    }
+  const double lumMean = lumSum / double(mask.size());
+  std::printf("%zu, mean luminance %.3f)\n", mask.size(), lumMean);
+  for (size_t k = 0; k < ns.size(); ++k) {
+    double s2 = 0.0, s1 = 0.0;
+    for (size_t i : mask) {
+      double d2 = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        double d = double(imgs[k].rgb[3 * i + c]) - ref.rgb[3 * i + c];
+        d2 += d * d;
+      }
+      s2 += d2;
+      s1 += std::sqrt(d2);
+    }
+    std::printf("  %3d  %14.4f  %16.4f\n", ns[k], std::sqrt(s2 / double(mask.size())) / lumMean,
+                s1 / double(mask.size()) / lumMean);
+  }
+}
+
 int main(int argc, char** argv) {
   int W = 800, H = 600;
   CLI::App app{
@@ -209,34 +242,7 @@ int main(int argc, char** argv) {
   std::printf("  128  %8.3f  %6.2f  %7.1f\n", ref.seconds, ref.seconds / t1,
               1e9 * ref.seconds / (double(W) * H * 128));
 
-  // Colour error over the pixels where the reference shows the spectrum (luminance > 0.1; the
-  // sky is 0.02): RMS of |ΔRGB| / mean reference luminance there, and the RMS chromaticity error.
-  std::printf(
-      "\n2. Colour error vs N (reference N = 128, spp 1, same pixel positions)\n"
-      "   N   rel. RMS |dRGB|   mean |dRGB|/lum   (pixels in the spectrum: ");
-  std::vector<size_t> mask;
-  double lumSum = 0.0;
-  for (size_t i = 0; i < size_t(W) * H; ++i)
-    if (luminance(&ref.rgb[3 * i]) > 0.1) {
-      mask.push_back(i);
-      lumSum += luminance(&ref.rgb[3 * i]);
-    }
-  const double lumMean = lumSum / double(mask.size());
-  std::printf("%zu, mean luminance %.3f)\n", mask.size(), lumMean);
-  for (size_t k = 0; k < ns.size(); ++k) {
-    double s2 = 0.0, s1 = 0.0;
-    for (size_t i : mask) {
-      double d2 = 0.0;
-      for (int c = 0; c < 3; ++c) {
-        double d = double(imgs[k].rgb[3 * i + c]) - ref.rgb[3 * i + c];
-        d2 += d * d;
-      }
-      s2 += d2;
-      s1 += std::sqrt(d2);
-    }
-    std::printf("  %3d  %14.4f  %16.4f\n", ns[k], std::sqrt(s2 / double(mask.size())) / lumMean,
-                s1 / double(mask.size()) / lumMean);
-  }
+  printColourError(imgs, ns, ref, W, H);
 
   if (int rc = heroSection(*ctx, dW, dH, dRes, timeSpp, refSpp, eW, eH); rc != 0) return rc;
 
