@@ -1,11 +1,11 @@
 // Which twin simulates a render's light (eikon::lightOnCpu, docs/light-simulator.md "Which twin
 // simulates a render"): the user's choice wins; "auto" without a GPU context is the CPU twin
 // (with one, the rule is the device type, measured by light_bench: docs/performance.md).
+#include "core/render/render_defaults.h"
+
 #include <gtest/gtest.h>
 
 #include <stdexcept>
-
-#include "core/render/render_defaults.h"
 
 namespace eikon::test {
 namespace {
