@@ -22,22 +22,14 @@ struct Bench {
 
 class BenchHelp : public ::testing::TestWithParam<Bench> {
  protected:
-  void SetUp() override {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_bench_cli_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-    dir_ = tmpl;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
   /// Run the benchmark with `args`; skips the test when it was not built.
   eikon::test::Outcome run(const std::string& args) {
     const std::string bin = GetParam().binary;
     if (bin.empty() || !fs::exists(bin)) return {-2, "", ""};
     return eikon::test::runProgram(bin, args, dir_);
   }
-  fs::path dir_;
+  eikon::test::TempDir tmp_{"eikon_bench_cli"};
+  const fs::path dir_ = tmp_.path();
 };
 
 TEST_P(BenchHelp, HelpPrintsUsageAndExitsZero) {
@@ -72,21 +64,13 @@ INSTANTIATE_TEST_SUITE_P(Benchmarks, BenchHelp,
 // each mistake one line naming the argument and a non-zero exit.
 class BaselineRatio : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_baseline_ratio_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-    dir_ = tmpl;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
   eikon::test::Outcome run(const std::string& args, const std::string& env = "") {
     return eikon::test::runProgram(std::string(EIKON_SOURCE_DIR) + "/bench/baseline_ratio.sh", args,
                                    dir_, env);
   }
   static int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
-  fs::path dir_;
+  eikon::test::TempDir tmp_{"eikon_baseline_ratio"};
+  const fs::path dir_ = tmp_.path();
 };
 
 TEST_F(BaselineRatio, MissingBaselineBinaryIsOneErrorLine) {

@@ -23,10 +23,8 @@ using eikon::test::Outcome;
 using eikon::test::quote;
 
 TEST(FacetedCli, TraceThroughTheTableRefractsAsSnellSays) {
-  std::string tmpl = (fs::temp_directory_path() / "eikon_faceted_cli_XXXXXX").string();
-  ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-  const fs::path dir = tmpl;
-  fs::create_directories(dir / "io");
+  const eikon::test::TempDir tmp("eikon_faceted_cli");  // removed at the end, unlike before
+  const fs::path& dir = tmp.path();
   const fs::path scene = dir / "plate.json";
   std::ofstream(scene) << R"({
   "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "resolution": 64,

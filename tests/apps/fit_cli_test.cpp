@@ -25,13 +25,6 @@ using eikon::test::Outcome;
 
 class FitCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_fit_cli_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-    dir_ = tmpl;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   std::string write(const std::string& name, const std::string& text) const {
     std::ofstream(path(name)) << text;
@@ -60,7 +53,8 @@ class FitCli : public ::testing::Test {
       EXPECT_EQ(e.path().filename().string().find(".out.json.tmp"), std::string::npos)
           << "temporary file left";
   }
-  fs::path dir_;
+  eikon::test::TempDir tmp_{"eikon_fit_cli"};
+  const fs::path dir_ = tmp_.path();
 };
 
 // The material file has exactly the contract's keys and the physics of §6 (n_d of N-BK7 within

@@ -22,16 +22,6 @@ using eikon::test::quote;
 
 class InputCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_input_cli_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-    dir_ = tmpl;
-    fs::create_directories(dir_ / "io");
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
   std::string write(const std::string& name, const std::string& bytes) const {
     std::ofstream(dir_ / name, std::ios::binary) << bytes;
     return (dir_ / name).string();
@@ -57,7 +47,8 @@ class InputCli : public ::testing::Test {
     EXPECT_NE(r.err.find(phrase), std::string::npos)
         << "stderr lacks '" << phrase << "': " << r.err;
   }
-  fs::path dir_;
+  eikon::test::TempDir tmp_{"eikon_input_cli"};
+  const fs::path dir_ = tmp_.path();
 };
 
 TEST_F(InputCli, BinaryFileGivesOnePrintableLine) {

@@ -59,17 +59,7 @@ std::vector<Mark> timingLines(const std::string& err) {
 
 class StartupCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string tmpl = (fs::temp_directory_path() / "eikon_startup_cli_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-    dir_ = tmpl;
-    fs::create_directories(dir_ / "io");
-    std::ofstream(dir_ / "scene.json") << kScene;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
+  void SetUp() override { std::ofstream(dir_ / "scene.json") << kScene; }
   /// `eikon render` of the scene, with validation and the caches in the test's own folder.
   Outcome render(const std::string& extra, const std::string& env = "") const {
     const std::string e = "EIKON_VALIDATION=1 EIKON_CACHE_DIR=" + quote((dir_ / "cache").string()) +
@@ -81,7 +71,8 @@ class StartupCli : public ::testing::Test {
     EXPECT_EQ(o.err.find("[vulkan validation]"), std::string::npos) << o.err;
     return o;
   }
-  fs::path dir_;
+  eikon::test::TempDir tmp_{"eikon_startup_cli"};
+  const fs::path dir_ = tmp_.path();
 };
 
 // Every stage up to the written output, once each, in the order they run, with the seconds since
