@@ -127,6 +127,32 @@ class ViewerTest : public ::testing::Test {
     EXPECT_EQ(o.err.find("validation"), std::string::npos) << o.err;
     return readPng(fs::path(out).replace_extension(".png"));
   }
+  /// The viewer on `scene` with `args`, in `server`'s display, sent the xdotool `actions` on its
+  /// window once the window shows; waits for it to exit. Its exit status, stdout and stderr.
+  struct ViewerRun {
+    int status = -1;
+    std::string out, err;
+  };
+  ViewerRun viewWhile(const Xvfb& server, const std::string& xdotool, const std::string& scene,
+                      const std::string& args, const std::string& actions) const {
+    const std::string cmd = env(server.display()) + " " + quote(EIKON_BINARY) + " view " +
+                            quote(scene) + " " + args + " >" + quote((dir_ / "view.out").string()) +
+                            " 2>" + quote((dir_ / "view.err").string()) + " </dev/null";
+    const pid_t viewer = ::fork();
+    if (viewer == 0) {
+      ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    const std::string send = "DISPLAY=" + quote(server.display()) + " timeout 300 " +
+                             quote(xdotool) + " search --sync --onlyvisible --name 'eikon view'" +
+                             actions + " >/dev/null 2>&1";
+    EXPECT_EQ(std::system(send.c_str()), 0) << send;
+    ViewerRun r;
+    EXPECT_EQ(::waitpid(viewer, &r.status, 0), viewer);
+    r.out = eikon::test::slurp(dir_ / "view.out");
+    r.err = eikon::test::slurp(dir_ / "view.err");
+    return r;
+  }
   eikon::test::TempDir tmp_{"eikon_viewer_test"};
   const fs::path dir_ = tmp_.path();
 };
@@ -173,31 +199,17 @@ TEST_F(ViewerTest, DragOrbitsAndRefinedViewMatchesRender) {
   Xvfb server(xvfb);
   ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
   const fs::path shot = dir_ / "shot.png";
-  // The viewer in the background; it exits once its last view is refined to 4 samples.
-  const std::string cmd = env(server.display()) + " " + quote(EIKON_BINARY) + " view " +
-                          quote(kGlassSphere) +
-                          " --width 160 --height 120 --spp 4 --exit-after-frames 100 "
-                          "--screenshot " +
-                          quote(shot.string()) + " >" + quote((dir_ / "view.out").string()) +
-                          " 2>" + quote((dir_ / "view.err").string()) + " </dev/null";
-  const pid_t viewer = ::fork();
-  if (viewer == 0) {
-    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  // Wait for the window, then drag across it with the left button: an orbit about look_at.
-  const std::string drag =
-      "DISPLAY=" + quote(server.display()) + " timeout 300 " + quote(xdotool) +
-      " search --sync --onlyvisible --name 'eikon view'"
-      " mousemove --window %1 60 60 sleep 0.1 mousedown 1 sleep 0.1"
-      " mousemove --window %1 75 64 sleep 0.1 mousemove --window %1 90 68 sleep 0.1"
-      " mousemove --window %1 105 72 sleep 0.1 mouseup 1 >/dev/null 2>&1";
-  EXPECT_EQ(std::system(drag.c_str()), 0) << drag;
-  int st = 0;
-  ASSERT_EQ(::waitpid(viewer, &st, 0), viewer);
-  const std::string out = eikon::test::slurp(dir_ / "view.out"),
-                    err = eikon::test::slurp(dir_ / "view.err");
-  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << err;
+  // The viewer exits once its last view is refined to 4 samples. Once its window shows, a drag
+  // across it with the left button: an orbit about look_at.
+  const ViewerRun run =
+      viewWhile(server, xdotool, kGlassSphere,
+                "--width 160 --height 120 --spp 4 --exit-after-frames 100 --screenshot " +
+                    quote(shot.string()),
+                " mousemove --window %1 60 60 sleep 0.1 mousedown 1 sleep 0.1"
+                " mousemove --window %1 75 64 sleep 0.1 mousemove --window %1 90 68 sleep 0.1"
+                " mousemove --window %1 105 72 sleep 0.1 mouseup 1");
+  const std::string &out = run.out, &err = run.err;
+  ASSERT_TRUE(WIFEXITED(run.status) && WEXITSTATUS(run.status) == 0) << err;
   EXPECT_EQ(err.find("validation"), std::string::npos) << err;
   EXPECT_NE(out.find("4 samples"), std::string::npos) << out;
 
@@ -253,29 +265,14 @@ TEST_F(ViewerTest, CtrlDragMovesTheLightAndSimulatesItAgain) {
   ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
   std::ofstream(dir_ / "lit.json") << kLitScene;
   const fs::path shot = dir_ / "lit.png";
-  const std::string cmd = env(server.display()) + " " + quote(EIKON_BINARY) + " view " +
-                          quote((dir_ / "lit.json").string()) +
-                          " --width 80 --height 60 --spp 1 --exit-after-frames 100 "
-                          "--screenshot " +
-                          quote(shot.string()) + " >" + quote((dir_ / "view.out").string()) +
-                          " 2>" + quote((dir_ / "view.err").string()) + " </dev/null";
-  const pid_t viewer = ::fork();
-  if (viewer == 0) {
-    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  const std::string drag =
-      "DISPLAY=" + quote(server.display()) + " timeout 300 " + quote(xdotool) +
-      " search --sync --onlyvisible --name 'eikon view'"
+  const ViewerRun run = viewWhile(
+      server, xdotool, (dir_ / "lit.json").string(),
+      "--width 80 --height 60 --spp 1 --exit-after-frames 100 --screenshot " + quote(shot.string()),
       " mousemove --window %1 40 30 sleep 0.1 keydown ctrl sleep 0.1 mousedown 1 sleep 0.1"
       " mousemove --window %1 46 30 sleep 0.1 mousemove --window %1 52 30 sleep 0.1"
-      " mouseup 1 sleep 0.1 keyup ctrl >/dev/null 2>&1";
-  EXPECT_EQ(std::system(drag.c_str()), 0) << drag;
-  int st = 0;
-  ASSERT_EQ(::waitpid(viewer, &st, 0), viewer);
-  const std::string out = eikon::test::slurp(dir_ / "view.out"),
-                    err = eikon::test::slurp(dir_ / "view.err");
-  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << err;
+      " mouseup 1 sleep 0.1 keyup ctrl");
+  const std::string &out = run.out, &err = run.err;
+  ASSERT_TRUE(WIFEXITED(run.status) && WEXITSTATUS(run.status) == 0) << err;
   EXPECT_EQ(err.find("validation"), std::string::npos) << err;
   const std::string said = "light 0 simulated again (from the light cache): position ";
   const size_t at = out.find(said);
