@@ -26,26 +26,22 @@
 #include "core/scene/scene.h"
 #include "core/volume/field.h"
 #include "core/volume/volume_set.h"
+#include "tests/core/polarised_fixtures.h"
 
 namespace eikon {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-double rad(double d) { return d * kPi / 180.0; }
+using test::kAside;
+using test::plate;
+using test::rad;
 
 struct Scenery {
   Scene scene;
   VolumeSet volume;
   VolumeField field;
   explicit Scenery(const std::string& objects, double ambient = 1.0)
-      : scene(parseScene(R"({"environment": {"type": "constant", "radiance": 1},
-                             "ambient_index": )" +
-                             std::to_string(ambient) +
-                             R"(, "volume": {"bounds_min": [-8, -8, -8], "bounds_max": [8, 8, 8],
-                             "resolution": 64}, "materials": {"glass": {"n": 1.5}},
-                             "objects": [)" +
-                             objects + "]}",
-                         "pol.json")),
+      : scene(parseScene(test::polarisedSceneJson(objects, ambient), "pol.json")),
         volume(voxelize(scene)),
         field(volume) {}
   PolarisedTrace trace(const glm::dvec3& o, const glm::dvec3& d, double nm,
@@ -61,14 +57,6 @@ std::string sheet(double z, double angle_deg) {
          std::to_string(std::cos(rad(angle_deg))) + ", " +
          std::to_string(std::sin(rad(angle_deg))) + R"(, 0], "size": [20, 20]})";
 }
-
-std::string plate(const std::string& material, double thickness, const std::string& axis) {
-  return R"({"shape": "box", "center": [0, 0, 0], "size": [14, 14, )" + std::to_string(thickness) +
-         R"(], "material": ")" + material + R"(", "optic_axis": )" + axis + "}";
-}
-
-const char* kAside =
-    R"({"shape": "sphere", "center": [5, 5, 5], "radius": 1, "material": "glass"})";
 
 TEST(PolarisedTrace, MalusWithTwoSheets) {
   double worst = 0.0;

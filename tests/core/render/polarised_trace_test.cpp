@@ -21,13 +21,13 @@
 #include <cmath>
 #include <cstdio>
 
+#include "tests/core/polarised_fixtures.h"
 #include "tests/core/test_support.h"
 
 namespace eikon::test {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-double rad(double d) { return d * kPi / 180.0; }
 
 /// One voxelised scene with both twins of the polarised trace; the sheets are passed per call.
 struct PolTwins {
@@ -36,13 +36,7 @@ struct PolTwins {
   VolumeField field;
   ViewRenderer gpu;
   explicit PolTwins(const std::string& objects, double ambient = 1.0)
-      : scene(sceneFromJson(R"({"environment": {"type": "constant", "radiance": 1},
-                               "ambient_index": )" +
-                            std::to_string(ambient) +
-                            R"(, "volume": {"bounds_min": [-8, -8, -8], "bounds_max": [8, 8, 8],
-                               "resolution": 64}, "materials": {"glass": {"n": 1.5}},
-                               "objects": [)" +
-                            objects + "]}")),
+      : scene(sceneFromJson(polarisedSceneJson(objects, ambient))),
         volume(voxelize(scene)),
         field(volume),
         gpu(context(), scene, volume) {}
@@ -60,14 +54,6 @@ PolarizerSheet sheet(double z, double angle_deg) {
   s.width = s.height = 20;
   return s;
 }
-
-std::string plate(const std::string& material, double thickness, const std::string& axis) {
-  return R"({"shape": "box", "center": [0, 0, 0], "size": [14, 14, )" + std::to_string(thickness) +
-         R"(], "material": ")" + material + R"(", "optic_axis": )" + axis + "}";
-}
-
-const char* kAside =
-    R"({"shape": "sphere", "center": [5, 5, 5], "radius": 1, "material": "glass"})";
 
 void expectStokesNear(const Stokes& g, const Stokes& c, double tol, const std::string& what) {
   for (int k = 0; k < 4; ++k) EXPECT_NEAR(g[k], c[k], tol) << what << " S" << k;
