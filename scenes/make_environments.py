@@ -10,8 +10,12 @@ scenes/diamond_lights.exr (scenes/diamond_brilliant.json): a black sky with 40 s
 round lights (radiance 30, radius 1.5°) scattered over the upper hemisphere (fixed seed), and a
 faint floor glow (0.01) below: point-like sources make the coloured flashes ("fire") of a
 brilliant visible instead of washing them out.
+scenes/polariscope_lightbox.exr (scenes/polariscope_gems_*.json): a polariscope's light box, white
+(radiance 1) below the horizon and black above, so that only light that came up through the
+polariser sheet reaches the camera (light from above would pass the analyser alone and veil the
+stones' extinction).
 
-Both are half-float, ZIPS-compressed scanline OpenEXR files (a few tens of kB).
+All are half-float, ZIPS-compressed scanline OpenEXR files (a few tens of kB).
 
     python3 scenes/make_environments.py         # rewrites both .exr files next to this script
 """
@@ -121,6 +125,11 @@ def main():
         return row
 
     write_exr(os.path.join(here, "diamond_lights.exr"), dw, dh, light_row)
+
+    # Polariscope light box: rows below the horizon (texel centre v > ½) white, above black.
+    lw, lh = 64, 32
+    write_exr(os.path.join(here, "polariscope_lightbox.exr"), lw, lh,
+              lambda yy: [1.0 if yy >= lh // 2 else 0.0] * lw)
 
 
 if __name__ == "__main__":

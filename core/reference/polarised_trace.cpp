@@ -217,7 +217,14 @@ PolarisedBeam recombine(const std::vector<const Branch*>& group, const Stokes& i
   const double k0 = 2.0 * kPi / (lambda_nm * 1e-6);
   const double width = lambda_nm * 1e-6 / s.source_angle_rad,
                length = lambda_nm * lambda_nm * 1e-6 / s.bandwidth_nm;
-  auto delta = [](const Branch& b) { return b.opl - glm::dot(b.p, b.x); };  // S on a wavefront
+  // The phase difference of two branches' plane waves at ONE point, the reference branch's exit
+  // point x_r: (S_b + p_b·(x_r − x_b)) − S_r, as the GPU twin does. (Extrapolating each to the
+  // world origin, S − p·x, made the o−e phase of a wedge, whose o and e leave in slightly
+  // different directions, depend on where the origin lies: a quartz wedge between crossed sheets
+  // showed one colour along its whole length.)
+  auto pathDifference = [](const Branch& b, const Branch& ref) {
+    return b.opl - ref.opl + glm::dot(b.p, ref.x - b.x);
+  };
   std::vector<bool> used(group.size(), false);
   for (size_t r = 0; r < group.size(); ++r) {
     if (used[r]) continue;
@@ -228,7 +235,7 @@ PolarisedBeam recombine(const std::vector<const Branch*>& group, const Stokes& i
       const Branch& b = *group[j];
       const glm::dvec3 sep = b.x - ref.x;
       const double lateral = glm::length(sep - glm::dot(sep, beam.direction) * beam.direction);
-      const double opd = delta(b) - delta(ref);  // the o−e (or path) difference
+      const double opd = pathDifference(b, ref);  // the o−e (or path) difference
       if (used[j] || lateral > width || std::abs(opd) > length) continue;
       used[j] = true;
       const Complex ph = std::exp(Complex(0.0, k0 * opd));

@@ -1,0 +1,120 @@
+// Closed forms of the polariscope scenes (scenes/polariscope_quartz_wedge.json,
+// scenes/conoscope_calcite.json), for the tests of both twins and of the renders:
+//
+//  - Michel-Lévy colours: white light through crossed polarisers with a retarder of retardation Γ
+//    at 45° between them keeps T(λ) = ½ sin²(πΓ(λ)/λ). Its colour is integrated at 1 nm against
+//    CIE 1931 exactly as the renderer turns a spectrum into colour (color.h: a flat spectrum is
+//    the renderer's white, a constant environment of radiance 1 under the E → D65 Bradford
+//    matrix), so that a render of a white light box differs from it only by the transport. The
+//    textbook chart's D65 illuminant (XYZ = ∫D65·T·cmf / ∫D65·ȳ, sRGB's own white) is given too:
+//    its colours differ from the renderer's by the chromatic adaptation of E to D65, not by
+//    physics.
+//  - The conoscopic figure of a c-cut uniaxial plate (optic axis along the normal z) of thickness
+//    t: a plane wave at incidence θ from air has the tangential wave-vector component
+//    k₀ sin θ in both modes; inside, the o-wave's normal component is k₀√(n_o² − sin²θ) and the
+//    e-wave's follows from its index surface x²/n_e² + z²/n_o² = 1 (x the tangential and z the
+//    normal component of p = k/k₀): p_z = (n_o/n_e)√(n_e² − sin²θ). The phase difference
+//    accumulated across the plate (the two waves share their tangential phase, so only p_z
+//    counts, walk-off or not) is δ(θ) = k₀ t [√(n_o² − sin²θ) − (n_o/n_e)√(n_e² − sin²θ)]; at
+//    θ = 0 it vanishes (the axis is isotropic), and between crossed polarisers the light is dark
+//    on the rings δ = 2πm and on the isogyres along the polariser and analyser directions, where
+//    the plane of incidence holds the polariser's field and the wave is a pure o (azimuth 90°)
+//    or e (0°) mode.
+#pragma once
+
+#include <cmath>
+#include <functional>
+#include <glm/glm.hpp>
+
+#include "core/spectrum/cie1931.h"
+#include "core/spectrum/color.h"
+#include "core/spectrum/illuminants.h"
+
+namespace eikon::test {
+
+constexpr double kMlPi = 3.14159265358979323846;
+
+/// ½ sin²(πΓ/λ), Γ and λ in nm: crossed polarisers with a retarder at 45°.
+inline double crossedRetarder(double gamma_nm, double lambda_nm) {
+  const double s = std::sin(kMlPi * gamma_nm / lambda_nm);
+  return 0.5 * s * s;
+}
+
+/// Linear sRGB of the renderer's white (a flat spectrum of radiance 1) filtered by T(λ): the
+/// trapezoid rule on the 1 nm CMF nodes over 380–780 nm and the renderer's colour matrix.
+inline glm::dvec3 transmittedSrgb(const std::function<double(double)>& T) {
+  return spectrum::spectrumToLinearSrgb(T);
+}
+
+/// The textbook Michel-Lévy colour: D65 light filtered by T(λ), XYZ normalised by D65's own Y,
+/// straight to linear sRGB (D65 is sRGB's white). 1 nm steps over 380–780 nm.
+inline glm::dvec3 transmittedSrgbD65(const std::function<double(double)>& T) {
+  glm::dvec3 xyz(0.0);
+  double white = 0.0;
+  for (int nm = int(spectrum::kVisibleMinNm); nm <= int(spectrum::kVisibleMaxNm); ++nm) {
+    const double w =
+        (nm == int(spectrum::kVisibleMinNm) || nm == int(spectrum::kVisibleMaxNm)) ? 0.5 : 1.0;
+    const glm::dvec3 c = spectrum::cmf(nm) * spectrum::d65(nm) * w;
+    xyz += c * T(nm);
+    white += c.y;
+  }
+  return spectrum::xyzToLinearSrgb(xyz / white);
+}
+
+/// CIE L*a*b* (1976) of a linear sRGB colour, reference white sRGB's (1, 1, 1) = D65.
+inline glm::dvec3 labOfLinearSrgb(const glm::dvec3& rgb) {
+  const glm::dvec3 xyz = spectrum::linearSrgbToXyz(rgb), w = spectrum::linearSrgbToXyz({1, 1, 1});
+  auto f = [](double t) {
+    const double e = 6.0 / 29.0;
+    return t > e * e * e ? std::cbrt(t) : t / (3 * e * e) + 4.0 / 29.0;
+  };
+  const double fx = f(xyz.x / w.x), fy = f(xyz.y / w.y), fz = f(xyz.z / w.z);
+  return {116 * fy - 16, 500 * (fx - fy), 200 * (fy - fz)};
+}
+
+/// ΔE*ab (CIE 1976) between two linear sRGB colours.
+inline double deltaE76(const glm::dvec3& a, const glm::dvec3& b) {
+  return glm::length(labOfLinearSrgb(a) - labOfLinearSrgb(b));
+}
+
+/// The o−e phase δ(θ)/2π (in waves) of a c-cut plate of thickness t_mm at incidence θ (rad, in
+/// air), wavelength λ.
+inline double conoscopeOrder(double theta, double t_mm, double n_o, double n_e, double lambda_nm) {
+  const double s2 = std::sin(theta) * std::sin(theta);
+  return t_mm * (std::sqrt(n_o * n_o - s2) - n_o / n_e * std::sqrt(n_e * n_e - s2)) /
+         (lambda_nm * 1e-6);
+}
+
+/// The incidence angle (rad) of the conoscope's m-th dark ring (δ = 2πm), by bisection on
+/// (0, π/2), where the order rises monotonically from 0 (negative crystals; positive ones fall).
+inline double conoscopeRing(double m, double t_mm, double n_o, double n_e, double lambda_nm) {
+  const double sign = n_o > n_e ? 1.0 : -1.0;
+  double lo = 0.0, hi = 0.5 * kMlPi;
+  for (int k = 0; k < 200; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (sign * conoscopeOrder(mid, t_mm, n_o, n_e, lambda_nm) > m ? hi : lo) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+/// The geometry of scenes/polariscope_quartz_wedge.json (its description): light from +z crosses
+/// the wedge (axis x + y, 1.0 mm thick at x = −20 mm rising by 0.005 mm per mm) and then the plate
+/// (axis x − y, 1.0 mm), so the net thickness of retardation is 0.1 + 0.005·x mm.
+constexpr double kWedgeSlope = 0.005, kWedgeOffsetMm = 0.1;
+inline double wedgeNetThicknessMm(double x_mm) { return kWedgeOffsetMm + kWedgeSlope * x_mm; }
+/// x (mm) where the net thickness is t_mm.
+inline double wedgeXForThickness(double t_mm) { return (t_mm - kWedgeOffsetMm) / kWedgeSlope; }
+
+/// Power transmittance 4n/(1 + n)² of one air–crystal face at normal incidence.
+inline double faceTransmittance(double n) { return 4.0 * n / ((1.0 + n) * (1.0 + n)); }
+
+/// The wedge between crossed sheets at normal incidence, Fresnel losses included: each of the two
+/// eigen-polarisations (±45°) is the e-wave in one piece and the o-wave in the other, so both
+/// keep the amplitude τ_oτ_e (τ the power transmittance of one face, the field amplitude of a
+/// face pair) and the crossed pair transmits ½(τ_oτ_e)² sin²(πΔn t/λ) of unpolarised light.
+inline double wedgeTransmission(double n_o, double n_e, double t_mm, double lambda_nm) {
+  const double a = faceTransmittance(n_o) * faceTransmittance(n_e);
+  return a * a * crossedRetarder((n_e - n_o) * t_mm * 1e6, lambda_nm);
+}
+
+}  // namespace eikon::test
