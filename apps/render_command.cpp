@@ -16,6 +16,7 @@
 #include "core/session/session.h"
 #include "core/vk/context.h"
 #include "core/vk/timings.h"
+#include "core/volume/polarised_render.h"
 
 namespace eikon::cli {
 
@@ -26,6 +27,7 @@ struct RenderArgs {
   double step = kDefaultRenderStepVoxels, exposure = 0.0;
   std::string integrator = "rk4", progress = "auto", spectral_sampling = "auto", layers;
   bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
+  bool polarised = false;
   // Light simulator (scenes with "lights").
   int light_bands = 0, max_patches = 1 << 20;
   double light_step = 0.0, light_split = 1.0;
@@ -69,8 +71,12 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
                   "auto (hero unless the scene attenuates, emits or has opaque objects; default)");
   sub->add_option("--layers", a.layers,
                   "Extra EXR layers, comma-separated: spectral (one S0.<nm> channel per "
-                  "wavelength bin; needs --wavelengths > 0) and modes (o.R..B, e.R..B: the o- and "
-                  "e-mode radiance); R, G, B are always written");
+                  "wavelength bin; needs --wavelengths > 0), modes (o.R..B, e.R..B: the o- and "
+                  "e-mode radiance) and stokes (S0.R..S3.B of a polarised render; implies "
+                  "--polarised); R, G, B are always written");
+  sub->add_flag("--polarised", a.polarised,
+                "Polarised render (Stokes transport, docs/polarisation.md) even without polariser "
+                "sheets or a camera analyzer, which make a render polarised by themselves");
   sub->add_option("--step", a.step,
                   "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4)");
@@ -133,6 +139,7 @@ ViewRequest viewRequest(const RenderArgs& a, const CLI::App& sub) {
   v.march = ms;
   v.sampling = parseSpectralSampling(a.spectral_sampling);
   parseLayers(a.layers, v);
+  v.polarised = a.polarised;
   return v;
 }
 
@@ -180,10 +187,11 @@ void printSummary(const RenderArgs& a, Session& session, const LightOutcome& lig
                                        : 0.0);
   double rays = double(img.width) * img.height * a.spp * std::max(1, rs.wavelengths);
   std::printf(
-      "eikon: rendered %s (%dx%d, %s, %d spp) on %s in %.2f s: %.3g rays/s, %.1f steps/ray -> %s, "
-      "%s\n",
+      "eikon: rendered %s (%dx%d, %s%s, %d spp) on %s in %.2f s: %.3g rays/s, %.1f steps/ray -> "
+      "%s, %s\n",
       a.scene.c_str(), img.width, img.height,
-      rs.wavelengths > 0 ? (std::to_string(rs.wavelengths) + " wavelengths").c_str() : "RGB", a.spp,
+      rs.wavelengths > 0 ? (std::to_string(rs.wavelengths) + " wavelengths").c_str() : "RGB",
+      isPolarisedRender(*session.scene(), rs) ? ", polarised" : "", a.spp,
       a.reference ? "CPU reference" : session.context().deviceName().c_str(), img.seconds,
       rays / img.seconds, img.mean_steps, out.c_str(), png.c_str());
 }
@@ -267,7 +275,10 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   // and a concurrent render to the same -o cannot interleave its pair with this one. The
   // preview first: it is the smaller, so a full disk is usually met before the EXR is encoded.
   writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)},
-                      {out, rs.spectral_layer || rs.mode_layers
+                      {out, !img.stokes.empty()
+                                ? exrStokesContent(img.width, img.height, img.rgb, img.stokes,
+                                                   kStokesFrame)
+                            : rs.spectral_layer || rs.mode_layers
                                 ? exrLayersContent(img.width, img.height, img.rgb, img.bins,
                                                    img.spectral, img.modes)
                                 : exrRgbContent(img.width, img.height, img.rgb)}});

@@ -12,6 +12,7 @@
 #include "core/io/exr.h"
 #include "core/light/light_cache.h"
 #include "core/vk/context.h"
+#include "core/volume/polarised_render.h"
 #include "python/module.h"
 
 namespace eikon::python {
@@ -126,13 +127,20 @@ py::dict layerArrays(const RenderImage& img) {
       d[m == 0 ? "o" : "e"] = a;
     }
   }
+  if (!img.stokes.empty()) {  // a polarised render (docs/polarisation.md "Polarised renders")
+    py::array_t<float> a(
+        {py::ssize_t(img.height), py::ssize_t(img.width), py::ssize_t(4), py::ssize_t(3)});
+    std::copy(img.stokes.begin(), img.stokes.end(), a.mutable_data());
+    d["stokes"] = a;
+    d["stokes_frame"] = std::string(kStokesFrame);
+  }
   return d;
 }
 
 py::object render(Prepared& p, int width, int height, int spp, std::optional<int> wavelengths,
                   double wavelength_nm, std::optional<MarchSettings> march,
                   const std::string& device, int threads, bool light, const py::object& light_cache,
-                  const std::string& sampling, const std::string& layers) {
+                  const std::string& sampling, const std::string& layers, bool polarised) {
   const bool gpu = isGpu(device);
   ViewRequest view;  // the CLI's defaults (core/session/session.h), then what the caller chose
   if (width != 0) view.width = width;
@@ -146,6 +154,7 @@ py::object render(Prepared& p, int width, int height, int spp, std::optional<int
     view.sampling = parseSpectralSampling(sampling);
     parseLayers(layers, view);
   });
+  view.polarised = polarised;
   RenderSettings settings;
   checkSetting([&] { settings = renderSettings(*p.scene, view); });
   const std::string cache_dir = light ? lightCacheDir(light_cache) : std::string();
@@ -158,7 +167,8 @@ py::object render(Prepared& p, int width, int height, int spp, std::optional<int
     }
     return s.render(settings, gpu);
   });
-  if (settings.spectral_layer || settings.mode_layers) return layerArrays(img);
+  if (settings.spectral_layer || settings.mode_layers || settings.stokes_layers)
+    return layerArrays(img);
   return imageArray(img);
 }
 
@@ -373,7 +383,7 @@ void bindRenderer(py::module_& m) {
            py::arg("wavelengths") = py::none(), py::arg("wavelength_nm") = 587.5618,
            py::arg("march") = py::none(), py::arg("device") = "gpu", py::arg("threads") = 0,
            py::arg("light") = true, py::arg("light_cache") = true, py::arg("sampling") = "auto",
-           py::arg("layers") = "",
+           py::arg("layers") = "", py::arg("polarised") = false,
            "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: wavelengths=None "
            "is 16 for a "
            "dispersive scene, else 0 (RGB; > 0 = spectral with that many samples); march=None is "
@@ -385,7 +395,10 @@ void bindRenderer(py::module_& m) {
            "folder, a path: that folder, False: none); light=False leaves an unsimulated scene "
            "unlit (--no-light); sampling='auto'|'hero'|'stratified' (--spectral-sampling); "
            "layers='spectral,modes' (--layers) returns a dict: rgb, spectral (H, W, N bins) with "
-           "wavelengths_nm (the bin centres), o and e (H, W, 3 each)")
+           "wavelengths_nm (the bin centres), o and e (H, W, 3 each); layers='stokes' (a polarised "
+           "render; also polarised=True, polariser sheets or a camera analyzer, which return the "
+           "plain (H, W, 3) S0 without it) adds stokes (H, W, 4, 3: S0..S3 x RGB) and "
+           "stokes_frame (docs/polarisation.md)")
       .def(
           "simulate_light", &simulateLight, py::arg("bands") = 0, py::arg("splat") = "accumulate",
           py::arg("step_voxels") = 0.5, py::arg("smoothing_voxels") = 1.0,

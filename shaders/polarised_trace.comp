@@ -348,7 +348,11 @@ PolarisedBeamOut recombine(int first, inout int taken, vec4 S, float lambdaMm, f
       if (branches < EIKON_POL_MAX_GROUPED) codes[branches] = (b.nmodes << 16) | b.modes;
       branches++;
     }
-    stokes += stokesOut(J, S);
+    if (P.pass.z != 0)  // renders: the Mueller matrix's first row (S0 out per input basis state)
+      stokes += vec4(stokesOut(J, vec4(1, 0, 0, 0)).x, stokesOut(J, vec4(0, 1, 0, 0)).x,
+                     stokesOut(J, vec4(0, 0, 1, 0)).x, stokesOut(J, vec4(0, 0, 0, 1)).x);
+    else
+      stokes += stokesOut(J, S);
     groups++;
   }
   beam.exit_point = vec4(f.x, float(branches));

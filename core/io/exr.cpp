@@ -200,6 +200,28 @@ FileContent exrLayersContent(int width, int height, const std::vector<float>& rg
   };
 }
 
+FileContent exrStokesContent(int width, int height, const std::vector<float>& rgb,
+                             const std::vector<float>& stokes, const std::string& frame) {
+  const size_t n = size_t(width) * size_t(height);
+  if (rgb.size() != 3 * n || stokes.size() != 12 * n)
+    throw std::invalid_argument("exrStokesContent: pixel count mismatch");
+  std::vector<std::string> names = {"R", "G", "B"};
+  for (const char* l : {"S0.", "S1.", "S2.", "S3."})
+    for (const char* c : {"R", "G", "B"}) names.push_back(std::string(l) + c);
+  auto planes =
+      std::make_shared<std::vector<std::vector<float>>>(names.size(), std::vector<float>(n));
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t c = 0; c < 3; ++c) (*planes)[c][i] = rgb[3 * i + c];
+    for (size_t c = 0; c < 12; ++c) (*planes)[3 + c][i] = stokes[12 * i + c];
+  }
+  const std::vector<std::pair<std::string, std::string>> attributes = {{"stokesFrame", frame}};
+  return [planes, names, attributes, width, height](const std::filesystem::path& tmp) {
+    std::vector<ExrChannel> channels;
+    for (size_t c = 0; c < names.size(); ++c) channels.push_back({names[c], (*planes)[c].data()});
+    encodeExr(tmp, width, height, channels, attributes);
+  };
+}
+
 void writeExrRgb(const std::filesystem::path& path, int width, int height,
                  const std::vector<float>& rgb) {
   writeFileAtomically(path, exrRgbContent(width, height, rgb));

@@ -54,6 +54,13 @@ std::string spectralChannelName(double centreNm);
 FileContent exrLayersContent(int width, int height, const std::vector<float>& rgb, int bins,
                              const std::vector<float>& spectral, const std::vector<float>& modes);
 
+/// A polarised render's EXR (ZIP, float): R, G, B (= S0) and the Stokes layers named as Mitsuba
+/// 3's Stokes film writes them, S0.R, S0.G, S0.B, S1.R, …, S3.B (`stokes`: 12 floats per pixel,
+/// S0.RGB first), with the string attribute stokesFrame = `frame` (their reference frame). For
+/// writeFilesTogether.
+FileContent exrStokesContent(int width, int height, const std::vector<float>& rgb,
+                             const std::vector<float>& stokes, const std::string& frame);
+
 /// Write linear RGB floats (3 per pixel) as an EXR with R, G, B channels, atomically.
 void writeExrRgb(const std::filesystem::path& path, int width, int height,
                  const std::vector<float>& rgb);

@@ -246,7 +246,8 @@ PolarisedBeam recombine(const std::vector<const Branch*>& group, const Stokes& i
       beam.modes += (beam.modes.empty() ? "" : ",") + (b.modes.empty() ? "-" : b.modes);
       beam.branches++;
     }
-    beam.stokes += muellerOf(J) * input;
+    const Mueller M = muellerOf(J);
+    beam.stokes += s.mueller_row ? Stokes(M.m[0][0], M.m[0][1], M.m[0][2], M.m[0][3]) : M * input;
     beam.coherent_groups++;
   }
   return beam;

@@ -14,6 +14,7 @@
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
 #include "core/vk/timings.h"
+#include "core/volume/polarised_render.h"
 #include "core/volume/render_layers.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/polarised_trace.spv.h"
@@ -578,7 +579,8 @@ std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<Polar
   gpu::ViewParams p = I.baseParams(MarchSettings{}, 0);
   p.image = glm::ivec4(int(rays.size()), 1, 0, 1);
   p.pass = glm::ivec4(std::min(settings.max_events, EIKON_POL_MAX_EVENTS),
-                      std::min(settings.max_branches, EIKON_POL_MAX_LEAVES), 0, 0);
+                      std::min(settings.max_branches, EIKON_POL_MAX_LEAVES),
+                      settings.mueller_row ? 1 : 0, 0);
   I.params.write(&p, sizeof p);
   vk::Buffer rb(I.ctx, in.size() * sizeof(gpu::PolarisedRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                 "polarised rays");
@@ -601,6 +603,22 @@ std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<Polar
   for (size_t i = 0; i < res.size(); ++i)
     out.push_back(unpackPolarised(res[i], glm::normalize(rays[i].direction)));
   return out;
+}
+
+// The shared driver (core/volume/polarised_render.h) over this twin's polarised trace: every pixel
+// sample's camera ray (at each wavelength) is one workgroup of polarised_trace.comp in its
+// Mueller-row variant (P.pass.z); the environment is looked up on the host per beam, with the
+// same Environment::lookup as the CPU twin, so the twins differ only in their traces.
+RenderImage ViewRenderer::renderPolarised(const RenderSettings& s,
+                                          const PolarisedTraceSettings& trace) {
+  const Scene& scene = impl_->scene;
+  return renderPolarisedWith(
+      scene, s,
+      [&](const std::vector<TraceRequest>& rays, const PolarisedTraceSettings& ts) {
+        return tracePolarised(scene.polarizers, rays,
+                              std::vector<Stokes>(rays.size(), Stokes(1, 0, 0, 0)), ts);
+      },
+      trace);
 }
 
 }  // namespace eikon

@@ -56,6 +56,11 @@ class ViewRenderer {
                                              const std::vector<TraceRequest>& rays,
                                              const std::vector<Stokes>& inputs,
                                              const PolarisedTraceSettings& settings = {});
+  /// A polarised render of the scene's camera (core/volume/polarised_render.h, the GPU twin of
+  /// core/reference/polarised_render.h): rgb = S0 after the camera's analyser, stokes layers if
+  /// asked. Throws as renderPolarisedWith and tracePolarised (at most 8 polariser sheets).
+  RenderImage renderPolarised(const RenderSettings& settings,
+                              const PolarisedTraceSettings& trace = {});
 
  private:
   struct Impl;

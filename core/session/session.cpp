@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/light/light_cache.h"
+#include "core/reference/polarised_render.h"
 #include "core/reference/polarised_trace.h"
 #include "core/reference/reference_lighting.h"
 #include "core/reference/reference_marcher.h"
@@ -11,6 +12,7 @@
 #include "core/render/render_defaults.h"
 #include "core/render/view_renderer.h"
 #include "core/vk/context.h"
+#include "core/volume/polarised_render.h"
 
 namespace eikon {
 
@@ -39,7 +41,7 @@ SpectralSampling parseSpectralSampling(const std::string& s) {
 }
 
 void parseLayers(const std::string& list, ViewRequest& view) {
-  view.spectral_layer = view.mode_layers = false;
+  view.spectral_layer = view.mode_layers = view.stokes_layers = false;
   size_t start = 0;
   while (start <= list.size() && !list.empty()) {
     const size_t end = std::min(list.find(',', start), list.size());
@@ -48,9 +50,12 @@ void parseLayers(const std::string& list, ViewRequest& view) {
       view.spectral_layer = true;
     else if (name == "modes")
       view.mode_layers = true;
+    else if (name == "stokes")
+      view.stokes_layers = true;
     else
-      throw SettingError("layers", "must be a comma-separated list of spectral and modes, got '" +
-                                       name + "' in '" + list + "'");
+      throw SettingError("layers",
+                         "must be a comma-separated list of spectral, modes and stokes, got '" +
+                             name + "' in '" + list + "'");
     start = end + 1;
   }
 }
@@ -81,6 +86,16 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
   rs.sampling = v.sampling;
   rs.spectral_layer = v.spectral_layer;
   rs.mode_layers = v.mode_layers;
+  rs.stokes_layers = v.stokes_layers;
+  rs.polarised = v.polarised;
+  if (isPolarisedRender(scene, rs) && (rs.spectral_layer || rs.mode_layers))
+    throw SettingError("layers", "a polarised render (" +
+                                     std::string(v.polarised ? "--polarised"
+                                                 : rs.stokes_layers ? "--layers stokes"
+                                                 : !scene.polarizers.empty()
+                                                     ? "the scene's polariser sheets"
+                                                     : "the camera's analyzer") +
+                                     ") writes the stokes layers only, not spectral or modes");
   if (rs.spectral_layer && rs.wavelengths <= 0)
     throw SettingError("layers", "spectral needs a spectral render (wavelengths > 0), got " +
                                      std::to_string(rs.wavelengths) + " wavelengths");
@@ -231,6 +246,11 @@ RenderImage Session::render(const RenderSettings& settings, bool gpu) {
   RenderSettings rs = settings;
   if (progress_.update && !rs.progress)
     rs.progress = [this](double f) { progress_.update("rendering", f); };
+  if (isPolarisedRender(*scene_, rs)) {  // docs/polarisation.md "Polarised renders"
+    if (gpu) return gpuRenderer().renderPolarised(rs);
+    cpuMarcher();  // makes field_
+    return renderPolarised(*field_, *scene_, rs, threads_);
+  }
   if (gpu) return gpuRenderer(&rs).render(rs);
   Camera cam = scene_->camera;
   if (rs.width > 0) cam.width = rs.width;

@@ -67,11 +67,14 @@ struct ViewRequest {
   std::optional<MarchSettings> march;  ///< step in (0, 4] voxels; unset: the render defaults
   SpectralSampling sampling = SpectralSampling::Auto;  ///< spectral renders (docs/spectra.md)
   bool spectral_layer = false, mode_layers = false;    ///< parseLayers; RenderSettings's
+  bool stokes_layers = false;                          ///< parseLayers ("stokes")
+  /// A polarised render even without polariser sheets or an analyser (`--polarised`).
+  bool polarised = false;
 };
 
 /// "euler", "midpoint" or "rk4"; else SettingError("integrator", ...).
 Integrator parseIntegrator(const std::string& name);
-/// A comma-separated list of "spectral" and "modes" (the extra image layers) into the request;
+/// A comma-separated list of "spectral", "modes" and "stokes" (the extra image layers) into the request;
 /// else SettingError("layers", ...). An empty list asks for none.
 void parseLayers(const std::string& list, ViewRequest& view);
 /// "auto", "hero" or "stratified"; else SettingError("spectral-sampling", ...).

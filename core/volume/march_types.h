@@ -55,6 +55,11 @@ struct RenderSettings {
   /// "Spectral layers"), so that the layers integrate to it exactly.
   bool spectral_layer = false;  ///< one channel per wavelength bin (spectral mode only)
   bool mode_layers = false;     ///< o- and e-mode radiance as separate RGB layers
+  /// A polarised render (docs/polarisation.md "Polarised renders"): asked for here (`eikon render
+  /// --polarised`), or implied by the scene's polariser sheets or camera analyser, or by
+  /// stokes_layers (isPolarisedRender in core/volume/polarised_render.h).
+  bool polarised = false;
+  bool stokes_layers = false;  ///< S0..S3 as RGB layers (RenderImage::stokes; --layers stokes)
   MarchSettings march;
   /// progress(fraction done); may be empty.
   std::function<void(double)> progress;
@@ -83,6 +88,11 @@ struct RenderImage {
   /// RenderSettings::mode_layers: 6 floats per pixel, the o-mode's and the e-mode's share of the
   /// linear sRGB (o + e = rgb; e = 0 in a scene without crystals); empty otherwise.
   std::vector<float> modes;
+  /// RenderSettings::stokes_layers (polarised renders): 12 floats per pixel, the Stokes vector's
+  /// linear sRGB (S0.R, S0.G, S0.B, S1.R, …, S3.B) after the camera's analyser, in the frame
+  /// stokesBasis(−v) of each pixel's camera ray v (kStokesFrame of core/volume/polarised_render.h;
+  /// S0 = rgb); empty otherwise.
+  std::vector<float> stokes;
 };
 
 /// One traced ray (one mode) as both twins report it. Directions are unit, world space.

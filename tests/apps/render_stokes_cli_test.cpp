@@ -1,0 +1,94 @@
+// `eikon render --layers stokes` (a polarised render, docs/polarisation.md "Polarised renders")
+// through the real binary, read back with OpenImageIO's iinfo: R, G, B and the Stokes channels
+// S0.R … S3.B (Mitsuba 3's names) with the frame in the string attribute stokesFrame. The scene:
+// a polariser sheet along x in front of a constant grey sky of 0.5, so every pixel holds S0 = ¼,
+// S1 = ¼ (x̂ of stokesBasis(−v) is +x for a camera looking along +z), S2 = S3 = 0. Stokes layers
+// with spectral or mode layers end the run with one line and no files.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/apps/cli_support.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using eikon::test::Outcome;
+using eikon::test::quote;
+
+constexpr const char* kScene = R"({
+  "camera": {"position": [0, 0, -40], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 2,
+             "width": 8, "height": 6},
+  "environment": {"type": "constant", "radiance": [0.5, 0.5, 0.5]},
+  "interfaces": "sharp",
+  "volume": {"bounds_min": [-8, -8, -8], "bounds_max": [8, 8, 8], "resolution": 24},
+  "materials": {"glass": {"n": 1.5}},
+  "objects": [{"shape": "sphere", "center": [6, 6, 6], "radius": 1, "material": "glass"},
+              {"shape": "polarizer", "center": [0, 0, 20], "normal": [0, 0, 1],
+               "transmission_axis": [1, 0, 0], "size": [40, 40]}]
+})";
+
+struct Dir {
+  eikon::test::TempDir tmp{"eikon_stokes_cli"};
+  const fs::path path = tmp.path();
+  Dir() { std::ofstream(path / "scene.json") << kScene; }
+};
+
+std::vector<double> statsRow(const std::string& out, const std::string& label, size_t n) {
+  std::vector<double> v(n, -1e30);
+  const size_t at = out.find(label);
+  if (at == std::string::npos) return {};
+  std::istringstream in(out.substr(at + label.size()));
+  for (double& x : v) in >> x;
+  return in ? v : std::vector<double>{};
+}
+
+TEST(RenderStokesCli, StokesChannelsAndFrameReadBackWithOpenImageIO) {
+  Dir d;
+  const fs::path out = d.path / "out.exr";
+  const Outcome r = eikon::test::runEikon("render " + quote((d.path / "scene.json").string()) +
+                                              " -o " + quote(out.string()) + " --layers stokes -q",
+                                          d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("polarised"), std::string::npos) << r.out;
+  const Outcome info = eikon::test::runProgram("iinfo", "-v " + quote(out.string()), d.path);
+  ASSERT_EQ(info.code, 0) << info.err;
+  EXPECT_NE(info.out.find("15 channel"), std::string::npos) << info.out;
+  for (const char* name :
+       {"S0.R", "S0.G", "S0.B", "S1.R", "S2.G", "S3.B", "stokesFrame", "stokes_basis(-v)"})
+    EXPECT_NE(info.out.find(name), std::string::npos) << name << " missing in\n" << info.out;
+  const Outcome stats = eikon::test::runProgram("iinfo", "--stats " + quote(out.string()), d.path);
+  ASSERT_EQ(stats.code, 0) << stats.err;
+  // OpenImageIO's order: R, G, B, then S0.R S0.G S0.B, S1.*, S2.*, S3.*.
+  const std::vector<double> lo = statsRow(stats.out, "Stats Min:", 15),
+                            hi = statsRow(stats.out, "Stats Max:", 15);
+  ASSERT_FALSE(lo.empty() || hi.empty()) << stats.out;
+  const double want[5] = {0.25, 0.25, 0.25, 0.0, 0.0};  // RGB, S0, S1, S2, S3
+  for (size_t c = 0; c < 15; ++c) {
+    EXPECT_NEAR(lo[c], want[c / 3], 1e-5) << "channel " << c;
+    EXPECT_NEAR(hi[c], want[c / 3], 1e-5) << "channel " << c;
+  }
+}
+
+TEST(RenderStokesCli, StokesWithOtherLayersIsOneLineAndNoFiles) {
+  Dir d;
+  const fs::path out = d.path / "out.exr";
+  for (const std::string& extra :
+       {std::string("--layers stokes,modes"), std::string("--layers spectral --wavelengths 4")}) {
+    const Outcome r = eikon::test::runEikon("render " + quote((d.path / "scene.json").string()) +
+                                                " -o " + quote(out.string()) + " " + extra + " -q",
+                                            d.path);
+    EXPECT_NE(r.code, 0) << extra;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << extra << ": " << r.err;
+    EXPECT_NE(r.err.find("polarised"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << extra;
+    EXPECT_FALSE(fs::exists(d.path / "out.png")) << extra;
+  }
+}
+
+}  // namespace
