@@ -28,6 +28,14 @@ pictures=(
   "caustic_sphere|800x600|--spp 4"
   "prism_rainbow|960x600|--spp 8"
   "smoke_sphere|960x600|--spp 4"
+  # Polarised (polariser sheets): deterministic, so 1 sample (the pixel centres). The conoscope
+  # and the gems in monochromatic light (RGB mode: one trace per pixel at 587.56 nm; a quartz
+  # brilliant's retardation is of high order, white in white light anyway), the wedge with 32
+  # stratified wavelengths per pixel (its colours are the spectrum's; fewer bins speckle).
+  "conoscope_calcite|800x600|--wavelengths 0"
+  "polariscope_gems_0|800x600|--wavelengths 0"
+  "polariscope_gems_45|800x600|--wavelengths 0"
+  "polariscope_quartz_wedge|800x300|--wavelengths 32"
 )
 
 want=("$@")

@@ -98,12 +98,12 @@ inline double conoscopeRing(double m, double t_mm, double n_o, double n_e, doubl
 }
 
 /// The geometry of scenes/polariscope_quartz_wedge.json (its description): light from +z crosses
-/// the wedge (axis x + y, 1.0 mm thick at x = −20 mm rising by 0.005 mm per mm) and then the plate
-/// (axis x − y, 1.0 mm), so the net thickness of retardation is 0.1 + 0.005·x mm.
+/// the wedge (axis x + y, 1.0 mm thick at x = +20 mm, 0.005 mm thicker per mm towards −x) and
+/// then the plate (axis x − y, 1.0 mm), so the net thickness of retardation is 0.1 − 0.005·x mm.
 constexpr double kWedgeSlope = 0.005, kWedgeOffsetMm = 0.1;
-inline double wedgeNetThicknessMm(double x_mm) { return kWedgeOffsetMm + kWedgeSlope * x_mm; }
+inline double wedgeNetThicknessMm(double x_mm) { return kWedgeOffsetMm - kWedgeSlope * x_mm; }
 /// x (mm) where the net thickness is t_mm.
-inline double wedgeXForThickness(double t_mm) { return (t_mm - kWedgeOffsetMm) / kWedgeSlope; }
+inline double wedgeXForThickness(double t_mm) { return (kWedgeOffsetMm - t_mm) / kWedgeSlope; }
 
 /// Power transmittance 4n/(1 + n)² of one air–crystal face at normal incidence.
 inline double faceTransmittance(double n) { return 4.0 * n / ((1.0 + n) * (1.0 + n)); }
