@@ -58,7 +58,7 @@ double s0(const RenderImage& img, size_t pixel) { return img.stokes[12 * pixel +
 
 TEST(PolarisedRenderGpu, MalusWithTwoSheets) {
   double worst = 0.0;
-  for (double phi : {0.0, 30.0, 60.0, 90.0}) {
+  for (double phi : {30.0, 90.0}) {  // each scene compiles its kernel: two of them
     PolRenderTwins t(sheetAt(-20, 0) + ", " + sheetAt(20, phi) + ", " + kAside, renderCamera());
     const RenderImage img = t.onGpu();
     ASSERT_EQ(img.stokes.size(), size_t(24 * 16 * 12));
@@ -105,12 +105,13 @@ TEST(PolarisedRenderGpu, CrossedSheetsWithQuartzPlateAtFiveWavelengths) {
   std::printf("rendered crossed sheets + quartz (GPU): max |S0 − ½sin²| = %.2e\n", worst);
 }
 
-// A conoscope: crossed sheets around a 1 mm c-cut calcite plate seen over a 24° field, so that the
-// pixels see isogyres and rings; RGB and spectral (4 bins) renders of both twins, pixel by pixel.
+// A conoscope: crossed sheets around a 1 mm c-cut calcite plate seen over an 18° field (every ray
+// through the plate's faces, none near its sides), so that the pixels see isogyres and rings; RGB
+// and spectral (4 bins) renders of both twins, pixel by pixel.
 TEST(PolarisedRenderGpu, TwinsAgreeOnAConoscopicFigure) {
   PolRenderTwins t(
       sheetAt(-20, 0) + ", " + sheetAt(20, 90) + ", " + plate("calcite", 1.0, "[0, 0, 1]"),
-      R"("camera": {"position": [0, 0, -25], "look_at": [0, 0, 0], "fov_deg": 24,
+      R"("camera": {"position": [0, 0, -25], "look_at": [0, 0, 0], "fov_deg": 18,
                                  "width": 24, "height": 16}, )");
   for (int wavelengths : {0, 4}) {
     const RenderImage g = t.onGpu(589.2938, wavelengths), c = t.onCpu(589.2938, wavelengths);
