@@ -22,13 +22,13 @@ using eikon::test::Outcome;
 using eikon::test::quote;
 
 constexpr const char* kScene = R"({
-  "camera": {"position": [0, 0, -40], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 2,
+  "camera": {"position": [0, 0, -40], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 0.5,
              "width": 8, "height": 6},
   "environment": {"type": "constant", "radiance": [0.5, 0.5, 0.5]},
   "interfaces": "sharp",
   "volume": {"bounds_min": [-8, -8, -8], "bounds_max": [8, 8, 8], "resolution": 24},
   "materials": {"glass": {"n": 1.5}},
-  "objects": [{"shape": "sphere", "center": [6, 6, 6], "radius": 1, "material": "glass"},
+  "objects": [{"shape": "sphere", "center": [4, 4, 4], "radius": 1, "material": "glass"},
               {"shape": "polarizer", "center": [0, 0, 20], "normal": [0, 0, 1],
                "transmission_axis": [1, 0, 0], "size": [40, 40]}]
 })";
