@@ -275,9 +275,8 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   // and a concurrent render to the same -o cannot interleave its pair with this one. The
   // preview first: it is the smaller, so a full disk is usually met before the EXR is encoded.
   writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)},
-                      {out, !img.stokes.empty()
-                                ? exrStokesContent(img.width, img.height, img.rgb, img.stokes,
-                                                   kStokesFrame)
+                      {out, !img.stokes.empty() ? exrStokesContent(img.width, img.height, img.rgb,
+                                                                   img.stokes, kStokesFrame)
                             : rs.spectral_layer || rs.mode_layers
                                 ? exrLayersContent(img.width, img.height, img.rgb, img.bins,
                                                    img.spectral, img.modes)

@@ -162,6 +162,7 @@ struct BoundaryAnswer {
 #define EIKON_POL_MAX_PIECES 96   // straight pieces per ray, all branches together (loop budget)
 #define EIKON_POL_MAX_BEAMS 4     // output beams per ray (exit directions)
 #define EIKON_POL_MAX_GROUPED 4   // branch mode codes reported per beam
+#define EIKON_POL_GROUP 8         // rays per workgroup of polarised_trace.comp (a SIMD group)
 // Sheets buffer: [0] = (sheet count, bandwidth_nm, source_angle_rad, reflect_at bit mask), then
 // per sheet (center, width), (unit normal, height), (unit transmission axis, 0).
 

@@ -24,9 +24,11 @@
 #extension GL_GOOGLE_include_directive : require
 #include "eikon_shared.h"
 
-// One invocation per workgroup: lavapipe's loop budget is shared by a SIMD group, and a ray tree
-// is many loops long.
-layout(local_size_x = 1) in;
+// Eight rays per workgroup, one per invocation: lavapipe runs them as one 8-wide SIMD group, and
+// its loop budget (65535 passes, shared by the group) is spent by the group's longest ray rather
+// than by the sum of the eight (a group runs each loop until its last lane is done); a ray cut by
+// the budget is reported (loopLimitReached sets `truncated`), never returned silently short.
+layout(local_size_x = EIKON_POL_GROUP) in;
 
 #include "march.glsl"
 #include "fresnel.glsl"
@@ -365,7 +367,7 @@ PolarisedBeamOut recombine(int first, inout int taken, vec4 S, float lambdaMm, f
 
 void main() {
   loadParams();
-  uint i = gl_WorkGroupID.x;
+  uint i = gl_GlobalInvocationID.x;
   if (i >= uint(P.image.x)) return;
   PolarisedRay ray = rays[i];
   setWavelength(ray.origin.w, true);

@@ -594,9 +594,11 @@ std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<Polar
   tracer.bindBuffer(EIKON_B_RAYS, rb);
   tracer.bindBuffer(EIKON_B_SHEETS, sb);
   tracer.bindBuffer(EIKON_B_OUTPUT, ob);
-  // One ray per workgroup (the kernel's local size is 1: its loop budget is its own).
-  I.ctx.submitAndWait(
-      [&](VkCommandBuffer cmd) { tracer.dispatch(cmd, uint32_t(in.size()), 1, 1, nullptr); });
+  // EIKON_POL_GROUP rays per workgroup (one SIMD group of lavapipe; polarised_trace.comp).
+  I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
+    tracer.dispatch(cmd, uint32_t((in.size() + EIKON_POL_GROUP - 1) / EIKON_POL_GROUP), 1, 1,
+                    nullptr);
+  });
   std::vector<gpu::PolarisedResult> res(in.size());
   ob.read(res.data(), res.size() * sizeof(gpu::PolarisedResult));
   std::vector<PolarisedTrace> out;

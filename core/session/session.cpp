@@ -53,9 +53,9 @@ void parseLayers(const std::string& list, ViewRequest& view) {
     else if (name == "stokes")
       view.stokes_layers = true;
     else
-      throw SettingError("layers",
-                         "must be a comma-separated list of spectral, modes and stokes, got '" +
-                             name + "' in '" + list + "'");
+      throw SettingError(
+          "layers", "must be a comma-separated list of spectral, modes and stokes, got '" + name +
+                        "' in '" + list + "'");
     start = end + 1;
   }
 }
@@ -88,14 +88,13 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
   rs.mode_layers = v.mode_layers;
   rs.stokes_layers = v.stokes_layers;
   rs.polarised = v.polarised;
-  if (isPolarisedRender(scene, rs) && (rs.spectral_layer || rs.mode_layers))
-    throw SettingError("layers", "a polarised render (" +
-                                     std::string(v.polarised ? "--polarised"
-                                                 : rs.stokes_layers ? "--layers stokes"
-                                                 : !scene.polarizers.empty()
-                                                     ? "the scene's polariser sheets"
-                                                     : "the camera's analyzer") +
-                                     ") writes the stokes layers only, not spectral or modes");
+  if (isPolarisedRender(scene, rs)) {  // refused before anything is voxelised
+    if (rs.spectral_layer || rs.mode_layers)
+      throw SettingError("layers", "spectral and modes do not go with a polarised render (" +
+                                       polarisedBecause(scene, rs) +
+                                       "), which writes the stokes layers");
+    checkPolarisedScene(scene, rs);
+  }
   if (rs.spectral_layer && rs.wavelengths <= 0)
     throw SettingError("layers", "spectral needs a spectral render (wavelengths > 0), got " +
                                      std::to_string(rs.wavelengths) + " wavelengths");

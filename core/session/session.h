@@ -74,8 +74,8 @@ struct ViewRequest {
 
 /// "euler", "midpoint" or "rk4"; else SettingError("integrator", ...).
 Integrator parseIntegrator(const std::string& name);
-/// A comma-separated list of "spectral", "modes" and "stokes" (the extra image layers) into the request;
-/// else SettingError("layers", ...). An empty list asks for none.
+/// A comma-separated list of "spectral", "modes" and "stokes" (the extra image layers) into the
+/// request; else SettingError("layers", ...). An empty list asks for none.
 void parseLayers(const std::string& list, ViewRequest& view);
 /// "auto", "hero" or "stratified"; else SettingError("spectral-sampling", ...).
 SpectralSampling parseSpectralSampling(const std::string& name);

@@ -55,10 +55,6 @@ void checkPolarisedRender(const Scene& scene, const RenderSettings& s, int width
     throw std::invalid_argument("wavelengths must be in [0, 256]");
   if (!(s.wavelength_nm > 0) || !std::isfinite(s.wavelength_nm))
     throw std::invalid_argument("the RGB index wavelength must be > 0 nm");
-  if (!scene.environment.polarization.unpolarized())
-    throw std::invalid_argument(
-        "polarised renders take an unpolarised environment (its \"polarization\" is used by "
-        "the trace only; docs/polarisation.md \"Polarised renders\")");
   if (s.spectral_layer || s.mode_layers)
     throw std::invalid_argument(
         "a polarised render writes the stokes layers only (not spectral or modes)");
@@ -77,6 +73,28 @@ struct RaySlot {
 bool isPolarisedRender(const Scene& scene, const RenderSettings& s) {
   return s.polarised || s.stokes_layers || !scene.polarizers.empty() ||
          scene.camera.analyzer.has_value();
+}
+
+std::string polarisedBecause(const Scene& scene, const RenderSettings& s) {
+  return s.polarised                 ? "--polarised"
+         : s.stokes_layers           ? "--layers stokes"
+         : !scene.polarizers.empty() ? "the scene's polariser sheets"
+         : scene.camera.analyzer     ? "the camera's analyzer"
+                                     : "";
+}
+
+void checkPolarisedScene(const Scene& scene, const RenderSettings& s) {
+  const std::string why = "a polarised render (" + polarisedBecause(scene, s) + ")";
+  if (scene.interfaces != Scene::Interfaces::Sharp)
+    throw std::runtime_error(scene.file.string() + ": /interfaces: " + why +
+                             " needs \"sharp\" interfaces, got \"smoothed\"");
+  const Stokes& p = scene.environment.polarization.stokes;
+  if (!scene.environment.polarization.unpolarized())
+    throw std::runtime_error(scene.file.string() + ": /environment/polarization: " + why +
+                             " takes an unpolarised environment (docs/polarisation.md), got "
+                             "stokes [" +
+                             std::to_string(p[0]) + ", " + std::to_string(p[1]) + ", " +
+                             std::to_string(p[2]) + ", " + std::to_string(p[3]) + "]");
 }
 
 Stokes cameraStokes(const Stokes& row, const glm::dvec3& v, const glm::dvec3& x_in) {
@@ -105,6 +123,7 @@ RenderImage renderPolarisedWith(const Scene& scene, const RenderSettings& s,
   img.width = s.width > 0 ? s.width : scene.camera.width;
   img.height = s.height > 0 ? s.height : scene.camera.height;
   checkPolarisedRender(scene, s, img.width, img.height);
+  checkPolarisedScene(scene, s);
   PolarisedTraceSettings ts = trace;
   ts.mueller_row = true;
   const CameraRays cam(scene.camera, img.width, img.height, s.spp);

@@ -28,6 +28,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "core/scene/scene.h"
@@ -45,6 +46,15 @@ inline constexpr const char* kStokesFrame =
 /// Whether a render of `scene` with `s` is polarised: asked for (s.polarised, s.stokes_layers), or
 /// the scene has polariser sheets or a camera analyser.
 bool isPolarisedRender(const Scene& scene, const RenderSettings& s);
+
+/// What makes the render polarised, in words ("--polarised", "--layers stokes", "the scene's
+/// polariser sheets", "the camera's analyzer"); empty when it is not.
+std::string polarisedBecause(const Scene& scene, const RenderSettings& s);
+
+/// Throws std::runtime_error (one line, "FILE: /json/path: ...") for a scene a polarised render
+/// cannot take: interfaces not sharp, a polarised environment. Front ends call it before
+/// voxelising; renderPolarisedWith calls it too.
+void checkPolarisedScene(const Scene& scene, const RenderSettings& s);
 
 /// A twin's polarised trace of many rays (one trace per ray, settings.mueller_row set).
 using PolarisedBatch = std::function<std::vector<PolarisedTrace>(

@@ -3,7 +3,8 @@
 // S0.R … S3.B (Mitsuba 3's names) with the frame in the string attribute stokesFrame. The scene:
 // a polariser sheet along x in front of a constant grey sky of 0.5, so every pixel holds S0 = ¼,
 // S1 = ¼ (x̂ of stokesBasis(−v) is +x for a camera looking along +z), S2 = S3 = 0. Stokes layers
-// with spectral or mode layers end the run with one line and no files.
+// with spectral or mode layers, smoothed interfaces and a polarised environment end the run with
+// one line (naming the JSON path) and no files.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tests/apps/cli_support.h"
@@ -22,13 +24,13 @@ using eikon::test::Outcome;
 using eikon::test::quote;
 
 constexpr const char* kScene = R"({
-  "camera": {"position": [0, 0, -40], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 2,
+  "camera": {"position": [0, 0, -40], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 0.5,
              "width": 8, "height": 6},
   "environment": {"type": "constant", "radiance": [0.5, 0.5, 0.5]},
   "interfaces": "sharp",
   "volume": {"bounds_min": [-8, -8, -8], "bounds_max": [8, 8, 8], "resolution": 24},
   "materials": {"glass": {"n": 1.5}},
-  "objects": [{"shape": "sphere", "center": [6, 6, 6], "radius": 1, "material": "glass"},
+  "objects": [{"shape": "sphere", "center": [4, 4, 4], "radius": 1, "material": "glass"},
               {"shape": "polarizer", "center": [0, 0, 20], "normal": [0, 0, 1],
                "transmission_axis": [1, 0, 0], "size": [40, 40]}]
 })";
@@ -88,6 +90,38 @@ TEST(RenderStokesCli, StokesWithOtherLayersIsOneLineAndNoFiles) {
     EXPECT_NE(r.err.find("polarised"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out)) << extra;
     EXPECT_FALSE(fs::exists(d.path / "out.png")) << extra;
+  }
+}
+
+TEST(RenderStokesCli, ScenesAPolarisedRenderCannotTakeAreOneLineAndNoFiles) {
+  Dir d;
+  const fs::path out = d.path / "out.exr";
+  const std::string base = kScene;
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"\"interfaces\": \"smoothed\"", "/interfaces"},
+      {"\"interfaces\": \"sharp\", \"environment\": {\"type\": \"constant\", \"radiance\": 1, "
+       "\"polarization\": {\"stokes\": [1, 1, 0, 0]}}",
+       "/environment/polarization"}};
+  for (const auto& [replacement, path] : cases) {
+    std::string text = base;
+    text.replace(text.find("\"interfaces\": \"sharp\""),
+                 std::string("\"interfaces\": \"sharp\"").size(), replacement);
+    if (path == "/environment/polarization") {  // drop the scene's own environment line
+      const size_t at = text.find("  \"environment\": {\"type\": \"constant\", \"radiance\": [0.5");
+      text.erase(at, text.find('\n', at) + 1 - at);
+    }
+    std::ofstream(d.path / "bad.json") << text;
+    const Outcome r = eikon::test::runEikon(
+        "render " + quote((d.path / "bad.json").string()) + " -o " + quote(out.string()) + " -q",
+        d.path);
+    EXPECT_NE(r.code, 0) << path;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << path << ": " << r.err;
+    EXPECT_NE(
+        r.err.find("bad.json: " + path + ": a polarised render (the scene's polariser sheets)"),
+        std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(out)) << path;
+    EXPECT_FALSE(fs::exists(d.path / "out.png")) << path;
   }
 }
 

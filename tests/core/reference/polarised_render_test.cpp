@@ -14,7 +14,8 @@
 //    environment along the reversed exit direction (the forward trace is tested against closed
 //    forms in polarised_trace_test.cpp);
 //  - spectral renders trace every bin: Malus holds per pixel between two spectral renders;
-//  - bad input: a polarised environment, spectral layers with a polarised render.
+//  - bad input: a polarised environment, smoothed interfaces, spectral layers with a polarised
+//    render.
 #include "core/reference/polarised_render.h"
 
 #include <gtest/gtest.h>
@@ -233,14 +234,17 @@ TEST(PolarisedRender, SpectralRendersTraceEveryBin) {
   EXPECT_NEAR(mean, 0.5, 0.1);
 }
 
-TEST(PolarisedRender, RefusesAPolarisedEnvironmentAndSpectralLayers) {
+TEST(PolarisedRender, RefusesAPolarisedEnvironmentSmoothedInterfacesAndSpectralLayers) {
   Scenery s(sheetAt(20, 0) + ", " + kAside, renderCamera(2, 2));
   RenderSettings rs;
   rs.spectral_layer = true;
   rs.wavelengths = 4;
   EXPECT_THROW(renderPolarised(s.field, s.scene, rs, 1), std::invalid_argument);
   s.scene.environment.polarization.stokes = {1, 1, 0, 0};
-  EXPECT_THROW(renderPolarised(s.field, s.scene, RenderSettings{}, 1), std::invalid_argument);
+  EXPECT_THROW(renderPolarised(s.field, s.scene, RenderSettings{}, 1), std::runtime_error);
+  s.scene.environment.polarization.stokes = {1, 0, 0, 0};
+  s.scene.interfaces = Scene::Interfaces::Smoothed;
+  EXPECT_THROW(renderPolarised(s.field, s.scene, RenderSettings{}, 1), std::runtime_error);
 }
 
 TEST(PolarisedRender, OnlyPolarisedScenesOrRequestsArePolarised) {
