@@ -23,6 +23,10 @@
 #ifndef EIKON_BOUNDARY_HAS_CONVEX
 #define EIKON_BOUNDARY_HAS_CONVEX true
 #endif
+// Likewise whether any shape may be a non-convex triangle mesh (EIKON_F_MESH: its traversal).
+#ifndef EIKON_BOUNDARY_HAS_MESH
+#define EIKON_BOUNDARY_HAS_MESH true
+#endif
 
 int shapeKind(int s) { return int(shapeTable[EIKON_SHAPE_STRIDE * s].x); }
 
@@ -82,6 +86,8 @@ float shapeSignedDistance(int s, vec3 x) {
   if (kind == EIKON_SHAPE_SPHERE) return length(p) - par.x;
   if (kind == EIKON_SHAPE_BOX) return boxDistance(p, par.xyz);
   if (kind == EIKON_SHAPE_ROUNDED_BOX) return boxDistance(p, par.xyz) - par.w;
+  // A mesh has no signed distance here: its crossings are meshFirstHit's (locateCrossing).
+  if (EIKON_BOUNDARY_HAS_MESH && kind == EIKON_SHAPE_MESH) return 0.0;
   float m = -3.0e38;
   if (!(EIKON_BOUNDARY_HAS_CONVEX)) return m;  // unreachable then: no shape has planes
   int first = int(head.y), count = int(head.z);
@@ -107,6 +113,8 @@ vec3 shapeDistanceGradient(int s, vec3 x) {
     g = l > 0.0 ? p / l : vec3(0.0, 0.0, 1.0);
   } else if (kind == EIKON_SHAPE_BOX || kind == EIKON_SHAPE_ROUNDED_BOX) {
     g = boxGradient(p, par.xyz);
+  } else if (EIKON_BOUNDARY_HAS_MESH && kind == EIKON_SHAPE_MESH) {
+    g = vec3(0.0);  // (see shapeSignedDistance)
   } else if (EIKON_BOUNDARY_HAS_CONVEX) {  // (else unreachable: no shape has planes)
     float m = -3.0e38;
     int first = int(head.y), count = int(head.z);
@@ -124,6 +132,111 @@ vec3 shapeDistanceGradient(int s, vec3 x) {
     }
   }
   return g.x * shapeTable[o + 2].xyz + g.y * shapeTable[o + 3].xyz + g.z * shapeTable[o + 4].xyz;
+}
+
+// ---- Triangle meshes (core/scene/mesh.cpp: MeshDistance::firstHit) ----
+
+// Where the segment o + t·d, t ∈ [t0, t1], enters the box [lo, hi]; 3e38 if it misses. inv =
+// 1/d with zero components replaced by ±1e-30 (no NaN from 0·∞; the boxes are padded).
+float meshBoxEntry(vec3 o, vec3 inv, float t0, float t1, vec4 lo, vec4 hi) {
+  vec3 a = (lo.xyz - o) * inv, b = (hi.xyz - o) * inv;
+  vec3 n = min(a, b), f = max(a, b);
+  float enter = max(t0, max(n.x, max(n.y, n.z)));
+  float leave = min(t1, min(f.x, min(f.y, f.z)));
+  return enter <= leave ? enter : 3.0e38;
+}
+
+// The watertight ray–triangle test (Woop, Benthin & Wald 2013) in the ray frame: corners and
+// origin already permuted to (kx, ky, kz), sh = (d_kx/d_kz, d_ky/d_kz, 1/d_kz). Returns t, or −1
+// if the ray misses. `precise` keeps the edge functions free of fused multiply-adds, so the two
+// triangles of an edge compute exact negatives of each other from the same sheared corners and a
+// ray through the edge cannot slip between them (floats otherwise; no double fallback).
+float meshTriangleHit(vec3 sh, vec3 op, vec3 a, vec3 b, vec3 c) {
+  precise vec3 A = a - op, B = b - op, C = c - op;
+  precise float ax = A.x - sh.x * A.z, ay = A.y - sh.y * A.z;
+  precise float bx = B.x - sh.x * B.z, by = B.y - sh.y * B.z;
+  precise float cx = C.x - sh.x * C.z, cy = C.y - sh.y * C.z;
+  precise float u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
+  if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) return -1.0;
+  precise float det = u + v + w;
+  if (det == 0.0) return -1.0;
+  return (u * sh.z * A.z + v * sh.z * B.z + w * sh.z * C.z) / det;
+}
+
+vec3 meshPermute(vec3 v, int kx, int ky, int kz) { return vec3(v[kx], v[ky], v[kz]); }
+
+// The first hit in (t0, t1] of the local segment o + t·d with a triangle of mesh s whose outward
+// normal n has sign(n·d) = facing (±1): MeshDistance::firstHit. One node per loop pass (a leaf's
+// ≤ 4 triangles unrolled in it), nearer child first, at most EIKON_MESH_MAX_PASSES passes (a search
+// cut there finds nothing, as on the CPU); the test at the end of a pass (no pass for a failing
+// test). gMeshPasses counts the passes (boundary_probe reports them).
+int gMeshPasses = 0;
+bool meshFirstHit(int s, vec3 o, vec3 d, float t0, float t1, float facing, out float tHit,
+                  out vec3 nHit) {
+  tHit = t1;
+  nHit = vec3(0.0);
+  vec4 head = shapeTable[EIKON_SHAPE_STRIDE * s];
+  int nodes = int(head.y), tris = int(head.w);
+  vec3 ad = abs(d);
+  int kz = ad.x >= ad.y && ad.x >= ad.z ? 0 : (ad.y >= ad.z ? 1 : 2);
+  int kx = kz == 2 ? 0 : kz + 1;
+  int ky = kx == 2 ? 0 : kx + 1;
+  if (d[kz] < 0.0) {
+    int tmp = kx;
+    kx = ky;
+    ky = tmp;
+  }
+  vec3 sh = vec3(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+  vec3 op = meshPermute(o, kx, ky, kz);
+  vec3 inv = 1.0 / mix(d, mix(vec3(-1e-30), vec3(1e-30), greaterThanEqual(d, vec3(0.0))),
+                       equal(d, vec3(0.0)));
+  bool found = false;
+  int stack[EIKON_MESH_STACK];
+  int top = 0;
+  if (meshBoxEntry(o, inv, t0, t1, shapeTable[nodes], shapeTable[nodes + 1]) < 3.0e38)
+    stack[top++] = 0;
+  int pass = 0;
+  if (top > 0) {
+    for (;;) {
+      int id = stack[--top];
+      vec4 lo = shapeTable[nodes + 2 * id], hi = shapeTable[nodes + 2 * id + 1];
+      int count = int(hi.w), first = int(lo.w);
+      if (count == 0) {
+        int l = id + 1, r = first;
+        float el = meshBoxEntry(o, inv, t0, tHit, shapeTable[nodes + 2 * l],
+                                shapeTable[nodes + 2 * l + 1]);
+        float er = meshBoxEntry(o, inv, t0, tHit, shapeTable[nodes + 2 * r],
+                                shapeTable[nodes + 2 * r + 1]);
+        bool leftFirst = el <= er;
+        if ((leftFirst ? er : el) < 3.0e38) stack[top++] = leftFirst ? r : l;
+        if ((leftFirst ? el : er) < 3.0e38) stack[top++] = leftFirst ? l : r;
+      } else {
+        [[unroll]] for (int j = 0; j < EIKON_MESH_LEAF; ++j) {
+          int k = tris + 3 * (first + min(j, count - 1));
+          vec4 va = shapeTable[k], vb = shapeTable[k + 1], vc = shapeTable[k + 2];
+          vec3 n = vec3(va.w, vb.w, vc.w);
+          if (j < count && dot(n, d) * facing > 0.0) {
+            float t = meshTriangleHit(sh, op, meshPermute(va.xyz, kx, ky, kz),
+                                      meshPermute(vb.xyz, kx, ky, kz),
+                                      meshPermute(vc.xyz, kx, ky, kz));
+            if (t > t0 && t <= tHit && (!found || t < tHit)) {
+              found = true;
+              tHit = t;
+              nHit = n;
+            }
+          }
+        }
+      }
+      ++pass;
+      if (top == 0) break;
+      if (pass >= EIKON_MESH_MAX_PASSES) {
+        found = false;  // cut: a nearer hit may be left on the stack
+        break;
+      }
+    }
+  }
+  gMeshPasses += pass;
+  return found;
 }
 
 // ---- The trilinear cell (boundary.cpp: Cell, cellAt) ----
@@ -330,6 +443,25 @@ bool boundaryRefineOnShape(int s, bool leavingOwner, vec3 a, vec3 b, float lenVo
   return false;
 }
 
+// A crossing of mesh s (boundary.cpp: meshCrossing): the first triangle hit of the crossing's
+// orientation within kMeshBracketVoxels (3.2) of the field's t, with the triangle's plane normal;
+// if there is none the field's zero and normal stand.
+void boundaryMeshCrossing(int s, bool leavingOwner, vec3 a, vec3 b, float lenVox,
+                          inout BoundaryCrossing c) {
+  int o = EIKON_SHAPE_STRIDE * s;
+  vec3 R0 = shapeTable[o + 2].xyz, R1 = shapeTable[o + 3].xyz, R2 = shapeTable[o + 4].xyz;
+  vec3 ba = b - a;
+  vec3 d = vec3(dot(R0, ba), dot(R1, ba), dot(R2, ba));
+  float w = 3.2 / lenVox, tHit;
+  vec3 n;
+  if (!meshFirstHit(s, shapeLocal(s, a), d, max(0.0, c.t - w), min(1.0, c.t + w),
+                    leavingOwner ? 1.0 : -1.0, tHit, n))
+    return;
+  c.t = tHit;
+  c.point = mix(a, b, tHit);
+  c.normal = (leavingOwner ? 1.0 : -1.0) * normalize(n.x * R0 + n.y * R1 + n.z * R2);
+}
+
 // The crossing in the cell between breaks t0 and t1 of the walk, if any: t and the region entered.
 bool boundaryCrossCell(int from, vec3 ua, vec3 du, float t0, float t1, float tol,
                        inout BoundaryCrossing out_) {
@@ -443,6 +575,10 @@ BoundaryCrossing locateCrossing(vec3 a, vec3 b, float tolVoxels, bool analytic) 
   if (length(grad) > 0.0) out_.normal = -normalize(grad);
   if (analytic && owner >= 1) {
     bool leaving = out_.from == owner;
+    if (EIKON_BOUNDARY_HAS_MESH && shapeKind(owner - 1) == EIKON_SHAPE_MESH) {
+      boundaryMeshCrossing(owner - 1, leaving, a, b, lenVox, out_);
+      return out_;
+    }
     if (boundaryRefineOnShape(owner - 1, leaving, a, b, lenVox, out_.t))
       out_.point = mix(a, b, out_.t);
     vec3 n = shapeDistanceGradient(owner - 1, out_.point);

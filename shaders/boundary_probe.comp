@@ -28,7 +28,7 @@ void main() {
   BoundaryCrossing c = locateCrossing(q.a.xyz, q.b.xyz, P.march.x, q.b.w > 0.5);
   o.regions = ivec4(boundaryRegion(q.a.xyz), c.found ? 1 : 0, c.from, c.to);
   o.crossing = vec4(c.point, c.t);
-  o.normal = vec4(c.normal, 0.0);
+  o.normal = vec4(c.normal, float(gMeshPasses));
   int s = int(q.s.x) - 1;
   o.shape = s >= 0 ? vec4(shapeSignedDistance(s, q.a.xyz), shapeDistanceGradient(s, q.a.xyz))
                    : vec4(0.0);

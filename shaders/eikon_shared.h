@@ -69,6 +69,7 @@ using uvec4 = glm::uvec4;
 #define EIKON_F_SHARP 1024      // sharp interfaces: march region by region (shaders/sharp.glsl)
 #define EIKON_F_VARYING 2048    // sharp: some region's medium varies in space (GRIN, radial axis)
 #define EIKON_F_CONVEX 4096     // sharp: some region's shape is a convex polyhedron (plane loops)
+#define EIKON_F_MESH 8192       // sharp: some region's shape is a non-convex mesh (BVH traversal)
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0
@@ -94,13 +95,28 @@ using uvec4 = glm::uvec4;
 //   [0] (kind EIKON_SHAPE_*, first plane (vec4 index), plane count, 0)   integers stored as floats
 //   [1] (centre (mm), 0)
 //   [2..4] the columns of the local → world rotation R (local p = Rᵀ(x − c): p_i = col_i · (x − c))
-//   [5] sphere: (radius, 0, 0, 0); box: (size/2, 0); rounded box: (size/2 − radius, radius)
-// then the planes of the convex shapes, (local unit outward normal, d): inside where n·p ≤ d.
+//   [5] sphere: (radius, 0, 0, 0); box: (size/2, 0); rounded box: (size/2 − radius, radius);
+//       mesh: (triangle count, hierarchy depth, 0, 0)
+// then the planes of the convex shapes, (local unit outward normal, d): inside where n·p ≤ d,
+// and the meshes (a mesh's [0] is (EIKON_SHAPE_MESH, first node, node count, first triangle)):
+// its bounding-volume hierarchy (core/scene/mesh.h MeshDistance), node k at first node + 2k:
+//   (box min (local mm, padded outward), inner: the right child k' / leaf: its first triangle),
+//   (box max, 0 for an inner node (the left child is k + 1) / the leaf's triangle count ≤ 4);
+// and its triangles in the leaves' order, triangle j at first triangle + 3j: (corner 0, n.x),
+// (corner 1, n.y), (corner 2, n.z), n the unit outward normal, corners counter-clockwise outside.
 #define EIKON_SHAPE_STRIDE 6
 #define EIKON_SHAPE_SPHERE 0
 #define EIKON_SHAPE_BOX 1
 #define EIKON_SHAPE_ROUNDED_BOX 2
 #define EIKON_SHAPE_CONVEX 3
+#define EIKON_SHAPE_MESH 4
+// A mesh's traversal (shaders/boundary.glsl meshFirstHit; MeshDistance::firstHit): the stack
+// holds depth + 1 nodes (packing refuses deeper hierarchies), a leaf holds at most
+// EIKON_MESH_LEAF triangles (one unrolled pass), and a search visits at most
+// EIKON_MESH_MAX_PASSES nodes (lavapipe's loop budget; past it the field's crossing stands).
+#define EIKON_MESH_STACK 24
+#define EIKON_MESH_LEAF 4
+#define EIKON_MESH_MAX_PASSES 256
 
 struct ViewParams {
   vec4 cam_pos;      // xyz: eye (mm); w: tan(fov_y / 2)
@@ -148,7 +164,7 @@ struct BoundaryAnswer {
   vec4 phi;       // x: φ_r(a) (mm); yzw: ∇φ_r(a)
   ivec4 regions;  // x: boundaryRegion(a); y: crossing found (0/1); z: from; w: to
   vec4 crossing;  // xyz: crossing point (mm); w: t along [a, b]
-  vec4 normal;    // xyz: unit normal from `from` into `to`; w: unused
+  vec4 normal;    // xyz: unit normal from `from` into `to`; w: mesh traversal passes (meshFirstHit)
   vec4 shape;     // x: signed distance of shape s at a (mm); yzw: its gradient (world)
 };
 

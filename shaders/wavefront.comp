@@ -132,6 +132,7 @@ layout(std430, binding = EIKON_B_MEDIA) readonly buffer MediaBuf { vec4 mediaTab
 float gLambdaUm = 0.5876;      // sharp.glsl's mediumIndex: set to P.wavelength.x in main()
 bool gDispersiveHit = false;  // written by mediumIndex, unused here
 #define EIKON_BOUNDARY_HAS_CONVEX hasFlag(EIKON_F_CONVEX)
+#define EIKON_BOUNDARY_HAS_MESH hasFlag(EIKON_F_MESH)
 #include "boundary.glsl"
 #include "fresnel.glsl"
 #define EIKON_SHARP_NO_MARCH

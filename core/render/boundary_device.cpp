@@ -6,10 +6,40 @@
 #include <type_traits>
 #include <variant>
 
+#include "core/scene/mesh.h"
 #include "shaders/boundary_probe.spv.h"
 
 namespace eikon {
 namespace {
+
+static_assert(MeshDistance::kLeafTriangles == EIKON_MESH_LEAF &&
+                  MeshDistance::kMaxTraversalPasses == EIKON_MESH_MAX_PASSES,
+              "a mesh's traversal is declared twice (mesh.h, eikon_shared.h)");
+
+// A mesh's hierarchy and triangles (eikon_shared.h, EIKON_SHAPE_MESH) appended to `extra`, whose
+// first entry has vec4 index `base`; its record's head and parameters. The node boxes are
+// widened by 2e-5 of the bounding radius (≥ 100 float ulps), so that the GPU's float slab test
+// cannot drop a triangle that touches its box; the triangles are tested exactly as stored.
+void packMesh(const MeshShape& m, int base, std::vector<glm::vec4>& extra, glm::vec4& head,
+              glm::vec4& par) {
+  const MeshDistance& d = *m.distance;
+  const auto& nodes = d.nodes();
+  const int first_node = base + int(extra.size());
+  const int first_tri = first_node + 2 * int(nodes.size());
+  head =
+      glm::vec4(float(EIKON_SHAPE_MESH), float(first_node), float(nodes.size()), float(first_tri));
+  par = glm::vec4(float(d.triangles().size()), float(d.depth()), 0.0f, 0.0f);
+  const double pad = 2e-5 * std::max(d.boundingRadius(), 1.0);
+  for (const MeshDistance::Node& n : nodes) {
+    extra.push_back(glm::vec4(glm::vec3(n.lo - pad), float(n.first)));
+    extra.push_back(glm::vec4(glm::vec3(n.hi + pad), float(n.count)));
+  }
+  for (uint32_t t : d.leafOrder()) {
+    const glm::dvec3 n = d.faceNormals()[t];
+    for (int k = 0; k < 3; ++k)
+      extra.push_back(glm::vec4(glm::vec3(d.vertices()[d.triangles()[t][size_t(k)]]), float(n[k])));
+  }
+}
 
 // The shape record of one shape (eikon_shared.h): header, centre, rotation columns, parameters.
 // Its planes go to `planes` (vec4 indices counted from the table's start by the caller).
@@ -29,8 +59,7 @@ void packShape(const Shape& shape, int first_plane, std::vector<glm::vec4>& out,
           head.x = EIKON_SHAPE_ROUNDED_BOX;
           par = glm::vec4(glm::vec3(0.5 * g.size - glm::dvec3(g.radius)), float(g.radius));
         } else if constexpr (std::is_same_v<T, MeshShape>) {
-          // core/scene refuses sharp interfaces for non-convex meshes (mesh.h).
-          throw std::logic_error("a non-convex mesh has no sharp boundary");
+          packMesh(g, first_plane, planes, head, par);
         } else {
           head = glm::vec4(float(EIKON_SHAPE_CONVEX), float(first_plane + int(planes.size())),
                            float(g.planes.size()), 0.0f);
@@ -67,11 +96,27 @@ void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field, const
                                  std::to_string(field.grid.dims[size_t(a)]) +
                                  " voxels per side but the device allows at most " +
                                  std::to_string(lim.max_image_dimension_3d));
-  // Records and planes, counted without packing: 6 vec4 per shape plus one per plane.
+  // Records, planes and meshes, counted without packing: 6 vec4 per shape, one per plane, two per
+  // mesh node and three per triangle.
   double entries = EIKON_SHAPE_STRIDE * double(field.shapes.size());
-  for (const Shape& s : field.shapes)
+  for (const Shape& s : field.shapes) {
     if (const auto* c = std::get_if<ConvexShape>(&s.geometry()))
       entries += double(c->planes.size());
+    if (const auto* m = std::get_if<MeshShape>(&s.geometry())) {
+      entries +=
+          2.0 * double(m->distance->nodes().size()) + 3.0 * double(m->distance->triangles().size());
+      if (m->distance->depth() + 1 > EIKON_MESH_STACK)
+        throw std::runtime_error(
+            where + "a mesh's hierarchy is " + std::to_string(m->distance->depth()) +
+            " levels deep, more than the GPU's traversal holds (" +
+            std::to_string(EIKON_MESH_STACK - 1) + "; or set \"interfaces\": \"smoothed\")");
+    }
+  }
+  // Indices are stored as floats: exact below 2^24.
+  if (entries >= 16777216.0)
+    throw std::runtime_error(where + "the shape table needs " + std::to_string(int64_t(entries)) +
+                             " entries, more than its float indices reach (16777216; or set "
+                             "\"interfaces\": \"smoothed\")");
   const double bytes = 16.0 * std::max(entries, 1.0);
   if (bytes > double(lim.max_storage_buffer_range))
     throw std::runtime_error(where + "the shape table needs " + std::to_string(int64_t(bytes)) +

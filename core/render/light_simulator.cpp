@@ -241,7 +241,8 @@ struct GpuWavefront::Impl {
 
   /// The EIKON_F_* flags of the run (wavefront.comp's kWaveFlags and WaveParams.grid_dims.w):
   /// what the volume holds, EIKON_F_UNIAXIAL for an e-mode run in a uniaxial volume, and
-  /// EIKON_F_CONVEX when the sharp path's boundary has a convex polyhedron (its plane loops).
+  /// EIKON_F_CONVEX when the sharp path's boundary has a convex polyhedron (its plane loops),
+  /// EIKON_F_MESH when it has a non-convex mesh (its hierarchy's traversal).
   int featureFlags() const {
     int flags = 0;
     if (vol.dispersive) flags |= EIKON_F_DISPERSIVE;
@@ -249,8 +250,10 @@ struct GpuWavefront::Impl {
     if (vol.opaque) flags |= EIKON_F_OPACITY;
     if (eMode) flags |= EIKON_F_UNIAXIAL;
     if (sharp)
-      for (const Shape& shape : vol.boundary.shapes)
+      for (const Shape& shape : vol.boundary.shapes) {
         if (std::holds_alternative<ConvexShape>(shape.geometry())) flags |= EIKON_F_CONVEX;
+        if (std::holds_alternative<MeshShape>(shape.geometry())) flags |= EIKON_F_MESH;
+      }
     return flags;
   }
   /// wavefront.comp's kWaveOptions: bit 0 straight steps, bit 1 pass caustics, bit 2 probe plane.

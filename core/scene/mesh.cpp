@@ -300,11 +300,12 @@ MeshDistance::MeshDistance(const TriangleMesh& m)
   for (const auto& x : v_) radius_ = std::max(radius_, glm::length(x));
   std::iota(tri_.begin(), tri_.end(), 0u);
   nodes_.reserve(2 * t_.size());
-  build(0, uint32_t(t_.size()));
+  build(0, uint32_t(t_.size()), 1);
 }
 
-uint32_t MeshDistance::build(uint32_t begin, uint32_t end) {
+uint32_t MeshDistance::build(uint32_t begin, uint32_t end, int level) {
   const uint32_t id = uint32_t(nodes_.size());
+  depth_ = std::max(depth_, level);
   nodes_.push_back({glm::dvec3(1e300), glm::dvec3(-1e300), begin, end - begin});
   glm::dvec3 clo(1e300), chi(-1e300);
   for (uint32_t i = begin; i < end; ++i)
@@ -312,7 +313,7 @@ uint32_t MeshDistance::build(uint32_t begin, uint32_t end) {
       nodes_[id].lo = glm::min(nodes_[id].lo, v_[c]);
       nodes_[id].hi = glm::max(nodes_[id].hi, v_[c]);
     }
-  if (end - begin <= 4) return id;
+  if (end - begin <= kLeafTriangles) return id;
   auto centroid = [&](uint32_t t) { return v_[t_[t][0]] + v_[t_[t][1]] + v_[t_[t][2]]; };
   for (uint32_t i = begin; i < end; ++i) {
     clo = glm::min(clo, centroid(tri_[i]));
@@ -324,8 +325,8 @@ uint32_t MeshDistance::build(uint32_t begin, uint32_t end) {
   std::nth_element(tri_.begin() + begin, tri_.begin() + mid, tri_.begin() + end,
                    [&](uint32_t a, uint32_t b) { return centroid(a)[axis] < centroid(b)[axis]; });
   nodes_[id].count = 0;
-  build(begin, mid);
-  const uint32_t right = build(mid, end);
+  build(begin, mid, level + 1);
+  const uint32_t right = build(mid, end, level + 1);
   nodes_[id].first = right;
   return id;
 }
@@ -370,9 +371,114 @@ double MeshDistance::signedDistance(const glm::dvec3& p, glm::dvec3* gradient) c
   return sign * d;
 }
 
-MeshShape makeMeshShape(const TriangleMesh& mesh, std::string why_not_convex) {
+namespace {
+
+/// Where the segment o + t·d, t ∈ [t0, t1], enters the box [lo, hi] (slab test; inv = 1/d with
+/// ±inf for zero components), or +inf if it misses the box.
+double boxEntry(const glm::dvec3& o, const glm::dvec3& inv, double t0, double t1,
+                const glm::dvec3& lo, const glm::dvec3& hi) {
+  for (int a = 0; a < 3; ++a) {
+    double n = (lo[a] - o[a]) * inv[a], f = (hi[a] - o[a]) * inv[a];
+    if (std::isnan(n) || std::isnan(f)) {  // d[a] = 0 and o[a] on a slab plane: inside it
+      if (o[a] < lo[a] || o[a] > hi[a]) return HUGE_VAL;
+      continue;
+    }
+    if (n > f) std::swap(n, f);
+    t0 = std::max(t0, n);
+    t1 = std::min(t1, f);
+  }
+  return t0 <= t1 ? t0 : HUGE_VAL;
+}
+
+/// The watertight test's ray frame (Woop et al. 2013, §3): kz the dominant axis of d, kx and ky
+/// the others (swapped when d[kz] < 0 to keep the winding), and the shear that maps d to +z.
+struct RayFrame {
+  int kx, ky, kz;
+  double sx, sy, sz;
+};
+
+RayFrame rayFrame(const glm::dvec3& d) {
+  const glm::dvec3 a = glm::abs(d);
+  RayFrame f{};
+  f.kz = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+  f.kx = (f.kz + 1) % 3;
+  f.ky = (f.kx + 1) % 3;
+  if (d[f.kz] < 0) std::swap(f.kx, f.ky);
+  f.sx = d[f.kx] / d[f.kz];
+  f.sy = d[f.ky] / d[f.kz];
+  f.sz = 1.0 / d[f.kz];
+  return f;
+}
+
+/// The ray parameter of the hit of o + t·d with triangle abc, or NaN if it misses. Corners on an
+/// edge function's zero count as inside for both triangles of the edge.
+double watertightHit(const RayFrame& f, const glm::dvec3& o, const glm::dvec3& a,
+                     const glm::dvec3& b, const glm::dvec3& c) {
+  const glm::dvec3 A = a - o, B = b - o, C = c - o;
+  const double ax = A[f.kx] - f.sx * A[f.kz], ay = A[f.ky] - f.sy * A[f.kz];
+  const double bx = B[f.kx] - f.sx * B[f.kz], by = B[f.ky] - f.sy * B[f.kz];
+  const double cx = C[f.kx] - f.sx * C[f.kz], cy = C[f.ky] - f.sy * C[f.kz];
+  const double u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
+  if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return std::nan("");
+  const double det = u + v + w;
+  if (det == 0.0) return std::nan("");  // the ray lies in the triangle's plane
+  return (u * f.sz * A[f.kz] + v * f.sz * B[f.kz] + w * f.sz * C[f.kz]) / det;
+}
+
+}  // namespace
+
+MeshDistance::Hit MeshDistance::firstHit(const glm::dvec3& o, const glm::dvec3& d, double t0,
+                                         double t1, int facing) const {
+  Hit best;
+  if (!(glm::dot(d, d) > 0.0) || !(t1 > t0)) return best;
+  const RayFrame f = rayFrame(d);
+  const glm::dvec3 inv = 1.0 / d;
+  double t_best = t1;
+  uint32_t stack[64];  // depth ≤ log2(100000 / 4) + 2 with median splits
+  int top = 0;
+  uint64_t passes = 0;
+  const glm::dvec3 pad(1e-9 * (radius_ + 1.0));
+  auto entry = [&](uint32_t n) {
+    return boxEntry(o, inv, t0, t_best, nodes_[n].lo - pad, nodes_[n].hi + pad);
+  };
+  if (entry(0) < HUGE_VAL) stack[top++] = 0;
+  bool cut = false;
+  while (top > 0) {
+    if (passes == uint64_t(kMaxTraversalPasses)) {
+      cut = true;
+      break;
+    }
+    ++passes;
+    const uint32_t id = stack[--top];
+    const Node& nd = nodes_[id];
+    if (nd.count == 0) {
+      // The children that the segment meets, the nearer on top (searched first).
+      const uint32_t l = id + 1, r = nd.first;
+      const double el = entry(l), er = entry(r);
+      const bool left_first = el <= er;
+      if ((left_first ? er : el) < HUGE_VAL) stack[top++] = left_first ? r : l;
+      if ((left_first ? el : er) < HUGE_VAL) stack[top++] = left_first ? l : r;
+      continue;
+    }
+    for (uint32_t i = nd.first; i < nd.first + nd.count; ++i) {
+      const uint32_t tri = tri_[i];
+      const double nd_dot = glm::dot(face_n_[tri], d);
+      if (facing != 0 && !(nd_dot * facing > 0.0)) continue;
+      const auto& T = t_[tri];
+      const double t = watertightHit(f, o, v_[T[0]], v_[T[1]], v_[T[2]]);
+      if (t > t0 && t <= t_best && (!best.found || t < best.t)) {
+        best = {true, t, face_n_[tri], tri};
+        t_best = t;
+      }
+    }
+  }
+  passes_.fetch_add(passes, std::memory_order_relaxed);
+  return cut ? Hit{} : best;
+}
+
+MeshShape makeMeshShape(const TriangleMesh& mesh) {
   auto d = std::make_shared<const MeshDistance>(mesh);
-  return MeshShape{d, d->boundingRadius(), std::move(why_not_convex)};
+  return MeshShape{d, d->boundingRadius()};
 }
 
 }  // namespace eikon

@@ -14,12 +14,14 @@
 // the tracer see the same planes as for the `planes` shape — a mesh box is the box. A non-convex
 // mesh becomes a MeshShape whose signed distance is exact (MeshDistance: the nearest triangle
 // through a bounding-volume hierarchy, O(log n) per voxel, signed by angle-weighted
-// pseudo-normals); it is voxelised with smoothed interfaces only: the sharp boundaries' GPU
-// crossing search knows planes and quadrics, and a triangle loop per step would not fit
-// lavapipe's loop budget (docs/scene-format.md).
+// pseudo-normals). With sharp interfaces its crossings are the exact ray–triangle hits found
+// through the same hierarchy (MeshDistance::firstHit; the GPU twin in shaders/boundary.glsl
+// traverses the hierarchy as packed by core/render/boundary_device.cpp), so each facet refracts
+// at its own triangle's plane (docs/scene-format.md).
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <glm/glm.hpp>
@@ -63,23 +65,58 @@ ConvexShape scaledConvex(const std::vector<Plane>& planes, const glm::dvec3& sca
 
 /// Exact signed distance to a closed, consistently outward-oriented mesh (checkClosedMesh): the
 /// distance to the nearest triangle, found through a bounding-volume hierarchy of its triangles
-/// (median splits, ≤ 4 per leaf), negative inside. The sign is that of (p − q)·N with q the nearest
-/// point and N the angle-weighted pseudo-normal of the feature q lies on (face, edge or vertex),
-/// which is exact for closed manifold meshes (Bærentzen & Aanæs, IEEE TVCG 11(3), 2005).
+/// (median splits, ≤ kLeafTriangles per leaf), negative inside. The sign is that of (p − q)·N with
+/// q the nearest point and N the angle-weighted pseudo-normal of the feature q lies on (face, edge
+/// or vertex), which is exact for closed manifold meshes (Bærentzen & Aanæs, IEEE TVCG 11(3),
+/// 2005).
 class MeshDistance {
  public:
+  struct Node {
+    glm::dvec3 lo, hi;
+    uint32_t first, count;  ///< leaf: tri_[first, first + count); inner: count 0, right child first
+  };                        ///< (the left child is the next node)
+  struct Hit {
+    bool found = false;
+    double t = 0.0;          ///< along the segment o + t·d
+    glm::dvec3 normal{0.0};  ///< the triangle's unit outward normal (its plane's)
+    uint32_t triangle = 0;   ///< index into the mesh's triangles
+  };
+  /// Most triangles in a leaf of the hierarchy (the GPU twin tests a leaf in one unrolled pass).
+  static constexpr uint32_t kLeafTriangles = 4;
+  /// Most nodes one firstHit visits (the GPU twin's bound for lavapipe's loop budget); a search
+  /// cut there reports no hit.
+  static constexpr int kMaxTraversalPasses = 256;
+
   explicit MeshDistance(const TriangleMesh& mesh);
   /// Signed distance (mm, negative inside); `gradient`, if given, gets its unit gradient (p − q)
   /// / |p − q| signed, or the face normal on the surface itself.
   double signedDistance(const glm::dvec3& p, glm::dvec3* gradient = nullptr) const;
   double boundingRadius() const { return radius_; }
 
+  /// The first crossing of the segment o + t·d, t ∈ (t0, t1], with a triangle whose outward normal
+  /// n has sign(n·d) = `facing` (+1: leaving the mesh, −1: entering it, 0: either), by the
+  /// watertight ray–triangle test of Woop, Benthin & Wald (JCGT 2(1), 2013) through the
+  /// hierarchy: the edge functions of two triangles sharing an edge are computed from the same
+  /// sheared corners and are exact negatives of each other, so a ray through the edge (or a
+  /// vertex) hits at least one of them — it cannot slip between. Adds the nodes visited (one GPU
+  /// loop pass each) to traversalPasses(). Boxes are tested with a margin of 1e-9 of the
+  /// bounding radius, so rounding cannot drop a triangle that touches its box.
+  Hit firstHit(const glm::dvec3& o, const glm::dvec3& d, double t0, double t1, int facing) const;
+  /// Nodes visited by every firstHit so far (all threads; the GPU twin's traversal passes).
+  uint64_t traversalPasses() const { return passes_.load(std::memory_order_relaxed); }
+
+  /// The hierarchy as the GPU twin packs it: nodes (root first), the triangle order of the
+  /// leaves, and the mesh (vertices, triangles, unit face normals).
+  const std::vector<Node>& nodes() const { return nodes_; }
+  const std::vector<uint32_t>& leafOrder() const { return tri_; }
+  const std::vector<glm::dvec3>& vertices() const { return v_; }
+  const std::vector<std::array<uint32_t, 3>>& triangles() const { return t_; }
+  const std::vector<glm::dvec3>& faceNormals() const { return face_n_; }
+  /// Levels of the hierarchy (root alone: 1); the GPU's traversal stack holds depth + 1.
+  int depth() const { return depth_; }
+
  private:
-  struct Node {
-    glm::dvec3 lo, hi;
-    uint32_t first, count;  ///< leaf: tri_[first, first + count); inner: count 0, right child first
-  };
-  uint32_t build(uint32_t begin, uint32_t end);
+  uint32_t build(uint32_t begin, uint32_t end, int level);
   std::vector<glm::dvec3> v_;                      ///< vertices
   std::vector<std::array<uint32_t, 3>> t_;         ///< triangles
   std::vector<glm::dvec3> face_n_;                 ///< unit face normals
@@ -88,10 +125,12 @@ class MeshDistance {
   std::vector<uint32_t> tri_;                      ///< triangle order of the leaves
   std::vector<Node> nodes_;
   double radius_ = 0.0;
+  int depth_ = 0;
+  mutable std::atomic<uint64_t> passes_{0};
 };
 
-/// A mesh that meshFacePlanes refused (`why_not_convex`: its message) as a shape; the distance
-/// is shared by copies of the Scene.
-MeshShape makeMeshShape(const TriangleMesh& mesh, std::string why_not_convex);
+/// A mesh that meshFacePlanes refused (not convex) as a shape; the distance and hierarchy are
+/// shared by copies of the Scene.
+MeshShape makeMeshShape(const TriangleMesh& mesh);
 
 }  // namespace eikon

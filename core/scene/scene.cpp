@@ -504,7 +504,7 @@ ConvexShape parseFaceted(const Node& o) {
 
 /// {"shape": "mesh", "file": "x.obj", "scale": s | [sx, sy, sz]}: a closed triangle mesh, read and
 /// checked by core/scene/mesh.h. A convex one becomes its exact polyhedron (one plane per face),
-/// any other an exact-distance MeshShape (smoothed interfaces only: parseObjects checks).
+/// any other an exact-distance MeshShape (sharp interfaces at its triangles, or smoothed).
 ShapeGeometry parseMesh(const Node& o) {
   const Node f = o.at("file");
   std::filesystem::path p = f.string();
@@ -525,11 +525,10 @@ ShapeGeometry parseMesh(const Node& o) {
     f.fail(printable(e.what(), 400));
   }
   std::vector<Plane> planes;
-  std::string why_not_convex;
   try {
     planes = meshFacePlanes(mesh, p.filename().string(), kMaxPlanes);
-  } catch (const std::invalid_argument& e) {
-    why_not_convex = printable(e.what(), 400);
+  } catch (const std::invalid_argument&) {
+    // Not convex (or more faces than a polyhedron takes): a MeshShape.
   }
   auto far = [&](double r) {
     if (!(r <= kMaxCoordinateMm))
@@ -542,7 +541,7 @@ ShapeGeometry parseMesh(const Node& o) {
       v *= scale;
       far(glm::length(v));
     }
-    return makeMeshShape(mesh, why_not_convex);
+    return makeMeshShape(mesh);
   }
   ConvexShape c = scaledConvex(planes, scale);
   for (const Plane& pl : c.planes) far(std::abs(pl.d));
@@ -1159,12 +1158,6 @@ static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::
       continue;
     }
     SceneObject obj = parseObject(o);
-    if (const auto* m = std::get_if<MeshShape>(&obj.shape.geometry()))
-      if (scene.interfaces == Scene::Interfaces::Sharp)
-        o.at("file").fail(m->why_not_convex +
-                          "; such a mesh needs \"interfaces\": \"smoothed\" (sharp interfaces "
-                          "take convex meshes of at most " +
-                          std::to_string(kMaxPlanes) + " faces)");
     if (!scene.materials.count(obj.material)) loadLibraryMaterial(o, obj, scene);
     const Material& mat = scene.materials[obj.material];
     if (obj.radial_axis && !mat.uniaxial)

@@ -44,11 +44,11 @@ void finishConvex(ConvexShape& shape);
 
 class MeshDistance;  // core/scene/mesh.h
 /// A closed triangle mesh that is not convex (a convex one becomes a ConvexShape), in the object's
-/// local frame with its scale applied: exact signed distance; smoothed interfaces only.
+/// local frame with its scale applied: exact signed distance, and with sharp interfaces the exact
+/// ray–triangle crossings of its hierarchy (MeshDistance::firstHit).
 struct MeshShape {
   std::shared_ptr<const MeshDistance> distance;
   double bounding_radius = 0.0;
-  std::string why_not_convex;  ///< for the error when sharp interfaces are asked for
 };
 
 using ShapeGeometry = std::variant<SphereShape, BoxShape, RoundedBoxShape, ConvexShape, MeshShape>;

@@ -6,6 +6,7 @@
 #include <map>
 #include <string>
 
+#include "core/scene/mesh.h"
 #include "core/scene/scene.h"
 
 namespace eikon {
@@ -171,6 +172,25 @@ bool refineOnShape(const Shape& s, bool leaving_owner, const glm::dvec3& a, cons
   return false;
 }
 
+// A crossing of a mesh's surface: the first exact ray–triangle hit (MeshDistance::firstHit) of
+// the right orientation (a triangle facing along the segment when leaving the mesh, against it
+// when entering) within kMeshBracketVoxels of the field's t, with its triangle's plane normal:
+// the facet refracts at its own plane. False (the field's zero and normal stand, as on the GPU,
+// which has no signed distance of a mesh to refine on) if there is none.
+bool meshCrossing(const Shape& s, const MeshShape& m, bool leaving_owner, const glm::dvec3& a,
+                  const glm::dvec3& b, double len_vox, BoundaryCrossing& out) {
+  const glm::dmat3 to_local = glm::transpose(s.rotation());
+  const glm::dvec3 o = to_local * (a - s.center()), d = to_local * (b - a);
+  const double w = kMeshBracketVoxels / len_vox;
+  const MeshDistance::Hit hit = m.distance->firstHit(
+      o, d, std::max(0.0, out.t - w), std::min(1.0, out.t + w), leaving_owner ? 1 : -1);
+  if (!hit.found) return false;
+  out.t = hit.t;
+  out.point = a + hit.t * (b - a);
+  out.normal = (leaving_owner ? 1.0 : -1.0) * (s.rotation() * hit.normal);
+  return true;
+}
+
 }  // namespace
 
 double boundaryHostBytes(const Grid& g) {
@@ -283,6 +303,10 @@ BoundaryCrossing locateCrossing(const BoundaryField& bf, const glm::dvec3& a, co
   if (opt.analytic && out.owner >= 1) {
     const Shape& s = bf.shapes[size_t(out.owner - 1)];
     const bool leaving = out.from == out.owner;
+    if (const auto* m = std::get_if<MeshShape>(&s.geometry())) {
+      meshCrossing(s, *m, leaving, a, b, len_vox, out);  // else the field's answer, as the GPU
+      return out;
+    }
     if (refineOnShape(s, leaving, a, b, len_vox, out.t)) out.point = a + out.t * (b - a);
     const glm::dvec3 n = s.distanceGradient(out.point);
     if (glm::length(n) > 0.0) out.normal = (leaving ? 1.0 : -1.0) * glm::normalize(n);

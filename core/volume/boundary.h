@@ -16,7 +16,8 @@
 // interpolation reproduces exactly (float rounding only); on curved surfaces the error is
 // second order in h (≤ 3h²/(8 r_min) for a sphere). The surface crossed belongs to the later of
 // the two regions' objects (max(from, to)), whose analytic shape gives the exact normal and,
-// optionally, refines the crossing on its own signed distance.
+// optionally, refines the crossing on its own signed distance (a triangle mesh: the exact
+// ray–triangle hit near the field's zero, with the triangle's plane normal).
 //
 // A boundary between two regions of the same material is reported too (equal media on both
 // sides: Snell and Fresnel leave the ray unchanged). Features thinner than a voxel whose 8
@@ -69,7 +70,8 @@ struct LocateOptions {
   /// The crossing is bracketed on the trilinear field to this width (voxels) along the segment.
   double tolerance_voxels = 1e-6;
   /// Refine the crossing on the crossed shape's exact signed distance and take its normal
-  /// (analytic shapes); false: the trilinear field's zero and gradient only (what a mesh gives).
+  /// (analytic shapes; a mesh: its exact triangle hit and that triangle's plane normal, see
+  /// kMeshBracketVoxels); false: the trilinear field's zero and gradient only.
   bool analytic = true;
 };
 
@@ -97,6 +99,10 @@ BoundaryCrossing locateCrossing(const BoundaryField& field, const glm::dvec3& a,
 /// the same constants.
 constexpr double kSliverVoxels = 0.25;
 constexpr double kNudgeVoxels = 1e-4;
+/// A crossing of a mesh (MeshShape) is the first exact triangle hit of the crossing's orientation
+/// within this many voxels of the field's zero along the segment (the widest bracket of the
+/// analytic shapes' refinement; the field's zero lies within 3h²/(8r) of a smooth surface).
+constexpr double kMeshBracketVoxels = 3.2;
 
 /// The first crossing on [a, b] out of `region` (the region a ray carries), as the sharp marches
 /// and the polarised trace search: just past a crossing of a curved surface the trilinear field
