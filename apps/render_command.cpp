@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
+#include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -69,8 +71,10 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
                   "auto (hero unless the scene attenuates, emits or has opaque objects; default)");
   sub->add_option("--layers", a.layers,
                   "Extra EXR layers, comma-separated: spectral (one S0.<nm> channel per "
-                  "wavelength bin; needs --wavelengths > 0) and modes (o.R..B, e.R..B: the o- and "
-                  "e-mode radiance); R, G, B are always written");
+                  "wavelength bin; needs --wavelengths > 0), modes (o.R..B, e.R..B: the o- and "
+                  "e-mode radiance) and aov (Z, Px Py Pz, Nx Ny Nz, objectId: the first interface "
+                  "of each pixel's first ray; steps: march steps per pixel); R, G, B are always "
+                  "written");
   sub->add_option("--step", a.step,
                   "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4)");
@@ -151,6 +155,12 @@ LightRequest lightRequest(const RenderArgs& a) {
 
 std::filesystem::path lightCacheDir(const RenderArgs& a) {
   return a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache);
+}
+
+/// The EXR channel names of img.aov (empty without the AOV layer).
+std::vector<std::string> aovNames(const RenderImage& img) {
+  if (img.aov.empty()) return {};
+  return std::vector<std::string>(std::begin(kAovChannelNames), std::end(kAovChannelNames));
 }
 
 /// A warning, or with --strict the error it becomes.
@@ -267,9 +277,9 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   // and a concurrent render to the same -o cannot interleave its pair with this one. The
   // preview first: it is the smaller, so a full disk is usually met before the EXR is encoded.
   writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)},
-                      {out, rs.spectral_layer || rs.mode_layers
+                      {out, rs.spectral_layer || rs.mode_layers || rs.aov_layer
                                 ? exrLayersContent(img.width, img.height, img.rgb, img.bins,
-                                                   img.spectral, img.modes)
+                                                   img.spectral, img.modes, aovNames(img), img.aov)
                                 : exrRgbContent(img.width, img.height, img.rgb)}});
   preview.finished = true;
   timings::mark("written");

@@ -11,6 +11,7 @@
 #include "core/render/render_defaults.h"
 #include "core/render/view_renderer.h"
 #include "core/vk/context.h"
+#include "core/volume/render_layers.h"
 
 namespace eikon {
 
@@ -39,7 +40,7 @@ SpectralSampling parseSpectralSampling(const std::string& s) {
 }
 
 void parseLayers(const std::string& list, ViewRequest& view) {
-  view.spectral_layer = view.mode_layers = false;
+  view.spectral_layer = view.mode_layers = view.aov_layer = false;
   size_t start = 0;
   while (start <= list.size() && !list.empty()) {
     const size_t end = std::min(list.find(',', start), list.size());
@@ -48,9 +49,12 @@ void parseLayers(const std::string& list, ViewRequest& view) {
       view.spectral_layer = true;
     else if (name == "modes")
       view.mode_layers = true;
+    else if (name == "aov")
+      view.aov_layer = true;
     else
-      throw SettingError("layers", "must be a comma-separated list of spectral and modes, got '" +
-                                       name + "' in '" + list + "'");
+      throw SettingError("layers",
+                         "must be a comma-separated list of spectral, modes and aov, got '" + name +
+                             "' in '" + list + "'");
     start = end + 1;
   }
 }
@@ -81,6 +85,7 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
   rs.sampling = v.sampling;
   rs.spectral_layer = v.spectral_layer;
   rs.mode_layers = v.mode_layers;
+  rs.aov_layer = v.aov_layer;
   if (rs.spectral_layer && rs.wavelengths <= 0)
     throw SettingError("layers", "spectral needs a spectral render (wavelengths > 0), got " +
                                      std::to_string(rs.wavelengths) + " wavelengths");
@@ -231,11 +236,21 @@ RenderImage Session::render(const RenderSettings& settings, bool gpu) {
   RenderSettings rs = settings;
   if (progress_.update && !rs.progress)
     rs.progress = [this](double f) { progress_.update("rendering", f); };
-  if (gpu) return gpuRenderer(&rs).render(rs);
-  Camera cam = scene_->camera;
-  if (rs.width > 0) cam.width = rs.width;
-  if (rs.height > 0) cam.height = rs.height;
-  return cpuMarcher().render(cam, rs, threads_);
+  RenderImage img;
+  if (gpu) {
+    img = gpuRenderer(&rs).render(rs);
+  } else {
+    Camera cam = scene_->camera;
+    if (rs.width > 0) cam.width = rs.width;
+    if (rs.height > 0) cam.height = rs.height;
+    img = cpuMarcher().render(cam, rs, threads_);
+  }
+  if (rs.aov_layer && scene_->interfaces == Scene::Interfaces::Smoothed) {
+    std::vector<Shape> shapes;
+    for (const SceneObject& o : scene_->objects) shapes.push_back(o.shape);
+    assignAovObjects(shapes, img);
+  }
+  return img;
 }
 
 std::vector<std::array<TraceOutcome, 2>> Session::trace(const std::vector<TraceRequest>& rays,

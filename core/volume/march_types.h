@@ -55,6 +55,9 @@ struct RenderSettings {
   /// "Spectral layers"), so that the layers integrate to it exactly.
   bool spectral_layer = false;  ///< one channel per wavelength bin (spectral mode only)
   bool mode_layers = false;     ///< o- and e-mode radiance as separate RGB layers
+  /// RenderImage::aov: the first interface of each pixel's first camera ray (depth, point,
+  /// normal, object id) and the march steps of all its marches (docs/view-renderer.md "AOV").
+  bool aov_layer = false;
   MarchSettings march;
   /// progress(fraction done); may be empty.
   std::function<void(double)> progress;
@@ -83,6 +86,31 @@ struct RenderImage {
   /// RenderSettings::mode_layers: 6 floats per pixel, the o-mode's and the e-mode's share of the
   /// linear sRGB (o + e = rgb; e = 0 in a scene without crystals); empty otherwise.
   std::vector<float> modes;
+  /// RenderSettings::aov_layer: kAovChannels floats per pixel (rows from the top), in the order
+  /// of kAovChannelNames: Z (distance from the eye to the first interface along the pixel's first
+  /// camera ray, mm; +inf where it meets none), Px Py Pz (that point, world, mm; 0 where none),
+  /// Nx Ny Nz (its unit world-space normal facing the camera; 0 where none), objectId (index of
+  /// the object whose surface it is in the scene's "objects", file order; −1 where none),
+  /// steps (march steps of all the pixel's marches: every sample, wavelength and mode); empty
+  /// otherwise.
+  std::vector<float> aov;
+};
+
+/// The AOV channels of RenderImage::aov per pixel and their EXR names (after pbrt-v4's
+/// GBufferFilm: Px Py Pz, Nx Ny Nz; Z as OpenEXR's depth channel; objectId and steps ours).
+constexpr int kAovChannels = 9;
+constexpr const char* kAovChannelNames[kAovChannels] = {"Z",  "Px", "Py",       "Pz",   "Nx",
+                                                        "Ny", "Nz", "objectId", "steps"};
+
+/// The first interface a march met (both twins, RenderSettings::aov_layer): with sharp
+/// interfaces the exact crossing (locateCrossing) and its analytic normal; with smoothed ones the
+/// point of largest |∇n| sampled in the first layer whose peak makes it an interface, with the
+/// layer's mean ∇n as normal (docs/view-renderer.md "AOV").
+struct FirstInterface {
+  bool hit = false;
+  glm::dvec3 point{0.0};   ///< world (mm)
+  glm::dvec3 normal{0.0};  ///< unit, facing the ray's origin (dot(normal, d) ≤ 0)
+  int object = -1;         ///< scene object index (sharp), −1 when unknown (smoothed)
 };
 
 /// One traced ray (one mode) as both twins report it. Directions are unit, world space.
