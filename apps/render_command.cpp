@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
+#include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -72,8 +74,9 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
   sub->add_option("--layers", a.layers,
                   "Extra EXR layers, comma-separated: spectral (one S0.<nm> channel per "
                   "wavelength bin; needs --wavelengths > 0), modes (o.R..B, e.R..B: the o- and "
-                  "e-mode radiance) and stokes (S0.R..S3.B of a polarised render; implies "
-                  "--polarised); R, G, B are always written");
+                  "e-mode radiance), aov (Z, Px Py Pz, Nx Ny Nz, objectId: the first interface "
+                  "of each pixel's first ray; steps: march steps per pixel) and stokes (S0.R..S3.B "
+                  "of a polarised render; implies --polarised); R, G, B are always written");
   sub->add_flag("--polarised", a.polarised,
                 "Polarised render (Stokes transport, docs/polarisation.md) even without polariser "
                 "sheets or a camera analyzer, which make a render polarised by themselves");
@@ -158,6 +161,12 @@ LightRequest lightRequest(const RenderArgs& a) {
 
 std::filesystem::path lightCacheDir(const RenderArgs& a) {
   return a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache);
+}
+
+/// The EXR channel names of img.aov (empty without the AOV layer).
+std::vector<std::string> aovNames(const RenderImage& img) {
+  if (img.aov.empty()) return {};
+  return std::vector<std::string>(std::begin(kAovChannelNames), std::end(kAovChannelNames));
 }
 
 /// A warning, or with --strict the error it becomes.
@@ -277,9 +286,9 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)},
                       {out, !img.stokes.empty() ? exrStokesContent(img.width, img.height, img.rgb,
                                                                    img.stokes, kStokesFrame)
-                            : rs.spectral_layer || rs.mode_layers
+                            : rs.spectral_layer || rs.mode_layers || rs.aov_layer
                                 ? exrLayersContent(img.width, img.height, img.rgb, img.bins,
-                                                   img.spectral, img.modes)
+                                                   img.spectral, img.modes, aovNames(img), img.aov)
                                 : exrRgbContent(img.width, img.height, img.rgb)}});
   preview.finished = true;
   timings::mark("written");

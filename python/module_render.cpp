@@ -134,6 +134,30 @@ py::dict layerArrays(const RenderImage& img) {
     d["stokes"] = a;
     d["stokes_frame"] = std::string(kStokesFrame);
   }
+  if (!img.aov.empty()) {
+    // The AOV layer (RenderImage::aov): depth (+inf where no interface), point and normal
+    // (height, width, 3), object id (int32, −1 where none or unknown) and march steps.
+    const size_t n = size_t(img.width) * size_t(img.height);
+    const py::ssize_t H = img.height, W = img.width;
+    py::array_t<float> depth({H, W}), point({H, W, py::ssize_t(3)}), normal({H, W, py::ssize_t(3)});
+    py::array_t<int32_t> object({H, W});
+    py::array_t<double> steps({H, W});
+    for (size_t i = 0; i < n; ++i) {
+      const float* a = &img.aov[i * size_t(kAovChannels)];
+      depth.mutable_data()[i] = a[0];
+      for (size_t c = 0; c < 3; ++c) {
+        point.mutable_data()[3 * i + c] = a[1 + c];
+        normal.mutable_data()[3 * i + c] = a[4 + c];
+      }
+      object.mutable_data()[i] = int32_t(a[7]);
+      steps.mutable_data()[i] = a[8];
+    }
+    d["depth"] = depth;
+    d["point"] = point;
+    d["normal"] = normal;
+    d["object_id"] = object;
+    d["steps"] = steps;
+  }
   return d;
 }
 
@@ -167,7 +191,8 @@ py::object render(Prepared& p, int width, int height, int spp, std::optional<int
     }
     return s.render(settings, gpu);
   });
-  if (settings.spectral_layer || settings.mode_layers || settings.stokes_layers)
+  if (settings.spectral_layer || settings.mode_layers || settings.aov_layer ||
+      settings.stokes_layers)
     return layerArrays(img);
   return imageArray(img);
 }
@@ -394,11 +419,13 @@ void bindRenderer(py::module_& m) {
            "default "
            "folder, a path: that folder, False: none); light=False leaves an unsimulated scene "
            "unlit (--no-light); sampling='auto'|'hero'|'stratified' (--spectral-sampling); "
-           "layers='spectral,modes' (--layers) returns a dict: rgb, spectral (H, W, N bins) with "
-           "wavelengths_nm (the bin centres), o and e (H, W, 3 each); layers='stokes' (a polarised "
-           "render; also polarised=True, polariser sheets or a camera analyzer, which return the "
-           "plain (H, W, 3) S0 without it) adds stokes (H, W, 4, 3: S0..S3 x RGB) and "
-           "stokes_frame (docs/polarisation.md)")
+           "layers='spectral,modes,aov' (--layers) returns a dict: rgb, spectral (H, W, N bins) "
+           "with wavelengths_nm (the bin centres), o and e (H, W, 3 each), and for aov depth "
+           "(H, W; mm, inf where none), point and normal (H, W, 3), object_id (H, W; int32, -1 "
+           "where none) and steps (H, W); layers='stokes' (a polarised render; also "
+           "polarised=True, polariser sheets or a camera analyzer, which return the plain "
+           "(H, W, 3) S0 without it) adds stokes (H, W, 4, 3: S0..S3 x RGB) and stokes_frame "
+           "(docs/polarisation.md)")
       .def(
           "simulate_light", &simulateLight, py::arg("bands") = 0, py::arg("splat") = "accumulate",
           py::arg("step_voxels") = 0.5, py::arg("smoothing_voxels") = 1.0,

@@ -81,10 +81,13 @@ vec4 gRecorded[6];
 // the features away instead (docs/performance.md). −1: read the value from P at run time.
 //   kSharpMarch: the sharp march (EIKON_F_SHARP) instead of the smoothed one;
 //   kViewFlags: the EIKON_F_* flags of the scene and the render (P.grid_dims.w);
-//   kIntegrator: EIKON_INT_* (P.march.w).
+//   kIntegrator: EIKON_INT_* (P.march.w);
+//   kAov: the march notes its first interface (MarchResult.hit…; view.comp's AOV layer). Off, the
+//     notes fold away and a render without the layer runs the code it ran before.
 layout(constant_id = 0) const bool kSharpMarch = false;
 layout(constant_id = 1) const int kViewFlags = -1;
 layout(constant_id = 2) const int kIntegrator = -1;
+layout(constant_id = 3) const bool kAov = false;
 
 #define EIKON_FIELD_FLAGS (kViewFlags == -1 ? P.grid_dims.w : kViewFlags)
 #define EIKON_FIELD_INV_H P.grid_extent.w
@@ -245,6 +248,12 @@ struct MarchResult {
   float drift;
   int interfaces;
   int tir;
+  // kAov: the first interface met (core/volume/march_types.h FirstInterface): its point, unit
+  // normal facing the ray's origin, and scene object (−1 unknown: smoothed interfaces).
+  bool hit;
+  vec3 hitPoint;
+  vec3 hitNormal;
+  int hitObject;
 };
 
 vec3 axisAt(vec3 x) { return axisField(x).xyz; }
@@ -309,6 +318,7 @@ struct MarchState {
   vec3 wBefore;
   vec3 gAcc;
   vec3 xOpen;
+  vec3 xPeak;  // kAov: where the layer's |∇n|·h peaked so far
 };
 
 // What an integration step leaves for the stages after it.
@@ -490,7 +500,9 @@ bool layerEvent(MarchState S, StepEnd E) {
 void layerAccumulate(inout MarchState S, StepEnd E) {
   if (!S.inLayer) return;
   S.gAcc += E.gradN * (P.march.x * P.grid_origin.w);
-  S.peak = max(S.peak, layerGradient(S, E));
+  float g = layerGradient(S, E);
+  if (kAov && g > S.peak) S.xPeak = S.x;
+  S.peak = max(S.peak, g);
 }
 
 // Interface bookkeeping: a layer opens where |∇n|·h rises above 1e-6 and closes where it falls
@@ -508,10 +520,17 @@ void layerStep(inout MarchState S, inout MarchResult R, StepEnd E, int mode) {
   }
   if (!S.inLayer) return;
   S.gAcc += E.gradN * ds;
+  if (kAov && g > S.peak) S.xPeak = S.x;
   S.peak = max(S.peak, g);
   if (!(g <= thrLow)) return;
   S.inLayer = false;
   vec3 N = dot(S.gAcc, S.gAcc) > 0.0 ? normalize(S.gAcc) : vec3(0.0);
+  if (kAov && !R.hit && S.peak > thrIface && dot(N, N) > 0.0) {
+    R.hit = true;
+    R.hitPoint = S.xPeak;
+    R.hitNormal = dot(N, S.wBefore) > 0.0 ? -N : N;
+    R.hitObject = -1;
+  }
   if (dot(N, N) > 0.0 && abs(dot(S.x - S.xOpen, N)) <= 12.0 * h) projectOnShell(S, E, N);
   if (S.peak > thrIface && !hasFlag(EIKON_F_NO_FRESNEL) && dot(N, N) > 0.0) fresnelAtLayer(S, R, N, mode);
 }
@@ -553,6 +572,10 @@ bool enterVolume(vec3 o, vec3 d, out MarchResult R, out float t0) {
   R.exit_point = o;
   R.exit_dir = d;
   R.wave_normal = d;
+  R.hit = false;
+  R.hitPoint = vec3(0.0);
+  R.hitNormal = vec3(0.0);
+  R.hitObject = -1;
   const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
   float t1;
   if (!boxHit(o, d, bmin, bmax, t0, t1)) {
@@ -587,6 +610,7 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   S.wBefore = S.w;
   S.gAcc = vec3(0.0);
   S.xOpen = S.x;
+  S.xPeak = S.x;
   const int maxSteps = P.limits.x;
   int steps = 0;
   // Per step: straightStep, integrateStep, mediumAlongStep, layerStep, clipToVolume. lavapipe runs

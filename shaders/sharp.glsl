@@ -393,6 +393,7 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   S.wBefore = vec3(0.0);
   S.gAcc = vec3(0.0);
   S.xOpen = vec3(0.0);
+  S.xPeak = vec3(0.0);
   S.T = vec3(1.0);
   S.L = vec3(0.0);
   S.stopped = false;
@@ -410,6 +411,12 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
     }
     BoundaryCrossing c;
     int ev = sharpAdvance(S, R, c, mode);
+    if (kAov && ev == kSharpCross && !R.hit) {  // the AOV layer: the exact crossing
+      R.hit = true;
+      R.hitPoint = c.point;
+      R.hitNormal = dot(c.normal, S.w) > 0.0 ? -c.normal : c.normal;
+      R.hitObject = max(c.from, c.to) - 1;
+    }
     if (ev == kSharpCross) crossInterface(S, R, c, mode);
     if (loopLimitReached()) {
       cut = true;

@@ -46,6 +46,18 @@ void layerWrite(int bandPixel, int mode, int channel, float v) {
   pixels[P.image.x * P.image.w + bandPixel * layerStride() + i / 4][i % 4] = v;
 }
 
+// The AOV layer (kAov; core/volume/render_layers.h): after the band's pixels and layers, two vec4s
+// per pixel: (first interface point, its object or −1), (its unit normal facing the eye, zero
+// where the pass's first march met no interface; the march steps of all the pass's marches).
+// Every pass writes both; the host takes the geometry from the pixel's first pass (sample 0, its
+// first wavelength, the o-mode) and adds up the steps.
+void aovWrite(int bandPixel, vec4 pointObject, vec3 normal, float steps) {
+  int layers = (P.pass.w & 2) != 0 ? layerStride() : 0;
+  int base = P.image.x * P.image.w * (1 + layers) + 2 * bandPixel;
+  pixels[base] = pointObject;
+  pixels[base + 1] = vec4(normal, steps);
+}
+
 // Hero wavelength sampling after the march (main): the lookups recorded before the path's first
 // dispersive event at all N wavelengths λ_j = 380 + ((k_h + j) mod N + u)·400/N, as CIE XYZ; with
 // layers, each λ_j's radiance per mode in its bin, the hero's own (after divergence) N times.
@@ -97,6 +109,10 @@ void main() {
   vec3 sum = vec3(0.0);
   float steps = 0.0;
   bool cut = false;
+  vec4 aovPoint = vec4(0.0, 0.0, 0.0, -1.0);  // kAov: the first march's first interface
+  vec3 aovNormal = vec3(0.0);
+  float aovSteps = 0.0;
+  bool aovFirst = true;
   {
     int s = P.pass.x;
     vec3 d = cameraRay(px, py, s, pixelIndex);
@@ -177,6 +193,14 @@ void main() {
         if (hero && mode == 0) heroCount0 = gNumRecorded;
         steps += float(r.steps) / float(hero ? 1 : N);
         cut = cut || r.cut;
+        if (kAov) {
+          aovSteps += float(r.steps);
+          if (aovFirst && r.hit) {
+            aovPoint = vec4(r.hitPoint, float(r.hitObject));
+            aovNormal = r.hitNormal;
+          }
+          aovFirst = false;
+        }
       }
       if (spectral) xyz += (hero ? float(N) : 1.0) * rad.x * cmf(lambda) * width;
       else sum += rad;
@@ -203,4 +227,5 @@ void main() {
     }
   }
   pixels[int(gid.y) * W + px] = vec4(sum, cut ? -(steps + 1.0) : steps);
+  if (kAov) aovWrite(int(gid.y) * W + px, aovPoint, aovNormal, aovSteps);
 }

@@ -162,18 +162,22 @@ std::string spectralChannelName(double centreNm) {
 }
 
 FileContent exrLayersContent(int width, int height, const std::vector<float>& rgb, int bins,
-                             const std::vector<float>& spectral, const std::vector<float>& modes) {
+                             const std::vector<float>& spectral, const std::vector<float>& modes,
+                             const std::vector<std::string>& extra_names,
+                             const std::vector<float>& extra) {
   const size_t n = size_t(width) * size_t(height);
   if (rgb.size() != 3 * n || spectral.size() != size_t(std::max(bins, 0)) * n ||
-      (!modes.empty() && modes.size() != 6 * n))
+      (!modes.empty() && modes.size() != 6 * n) || extra.size() != extra_names.size() * n)
     throw std::invalid_argument("exrLayersContent: pixel count mismatch");
-  // One plane per channel: R, G, B, then the bins, then o.R … e.B.
+  // One plane per channel: R, G, B, then the bins, then o.R … e.B, then the extra channels.
   std::vector<std::string> names = {"R", "G", "B"};
   const double width_nm = bins > 0 ? 400.0 / bins : 0.0;
   for (int k = 0; k < bins; ++k) names.push_back(spectralChannelName(380.0 + (k + 0.5) * width_nm));
   if (!modes.empty())
     for (const char* m : {"o.", "e."})
       for (const char* c : {"R", "G", "B"}) names.push_back(std::string(m) + c);
+  const size_t extraAt = names.size(), E = extra_names.size();
+  names.insert(names.end(), extra_names.begin(), extra_names.end());
   auto planes =
       std::make_shared<std::vector<std::vector<float>>>(names.size(), std::vector<float>(n));
   for (size_t i = 0; i < n; ++i) {
@@ -183,6 +187,7 @@ FileContent exrLayersContent(int width, int height, const std::vector<float>& rg
     if (!modes.empty())
       for (size_t c = 0; c < 6; ++c)
         (*planes)[3 + size_t(std::max(bins, 0)) + c][i] = modes[6 * i + c];
+    for (size_t c = 0; c < E; ++c) (*planes)[extraAt + c][i] = extra[E * i + c];
   }
   std::vector<std::pair<std::string, std::string>> attributes;
   if (bins > 0) {

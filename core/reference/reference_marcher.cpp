@@ -69,6 +69,7 @@ struct MarchResult {
   bool left = true;
   int steps = 0, interfaces = 0, tir = 0;
   long long fetches = 0;  ///< volume-field reads (CountedField)
+  FirstInterface first;   ///< the first interface met (the AOV layer)
 };
 
 /// The state of one march between its stages (march.glsl's MarchState).
@@ -82,6 +83,7 @@ struct MarchState {
   bool inLayer = false;
   double peak = 0.0;
   glm::dvec3 wBefore{0.0}, gAcc{0.0}, xOpen{0.0};
+  glm::dvec3 xPeak{0.0};  ///< where the layer's |∇n|·h peaked so far (the AOV layer)
 };
 
 /// What an integration step leaves for the stages after it (march.glsl's StepEnd).
@@ -480,10 +482,13 @@ void RayMarch::layerStep(MarchState& S, MarchResult& R, const StepEnd& E) const 
   }
   if (!S.inLayer) return;
   S.gAcc += E.gradN * ds_;
+  if (g > S.peak) S.xPeak = S.x;
   S.peak = std::max(S.peak, g);
   if (!(g <= thrLow)) return;
   S.inLayer = false;
   const glm::dvec3 N = glm::dot(S.gAcc, S.gAcc) > 0.0 ? glm::normalize(S.gAcc) : glm::dvec3(0.0);
+  if (!R.first.hit && S.peak > m_.interface_threshold && glm::dot(N, N) > 0.0)
+    R.first = {true, S.xPeak, glm::dot(N, S.wBefore) > 0.0 ? -N : N, -1};
   if (glm::dot(N, N) > 0.0 && std::abs(glm::dot(S.x - S.xOpen, N)) <= 12.0 * h_)
     projectOnShell(S, E, N);
   if (S.peak > m_.interface_threshold && m_.fresnel && glm::dot(N, N) > 0.0)
@@ -776,6 +781,9 @@ MarchResult RayMarch::marchSharp(const glm::dvec3& o, const glm::dvec3& d) const
     }
     BoundaryCrossing c;
     const SharpEvent ev = m.homogeneous ? sharpSegment(S, R, c) : sharpStep(S, R, c);
+    if (ev == SharpEvent::Cross && !R.first.hit)  // the AOV layer: the exact crossing
+      R.first = {true, c.point, glm::dot(c.normal, S.w) > 0.0 ? -c.normal : c.normal,
+                 std::max(c.from, c.to) - 1};
     if (ev == SharpEvent::Leave) break;
     if (ev == SharpEvent::Cross) crossInterface(S, R, c);
   }
@@ -829,9 +837,25 @@ TraceOutcome ReferenceMarcher::trace(const TraceRequest& ray, const MarchSetting
   return t;
 }
 
+/// What the marches of one pixel sample add up to: steps and field reads as the mean per march
+/// (divided by the wavelengths marched one by one), all steps taken (the AOV layer's steps), and
+/// the first interface of the sample's first march.
+struct ReferenceMarcher::SampleTally {
+  double steps = 0.0, fetches = 0.0, marchSteps = 0.0;
+  FirstInterface first;
+  bool marched = false;
+  void add(const Result& r, double share) {
+    if (!marched) first = r.first;
+    marched = true;
+    steps += double(r.steps) / share;
+    fetches += double(r.fetches) / share;
+    marchSteps += double(r.steps);
+  }
+};
+
 glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
-                                           uint32_t sample, const RenderSettings& s, double& steps,
-                                           double& fetches, LayerSums* layers) const {
+                                           uint32_t sample, const RenderSettings& s,
+                                           SampleTally& tally, LayerSums* layers) const {
   // view.comp's hero branch: one march (per mode) at λ_0, its lookups before the path's first
   // dispersive event recorded for all N wavelengths, the rest the hero's alone, counted N times.
   const auto n = uint32_t(s.wavelengths);
@@ -846,8 +870,7 @@ glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3
     Result r = march(o, d, lambdas[0], true, s.march, mode, &rec);
     heroMode[mode] = rec.weight * r.radiance.x;
     if (mode == 0) count0 = rec.count;
-    steps += double(r.steps);
-    fetches += double(r.fetches);
+    tally.add(r, 1.0);
   }
   glm::dvec3 xyz =
       double(n) * (heroMode[0] + heroMode[1]) * spectrum::sampleWeightXyz(lambdas[0], n);
@@ -872,6 +895,52 @@ glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3
   return xyz;
 }
 
+glm::dvec3 ReferenceMarcher::sampleRgb(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel,
+                                       uint32_t sidx, const RenderSettings& s, bool hero,
+                                       SampleTally& tally, LayerSums& layers) const {
+  const glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
+  if (s.wavelengths > 0 && hero)
+    return M * heroSampleXyz(eye, d, pixel, sidx, s, tally, layers.active() ? &layers : nullptr);
+  if (s.wavelengths > 0) {
+    auto lambdas = spectrum::stratifiedWavelengths(pixel, sidx, uint32_t(s.wavelengths));
+    glm::dvec3 xyz(0.0);
+    for (size_t k = 0; k < lambdas.size(); ++k) {
+      const double l = lambdas[k];
+      Result r = march(eye, d, l, true, s.march, 0);
+      double rad = r.radiance.x;
+      tally.add(r, s.wavelengths);
+      if (field_.uniaxial()) {  // unpolarised: each mode carries half
+        Result re = march(eye, d, l, true, s.march, 1);
+        rad = 0.5 * (rad + re.radiance.x);
+        tally.add(re, s.wavelengths);
+        if (layers.active()) {
+          layers.at(pixel, 0)[k] += 0.5 * r.radiance.x;
+          layers.at(pixel, 1)[k] += 0.5 * re.radiance.x;
+        }
+      } else if (layers.active()) {
+        layers.at(pixel, 0)[k] += rad;
+      }
+      xyz += rad * spectrum::sampleWeightXyz(l, uint32_t(s.wavelengths));
+    }
+    return M * xyz;
+  }
+  Result r = march(eye, d, s.wavelength_nm, false, s.march, 0);
+  glm::dvec3 rad = r.radiance;
+  tally.add(r, 1.0);
+  glm::dvec3 modeRad[2] = {rad, glm::dvec3(0.0)};
+  if (field_.uniaxial()) {
+    Result re = march(eye, d, s.wavelength_nm, false, s.march, 1);
+    rad = 0.5 * (rad + re.radiance);
+    modeRad[0] = 0.5 * r.radiance;
+    modeRad[1] = 0.5 * re.radiance;
+    tally.add(re, 1.0);
+  }
+  if (layers.active())
+    for (int m = 0; m < 2; ++m)
+      for (int c = 0; c < 3; ++c) layers.at(pixel, m)[c] += modeRad[m][c];
+  return rad;
+}
+
 RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
                                      int threads) const {
   validate(s.march);
@@ -884,9 +953,9 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
   const glm::dvec3 up = glm::cross(right, fwd);
   const double tanh = std::tan(0.5 * cam.fov_deg * kPi / 180.0),
                aspect = double(img.width) / img.height;
-  const glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
   const bool hero = useHeroSampling(s.sampling, field_.weightsDependOnLambda());
   LayerSums layers(s, size_t(img.width) * size_t(img.height), field_.uniaxial());
+  if (s.aov_layer) initAov(img);
   std::atomic<int> next{0}, rows_done{0};
   std::atomic<long long> total_steps{0}, total_fetches{0};
   std::mutex progress_mutex;  // progress per row, one report at a time (skipped when busy)
@@ -911,52 +980,13 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
           double u = ((x + jx) / img.width * 2.0 - 1.0) * tanh * aspect;
           double v = (1.0 - (y + jy) / img.height * 2.0) * tanh;
           glm::dvec3 d = glm::normalize(fwd + u * right + v * up);
-          if (s.wavelengths > 0 && hero) {
-            sum += M * heroSampleXyz(cam.position, d, pixel, uint32_t(sidx), s, steps, fetches,
-                                     layers.active() ? &layers : nullptr);
-          } else if (s.wavelengths > 0) {
-            auto lambdas =
-                spectrum::stratifiedWavelengths(pixel, uint32_t(sidx), uint32_t(s.wavelengths));
-            glm::dvec3 xyz(0.0);
-            for (size_t k = 0; k < lambdas.size(); ++k) {
-              const double l = lambdas[k];
-              Result r = march(cam.position, d, l, true, s.march, 0);
-              double rad = r.radiance.x;
-              steps += double(r.steps) / s.wavelengths;
-              fetches += double(r.fetches) / s.wavelengths;
-              if (field_.uniaxial()) {  // unpolarised: each mode carries half
-                Result re = march(cam.position, d, l, true, s.march, 1);
-                rad = 0.5 * (rad + re.radiance.x);
-                steps += double(re.steps) / s.wavelengths;
-                fetches += double(re.fetches) / s.wavelengths;
-                if (layers.active()) {
-                  layers.at(pixel, 0)[k] += 0.5 * r.radiance.x;
-                  layers.at(pixel, 1)[k] += 0.5 * re.radiance.x;
-                }
-              } else if (layers.active()) {
-                layers.at(pixel, 0)[k] += rad;
-              }
-              xyz += rad * spectrum::sampleWeightXyz(l, uint32_t(s.wavelengths));
-            }
-            sum += M * xyz;
-          } else {
-            Result r = march(cam.position, d, s.wavelength_nm, false, s.march, 0);
-            glm::dvec3 rad = r.radiance;
-            steps += r.steps;
-            fetches += double(r.fetches);
-            glm::dvec3 modeRad[2] = {rad, glm::dvec3(0.0)};
-            if (field_.uniaxial()) {
-              Result re = march(cam.position, d, s.wavelength_nm, false, s.march, 1);
-              rad = 0.5 * (rad + re.radiance);
-              modeRad[0] = 0.5 * r.radiance;
-              modeRad[1] = 0.5 * re.radiance;
-              steps += re.steps;
-              fetches += double(re.fetches);
-            }
-            if (layers.active())
-              for (int m = 0; m < 2; ++m)
-                for (int c = 0; c < 3; ++c) layers.at(pixel, m)[c] += modeRad[m][c];
-            sum += rad;
+          SampleTally tally;
+          sum += sampleRgb(cam.position, d, pixel, uint32_t(sidx), s, hero, tally, layers);
+          steps += tally.steps;
+          fetches += tally.fetches;
+          if (s.aov_layer) {
+            if (sidx == 0) setAovGeometry(img, pixel, cam.position, tally.first);
+            addAovSteps(img, pixel, tally.marchSteps);
           }
         }
         size_t o = (size_t(y) * size_t(img.width) + size_t(x)) * 3;

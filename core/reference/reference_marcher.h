@@ -59,13 +59,19 @@ class ReferenceMarcher {
 
  private:
   struct Result;
+  struct SampleTally;  // the marches of one pixel sample (the .cpp)
   Result march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar,
                const MarchSettings& m, int mode, HeroRecord* hero = nullptr) const;
   /// CIE XYZ (unnormalised, as Σ L·sampleWeightXyz) of one pixel sample by hero wavelength
-  /// sampling (docs/spectra.md); adds its steps and field reads, and its bins to `layers`.
+  /// sampling (docs/spectra.md); adds its marches to `tally`, and its bins to `layers`.
   glm::dvec3 heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
-                           uint32_t sample, const RenderSettings& s, double& steps, double& fetches,
+                           uint32_t sample, const RenderSettings& s, SampleTally& tally,
                            LayerSums* layers) const;
+  /// Linear sRGB of one pixel sample along d from eye (hero, stratified or RGB), its marches
+  /// added to `tally` and their radiance to `layers`.
+  glm::dvec3 sampleRgb(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel, uint32_t sidx,
+                       const RenderSettings& s, bool hero, SampleTally& tally,
+                       LayerSums& layers) const;
   const Field& field_;
   const Environment& env_;
 };

@@ -153,7 +153,7 @@ struct ViewRenderer::Impl {
   // marches many times faster than one that tests them at run time (docs/performance.md).
   std::vector<vk::BindingSpec> viewBindings, traceBindings, polarisedBindings;
   enum Kernel { kView = 0, kTrace = 1, kPolarised = 2 };
-  using Key = std::tuple<int, int, int, int>;  // kernel, flags, integrator, sharp
+  using Key = std::tuple<int, int, int, int, int>;  // kernel, flags, integrator, sharp, AOV
   std::map<Key, vk::ComputePipeline> pipelines;
   // The expected render's view pipeline, compiled while the volume is uploaded (the compile runs
   // on one core, the upload mostly on the other); adopted by pipeline() when its key comes up.
@@ -254,15 +254,18 @@ struct ViewRenderer::Impl {
     timings::mark("volume uploaded");
   }
 
+  // The AOV layer is view.comp's pass.w bit 8 (render()), its kAov constant.
   static Key keyOf(Kernel kernel, const gpu::ViewParams& p, bool sharp) {
-    return std::make_tuple(int(kernel), p.grid_dims.w, int(p.march.w), sharp ? 1 : 0);
+    const int aov = kernel == kView && (p.pass.w & 8) != 0 ? 1 : 0;
+    return std::make_tuple(int(kernel), p.grid_dims.w, int(p.march.w), sharp ? 1 : 0, aov);
   }
 
   // The view, trace or polarised-trace kernel specialised for the flags and integrator of a key.
   vk::ComputePipeline build(const Key& key) const {
-    const auto [kernel, flags, integrator, sharpMarch] = key;
-    // constant_id 0: kSharpMarch, 1: kViewFlags, 2: kIntegrator (march.glsl).
-    const std::vector<uint32_t> spec{uint32_t(sharpMarch), uint32_t(flags), uint32_t(integrator)};
+    const auto [kernel, flags, integrator, sharpMarch, aov] = key;
+    // constant_id 0: kSharpMarch, 1: kViewFlags, 2: kIntegrator, 3: kAov (march.glsl).
+    const std::vector<uint32_t> spec{uint32_t(sharpMarch), uint32_t(flags), uint32_t(integrator),
+                                     uint32_t(aov)};
     auto make = [&](std::span<const uint32_t> code, const std::vector<vk::BindingSpec>& b,
                     const char* name) { return vk::ComputePipeline(ctx, code, b, 0, name, spec); };
     return kernel == kTrace  ? make({k_trace_spv, sizeof(k_trace_spv) / 4}, traceBindings, "trace")
@@ -279,7 +282,9 @@ struct ViewRenderer::Impl {
     } catch (const std::invalid_argument&) {
       return;
     }
-    prefetchedKey = keyOf(kView, baseParams(s.march, renderFlags(s)), sharp);
+    gpu::ViewParams p = baseParams(s.march, renderFlags(s));
+    p.pass.w = s.aov_layer ? 8 : 0;
+    prefetchedKey = keyOf(kView, p, sharp);
     prefetched = std::async(std::launch::async, [this, key = prefetchedKey] { return build(key); });
   }
 
@@ -399,6 +404,24 @@ void addLayers(LayerSums& layers, const std::vector<glm::vec4>& band, int width,
     }
   }
 }
+
+// Adds one band's AOV records (view.comp aovWrite, after the band's pixels and layers) to the
+// image: every pass's march steps, and the first pass's first interface (sample 0, its first
+// wavelength, the o-mode); a zero normal is a march that met none.
+void addAov(RenderImage& img, const std::vector<glm::vec4>& band, int rows, int y0, size_t stride,
+            bool firstPass, const glm::dvec3& eye) {
+  const size_t n = size_t(img.width) * size_t(rows);
+  const glm::vec4* aov = band.data() + n * (1 + stride);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t pixel = size_t(y0) * size_t(img.width) + i;
+    const glm::vec4 a = aov[2 * i], b = aov[2 * i + 1];
+    addAovSteps(img, pixel, b.w);
+    if (!firstPass || glm::vec3(b) == glm::vec3(0.0f)) continue;
+    setAovGeometry(
+        img, pixel, eye,
+        FirstInterface{true, glm::dvec3(glm::vec3(a)), glm::dvec3(glm::vec3(b)), int(a.w)});
+  }
+}
 }  // namespace
 
 RenderImage ViewRenderer::render(const RenderSettings& s) {
@@ -439,23 +462,27 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   LayerSums layers(s, size_t(img.width) * size_t(img.height), I.uniaxial);
   const int layerBits = layers.active() ? (2 | (layers.modes() == 2 ? 4 : 0)) : 0;
   const size_t stride = layers.active() ? size_t((layers.channels() * layers.modes() + 3) / 4) : 0;
+  // The AOV layer: two vec4s per pixel after those (view.comp aovWrite).
+  const size_t perPixel = 1 + stride + (s.aov_layer ? 2 : 0);
+  if (s.aov_layer) initAov(img);
   const double rowWork = double(img.width) * perPass;
   int max_rows = std::clamp(int(std::ceil(2.0e5 / std::max(rowWork, 1.0))), EIKON_WG_Y, img.height);
   max_rows = (max_rows + EIKON_WG_Y - 1) / EIKON_WG_Y * EIKON_WG_Y;
   int rows = EIKON_WG_Y;
-  vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * (1 + stride) * sizeof(glm::vec4),
+  vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * perPixel * sizeof(glm::vec4),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
+  p.pass.w = s.aov_layer ? 8 : 0;  // the pipeline's key (keyOf)
   vk::ComputePipeline& view = I.pipeline(Impl::kView, p);
   view.bindBuffer(EIKON_B_OUTPUT, out);
   const size_t pixels = size_t(img.width) * size_t(img.height);
   std::vector<double> acc(pixels * 3, 0.0);
   img.rgb.assign(pixels * 3, 0.0f);
-  std::vector<glm::vec4> band(size_t(img.width) * size_t(max_rows) * (1 + stride));
+  std::vector<glm::vec4> band(size_t(img.width) * size_t(max_rows) * perPixel);
   double steps = 0.0;
   auto t0 = std::chrono::steady_clock::now();
   for (int pass = 0; pass < passes; ++pass) {
     p.pass = glm::ivec4(pass / passesPerSample, (pass % passesPerSample) * perPass, perPass,
-                        (hero ? 1 : 0) | layerBits);
+                        (hero ? 1 : 0) | layerBits | (s.aov_layer ? 8 : 0));
     for (int y0 = 0, n = 0; y0 < img.height; y0 += n) {
       n = std::min(rows, img.height - y0);
       const auto band_start = std::chrono::steady_clock::now();
@@ -466,7 +493,8 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
         view.dispatch(cmd, uint32_t((img.width + EIKON_WG_X - 1) / EIKON_WG_X),
                       uint32_t((n + EIKON_WG_Y - 1) / EIKON_WG_Y), 1, nullptr);
       });
-      out.read(band.data(), size_t(img.width) * size_t(n) * (1 + stride) * sizeof(glm::vec4));
+      out.read(band.data(), size_t(img.width) * size_t(n) * perPixel * sizeof(glm::vec4));
+      if (s.aov_layer) addAov(img, band, n, y0, stride, pass == 0, I.scene.camera.position);
       if (layers.active()) {
         const int c0 = s.wavelengths == 0 || hero ? 0 : p.pass.y;
         const int c1 = s.wavelengths == 0 ? 3 : hero ? N : std::min(p.pass.y + p.pass.z, N);

@@ -13,6 +13,7 @@
 #include "core/render/view_renderer.h"
 #include "core/vk/context.h"
 #include "core/volume/polarised_render.h"
+#include "core/volume/render_layers.h"
 
 namespace eikon {
 
@@ -41,7 +42,7 @@ SpectralSampling parseSpectralSampling(const std::string& s) {
 }
 
 void parseLayers(const std::string& list, ViewRequest& view) {
-  view.spectral_layer = view.mode_layers = view.stokes_layers = false;
+  view.spectral_layer = view.mode_layers = view.aov_layer = view.stokes_layers = false;
   size_t start = 0;
   while (start <= list.size() && !list.empty()) {
     const size_t end = std::min(list.find(',', start), list.size());
@@ -50,12 +51,14 @@ void parseLayers(const std::string& list, ViewRequest& view) {
       view.spectral_layer = true;
     else if (name == "modes")
       view.mode_layers = true;
+    else if (name == "aov")
+      view.aov_layer = true;
     else if (name == "stokes")
       view.stokes_layers = true;
     else
       throw SettingError(
-          "layers", "must be a comma-separated list of spectral, modes and stokes, got '" + name +
-                        "' in '" + list + "'");
+          "layers", "must be a comma-separated list of spectral, modes, aov and stokes, got '" +
+                        name + "' in '" + list + "'");
     start = end + 1;
   }
 }
@@ -86,11 +89,12 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
   rs.sampling = v.sampling;
   rs.spectral_layer = v.spectral_layer;
   rs.mode_layers = v.mode_layers;
+  rs.aov_layer = v.aov_layer;
   rs.stokes_layers = v.stokes_layers;
   rs.polarised = v.polarised;
   if (isPolarisedRender(scene, rs)) {  // refused before anything is voxelised
-    if (rs.spectral_layer || rs.mode_layers)
-      throw SettingError("layers", "spectral and modes do not go with a polarised render (" +
+    if (rs.spectral_layer || rs.mode_layers || rs.aov_layer)
+      throw SettingError("layers", "spectral, modes and aov do not go with a polarised render (" +
                                        polarisedBecause(scene, rs) +
                                        "), which writes the stokes layers");
     checkPolarisedScene(scene, rs);
@@ -250,11 +254,21 @@ RenderImage Session::render(const RenderSettings& settings, bool gpu) {
     cpuMarcher();  // makes field_
     return renderPolarised(*field_, *scene_, rs, threads_);
   }
-  if (gpu) return gpuRenderer(&rs).render(rs);
-  Camera cam = scene_->camera;
-  if (rs.width > 0) cam.width = rs.width;
-  if (rs.height > 0) cam.height = rs.height;
-  return cpuMarcher().render(cam, rs, threads_);
+  RenderImage img;
+  if (gpu) {
+    img = gpuRenderer(&rs).render(rs);
+  } else {
+    Camera cam = scene_->camera;
+    if (rs.width > 0) cam.width = rs.width;
+    if (rs.height > 0) cam.height = rs.height;
+    img = cpuMarcher().render(cam, rs, threads_);
+  }
+  if (rs.aov_layer && scene_->interfaces == Scene::Interfaces::Smoothed) {
+    std::vector<Shape> shapes;
+    for (const SceneObject& o : scene_->objects) shapes.push_back(o.shape);
+    assignAovObjects(shapes, img);
+  }
+  return img;
 }
 
 std::vector<std::array<TraceOutcome, 2>> Session::trace(const std::vector<TraceRequest>& rays,

@@ -67,6 +67,7 @@ struct ViewRequest {
   std::optional<MarchSettings> march;  ///< step in (0, 4] voxels; unset: the render defaults
   SpectralSampling sampling = SpectralSampling::Auto;  ///< spectral renders (docs/spectra.md)
   bool spectral_layer = false, mode_layers = false;    ///< parseLayers; RenderSettings's
+  bool aov_layer = false;                              ///< parseLayers; RenderSettings's
   bool stokes_layers = false;                          ///< parseLayers ("stokes")
   /// A polarised render even without polariser sheets or an analyser (`--polarised`).
   bool polarised = false;
@@ -74,8 +75,8 @@ struct ViewRequest {
 
 /// "euler", "midpoint" or "rk4"; else SettingError("integrator", ...).
 Integrator parseIntegrator(const std::string& name);
-/// A comma-separated list of "spectral", "modes" and "stokes" (the extra image layers) into the
-/// request; else SettingError("layers", ...). An empty list asks for none.
+/// A comma-separated list of "spectral", "modes", "aov" and "stokes" (the extra image layers)
+/// into the request; else SettingError("layers", ...). An empty list asks for none.
 void parseLayers(const std::string& list, ViewRequest& view);
 /// "auto", "hero" or "stratified"; else SettingError("spectral-sampling", ...).
 SpectralSampling parseSpectralSampling(const std::string& name);

@@ -60,6 +60,9 @@ struct RenderSettings {
   /// stokes_layers (isPolarisedRender in core/volume/polarised_render.h).
   bool polarised = false;
   bool stokes_layers = false;  ///< S0..S3 as RGB layers (RenderImage::stokes; --layers stokes)
+  /// RenderImage::aov: the first interface of each pixel's first camera ray (depth, point,
+  /// normal, object id) and the march steps of all its marches (docs/view-renderer.md "AOV").
+  bool aov_layer = false;
   MarchSettings march;
   /// progress(fraction done); may be empty.
   std::function<void(double)> progress;
@@ -93,6 +96,31 @@ struct RenderImage {
   /// stokesBasis(−v) of each pixel's camera ray v (kStokesFrame of core/volume/polarised_render.h;
   /// S0 = rgb); empty otherwise.
   std::vector<float> stokes;
+  /// RenderSettings::aov_layer: kAovChannels floats per pixel (rows from the top), in the order
+  /// of kAovChannelNames: Z (distance from the eye to the first interface along the pixel's first
+  /// camera ray, mm; +inf where it meets none), Px Py Pz (that point, world, mm; 0 where none),
+  /// Nx Ny Nz (its unit world-space normal facing the camera; 0 where none), objectId (index of
+  /// the object whose surface it is in the scene's "objects", file order; −1 where none),
+  /// steps (march steps of all the pixel's marches: every sample, wavelength and mode); empty
+  /// otherwise.
+  std::vector<float> aov;
+};
+
+/// The AOV channels of RenderImage::aov per pixel and their EXR names (after pbrt-v4's
+/// GBufferFilm: Px Py Pz, Nx Ny Nz; Z as OpenEXR's depth channel; objectId and steps ours).
+constexpr int kAovChannels = 9;
+constexpr const char* kAovChannelNames[kAovChannels] = {"Z",  "Px", "Py",       "Pz",   "Nx",
+                                                        "Ny", "Nz", "objectId", "steps"};
+
+/// The first interface a march met (both twins, RenderSettings::aov_layer): with sharp
+/// interfaces the exact crossing (locateCrossing) and its analytic normal; with smoothed ones the
+/// point of largest |∇n| sampled in the first layer whose peak makes it an interface, with the
+/// layer's mean ∇n as normal (docs/view-renderer.md "AOV").
+struct FirstInterface {
+  bool hit = false;
+  glm::dvec3 point{0.0};   ///< world (mm)
+  glm::dvec3 normal{0.0};  ///< unit, facing the ray's origin (dot(normal, d) ≤ 0)
+  int object = -1;         ///< scene object index (sharp), −1 when unknown (smoothed)
 };
 
 /// One traced ray (one mode) as both twins report it. Directions are unit, world space.

@@ -1,7 +1,9 @@
 // Render layers shared by both twins: see render_layers.h.
 #include "core/volume/render_layers.h"
 
+#include <cmath>
 #include <glm/glm.hpp>
+#include <limits>
 #include <stdexcept>
 
 #include "core/spectrum/cie1931.h"
@@ -68,6 +70,43 @@ void LayerSums::finish(RenderImage& img, int spp) const {
   }
   if (wantSpectral_) img.spectral = std::move(spectral);
   if (keepModes_) img.modes = std::move(modes);
+}
+
+void initAov(RenderImage& img) {
+  const std::size_t pixels = std::size_t(img.width) * std::size_t(img.height);
+  img.aov.assign(pixels * kAovChannels, 0.0f);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    img.aov[p * kAovChannels] = std::numeric_limits<float>::infinity();
+    img.aov[p * kAovChannels + 7] = -1.0f;
+  }
+}
+
+void setAovGeometry(RenderImage& img, std::size_t pixel, const glm::dvec3& eye,
+                    const FirstInterface& first) {
+  if (!first.hit) return;
+  float* a = &img.aov[pixel * kAovChannels];
+  a[0] = float(glm::length(first.point - eye));
+  for (int c = 0; c < 3; ++c) {
+    a[1 + c] = float(first.point[c]);
+    a[4 + c] = float(first.normal[c]);
+  }
+  a[7] = float(first.object);
+}
+
+void assignAovObjects(const std::vector<Shape>& shapes, RenderImage& img) {
+  for (std::size_t p = 0; p * kAovChannels < img.aov.size(); ++p) {
+    float* a = &img.aov[p * kAovChannels];
+    if (!std::isfinite(a[0]) || a[7] >= 0.0f) continue;
+    const glm::dvec3 x(a[1], a[2], a[3]);
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < shapes.size(); ++i) {
+      const double d = std::abs(shapes[i].signedDistance(x));
+      if (d <= best) {
+        best = d;
+        a[7] = float(i);
+      }
+    }
+  }
 }
 
 }  // namespace eikon

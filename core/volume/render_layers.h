@@ -20,8 +20,10 @@
 #pragma once
 
 #include <cstddef>
+#include <glm/glm.hpp>
 #include <vector>
 
+#include "core/scene/shapes.h"
 #include "core/volume/march_types.h"
 
 namespace eikon {
@@ -51,5 +53,26 @@ class LayerSums {
   int channels_ = 3, modes_ = 1;
   std::vector<double> sum_;
 };
+
+/// The AOV layer (RenderSettings::aov_layer, RenderImage::aov), filled the same way by both
+/// twins: the first interface of the pixel's first camera ray — sample 0 (the pixel centre when
+/// spp = 1, else its first jittered position), its first march (the o-mode, at the first
+/// wavelength marched) — and `steps`, the march steps of all of the pixel's marches. Depth, normal
+/// and id are not averaged over samples: a mean depth or normal at a silhouette is a surface
+/// that is not there, and a mean id no object at all.
+/// Sizes img.aov for img.width × img.height pixels, every pixel "no interface, 0 steps".
+void initAov(RenderImage& img);
+/// Writes pixel `pixel`'s AOV channels from the first interface of its first ray from `eye`.
+void setAovGeometry(RenderImage& img, std::size_t pixel, const glm::dvec3& eye,
+                    const FirstInterface& first);
+/// Smoothed interfaces carry no object identity (the march sees only n and its gradient): the
+/// object of each first interface found without one is the shape whose surface lies nearest to
+/// its point (least |signed distance|; the later object on a tie, as objects paint over earlier
+/// ones). `shapes` are the scene's objects' in file order.
+void assignAovObjects(const std::vector<Shape>& shapes, RenderImage& img);
+/// Adds march steps to pixel `pixel`'s steps channel.
+inline void addAovSteps(RenderImage& img, std::size_t pixel, double steps) {
+  img.aov[pixel * kAovChannels + 8] += float(steps);
+}
 
 }  // namespace eikon
