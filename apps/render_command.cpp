@@ -24,7 +24,8 @@ struct RenderArgs {
   std::string scene, output;
   int width = 0, height = 0, spp = 1, wavelengths = -1, threads = 0;
   double step = kDefaultRenderStepVoxels, exposure = 0.0;
-  std::string integrator = "rk4", progress = "auto", spectral_sampling = "auto", layers;
+  std::string integrator = "rk4", progress = "auto", spectral_sampling = "auto", layers,
+              modes = "both";
   bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
   // Light simulator (scenes with "lights").
   int light_bands = 0, max_patches = 1 << 20;
@@ -71,6 +72,9 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
                   "Extra EXR layers, comma-separated: spectral (one S0.<nm> channel per "
                   "wavelength bin; needs --wavelengths > 0) and modes (o.R..B, e.R..B: the o- and "
                   "e-mode radiance); R, G, B are always written");
+  sub->add_option("--modes", a.modes,
+                  "Crystal scenes: both (unpolarised light, each mode carrying half; default), o "
+                  "or e (that mode alone, at the whole of the light: o + e = 2 x both)");
   sub->add_option("--step", a.step,
                   "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4)");
@@ -133,6 +137,7 @@ ViewRequest viewRequest(const RenderArgs& a, const CLI::App& sub) {
   v.march = ms;
   v.sampling = parseSpectralSampling(a.spectral_sampling);
   parseLayers(a.layers, v);
+  v.modes = parseModes(a.modes);
   return v;
 }
 

@@ -837,11 +837,12 @@ glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3
   const auto n = uint32_t(s.wavelengths);
   const std::vector<double> lambdas = spectrum::heroWavelengths(pixel, sample, n);
   const int modes = field_.uniaxial() ? 2 : 1;
+  const ModeRange mr = modeRange(s.modes, field_.uniaxial());
   HeroRecord rec;
-  rec.weight = modes == 2 ? 0.5 : 1.0;
+  rec.weight = mr.weight;
   double heroMode[2] = {0.0, 0.0};  // each mode's own radiance after its path dispersed
   int count0 = 0;                   // records made by the o-mode's march
-  for (int mode = 0; mode < modes; ++mode) {
+  for (int mode = mr.first; mode < mr.end; ++mode) {
     rec.diverged = field_.weightsDependOnLambda();
     Result r = march(o, d, lambdas[0], true, s.march, mode, &rec);
     heroMode[mode] = rec.weight * r.radiance.x;
@@ -872,9 +873,48 @@ glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3
   return xyz;
 }
 
+glm::dvec3 ReferenceMarcher::stratifiedSample(const glm::dvec3& o, const glm::dvec3& d,
+                                              uint32_t pixel, uint32_t sample,
+                                              const RenderSettings& s, double& steps,
+                                              double& fetches, LayerSums* layers) const {
+  // Unpolarised light: each mode carries half, or the one selected the whole (modeRange).
+  const ModeRange mr = modeRange(s.modes, field_.uniaxial());
+  if (s.wavelengths == 0) {  // RGB mode: one march per mode at the index wavelength
+    glm::dvec3 rad(0.0);
+    for (int mode = mr.first; mode < mr.end; ++mode) {
+      const Result r = march(o, d, s.wavelength_nm, false, s.march, mode);
+      const glm::dvec3 part = mr.weight * r.radiance;
+      rad += part;
+      steps += r.steps;
+      fetches += double(r.fetches);
+      if (layers)
+        for (int c = 0; c < 3; ++c) layers->at(pixel, mode)[c] += part[c];
+    }
+    return rad;
+  }
+  const auto n = uint32_t(s.wavelengths);
+  const std::vector<double> lambdas = spectrum::stratifiedWavelengths(pixel, sample, n);
+  glm::dvec3 xyz(0.0);
+  for (size_t k = 0; k < lambdas.size(); ++k) {
+    double rad = 0.0;
+    for (int mode = mr.first; mode < mr.end; ++mode) {
+      const Result r = march(o, d, lambdas[k], true, s.march, mode);
+      const double part = mr.weight * r.radiance.x;
+      rad += part;
+      steps += double(r.steps) / s.wavelengths;
+      fetches += double(r.fetches) / s.wavelengths;
+      if (layers) layers->at(pixel, mode)[k] += part;
+    }
+    xyz += rad * spectrum::sampleWeightXyz(lambdas[k], n);
+  }
+  return spectrum::spectralToLinearSrgbMatrix() * xyz;
+}
+
 RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
                                      int threads) const {
   validate(s.march);
+  if (int(s.modes) < 0 || int(s.modes) > 2)
+    throw std::invalid_argument("modes must be both, o or e");
   RenderImage img;
   img.width = s.width > 0 ? s.width : cam.width;
   img.height = s.height > 0 ? s.height : cam.height;
@@ -911,53 +951,11 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
           double u = ((x + jx) / img.width * 2.0 - 1.0) * tanh * aspect;
           double v = (1.0 - (y + jy) / img.height * 2.0) * tanh;
           glm::dvec3 d = glm::normalize(fwd + u * right + v * up);
-          if (s.wavelengths > 0 && hero) {
-            sum += M * heroSampleXyz(cam.position, d, pixel, uint32_t(sidx), s, steps, fetches,
-                                     layers.active() ? &layers : nullptr);
-          } else if (s.wavelengths > 0) {
-            auto lambdas =
-                spectrum::stratifiedWavelengths(pixel, uint32_t(sidx), uint32_t(s.wavelengths));
-            glm::dvec3 xyz(0.0);
-            for (size_t k = 0; k < lambdas.size(); ++k) {
-              const double l = lambdas[k];
-              Result r = march(cam.position, d, l, true, s.march, 0);
-              double rad = r.radiance.x;
-              steps += double(r.steps) / s.wavelengths;
-              fetches += double(r.fetches) / s.wavelengths;
-              if (field_.uniaxial()) {  // unpolarised: each mode carries half
-                Result re = march(cam.position, d, l, true, s.march, 1);
-                rad = 0.5 * (rad + re.radiance.x);
-                steps += double(re.steps) / s.wavelengths;
-                fetches += double(re.fetches) / s.wavelengths;
-                if (layers.active()) {
-                  layers.at(pixel, 0)[k] += 0.5 * r.radiance.x;
-                  layers.at(pixel, 1)[k] += 0.5 * re.radiance.x;
-                }
-              } else if (layers.active()) {
-                layers.at(pixel, 0)[k] += rad;
-              }
-              xyz += rad * spectrum::sampleWeightXyz(l, uint32_t(s.wavelengths));
-            }
-            sum += M * xyz;
-          } else {
-            Result r = march(cam.position, d, s.wavelength_nm, false, s.march, 0);
-            glm::dvec3 rad = r.radiance;
-            steps += r.steps;
-            fetches += double(r.fetches);
-            glm::dvec3 modeRad[2] = {rad, glm::dvec3(0.0)};
-            if (field_.uniaxial()) {
-              Result re = march(cam.position, d, s.wavelength_nm, false, s.march, 1);
-              rad = 0.5 * (rad + re.radiance);
-              modeRad[0] = 0.5 * r.radiance;
-              modeRad[1] = 0.5 * re.radiance;
-              steps += re.steps;
-              fetches += double(re.fetches);
-            }
-            if (layers.active())
-              for (int m = 0; m < 2; ++m)
-                for (int c = 0; c < 3; ++c) layers.at(pixel, m)[c] += modeRad[m][c];
-            sum += rad;
-          }
+          LayerSums* lp = layers.active() ? &layers : nullptr;
+          if (s.wavelengths > 0 && hero)
+            sum += M * heroSampleXyz(cam.position, d, pixel, uint32_t(sidx), s, steps, fetches, lp);
+          else
+            sum += stratifiedSample(cam.position, d, pixel, uint32_t(sidx), s, steps, fetches, lp);
         }
         size_t o = (size_t(y) * size_t(img.width) + size_t(x)) * 3;
         for (int c = 0; c < 3; ++c) img.rgb[o + size_t(c)] = float(sum[c] / s.spp);

@@ -66,6 +66,12 @@ class ReferenceMarcher {
   glm::dvec3 heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
                            uint32_t sample, const RenderSettings& s, double& steps, double& fetches,
                            LayerSums* layers) const;
+  /// Linear sRGB of one pixel sample by stratified wavelengths (spectral) or at the RGB mode's
+  /// wavelength, of the modes settings.modes selects (modeRange); adds its steps, field reads and
+  /// layer values as heroSampleXyz does.
+  glm::dvec3 stratifiedSample(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
+                              uint32_t sample, const RenderSettings& s, double& steps,
+                              double& fetches, LayerSums* layers) const;
   const Field& field_;
   const Environment& env_;
 };

@@ -3,9 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <future>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <functional>
 #include <map>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
+#include <thread>
 #include <tuple>
 #include <variant>
 
@@ -99,7 +105,102 @@ void validateRender(const RenderSettings& s, const Scene& scene) {
   if (s.spp < 1 || s.spp > 4096) throw std::invalid_argument("spp must be in [1, 4096]");
   if (s.wavelengths < 0 || s.wavelengths > 256)
     throw std::invalid_argument("wavelengths must be in [0, 256]");
+  if (int(s.modes) < 0 || int(s.modes) > 2)
+    throw std::invalid_argument("modes must be both, o or e");
 }
+
+/// Pipelines compiled on a thread of its own, one at a time, in the order asked
+/// (ViewRenderer::prefetch): a compile keeps one core busy for seconds on lavapipe, and the
+/// renderer's dispatches (and the viewer's window) go on meanwhile. The destructor drops what is
+/// still queued and waits for the compile in progress.
+template <class Key>
+class BackgroundCompiler {
+ public:
+  using Build = std::function<vk::ComputePipeline(const Key&)>;
+  explicit BackgroundCompiler(Build build) : build_(std::move(build)) {}
+  ~BackgroundCompiler() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      stop_ = true;
+      queue_.clear();
+    }
+    cv_.notify_all();
+    if (worker_.joinable()) worker_.join();
+  }
+  BackgroundCompiler(const BackgroundCompiler&) = delete;
+  BackgroundCompiler& operator=(const BackgroundCompiler&) = delete;
+
+  /// Queues `key` unless it is queued, compiling or compiled already.
+  void request(const Key& key) {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      if (done_.count(key) || building_ == key ||
+          std::find(queue_.begin(), queue_.end(), key) != queue_.end())
+        return;
+      queue_.push_back(key);
+      if (!worker_.joinable()) worker_ = std::thread([this] { run(); });
+    }
+    cv_.notify_all();
+  }
+  /// Whether `key` was compiled (or its compile failed) and waits to be taken.
+  bool ready(const Key& key) {
+    std::lock_guard<std::mutex> lock(m_);
+    return done_.count(key) > 0;
+  }
+  /// `key`'s pipeline: waited for while it compiles; not built (the caller builds it) if it was
+  /// never asked for or has not started (it is then taken off the queue). Rethrows what the
+  /// compile threw.
+  vk::ComputePipeline take(const Key& key) {
+    std::unique_lock<std::mutex> lock(m_);
+    const auto queued = std::find(queue_.begin(), queue_.end(), key);
+    if (queued != queue_.end()) {
+      queue_.erase(queued);
+      return {};
+    }
+    cv_.wait(lock, [&] { return building_ != key; });
+    const auto it = done_.find(key);
+    if (it == done_.end()) return {};
+    Result r = std::move(it->second);
+    done_.erase(it);
+    if (r.error) std::rethrow_exception(r.error);
+    return std::move(r.pipeline);
+  }
+
+ private:
+  struct Result {
+    vk::ComputePipeline pipeline;
+    std::exception_ptr error;
+  };
+  void run() {
+    std::unique_lock<std::mutex> lock(m_);
+    for (;;) {
+      cv_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+      if (stop_) return;
+      const Key key = queue_.front();
+      queue_.pop_front();
+      building_ = key;
+      lock.unlock();
+      Result r;
+      try {
+        r.pipeline = build_(key);
+      } catch (...) {
+        r.error = std::current_exception();
+      }
+      lock.lock();
+      done_.emplace(key, std::move(r));
+      building_.reset();
+      cv_.notify_all();
+    }
+  }
+  Build build_;
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::deque<Key> queue_;
+  std::optional<Key> building_;
+  std::map<Key, Result> done_;
+  bool stop_ = false;
+  std::thread worker_;
+};
 
 }  // namespace
 
@@ -153,10 +254,11 @@ struct ViewRenderer::Impl {
   enum Kernel { kView = 0, kTrace = 1, kPolarised = 2 };
   using Key = std::tuple<int, int, int, int>;  // kernel, flags, integrator, sharp
   std::map<Key, vk::ComputePipeline> pipelines;
-  // The expected render's view pipeline, compiled while the volume is uploaded (the compile runs
-  // on one core, the upload mostly on the other); adopted by pipeline() when its key comes up.
-  Key prefetchedKey{};
-  std::future<vk::ComputePipeline> prefetched;
+  // View pipelines compiled ahead on a thread of their own (prefetch()): the expected render's
+  // while the volume is uploaded (the compile runs on one core, the upload mostly on the other),
+  // the viewer's alternatives (its keys) while it shows a view; adopted by pipeline() when their
+  // key comes up. Declared after what build() reads, so that it ends first.
+  BackgroundCompiler<Key> compiler{[this](const Key& key) { return build(key); }};
   int skip_cap = 32;
   double ambient = 1.0;
 
@@ -267,16 +369,21 @@ struct ViewRenderer::Impl {
                                     polarisedBindings, "polarised trace");
   }
 
-  // Starts compiling the view pipeline of a render with settings `s` on a thread of its own.
-  // Settings render() would refuse start nothing (it reports them, without waiting for a build).
+  // Queues the view pipeline of a render with settings `s` for the background compiler, unless
+  // it is built. Settings render() would refuse start nothing (it reports them, without waiting
+  // for a build).
   void prefetch(const RenderSettings& s) {
     try {
       validateRender(s, scene);
     } catch (const std::invalid_argument&) {
       return;
     }
-    prefetchedKey = keyOf(kView, baseParams(s.march, renderFlags(s)), sharp);
-    prefetched = std::async(std::launch::async, [this, key = prefetchedKey] { return build(key); });
+    const Key key = viewKey(s);
+    if (!pipelines.count(key)) compiler.request(key);
+  }
+
+  Key viewKey(const RenderSettings& s) const {
+    return keyOf(kView, baseParams(s.march, renderFlags(s)), sharp);
   }
 
   // The pipeline for a dispatch with parameters p, built (or adopted from prefetch()) on first use.
@@ -284,14 +391,7 @@ struct ViewRenderer::Impl {
     const Key key = keyOf(kernel, p, sharp);
     auto it = pipelines.find(key);
     if (it != pipelines.end()) return it->second;
-    vk::ComputePipeline pl;
-    if (prefetched.valid()) {
-      vk::ComputePipeline ready = prefetched.get();  // rethrows what the build threw
-      if (prefetchedKey == key)
-        pl = std::move(ready);
-      else
-        adopt(prefetchedKey, std::move(ready));
-    }
+    vk::ComputePipeline pl = compiler.take(key);  // rethrows what its compile threw
     if (!pl.built()) pl = build(key);
     return adopt(key, std::move(pl));
   }
@@ -378,6 +478,19 @@ ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet
     : impl_(std::make_unique<Impl>(ctx, scene, volume, expected)) {}
 ViewRenderer::~ViewRenderer() = default;
 
+void ViewRenderer::prefetch(const RenderSettings& settings) { impl_->prefetch(settings); }
+
+bool ViewRenderer::ready(const RenderSettings& settings) {
+  Impl& I = *impl_;
+  try {
+    validateRender(settings, I.scene);
+  } catch (const std::invalid_argument&) {
+    return true;  // render() refuses it at once
+  }
+  const auto key = I.viewKey(settings);
+  return I.pipelines.count(key) > 0 || I.compiler.ready(key);
+}
+
 namespace {
 // Adds one band's layer values (view.comp layerWrite) to the sums: channels [c0, c1) of each mode
 // kept apart (the pass's wavelength bins, all N for a hero pass; r, g, b in RGB mode).
@@ -450,7 +563,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   auto t0 = std::chrono::steady_clock::now();
   for (int pass = 0; pass < passes; ++pass) {
     p.pass = glm::ivec4(pass / passesPerSample, (pass % passesPerSample) * perPass, perPass,
-                        (hero ? 1 : 0) | layerBits);
+                        (hero ? 1 : 0) | layerBits | (int(s.modes) << 3));
     for (int y0 = 0, n = 0; y0 < img.height; y0 += n) {
       n = std::min(rows, img.height - y0);
       const auto band_start = std::chrono::steady_clock::now();

@@ -38,6 +38,13 @@ SpectralSampling parseSpectralSampling(const std::string& s) {
   throw SettingError("spectral-sampling", "must be auto, hero or stratified, got '" + s + "'");
 }
 
+Modes parseModes(const std::string& s) {
+  if (s == "both") return Modes::Both;
+  if (s == "o") return Modes::O;
+  if (s == "e") return Modes::E;
+  throw SettingError("modes", "must be o, e or both, got '" + s + "'");
+}
+
 void parseLayers(const std::string& list, ViewRequest& view) {
   view.spectral_layer = view.mode_layers = false;
   size_t start = 0;
@@ -81,6 +88,7 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
   rs.sampling = v.sampling;
   rs.spectral_layer = v.spectral_layer;
   rs.mode_layers = v.mode_layers;
+  rs.modes = v.modes;
   if (rs.spectral_layer && rs.wavelengths <= 0)
     throw SettingError("layers", "spectral needs a spectral render (wavelengths > 0), got " +
                                      std::to_string(rs.wavelengths) + " wavelengths");
@@ -225,6 +233,14 @@ ReferenceMarcher& Session::cpuMarcher() {
     cpu_ = std::make_unique<ReferenceMarcher>(*field_, scene_->environment);
   }
   return *cpu_;
+}
+
+void Session::prefetchRender(const RenderSettings& settings) {
+  gpuRenderer(&settings).prefetch(settings);
+}
+
+bool Session::renderReady(const RenderSettings& settings) {
+  return gpuRenderer(&settings).ready(settings);
 }
 
 RenderImage Session::render(const RenderSettings& settings, bool gpu) {
