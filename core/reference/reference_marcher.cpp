@@ -581,11 +581,16 @@ glm::dvec3 RayMarch::sharpDirection(const MarchState& S) const {
                                       regionIndex(S.region, 1, S.x)));
 }
 
-// The first crossing on [a, b] out of the ray's region (nextCrossingOutOf: the sliver rule),
-// counting the cells each search reads: the region at its start, the cells walked to the
-// crossing, and (found) the cells past it and at it (the region entered, the field's normal).
+// The first crossing on [a, b] out of the ray's region (nextCrossingOutOf: the sliver rule; or
+// convexCrossingOutOf where every shape is a convex polyhedron apart from the others), counting
+// the cells each search reads: the region at its start, the cells walked to the crossing, and
+// (found) the cells past it and at it (the region entered, the field's normal).
 BoundaryCrossing RayMarch::nextCrossing(const glm::dvec3& a, const glm::dvec3& b,
                                         int region) const {
+  if (bf_->convex_apart) {  // the planes' own crossing (march.glsl: EIKON_F_CONVEX_APART)
+    f_.fetches += 1;        // the cell of the field normal
+    return convexCrossingOutOf(*bf_, a, b, region);
+  }
   return nextCrossingOutOf(
       *bf_, a, b, region, [&](const glm::dvec3& start, const BoundaryCrossing& c) {
         f_.fetches += 1 + cellsOn(start, c.found ? c.point : b) + (c.found ? 2 : 0);

@@ -240,6 +240,7 @@ struct ViewRenderer::Impl {
   bool sharp = false;    // march region by region (shaders/sharp.glsl), as the CPU twin does
   bool varying = false;  // sharp: some region's medium varies in space (GRIN, radial axis)
   bool convex = false;   // sharp: some region's shape is a convex polyhedron
+  bool convexApart = false;  // sharp: every shape is one, apart (core/volume/boundary.h)
   // [oA, oB, oC, (eA, eB, eC), medO, (medE), emission, (axis), (scatter), (fluence, flux)]
   std::vector<vk::Image3D> images;
   size_t scatterImage = 0, fluenceImage = 0,
@@ -278,6 +279,7 @@ struct ViewRenderer::Impl {
     for (const MediumRecord& r : v.media.regions) varying = varying || !r.homogeneous;
     for (const Shape& shape : v.boundary.shapes)
       convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());
+    convexApart = v.boundary.convex_apart;
     std::vector<vk::BindingSpec> common;  // the bindings of both kernels (the trace's adds rays)
     for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
@@ -454,6 +456,7 @@ struct ViewRenderer::Impl {
     if (sharp) flags |= EIKON_F_SHARP;
     if (sharp && varying) flags |= EIKON_F_VARYING;
     if (sharp && convex) flags |= EIKON_F_CONVEX;
+    if (sharp && convexApart) flags |= EIKON_F_CONVEX_APART;
     if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
     if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
