@@ -307,7 +307,9 @@ TEST_F(ViewerTest, CtrlDragMovesTheLightAndSimulatesItAgain) {
   ASSERT_TRUE(WIFEXITED(run.status) && WEXITSTATUS(run.status) == 0) << err;
   EXPECT_EQ(err.find("validation"), std::string::npos) << err;
   const std::string said = "light 0 simulated again (from the light cache): position ";
-  const size_t at = out.find(said);
+  // The last report: a viewer that handles the drag's motion events while it compiles (issue 17
+  // item 3) may simulate the light at the drag's first position and then at its last.
+  const size_t at = out.rfind(said);
   ASSERT_NE(at, std::string::npos) << out;
   const size_t open = at + said.size();
   const nlohmann::json position =
