@@ -465,9 +465,18 @@ const float kGrazeVoxels = 1e-3;
 // The line a + t(b − a) in convex shape s: (t_in, t_out, plane of t_in, plane of t_out), planes
 // −1 where none; t_in > t_out when it misses. Planes as in shapeSignedDistance (clamped index:
 // the strict comparisons never take a repeated plane twice).
+// Plane i of the shape whose record is at o: the table's, or a box's ±x, ±y, ±z
+// (boundary.cpp localPlanes).
+vec4 slabPlane(int o, int i) {
+  if (int(shapeTable[o].x) != EIKON_SHAPE_BOX) return shapeTable[int(shapeTable[o].y) + i];
+  vec3 n = vec3(0.0);
+  n[i >> 1] = (i & 1) != 0 ? 1.0 : -1.0;
+  return vec4(n, shapeTable[o + 5][i >> 1]);
+}
+
 vec4 convexSlab(int s, vec3 a, vec3 b) {
   int o = EIKON_SHAPE_STRIDE * s;
-  int first = int(shapeTable[o].y), count = int(shapeTable[o].z);
+  int count = int(shapeTable[o].x) == EIKON_SHAPE_BOX ? 6 : int(shapeTable[o].z);
   vec3 p = shapeLocal(s, a), ab = b - a;
   vec3 d = vec3(dot(shapeTable[o + 2].xyz, ab), dot(shapeTable[o + 3].xyz, ab),
                 dot(shapeTable[o + 4].xyz, ab));
@@ -475,7 +484,7 @@ vec4 convexSlab(int s, vec3 a, vec3 b) {
   for (int k = 0; count > 0;) {
     [[unroll]] for (int j = 0; j < kShapePlanesPerPass; ++j) {
       int i = min(k + j, count - 1);
-      vec4 pl = shapeTable[first + i];
+      vec4 pl = slabPlane(o, i);
       float nd = dot(pl.xyz, d), v = dot(pl.xyz, p) - pl.w;
       float t = -v / (nd != 0.0 ? nd : 1.0);
       if (nd > 0.0 && t < r.y) r.yw = vec2(t, float(i));
@@ -518,7 +527,7 @@ BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
   }
   if (shape < 0) return c;
   int o = EIKON_SHAPE_STRIDE * shape;
-  vec3 g = shapeTable[int(shapeTable[o].y) + face].xyz;
+  vec3 g = slabPlane(o, face).xyz;
   vec3 n = g.x * shapeTable[o + 2].xyz + g.y * shapeTable[o + 3].xyz + g.z * shapeTable[o + 4].xyz;
   c.found = true;
   c.t = t;

@@ -319,11 +319,14 @@ BoundaryCrossing nextCrossingOutOf(
 
 namespace eikon {
 
+// Boxes count as the convex polyhedra they are (localPlanes: six planes).
 bool convexShapesApart(const std::vector<Shape>& shapes, double h) {
   if (shapes.empty()) return false;
   const double gap = kCrossingApartVoxels * h;
   for (size_t i = 0; i < shapes.size(); ++i) {
-    if (!std::holds_alternative<ConvexShape>(shapes[i].geometry())) return false;
+    if (!std::holds_alternative<ConvexShape>(shapes[i].geometry()) &&
+        !std::holds_alternative<BoxShape>(shapes[i].geometry()))
+      return false;
     const auto [amin, amax] = shapes[i].bounds();
     for (size_t j = 0; j < i; ++j) {
       const auto [bmin, bmax] = shapes[j].bounds();
@@ -345,8 +348,22 @@ struct Slab {
   int face_in = -1, face_out = -1;
 };
 
+/// The local planes of a convex polyhedron or a box (±x, ±y, ±z: boundary.glsl's order).
+std::vector<Plane> localPlanes(const Shape& s) {
+  if (const auto* c = std::get_if<ConvexShape>(&s.geometry())) return c->planes;
+  const glm::dvec3 half = 0.5 * std::get<BoxShape>(s.geometry()).size;
+  std::vector<Plane> planes;
+  for (int a = 0; a < 3; ++a)
+    for (double sign : {-1.0, 1.0}) {
+      glm::dvec3 n(0.0);
+      n[a] = sign;
+      planes.push_back({n, half[a]});
+    }
+  return planes;
+}
+
 Slab convexSlab(const Shape& s, const glm::dvec3& a, const glm::dvec3& b) {
-  const auto& planes = std::get<ConvexShape>(s.geometry()).planes;
+  const std::vector<Plane> planes = localPlanes(s);
   const glm::dmat3 to_local = glm::transpose(s.rotation());
   const glm::dvec3 p = to_local * (a - s.center()), d = to_local * (b - a);
   Slab out;
@@ -393,8 +410,7 @@ BoundaryCrossing convexCrossingOutOf(const BoundaryField& bf, const glm::dvec3& 
     out.to = shape + 1;
   }
   const Shape& s = bf.shapes[size_t(shape)];
-  const glm::dvec3 n =
-      s.rotation() * std::get<ConvexShape>(s.geometry()).planes[size_t(face)].normal;
+  const glm::dvec3 n = s.rotation() * localPlanes(s)[size_t(face)].normal;
   out.found = true;
   out.t = t;
   out.point = a + t * (b - a);
