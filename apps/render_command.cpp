@@ -27,7 +27,8 @@ struct RenderArgs {
   std::string scene, output;
   int width = 0, height = 0, spp = 1, wavelengths = -1, threads = 0;
   double step = kDefaultRenderStepVoxels, exposure = 0.0;
-  std::string integrator = "rk4", progress = "auto", spectral_sampling = "auto", layers;
+  std::string integrator = "rk4", progress = "auto", spectral_sampling = "auto", layers,
+              modes = "both";
   bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
   bool polarised = false;
   // Light simulator (scenes with "lights").
@@ -80,6 +81,9 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
   sub->add_flag("--polarised", a.polarised,
                 "Polarised render (Stokes transport, docs/polarisation.md) even without polariser "
                 "sheets or a camera analyzer, which make a render polarised by themselves");
+  sub->add_option("--modes", a.modes,
+                  "Crystal scenes: both (unpolarised light, each mode carrying half; default), o "
+                  "or e (that mode alone, at the whole of the light: o + e = 2 x both)");
   sub->add_option("--step", a.step,
                   "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4)");
@@ -143,6 +147,7 @@ ViewRequest viewRequest(const RenderArgs& a, const CLI::App& sub) {
   v.sampling = parseSpectralSampling(a.spectral_sampling);
   parseLayers(a.layers, v);
   v.polarised = a.polarised;
+  v.modes = parseModes(a.modes);
   return v;
 }
 

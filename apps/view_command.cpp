@@ -45,8 +45,8 @@ struct ViewArgs {
   std::string scene, screenshot;
   int width = 0, height = 0, spp = 16, wavelengths = -1, coarse = 4, exit_after_frames = 0;
   double exposure = 0.0;
-  std::string integrator = "rk4";
-  bool no_light = false;
+  std::string integrator = "rk4", modes = "both";
+  bool no_light = false, no_prefetch = false;
 };
 
 void addViewOptions(CLI::App* sub, ViewArgs& a) {
@@ -64,6 +64,12 @@ void addViewOptions(CLI::App* sub, ViewArgs& a) {
                   "The first frame after a change has 1/N of the resolution per side, N in [1, "
                   "16] (default 4); N doubles while a coarse frame takes over 0.1 s");
   sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4; I cycles)");
+  sub->add_option("--modes", a.modes,
+                  "Crystal scenes: both (default), o or e: that mode alone, as eikon render "
+                  "--modes (M cycles)");
+  sub->add_flag("--no-prefetch", a.no_prefetch,
+                "Do not compile the pipelines of the R and I keys ahead in the background (a key "
+                "then shows 'compiling' while its pipeline compiles)");
   sub->add_option("--exposure", a.exposure, "Exposure in stops, as eikon render's PNG (default 0)");
   sub->add_flag("--no-light", a.no_light, "Do not simulate the scene's lights");
   sub->add_option("--exit-after-frames", a.exit_after_frames,
@@ -148,7 +154,8 @@ class Viewer {
         chain_(chain),
         base_(std::move(base)),
         mover_(mover),
-        integrator_(base_.march.integrator) {
+        integrator_(base_.march.integrator),
+        modes_(base_.modes) {
     if (mover_) wanted_light_ = session_.scene()->lights.front();
     full_wavelengths_ = base_.wavelengths > 0 ? base_.wavelengths : defaultSpectral();
     spectral_ = base_.wavelengths > 0;
@@ -209,12 +216,17 @@ class Viewer {
         "(1 sample, eikon render's default) after %.2f s, %d samples after %.2f s",
         frames_, first_frame_seconds_, coarse.size(), median, median > 0 ? 1.0 / median : 0.0,
         coarse_, full_quality_seconds_, refined_spp_, refined_seconds_);
-    return buf;
+    char compiles[160];
+    std::snprintf(compiles, sizeof compiles,
+                  "; %lld frames presented while a pipeline compiled (the longest wait %.2f s)",
+                  compile_frames_, longest_compile_);
+    return std::string(buf) + compiles;
   }
 
   const RenderImage& shown() const { return shown_; }
   int shownSamples() const { return shown_spp_; }
   int shownWavelengths() const { return shown_wavelengths_; }
+  Modes shownModes() const { return shown_modes_; }
 
  private:
   int defaultSpectral() const {
@@ -250,14 +262,17 @@ class Viewer {
       rs.spp = st.spp;
       rs.wavelengths = st.wavelengths;
       rs.march.integrator = integrator_;
+      rs.modes = stage_modes_ = modes_;
+      if (st.width <= 0 || st.height <= 0) return;
+      waitForPipeline(rs);
       const auto start = Clock::now();
       rs.progress = [this](double) { poll(); };
       rs.on_pass = [&](const RenderImage& so_far, int done, int) {
         show(so_far, done, st.wavelengths, start, st.width < full_width);
       };
-      if (st.width <= 0 || st.height <= 0) return;
       RenderImage img = session_.render(rs, true);
       show(img, st.spp, st.wavelengths, start, st.width < full_width);
+      if (!prefetched_) prefetchKeys();
       finish_stage_ = false;
       poll();  // a change during the coarse frame restarts here
     }
@@ -265,6 +280,59 @@ class Viewer {
     refined_seconds_ = std::chrono::duration<double>(Clock::now() - change_time_).count();
     refined_ = true;
     updateTitle(Clock::now());
+  }
+
+  /// A stage whose view pipeline is not compiled yet (a key changed the integrator or RGB ↔
+  /// spectral before its background compile finished, or --no-prefetch): it compiles on the
+  /// renderer's thread while the last image stays on screen, presented again about 10 times a
+  /// second under a "compiling..." title, and events are handled: the window keeps responding,
+  /// and a change restarts the view (the compile goes on).
+  void waitForPipeline(const RenderSettings& rs) {
+    if (session_.renderReady(rs)) return;
+    session_.prefetchRender(rs);
+    const auto start = Clock::now();
+    compiling_ = true;
+    do {
+      if (!shown_.rgb.empty()) {
+        const std::vector<unsigned char> px =
+            previewPixels(shown_.width, shown_.height, shown_.rgb, args_.exposure);
+        if (!chain_.present(px.data(), shown_.width, shown_.height)) resized_ = true;
+        ++compile_frames_;
+        updateTitle(Clock::now());
+      } else {  // no frame yet: the title counts none (scripts wait for "frames/s")
+        glfwSetWindowTitle(window_, ("eikon view: " + session_.scene()->file.filename().string() +
+                                     " (compiling the view pipeline)")
+                                        .c_str());
+      }
+      glfwWaitEventsTimeout(0.1);
+      handleRequests();
+      if (changed_ || resized_ || quit_ || glfwWindowShouldClose(window_)) {
+        compiling_ = false;
+        throw Interrupted{};
+      }
+    } while (!session_.renderReady(rs));
+    compiling_ = false;
+    longest_compile_ =
+        std::max(longest_compile_, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+
+  /// The view pipelines the R and I keys lead to, compiled ahead in the background, one at a time
+  /// (the M key needs none): RGB ↔ spectral first, then the next integrators, then both.
+  void prefetchKeys() {
+    prefetched_ = true;
+    if (args_.no_prefetch) return;
+    RenderSettings rs = base_;
+    rs.modes = modes_;
+    const int i0 = int(integrator_);
+    for (const auto& [spectral, k] : {std::pair{!spectral_, 0},
+                                      {spectral_, 1},
+                                      {spectral_, 2},
+                                      {!spectral_, 1},
+                                      {!spectral_, 2}}) {
+      rs.wavelengths = spectral ? full_wavelengths_ : 0;
+      rs.march.integrator = Integrator((i0 + k) % 3);
+      session_.prefetchRender(rs);
+    }
   }
 
   int fullWidth() const {
@@ -291,6 +359,7 @@ class Viewer {
     shown_ = img;
     shown_spp_ = samples;
     shown_wavelengths_ = wavelengths;
+    shown_modes_ = stage_modes_;
     ++frames_;
     ++frames_since_change_;
     frame_times_.push_back(now);
@@ -320,13 +389,17 @@ class Viewer {
       fps = double(frame_times_.size() - 1) /
             std::max(1e-6, std::chrono::duration<double>(now - frame_times_.front()).count());
     char buf[512];
-    std::snprintf(
-        buf, sizeof buf, "eikon view: %s | %.1f frames/s | %dx%d, %d/%d samples, %s | %s%s",
-        session_.scene()->file.filename().c_str(), fps, shown_.width, shown_.height, shown_spp_,
-        args_.spp,
-        shown_wavelengths_ > 0 ? (std::to_string(shown_wavelengths_) + " wavelengths").c_str()
-                               : "RGB",
-        integratorName(integrator_), refined_ ? " | refined" : "");
+    std::snprintf(buf, sizeof buf,
+                  "eikon view: %s | %.1f frames/s | %dx%d, %d/%d samples, %s | %s | modes %s%s",
+                  session_.scene()->file.filename().c_str(), fps, shown_.width, shown_.height,
+                  shown_spp_, args_.spp,
+                  shown_wavelengths_ > 0
+                      ? (std::to_string(shown_wavelengths_) + " wavelengths").c_str()
+                      : "RGB",
+                  integratorName(integrator_), modesName(modes_),
+                  compiling_ ? " | compiling..."
+                  : refined_ ? " | refined"
+                             : "");
     glfwSetWindowTitle(window_, buf);
   }
 
@@ -367,6 +440,7 @@ class Viewer {
   /// The light volumes simulated in the background, from the light cache, into the view.
   void applyLight() {
     light_ready_ = false;
+    prefetched_ = false;  // the renderer is made again, its pipelines too
     session_.scene()->lights.front() = ready_light_;
     const LightOutcome o = session_.simulateLight(LightRequest{}, false, defaultLightCacheDir());
     for (const std::string& w : o.warnings) std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
@@ -441,6 +515,10 @@ class Viewer {
         integrator_ = Integrator((int(integrator_) + 1) % 3);
         changed_ = true;
         break;
+      case GLFW_KEY_M:  // both → o → e → both (crystal scenes; no new pipeline)
+        modes_ = Modes((int(modes_) + 1) % 3);
+        changed_ = true;
+        break;
       case GLFW_KEY_S:
         save_requested_ = true;
         break;
@@ -486,7 +564,12 @@ class Viewer {
   Light wanted_light_, ready_light_;
   bool light_moved_ = false, light_ready_ = false;
   Integrator integrator_;
+  Modes modes_, stage_modes_ = modes_, shown_modes_ = modes_;
   bool spectral_ = false;
+  bool compiling_ = false;        ///< waiting for a pipeline (waitForPipeline; the title says so)
+  bool prefetched_ = false;       ///< the pipelines of the keys were asked for (prefetchKeys)
+  long long compile_frames_ = 0;  ///< frames presented while a pipeline compiled
+  double longest_compile_ = 0;    ///< the longest such wait, seconds
   int full_wavelengths_ = 0;
   bool changed_ = false, resized_ = false, quit_ = false, save_requested_ = false;
   bool refined_ = false;       ///< the view is fully refined (the title says so)
@@ -550,6 +633,7 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   if (sub.count("--height")) view.height = a.height;
   view.spp = a.spp;
   if (sub.count("--wavelengths")) view.wavelengths = a.wavelengths;
+  view.modes = parseModes(a.modes);
   checkViewRequest(view);
   if (a.coarse < 1 || a.coarse > 16)
     throw CliError("--coarse must be in [1, 16], got " + std::to_string(a.coarse));
@@ -605,11 +689,12 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   if (!a.screenshot.empty() && !img.rgb.empty()) {
     writeFilesTogether(
         {{a.screenshot, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)}});
-    std::printf("eikon view: screenshot %s (%dx%d, %d samples, %s)\n\"camera\": %s\n",
+    std::printf("eikon view: screenshot %s (%dx%d, %d samples, %s, modes %s)\n\"camera\": %s\n",
                 a.screenshot.c_str(), img.width, img.height, viewer.shownSamples(),
                 viewer.shownWavelengths() > 0
                     ? (std::to_string(viewer.shownWavelengths()) + " wavelengths").c_str()
                     : "RGB",
+                modesName(viewer.shownModes()),
                 cameraJson(scene->camera, img.width, img.height).c_str());
   }
 }

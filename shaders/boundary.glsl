@@ -27,6 +27,12 @@
 #ifndef EIKON_BOUNDARY_HAS_MESH
 #define EIKON_BOUNDARY_HAS_MESH true
 #endif
+// Whether every shape is a convex polyhedron apart from the others (EIKON_F_CONVEX_APART in the
+// view kernel; core/volume/boundary.h convex_apart): nextCrossing (sharp.glsl) then takes
+// convexCrossing instead of the walk. Other kernels keep the walk.
+#ifndef EIKON_BOUNDARY_CONVEX_APART
+#define EIKON_BOUNDARY_CONVEX_APART false
+#endif
 
 int shapeKind(int s) { return int(shapeTable[EIKON_SHAPE_STRIDE * s].x); }
 
@@ -585,6 +591,86 @@ BoundaryCrossing locateCrossing(vec3 a, vec3 b, float tolVoxels, bool analytic) 
     if (length(n) > 0.0) out_.normal = (leaving ? 1.0 : -1.0) * normalize(n);
   }
   return out_;
+}
+
+// ---- Convex polyhedra apart from each other (boundary.cpp: convexCrossingOutOf) ----
+
+// A crossing this close to the segment's start (voxels) is a graze at the point the ray is on.
+const float kGrazeVoxels = 1e-3;
+
+// The line a + t(b − a) in convex shape s: (t_in, t_out, plane of t_in, plane of t_out), planes
+// −1 where none; t_in > t_out when it misses. Planes as in shapeSignedDistance (clamped index:
+// the strict comparisons never take a repeated plane twice).
+// Plane i of the shape whose record is at o: the table's, or a box's ±x, ±y, ±z
+// (boundary.cpp localPlanes).
+vec4 slabPlane(int o, int i) {
+  if (int(shapeTable[o].x) != EIKON_SHAPE_BOX) return shapeTable[int(shapeTable[o].y) + i];
+  vec3 n = vec3(0.0);
+  n[i >> 1] = (i & 1) != 0 ? 1.0 : -1.0;
+  return vec4(n, shapeTable[o + 5][i >> 1]);
+}
+
+vec4 convexSlab(int s, vec3 a, vec3 b) {
+  int o = EIKON_SHAPE_STRIDE * s;
+  int count = int(shapeTable[o].x) == EIKON_SHAPE_BOX ? 6 : int(shapeTable[o].z);
+  vec3 p = shapeLocal(s, a), ab = b - a;
+  vec3 d = vec3(dot(shapeTable[o + 2].xyz, ab), dot(shapeTable[o + 3].xyz, ab),
+                dot(shapeTable[o + 4].xyz, ab));
+  vec4 r = vec4(-3.0e38, 3.0e38, -1.0, -1.0);
+  for (int k = 0; count > 0;) {
+    [[unroll]] for (int j = 0; j < kShapePlanesPerPass; ++j) {
+      int i = min(k + j, count - 1);
+      vec4 pl = slabPlane(o, i);
+      float nd = dot(pl.xyz, d), v = dot(pl.xyz, p) - pl.w;
+      float t = -v / (nd != 0.0 ? nd : 1.0);
+      if (nd > 0.0 && t < r.y) r.yw = vec2(t, float(i));
+      else if (nd < 0.0 && t > r.x) r.xz = vec2(t, float(i));
+      else if (nd == 0.0 && v > 0.0) r.xy = vec2(3.0e38, -3.0e38);  // parallel, outside
+    }
+    k += kShapePlanesPerPass;
+    if (k >= count) break;
+  }
+  return r;
+}
+
+// The first crossing on [a, b] out of `region` where every shape is a convex polyhedron apart
+// from the others: inside a polyhedron, the first of its planes ahead (into the ambient); in the
+// ambient, the nearest polyhedron the segment passes through (beyond kGrazeVoxels). One loop over
+// the shapes it may cross (its own, or all: the record's w), one pass per 32 planes each.
+BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
+  BoundaryCrossing c;
+  c.found = false;
+  c.t = 1.0;
+  c.point = b;
+  c.normal = vec3(0.0);
+  c.from = region;
+  c.to = region;
+  float graze = kGrazeVoxels * P.grid_origin.w / length(b - a);
+  bool inside = region >= 1;
+  int k0 = inside ? region - 1 : 0, k1 = inside ? region : int(shapeTable[0].w);
+  int shape = -1, face = -1;
+  float t = 3.0e38;
+  for (int k = k0; k < k1; ++k) {
+    vec4 sl = convexSlab(k, a, b);
+    bool hit = inside ? sl.w >= 0.0 && sl.y <= 1.0
+                      : sl.x <= sl.y && sl.y > graze && sl.x <= 1.0 && sl.z >= 0.0;
+    float tk = max(inside ? sl.y : sl.x, 0.0);
+    if (hit && tk < t) {
+      t = tk;
+      shape = k;
+      face = int(inside ? sl.w : sl.z);
+    }
+  }
+  if (shape < 0) return c;
+  int o = EIKON_SHAPE_STRIDE * shape;
+  vec3 g = slabPlane(o, face).xyz;
+  vec3 n = g.x * shapeTable[o + 2].xyz + g.y * shapeTable[o + 3].xyz + g.z * shapeTable[o + 4].xyz;
+  c.found = true;
+  c.t = t;
+  c.point = mix(a, b, t);
+  c.normal = (inside ? 1.0 : -1.0) * normalize(n);
+  c.to = inside ? 0 : shape + 1;
+  return c;
 }
 
 #endif  // EIKON_BOUNDARY_GLSL

@@ -70,6 +70,9 @@ using uvec4 = glm::uvec4;
 #define EIKON_F_VARYING 2048    // sharp: some region's medium varies in space (GRIN, radial axis)
 #define EIKON_F_CONVEX 4096     // sharp: some region's shape is a convex polyhedron (plane loops)
 #define EIKON_F_MESH 8192       // sharp: some region's shape is a non-convex mesh (BVH traversal)
+// sharp: every shape is a convex polyhedron, apart from the others (core/volume/boundary.h
+// convex_apart): crossings come from the planes (boundary.glsl convexCrossing), no cell walk.
+#define EIKON_F_CONVEX_APART 16384
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0
@@ -92,7 +95,7 @@ using uvec4 = glm::uvec4;
 
 // Shape table (EIKON_B_SHAPES; packed by core/render/boundary_device.cpp): the shape of region
 // r ≥ 1 is the record at vec4 index EIKON_SHAPE_STRIDE·(r − 1):
-//   [0] (kind EIKON_SHAPE_*, first plane (vec4 index), plane count, 0)   integers stored as floats
+//   [0] (kind EIKON_SHAPE_*, first plane (vec4 index), plane count, number of shapes)   integers stored as floats
 //   [1] (centre (mm), 0)
 //   [2..4] the columns of the local → world rotation R (local p = Rᵀ(x − c): p_i = col_i · (x − c))
 //   [5] sphere: (radius, 0, 0, 0); box: (size/2, 0); rounded box: (size/2 − radius, radius);

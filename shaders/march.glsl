@@ -99,6 +99,7 @@ layout(constant_id = 3) const bool kAov = false;
   if (any(notEqual(b, vec4(0.0))) || any(notEqual(c, vec4(0.0)))) gDispersiveHit = true
 #define EIKON_BOUNDARY_HAS_CONVEX hasFlag(EIKON_F_CONVEX)
 #define EIKON_BOUNDARY_HAS_MESH hasFlag(EIKON_F_MESH)
+#define EIKON_BOUNDARY_CONVEX_APART hasFlag(EIKON_F_CONVEX_APART)
 #include "field.glsl"
 #include "boundary.glsl"
 

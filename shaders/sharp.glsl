@@ -175,6 +175,7 @@ BoundaryCrossing nextCrossing(vec3 a, vec3 b, int region) {
   none.to = region;
   float total = length(b - a);
   if (!(total > 0.0)) return none;
+  if (EIKON_BOUNDARY_CONVEX_APART) return convexCrossing(a, b, region);
   vec3 dir = (b - a) / total;
   float h = P.grid_origin.w;
   vec3 start = a;

@@ -1,8 +1,10 @@
 #version 450
 // View renderer: one thread per pixel and one pass per dispatch: pixel sample P.pass.x (jittered
 // when spp > 1) at wavelengths [P.pass.y, P.pass.y + P.pass.z) of its N stratified ones (spectral
-// mode, CIE 1931 → linear sRGB), or at all N by hero wavelength sampling (P.pass.w & 1) or at the fixed wavelength (RGB mode, RGB attenuation). Uniaxial
-// scenes march the o- and e-modes, each carrying half of the unpolarised radiance. Output: this
+// mode, CIE 1931 → linear sRGB), or at all N by hero wavelength sampling (P.pass.w & 1) or at the
+// fixed wavelength (RGB mode, RGB attenuation). Uniaxial scenes march the o- and e-modes, each
+// carrying half of the unpolarised radiance, or one of them at the whole of it ((P.pass.w >> 3) & 3
+// = 1: o only, 2: e only; RenderSettings::modes, core/volume/march_types.h). Output: this
 // pass's share of the pixel's linear sRGB radiance (the host sums the passes and divides by spp),
 // w = its steps, or −(steps + 1) when a march of the pass ran out of the driver's loop budget.
 //
@@ -121,7 +123,13 @@ void main() {
     bool spectral = hasFlag(EIKON_F_SPECTRAL);
     int N = spectral ? P.limits.z : 1;
     int k0 = spectral ? P.pass.y : 0, k1 = spectral ? min(P.pass.y + P.pass.z, N) : 1;
-    int modes = hasFlag(EIKON_F_UNIAXIAL) ? 2 : 1;  // unpolarised: each mode carries 1/modes
+    // The modes marched, [m0, m1): both, each carrying half of the unpolarised light, or the one
+    // selected at the whole of it (march_types.h modeRange). Isotropic scenes: the one mode.
+    const int modes = hasFlag(EIKON_F_UNIAXIAL) ? 2 : 1;
+    const int selected = (P.pass.w >> 3) & 3;
+    const int m0 = modes == 2 && selected == 2 ? 1 : 0;
+    const int m1 = modes == 2 && selected == 1 ? 1 : modes;
+    const float modeWeight = m1 - m0 == 2 ? 0.5 : 1.0;
     uint seed = pcg_hash(pixelIndex + pcg_hash(uint(s)));
     vec3 xyz = vec3(0.0);
     // Wavelength sharing (march.glsl): only where nothing but the index can depend on λ, and only
@@ -154,7 +162,7 @@ void main() {
       k1 = kh + 1;
       gHero = true;
       gNumRecorded = 0;
-      gRecordWeight = modes == 2 ? 0.5 : 1.0;
+      gRecordWeight = modeWeight;
     }
     for (int k = k0; k < k1; ++k) {
       float lambda = 0.0;
@@ -174,8 +182,8 @@ void main() {
       }
       vec3 rad = vec3(0.0);
       vec3 radMode[2] = vec3[2](vec3(0.0), vec3(0.0));
-      for (int mode = 0; mode < modes; ++mode) {
-        if (mode == 0 && !hero) {
+      for (int mode = m0; mode < m1; ++mode) {
+        if (mode == m0 && !hero) {
           gRecord = share && k == k0;
           gNumRecorded = 0;
           gRecordOverflow = false;
@@ -183,11 +191,11 @@ void main() {
         }
         if (hero) gDispersiveHit = hasFlag(weightDependent);
         MarchResult r = march(P.cam_pos.xyz, d, mode);
-        if (mode == 0 && !hero) {
+        if (mode == m0 && !hero) {
           reuse = gRecord && !gDispersiveHit && !gRecordOverflow;
           gRecord = false;
         }
-        vec3 part = modes == 2 ? 0.5 * r.radiance : r.radiance;
+        vec3 part = modeWeight * r.radiance;
         rad += part;
         radMode[mode] = part;
         if (hero && mode == 0) heroCount0 = gNumRecorded;

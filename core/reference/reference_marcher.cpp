@@ -586,11 +586,16 @@ glm::dvec3 RayMarch::sharpDirection(const MarchState& S) const {
                                       regionIndex(S.region, 1, S.x)));
 }
 
-// The first crossing on [a, b] out of the ray's region (nextCrossingOutOf: the sliver rule),
-// counting the cells each search reads: the region at its start, the cells walked to the
-// crossing, and (found) the cells past it and at it (the region entered, the field's normal).
+// The first crossing on [a, b] out of the ray's region (nextCrossingOutOf: the sliver rule; or
+// convexCrossingOutOf where every shape is a convex polyhedron apart from the others), counting
+// the cells each search reads: the region at its start, the cells walked to the crossing, and
+// (found) the cells past it and at it (the region entered, the field's normal).
 BoundaryCrossing RayMarch::nextCrossing(const glm::dvec3& a, const glm::dvec3& b,
                                         int region) const {
+  if (bf_->convex_apart) {  // the planes' own crossing (march.glsl: EIKON_F_CONVEX_APART)
+    f_.fetches += 1;        // the cell of the field normal
+    return convexCrossingOutOf(*bf_, a, b, region);
+  }
   return nextCrossingOutOf(
       *bf_, a, b, region, [&](const glm::dvec3& start, const BoundaryCrossing& c) {
         f_.fetches += 1 + cellsOn(start, c.found ? c.point : b) + (c.found ? 2 : 0);
@@ -861,11 +866,12 @@ glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3
   const auto n = uint32_t(s.wavelengths);
   const std::vector<double> lambdas = spectrum::heroWavelengths(pixel, sample, n);
   const int modes = field_.uniaxial() ? 2 : 1;
+  const ModeRange mr = modeRange(s.modes, field_.uniaxial());
   HeroRecord rec;
-  rec.weight = modes == 2 ? 0.5 : 1.0;
+  rec.weight = mr.weight;
   double heroMode[2] = {0.0, 0.0};  // each mode's own radiance after its path dispersed
   int count0 = 0;                   // records made by the o-mode's march
-  for (int mode = 0; mode < modes; ++mode) {
+  for (int mode = mr.first; mode < mr.end; ++mode) {
     rec.diverged = field_.weightsDependOnLambda();
     Result r = march(o, d, lambdas[0], true, s.march, mode, &rec);
     heroMode[mode] = rec.weight * r.radiance.x;
@@ -899,51 +905,44 @@ glm::dvec3 ReferenceMarcher::sampleRgb(const glm::dvec3& eye, const glm::dvec3& 
                                        uint32_t sidx, const RenderSettings& s, bool hero,
                                        SampleTally& tally, LayerSums& layers) const {
   const glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
-  if (s.wavelengths > 0 && hero)
-    return M * heroSampleXyz(eye, d, pixel, sidx, s, tally, layers.active() ? &layers : nullptr);
-  if (s.wavelengths > 0) {
-    auto lambdas = spectrum::stratifiedWavelengths(pixel, sidx, uint32_t(s.wavelengths));
-    glm::dvec3 xyz(0.0);
-    for (size_t k = 0; k < lambdas.size(); ++k) {
-      const double l = lambdas[k];
-      Result r = march(eye, d, l, true, s.march, 0);
-      double rad = r.radiance.x;
-      tally.add(r, s.wavelengths);
-      if (field_.uniaxial()) {  // unpolarised: each mode carries half
-        Result re = march(eye, d, l, true, s.march, 1);
-        rad = 0.5 * (rad + re.radiance.x);
-        tally.add(re, s.wavelengths);
-        if (layers.active()) {
-          layers.at(pixel, 0)[k] += 0.5 * r.radiance.x;
-          layers.at(pixel, 1)[k] += 0.5 * re.radiance.x;
-        }
-      } else if (layers.active()) {
-        layers.at(pixel, 0)[k] += rad;
-      }
-      xyz += rad * spectrum::sampleWeightXyz(l, uint32_t(s.wavelengths));
+  LayerSums* lp = layers.active() ? &layers : nullptr;
+  if (s.wavelengths > 0 && hero) return M * heroSampleXyz(eye, d, pixel, sidx, s, tally, lp);
+  // Unpolarised light: each mode carries half, or the one selected the whole (modeRange).
+  const ModeRange mr = modeRange(s.modes, field_.uniaxial());
+  if (s.wavelengths == 0) {  // RGB mode: one march per mode at the index wavelength
+    glm::dvec3 rad(0.0);
+    for (int mode = mr.first; mode < mr.end; ++mode) {
+      const Result r = march(eye, d, s.wavelength_nm, false, s.march, mode);
+      const glm::dvec3 part = mr.weight * r.radiance;
+      rad += part;
+      tally.add(r, 1.0);
+      if (lp)
+        for (int c = 0; c < 3; ++c) lp->at(pixel, mode)[c] += part[c];
     }
-    return M * xyz;
+    return rad;
   }
-  Result r = march(eye, d, s.wavelength_nm, false, s.march, 0);
-  glm::dvec3 rad = r.radiance;
-  tally.add(r, 1.0);
-  glm::dvec3 modeRad[2] = {rad, glm::dvec3(0.0)};
-  if (field_.uniaxial()) {
-    Result re = march(eye, d, s.wavelength_nm, false, s.march, 1);
-    rad = 0.5 * (rad + re.radiance);
-    modeRad[0] = 0.5 * r.radiance;
-    modeRad[1] = 0.5 * re.radiance;
-    tally.add(re, 1.0);
+  const auto n = uint32_t(s.wavelengths);
+  const std::vector<double> lambdas = spectrum::stratifiedWavelengths(pixel, sidx, n);
+  glm::dvec3 xyz(0.0);
+  for (size_t k = 0; k < lambdas.size(); ++k) {
+    double rad = 0.0;
+    for (int mode = mr.first; mode < mr.end; ++mode) {
+      const Result r = march(eye, d, lambdas[k], true, s.march, mode);
+      const double part = mr.weight * r.radiance.x;
+      rad += part;
+      tally.add(r, s.wavelengths);
+      if (lp) lp->at(pixel, mode)[k] += part;
+    }
+    xyz += rad * spectrum::sampleWeightXyz(lambdas[k], n);
   }
-  if (layers.active())
-    for (int m = 0; m < 2; ++m)
-      for (int c = 0; c < 3; ++c) layers.at(pixel, m)[c] += modeRad[m][c];
-  return rad;
+  return M * xyz;
 }
 
 RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
                                      int threads) const {
   validate(s.march);
+  if (int(s.modes) < 0 || int(s.modes) > 2)
+    throw std::invalid_argument("modes must be both, o or e");
   RenderImage img;
   img.width = s.width > 0 ? s.width : cam.width;
   img.height = s.height > 0 ? s.height : cam.height;

@@ -67,8 +67,9 @@ class ReferenceMarcher {
   glm::dvec3 heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
                            uint32_t sample, const RenderSettings& s, SampleTally& tally,
                            LayerSums* layers) const;
-  /// Linear sRGB of one pixel sample along d from eye (hero, stratified or RGB), its marches
-  /// added to `tally` and their radiance to `layers`.
+  /// Linear sRGB of one pixel sample along d from eye (hero, stratified or RGB) of the modes
+  /// settings.modes selects (modeRange), its marches added to `tally` and their radiance to
+  /// `layers`.
   glm::dvec3 sampleRgb(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel, uint32_t sidx,
                        const RenderSettings& s, bool hero, SampleTally& tally,
                        LayerSums& layers) const;

@@ -80,6 +80,11 @@ std::vector<glm::vec4> packShapeTable(const BoundaryField& field) {
   std::vector<glm::vec4> table, planes;
   const int first_plane = EIKON_SHAPE_STRIDE * int(field.shapes.size());
   for (const Shape& s : field.shapes) packShape(s, first_plane, table, planes);
+  // Every record's header w: the number of shapes (boundary.glsl convexCrossing loops over them),
+  // except a mesh's, whose w is its first triangle (convexCrossing never runs with a mesh).
+  for (size_t r = 0; r < field.shapes.size(); ++r)
+    if (int(table[r * EIKON_SHAPE_STRIDE].x) != EIKON_SHAPE_MESH)
+      table[r * EIKON_SHAPE_STRIDE].w = float(field.shapes.size());
   table.insert(table.end(), planes.begin(), planes.end());
   if (table.empty()) table.push_back(glm::vec4(0.0f));
   return table;

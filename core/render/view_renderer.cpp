@@ -3,9 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <future>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <functional>
 #include <map>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
+#include <thread>
 #include <tuple>
 #include <variant>
 
@@ -23,6 +29,10 @@
 
 namespace eikon {
 namespace {
+
+// ViewParams.pass.w bit 5: the aov layer. The kernel reads kAov (a specialisation constant), so the
+// bit only keys the pipeline; bits 0–4 are the kernel's (hero, layers, modes: view.comp).
+constexpr int kAovPassBit = 32;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -100,7 +110,102 @@ void validateRender(const RenderSettings& s, const Scene& scene) {
   if (s.spp < 1 || s.spp > 4096) throw std::invalid_argument("spp must be in [1, 4096]");
   if (s.wavelengths < 0 || s.wavelengths > 256)
     throw std::invalid_argument("wavelengths must be in [0, 256]");
+  if (int(s.modes) < 0 || int(s.modes) > 2)
+    throw std::invalid_argument("modes must be both, o or e");
 }
+
+/// Pipelines compiled on a thread of its own, one at a time, in the order asked
+/// (ViewRenderer::prefetch): a compile keeps one core busy for seconds on lavapipe, and the
+/// renderer's dispatches (and the viewer's window) go on meanwhile. The destructor drops what is
+/// still queued and waits for the compile in progress.
+template <class Key>
+class BackgroundCompiler {
+ public:
+  using Build = std::function<vk::ComputePipeline(const Key&)>;
+  explicit BackgroundCompiler(Build build) : build_(std::move(build)) {}
+  ~BackgroundCompiler() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      stop_ = true;
+      queue_.clear();
+    }
+    cv_.notify_all();
+    if (worker_.joinable()) worker_.join();
+  }
+  BackgroundCompiler(const BackgroundCompiler&) = delete;
+  BackgroundCompiler& operator=(const BackgroundCompiler&) = delete;
+
+  /// Queues `key` unless it is queued, compiling or compiled already.
+  void request(const Key& key) {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      if (done_.count(key) || building_ == key ||
+          std::find(queue_.begin(), queue_.end(), key) != queue_.end())
+        return;
+      queue_.push_back(key);
+      if (!worker_.joinable()) worker_ = std::thread([this] { run(); });
+    }
+    cv_.notify_all();
+  }
+  /// Whether `key` was compiled (or its compile failed) and waits to be taken.
+  bool ready(const Key& key) {
+    std::lock_guard<std::mutex> lock(m_);
+    return done_.count(key) > 0;
+  }
+  /// `key`'s pipeline: waited for while it compiles; not built (the caller builds it) if it was
+  /// never asked for or has not started (it is then taken off the queue). Rethrows what the
+  /// compile threw.
+  vk::ComputePipeline take(const Key& key) {
+    std::unique_lock<std::mutex> lock(m_);
+    const auto queued = std::find(queue_.begin(), queue_.end(), key);
+    if (queued != queue_.end()) {
+      queue_.erase(queued);
+      return {};
+    }
+    cv_.wait(lock, [&] { return building_ != key; });
+    const auto it = done_.find(key);
+    if (it == done_.end()) return {};
+    Result r = std::move(it->second);
+    done_.erase(it);
+    if (r.error) std::rethrow_exception(r.error);
+    return std::move(r.pipeline);
+  }
+
+ private:
+  struct Result {
+    vk::ComputePipeline pipeline;
+    std::exception_ptr error;
+  };
+  void run() {
+    std::unique_lock<std::mutex> lock(m_);
+    for (;;) {
+      cv_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+      if (stop_) return;
+      const Key key = queue_.front();
+      queue_.pop_front();
+      building_ = key;
+      lock.unlock();
+      Result r;
+      try {
+        r.pipeline = build_(key);
+      } catch (...) {
+        r.error = std::current_exception();
+      }
+      lock.lock();
+      done_.emplace(key, std::move(r));
+      building_.reset();
+      cv_.notify_all();
+    }
+  }
+  Build build_;
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::deque<Key> queue_;
+  std::optional<Key> building_;
+  std::map<Key, Result> done_;
+  bool stop_ = false;
+  std::thread worker_;
+};
 
 }  // namespace
 
@@ -137,10 +242,11 @@ struct ViewRenderer::Impl {
   Grid grid;
   bool uniaxial = false, dispersive = false, attenuating = false, emissive = false, opaque = false;
   bool scattering = false, lit = false;
-  bool sharp = false;    // march region by region (shaders/sharp.glsl), as the CPU twin does
-  bool varying = false;  // sharp: some region's medium varies in space (GRIN, radial axis)
-  bool convex = false;   // sharp: some region's shape is a convex polyhedron
-  bool mesh = false;     // sharp: some region's shape is a non-convex mesh
+  bool sharp = false;        // march region by region (shaders/sharp.glsl), as the CPU twin does
+  bool varying = false;      // sharp: some region's medium varies in space (GRIN, radial axis)
+  bool convex = false;       // sharp: some region's shape is a convex polyhedron
+  bool mesh = false;         // sharp: some region's shape is a non-convex mesh
+  bool convexApart = false;  // sharp: every shape is one, apart (core/volume/boundary.h)
   // [oA, oB, oC, (eA, eB, eC), medO, (medE), emission, (axis), (scatter), (fluence, flux)]
   std::vector<vk::Image3D> images;
   size_t scatterImage = 0, fluenceImage = 0,
@@ -155,10 +261,11 @@ struct ViewRenderer::Impl {
   enum Kernel { kView = 0, kTrace = 1, kPolarised = 2 };
   using Key = std::tuple<int, int, int, int, int>;  // kernel, flags, integrator, sharp, AOV
   std::map<Key, vk::ComputePipeline> pipelines;
-  // The expected render's view pipeline, compiled while the volume is uploaded (the compile runs
-  // on one core, the upload mostly on the other); adopted by pipeline() when its key comes up.
-  Key prefetchedKey{};
-  std::future<vk::ComputePipeline> prefetched;
+  // View pipelines compiled ahead on a thread of their own (prefetch()): the expected render's
+  // while the volume is uploaded (the compile runs on one core, the upload mostly on the other),
+  // the viewer's alternatives (its keys) while it shows a view; adopted by pipeline() when their
+  // key comes up. Declared after what build() reads, so that it ends first.
+  BackgroundCompiler<Key> compiler{[this](const Key& key) { return build(key); }};
   int skip_cap = 32;
   double ambient = 1.0;
 
@@ -180,6 +287,7 @@ struct ViewRenderer::Impl {
       convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());
       mesh = mesh || std::holds_alternative<MeshShape>(shape.geometry());
     }
+    convexApart = v.boundary.convex_apart;
     std::vector<vk::BindingSpec> common;  // the bindings of both kernels (the trace's adds rays)
     for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
@@ -256,7 +364,7 @@ struct ViewRenderer::Impl {
 
   // The AOV layer is view.comp's pass.w bit 8 (render()), its kAov constant.
   static Key keyOf(Kernel kernel, const gpu::ViewParams& p, bool sharp) {
-    const int aov = kernel == kView && (p.pass.w & 8) != 0 ? 1 : 0;
+    const int aov = kernel == kView && (p.pass.w & kAovPassBit) != 0 ? 1 : 0;
     return std::make_tuple(int(kernel), p.grid_dims.w, int(p.march.w), sharp ? 1 : 0, aov);
   }
 
@@ -274,18 +382,23 @@ struct ViewRenderer::Impl {
                                     polarisedBindings, "polarised trace");
   }
 
-  // Starts compiling the view pipeline of a render with settings `s` on a thread of its own.
-  // Settings render() would refuse start nothing (it reports them, without waiting for a build).
+  // Queues the view pipeline of a render with settings `s` for the background compiler, unless
+  // it is built. Settings render() would refuse start nothing (it reports them, without waiting
+  // for a build).
   void prefetch(const RenderSettings& s) {
     try {
       validateRender(s, scene);
     } catch (const std::invalid_argument&) {
       return;
     }
+    const Key key = viewKey(s);
+    if (!pipelines.count(key)) compiler.request(key);
+  }
+
+  Key viewKey(const RenderSettings& s) const {
     gpu::ViewParams p = baseParams(s.march, renderFlags(s));
-    p.pass.w = s.aov_layer ? 8 : 0;
-    prefetchedKey = keyOf(kView, p, sharp);
-    prefetched = std::async(std::launch::async, [this, key = prefetchedKey] { return build(key); });
+    p.pass.w = s.aov_layer ? kAovPassBit : 0;
+    return keyOf(kView, p, sharp);
   }
 
   // The pipeline for a dispatch with parameters p, built (or adopted from prefetch()) on first use.
@@ -293,14 +406,7 @@ struct ViewRenderer::Impl {
     const Key key = keyOf(kernel, p, sharp);
     auto it = pipelines.find(key);
     if (it != pipelines.end()) return it->second;
-    vk::ComputePipeline pl;
-    if (prefetched.valid()) {
-      vk::ComputePipeline ready = prefetched.get();  // rethrows what the build threw
-      if (prefetchedKey == key)
-        pl = std::move(ready);
-      else
-        adopt(prefetchedKey, std::move(ready));
-    }
+    vk::ComputePipeline pl = compiler.take(key);  // rethrows what its compile threw
     if (!pl.built()) pl = build(key);
     return adopt(key, std::move(pl));
   }
@@ -364,6 +470,7 @@ struct ViewRenderer::Impl {
     if (sharp && varying) flags |= EIKON_F_VARYING;
     if (sharp && convex) flags |= EIKON_F_CONVEX;
     if (sharp && mesh) flags |= EIKON_F_MESH;
+    if (sharp && convexApart) flags |= EIKON_F_CONVEX_APART;
     if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
     if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
@@ -387,6 +494,19 @@ ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet
                            const RenderSettings* expected)
     : impl_(std::make_unique<Impl>(ctx, scene, volume, expected)) {}
 ViewRenderer::~ViewRenderer() = default;
+
+void ViewRenderer::prefetch(const RenderSettings& settings) { impl_->prefetch(settings); }
+
+bool ViewRenderer::ready(const RenderSettings& settings) {
+  Impl& I = *impl_;
+  try {
+    validateRender(settings, I.scene);
+  } catch (const std::invalid_argument&) {
+    return true;  // render() refuses it at once
+  }
+  const auto key = I.viewKey(settings);
+  return I.pipelines.count(key) > 0 || I.compiler.ready(key);
+}
 
 namespace {
 // Adds one band's layer values (view.comp layerWrite) to the sums: channels [c0, c1) of each mode
@@ -471,7 +591,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   int rows = EIKON_WG_Y;
   vk::Buffer out(I.ctx, size_t(img.width) * size_t(max_rows) * perPixel * sizeof(glm::vec4),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "pixels");
-  p.pass.w = s.aov_layer ? 8 : 0;  // the pipeline's key (keyOf)
+  p.pass.w = s.aov_layer ? kAovPassBit : 0;  // the pipeline's key (keyOf)
   vk::ComputePipeline& view = I.pipeline(Impl::kView, p);
   view.bindBuffer(EIKON_B_OUTPUT, out);
   const size_t pixels = size_t(img.width) * size_t(img.height);
@@ -481,8 +601,9 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   double steps = 0.0;
   auto t0 = std::chrono::steady_clock::now();
   for (int pass = 0; pass < passes; ++pass) {
-    p.pass = glm::ivec4(pass / passesPerSample, (pass % passesPerSample) * perPass, perPass,
-                        (hero ? 1 : 0) | layerBits | (s.aov_layer ? 8 : 0));
+    p.pass = glm::ivec4(
+        pass / passesPerSample, (pass % passesPerSample) * perPass, perPass,
+        (hero ? 1 : 0) | layerBits | (int(s.modes) << 3) | (s.aov_layer ? kAovPassBit : 0));
     for (int y0 = 0, n = 0; y0 < img.height; y0 += n) {
       n = std::min(rows, img.height - y0);
       const auto band_start = std::chrono::steady_clock::now();

@@ -41,6 +41,15 @@ class ViewRenderer {
 
   /// Render the scene's camera view. Throws std::invalid_argument for bad settings.
   RenderImage render(const RenderSettings& settings);
+  /// Compile the view pipeline a render with `settings` needs on a thread of its own, unless it
+  /// is built or asked for already: one compile at a time, in the order asked (the viewer asks
+  /// for those of its keys ahead; docs/viewer.md). render() adopts it, or waits for it while it
+  /// compiles.
+  void prefetch(const RenderSettings& settings);
+  /// Whether render(settings) starts without compiling its view pipeline (built, or compiled in
+  /// the background). On lavapipe the first dispatch of a new pipeline may still compile machine
+  /// code that Mesa's shader cache does not hold yet.
+  bool ready(const RenderSettings& settings);
   /// Trace individual rays at their wavelengths: the o-mode (isotropic scenes: the ray).
   std::vector<TraceOutcome> trace(const std::vector<TraceRequest>& rays,
                                   const MarchSettings& settings);

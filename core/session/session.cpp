@@ -41,6 +41,13 @@ SpectralSampling parseSpectralSampling(const std::string& s) {
   throw SettingError("spectral-sampling", "must be auto, hero or stratified, got '" + s + "'");
 }
 
+Modes parseModes(const std::string& s) {
+  if (s == "both") return Modes::Both;
+  if (s == "o") return Modes::O;
+  if (s == "e") return Modes::E;
+  throw SettingError("modes", "must be o, e or both, got '" + s + "'");
+}
+
 void parseLayers(const std::string& list, ViewRequest& view) {
   view.spectral_layer = view.mode_layers = view.aov_layer = view.stokes_layers = false;
   size_t start = 0;
@@ -92,11 +99,15 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
   rs.aov_layer = v.aov_layer;
   rs.stokes_layers = v.stokes_layers;
   rs.polarised = v.polarised;
+  rs.modes = v.modes;
   if (isPolarisedRender(scene, rs)) {  // refused before anything is voxelised
     if (rs.spectral_layer || rs.mode_layers || rs.aov_layer)
       throw SettingError("layers", "spectral, modes and aov do not go with a polarised render (" +
                                        polarisedBecause(scene, rs) +
                                        "), which writes the stokes layers");
+    if (rs.modes != Modes::Both)
+      throw SettingError("modes", "a polarised render (" + polarisedBecause(scene, rs) +
+                                      ") carries both modes coherently, got one mode alone");
     checkPolarisedScene(scene, rs);
   }
   if (rs.spectral_layer && rs.wavelengths <= 0)
@@ -243,6 +254,14 @@ ReferenceMarcher& Session::cpuMarcher() {
     cpu_ = std::make_unique<ReferenceMarcher>(*field_, scene_->environment);
   }
   return *cpu_;
+}
+
+void Session::prefetchRender(const RenderSettings& settings) {
+  gpuRenderer(&settings).prefetch(settings);
+}
+
+bool Session::renderReady(const RenderSettings& settings) {
+  return gpuRenderer(&settings).ready(settings);
 }
 
 RenderImage Session::render(const RenderSettings& settings, bool gpu) {

@@ -71,6 +71,7 @@ struct ViewRequest {
   bool stokes_layers = false;                          ///< parseLayers ("stokes")
   /// A polarised render even without polariser sheets or an analyser (`--polarised`).
   bool polarised = false;
+  Modes modes = Modes::Both;  ///< parseModes; RenderSettings's
 };
 
 /// "euler", "midpoint" or "rk4"; else SettingError("integrator", ...).
@@ -80,6 +81,8 @@ Integrator parseIntegrator(const std::string& name);
 void parseLayers(const std::string& list, ViewRequest& view);
 /// "auto", "hero" or "stratified"; else SettingError("spectral-sampling", ...).
 SpectralSampling parseSpectralSampling(const std::string& name);
+/// "both", "o" or "e" (RenderSettings::modes); else SettingError("modes", ...).
+Modes parseModes(const std::string& name);
 /// March step in (0, 4] voxels; else SettingError("step", ...).
 void checkMarchStep(double step_voxels);
 /// Every range of a ViewRequest (SettingError for the first one out of range).
@@ -157,6 +160,10 @@ class Session {
   LightOutcome simulateLight(const LightRequest& light, bool cpu_render,
                              const std::filesystem::path& cache_dir);
   RenderImage render(const RenderSettings& settings, bool gpu);
+  /// The GPU twin's ViewRenderer::prefetch and ::ready (the viewer: pipelines of its keys compiled
+  /// ahead, and the window kept responding while one compiles).
+  void prefetchRender(const RenderSettings& settings);
+  bool renderReady(const RenderSettings& settings);
   /// Both modes {o, e} of each ray. Isotropic scenes: one march, reported as both (the e-mode is
   /// the o-mode by definition).
   std::vector<std::array<TraceOutcome, 2>> trace(const std::vector<TraceRequest>& rays,

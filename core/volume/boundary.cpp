@@ -219,6 +219,7 @@ BoundaryField buildBoundaryField(const Scene& scene, const Grid& g, int threads)
     bf.shapes.push_back(obj.shape);
     bf.medium.push_back(material_ids.at(obj.material));
   }
+  bf.convex_apart = convexShapesApart(bf.shapes, g.h);
   // Objects in scene order, each painting over the earlier ones where it contains the centre (the
   // compositing's order). Inside object i the distance restarts at −sd_i; outside it, sd_i bounds
   // the distance to the region boundary it makes (the region r < i + 1 is cut by it).
@@ -336,6 +337,115 @@ BoundaryCrossing nextCrossingOutOf(
     if (along + kNudgeVoxels * h >= total) return BoundaryCrossing{};
   }
   return BoundaryCrossing{};
+}
+
+}  // namespace eikon
+
+namespace eikon {
+
+// Boxes count as the convex polyhedra they are (localPlanes: six planes).
+bool convexShapesApart(const std::vector<Shape>& shapes, double h) {
+  if (shapes.empty()) return false;
+  const double gap = kCrossingApartVoxels * h;
+  for (size_t i = 0; i < shapes.size(); ++i) {
+    if (!std::holds_alternative<ConvexShape>(shapes[i].geometry()) &&
+        !std::holds_alternative<BoxShape>(shapes[i].geometry()))
+      return false;
+    const auto [amin, amax] = shapes[i].bounds();
+    for (size_t j = 0; j < i; ++j) {
+      const auto [bmin, bmax] = shapes[j].bounds();
+      bool apart = false;
+      for (int c = 0; c < 3; ++c)
+        apart = apart || amin[c] > bmax[c] + gap || bmin[c] > amax[c] + gap;
+      if (!apart) return false;
+    }
+  }
+  return true;
+}
+
+namespace {
+
+/// The parameters [t_in, t_out] of the line a + t·(b − a) inside a convex shape and the planes
+/// that bound them (−1: none); t_in > t_out when the line misses it.
+struct Slab {
+  double t_in = -1e300, t_out = 1e300;
+  int face_in = -1, face_out = -1;
+};
+
+/// The local planes of a convex polyhedron or a box (±x, ±y, ±z: boundary.glsl's order).
+std::vector<Plane> localPlanes(const Shape& s) {
+  if (const auto* c = std::get_if<ConvexShape>(&s.geometry())) return c->planes;
+  const glm::dvec3 half = 0.5 * std::get<BoxShape>(s.geometry()).size;
+  std::vector<Plane> planes;
+  for (int a = 0; a < 3; ++a)
+    for (double sign : {-1.0, 1.0}) {
+      glm::dvec3 n(0.0);
+      n[a] = sign;
+      planes.push_back({n, half[a]});
+    }
+  return planes;
+}
+
+Slab convexSlab(const Shape& s, const glm::dvec3& a, const glm::dvec3& b) {
+  const std::vector<Plane> planes = localPlanes(s);
+  const glm::dmat3 to_local = glm::transpose(s.rotation());
+  const glm::dvec3 p = to_local * (a - s.center()), d = to_local * (b - a);
+  Slab out;
+  for (size_t k = 0; k < planes.size(); ++k) {
+    const double nd = glm::dot(planes[k].normal, d),
+                 v = glm::dot(planes[k].normal, p) - planes[k].d;
+    if (nd > 0.0) {
+      if (-v / nd < out.t_out) out.t_out = -v / nd, out.face_out = int(k);
+    } else if (nd < 0.0) {
+      if (-v / nd > out.t_in) out.t_in = -v / nd, out.face_in = int(k);
+    } else if (v > 0.0) {
+      out.t_in = 1e300, out.t_out = -1e300;  // parallel to a plane, outside it
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+BoundaryCrossing convexCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a,
+                                     const glm::dvec3& b, int region) {
+  BoundaryCrossing out;
+  out.from = out.to = region;
+  out.point = b;
+  const double len_vox = glm::length(b - a) / bf.grid.h;
+  if (!(len_vox > 0.0)) return out;
+  const double graze = kGrazeVoxels / len_vox;
+  int shape = -1, face = -1;
+  double t = 1e300;
+  if (region >= 1) {  // leaving the polyhedron: the first plane ahead
+    const Slab sl = convexSlab(bf.shapes[size_t(region - 1)], a, b);
+    if (sl.face_out < 0 || sl.t_out > 1.0) return out;
+    shape = region - 1;
+    face = sl.face_out;
+    t = std::max(sl.t_out, 0.0);
+    out.to = 0;
+  } else {  // entering the nearest polyhedron the segment passes through
+    for (size_t k = 0; k < bf.shapes.size(); ++k) {
+      const Slab sl = convexSlab(bf.shapes[k], a, b);
+      if (sl.t_in > sl.t_out || sl.t_out <= graze || sl.t_in > 1.0 || sl.face_in < 0) continue;
+      if (std::max(sl.t_in, 0.0) < t) t = std::max(sl.t_in, 0.0), shape = int(k), face = sl.face_in;
+    }
+    if (shape < 0) return out;
+    out.to = shape + 1;
+  }
+  const Shape& s = bf.shapes[size_t(shape)];
+  const glm::dvec3 n = s.rotation() * localPlanes(s)[size_t(face)].normal;
+  out.found = true;
+  out.t = t;
+  out.point = a + t * (b - a);
+  out.normal = (region >= 1 ? 1.0 : -1.0) * glm::normalize(n);
+  out.owner = shape + 1;
+  out.from_medium = bf.medium[size_t(out.from)];
+  out.to_medium = bf.medium[size_t(out.to)];
+  glm::dvec3 grad;
+  boundaryPhi(bf, out.point, out.from, &grad);
+  out.field_normal = glm::length(grad) > 0.0 ? -glm::normalize(grad) : out.normal;
+  return out;
 }
 
 }  // namespace eikon

@@ -44,6 +44,27 @@ inline bool useHeroSampling(SpectralSampling s, bool weights_depend_on_lambda) {
   return s == SpectralSampling::Hero || (s == SpectralSampling::Auto && !weights_depend_on_lambda);
 }
 
+/// Which polarisation modes of a crystal a render shows (`eikon render --modes`, the viewer's M
+/// key). Unpolarised light splits at a crystal into the o- and the e-mode, each carrying half of
+/// it: Both is that physical image, ½·(o-mode radiance + e-mode radiance). O and E march one mode
+/// only, at the whole of the light (the image seen through an analyser that passes that mode), so
+/// that O + E = 2·Both exactly (the same marches, float rounding aside). In a scene without
+/// crystals there is one mode and all three images are the same.
+enum class Modes { Both = 0, O = 1, E = 2 };
+
+/// The modes a pixel sample marches, [first, end), and the share of the radiance each carries:
+/// both twins decide by this.
+struct ModeRange {
+  int first = 0, end = 1;
+  double weight = 1.0;
+};
+inline ModeRange modeRange(Modes m, bool uniaxial) {
+  if (!uniaxial || m == Modes::O) return {0, 1, 1.0};
+  if (m == Modes::E) return {1, 2, 1.0};
+  return {0, 2, 0.5};
+}
+inline const char* modesName(Modes m) { return m == Modes::O ? "o" : m == Modes::E ? "e" : "both"; }
+
 struct RenderSettings {
   int width = 0, height = 0;        ///< 0 = the scene camera's
   int spp = 1;                      ///< jittered samples per pixel
@@ -63,6 +84,7 @@ struct RenderSettings {
   /// RenderImage::aov: the first interface of each pixel's first camera ray (depth, point,
   /// normal, object id) and the march steps of all its marches (docs/view-renderer.md "AOV").
   bool aov_layer = false;
+  Modes modes = Modes::Both;  ///< the modes shown (crystal scenes)
   MarchSettings march;
   /// progress(fraction done); may be empty.
   std::function<void(double)> progress;

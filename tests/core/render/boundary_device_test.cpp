@@ -235,7 +235,9 @@ TEST(BoundaryDevice, ShapeTableLayout) {
   ASSERT_EQ(t.size(), size_t(4 * EIKON_SHAPE_STRIDE + 5));  // a triangular prism has 5 planes
   EXPECT_EQ(t[0].x, float(EIKON_SHAPE_BOX));
   EXPECT_EQ(t[EIKON_SHAPE_STRIDE + 5].x, 0.45f);
-  EXPECT_EQ(t[3 * EIKON_SHAPE_STRIDE], glm::vec4(EIKON_SHAPE_CONVEX, 4 * EIKON_SHAPE_STRIDE, 5, 0));
+  // Header: kind, first plane, plane count, the number of shapes (boundary.glsl convexCrossing).
+  EXPECT_EQ(t[3 * EIKON_SHAPE_STRIDE], glm::vec4(EIKON_SHAPE_CONVEX, 4 * EIKON_SHAPE_STRIDE, 5, 4));
+  for (int r = 0; r < 4; ++r) EXPECT_EQ(t[size_t(r * EIKON_SHAPE_STRIDE)].w, 4.0f) << r;
   // The rotation columns are orthonormal.
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(glm::length(glm::vec3(t[size_t(2 + c)])), 1.0, 1e-6);
   // deviceBytes counts the field: 8 bytes per voxel and the table.
