@@ -47,7 +47,7 @@ struct CameraRays {
   }
 };
 
-void checkPolarisedRender(const Scene& scene, const RenderSettings& s, int width, int height) {
+void checkPolarisedRender(const RenderSettings& s, int width, int height) {
   if (width < 1 || height < 1 || width > 16384 || height > 16384)
     throw std::invalid_argument("image size must be in [1, 16384] pixels per side");
   if (s.spp < 1 || s.spp > 4096) throw std::invalid_argument("spp must be in [1, 4096]");
@@ -55,9 +55,11 @@ void checkPolarisedRender(const Scene& scene, const RenderSettings& s, int width
     throw std::invalid_argument("wavelengths must be in [0, 256]");
   if (!(s.wavelength_nm > 0) || !std::isfinite(s.wavelength_nm))
     throw std::invalid_argument("the RGB index wavelength must be > 0 nm");
-  if (s.spectral_layer || s.mode_layers)
+  if (s.spectral_layer || s.mode_layers || s.aov_layer)
     throw std::invalid_argument(
-        "a polarised render writes the stokes layers only (not spectral or modes)");
+        "a polarised render writes the stokes layers only (not spectral, modes or aov)");
+  if (s.modes != Modes::Both)
+    throw std::invalid_argument("a polarised render carries both modes coherently, not one alone");
 }
 
 /// One ray of a batch: its pixel, its camera direction and the spectral weight of its sample.
@@ -122,7 +124,7 @@ RenderImage renderPolarisedWith(const Scene& scene, const RenderSettings& s,
   RenderImage img;
   img.width = s.width > 0 ? s.width : scene.camera.width;
   img.height = s.height > 0 ? s.height : scene.camera.height;
-  checkPolarisedRender(scene, s, img.width, img.height);
+  checkPolarisedRender(s, img.width, img.height);
   checkPolarisedScene(scene, s);
   PolarisedTraceSettings ts = trace;
   ts.mueller_row = true;

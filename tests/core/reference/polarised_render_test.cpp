@@ -240,6 +240,12 @@ TEST(PolarisedRender, RefusesAPolarisedEnvironmentSmoothedInterfacesAndSpectralL
   rs.spectral_layer = true;
   rs.wavelengths = 4;
   EXPECT_THROW(renderPolarised(s.field, s.scene, rs, 1), std::invalid_argument);
+  RenderSettings aov;  // the aov layer and one mode alone do not go with coherent o and e either
+  aov.aov_layer = true;
+  EXPECT_THROW(renderPolarised(s.field, s.scene, aov, 1), std::invalid_argument);
+  RenderSettings one;
+  one.modes = Modes::O;
+  EXPECT_THROW(renderPolarised(s.field, s.scene, one, 1), std::invalid_argument);
   s.scene.environment.polarization.stokes = {1, 1, 0, 0};
   EXPECT_THROW(renderPolarised(s.field, s.scene, RenderSettings{}, 1), std::runtime_error);
   s.scene.environment.polarization.stokes = {1, 0, 0, 0};

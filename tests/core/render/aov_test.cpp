@@ -257,7 +257,9 @@ TEST(Aov, StepsSumOverSamplesAndRenderWithoutTheLayerIsUnchanged) {
     EXPECT_EQ(gh.aov[p * kAovChannels + 8], ch.aov[p * kAovChannels + 8]) << "pixel " << p;
     EXPECT_EQ(gh.aov[p * kAovChannels + 7], with.aov[p * kAovChannels + 7]) << "pixel " << p;
     const float z = gh.aov[p * kAovChannels], z0 = with.aov[p * kAovChannels];
-    if (std::isfinite(z0)) EXPECT_NEAR(z, z0, 1e-4) << "pixel " << p;
+    if (std::isfinite(z0)) {
+      EXPECT_NEAR(z, z0, 1e-4) << "pixel " << p;
+    }
   }
 }
 
