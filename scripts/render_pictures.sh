@@ -12,12 +12,14 @@ EIKON="${EIKON:-build/apps/eikon}"
 [[ -x "$EIKON" ]] || { echo "render_pictures: error: $EIKON not built (run ./scripts/build.sh)" >&2; exit 1; }
 
 # name | width×height | extra arguments (the scene's own aspect ratio, at least 800×600).
-# Spectral scenes use 16 stratified wavelengths per sample (the default); the jittered samples
-# per pixel are what takes the colour noise of the wavelength sampling out.
+# Spectral scenes use 16 wavelengths per sample (the default), by hero sampling where the
+# path weights do not depend on λ (docs/spectra.md): one wavelength carries a sample past the
+# first dispersive facet, so the jittered samples per pixel are what take the colour noise out
+# (the diamond's small bright lights need 64).
 pictures=(
   "glass_sphere|800x600|--spp 4"
   "prism_bk7|800x600|--spp 8"
-  "diamond_brilliant|800x600|--spp 8"
+  "diamond_brilliant|800x600|--spp 64"
   "faceted_round_brilliant|800x600|--spp 8 --exposure 2"
   "faceted_emerald_cut|800x600|--spp 8 --exposure 2"
   "faceted_oval|800x600|--spp 8 --exposure 2"

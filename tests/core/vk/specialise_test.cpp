@@ -52,9 +52,9 @@ TEST(SpecialiseSpirv, TheViewKernelsSpecConstantsAreFrozenAndTheirDeadCodeRemove
   const std::vector<uint32_t> generic(viewSpirv().begin(), viewSpirv().end());
   const Census before = census(generic);
   ASSERT_TRUE(before.well_formed);
-  ASSERT_EQ(before.spec_ids, 3);  // kSharpMarch, kViewFlags, kIntegrator (march.glsl)
-  // glass_sphere's render: the sharp march, no other feature, RK4.
-  const std::vector<uint32_t> sharp = {1u, uint32_t(EIKON_F_SHARP), 2u};
+  ASSERT_EQ(before.spec_ids, 4);  // kSharpMarch, kViewFlags, kIntegrator, kAov (march.glsl)
+  // glass_sphere's render: the sharp march, no other feature, RK4, no aov layer.
+  const std::vector<uint32_t> sharp = {1u, uint32_t(EIKON_F_SHARP), 2u, 0u};
   const auto s = specialiseSpirv(viewSpirv(), sharp);
   const Census after = census(s);
   EXPECT_TRUE(after.well_formed);
@@ -63,7 +63,7 @@ TEST(SpecialiseSpirv, TheViewKernelsSpecConstantsAreFrozenAndTheirDeadCodeRemove
   EXPECT_LT(s.size(), generic.size() * 9 / 10);  // the smoothed march and the features are gone
   // The smoothed march with every feature on keeps code the sharp one dropped, and the other way
   // round: the two modules differ, and neither is the generic one.
-  const auto m = specialiseSpirv(viewSpirv(), std::vector<uint32_t>{0u, 0x3ffu, 0u});
+  const auto m = specialiseSpirv(viewSpirv(), std::vector<uint32_t>{0u, 0x3ffu, 0u, 0u});
   EXPECT_EQ(census(m).spec_constants, 0);
   EXPECT_NE(m, s);
   EXPECT_NE(m, generic);
