@@ -23,6 +23,7 @@ pictures=(
   "faceted_round_brilliant|800x600|--spp 48 --exposure 2"
   "faceted_emerald_cut|800x600|--spp 16 --exposure 2"
   "faceted_oval|800x600|--spp 64 --exposure 2"
+  "faceted_pear|800x600|--spp 32 --exposure 2"
   "mesh_icosphere|800x600|--spp 4"
   "mesh_torus|800x600|--spp 4"
   "calcite_rhomb|800x600|--spp 8"
