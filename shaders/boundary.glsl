@@ -633,11 +633,8 @@ vec4 convexSlab(int s, vec3 a, vec3 b) {
   return r;
 }
 
-// The first crossing on [a, b] out of `region` where every shape is a convex polyhedron apart
-// from the others: inside a polyhedron, the first of its planes ahead (into the ambient); in the
-// ambient, the nearest polyhedron the segment passes through (beyond kGrazeVoxels). One loop over
-// the shapes it may cross (its own, or all: the record's w), one pass per 32 planes each.
-BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
+// What a search that finds nothing on [a, b] reports: the segment's end, still in `region`.
+BoundaryCrossing noCrossing(vec3 b, int region) {
   BoundaryCrossing c;
   c.found = false;
   c.t = 1.0;
@@ -645,6 +642,15 @@ BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
   c.normal = vec3(0.0);
   c.from = region;
   c.to = region;
+  return c;
+}
+
+// The first crossing on [a, b] out of `region` where every shape is a convex polyhedron apart
+// from the others: inside a polyhedron, the first of its planes ahead (into the ambient); in the
+// ambient, the nearest polyhedron the segment passes through (beyond kGrazeVoxels). One loop over
+// the shapes it may cross (its own, or all: the record's w), one pass per 32 planes each.
+BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
+  BoundaryCrossing c = noCrossing(b, region);
   float graze = kGrazeVoxels * P.grid_origin.w / length(b - a);
   bool inside = region >= 1;
   int k0 = inside ? region - 1 : 0, k1 = inside ? region : int(shapeTable[0].w);

@@ -166,13 +166,7 @@ vec3 sharpDirection(MarchState S, int mode) {
 // The first crossing on [a, b] out of the ray's region, skipping slivers (a crossing back into the
 // ray's own region within kSliverVoxels of a).
 BoundaryCrossing nextCrossing(vec3 a, vec3 b, int region) {
-  BoundaryCrossing none;
-  none.found = false;
-  none.t = 1.0;
-  none.point = b;
-  none.normal = vec3(0.0);
-  none.from = region;
-  none.to = region;
+  BoundaryCrossing none = noCrossing(b, region);
   float total = length(b - a);
   if (!(total > 0.0)) return none;
   if (EIKON_BOUNDARY_CONVEX_APART) return convexCrossing(a, b, region);
