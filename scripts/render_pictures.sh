@@ -27,8 +27,8 @@ pictures=(
   "mesh_icosphere|800x600|--spp 4"
   "mesh_torus|800x600|--spp 4"
   "calcite_rhomb|800x600|--spp 8"
-  "tourmaline|800x600|--spp 4"
-  "caustic_sphere|800x600|--spp 4"
+  "tourmaline|800x600|--spp 16"
+  "caustic_sphere|800x600|--spp 16"
   "prism_rainbow|960x600|--spp 8"
   "smoke_sphere|960x600|--spp 4"
   # Polarised (polariser sheets): deterministic, so 1 sample (the pixel centres). The conoscope
