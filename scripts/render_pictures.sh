@@ -30,7 +30,7 @@ pictures=(
   "tourmaline|800x600|--spp 16"
   "caustic_sphere|800x600|--spp 16"
   "prism_rainbow|960x600|--spp 8"
-  "smoke_sphere|960x600|--spp 4"
+  "smoke_sphere|960x600|--spp 8"
   # Polarised (polariser sheets): deterministic, so 1 sample (the pixel centres). The conoscope
   # and the gems in monochromatic light (RGB mode: one trace per pixel at 587.56 nm; a quartz
   # brilliant's retardation is of high order, white in white light anyway), the wedge with 32
