@@ -206,6 +206,7 @@ class Viewer {
       changed_ = false;
       refined_ = false;
       frames_since_change_ = 0;
+      few_frames_ = 0;
       change_time_ = Clock::now();
       try {
         refine();
@@ -241,10 +242,11 @@ class Viewer {
         "(1 sample, eikon render's default) after %.2f s, %d samples after %.2f s",
         frames_, first_frame_seconds_, coarse.size(), median, median > 0 ? 1.0 / median : 0.0,
         coarse_, full_quality_seconds_, refined_spp_, refined_seconds_);
-    char compiles[160];
+    char compiles[200];
     std::snprintf(compiles, sizeof compiles,
-                  "; %lld frames presented while a pipeline compiled (the longest wait %.2f s)",
-                  compile_frames_, longest_compile_);
+                  " (%d full-size frames at fewer wavelengths before); %lld frames presented "
+                  "while a pipeline compiled (the longest wait %.2f s)",
+                  few_frames_, compile_frames_, longest_compile_);
     return std::string(buf) + compiles;
   }
 
@@ -260,7 +262,11 @@ class Viewer {
   }
 
   /// Coarse (1/--coarse of the size, one sample, few wavelengths), then the full size at few
-  /// wavelengths (spectral only), then the full render; stages the settings make equal are one.
+  /// wavelengths (spectral, stratified passes only), then the full render; stages the settings
+  /// make equal are one. With hero wavelength sampling (docs/spectra.md) a pixel sample is one
+  /// march that carries every wavelength, so few wavelengths at the full size cost nearly what
+  /// the first full-quality sample costs (diamond_brilliant at 400×300: 5.39 s at 4 wavelengths,
+  /// 5.87 s at 16, docs/performance.md "Viewer"): that stage is skipped.
   std::vector<Stage> stages() const {
     int w = 0, h = 0;
     glfwGetFramebufferSize(window_, &w, &h);
@@ -269,9 +275,16 @@ class Viewer {
     const int c = coarse_;
     std::vector<Stage> s;
     if (c > 1) s.push_back({std::max(1, w / c), std::max(1, h / c), 1, few});
-    if (few != full) s.push_back({w, h, 1, few});
+    if (few != full && !heroSampling()) s.push_back({w, h, 1, few});
     s.push_back({w, h, args_.spp, full});
     return s;
+  }
+
+  /// Whether spectral renders of this scene sample by hero wavelengths (the renderer decides by
+  /// the same test: core/volume/march_types.h).
+  bool heroSampling() const {
+    const VolumeSet& v = session_.prepare(true);  // made before the first render
+    return useHeroSampling(base_.sampling, v.attenuating || v.emissive || v.opaque);
   }
 
   void refine() {
@@ -297,7 +310,6 @@ class Viewer {
       };
       RenderImage img = session_.render(rs, true);
       show(img, st.spp, st.wavelengths, start, st.width < full_width);
-      if (!prefetched_) prefetchKeys();
       finish_stage_ = false;
       poll();  // a change during the coarse frame restarts here
     }
@@ -305,6 +317,10 @@ class Viewer {
     refined_seconds_ = std::chrono::duration<double>(Clock::now() - change_time_).count();
     refined_ = true;
     updateTitle(Clock::now());
+    // The keys' pipelines compile on a core of their own, which a refining view would share (up
+    // to half of the machine on lavapipe's 2 cores here): asked for once a view is refined, unless
+    // the viewer ends now (--exit-after-frames; the renderer would wait for the compile).
+    if (!prefetched_ && !(args_.exit_after_frames > 0 && !lightPending())) prefetchKeys();
   }
 
   /// A stage whose view pipeline is not compiled yet (a key changed the integrator or RGB ↔
@@ -390,6 +406,7 @@ class Viewer {
     if (frames_ == 0) first_frame_seconds_ = std::chrono::duration<double>(now - opened_).count();
     if (samples == 1 && wavelengths == (spectral_ ? full_wavelengths_ : 0) && !coarse)
       full_quality_seconds_ = std::chrono::duration<double>(now - change_time_).count();
+    if (wavelengths != (spectral_ ? full_wavelengths_ : 0) && !coarse) ++few_frames_;
     if (coarse) {
       const double seconds = std::chrono::duration<double>(now - start).count();
       if (frames_ > 0) adaptCoarse(seconds);  // the first frame waited for the compilation too
@@ -635,6 +652,7 @@ class Viewer {
   bool have_cursor_ = false;
   long long frames_ = 0;
   int frames_since_change_ = 0;
+  int few_frames_ = 0;  ///< full-size frames of the last view at fewer wavelengths than all
   Clock::time_point change_time_ = Clock::now();
   std::deque<Clock::time_point> frame_times_;
   std::vector<double> coarse_seconds_;

@@ -421,4 +421,39 @@ TEST_F(ViewerTest, CtrlDragMovesTheLightInTheBackground) {
   EXPECT_EQ(cached.position, position) << again.out;
 }
 
+/// An N-BK7 (Sellmeier: dispersive, so 16 wavelengths) sphere; `attenuation` per mm in it.
+std::string dispersiveScene(double attenuation) {
+  return R"({
+  "camera": {"position": [0, 0, -40], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 30, "width": 40, "height": 30},
+  "environment": {"type": "checker", "squares": 8},
+  "volume": {"bounds_min": [-8, -8, -8], "bounds_max": [8, 8, 8], "resolution": 16},
+  "materials": {"glass": {"n": {"sellmeier": [1.03961212, 0.231792344, 1.01046945, 0.00600069867, 0.0200179144, 103.560653]}, "attenuation_per_mm": )" +
+         std::to_string(attenuation) + R"(}},
+  "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 5, "material": "glass"}]
+})";
+}
+
+/// The refinement's middle stage (the full size at few wavelengths) is kept where spectral passes
+/// are stratified (an attenuating medium, docs/spectra.md: one march per wavelength, so few
+/// wavelengths are cheaper) and skipped under hero wavelength sampling, where one march carries
+/// every wavelength and few cost nearly as much as all (docs/viewer.md "Progressive refinement").
+TEST_F(ViewerTest, HeroSpectralViewGoesFromCoarseStraightToFullQuality) {
+  const std::string xvfb = findProgram("Xvfb"), xdotool = findProgram("xdotool");
+  if (xvfb.empty()) GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb)";
+  ASSERT_FALSE(xdotool.empty()) << "xdotool is not installed (Debian package xdotool)";
+  Xvfb server(xvfb);
+  ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
+  for (const auto& [attenuation, few] : {std::pair{0.0, 0}, std::pair{0.02, 1}}) {
+    std::ofstream(dir_ / "sphere.json") << dispersiveScene(attenuation);
+    const ViewerRun run =
+        viewWhile(server, xdotool, (dir_ / "sphere.json").string(),
+                  "--width 40 --height 30 --spp 2 --exit-after-frames 100 --no-light", "");
+    ASSERT_TRUE(WIFEXITED(run.status) && WEXITSTATUS(run.status) == 0) << run.err;
+    EXPECT_EQ(run.err.find("validation"), std::string::npos) << run.err;
+    const std::string said = "(" + std::to_string(few) + " full-size frames at fewer wavelengths";
+    EXPECT_NE(run.out.find(said), std::string::npos) << attenuation << ": " << run.out;
+    EXPECT_NE(run.out.find("2 samples after"), std::string::npos) << run.out;
+  }
+}
+
 }  // namespace
