@@ -80,55 +80,76 @@ void addViewOptions(CLI::App* sub, ViewArgs& a) {
                   "the camera");
 }
 
-/// The first light moved by a drag, simulated again in the background: a Session of its own (a
-/// copy of the scene with the moved light, voxelised again) fills the light cache on a thread of
-/// its own, while the viewer keeps showing the last light volumes; the viewer's session then
-/// loads the new volumes from the cache (the key covers the medium, the lights and the simulator
-/// settings, never the camera) and restarts the view.
+/// A light simulated in the background (LightMover): its light volumes, ready to be swapped in.
+struct MovedLight {
+  Light light;                           ///< the light simulated
+  std::vector<glm::vec4> fluence, flux;  ///< its light volumes (VolumeSet's)
+  bool cached = false;                   ///< they came from the light cache
+  double seconds = 0;                    ///< the simulation's (or the cache lookup's) time
+  std::vector<std::string> warnings;     ///< "light cache: ..."
+  std::string error;                     ///< the simulation failed: why
+};
+
+/// The first light moved by a drag, simulated again in the background: a Session of its own on a
+/// copy of the scene (voxelised once, at the first move, on the worker thread) simulates the moved
+/// light through the light cache (the key covers the medium, the lights and the simulator
+/// settings, never the camera: a light put back where it was simulated before is only looked up),
+/// while the viewer keeps rendering with the light volumes it has. The viewer then swaps the new
+/// volumes into its renderer in place (Session::setLightVolumes): no renderer or pipeline is made
+/// again.
 class LightMover {
  public:
-  LightMover(bool on_cpu, std::filesystem::path cache)
-      : on_cpu_(on_cpu), cache_(std::move(cache)) {}
+  LightMover(const Scene& scene, bool on_cpu, std::filesystem::path cache)
+      : scene_(std::make_shared<Scene>(scene)), on_cpu_(on_cpu), cache_(std::move(cache)) {}
   ~LightMover() {
     if (worker_.joinable()) worker_.join();
   }
   bool busy() const { return worker_.joinable() && !done_; }
   /// A simulation has finished and finished() has not reported it yet.
   bool done() const { return worker_.joinable() && done_; }
-  /// Simulate `scene`'s light (its lights[0] moved) unless a simulation is running.
-  bool start(const Scene& scene) {
+  /// Simulate the scene with its first light replaced by `light`, unless a simulation is running.
+  bool start(const Light& light) {
     if (busy()) return false;
-    if (worker_.joinable()) worker_.join();
+    if (worker_.joinable()) worker_.join();  // the scene and the session are this thread's now
     done_ = false;
-    simulated_ = scene.lights.front();
-    worker_ = std::thread([this, copy = std::make_shared<Scene>(scene)] {
+    scene_->lights.front() = light;
+    result_ = MovedLight{};
+    result_.light = light;
+    worker_ = std::thread([this] {
+      const auto start = Clock::now();
       try {
-        Session session(copy);  // its own Vulkan device, made only if the GPU twin simulates
-        session.simulateLight(LightRequest{}, on_cpu_, cache_);
+        // Its own Vulkan device, made only if the GPU twin simulates.
+        if (!session_) session_ = std::make_unique<Session>(scene_);
+        const LightOutcome o = session_->simulateLight(LightRequest{}, on_cpu_, cache_);
+        result_.cached = o.cached;
+        result_.warnings = o.warnings;
+        VolumeSet& v = session_->prepare(false);  // made by simulateLight; refilled by the next
+        result_.fluence = std::move(v.light_fluence);
+        result_.flux = std::move(v.light_flux);
       } catch (const std::exception& e) {
-        error_ = e.what();
+        result_.error = e.what();
       }
+      result_.seconds = std::chrono::duration<double>(Clock::now() - start).count();
       done_ = true;
     });
     return true;
   }
-  /// True once, when a simulation has finished: `light` is the light it simulated.
-  bool finished(Light& light, std::string& error) {
+  /// True once, when a simulation has finished: what it made.
+  bool finished(MovedLight& out) {
     if (!worker_.joinable() || !done_) return false;
     worker_.join();
-    light = simulated_;
-    error = error_;
-    error_.clear();
+    out = std::move(result_);
     return true;
   }
 
  private:
+  const std::shared_ptr<Scene> scene_;
   const bool on_cpu_;
   const std::filesystem::path cache_;
+  std::unique_ptr<Session> session_;
   std::thread worker_;
   std::atomic<bool> done_{false};
-  Light simulated_;
-  std::string error_;
+  MovedLight result_;
 };
 
 /// Thrown out of a render by its callbacks when the view changed (restart) or the window closes.
@@ -185,6 +206,7 @@ class Viewer {
       changed_ = false;
       refined_ = false;
       frames_since_change_ = 0;
+      few_frames_ = 0;
       change_time_ = Clock::now();
       try {
         refine();
@@ -194,8 +216,12 @@ class Viewer {
       // Fully refined in fewer frames; a light still being simulated is waited for.
       if (args_.exit_after_frames > 0 && !lightPending()) break;
       while (!changed_ && !resized_ && !quit_ && !glfwWindowShouldClose(window_)) {
-        glfwWaitEventsTimeout(0.25);
+        const bool simulating = mover_ && mover_->busy();
+        glfwWaitEventsTimeout(simulating ? 0.1 : 0.25);
         handleRequests();
+        // The view is refined and a moved light is being simulated: the last image is presented
+        // again about 10 times a second, its title saying so, until the new light arrives.
+        if (simulating && !changed_) presentAgain();
       }
     }
   }
@@ -216,10 +242,11 @@ class Viewer {
         "(1 sample, eikon render's default) after %.2f s, %d samples after %.2f s",
         frames_, first_frame_seconds_, coarse.size(), median, median > 0 ? 1.0 / median : 0.0,
         coarse_, full_quality_seconds_, refined_spp_, refined_seconds_);
-    char compiles[160];
+    char compiles[200];
     std::snprintf(compiles, sizeof compiles,
-                  "; %lld frames presented while a pipeline compiled (the longest wait %.2f s)",
-                  compile_frames_, longest_compile_);
+                  " (%d full-size frames at fewer wavelengths before); %lld frames presented "
+                  "while a pipeline compiled (the longest wait %.2f s)",
+                  few_frames_, compile_frames_, longest_compile_);
     return std::string(buf) + compiles;
   }
 
@@ -235,7 +262,11 @@ class Viewer {
   }
 
   /// Coarse (1/--coarse of the size, one sample, few wavelengths), then the full size at few
-  /// wavelengths (spectral only), then the full render; stages the settings make equal are one.
+  /// wavelengths (spectral, stratified passes only), then the full render; stages the settings
+  /// make equal are one. With hero wavelength sampling (docs/spectra.md) a pixel sample is one
+  /// march that carries every wavelength, so few wavelengths at the full size cost nearly what
+  /// the first full-quality sample costs (diamond_brilliant at 400×300: 5.39 s at 4 wavelengths,
+  /// 5.87 s at 16, docs/performance.md "Viewer"): that stage is skipped.
   std::vector<Stage> stages() const {
     int w = 0, h = 0;
     glfwGetFramebufferSize(window_, &w, &h);
@@ -244,9 +275,16 @@ class Viewer {
     const int c = coarse_;
     std::vector<Stage> s;
     if (c > 1) s.push_back({std::max(1, w / c), std::max(1, h / c), 1, few});
-    if (few != full) s.push_back({w, h, 1, few});
+    if (few != full && !heroSampling()) s.push_back({w, h, 1, few});
     s.push_back({w, h, args_.spp, full});
     return s;
+  }
+
+  /// Whether spectral renders of this scene sample by hero wavelengths (the renderer decides by
+  /// the same test: core/volume/march_types.h).
+  bool heroSampling() const {
+    const VolumeSet& v = session_.prepare(true);  // made before the first render
+    return useHeroSampling(base_.sampling, v.attenuating || v.emissive || v.opaque);
   }
 
   void refine() {
@@ -272,7 +310,6 @@ class Viewer {
       };
       RenderImage img = session_.render(rs, true);
       show(img, st.spp, st.wavelengths, start, st.width < full_width);
-      if (!prefetched_) prefetchKeys();
       finish_stage_ = false;
       poll();  // a change during the coarse frame restarts here
     }
@@ -280,6 +317,10 @@ class Viewer {
     refined_seconds_ = std::chrono::duration<double>(Clock::now() - change_time_).count();
     refined_ = true;
     updateTitle(Clock::now());
+    // The keys' pipelines compile on a core of their own, which a refining view would share (up
+    // to half of the machine on lavapipe's 2 cores here): asked for once a view is refined, unless
+    // the viewer ends now (--exit-after-frames; the renderer would wait for the compile).
+    if (!prefetched_ && !(args_.exit_after_frames > 0 && !lightPending())) prefetchKeys();
   }
 
   /// A stage whose view pipeline is not compiled yet (a key changed the integrator or RGB ↔
@@ -292,14 +333,12 @@ class Viewer {
     session_.prefetchRender(rs);
     const auto start = Clock::now();
     compiling_ = true;
+    bool said_compiling = false;
     do {
       if (!shown_.rgb.empty()) {
-        const std::vector<unsigned char> px =
-            previewPixels(shown_.width, shown_.height, shown_.rgb, args_.exposure);
-        if (!chain_.present(px.data(), shown_.width, shown_.height)) resized_ = true;
-        ++compile_frames_;
-        updateTitle(Clock::now());
-      } else {  // no frame yet: the title counts none (scripts wait for "frames/s")
+        if (presentAgain()) ++compile_frames_;
+      } else if (!said_compiling) {  // no frame yet: the title counts none (scripts wait for
+        said_compiling = true;       // "frames/s"); set once: each new title wakes the wait
         glfwSetWindowTitle(window_, ("eikon view: " + session_.scene()->file.filename().string() +
                                      " (compiling the view pipeline)")
                                         .c_str());
@@ -314,6 +353,22 @@ class Viewer {
     compiling_ = false;
     longest_compile_ =
         std::max(longest_compile_, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+
+  /// The image on screen presented again (the window shows it is alive while the view waits for a
+  /// pipeline or a light), with the title brought up to date; at most 10 times a second (a new
+  /// title is an X event, which ends the wait for events at once: unthrottled, this would spin).
+  /// False when it was too soon.
+  bool presentAgain() {
+    const auto now = Clock::now();
+    if (shown_.rgb.empty() || now - last_again_ < std::chrono::milliseconds(95)) return false;
+    last_again_ = now;
+    const std::vector<unsigned char> px =
+        previewPixels(shown_.width, shown_.height, shown_.rgb, args_.exposure);
+    if (!chain_.present(px.data(), shown_.width, shown_.height)) resized_ = true;
+    if (mover_ && mover_->busy()) ++light_frames_;
+    updateTitle(now);
+    return true;
   }
 
   /// The view pipelines the R and I keys lead to, compiled ahead in the background, one at a time
@@ -351,6 +406,7 @@ class Viewer {
     if (frames_ == 0) first_frame_seconds_ = std::chrono::duration<double>(now - opened_).count();
     if (samples == 1 && wavelengths == (spectral_ ? full_wavelengths_ : 0) && !coarse)
       full_quality_seconds_ = std::chrono::duration<double>(now - change_time_).count();
+    if (wavelengths != (spectral_ ? full_wavelengths_ : 0) && !coarse) ++few_frames_;
     if (coarse) {
       const double seconds = std::chrono::duration<double>(now - start).count();
       if (frames_ > 0) adaptCoarse(seconds);  // the first frame waited for the compilation too
@@ -360,6 +416,7 @@ class Viewer {
     shown_spp_ = samples;
     shown_wavelengths_ = wavelengths;
     shown_modes_ = stage_modes_;
+    if (mover_ && mover_->busy()) ++light_rendered_;
     ++frames_;
     ++frames_since_change_;
     frame_times_.push_back(now);
@@ -388,9 +445,9 @@ class Viewer {
     if (frame_times_.size() > 1)
       fps = double(frame_times_.size() - 1) /
             std::max(1e-6, std::chrono::duration<double>(now - frame_times_.front()).count());
-    char buf[512];
+    char buf[560];
     std::snprintf(buf, sizeof buf,
-                  "eikon view: %s | %.1f frames/s | %dx%d, %d/%d samples, %s | %s | modes %s%s",
+                  "eikon view: %s | %.1f frames/s | %dx%d, %d/%d samples, %s | %s | modes %s%s%s",
                   session_.scene()->file.filename().c_str(), fps, shown_.width, shown_.height,
                   shown_spp_, args_.spp,
                   shown_wavelengths_ > 0
@@ -399,7 +456,8 @@ class Viewer {
                   integratorName(integrator_), modesName(modes_),
                   compiling_ ? " | compiling..."
                   : refined_ ? " | refined"
-                             : "");
+                             : "",
+                  mover_ && mover_->busy() ? " | simulating the light..." : light_note_.c_str());
     glfwSetWindowTitle(window_, buf);
   }
 
@@ -417,19 +475,22 @@ class Viewer {
       save();
     }
     if (!mover_) return;
-    std::string error;
-    if (mover_->finished(ready_light_, error)) {
-      if (error.empty()) {
-        light_ready_ = changed_ = true;  // applied between renders (it replaces the renderer)
+    if (mover_->finished(moved_)) {
+      for (const std::string& w : moved_.warnings)
+        std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+      if (moved_.error.empty()) {
+        light_ready_ = changed_ = true;  // swapped in between renders (applyLight)
       } else {
         std::fprintf(stderr, "eikon: warning: the moved light was not simulated: %s\n",
-                     error.c_str());
+                     moved_.error.c_str());
+        light_rendered_ = light_frames_ = 0;
       }
     }
     if (light_moved_ && !mover_->busy()) {
-      Scene moved = *session_.scene();
-      moved.lights.front() = wanted_light_;
-      light_moved_ = !mover_->start(moved);
+      if (mover_->start(wanted_light_)) {
+        light_moved_ = false;
+        updateTitle(Clock::now());
+      }
     }
   }
 
@@ -437,18 +498,24 @@ class Viewer {
     return mover_ && (light_moved_ || light_ready_ || mover_->busy() || mover_->done());
   }
 
-  /// The light volumes simulated in the background, from the light cache, into the view.
+  /// The light volumes simulated in the background into the view: written into the renderer's
+  /// images in place (no renderer or pipeline made again); the view then restarts.
   void applyLight() {
     light_ready_ = false;
-    prefetched_ = false;  // the renderer is made again, its pipelines too
-    session_.scene()->lights.front() = ready_light_;
-    const LightOutcome o = session_.simulateLight(LightRequest{}, false, defaultLightCacheDir());
-    for (const std::string& w : o.warnings) std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
-    std::printf("eikon view: light 0 simulated again (%s): position %s, direction %s\n",
-                o.cached ? "from the light cache" : "in the foreground",
-                vectorJson(ready_light_.position).c_str(),
-                vectorJson(ready_light_.direction).c_str());
+    session_.scene()->lights.front() = moved_.light;
+    session_.setLightVolumes(std::move(moved_.fluence), std::move(moved_.flux));
+    std::printf(
+        "eikon view: light 0 simulated again in the background (%s, %.2f s; meanwhile %lld frames "
+        "rendered with the former light and %lld presented again): position %s, direction %s\n",
+        moved_.cached ? "from the light cache" : "simulated", moved_.seconds, light_rendered_,
+        light_frames_, vectorJson(moved_.light.position).c_str(),
+        vectorJson(moved_.light.direction).c_str());
     std::fflush(stdout);
+    light_rendered_ = light_frames_ = 0;
+    char note[96];
+    std::snprintf(note, sizeof note, " | light moved (%s, %.2f s)",
+                  moved_.cached ? "from the light cache" : "simulated", moved_.seconds);
+    light_note_ = note;
   }
 
   void resize() {
@@ -561,8 +628,13 @@ class Viewer {
   vk::Swapchain& chain_;
   RenderSettings base_;
   LightMover* mover_;
-  Light wanted_light_, ready_light_;
+  Light wanted_light_;
+  MovedLight moved_;  ///< the last light the mover finished, until applyLight swaps it in
   bool light_moved_ = false, light_ready_ = false;
+  long long light_rendered_ = 0;  ///< frames rendered while the mover simulated
+  long long light_frames_ = 0;    ///< frames presented again meanwhile (the view was refined)
+  std::string light_note_;        ///< the title's word on the last moved light
+  Clock::time_point last_again_;  ///< presentAgain's last frame
   Integrator integrator_;
   Modes modes_, stage_modes_ = modes_, shown_modes_ = modes_;
   bool spectral_ = false;
@@ -580,6 +652,7 @@ class Viewer {
   bool have_cursor_ = false;
   long long frames_ = 0;
   int frames_since_change_ = 0;
+  int few_frames_ = 0;  ///< full-size frames of the last view at fewer wavelengths than all
   Clock::time_point change_time_ = Clock::now();
   std::deque<Clock::time_point> frame_times_;
   std::vector<double> coarse_seconds_;
@@ -673,7 +746,7 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   vk::Swapchain chain(ctx, surface, uint32_t(fw), uint32_t(fh));
   std::unique_ptr<LightMover> mover;
   if (!scene->lights.empty() && !a.no_light)
-    mover = std::make_unique<LightMover>(lightOnCpu("auto", &ctx), defaultLightCacheDir());
+    mover = std::make_unique<LightMover>(*scene, lightOnCpu("auto", &ctx), defaultLightCacheDir());
   // Input is handled from here on: events that arrive while the scene is voxelised (polled by
   // the progress callbacks) already move the camera of the first frame.
   Viewer viewer(a, session, window.handle, chain, base, mover.get());

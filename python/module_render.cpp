@@ -164,7 +164,8 @@ py::dict layerArrays(const RenderImage& img) {
 py::object render(Prepared& p, int width, int height, int spp, std::optional<int> wavelengths,
                   double wavelength_nm, std::optional<MarchSettings> march,
                   const std::string& device, int threads, bool light, const py::object& light_cache,
-                  const std::string& sampling, const std::string& layers, bool polarised) {
+                  const std::string& sampling, const std::string& layers, bool polarised,
+                  const std::string& modes) {
   const bool gpu = isGpu(device);
   ViewRequest view;  // the CLI's defaults (core/session/session.h), then what the caller chose
   if (width != 0) view.width = width;
@@ -177,6 +178,7 @@ py::object render(Prepared& p, int width, int height, int spp, std::optional<int
     checkViewRequest(view);
     view.sampling = parseSpectralSampling(sampling);
     parseLayers(layers, view);
+    view.modes = parseModes(modes);
   });
   view.polarised = polarised;
   RenderSettings settings;
@@ -408,7 +410,7 @@ void bindRenderer(py::module_& m) {
            py::arg("wavelengths") = py::none(), py::arg("wavelength_nm") = 587.5618,
            py::arg("march") = py::none(), py::arg("device") = "gpu", py::arg("threads") = 0,
            py::arg("light") = true, py::arg("light_cache") = true, py::arg("sampling") = "auto",
-           py::arg("layers") = "", py::arg("polarised") = false,
+           py::arg("layers") = "", py::arg("polarised") = false, py::arg("modes") = "both",
            "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: wavelengths=None "
            "is 16 for a "
            "dispersive scene, else 0 (RGB; > 0 = spectral with that many samples); march=None is "
@@ -425,7 +427,8 @@ void bindRenderer(py::module_& m) {
            "where none) and steps (H, W); layers='stokes' (a polarised render; also "
            "polarised=True, polariser sheets or a camera analyzer, which return the plain "
            "(H, W, 3) S0 without it) adds stokes (H, W, 4, 3: S0..S3 x RGB) and stokes_frame "
-           "(docs/polarisation.md)")
+           "(docs/polarisation.md); modes='both'|'o'|'e' (--modes): a crystal's two modes, each "
+           "carrying half of the light, or one mode alone at the whole of it, so o + e = 2·both")
       .def(
           "simulate_light", &simulateLight, py::arg("bands") = 0, py::arg("splat") = "accumulate",
           py::arg("step_voxels") = 0.5, py::arg("smoothing_voxels") = 1.0,

@@ -8,7 +8,7 @@ set -euo pipefail
 EIKON=${1:?usage: viewer_frames.sh EIKON SCENE OUTDIR [W H SPP FRAMES DX DY]}
 SCENE=${2:?scene}
 OUT=${3:?output folder}
-W=${4:-200} H=${5:-150} SPP=${6:-4} FRAMES=${7:-4} DX=${8:-25} DY=${9:-8}
+W=${4:-400} H=${5:-300} SPP=${6:-4} FRAMES=${7:-4} DX=${8:-50} DY=${9:-16}
 tmp=$(mktemp -d)
 Xvfb -displayfd 3 -screen 0 $((W + 64))x$((H + 64))x24 -nolisten tcp 3>"$tmp/display" 2>/dev/null &
 xvfb=$!

@@ -508,6 +508,19 @@ bool ViewRenderer::ready(const RenderSettings& settings) {
   return I.pipelines.count(key) > 0 || I.compiler.ready(key);
 }
 
+bool ViewRenderer::updateLight(const VolumeSet& v) {
+  Impl& I = *impl_;
+  if (!I.lit || !v.lit()) return false;
+  if (v.grid.dims != I.grid.dims || v.light_fluence.size() != I.grid.count() ||
+      v.light_flux.size() != I.grid.count())
+    throw std::invalid_argument("light volumes do not match the renderer's grid");
+  // Renders are synchronous (submitAndWait), so no dispatch reads the images while they change.
+  I.images[I.fluenceImage].upload(I.ctx, v.light_fluence.data(),
+                                  v.light_fluence.size() * sizeof(glm::vec4));
+  I.images[I.fluxImage].upload(I.ctx, v.light_flux.data(), v.light_flux.size() * sizeof(glm::vec4));
+  return true;
+}
+
 namespace {
 // Adds one band's layer values (view.comp layerWrite) to the sums: channels [c0, c1) of each mode
 // kept apart (the pass's wavelength bins, all N for a hero pass; r, g, b in RGB mode).

@@ -50,6 +50,11 @@ class ViewRenderer {
   /// the background). On lavapipe the first dispatch of a new pipeline may still compile machine
   /// code that Mesa's shader cache does not hold yet.
   bool ready(const RenderSettings& settings);
+  /// Write `volume`'s light volumes (the same grid; a light moved and simulated again: the
+  /// viewer) into the images this renderer reads, in place: no pipeline is built again. False,
+  /// changing nothing, when this renderer was made without light volumes or `volume` has none
+  /// (a new renderer is needed then).
+  bool updateLight(const VolumeSet& volume);
   /// Trace individual rays at their wavelengths: the o-mode (isotropic scenes: the ray).
   std::vector<TraceOutcome> trace(const std::vector<TraceRequest>& rays,
                                   const MarchSettings& settings);

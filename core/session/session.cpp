@@ -234,8 +234,24 @@ LightOutcome Session::simulateLight(const LightRequest& light, bool cpu_render,
       if (!err.empty()) out.warnings.push_back("light cache: " + err);
     }
   }
-  dropRenderers();  // renderers made before hold the unlit volume
+  lightChanged();  // renderers made before hold the former light volumes (or none)
   return out;
+}
+
+void Session::setLightVolumes(std::vector<glm::vec4> fluence, std::vector<glm::vec4> flux) {
+  VolumeSet& volume = prepare(false);
+  if (fluence.size() != volume.grid.count() || flux.size() != volume.grid.count())
+    throw std::invalid_argument("light volumes of " + std::to_string(fluence.size()) +
+                                " voxels for a volume of " + std::to_string(volume.grid.count()));
+  volume.light_fluence = std::move(fluence);
+  volume.light_flux = std::move(flux);
+  lightChanged();
+}
+
+void Session::lightChanged() {
+  cpu_.reset();
+  field_.reset();
+  if (gpu_ && !gpu_->updateLight(*volume_)) gpu_.reset();
 }
 
 ViewRenderer& Session::gpuRenderer(const RenderSettings* expected) {

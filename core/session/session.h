@@ -156,9 +156,15 @@ class Session {
 
   /// Simulate the scene's lights into the volume (callers skip scenes without lights): by the CPU
   /// twin when cpu_render or lightOnCpu(light.device) says so, else the GPU twin; through the light
-  /// cache in `cache_dir` unless it is empty. Renderers made before are rebuilt on their next use.
+  /// cache in `cache_dir` unless it is empty. A GPU renderer made before with light volumes gets
+  /// the new ones written in place (ViewRenderer::updateLight: no pipeline built again); other
+  /// renderers made before are rebuilt on their next use.
   LightOutcome simulateLight(const LightRequest& light, bool cpu_render,
                              const std::filesystem::path& cache_dir);
+  /// Light volumes simulated elsewhere for this session's volume (the viewer's background
+  /// simulation of a moved light, on a session of its own), swapped in as simulateLight's are.
+  /// Throws std::invalid_argument when their size is not the volume's.
+  void setLightVolumes(std::vector<glm::vec4> fluence, std::vector<glm::vec4> flux);
   RenderImage render(const RenderSettings& settings, bool gpu);
   /// The GPU twin's ViewRenderer::prefetch and ::ready (the viewer: pipelines of its keys compiled
   /// ahead, and the window kept responding while one compiles).
@@ -178,6 +184,8 @@ class Session {
 
  private:
   void dropRenderers();
+  /// The light volumes changed: the GPU renderer takes them in place where it can.
+  void lightChanged();
   /// `expected`: the render about to run, whose pipeline then compiles during the upload.
   ViewRenderer& gpuRenderer(const RenderSettings* expected = nullptr);
   ReferenceMarcher& cpuMarcher();

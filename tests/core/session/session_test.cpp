@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 
@@ -127,6 +129,45 @@ TEST(Session, CpuTwinTracesBothModesAndVoxelisesOnce) {
     EXPECT_EQ(t.interfaces, 0);
   }
   EXPECT_FALSE(session.hasContext());
+}
+
+// A glass ball over a diffuse floor under a point light, small enough to simulate in a second.
+constexpr const char* kLitScene = R"({
+  "camera": {"position": [0, 12, -30], "look_at": [0, -2, 0], "up": [0, 1, 0], "fov_deg": 40, "width": 32, "height": 24},
+  "environment": {"type": "constant", "radiance": [0.02, 0.02, 0.02]},
+  "volume": {"bounds_min": [-8, -5, -8], "bounds_max": [8, 9, 8], "resolution": 16},
+  "materials": {"glass": {"n": 1.5}, "floor": {"n": 1.0, "opacity": 1, "albedo": 0.8}},
+  "objects": [{"shape": "box", "center": [0, -4, 0], "size": [15, 1, 15], "material": "floor"},
+              {"shape": "sphere", "center": [0, 1, 0], "radius": 3, "material": "glass"}],
+  "lights": [{"type": "point", "position": [0, 7, 0], "intensity": 40}]
+})";
+
+/// The viewer's moved light (docs/viewer.md "Moving a light"): light volumes simulated by another
+/// session and swapped in render exactly what a session simulating the moved light itself
+/// renders, through the same GPU renderer (its pipeline stays built: no compile).
+TEST(Session, SwappedLightVolumesRenderAsASessionOfTheMovedLight) {
+  auto scene = std::make_shared<Scene>(parseScene(kLitScene, "lit.json"));
+  auto moved = std::make_shared<Scene>(*scene);
+  moved->lights.front().position = {-4, 7, 0};
+  Session session(scene), other(moved);
+  RenderSettings rs = renderSettings(*scene, ViewRequest{});
+  session.simulateLight(LightRequest{}, false, {});
+  const RenderImage before = session.render(rs, true);
+  other.simulateLight(LightRequest{}, false, {});
+  const RenderImage expected = other.render(rs, true);
+  const VolumeSet& v = other.prepare(true);
+  session.setLightVolumes(v.light_fluence, v.light_flux);
+  EXPECT_TRUE(session.renderReady(rs)) << "the renderer was made again";
+  const RenderImage after = session.render(rs, true);
+  ASSERT_EQ(after.rgb.size(), expected.rgb.size());
+  double worst = 0, changed = 0;
+  for (size_t i = 0; i < after.rgb.size(); ++i) {
+    worst = std::max(worst, double(std::abs(after.rgb[i] - expected.rgb[i])));
+    changed = std::max(changed, double(std::abs(after.rgb[i] - before.rgb[i])));
+  }
+  EXPECT_EQ(worst, 0.0);     // the same volumes through the same kernel
+  EXPECT_GT(changed, 0.05);  // and the light did move
+  EXPECT_THROW(session.setLightVolumes({}, {}), std::invalid_argument);
 }
 
 }  // namespace
