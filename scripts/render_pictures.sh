@@ -43,12 +43,13 @@ pictures=(
   "smoke_sphere|960x600|--spp 8"
   # Polarised (polariser sheets): deterministic, so 1 sample (the pixel centres). The conoscope
   # and the gems in monochromatic light (RGB mode: one trace per pixel at 587.56 nm; a quartz
-  # brilliant's retardation is of high order, white in white light anyway), the wedge with 32
-  # stratified wavelengths per pixel (its colours are the spectrum's; fewer bins speckle).
+  # brilliant's retardation is of high order, white in white light anyway), the wedge at 32
+  # wavelengths per pixel, at one sample the 32 bins' centres for every pixel (no colour grain;
+  # fewer bins miss the third order's period). The CPU twin (--reference) renders them.
   "conoscope_calcite|800x600|--wavelengths 0"
-  "polariscope_gems_0|800x600|--wavelengths 0"
-  "polariscope_gems_45|800x600|--wavelengths 0"
-  "polariscope_quartz_wedge|800x300|--wavelengths 32"
+  "polariscope_gems_0|800x600|--wavelengths 0 --reference"
+  "polariscope_gems_45|800x600|--wavelengths 0 --reference"
+  "polariscope_quartz_wedge|800x600|--wavelengths 32 --reference"
 )
 
 want=("$@")

@@ -39,6 +39,7 @@ layout(std430, binding = EIKON_B_OUTPUT) writeonly buffer ResultBuf { PolarisedR
 layout(std430, binding = EIKON_B_SHEETS) readonly buffer SheetBuf { vec4 sheets[]; };
 
 const float kFarMm = 1e9;  // "to infinity": sheets beyond the volume
+const float kGrazeCos = 1e-6;  // a ray this close to a face's plane runs along it (cross)
 
 // ---- Complex numbers (vec2) and complex 3-vectors ----
 
@@ -217,6 +218,13 @@ void cross(Branch b, BoundaryCrossing c) {
   float nIn = length(b.p);
   vec3 s = b.p / nIn;
   vec3 m = orientNormal(c.normal, b.ray);
+  // Along the face (the CPU's kGrazeCos): not a crossing; the Fresnel factor √(n₂cos t/(n₁cos i))
+  // divides by cos i = 0 there (NaN). The branch goes on in its own medium, one event spent.
+  if (min(abs(dot(s, m)), abs(dot(normalize(b.ray), m))) < kGrazeCos) {
+    b.events++;
+    push(b);
+    return;
+  }
   vec3 pt = b.p - dot(b.p, m) * m;
   ModeWave w[2];
   for (int k = 0; k < 2; ++k) w[k] = solveInterfaceMode(pt, m, k == 1, afB.xyz, noB, neB, true);

@@ -30,6 +30,19 @@ bool boxHit(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& bmin,
   return t1 >= std::max(t0, 0.0);
 }
 
+/// A ray whose ray direction or wave normal makes |cos| below this with a face's normal runs along
+/// the face (a ray exactly in the plane of a wedge's side face): it does not cross it. The
+/// interface solve divides by the normal flux (the transmitted power fraction √(flux_out/flux_in)),
+/// which is zero there: such rays returned NaN Stokes vectors. The grazing limit of the exact
+/// equations transmits nothing and reflects along the ray itself, so the branch simply goes on, in
+/// its own medium. shaders/polarised_trace.comp uses the same constant.
+constexpr double kGrazeCos = 1e-6;
+
+bool grazes(const glm::dvec3& p, const glm::dvec3& ray, const glm::dvec3& normal) {
+  return std::abs(glm::dot(glm::normalize(p), normal)) < kGrazeCos ||
+         std::abs(glm::dot(glm::normalize(ray), normal)) < kGrazeCos;
+}
+
 /// One path of the o/e ray tree: where it is, its wave vector and ray, and the power-normalised
 /// fields G[b] it carries for the input basis states b = x̂_in, ŷ_in (unit power each).
 struct Branch {
@@ -152,6 +165,12 @@ void Tracer::cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branc
     Branch same = b;
     same.region = c.to;
     stack.push_back(same);
+    return;
+  }
+  if (grazes(b.p, b.ray, c.normal)) {  // along the face: not a crossing (see kGrazeCos)
+    Branch along = b;
+    along.events = b.events + 1;  // bounds a ray that runs along a face from graze to graze
+    stack.push_back(along);
     return;
   }
   const InterfaceMap map = interfaceMap(from, b.mode, glm::normalize(b.p), c.normal, to);

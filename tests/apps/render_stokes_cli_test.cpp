@@ -4,7 +4,10 @@
 // a polariser sheet along x in front of a constant grey sky of 0.5, so every pixel holds S0 = ¼,
 // S1 = ¼ (x̂ of stokesBasis(−v) is +x for a camera looking along +z), S2 = S3 = 0. Stokes layers
 // with spectral or mode layers, smoothed interfaces and a polarised environment end the run with
-// one line (naming the JSON path) and no files.
+// one line (naming the JSON path) and no files. A render of scenes/polariscope_quartz_wedge.json's
+// wedge whose middle column and row of pixels look along the planes of its side faces has no NaN
+// in any channel on either twin (those rays were NaN: the interface solve divided by their zero
+// normal flux).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -123,6 +126,64 @@ TEST(RenderStokesCli, ScenesAPolarisedRenderCannotTakeAreOneLineAndNoFiles) {
     EXPECT_FALSE(fs::exists(out)) << path;
     EXPECT_FALSE(fs::exists(d.path / "out.png")) << path;
   }
+}
+
+// The wedge and plate of scenes/polariscope_quartz_wedge.json with the camera over the corner
+// x = 20, y = −15: with an odd image size the middle column's rays lie in the plane x = 20 and the
+// middle row's in y = −15 (u, v = 0 exactly), both side faces of both pieces.
+constexpr const char* kWedgeCorner = R"({
+  "camera": {"position": [20, -15, -250], "look_at": [20, -15, 0], "up": [0, 1, 0],
+             "fov_deg": 0.1, "width": 5, "height": 5},
+  "environment": {"type": "constant", "radiance": 1},
+  "volume": {"bounds_min": [-21, -16, -2.4], "bounds_max": [21, 16, 2], "resolution": 224},
+  "objects": [
+    {"shape": "polarizer", "center": [0, 0, 10], "normal": [0, 0, 1],
+     "transmission_axis": [1, 0, 0], "size": [80, 80]},
+    {"shape": "polarizer", "center": [0, 0, -10], "normal": [0, 0, 1],
+     "transmission_axis": [0, 1, 0], "size": [80, 80]},
+    {"shape": "box", "center": [0, 0, -1.1], "size": [40, 30, 1.0], "material": "quartz",
+     "optic_axis": [1, -1, 0]},
+    {"shape": "planes", "material": "quartz", "optic_axis": [1, 1, 0],
+     "planes": [[1, 0, 0, 20], [-1, 0, 0, 20], [0, 1, 0, 15], [0, -1, 0, 15], [0, 0, -1, 0],
+                [0.005, 0, 1, 1.1]]}]
+})";
+
+TEST(RenderStokesCli, WedgeRenderedAlongItsSideFacesHasNoNan) {
+  Dir d;
+  std::ofstream(d.path / "wedge.json") << kWedgeCorner;
+  for (const std::string& twin : {std::string("--reference"), std::string("")})
+    for (const std::string& spectrum :
+         {std::string("--wavelengths 0"), std::string("--wavelengths 4")}) {
+      const fs::path out = d.path / "wedge.exr";
+      const Outcome r = eikon::test::runEikon("render " + quote((d.path / "wedge.json").string()) +
+                                                  " -o " + quote(out.string()) +
+                                                  " --layers stokes -q " + twin + " " + spectrum,
+                                              d.path);
+      ASSERT_EQ(r.code, 0) << twin << " " << spectrum << ": " << r.err;
+      const Outcome stats =
+          eikon::test::runProgram("iinfo", "--stats " + quote(out.string()), d.path);
+      ASSERT_EQ(stats.code, 0) << stats.err;
+      const std::vector<double> nan = statsRow(stats.out, "Stats NanCount:", 15),
+                                inf = statsRow(stats.out, "Stats InfCount:", 15),
+                                lo = statsRow(stats.out, "Stats Min:", 15),
+                                hi = statsRow(stats.out, "Stats Max:", 15);
+      ASSERT_FALSE(nan.empty() || inf.empty() || lo.empty() || hi.empty()) << stats.out;
+      for (size_t c = 0; c < 15; ++c) {
+        EXPECT_EQ(nan[c], 0.0) << twin << " " << spectrum << ": channel " << c;
+        EXPECT_EQ(inf[c], 0.0) << twin << " " << spectrum << ": channel " << c;
+      }
+      // RGB mode (one wavelength, white light box of 1): unpolarised light through a polariser
+      // keeps at most half its power, so 0 <= S0 <= 1/2 in every channel. (A spectral render's
+      // linear sRGB channels of a spectrum may overshoot.)
+      if (spectrum == "--wavelengths 0") {
+        for (size_t c = 3; c < 6; ++c) {
+          EXPECT_GE(lo[c], 0.0) << twin;
+          EXPECT_LE(hi[c], 0.5 + 1e-5) << twin;
+        }
+      }
+      fs::remove(out);
+      fs::remove(d.path / "wedge.png");
+    }
 }
 
 }  // namespace

@@ -20,11 +20,19 @@
 //    on the rings δ = 2πm and on the isogyres along the polariser and analyser directions, where
 //    the plane of incidence holds the polariser's field and the wave is a pure o (azimuth 90°)
 //    or e (0°) mode.
+//  - A singly refractive stone (scenes/polariscope_gems_*.json's spinel) between polariser
+//    sheets, along a ray that enters a crown facet and leaves the pavilion facet below it: at
+//    each face the field splits into its s and p parts (ŝ ⊥ the plane of incidence, p̂ = ŝ × k̂
+//    before and after, so that the Born & Wolf amplitudes are positive) and each keeps the
+//    amplitude √T_s or √T_p of its power transmittance; an ideal sheet removes the field along
+//    its absorbing direction normal × axis projected ⊥ k̂. Between crossed sheets only the s/p
+//    difference of the two faces (and the sheets' own leak at oblique k̂) lets light through.
 #pragma once
 
 #include <cmath>
 #include <functional>
 #include <glm/glm.hpp>
+#include <limits>
 
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
@@ -115,6 +123,75 @@ inline double faceTransmittance(double n) { return 4.0 * n / ((1.0 + n) * (1.0 +
 inline double wedgeTransmission(double n_o, double n_e, double t_mm, double lambda_nm) {
   const double a = faceTransmittance(n_o) * faceTransmittance(n_e);
   return a * a * crossedRetarder((n_e - n_o) * t_mm * 1e6, lambda_nm);
+}
+
+/// The same between parallel sheets (the scene's lower half, y < 0): the complement,
+/// ½(τ_oτ_e)² cos²(πΔn t/λ).
+inline double wedgeTransmissionParallel(double n_o, double n_e, double t_mm, double lambda_nm) {
+  const double a = faceTransmittance(n_o) * faceTransmittance(n_e);
+  return a * a * (0.5 - crossedRetarder((n_e - n_o) * t_mm * 1e6, lambda_nm));
+}
+
+/// Power transmittances (T_s, T_p) from index n1 into n2 at incidence cos i = ci; NaN beyond the
+/// critical angle (total internal reflection: no transmitted beam).
+inline glm::dvec2 fresnelPowerTransmittance(double n1, double n2, double ci) {
+  const double st2 = (n1 / n2) * (n1 / n2) * (1.0 - ci * ci);
+  if (st2 > 1.0) return glm::dvec2(std::numeric_limits<double>::quiet_NaN());
+  const double ct = std::sqrt(1.0 - st2);
+  const double rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct),
+               rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
+  return {1.0 - rs * rs, 1.0 - rp * rp};
+}
+
+/// A real field E on a ray k̂ (unit) crossing a face with unit normal m (pointing back towards
+/// the incoming side) from n1 into n2: k̂ becomes the refracted direction, E the transmitted
+/// power-normalised field. False (E, k̂ unchanged) on total internal reflection.
+inline bool refractField(glm::dvec3& E, glm::dvec3& k, const glm::dvec3& m, double n1, double n2) {
+  const double ci = -glm::dot(k, m), eta = n1 / n2;
+  const glm::dvec2 T = fresnelPowerTransmittance(n1, n2, ci);
+  if (std::isnan(T.x)) return false;
+  const double ct = std::sqrt(1.0 - eta * eta * (1.0 - ci * ci));
+  const glm::dvec3 kt = eta * k + (eta * ci - ct) * m;
+  glm::dvec3 s = glm::cross(k, m);
+  if (glm::length(s) < 1e-12) {  // normal incidence: any ŝ ⊥ k̂, both amplitudes equal
+    s = glm::normalize(
+        glm::cross(k, std::abs(k.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
+  }
+  s = glm::normalize(s);
+  const double Es = glm::dot(E, s), Ep = glm::dot(E, glm::cross(s, k));
+  E = std::sqrt(T.x) * Es * s + std::sqrt(T.y) * Ep * glm::cross(s, kt);
+  k = kt;
+  return true;
+}
+
+/// An ideal polariser sheet (unit normal, transmission axis) on a field E travelling along k̂.
+inline glm::dvec3 sheetField(const glm::dvec3& E, const glm::dvec3& k, const glm::dvec3& normal,
+                             const glm::dvec3& axis) {
+  glm::dvec3 a = glm::cross(normal, axis);
+  a -= glm::dot(a, k) * k;
+  if (glm::length(a) < 1e-12) return E;
+  a = glm::normalize(a);
+  return E - glm::dot(E, a) * a;
+}
+
+/// Unpolarised light of unit power along k̂₀ through sheet `first`, then into a stone of index n
+/// through the face with outward normal m_in and out of it through the face with outward normal
+/// m_out, then through sheet `second` (each sheet: {normal, axis}): the power that leaves, the
+/// mean over two orthogonal input states. NaN where the ray is totally reflected at m_out.
+inline double stoneBetweenSheets(const glm::dvec3& k0, const glm::dvec3 first[2],
+                                 const glm::dvec3 second[2], const glm::dvec3& m_in,
+                                 const glm::dvec3& m_out, double n) {
+  const glm::dvec3 u = glm::normalize(
+      glm::cross(k0, std::abs(k0.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
+  double power = 0.0;
+  for (const glm::dvec3& E0 : {u, glm::cross(k0, u)}) {
+    glm::dvec3 k = k0, E = sheetField(E0, k, first[0], first[1]);
+    if (!refractField(E, k, m_in, 1.0, n) || !refractField(E, k, -m_out, n, 1.0))
+      return std::numeric_limits<double>::quiet_NaN();
+    E = sheetField(E, k, second[0], second[1]);
+    power += 0.5 * glm::dot(E, E);
+  }
+  return power;
 }
 
 }  // namespace eikon::test

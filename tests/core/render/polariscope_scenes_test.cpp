@@ -7,7 +7,9 @@
 //    cancelling between wedge and plate), and the Michel-Lévy colours within ΔE76 ≤ 2;
 //  - scenes/conoscope_calcite.json: the m-th dark ring within 1% of the closed-form angle
 //    (m = 1, 2, 3, 5, 8), dark isogyres along the sheets' axes. A c-cut plate's modes are pure s
-//    and p, where the GPU's D-projection split at crystal faces is exact.
+//    and p, where the GPU's D-projection split at crystal faces is exact;
+//  - rays exactly in the planes of the wedge's side faces give finite Stokes vectors (they were
+//    NaN: the Fresnel factor √(n₂cos t/(n₁cos i)) divided by their cos i = 0).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -118,6 +120,33 @@ TEST(PolariscopeScenesGpu, ConoscopeRingsAndIsogyresOfCalcite) {
     EXPECT_NEAR(got, want, 0.01 * want) << mth;
     EXPECT_LT(b, 1e-3) << mth;
     EXPECT_GT(I[121], 0.35) << mth;  // the half order between the rings
+  }
+  expectNoValidationMessages();
+}
+
+TEST(PolariscopeScenesGpu, RaysAlongTheWedgesSideFacesGiveFiniteStokes) {
+  ShippedGpu s("polariscope_quartz_wedge.json");
+  std::vector<TraceRequest> rays;
+  for (const glm::dvec3& o :
+       {glm::dvec3(20, 0.3, 20), glm::dvec3(-20, 0.3, 20), glm::dvec3(20, -0.3, 20),
+        glm::dvec3(-20, -0.3, 20), glm::dvec3(0, 15, 20), glm::dvec3(0, -15, 20),
+        glm::dvec3(-10, 15, 20), glm::dvec3(10, -15, 20), glm::dvec3(20, -15, 20),
+        glm::dvec3(-20, 15, 20)})
+    for (double nm : {450.0, 550.0, 650.0}) rays.push_back({o, {0, 0, -1}, nm});
+  const std::vector<PolarisedTrace> traces = s.gpu.tracePolarised(
+      s.scene.polarizers, rays, std::vector<Stokes>(rays.size(), {1, 0, 0, 0}));
+  ASSERT_EQ(traces.size(), rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) {
+    ASSERT_FALSE(traces[i].beams.empty()) << i;
+    double S0 = 0.0;
+    for (const PolarisedBeam& b : traces[i].beams) {
+      for (int c = 0; c < 4; ++c) ASSERT_TRUE(std::isfinite(b.stokes[c])) << "ray " << i;
+      EXPECT_LE(std::hypot(b.stokes[1], b.stokes[2], b.stokes[3]), b.stokes[0] * (1 + 1e-5) + 1e-7);
+      S0 += b.stokes[0];
+    }
+    // Through a polariser, unpolarised light keeps at most half its power.
+    EXPECT_GE(S0, 0.0) << "ray " << i;
+    EXPECT_LE(S0, 0.5 + 1e-5) << "ray " << i;
   }
   expectNoValidationMessages();
 }

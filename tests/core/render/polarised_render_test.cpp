@@ -121,7 +121,7 @@ TEST(PolarisedRenderGpu, TwinsAgreeOnAConoscopicFigure) {
     ASSERT_EQ(g.stokes.size(), c.stokes.size());
     double worst = 0.0, brightest = 0.0;
     for (size_t i = 0; i < c.stokes.size(); ++i) {
-      const size_t pixel = i / 12, channel = i % 3;
+      const size_t channel = i % 3;
       // Per wavelength a Stokes component of unit light is within ½δΔ = π·t·2.4e-7/λ (above; 1.3e-3
       // at 589 nm, +20% for the oblique paths); a spectral channel sums its wavelengths' with
       // their colour weights |M·sampleWeightXyz|.
@@ -129,10 +129,13 @@ TEST(PolarisedRenderGpu, TwinsAgreeOnAConoscopicFigure) {
       double tol = perWave(589.2938);
       if (wavelengths > 0) {
         tol = 1e-6;
-        for (double l : spectrum::stratifiedWavelengths(uint32_t(pixel), 0, uint32_t(wavelengths)))
+        // One sample per pixel traces the bins' centres (polarised_render.cpp binCentres).
+        for (int k = 0; k < wavelengths; ++k) {
+          const double l = 380.0 + (k + 0.5) * 400.0 / wavelengths;
           tol += perWave(l) *
                  std::abs((spectrum::spectralToLinearSrgbMatrix() *
                            spectrum::sampleWeightXyz(l, uint32_t(wavelengths)))[int(channel)]);
+        }
       }
       worst = std::max(worst, std::abs(double(g.stokes[i]) - c.stokes[i]) / tol);
       brightest = std::max(brightest, double(c.stokes[i]));
