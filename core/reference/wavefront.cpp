@@ -1019,7 +1019,7 @@ bool SharpInterfaces::active() const {
                      [](const WavefrontMedium& m) { return m.homogeneous; });
 }
 
-SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm) {
+SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm, bool with_skip) {
   SharpInterfaces si;
   if (volume.boundary.empty() || volume.media.empty()) return si;
   si.boundary = &volume.boundary;
@@ -1036,7 +1036,7 @@ SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm
     m.opaque = r.opaque();
     si.media.push_back(m);
   }
-  si.skip = sharpSkipDistances(volume);
+  if (with_skip) si.skip = sharpSkipDistances(volume);
   if (!si.skip.empty()) si.opacity_skip = opacitySkipDistances(volume);  // the same grid
   return si;
 }

@@ -89,7 +89,10 @@ struct SharpInterfaces {
 /// material's own dispersion formula, σ_o, σ_e interpolated between the bands (field::bandAt);
 /// and its sharp skip distances (sharpSkipDistances).
 /// Inactive when the scene was voxelised with "interfaces": "smoothed" (no boundary field).
-SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm);
+/// with_skip = false leaves the skip distances out (a caller running several wavelengths computes
+/// them once: they depend on the volume only).
+SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm,
+                                   bool with_skip = true);
 
 class WavefrontSimulator {
  public:
