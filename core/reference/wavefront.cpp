@@ -204,7 +204,9 @@ class PatchStepper {
   int straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1) const;
   double skipAt(const glm::dvec3& x) const;
   size_t sharpVoxel(const glm::dvec3& x) const;
-  bool oneRegionAlong(const glm::dvec3& a, const glm::dvec3& b, int r) const;
+  enum class Along { OneRegion, SameMotion, Others };
+  Along regionsAlong(const glm::dvec3& a, const glm::dvec3& b, int r) const;
+  bool sameMotion(int r, int q) const;
   // The stages of a step.
   PatchStep moveStep(Chunk& ch, Patch& p) const;
   glm::dvec4 attenuateStep(Chunk& ch, Patch& p, PatchStep& st) const;
@@ -405,13 +407,21 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
     // skip distance D (the argument of straight steps; the sharp path's D counts region changes
     // only) or when every boundary-field cell it touches lies in its region: locateCrossing would
     // find none, so it is not called (issue 14: most corners near a surface are such corners).
-    if (guard == 0 && s_.skip_empty &&
-        (len <= (skipAt(x) - 1.5) * h_ || oneRegionAlong(x, x + d, r))) {
+    const Along along =
+        guard == 0 && s_.skip_empty
+            ? (len <= (skipAt(x) - 1.5) * h_ ? Along::OneRegion : regionsAlong(x, x + d, r))
+            : Along::Others;
+    if (along == Along::OneRegion) {
       absorb += mediumSigma(r, p.w[size_t(k)]) * len;
       x += d;
       break;
     }
-    BoundaryCrossing c = guard < 16 ? locateCrossing(bf, x, x + d) : BoundaryCrossing{};
+    // Only regions whose media move a corner as r's does (an opaque floor of the ambient's
+    // index): where the crossing lies changes the corner's end point by round-off only, so the
+    // trilinear field's zero is taken without the refinement on the exact shape.
+    LocateOptions opt;
+    opt.analytic = along != Along::SameMotion;
+    BoundaryCrossing c = guard < 16 ? locateCrossing(bf, x, x + d, opt) : BoundaryCrossing{};
     if (c.found && c.from != r && c.to == r) {
       // The trilinear field's zero lies just past the exact surface where the corner was turned
       // (curved faces: by up to 3h²/8r): not a new boundary, so go on past it.
@@ -515,30 +525,46 @@ void PatchStepper::splatSegment(Chunk& ch, const glm::dvec3& c0, const glm::dvec
   }
 }
 
-// Sharp interfaces: whether every voxel of every trilinear cell of the boundary field that the
-// segment [a, b] touches lies in region r, so that locateCrossing would find no crossing on it
-// (its cells have no other region: φ_r > 0 throughout). The cells of the points u (voxel
-// coordinates) have corners L(u) and L(u) + 1 per axis, L(u) = clamp(⌊u⌋, 0, n − 2) (boundary.cpp
-// cellAt), monotone in u: so the voxels L(min) … L(max) + 1 per axis hold them all.
-bool PatchStepper::oneRegionAlong(const glm::dvec3& a, const glm::dvec3& b, int r) const {
+// Sharp interfaces: the regions of every voxel of every trilinear cell of the boundary field that
+// the segment [a, b] touches. OneRegion: all are r, so locateCrossing would find no crossing on
+// it (its cells have no other region: φ_r > 0 throughout). SameMotion: the others' media have
+// r's indices, axis and attenuation (sameMotion). The cells of the points u (voxel coordinates)
+// have corners L(u) and L(u) + 1 per axis, L(u) = clamp(⌊u⌋, 0, n − 2) (boundary.cpp cellAt),
+// monotone in u: so the voxels L(min) … L(max) + 1 per axis hold them all.
+PatchStepper::Along PatchStepper::regionsAlong(const glm::dvec3& a, const glm::dvec3& b,
+                                               int r) const {
   const BoundaryField& bf = *sharp_->boundary;
   const Grid& g = bf.grid;
   int lo[3], hi[3];
   for (int ax = 0; ax < 3; ++ax) {
     const int n = g.dims[size_t(ax)];
     const double ua = (a[ax] - g.origin[ax]) / g.h - 0.5, ub = (b[ax] - g.origin[ax]) / g.h - 0.5;
-    if (!(std::isfinite(ua) && std::isfinite(ub))) return false;
+    if (!(std::isfinite(ua) && std::isfinite(ub))) return Along::Others;
     const auto L = [n](double u) {
       return n < 2 ? 0 : int(std::clamp(std::floor(u), 0.0, n - 2.0));
     };
     lo[ax] = L(std::min(ua, ub));
     hi[ax] = std::min(L(std::max(ua, ub)) + 1, n - 1);
   }
+  Along along = Along::OneRegion;
   for (int k = lo[2]; k <= hi[2]; ++k)
     for (int j = lo[1]; j <= hi[1]; ++j)
-      for (int i = lo[0]; i <= hi[0]; ++i)
-        if (int(bf.region[g.index(i, j, k)]) != r) return false;
-  return true;
+      for (int i = lo[0]; i <= hi[0]; ++i) {
+        const int q = int(bf.region[g.index(i, j, k)]);
+        if (q == r) continue;
+        if (!sameMotion(r, q)) return Along::Others;
+        along = Along::SameMotion;
+      }
+  return along;
+}
+
+// Whether a corner moves and is attenuated in region q's medium exactly as in r's (the same n,
+// n_e, optic axis of a crystal, σ_o, σ_e; opacity aside): crossInterface then only changes the
+// corner's region id.
+bool PatchStepper::sameMotion(int r, int q) const {
+  const WavefrontMedium &a = mediumOf(r), &b = mediumOf(q);
+  return a.n == b.n && a.n_e == b.n_e && (a.n_e == 0.0 || a.axis == b.axis) && a.sigma == b.sigma &&
+         a.sigma_e == b.sigma_e;
 }
 
 // How many time steps p may take at once along straight lines (0: none, take an RK4 step), and
