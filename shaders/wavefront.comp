@@ -363,8 +363,11 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, ivec4 region, ou
   const int r0 = regionOf(region.x);
   if (kSharpLight && (straddles(region) || mediumOpaque(r0))) return 0;
   const vec3 c0 = centreOf(x);
-  const float Dc = skipAt(c0);
-  if (Dc < 2.0) return 0;
+  // Sharp: the centre reads no field but the opacity, tested below at every time step's midpoint
+  // as single steps would, so only the corners need skip distances (the host binds the sharp
+  // path's own, core/light/sharp_skip.h).
+  const float Dc = kSharpLight ? 0.0 : skipAt(c0);
+  if (!kSharpLight && Dc < 2.0) return 0;
   float D[4];
   for (int k = 0; k < 4; ++k) {
     D[k] = skipAt(x[k]);
@@ -392,7 +395,7 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, ivec4 region, ou
   const float dt = P.step.x, h = P.grid_origin.w, maxEdge = P.step.y;
   float kmax = float(P.control.z - state.w);
   float sp = length(vc) * dt;
-  if (sp > 0.0) kmax = min(kmax, floor((Dc - 1.5) * h / sp));
+  if (!kSharpLight && sp > 0.0) kmax = min(kmax, floor((Dc - 1.5) * h / sp));
   for (int k = 0; k < 4; ++k) {
     sp = length(v[k]) * dt;
     if (sp > 0.0) kmax = min(kmax, floor((D[k] - 1.5) * h / sp));
@@ -424,6 +427,8 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, ivec4 region, ou
       entered = true;
     else if (entered || !rayHitsBox(c, wm / wl))
       stop = true;
+    // Sharp: the opacity kill at the step's midpoint (attenuateStep reads it at the same point).
+    if (kSharpLight && mediumAt(c0 + (float(j) - 0.5) * dt * vc).w >= 0.5) stop = true;
     if (stop) return j;
   }
   return K;
@@ -438,6 +443,7 @@ struct PatchStep {
   vec3 c0, c1;    // the centre before and after
   vec3 wm0;       // the mean w before
   vec3 dA, dB, dC, dD;  // straight step: the diagonals at the start and their change per time step
+  vec3 vc;              // straight step: the centre's velocity (the mean of the corners')
   float ds;       // |c1 − c0|
   float sigma;    // attenuation at the step's midpoint
   float E0;       // flux before the step
@@ -555,18 +561,22 @@ PatchStep moveStep(inout vec3 x[4], inout vec3 w[4], inout WavePatch p) {
   float sigma1;
   st.kStraight = straightSteps(x, w, p.flux, p.state, p.region, vel, sigma1);
   st.dA = vec3(0.0), st.dB = vec3(0.0), st.dC = vec3(0.0), st.dD = vec3(0.0);
+  st.vc = vec3(0.0);
   st.fresnel = 1.0;
   st.attenuation = 1.0;
-  if (kSharpLight && st.kStraight == 0) {
-    for (int k = 0; k < 4; ++k) sharpCorner(x[k], w[k], p.region[k], st);
-    ++p.state.w;
-  } else if (st.kStraight > 0) {
+  // The sharp corners and RK4 under the constant kSharpLight, so that each run's pipeline holds
+  // only one of them (llvmpipe would run both under masks).
+  if (st.kStraight > 0) {
     st.dA = x[2] - x[0], st.dB = dt * (vel[2] - vel[0]), st.dC = x[3] - x[1], st.dD = dt * (vel[3] - vel[1]);
+    for (int k = 0; k < 4; ++k) st.vc += 0.25 * vel[k];  // as straightSteps sums it
     const float T = float(st.kStraight) * dt;
     for (int k = 0; k < 4; ++k) x[k] += T * vel[k];
     p.state.w += st.kStraight;
     // Sharp: no boundary on the way (no Fresnel), the corners' attenuation over the path.
     if (kSharpLight) st.attenuation = exp(-sigma1 * length(centreOf(x) - st.c0));
+  } else if (kSharpLight) {
+    for (int k = 0; k < 4; ++k) sharpCorner(x[k], w[k], p.region[k], st);
+    ++p.state.w;
   } else {
     for (int k = 0; k < 4; ++k) rk4(x[k], w[k], dt);
     ++p.state.w;
@@ -580,7 +590,10 @@ PatchStep moveStep(inout vec3 x[4], inout vec3 w[4], inout WavePatch p) {
 // Sharp interfaces: first the corners' Fresnel losses (added to `reflected`), then their
 // attenuation; σ is the mean over the centre's path.
 vec4 attenuateStep(inout WavePatch p, inout PatchStep st, vec3 w[4], inout float reflected) {
-  const vec3 m = 0.5 * (st.c0 + st.c1);
+  // Sharp straight steps: the medium (the opacity kill) at the last time step's midpoint, where
+  // single steps would have read it (straightSteps stops there when it is opaque).
+  const vec3 m = kSharpLight && st.kStraight > 0 ? st.c0 + (float(st.kStraight) - 0.5) * P.step.x * st.vc
+                                                 : 0.5 * (st.c0 + st.c1);
   const vec4 med = mediumAt(m);
   float att;
   if (kSharpLight) {

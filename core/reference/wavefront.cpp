@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "core/light/seeding.h"
+#include "core/light/sharp_skip.h"
 #include "core/reference/field.h"
 #include "optics/fresnel.h"
 #include "optics/interface.h"
@@ -142,6 +143,7 @@ struct PatchStep {
   glm::dvec3 c0{0.0}, c1{0.0};  ///< the centre before and after
   glm::dvec3 wm0{0.0};          ///< the mean w before (e-mode)
   glm::dvec3 diag[4];  ///< straight step: the diagonals at the start and their change per time step
+  glm::dvec3 vc{0.0};  ///< straight step: the centre's velocity (the mean of the corners')
   double ds = 0.0;     ///< |c1 − c0|
   double sigma = 0.0;  ///< attenuation at the step's midpoint
   double E0 = 0.0;     ///< flux before the step
@@ -200,6 +202,11 @@ class PatchStepper {
                     double sigma, const glm::dvec3& dir, double ds1,
                     const glm::dvec3 diag[4]) const;
   int straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1) const;
+  double skipAt(const glm::dvec3& x) const;
+  size_t sharpVoxel(const glm::dvec3& x) const;
+  enum class Along { OneRegion, SameMotion, Others };
+  Along regionsAlong(const glm::dvec3& a, const glm::dvec3& b, int r) const;
+  bool sameMotion(int r, int q) const;
   // The stages of a step.
   PatchStep moveStep(Chunk& ch, Patch& p) const;
   glm::dvec4 attenuateStep(Chunk& ch, Patch& p, PatchStep& st) const;
@@ -224,6 +231,22 @@ class PatchStepper {
   bool eMode_;
   const SharpInterfaces* sharp_;  ///< null: the smoothed path
 };
+
+// The skip distance at x (voxels): the sharp path's own (SharpInterfaces::skip, on the boundary
+// field's grid, looked up as VolumeField::skipDistance does) when it has them, else the field's.
+double PatchStepper::skipAt(const glm::dvec3& x) const {
+  if (!sharp_ || sharp_->skip.empty()) return f_.skipDistance(x);
+  return double(sharp_->skip[sharpVoxel(x)]);
+}
+
+// The voxel of the boundary field's grid that holds x, clamped (as VolumeField::skipDistance).
+size_t PatchStepper::sharpVoxel(const glm::dvec3& x) const {
+  const Grid& g = sharp_->boundary->grid;
+  int i[3];
+  for (int a = 0; a < 3; ++a)
+    i[a] = std::clamp(int(std::floor((x[a] - g.origin[a]) / g.h)), 0, g.dims[size_t(a)] - 1);
+  return g.index(i[0], i[1], i[2]);
+}
 
 // Wave vector along the unit direction s at x on the simulated mode's shell (wavefront.comp
 // onShell): the seeding's (core/light/seeding.h), which both twins share.
@@ -380,7 +403,25 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
     const int r = p.region[size_t(k)];
     const glm::dvec3 d = T * mediumVelocity(r, p.w[size_t(k)]);
     const double len = glm::length(d);
-    BoundaryCrossing c = guard < 16 ? locateCrossing(bf, x, x + d) : BoundaryCrossing{};
+    // No boundary can lie on the corner's way when it moves at most (D − 1.5)·h from a voxel of
+    // skip distance D (the argument of straight steps; the sharp path's D counts region changes
+    // only) or when every boundary-field cell it touches lies in its region: locateCrossing would
+    // find none, so it is not called (issue 14: most corners near a surface are such corners).
+    const Along along =
+        guard == 0 && s_.skip_empty
+            ? (len <= (skipAt(x) - 1.5) * h_ ? Along::OneRegion : regionsAlong(x, x + d, r))
+            : Along::Others;
+    if (along == Along::OneRegion) {
+      absorb += mediumSigma(r, p.w[size_t(k)]) * len;
+      x += d;
+      break;
+    }
+    // Only regions whose media move a corner as r's does (an opaque floor of the ambient's
+    // index): where the crossing lies changes the corner's end point by round-off only, so the
+    // trilinear field's zero is taken without the refinement on the exact shape.
+    LocateOptions opt;
+    opt.analytic = along != Along::SameMotion;
+    BoundaryCrossing c = guard < 16 ? locateCrossing(bf, x, x + d, opt) : BoundaryCrossing{};
     if (c.found && c.from != r && c.to == r) {
       // The trilinear field's zero lies just past the exact surface where the corner was turned
       // (curved faces: by up to 3h²/8r): not a new boundary, so go on past it.
@@ -401,8 +442,8 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
     c.from = r;  // the corner's own region, whatever the field says at its start
     if (crossInterface(c, p, k, trans)) ++ch.st.interface_events;
   }
-  st.fresnel *= std::pow(trans, 0.25);
-  st.attenuation *= std::exp(-0.25 * absorb);
+  if (trans != 1.0) st.fresnel *= std::pow(trans, 0.25);  // pow(1, ¼) = 1 exactly
+  if (absorb != 0.0) st.attenuation *= std::exp(-0.25 * absorb);
 }
 
 // Sharp interfaces: the corners lie in different regions, or only some have been mirrored. Such a
@@ -484,6 +525,48 @@ void PatchStepper::splatSegment(Chunk& ch, const glm::dvec3& c0, const glm::dvec
   }
 }
 
+// Sharp interfaces: the regions of every voxel of every trilinear cell of the boundary field that
+// the segment [a, b] touches. OneRegion: all are r, so locateCrossing would find no crossing on
+// it (its cells have no other region: φ_r > 0 throughout). SameMotion: the others' media have
+// r's indices, axis and attenuation (sameMotion). The cells of the points u (voxel coordinates)
+// have corners L(u) and L(u) + 1 per axis, L(u) = clamp(⌊u⌋, 0, n − 2) (boundary.cpp cellAt),
+// monotone in u: so the voxels L(min) … L(max) + 1 per axis hold them all.
+PatchStepper::Along PatchStepper::regionsAlong(const glm::dvec3& a, const glm::dvec3& b,
+                                               int r) const {
+  const BoundaryField& bf = *sharp_->boundary;
+  const Grid& g = bf.grid;
+  int lo[3], hi[3];
+  for (int ax = 0; ax < 3; ++ax) {
+    const int n = g.dims[size_t(ax)];
+    const double ua = (a[ax] - g.origin[ax]) / g.h - 0.5, ub = (b[ax] - g.origin[ax]) / g.h - 0.5;
+    if (!(std::isfinite(ua) && std::isfinite(ub))) return Along::Others;
+    const auto L = [n](double u) {
+      return n < 2 ? 0 : int(std::clamp(std::floor(u), 0.0, n - 2.0));
+    };
+    lo[ax] = L(std::min(ua, ub));
+    hi[ax] = std::min(L(std::max(ua, ub)) + 1, n - 1);
+  }
+  Along along = Along::OneRegion;
+  for (int k = lo[2]; k <= hi[2]; ++k)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int i = lo[0]; i <= hi[0]; ++i) {
+        const int q = int(bf.region[g.index(i, j, k)]);
+        if (q == r) continue;
+        if (!sameMotion(r, q)) return Along::Others;
+        along = Along::SameMotion;
+      }
+  return along;
+}
+
+// Whether a corner moves and is attenuated in region q's medium exactly as in r's (the same n,
+// n_e, optic axis of a crystal, σ_o, σ_e; opacity aside): crossInterface then only changes the
+// corner's region id.
+bool PatchStepper::sameMotion(int r, int q) const {
+  const WavefrontMedium &a = mediumOf(r), &b = mediumOf(q);
+  return a.n == b.n && a.n_e == b.n_e && (a.n_e == 0.0 || a.axis == b.axis) && a.sigma == b.sigma &&
+         a.sigma_e == b.sigma_e;
+}
+
 // How many time steps p may take at once along straight lines (0: none, take an RK4 step), and
 // the corners' constant velocities dx/dt. Conditions (docs/light-simulator.md, "Straight
 // steps"): the centre and all corners lie in voxels of skip distance D ≥ 2, the centre's voxel is
@@ -503,11 +586,13 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1)
   // takes single steps), moving at that medium's constant velocity.
   if (sharp_ && (straddles(p) || mediumOf(p.region[0]).opaque)) return 0;
   const glm::dvec3 c0 = centre(p);
-  double Dmin = f_.skipDistance(c0);
-  if (Dmin < 2.0) return 0;
+  // Sharp interfaces: the centre reads no field but the opacity, which the loop below tests at
+  // every time step's midpoint as single steps would, so only the corners need skip distances.
+  const double Dmin = sharp_ ? 0.0 : skipAt(c0);
+  if (!sharp_ && Dmin < 2.0) return 0;
   double D[4];
   for (int k = 0; k < 4; ++k) {
-    D[k] = f_.skipDistance(p.x[size_t(k)]);
+    D[k] = skipAt(p.x[size_t(k)]);
     if (D[k] < 2.0) return 0;
   }
   if (f_.medium(c0).w >= 0.5) return 0;
@@ -534,7 +619,7 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1)
     const double sp = glm::length(vel) * dt_;
     if (sp > 0) kmax = std::min(kmax, std::floor((Dv - 1.5) * h_ / sp));
   };
-  capBy(Dmin, vc);
+  if (!sharp_) capBy(Dmin, vc);
   for (int k = 0; k < 4; ++k) capBy(D[k], v[k]);
   // Energy: a patch already below the threshold (a child of a split) is killed after its next
   // step; otherwise the first step at which exp(−σ·j·ds1) takes it below.
@@ -558,6 +643,12 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1)
   // A mirror reverses the orientation (endOfStep).
   const int orientation = sharp_ && p.mirrored != 0u ? -p.orientation : p.orientation;
   bool entered = p.entered || in0;
+  // Sharp: how far the centre may go before its opacity can reach 0.5 (opacitySkipDistances; c0
+  // is not opaque, so within that distance it is below 0.5 throughout).
+  const double opacitySafe = sharp_ && !sharp_->opacity_skip.empty()
+                                 ? (double(sharp_->opacity_skip[sharpVoxel(c0)]) - 1.5) * h_
+                                 : -1.0;
+  const double vcl = glm::length(vc);
   for (int j = 1; j <= K; ++j) {
     glm::dvec3 x[4];
     for (int k = 0; k < 4; ++k) x[k] = p.x[size_t(k)] + (double(j) * dt_) * v[k];
@@ -570,6 +661,10 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1)
       entered = true;
     else if (entered || !rayHitsBox(c, wm / wl, lo_, hi_))
       stop = true;
+    // Sharp: the opacity kill at the step's midpoint (attenuateStep reads it at the same point).
+    if (sharp_ && (double(j) - 0.5) * dt_ * vcl > opacitySafe &&
+        f_.medium(c0 + (double(j) - 0.5) * dt_ * vc).w >= 0.5)
+      stop = true;
     if (stop) return j;
   }
   return K;
@@ -578,6 +673,14 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1)
 // Split p (repeatedly) until no edge exceeds maxEdge_ or the patch budget is spent: a split is
 // refused when it would take ch.live above `budget` (LLONG_MAX: never; see the step loop).
 void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
+  // Most patches need no split: emitted as they are, without the work stack's copies.
+  double e0 = 0;
+  for (int k = 0; k < 4; ++k)
+    e0 = std::max(e0, glm::length(p0.x[size_t((k + 1) % 4)] - p0.x[size_t(k)]));
+  if (e0 <= maxEdge_ || (sharp_ && straddles(p0))) {
+    ch.next->push_back(p0);
+    return;
+  }
   std::vector<Patch>& work = ch.work;
   work.clear();
   work.push_back(p0);
@@ -647,6 +750,7 @@ PatchStep PatchStepper::moveStep(Chunk& ch, Patch& p) const {
     // diag: the diagonals at the start and their change per time step (the area along the path).
     st.diag[0] = p.x[2] - p.x[0], st.diag[1] = dt_ * (vel[2] - vel[0]);
     st.diag[2] = p.x[3] - p.x[1], st.diag[3] = dt_ * (vel[3] - vel[1]);
+    for (int k = 0; k < 4; ++k) st.vc += 0.25 * vel[k];  // as straightSteps sums it
     const double T = double(st.kStraight) * dt_;
     for (int k = 0; k < 4; ++k) p.x[size_t(k)] += T * vel[k];
     // Sharp: no boundary on the way (no Fresnel), the corners' attenuation over the path.
@@ -667,7 +771,11 @@ PatchStep PatchStepper::moveStep(Chunk& ch, Patch& p) const {
 // flux ← flux·exp(−σΔs), σ at the midpoint of the centre's path; returns the medium there
 // (wavefront.comp attenuateStep).
 glm::dvec4 PatchStepper::attenuateStep(Chunk& ch, Patch& p, PatchStep& st) const {
-  const glm::dvec3 m = 0.5 * (st.c0 + st.c1);
+  // Sharp straight steps: the medium (for the opacity kill) at the midpoint of the last time
+  // step, where single steps would have read it (straightSteps stops there when it is opaque).
+  const glm::dvec3 m = sharp_ && st.kStraight > 0
+                           ? st.c0 + (double(st.kStraight) - 0.5) * dt_ * st.vc
+                           : 0.5 * (st.c0 + st.c1);
   const glm::dvec4 med = f_.medium(m);
   if (sharp_) {
     // The corners' Fresnel losses, then their attenuation; σ: the mean over the centre's path.
@@ -937,7 +1045,7 @@ bool SharpInterfaces::active() const {
                      [](const WavefrontMedium& m) { return m.homogeneous; });
 }
 
-SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm) {
+SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm, bool with_skip) {
   SharpInterfaces si;
   if (volume.boundary.empty() || volume.media.empty()) return si;
   si.boundary = &volume.boundary;
@@ -954,6 +1062,8 @@ SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm
     m.opaque = r.opaque();
     si.media.push_back(m);
   }
+  if (with_skip) si.skip = sharpSkipDistances(volume);
+  if (!si.skip.empty()) si.opacity_skip = opacitySkipDistances(volume);  // the same grid
   return si;
 }
 

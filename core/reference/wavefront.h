@@ -41,6 +41,7 @@
 //   eikon::WavefrontResult r = sim.run(scene.lights[0]);
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "core/light/wavefront_types.h"
@@ -72,15 +73,26 @@ struct WavefrontMedium {
 struct SharpInterfaces {
   const BoundaryField* boundary = nullptr;
   std::vector<WavefrontMedium> media;
+  /// The sharp path's skip distances on the boundary field's grid (core/light/sharp_skip.h:
+  /// region and opacity changes only), for straight steps and the corners' crossing searches;
+  /// empty: the field's own skip distances (Field::skipDistance, every field's changes).
+  std::vector<uint8_t> skip;
+  /// The distances to the nearest change of the opacity's side of 0.5 (opacitySkipDistances),
+  /// on the same grid: a straight step tests the centre's opacity only beyond them. May be empty.
+  std::vector<uint8_t> opacity_skip;
   /// Whether the sharp path applies (see above).
   bool active() const;
 };
 
 /// The sharp interfaces of a voxelised scene at a wavelength: its boundary field (referenced) and
 /// its media table (VolumeSet::media, core/volume/media.h) evaluated there: n_o, n_e with each
-/// material's own dispersion formula, σ_o, σ_e interpolated between the bands (field::bandAt).
+/// material's own dispersion formula, σ_o, σ_e interpolated between the bands (field::bandAt);
+/// and its sharp skip distances (sharpSkipDistances).
 /// Inactive when the scene was voxelised with "interfaces": "smoothed" (no boundary field).
-SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm);
+/// with_skip = false leaves the skip distances out (a caller running several wavelengths computes
+/// them once: they depend on the volume only).
+SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm,
+                                   bool with_skip = true);
 
 class WavefrontSimulator {
  public:

@@ -11,6 +11,7 @@
 
 #include "core/light/lighting.h"
 #include "core/light/seeding.h"
+#include "core/light/sharp_skip.h"
 #include "core/render/boundary_device.h"
 #include "core/vk/resources.h"
 #include "core/volume/media.h"
@@ -181,7 +182,13 @@ struct GpuWavefront::Impl {
       upload(vol.axis, "wavefront axis");
     }
     // Skip distances for straight steps (w of the emission image; zeros where none was computed).
-    if (vol.emission.size() == g.count())
+    // Sharp light reads the sharp path's own, as the CPU twin (core/light/sharp_skip.h).
+    std::vector<uint8_t> sharpSkip = sharp ? sharpSkipDistances(vol) : std::vector<uint8_t>{};
+    if (!sharpSkip.empty()) {
+      std::vector<glm::vec4> skip(g.count(), glm::vec4(0.0f));
+      for (size_t i = 0; i < skip.size(); ++i) skip[i].w = float(sharpSkip[i]);
+      upload(skip, "wavefront skip");
+    } else if (vol.emission.size() == g.count())
       upload(vol.emission, "wavefront skip");
     else
       upload(std::vector<glm::vec4>(g.count(), glm::vec4(0.0f)), "wavefront skip");

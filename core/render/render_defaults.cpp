@@ -39,8 +39,10 @@ LightingOptions defaultLightingOptions() {
 bool lightOnCpu(const std::string& device, const vk::Context* ctx) {
   if (device == "cpu") return true;
   if (device == "gpu") return false;
-  if (device == "auto") return !ctx || ctx->deviceTypeName() == "CPU";
+  if (device == "auto") return !ctx || lightOnCpuForDeviceType(ctx->deviceTypeName());
   throw std::invalid_argument("light device must be auto, gpu or cpu, got '" + device + "'");
 }
+
+bool lightOnCpuForDeviceType(const std::string& device_type) { return device_type == "CPU"; }
 
 }  // namespace eikon

@@ -46,4 +46,10 @@ LightingOptions defaultLightingOptions();
 /// device name.
 bool lightOnCpu(const std::string& device, const vk::Context* ctx);
 
+/// The "auto" rule of lightOnCpu for a Vulkan device of the given type (vk::Context::
+/// deviceTypeName): the CPU twin on "CPU" (a software Vulkan such as lavapipe runs the GPU twin's
+/// kernel on the same cores, where the double-precision twin measured faster for light), the GPU
+/// twin on every real GPU ("discrete GPU", "integrated GPU", "virtual GPU") and on "other".
+bool lightOnCpuForDeviceType(const std::string& device_type);
+
 }  // namespace eikon
