@@ -282,8 +282,13 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   timings::mark("rendered");
   if (img.cut_samples > 0)
     warn(std::to_string(img.cut_samples) +
-             " pixel samples were cut short by the Vulkan driver's loop limit and lack the light "
-             "they would have reached (docs/view-renderer.md); render them with --reference",
+             (!img.stokes.empty()
+                  ? " pixel samples were cut short by the polarised trace's limits (max_branches, "
+                    "max_events; on the GPU twin also the driver's loop limit) and lack the "
+                    "light they would have reached"
+                  : " pixel samples were cut short by the Vulkan driver's loop limit and lack the "
+                    "light they would have reached (docs/view-renderer.md); render them with "
+                    "--reference"),
          a.strict);
   // The pair as a pair (core/io/atomic_write.h): both files or neither replace what is there,
   // and a concurrent render to the same -o cannot interleave its pair with this one. The
