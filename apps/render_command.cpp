@@ -273,6 +273,8 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   if (!a.reference) {
     session.context();  // what prepare() does first, marked apart from the voxelising
     timings::mark("device created");
+    // The view pipeline compiles beside the voxelising and the upload (docs/performance.md).
+    session.startRenderPipeline(rs, !scene->lights.empty() && !a.no_light);
   }
   session.prepare(!a.reference);
   timings::mark("voxelised");

@@ -10,6 +10,7 @@
 #include "core/reference/reference_marcher.h"
 #include "core/render/light_transport.h"
 #include "core/render/render_defaults.h"
+#include "core/render/view_pipeline_start.h"
 #include "core/render/view_renderer.h"
 #include "core/vk/context.h"
 #include "core/volume/polarised_render.h"
@@ -265,6 +266,11 @@ ReferenceMarcher& Session::cpuMarcher() {
     cpu_ = std::make_unique<ReferenceMarcher>(*field_, scene_->environment);
   }
   return *cpu_;
+}
+
+void Session::startRenderPipeline(const RenderSettings& settings, bool lit) {
+  if (!gpu_ && !early_pipeline_)
+    early_pipeline_ = startViewPipeline(context(), *scene_, lit, settings);
 }
 
 void Session::prefetchRender(const RenderSettings& settings) {

@@ -170,6 +170,10 @@ class Session {
   LightOutcome simulateLight(const LightRequest& light, bool cpu_render,
                              const std::filesystem::path& cache_dir);
   RenderImage render(const RenderSettings& settings, bool gpu);
+  /// Start compiling the GPU render's view pipeline now, on a thread of its own, before the
+  /// volume exists (core/render/view_pipeline_start.h): `eikon render` calls it once the device is
+  /// made. `lit`: light volumes will be simulated (or read from the light cache) before the render.
+  void startRenderPipeline(const RenderSettings& settings, bool lit);
   /// The GPU twin's ViewRenderer::prefetch and ::ready (the viewer: pipelines of its keys compiled
   /// ahead, and the window kept responding while one compiles).
   void prefetchRender(const RenderSettings& settings);
@@ -205,6 +209,7 @@ class Session {
   std::unique_ptr<ViewRenderer> gpu_;
   std::unique_ptr<VolumeField> field_;
   std::unique_ptr<ReferenceMarcher> cpu_;
+  std::shared_ptr<void> early_pipeline_;  // startRenderPipeline's; ends before ctx_
 };
 
 }  // namespace eikon
