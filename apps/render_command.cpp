@@ -126,8 +126,9 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
   sub->add_flag("--no-light-cache", a.no_light_cache,
                 "Simulate the light even if a cached result exists, and store none");
   sub->add_flag("--no-volume-cache", a.no_volume_cache,
-                "Voxelise the scene even if a cached volume exists, and store none (the volume "
-                "cache: $EIKON_CACHE_DIR, $XDG_CACHE_HOME/eikon or ~/.cache/eikon)");
+                "Voxelise the scene even if a cached volume exists, and store none (GPU renders "
+                "keep their voxelised volumes in $EIKON_CACHE_DIR, $XDG_CACHE_HOME/eikon or "
+                "~/.cache/eikon)");
   sub->add_flag("--no-light", a.no_light,
                 "Do not simulate the scene's lights (no caustics, in-scatter or lit surfaces)");
   sub->add_flag("--timings", a.timings,
@@ -264,7 +265,9 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   Progress progress(progressMode(a.progress, a.quiet));
   Session session(scene);
   session.setThreads(a.threads);
-  if (!a.no_volume_cache)
+  // The GPU render's start-up (docs/performance.md "Start-up"); the CPU twin takes far longer to
+  // render than to voxelise, and voxelises every time.
+  if (!a.reference && !a.no_volume_cache)
     session.setVolumeCache(defaultCacheDir(), [](const std::string& note) {
       std::fprintf(stderr, "eikon: note: %s\n", note.c_str());
     });
