@@ -321,7 +321,12 @@ std::shared_ptr<void> startViewPipeline(vk::Context& ctx, const Scene& scene, bo
     return nullptr;  // render() refuses them
   }
   if (isPolarisedRender(scene, s)) return nullptr;  // another kernel
-  const int volume_flags = predictVolumeFeatureFlags(scene, lit);
+  int volume_flags = 0;
+  try {
+    volume_flags = predictVolumeFeatureFlags(scene, lit);
+  } catch (const std::exception&) {
+    return nullptr;  // the voxeliser reports what is wrong with the scene, in its own words
+  }
   auto early = std::make_shared<EarlyPipeline>();
   early->ctx = &ctx;
   early->key = {kViewKernel, volume_flags | renderFlagsOf(s) | marchFlagsOf(s.march),
