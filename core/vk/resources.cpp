@@ -5,6 +5,7 @@
 
 #include "core/vk/check.h"
 #include "core/vk/specialise.h"
+#include "core/vk/spirv_cache.h"
 
 namespace eikon::vk {
 
@@ -262,7 +263,10 @@ ComputePipeline::ComputePipeline(const Context& ctx, std::span<const uint32_t> s
   // the constants disable, and no specialisation info.
   std::vector<uint32_t> specialised;
   if (!specialization.empty()) {
-    specialised = specialiseSpirv(spirv, specialization);
+    // Through the SPIR-V cache beside the pipeline cache (core/vk/spirv_cache.h).
+    const std::filesystem::path& cache = ctx.pipelineCacheFile();
+    specialised =
+        specialiseSpirvCached(spirv, specialization, cache.empty() ? cache : cache.parent_path());
     spirv = specialised;
   }
   VkShaderModuleCreateInfo si{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
