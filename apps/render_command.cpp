@@ -12,6 +12,7 @@
 
 #include "apps/commands.h"
 #include "apps/progress.h"
+#include "core/io/cache_dir.h"
 #include "core/io/exr.h"
 #include "core/light/light_cache.h"
 #include "core/render/render_defaults.h"
@@ -35,7 +36,7 @@ struct RenderArgs {
   int light_bands = 0, max_patches = 1 << 20;
   double light_step = 0.0, light_split = 1.0;
   std::string light_splat = "accumulate", light_cache, caustics = "pass", light_device = "auto";
-  bool no_light = false, no_light_cache = false;
+  bool no_light = false, no_light_cache = false, no_volume_cache = false;
   bool timings = false;
 };
 
@@ -124,6 +125,10 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
                   "$XDG_CACHE_HOME/eikon or ~/.cache/eikon)");
   sub->add_flag("--no-light-cache", a.no_light_cache,
                 "Simulate the light even if a cached result exists, and store none");
+  sub->add_flag("--no-volume-cache", a.no_volume_cache,
+                "Voxelise the scene even if a cached volume exists, and store none (GPU renders "
+                "keep their voxelised volumes in $EIKON_CACHE_DIR, $XDG_CACHE_HOME/eikon or "
+                "~/.cache/eikon)");
   sub->add_flag("--no-light", a.no_light,
                 "Do not simulate the scene's lights (no caustics, in-scatter or lit surfaces)");
   sub->add_flag("--timings", a.timings,
@@ -260,11 +265,19 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   Progress progress(progressMode(a.progress, a.quiet));
   Session session(scene);
   session.setThreads(a.threads);
+  // The GPU render's start-up (docs/performance.md "Start-up"); the CPU twin takes far longer to
+  // render than to voxelise, and voxelises every time.
+  if (!a.reference && !a.no_volume_cache)
+    session.setVolumeCache(defaultCacheDir(), [](const std::string& note) {
+      std::fprintf(stderr, "eikon: note: %s\n", note.c_str());
+    });
   session.setProgress({[&](const char* what, double f) { progress.update(what, f); },
                        [&](const char* what) { progress.working(what); }});
   if (!a.reference) {
     session.context();  // what prepare() does first, marked apart from the voxelising
     timings::mark("device created");
+    // The view pipeline compiles beside the voxelising and the upload (docs/performance.md).
+    session.startRenderPipeline(rs, !scene->lights.empty() && !a.no_light);
   }
   session.prepare(!a.reference);
   timings::mark("voxelised");

@@ -7,6 +7,7 @@
 #include <deque>
 #include <exception>
 #include <functional>
+#include <future>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -16,6 +17,7 @@
 #include <variant>
 
 #include "core/render/boundary_device.h"
+#include "core/render/view_pipeline_start.h"
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
@@ -207,7 +209,149 @@ class BackgroundCompiler {
   std::thread worker_;
 };
 
+// A pipeline's key: kernel, flags, integrator, sharp, AOV; kernel 0 is ViewRenderer::Impl::kView.
+using PipelineKey = std::tuple<int, int, int, int, int>;
+constexpr int kViewKernel = 0;
+
+/// The bindings of the view kernel (the trace kernels add theirs).
+std::vector<vk::BindingSpec> viewKernelBindings() {
+  std::vector<vk::BindingSpec> common;
+  for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
+    common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  for (uint32_t b :
+       {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
+    common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
+                     uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
+    common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+  for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
+  return common;
+}
+
+/// The specialisation constants of a key: constant_id 0: kSharpMarch, 1: kViewFlags,
+/// 2: kIntegrator, 3: kAov (march.glsl).
+std::vector<uint32_t> specialisationOf(const PipelineKey& key) {
+  const auto [kernel, flags, integrator, sharpMarch, aov] = key;
+  return {uint32_t(sharpMarch), uint32_t(flags), uint32_t(integrator), uint32_t(aov)};
+}
+
+/// The EIKON_F_* flags of a render's settings (spectral) and march (no skipping, no Fresnel).
+int renderFlagsOf(const RenderSettings& s) { return s.wavelengths > 0 ? EIKON_F_SPECTRAL : 0; }
+int marchFlagsOf(const MarchSettings& m) {
+  return (m.skip_empty ? 0 : EIKON_F_NO_SKIP) | (m.fresnel ? 0 : EIKON_F_NO_FRESNEL);
+}
+
+/// View pipelines started before their renderer (startViewPipeline): compiled on a thread of their
+/// own; the first renderer on the same context whose key matches takes the result.
+struct EarlyPipeline {
+  const vk::Context* ctx = nullptr;
+  PipelineKey key;
+  std::future<vk::ComputePipeline> result;  // waited for when dropped
+};
+std::mutex early_mutex;
+std::vector<EarlyPipeline*> early_pipelines;
+
+/// Whether a started pipeline of `key` on `ctx` waits to be taken.
+bool earlyPending(const vk::Context* ctx, const PipelineKey& key) {
+  std::lock_guard<std::mutex> lock(early_mutex);
+  for (const EarlyPipeline* e : early_pipelines)
+    if (e->ctx == ctx && e->key == key && e->result.valid()) return true;
+  return false;
+}
+
+/// The started pipeline of `key` on `ctx`, waited for (rethrowing what its compile threw); an
+/// unbuilt pipeline when none was started.
+vk::ComputePipeline takeEarly(const vk::Context* ctx, const PipelineKey& key) {
+  std::future<vk::ComputePipeline> f;
+  {
+    std::lock_guard<std::mutex> lock(early_mutex);
+    for (EarlyPipeline* e : early_pipelines)
+      if (e->ctx == ctx && e->key == key && e->result.valid()) {
+        f = std::move(e->result);
+        break;
+      }
+  }
+  return f.valid() ? f.get() : vk::ComputePipeline{};
+}
+
 }  // namespace
+
+int volumeFeatureFlags(const VolumeSet& v) {
+  const bool sharp = !v.boundary.empty() && !v.media.empty();
+  bool varying = false, convex = false, mesh = false;
+  for (const MediumRecord& r : v.media.regions) varying = varying || !r.homogeneous;
+  for (const Shape& shape : v.boundary.shapes) {
+    convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());
+    mesh = mesh || std::holds_alternative<MeshShape>(shape.geometry());
+  }
+  int flags = 0;
+  if (v.dispersive) flags |= EIKON_F_DISPERSIVE;
+  if (v.uniaxial) flags |= EIKON_F_UNIAXIAL;
+  if (v.attenuating) flags |= EIKON_F_ATTENUATION;
+  if (v.emissive) flags |= EIKON_F_EMISSION;
+  if (v.opaque) flags |= EIKON_F_OPACITY;
+  if (v.scattering) flags |= EIKON_F_SCATTER;
+  if (v.lit()) flags |= EIKON_F_LIT;
+  if (sharp) flags |= EIKON_F_SHARP;
+  if (sharp && varying) flags |= EIKON_F_VARYING;
+  if (sharp && convex) flags |= EIKON_F_CONVEX;
+  if (sharp && mesh) flags |= EIKON_F_MESH;
+  if (sharp && v.boundary.convex_apart) flags |= EIKON_F_CONVEX_APART;
+  return flags;
+}
+
+int predictVolumeFeatureFlags(const Scene& scene, bool lit) {
+  // The flags come from the materials and the shapes (voxelize's materialValues, the boundary
+  // field's shapes and the media table), not from the grid, except convex_apart: a 4-voxel
+  // voxelisation of the same scene gives them in milliseconds, convex_apart taken at the real h.
+  Scene tiny = scene;
+  tiny.environment = Environment{};  // not read by the voxeliser; not copied needlessly
+  tiny.volume.resolution = 4;
+  VolumeSet v = voxelize(tiny, VoxelizeOptions{{}, 1});
+  v.boundary.convex_apart = convexShapesApart(v.boundary.shapes, makeGrid(scene.volume).h);
+  if (lit) v.light_fluence.assign(1, glm::vec4(0.0f));
+  return volumeFeatureFlags(v);
+}
+
+std::shared_ptr<void> startViewPipeline(vk::Context& ctx, const Scene& scene, bool lit,
+                                        const RenderSettings& s) {
+  try {
+    validateRender(s, scene);
+  } catch (const std::invalid_argument&) {
+    return nullptr;  // render() refuses them
+  }
+  if (isPolarisedRender(scene, s)) return nullptr;  // another kernel
+  int volume_flags = 0;
+  try {
+    volume_flags = predictVolumeFeatureFlags(scene, lit);
+  } catch (const std::exception&) {
+    return nullptr;  // the voxeliser reports what is wrong with the scene, in its own words
+  }
+  auto early = std::make_shared<EarlyPipeline>();
+  early->ctx = &ctx;
+  early->key = {kViewKernel, volume_flags | renderFlagsOf(s) | marchFlagsOf(s.march),
+                int(s.march.integrator), (volume_flags & EIKON_F_SHARP) ? 1 : 0,
+                s.aov_layer ? 1 : 0};
+  const vk::Context* context = &ctx;
+  const PipelineKey key = early->key;
+  early->result = std::async(std::launch::async, [context, key] {
+    const std::vector<vk::BindingSpec> bindings = viewKernelBindings();
+    return vk::ComputePipeline(*context, {k_view_spv, sizeof(k_view_spv) / 4}, bindings, 0, "view",
+                               specialisationOf(key));
+  });
+  {
+    std::lock_guard<std::mutex> lock(early_mutex);
+    early_pipelines.push_back(early.get());
+  }
+  // Dropped: off the list, then the future's destructor waits for a compile still running.
+  return std::shared_ptr<void>(early.get(), [early](void*) mutable {
+    {
+      std::lock_guard<std::mutex> lock(early_mutex);
+      early_pipelines.erase(std::find(early_pipelines.begin(), early_pipelines.end(), early.get()));
+    }
+    early.reset();
+  });
+}
 
 void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scene) {
   const auto& lim = ctx.limits();
@@ -240,13 +384,9 @@ struct ViewRenderer::Impl {
   vk::Context& ctx;
   const Scene& scene;
   Grid grid;
-  bool uniaxial = false, dispersive = false, attenuating = false, emissive = false, opaque = false;
-  bool scattering = false, lit = false;
-  bool sharp = false;        // march region by region (shaders/sharp.glsl), as the CPU twin does
-  bool varying = false;      // sharp: some region's medium varies in space (GRIN, radial axis)
-  bool convex = false;       // sharp: some region's shape is a convex polyhedron
-  bool mesh = false;         // sharp: some region's shape is a non-convex mesh
-  bool convexApart = false;  // sharp: every shape is one, apart (core/volume/boundary.h)
+  bool uniaxial = false, scattering = false, lit = false;
+  bool sharp = false;    // march region by region (shaders/sharp.glsl), as the CPU twin does
+  int volume_flags = 0;  // volumeFeatureFlags: the EIKON_F_* of the volume's features
   // [oA, oB, oC, (eA, eB, eC), medO, (medE), emission, (axis), (scatter), (fluence, flux)]
   std::vector<vk::Image3D> images;
   size_t scatterImage = 0, fluenceImage = 0,
@@ -259,7 +399,8 @@ struct ViewRenderer::Impl {
   // marches many times faster than one that tests them at run time (docs/performance.md).
   std::vector<vk::BindingSpec> viewBindings, traceBindings, polarisedBindings;
   enum Kernel { kView = 0, kTrace = 1, kPolarised = 2 };
-  using Key = std::tuple<int, int, int, int, int>;  // kernel, flags, integrator, sharp, AOV
+  using Key = PipelineKey;  // kernel, flags, integrator, sharp, AOV
+  static_assert(kView == kViewKernel, "startViewPipeline's key names the view kernel");
   std::map<Key, vk::ComputePipeline> pipelines;
   // View pipelines compiled ahead on a thread of their own (prefetch()): the expected render's
   // while the volume is uploaded (the compile runs on one core, the upload mostly on the other),
@@ -273,31 +414,13 @@ struct ViewRenderer::Impl {
       : ctx(context), scene(s), grid(v.grid) {
     checkVolumeFits(ctx, grid, scene);
     uniaxial = v.uniaxial;
-    dispersive = v.dispersive;
-    attenuating = v.attenuating;
-    emissive = v.emissive;
-    opaque = v.opaque;
     scattering = v.scattering;
     lit = v.lit();
     skip_cap = v.skip_cap;
     ambient = v.ambient_index;
-    sharp = !v.boundary.empty() && !v.media.empty();
-    for (const MediumRecord& r : v.media.regions) varying = varying || !r.homogeneous;
-    for (const Shape& shape : v.boundary.shapes) {
-      convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());
-      mesh = mesh || std::holds_alternative<MeshShape>(shape.geometry());
-    }
-    convexApart = v.boundary.convex_apart;
-    std::vector<vk::BindingSpec> common;  // the bindings of both kernels (the trace's adds rays)
-    for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t b :
-         {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
-                       uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
-      common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
+    volume_flags = volumeFeatureFlags(v);
+    sharp = (volume_flags & EIKON_F_SHARP) != 0;
+    const std::vector<vk::BindingSpec> common = viewKernelBindings();  // the trace's add rays
     viewBindings = common;
     traceBindings = common;
     traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
@@ -370,10 +493,8 @@ struct ViewRenderer::Impl {
 
   // The view, trace or polarised-trace kernel specialised for the flags and integrator of a key.
   vk::ComputePipeline build(const Key& key) const {
-    const auto [kernel, flags, integrator, sharpMarch, aov] = key;
-    // constant_id 0: kSharpMarch, 1: kViewFlags, 2: kIntegrator, 3: kAov (march.glsl).
-    const std::vector<uint32_t> spec{uint32_t(sharpMarch), uint32_t(flags), uint32_t(integrator),
-                                     uint32_t(aov)};
+    const int kernel = std::get<0>(key);
+    const std::vector<uint32_t> spec = specialisationOf(key);
     auto make = [&](std::span<const uint32_t> code, const std::vector<vk::BindingSpec>& b,
                     const char* name) { return vk::ComputePipeline(ctx, code, b, 0, name, spec); };
     return kernel == kTrace  ? make({k_trace_spv, sizeof(k_trace_spv) / 4}, traceBindings, "trace")
@@ -392,7 +513,7 @@ struct ViewRenderer::Impl {
       return;
     }
     const Key key = viewKey(s);
-    if (!pipelines.count(key)) compiler.request(key);
+    if (!pipelines.count(key) && !earlyPending(&ctx, key)) compiler.request(key);
   }
 
   Key viewKey(const RenderSettings& s) const {
@@ -406,7 +527,10 @@ struct ViewRenderer::Impl {
     const Key key = keyOf(kernel, p, sharp);
     auto it = pipelines.find(key);
     if (it != pipelines.end()) return it->second;
-    vk::ComputePipeline pl = compiler.take(key);  // rethrows what its compile threw
+    // Started before this renderer (startViewPipeline), else by prefetch(), else built here;
+    // each rethrows what its compile threw.
+    vk::ComputePipeline pl = takeEarly(&ctx, key);
+    if (!pl.built()) pl = compiler.take(key);
     if (!pl.built()) pl = build(key);
     return adopt(key, std::move(pl));
   }
@@ -418,9 +542,7 @@ struct ViewRenderer::Impl {
     return pipelines.emplace(key, std::move(pl)).first->second;
   }
 
-  static int renderFlags(const RenderSettings& s) {
-    return s.wavelengths > 0 ? EIKON_F_SPECTRAL : 0;
-  }
+  static int renderFlags(const RenderSettings& s) { return renderFlagsOf(s); }
 
   void bindCommon(vk::ComputePipeline& p) {
     size_t oA = 0, eA = uniaxial ? 3 : 0;
@@ -458,21 +580,7 @@ struct ViewRenderer::Impl {
     p.cam_up = glm::vec4(glm::vec3(up), 0.0f);
     p.grid_origin = glm::vec4(glm::vec3(grid.origin), float(grid.h));
     p.grid_extent = glm::vec4(glm::vec3(grid.extent), float(1.0 / grid.h));
-    int flags = flags_extra;
-    if (dispersive) flags |= EIKON_F_DISPERSIVE;
-    if (uniaxial) flags |= EIKON_F_UNIAXIAL;
-    if (attenuating) flags |= EIKON_F_ATTENUATION;
-    if (emissive) flags |= EIKON_F_EMISSION;
-    if (opaque) flags |= EIKON_F_OPACITY;
-    if (scattering) flags |= EIKON_F_SCATTER;
-    if (lit) flags |= EIKON_F_LIT;
-    if (sharp) flags |= EIKON_F_SHARP;
-    if (sharp && varying) flags |= EIKON_F_VARYING;
-    if (sharp && convex) flags |= EIKON_F_CONVEX;
-    if (sharp && mesh) flags |= EIKON_F_MESH;
-    if (sharp && convexApart) flags |= EIKON_F_CONVEX_APART;
-    if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
-    if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
+    const int flags = flags_extra | volume_flags | marchFlagsOf(m);
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
     p.march = glm::vec4(float(m.step_voxels), float(m.interface_threshold), float(ambient),
                         float(int(m.integrator)));

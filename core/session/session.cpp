@@ -10,10 +10,12 @@
 #include "core/reference/reference_marcher.h"
 #include "core/render/light_transport.h"
 #include "core/render/render_defaults.h"
+#include "core/render/view_pipeline_start.h"
 #include "core/render/view_renderer.h"
 #include "core/vk/context.h"
 #include "core/volume/polarised_render.h"
 #include "core/volume/render_layers.h"
+#include "core/volume/volume_cache.h"
 
 namespace eikon {
 
@@ -194,7 +196,17 @@ VolumeSet& Session::prepare(bool gpu) {
     vo.threads = threads_;
     if (progress_.update)
       vo.progress = [this](double f, const char*) { progress_.update("voxelising", f); };
-    volume_ = std::make_unique<VolumeSet>(voxelize(*scene_, vo));
+    auto volume = std::make_unique<VolumeSet>();
+    const uint64_t key = volume_cache_.empty() ? 0 : volumeCacheKey(*scene_);
+    std::string notice;
+    volume_from_cache_ = key != 0 && loadVolumeCache(volume_cache_, key, *scene_, *volume, &notice);
+    if (!notice.empty() && volume_note_) volume_note_(printable(notice));
+    if (!volume_from_cache_) {
+      *volume = voxelize(*scene_, vo);
+      const std::string err = key != 0 ? saveVolumeCache(volume_cache_, key, *volume) : "";
+      if (!err.empty() && volume_note_) volume_note_("volume cache: " + printable(err));
+    }
+    volume_ = std::move(volume);
     voxelized_spec_ = scene_->volume;
   }
   return *volume_;
@@ -270,6 +282,11 @@ ReferenceMarcher& Session::cpuMarcher() {
     cpu_ = std::make_unique<ReferenceMarcher>(*field_, scene_->environment);
   }
   return *cpu_;
+}
+
+void Session::startRenderPipeline(const RenderSettings& settings, bool lit) {
+  if (!gpu_ && !early_pipeline_)
+    early_pipeline_ = startViewPipeline(context(), *scene_, lit, settings);
 }
 
 void Session::prefetchRender(const RenderSettings& settings) {

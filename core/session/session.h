@@ -141,6 +141,16 @@ class Session {
   const std::shared_ptr<Scene>& scene() const { return scene_; }
   void setProgress(SessionProgress progress) { progress_ = std::move(progress); }
   void setThreads(int threads) { threads_ = threads; }  ///< voxelising and the CPU twin
+  /// Read the voxelised volume from, and store it in, the volume cache in `dir`
+  /// (core/volume/volume_cache.h) instead of voxelising on every run; empty (the default): no
+  /// cache. `note` gets its one-line notices (an unusable entry ignored, a failed save).
+  void setVolumeCache(std::filesystem::path dir,
+                      std::function<void(const std::string&)> note = {}) {
+    volume_cache_ = std::move(dir);
+    volume_note_ = std::move(note);
+  }
+  /// Whether the volume came from the volume cache.
+  bool volumeFromCache() const { return volume_from_cache_; }
 
   /// The Vulkan context, made on first use; the scene's volume is checked against its limits
   /// then (checkVolumeFits), before anything is voxelised.
@@ -166,6 +176,10 @@ class Session {
   /// Throws std::invalid_argument when their size is not the volume's.
   void setLightVolumes(std::vector<glm::vec4> fluence, std::vector<glm::vec4> flux);
   RenderImage render(const RenderSettings& settings, bool gpu);
+  /// Start compiling the GPU render's view pipeline now, on a thread of its own, before the
+  /// volume exists (core/render/view_pipeline_start.h): `eikon render` calls it once the device is
+  /// made. `lit`: light volumes will be simulated (or read from the light cache) before the render.
+  void startRenderPipeline(const RenderSettings& settings, bool lit);
   /// The GPU twin's ViewRenderer::prefetch and ::ready (the viewer: pipelines of its keys compiled
   /// ahead, and the window kept responding while one compiles).
   void prefetchRender(const RenderSettings& settings);
@@ -196,10 +210,14 @@ class Session {
   int threads_ = 0;
   std::shared_ptr<vk::Context> ctx_;
   std::unique_ptr<VolumeSet> volume_;
+  std::filesystem::path volume_cache_;
+  std::function<void(const std::string&)> volume_note_;
+  bool volume_from_cache_ = false;
   VolumeSpec voxelized_spec_;
   std::unique_ptr<ViewRenderer> gpu_;
   std::unique_ptr<VolumeField> field_;
   std::unique_ptr<ReferenceMarcher> cpu_;
+  std::shared_ptr<void> early_pipeline_;  // startRenderPipeline's; ends before ctx_
 };
 
 }  // namespace eikon

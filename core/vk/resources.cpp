@@ -5,6 +5,7 @@
 
 #include "core/vk/check.h"
 #include "core/vk/specialise.h"
+#include "core/vk/spirv_cache.h"
 
 namespace eikon::vk {
 
@@ -74,6 +75,73 @@ void Buffer::read(void* dst, VkDeviceSize bytes, VkDeviceSize offset) const {
 }
 
 // ---------------------------------------------------------------- Image3D
+// On a CPU device (lavapipe), whose only memory is host memory, a volume is made with linear
+// tiling in host-visible memory where the device allows it for the format, and upload() writes
+// the texels straight into it: one copy instead of three (into a staging buffer, then the
+// device's copy into the image, each into freshly faulted pages) and no staging allocation
+// (issue 14 start-up: a 128³ RGBA32F volume is 32 MiB per image). Elsewhere: optimal tiling in
+// device-local memory and a staging copy, as GPUs want.
+namespace {
+
+/// Whether an image of this format and extent can be a linear-tiled storage image in host-visible
+/// memory that the host writes directly (Image3D's comment): on a CPU device only, where that
+/// memory is all the device has and linear tiling costs its kernels nothing.
+bool directUploadSupported(const Context& ctx, std::array<uint32_t, 3> extent, VkFormat format) {
+  if (ctx.properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return false;
+  VkFormatProperties fp;
+  vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice(), format, &fp);
+  if (!(fp.linearTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT)) return false;
+  VkImageFormatProperties ip;
+  if (vkGetPhysicalDeviceImageFormatProperties(
+          ctx.physicalDevice(), format, VK_IMAGE_TYPE_3D, VK_IMAGE_TILING_LINEAR,
+          VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, 0, &ip) != VK_SUCCESS)
+    return false;
+  return extent[0] <= ip.maxExtent.width && extent[1] <= ip.maxExtent.height &&
+         extent[2] <= ip.maxExtent.depth;
+}
+
+/// Image3D::upload of a directUploadSupported image: the texels written through a mapping of its
+/// memory (rows placed at the driver's pitches), then one barrier from the host's writes and the
+/// PREINITIALIZED layout to GENERAL.
+void uploadDirect(const Context& ctx, VkDevice device, VkImage image, VkDeviceMemory memory,
+                  const std::array<uint32_t, 3>& extent, const std::string& name, const void* data,
+                  VkDeviceSize bytes) {
+  VkImageSubresource sub{VK_IMAGE_ASPECT_COLOR_BIT, 0, 0};
+  VkSubresourceLayout layout;
+  vkGetImageSubresourceLayout(device, image, &sub, &layout);
+  const VkDeviceSize row = bytes / (VkDeviceSize(extent[1]) * extent[2]);
+  if (row * extent[1] * extent[2] != bytes || row > layout.rowPitch)
+    throw std::invalid_argument("volume '" + name + "': " + std::to_string(bytes) +
+                                " bytes do not fill its texels");
+  void* mapped = nullptr;
+  VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &mapped));
+  char* dst = static_cast<char*>(mapped) + layout.offset;
+  const char* src = static_cast<const char*>(data);
+  if (layout.rowPitch == row && layout.depthPitch == row * extent[1]) {
+    std::memcpy(dst, src, bytes);  // tightly packed, as the source: one copy
+  } else {
+    for (uint32_t z = 0; z < extent[2]; ++z)
+      for (uint32_t y = 0; y < extent[1]; ++y)
+        std::memcpy(dst + z * layout.depthPitch + y * layout.rowPitch,
+                    src + (VkDeviceSize(z) * extent[1] + y) * row, row);
+  }
+  vkUnmapMemory(device, memory);
+  ctx.submitAndWait([&](VkCommandBuffer cmd) {  // the host's writes made visible, in GENERAL
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_HOST_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_PREINITIALIZED;
+    b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_HOST_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
+                         0, nullptr, 0, nullptr, 1, &b);
+  });
+}
+
+}  // namespace
+
 Image3D::Image3D(const Context& ctx, std::array<uint32_t, 3> extent, VkFormat format,
                  std::string name)
     : device_(ctx.device()), extent_(extent), format_(format), name_(std::move(name)) {
@@ -88,6 +156,7 @@ Image3D::Image3D(const Context& ctx, std::array<uint32_t, 3> extent, VkFormat fo
   if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT))
     throw std::runtime_error("volume '" + name_ +
                              "': the device cannot use this format as a storage image");
+  const bool direct = directUploadSupported(ctx, extent, format);
   VkImageCreateInfo ii{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   ii.imageType = VK_IMAGE_TYPE_3D;
   ii.format = format;
@@ -95,9 +164,9 @@ Image3D::Image3D(const Context& ctx, std::array<uint32_t, 3> extent, VkFormat fo
   ii.mipLevels = 1;
   ii.arrayLayers = 1;
   ii.samples = VK_SAMPLE_COUNT_1_BIT;
-  ii.tiling = VK_IMAGE_TILING_OPTIMAL;
+  ii.tiling = direct ? VK_IMAGE_TILING_LINEAR : VK_IMAGE_TILING_OPTIMAL;
   ii.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-  ii.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  ii.initialLayout = direct ? VK_IMAGE_LAYOUT_PREINITIALIZED : VK_IMAGE_LAYOUT_UNDEFINED;
   VK_CHECK(vkCreateImage(device_, &ii, nullptr, &image_));
   VkMemoryRequirements req;
   vkGetImageMemoryRequirements(device_, image_, &req);
@@ -107,7 +176,10 @@ Image3D::Image3D(const Context& ctx, std::array<uint32_t, 3> extent, VkFormat fo
                              std::to_string(ctx.limits().heap_size >> 20) + " MiB)");
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   ai.allocationSize = req.size;
-  ai.memoryTypeIndex = ctx.findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  ai.memoryTypeIndex =
+      ctx.findMemoryType(req.memoryTypeBits, direct ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                                          VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                                    : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   VkResult r = vkAllocateMemory(device_, &ai, nullptr, &memory_);
   if (r != VK_SUCCESS) {
     release();
@@ -150,6 +222,8 @@ void Image3D::release() noexcept {
 }
 
 void Image3D::upload(const Context& ctx, const void* data, VkDeviceSize bytes) {
+  if (directUploadSupported(ctx, extent_, format_))  // as the constructor decided
+    return uploadDirect(ctx, device_, image_, memory_, extent_, name_, data, bytes);
   Buffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, name_ + " staging");
   staging.write(data, bytes);
   ctx.submitAndWait([&](VkCommandBuffer cmd) {
@@ -189,7 +263,10 @@ ComputePipeline::ComputePipeline(const Context& ctx, std::span<const uint32_t> s
   // the constants disable, and no specialisation info.
   std::vector<uint32_t> specialised;
   if (!specialization.empty()) {
-    specialised = specialiseSpirv(spirv, specialization);
+    // Through the SPIR-V cache beside the pipeline cache (core/vk/spirv_cache.h).
+    const std::filesystem::path& cache = ctx.pipelineCacheFile();
+    specialised =
+        specialiseSpirvCached(spirv, specialization, cache.empty() ? cache : cache.parent_path());
     spirv = specialised;
   }
   VkShaderModuleCreateInfo si{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};

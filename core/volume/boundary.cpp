@@ -198,7 +198,7 @@ double boundaryHostBytes(const Grid& g) {
          double(g.dims[2]);
 }
 
-BoundaryField buildBoundaryField(const Scene& scene, const Grid& g, int threads) {
+BoundaryField boundaryFieldShapes(const Scene& scene, const Grid& g) {
   if (scene.objects.size() > kMaxRegions)
     throw SceneError(scene.file.string() + ": /objects: sharp interfaces allow at most " +
                      std::to_string(kMaxRegions) + " objects, got " +
@@ -206,8 +206,6 @@ BoundaryField buildBoundaryField(const Scene& scene, const Grid& g, int threads)
                      " (or set \"interfaces\": \"smoothed\")");
   BoundaryField bf;
   bf.grid = g;
-  bf.region.assign(g.count(), 0);
-  bf.distance.assign(g.count(), bf.cap);
   std::map<std::string, int> material_ids;
   bf.media = {""};
   for (const auto& [name, m] : scene.materials) {
@@ -220,6 +218,13 @@ BoundaryField buildBoundaryField(const Scene& scene, const Grid& g, int threads)
     bf.medium.push_back(material_ids.at(obj.material));
   }
   bf.convex_apart = convexShapesApart(bf.shapes, g.h);
+  return bf;
+}
+
+BoundaryField buildBoundaryField(const Scene& scene, const Grid& g, int threads) {
+  BoundaryField bf = boundaryFieldShapes(scene, g);
+  bf.region.assign(g.count(), 0);
+  bf.distance.assign(g.count(), bf.cap);
   // Objects in scene order, each painting over the earlier ones where it contains the centre (the
   // compositing's order). Inside object i the distance restarts at −sd_i; outside it, sd_i bounds
   // the distance to the region boundary it makes (the region r < i + 1 is cut by it).

@@ -60,6 +60,11 @@ double boundaryHostBytes(const Grid& grid);
 /// SceneError if the scene has more objects than a 16-bit region id holds.
 BoundaryField buildBoundaryField(const Scene& scene, const Grid& grid, int threads = 0);
 
+/// A scene's field without its per-voxel arrays: the grid, the shapes, the media and their names,
+/// convex_apart (what buildBoundaryField sets before painting the voxels; the volume cache
+/// rebuilds a stored field's with it). Throws as buildBoundaryField.
+BoundaryField boundaryFieldShapes(const Scene& scene, const Grid& grid);
+
 /// φ_A at a world point (mm; > 0 inside region A), trilinear; its gradient (∂φ/∂x, unitless) in
 /// *gradient when given.
 double boundaryPhi(const BoundaryField& field, const glm::dvec3& x, int region,

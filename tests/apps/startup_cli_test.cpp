@@ -168,4 +168,61 @@ TEST_F(StartupCli, PipelineCacheIsWrittenAndACorruptOneIgnored) {
   EXPECT_EQ(third.err, "");
 }
 
+/// The volume cache's entries (core/volume/volume_cache.h) in the test's cache folder.
+std::vector<fs::path> volumeEntries(const fs::path& cache) {
+  std::vector<fs::path> files;
+  if (!fs::exists(cache)) return files;
+  for (const auto& e : fs::directory_iterator(cache))
+    if (e.path().filename().string().rfind("volume-", 0) == 0) files.push_back(e.path());
+  return files;
+}
+
+// A GPU render stores its voxelised volume in EIKON_CACHE_DIR; the next render of the scene reads
+// it back and writes the same EXR, byte for byte, as the first and as a render that voxelises
+// (--no-volume-cache, which neither reads nor writes an entry).
+TEST_F(StartupCli, VolumeCacheGivesTheSameRender) {
+  const Outcome plain = render("-q --no-volume-cache");
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_TRUE(volumeEntries(dir_ / "cache").empty());
+  const std::string voxelised = eikon::test::slurp(dir_ / "out.exr");
+  const Outcome first = render("-q");
+  ASSERT_EQ(first.code, 0) << first.err;
+  EXPECT_EQ(first.err, "");
+  ASSERT_EQ(volumeEntries(dir_ / "cache").size(), 1u);
+  EXPECT_EQ(eikon::test::slurp(volumeEntries(dir_ / "cache")[0]).substr(0, 8), "EIKVOXEL");
+  EXPECT_EQ(eikon::test::slurp(dir_ / "out.exr"), voxelised);
+  const Outcome second = render("-q");
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_EQ(second.err, "");
+  EXPECT_EQ(volumeEntries(dir_ / "cache").size(), 1u);
+  EXPECT_EQ(eikon::test::slurp(dir_ / "out.exr"), voxelised);
+}
+
+// A damaged entry is ignored with one "eikon: note:" line, the scene voxelised again (the same
+// render), and the entry replaced: the next render is silent.
+TEST_F(StartupCli, ACorruptVolumeCacheIsIgnoredWithOneNote) {
+  ASSERT_EQ(render("-q").code, 0);
+  const std::string good_render = eikon::test::slurp(dir_ / "out.exr");
+  const std::vector<fs::path> files = volumeEntries(dir_ / "cache");
+  ASSERT_EQ(files.size(), 1u);
+  const std::string good = eikon::test::slurp(files[0]);
+  std::string flipped = good;
+  flipped[flipped.size() - 5] ^= 0x20;
+  for (const std::string& bad : {good.substr(0, good.size() / 3), flipped}) {
+    std::ofstream(files[0], std::ios::binary | std::ios::trunc) << bad;
+    const Outcome r = render("-q");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.rfind("eikon: note: volume cache '", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(bad.size() < good.size() ? "ignored: truncated" : "checksum mismatch"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(eikon::test::slurp(dir_ / "out.exr"), good_render);
+    EXPECT_EQ(eikon::test::slurp(files[0]), good);  // replaced by a whole entry
+  }
+  const Outcome after = render("-q");
+  ASSERT_EQ(after.code, 0) << after.err;
+  EXPECT_EQ(after.err, "");
+}
+
 }  // namespace
