@@ -247,6 +247,7 @@ struct ViewRenderer::Impl {
   bool convex = false;       // sharp: some region's shape is a convex polyhedron
   bool mesh = false;         // sharp: some region's shape is a non-convex mesh
   bool convexApart = false;  // sharp: every shape is one, apart (core/volume/boundary.h)
+  int exact = 0;             // sharp, on the shapes (boundary.h exact): kExact (march.glsl)
   // [oA, oB, oC, (eA, eB, eC), medO, (medE), emission, (axis), (scatter), (fluence, flux)]
   std::vector<vk::Image3D> images;
   size_t scatterImage = 0, fluenceImage = 0,
@@ -288,6 +289,7 @@ struct ViewRenderer::Impl {
       mesh = mesh || std::holds_alternative<MeshShape>(shape.geometry());
     }
     convexApart = v.boundary.convex_apart;
+    if (sharp && v.boundary.exact) exact = exactConstant(v.boundary);
     std::vector<vk::BindingSpec> common;  // the bindings of both kernels (the trace's adds rays)
     for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
       common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
@@ -362,6 +364,23 @@ struct ViewRenderer::Impl {
     timings::mark("volume uploaded");
   }
 
+  // kExact (march.glsl): the shape table's rows, the shape count and the kinds present.
+  static int exactConstant(const BoundaryField& bf) {
+    int kinds = 0;
+    for (const Shape& shape : bf.shapes)
+      std::visit(
+          [&](const auto& g) {
+            using T = std::decay_t<decltype(g)>;
+            if constexpr (std::is_same_v<T, SphereShape>) kinds |= 1 << EIKON_SHAPE_SPHERE;
+            if constexpr (std::is_same_v<T, BoxShape>) kinds |= 1 << EIKON_SHAPE_BOX;
+            if constexpr (std::is_same_v<T, RoundedBoxShape>) kinds |= 1 << EIKON_SHAPE_ROUNDED_BOX;
+            if constexpr (std::is_same_v<T, ConvexShape>) kinds |= 1 << EIKON_SHAPE_CONVEX;
+          },
+          shape.geometry());
+    const int rows = exactTableRows(bf.shapes);  // ≤ kExactMaxRows (256) on the exact path
+    return rows | int(bf.shapes.size()) << 10 | kinds << 20;
+  }
+
   // The AOV layer is view.comp's pass.w bit 8 (render()), its kAov constant.
   static Key keyOf(Kernel kernel, const gpu::ViewParams& p, bool sharp) {
     const int aov = kernel == kView && (p.pass.w & kAovPassBit) != 0 ? 1 : 0;
@@ -371,9 +390,10 @@ struct ViewRenderer::Impl {
   // The view, trace or polarised-trace kernel specialised for the flags and integrator of a key.
   vk::ComputePipeline build(const Key& key) const {
     const auto [kernel, flags, integrator, sharpMarch, aov] = key;
-    // constant_id 0: kSharpMarch, 1: kViewFlags, 2: kIntegrator, 3: kAov (march.glsl).
+    // constant_id 0: kSharpMarch, 1: kViewFlags, 2: kIntegrator, 3: kAov, 4: kExact (march.glsl;
+    // kExact is the scene's, like the volumes: one Impl per scene).
     const std::vector<uint32_t> spec{uint32_t(sharpMarch), uint32_t(flags), uint32_t(integrator),
-                                     uint32_t(aov)};
+                                     uint32_t(aov), uint32_t(exact)};
     auto make = [&](std::span<const uint32_t> code, const std::vector<vk::BindingSpec>& b,
                     const char* name) { return vk::ComputePipeline(ctx, code, b, 0, name, spec); };
     return kernel == kTrace  ? make({k_trace_spv, sizeof(k_trace_spv) / 4}, traceBindings, "trace")
@@ -471,6 +491,7 @@ struct ViewRenderer::Impl {
     if (sharp && convex) flags |= EIKON_F_CONVEX;
     if (sharp && mesh) flags |= EIKON_F_MESH;
     if (sharp && convexApart) flags |= EIKON_F_CONVEX_APART;
+    if (sharp && exact != 0) flags |= EIKON_F_EXACT;
     if (!m.skip_empty) flags |= EIKON_F_NO_SKIP;
     if (!m.fresnel) flags |= EIKON_F_NO_FRESNEL;
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
