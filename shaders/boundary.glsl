@@ -679,4 +679,271 @@ BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
   return c;
 }
 
+
+// ---- Crossings on the analytic shapes (boundary.cpp: regionAt, exactCrossingOutOf;
+// shapes.cpp: Shape::clipLine) ----
+// EIKON_BOUNDARY_EXACT: every shape is analytic and not convex_apart (EIKON_F_EXACT in the view
+// kernels; core/volume/boundary.h exact): nextCrossing (sharp.glsl) then takes exactCrossingOutOf
+// and sharpEnter exactRegionAt. EIKON_BOUNDARY_EXACT_ROWS: the shape table's rows (6 per shape,
+// one per plane), _SHAPES: the shape count, _KINDS: the kinds present (bit 1 << EIKON_SHAPE_*), so
+// that the clip of a kind the scene lacks is compiled out (a rounded box's is ~100 distances).
+// march.glsl makes all four specialization constants (kExact); other kernels keep the walk.
+#ifndef EIKON_BOUNDARY_EXACT
+#define EIKON_BOUNDARY_EXACT false
+#define EIKON_BOUNDARY_EXACT_ROWS 0
+#define EIKON_BOUNDARY_EXACT_SHAPES 0
+#define EIKON_BOUNDARY_EXACT_KINDS 0
+#endif
+#define EIKON_EXACT_HAS(kind) ((EIKON_BOUNDARY_EXACT_KINDS & (1 << (kind))) != 0)
+const float kExactMergeVoxels = 1e-4;
+// The loops over the shapes read the table's rows from this private copy, made once per
+// invocation (exactLoadShapes): llvmpipe reads a storage buffer at a varying index inside
+// divergent control flow one lane at a time (a loop over the 8 lanes, each behind a branch), a
+// private array with a gather. kExactMaxRows (core/volume/boundary.h) bounds the copy.
+const int kExactMaxRows = 256;
+vec4 gShapeRows[kExactMaxRows];
+bool gShapeRowsLoaded = false;
+
+void exactLoadShapes() {
+  if (gShapeRowsLoaded) return;
+  gShapeRowsLoaded = true;
+  for (int k = 0; k < min(EIKON_BOUNDARY_EXACT_ROWS, kExactMaxRows); ++k)
+    gShapeRows[k] = shapeTable[k];
+}
+
+struct LineClip {
+  bool hit;
+  float t0, t1;  // the line o + t·d inside the shape for t ∈ [t0, t1]
+  vec3 n0, n1;   // local outward normals at the two ends
+};
+
+LineClip clipOpen() {
+  LineClip c;
+  c.hit = true;
+  c.t0 = -3.0e38;
+  c.t1 = 3.0e38;
+  c.n0 = vec3(0.0);
+  c.n1 = vec3(0.0);
+  return c;
+}
+
+// The slab of one plane n·(p + t q) ≤ d narrows [t0, t1] (shapes.cpp clipPlane).
+void clipPlaneInto(vec3 n, float d, vec3 p, vec3 q, inout LineClip c) {
+  float denom = dot(n, q), num = d - dot(n, p);
+  float t = num / (denom != 0.0 ? denom : 1.0);
+  if (denom > 0.0 && t < c.t1) {
+    c.t1 = t;
+    c.n1 = n;
+  } else if (denom < 0.0 && t > c.t0) {
+    c.t0 = t;
+    c.n0 = n;
+  } else if (denom == 0.0 && num < 0.0) {
+    c.hit = false;  // parallel to the plane and outside it
+  }
+}
+
+// |p + t q| = r without cancellation (clipSphere).
+LineClip clipSphereLocal(vec3 p, vec3 q, float r) {
+  LineClip c = clipOpen();
+  float a = dot(q, q), b = dot(p, q), cc = dot(p, p) - r * r;
+  float disc = b * b - a * cc;
+  c.hit = a > 0.0 && disc >= 0.0;
+  float k = -(b + (b < 0.0 ? -sqrt(max(disc, 0.0)) : sqrt(max(disc, 0.0))));
+  float ta = k / a, tb = k != 0.0 ? cc / k : -ta;
+  c.t0 = min(ta, tb);
+  c.t1 = max(ta, tb);
+  c.n0 = (p + c.t0 * q) / r;
+  c.n1 = (p + c.t1 * q) / r;
+  return c;
+}
+
+float roundedAlong(vec3 p, vec3 q, vec4 par, float t) {
+  return boxDistance(p + t * q, par.xyz) - par.w;
+}
+
+// A rounded box (the box `core` = par.xyz grown by r = par.w): its signed distance along the line
+// is convex inside the outer box, so a golden-section search finds its minimum and bisections its
+// two zeros (clipRoundedBox). Four steps per loop pass (lavapipe's loop budget).
+LineClip clipRoundedBoxLocal(vec3 p, vec3 q, vec4 par, LineClip outer) {
+  const float g = 0.6180339887;
+  float lo = outer.t0, hi = outer.t1;
+  float x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+  float f1 = roundedAlong(p, q, par, x1), f2 = roundedAlong(p, q, par, x2);
+  for (int it = 0; it < 10; ++it) {
+    [[unroll]] for (int j = 0; j < 4; ++j) {
+      if (f1 < f2) {
+        hi = x2;
+        x2 = x1;
+        f2 = f1;
+        x1 = hi - g * (hi - lo);
+        f1 = roundedAlong(p, q, par, x1);
+      } else {
+        lo = x1;
+        x1 = x2;
+        f1 = f2;
+        x2 = lo + g * (hi - lo);
+        f2 = roundedAlong(p, q, par, x2);
+      }
+    }
+  }
+  float tm = f1 < f2 ? x1 : x2;
+  LineClip c = outer;
+  c.hit = outer.hit && roundedAlong(p, q, par, tm) <= 0.0;
+  [[unroll]] for (int e = 0; e < 2; ++e) {
+    float inside = tm, outside = e == 0 ? outer.t0 : outer.t1;
+    if (roundedAlong(p, q, par, outside) <= 0.0) {
+      inside = outside;
+    } else {
+      for (int it = 0; it < 8; ++it) {
+        [[unroll]] for (int j = 0; j < 4; ++j) {
+          float mid = 0.5 * (inside + outside);
+          if (roundedAlong(p, q, par, mid) <= 0.0) inside = mid;
+          else outside = mid;
+        }
+      }
+    }
+    if (e == 0) c.t0 = inside;
+    else c.t1 = inside;
+  }
+  c.n0 = boxGradient(p + c.t0 * q, par.xyz);
+  c.n1 = boxGradient(p + c.t1 * q, par.xyz);
+  return c;
+}
+
+const int kExactPlanesPerPass = 8;
+
+// Shape s's interval along the world line o + t·d (Shape::clipLine), normals in the shape's local
+// frame. A box and a convex polyhedron share one plane loop (a box's six planes made from its
+// half sizes, boundary.cpp localPlanes), so that llvmpipe, which runs every kind's code for every
+// shape, runs one; kExactPlanesPerPass planes a pass (the index clamped to the last plane, which
+// a repeated slab leaves unchanged).
+LineClip exactClip(int s, vec3 o, vec3 d) {
+  int off = EIKON_SHAPE_STRIDE * s;
+  vec4 head = gShapeRows[off], par = gShapeRows[off + 5];
+  vec3 R0 = gShapeRows[off + 2].xyz, R1 = gShapeRows[off + 3].xyz, R2 = gShapeRows[off + 4].xyz;
+  vec3 x = o - gShapeRows[off + 1].xyz;
+  vec3 p = vec3(dot(R0, x), dot(R1, x), dot(R2, x)), q = vec3(dot(R0, d), dot(R1, d), dot(R2, d));
+  int kind = int(head.x);
+  if (EIKON_EXACT_HAS(EIKON_SHAPE_SPHERE) && kind == EIKON_SHAPE_SPHERE)
+    return clipSphereLocal(p, q, par.x);
+  bool rounded = EIKON_EXACT_HAS(EIKON_SHAPE_ROUNDED_BOX) && kind == EIKON_SHAPE_ROUNDED_BOX;
+  bool box = kind == EIKON_SHAPE_BOX || rounded;
+  LineClip c = clipOpen();
+  if (!EIKON_EXACT_HAS(EIKON_SHAPE_BOX) && !EIKON_EXACT_HAS(EIKON_SHAPE_CONVEX) &&
+      !EIKON_EXACT_HAS(EIKON_SHAPE_ROUNDED_BOX)) {
+    c.hit = false;  // unreachable: spheres only
+    return c;
+  }
+  vec3 half_size = rounded ? par.xyz + vec3(par.w) : par.xyz;
+  int first = int(head.y), count = box ? 6 : int(head.z);
+  for (int k = 0; count > 0;) {  // the test at the end: no pass is spent on a failing test
+    [[unroll]] for (int j = 0; j < kExactPlanesPerPass; ++j) {
+      int i = min(k + j, count - 1);
+      vec4 pl;
+      if (!EIKON_EXACT_HAS(EIKON_SHAPE_CONVEX) || box) {
+        vec3 n = vec3(0.0);
+        n[i >> 1] = (i & 1) != 0 ? 1.0 : -1.0;
+        pl = vec4(n, half_size[i >> 1]);
+      } else {
+        pl = gShapeRows[min(first + i, kExactMaxRows - 1)];
+      }
+      clipPlaneInto(pl.xyz, pl.w, p, q, c);
+    }
+    k += kExactPlanesPerPass;
+    if (k >= count) break;
+  }
+  c.hit = c.hit && c.t0 <= c.t1;
+  if (rounded && c.hit) return clipRoundedBoxLocal(p, q, par, c);
+  return c;
+}
+
+// A local normal of shape s in world space.
+vec3 exactToWorld(int s, vec3 n) {
+  int off = EIKON_SHAPE_STRIDE * s;
+  return n.x * gShapeRows[off + 2].xyz + n.y * gShapeRows[off + 3].xyz +
+         n.z * gShapeRows[off + 4].xyz;
+}
+
+// Whether world point x lies in shape s (signed distance ≤ 0, Shape::signedDistance's sign).
+bool exactInside(int s, vec3 x) {
+  int off = EIKON_SHAPE_STRIDE * s;
+  vec4 head = gShapeRows[off], par = gShapeRows[off + 5];
+  vec3 y = x - gShapeRows[off + 1].xyz;
+  vec3 p = vec3(dot(gShapeRows[off + 2].xyz, y), dot(gShapeRows[off + 3].xyz, y),
+                dot(gShapeRows[off + 4].xyz, y));
+  int kind = int(head.x);
+  if (kind == EIKON_SHAPE_SPHERE) return length(p) <= par.x;
+  if (kind == EIKON_SHAPE_BOX) return boxDistance(p, par.xyz) <= 0.0;
+  if (kind == EIKON_SHAPE_ROUNDED_BOX) return boxDistance(p, par.xyz) <= par.w;
+  float m = -3.0e38;
+  if (!EIKON_EXACT_HAS(EIKON_SHAPE_CONVEX)) return false;  // (unreachable then)
+  int first = int(head.y), count = int(head.z);
+  for (int k = 0; count > 0;) {
+    [[unroll]] for (int j = 0; j < kExactPlanesPerPass; ++j) {
+      vec4 pl = gShapeRows[min(first + min(k + j, count - 1), kExactMaxRows - 1)];
+      m = max(m, dot(pl.xyz, p) - pl.w);
+    }
+    k += kExactPlanesPerPass;
+    if (k >= count) break;
+  }
+  return m <= 0.0;
+}
+
+// The later of the objects containing x (boundary.cpp regionAt); 0 for none.
+int exactRegionAt(vec3 x) {
+  exactLoadShapes();
+  int r = 0;
+  for (int i = 0; i < EIKON_BOUNDARY_EXACT_SHAPES; ++i)
+    if (exactInside(i, x)) r = i + 1;
+  return r;
+}
+
+// The region at x: on the shapes on the exact path (regionAt), else the field's.
+int regionAt(vec3 x) { return EIKON_BOUNDARY_EXACT ? exactRegionAt(x) : boundaryRegion(x); }
+
+// The first point of [a, b] where the region changes from `region` (boundary.cpp
+// exactCrossingOutOf): pass 0 over the shapes from the ray's own on finds where the line leaves
+// its shape or enters a later one, pass 1 over all the region just past that point (the last
+// shape whose interval holds it) and its entry normal. One loop body (exactClip inlined once);
+// ~2 × the shape count loop passes and no voxel read per crossing.
+BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
+  exactLoadShapes();
+  BoundaryCrossing out_ = noCrossing(b, region);
+  vec3 d = b - a;
+  float len = length(d);
+  if (!(len > 0.0)) return out_;
+  float eps = kExactMergeVoxels * P.grid_origin.w / len;
+  float t = 2.0, tq = 0.0;
+  int to = 0;
+  vec3 nOwn = vec3(0.0), nTo = vec3(0.0);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int i = pass == 0 ? max(region - 1, 0) : 0; i < EIKON_BOUNDARY_EXACT_SHAPES; ++i) {
+      LineClip c = exactClip(i, a, d);
+      if (!c.hit) continue;
+      if (pass == 1) {
+        if (c.t0 <= tq && tq <= c.t1) {
+          to = i + 1;
+          nTo = c.n0;
+        }
+      } else if (i + 1 == region) {
+        t = min(t, max(c.t1, 0.0));
+        nOwn = c.n1;
+      } else if (c.t0 > eps && c.t1 - c.t0 > eps) {
+        t = min(t, c.t0);
+      }
+    }
+    if (t > 1.0) return out_;
+    tq = t + eps;
+  }
+  if (to == region) return out_;
+  int owner = max(region, to);
+  vec3 n = exactToWorld(owner - 1, to == owner ? -nTo : nOwn);
+  out_.found = true;
+  out_.t = t;
+  out_.point = a + t * d;
+  out_.normal = length(n) > 0.0 ? normalize(n) : n;
+  out_.to = to;
+  return out_;
+}
+
 #endif  // EIKON_BOUNDARY_GLSL

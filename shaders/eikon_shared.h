@@ -73,6 +73,9 @@ using uvec4 = glm::uvec4;
 // sharp: every shape is a convex polyhedron, apart from the others (core/volume/boundary.h
 // convex_apart): crossings come from the planes (boundary.glsl convexCrossing), no cell walk.
 #define EIKON_F_CONVEX_APART 16384
+// sharp: every shape is analytic and they are not convex_apart (core/volume/boundary.h exact):
+// crossings and regions on the shapes (boundary.glsl exactCrossingOutOf), no voxel read.
+#define EIKON_F_EXACT 32768
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0

@@ -82,12 +82,16 @@ vec4 gRecorded[6];
 //   kSharpMarch: the sharp march (EIKON_F_SHARP) instead of the smoothed one;
 //   kViewFlags: the EIKON_F_* flags of the scene and the render (P.grid_dims.w);
 //   kIntegrator: EIKON_INT_* (P.march.w);
+//   kExact: on the exact path (EIKON_F_EXACT, core/volume/boundary.h exact) the shape table's
+//     rows in bits 0–9, the shape count in bits 10–19 and the kinds present (1 << EIKON_SHAPE_*)
+//     in bits 20–24 (boundary.glsl exactCrossingOutOf); 0 otherwise.
 //   kAov: the march notes its first interface (MarchResult.hit…; view.comp's AOV layer). Off, the
 //     notes fold away and a render without the layer runs the code it ran before.
 layout(constant_id = 0) const bool kSharpMarch = false;
 layout(constant_id = 1) const int kViewFlags = -1;
 layout(constant_id = 2) const int kIntegrator = -1;
 layout(constant_id = 3) const bool kAov = false;
+layout(constant_id = 4) const int kExact = 0;
 
 #define EIKON_FIELD_FLAGS (kViewFlags == -1 ? P.grid_dims.w : kViewFlags)
 #define EIKON_FIELD_INV_H P.grid_extent.w
@@ -100,6 +104,10 @@ layout(constant_id = 3) const bool kAov = false;
 #define EIKON_BOUNDARY_HAS_CONVEX hasFlag(EIKON_F_CONVEX)
 #define EIKON_BOUNDARY_HAS_MESH hasFlag(EIKON_F_MESH)
 #define EIKON_BOUNDARY_CONVEX_APART hasFlag(EIKON_F_CONVEX_APART)
+#define EIKON_BOUNDARY_EXACT (hasFlag(EIKON_F_EXACT) && kExact != 0)
+#define EIKON_BOUNDARY_EXACT_ROWS (kExact & 0x3FF)
+#define EIKON_BOUNDARY_EXACT_SHAPES ((kExact >> 10) & 0x3FF)
+#define EIKON_BOUNDARY_EXACT_KINDS (kExact >> 20)
 #include "field.glsl"
 #include "boundary.glsl"
 

@@ -146,7 +146,7 @@ vec3 orientNormal(vec3 N, vec3 flow) { return dot(N, flow) < 0.0 ? -N : N; }
 // Box entry: the region there, and the wave vector of the mode in its medium along d.
 void sharpEnter(inout MarchState S, vec3 x, vec3 d, int mode) {
   S.x = x;
-  S.region = boundaryRegion(x);
+  S.region = regionAt(x);  // on the shapes on the exact path, else the field's
   float n = regionIndex(S.region, 0, x);
   vec4 af = regionAxisField(S.region, x);
   if (mode == 1 && hasAxis(af.xyz))
@@ -163,13 +163,17 @@ vec3 sharpDirection(MarchState S, int mode) {
 
 #endif  // EIKON_SHARP_NO_MARCH
 
-// The first crossing on [a, b] out of the ray's region, skipping slivers (a crossing back into the
-// ray's own region within kSliverVoxels of a).
+// The first crossing on [a, b] out of the ray's region by the one dispatch of both twins
+// (core/volume/boundary.h crossingOutOf): the planes of convex polyhedra apart from each other
+// (convexCrossing), else the analytic shapes (exactCrossingOutOf), else the walk over the field
+// (a mesh's crossing refined on its BVH), skipping slivers (a crossing back into the ray's own
+// region within kSliverVoxels of a).
 BoundaryCrossing nextCrossing(vec3 a, vec3 b, int region) {
   BoundaryCrossing none = noCrossing(b, region);
   float total = length(b - a);
   if (!(total > 0.0)) return none;
   if (EIKON_BOUNDARY_CONVEX_APART) return convexCrossing(a, b, region);
+  if (EIKON_BOUNDARY_EXACT) return exactCrossingOutOf(a, b, region);
   vec3 dir = (b - a) / total;
   float h = P.grid_origin.w;
   vec3 start = a;

@@ -103,9 +103,10 @@ OpticalMedium Tracer::mediumOf(int region, const glm::dvec3& x) const {
       Uniaxial(n_o, mediumIndexAt(m, 1, lambda_, x), glm::dvec3(mediumAxisField(m, x))));
 }
 
-// The sharp marches' search (core/volume/boundary.h nextCrossingOutOf: the sliver rule).
+// The sharp marches' search (core/volume/boundary.h crossingOutOf: the planes, the shapes or the
+// walk with its sliver rule, as polarised_trace.comp's nextCrossing).
 BoundaryCrossing Tracer::nextCrossing(const glm::dvec3& a, const glm::dvec3& b, int region) const {
-  return nextCrossingOutOf(*bf_, a, b, region);
+  return crossingOutOf(*bf_, a, b, region);
 }
 
 // An ideal dichroic sheet absorbs the field along its absorbing direction b = normal × axis

@@ -568,8 +568,8 @@ MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
 // Box entry: the region there, and the wave vector of the mode in its medium along d.
 void RayMarch::sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& d) const {
   S.x = x;
-  S.region = boundaryRegion(*bf_, x);
-  ++f_.fetches;  // the cell around x
+  S.region = regionAt(*bf_, x);
+  if (!bf_->exact) ++f_.fetches;  // the cell around x (exact: on the shapes, no cell)
   const MediumRecord& m = rec(S.region);
   double n = regionIndex(S.region, 0, x);
   const glm::dvec4 af = mediumAxisField(m, x);
@@ -586,20 +586,17 @@ glm::dvec3 RayMarch::sharpDirection(const MarchState& S) const {
                                       regionIndex(S.region, 1, S.x)));
 }
 
-// The first crossing on [a, b] out of the ray's region (nextCrossingOutOf: the sliver rule; or
-// convexCrossingOutOf where every shape is a convex polyhedron apart from the others), counting
-// the cells each search reads: the region at its start, the cells walked to the crossing, and
-// (found) the cells past it and at it (the region entered, the field's normal).
+// The first crossing on [a, b] out of the ray's region by the one dispatch (crossingOutOf, as
+// march.glsl's nextCrossing): the planes (convex_apart), the shapes (exact) or the walk (the
+// sliver rule), counting the cells each search reads: convex_apart the field normal's cell;
+// exact none; the walk the region at its start, the cells walked to the crossing, and (found)
+// the cells past it and at it (the region entered, the field's normal).
 BoundaryCrossing RayMarch::nextCrossing(const glm::dvec3& a, const glm::dvec3& b,
                                         int region) const {
-  if (bf_->convex_apart) {  // the planes' own crossing (march.glsl: EIKON_F_CONVEX_APART)
-    f_.fetches += 1;        // the cell of the field normal
-    return convexCrossingOutOf(*bf_, a, b, region);
-  }
-  return nextCrossingOutOf(
-      *bf_, a, b, region, [&](const glm::dvec3& start, const BoundaryCrossing& c) {
-        f_.fetches += 1 + cellsOn(start, c.found ? c.point : b) + (c.found ? 2 : 0);
-      });
+  if (bf_->convex_apart) f_.fetches += 1;  // the cell of the field normal
+  return crossingOutOf(*bf_, a, b, region, [&](const glm::dvec3& start, const BoundaryCrossing& c) {
+    f_.fetches += 1 + cellsOn(start, c.found ? c.point : b) + (c.found ? 2 : 0);
+  });
 }
 
 // The trilinear cells of the boundary field that [a, b] passes through, which locateCrossing

@@ -30,6 +30,10 @@ namespace eikon {
 /// what the view kernel's specialisation takes from the volume (a render adds its own).
 int volumeFeatureFlags(const VolumeSet& volume);
 
+/// The view kernel's kExact constant for a volume (march.glsl: the shape table's rows, shape
+/// count and kinds of the exact path), 0 where the volume does not take that path.
+int volumeExactConstant(const VolumeSet& volume);
+
 /// volumeFeatureFlags(voxelize(scene)) (with light volumes when `lit`), without voxelising the
 /// scene at its resolution: milliseconds.
 int predictVolumeFeatureFlags(const Scene& scene, bool lit);

@@ -209,8 +209,9 @@ class BackgroundCompiler {
   std::thread worker_;
 };
 
-// A pipeline's key: kernel, flags, integrator, sharp, AOV; kernel 0 is ViewRenderer::Impl::kView.
-using PipelineKey = std::tuple<int, int, int, int, int>;
+// A pipeline's key: kernel, flags, integrator, sharp, AOV, kExact; kernel 0 is
+// ViewRenderer::Impl::kView.
+using PipelineKey = std::tuple<int, int, int, int, int, int>;
 constexpr int kViewKernel = 0;
 
 /// The bindings of the view kernel (the trace kernels add theirs).
@@ -228,11 +229,29 @@ std::vector<vk::BindingSpec> viewKernelBindings() {
   return common;
 }
 
+// kExact (march.glsl): the shape table's rows, the shape count and the kinds present.
+int exactConstant(const BoundaryField& bf) {
+  int kinds = 0;
+  for (const Shape& shape : bf.shapes)
+    std::visit(
+        [&](const auto& g) {
+          using T = std::decay_t<decltype(g)>;
+          if constexpr (std::is_same_v<T, SphereShape>) kinds |= 1 << EIKON_SHAPE_SPHERE;
+          if constexpr (std::is_same_v<T, BoxShape>) kinds |= 1 << EIKON_SHAPE_BOX;
+          if constexpr (std::is_same_v<T, RoundedBoxShape>) kinds |= 1 << EIKON_SHAPE_ROUNDED_BOX;
+          if constexpr (std::is_same_v<T, ConvexShape>) kinds |= 1 << EIKON_SHAPE_CONVEX;
+        },
+        shape.geometry());
+  const int rows = exactTableRows(bf.shapes);  // ≤ kExactMaxRows (256) on the exact path
+  return rows | int(bf.shapes.size()) << 10 | kinds << 20;
+}
+
 /// The specialisation constants of a key: constant_id 0: kSharpMarch, 1: kViewFlags,
-/// 2: kIntegrator, 3: kAov (march.glsl).
+/// 2: kIntegrator, 3: kAov, 4: kExact (march.glsl).
 std::vector<uint32_t> specialisationOf(const PipelineKey& key) {
-  const auto [kernel, flags, integrator, sharpMarch, aov] = key;
-  return {uint32_t(sharpMarch), uint32_t(flags), uint32_t(integrator), uint32_t(aov)};
+  const auto [kernel, flags, integrator, sharpMarch, aov, exact] = key;
+  return {uint32_t(sharpMarch), uint32_t(flags), uint32_t(integrator), uint32_t(aov),
+          uint32_t(exact)};
 }
 
 /// The EIKON_F_* flags of a render's settings (spectral) and march (no skipping, no Fresnel).
@@ -297,20 +316,32 @@ int volumeFeatureFlags(const VolumeSet& v) {
   if (sharp && convex) flags |= EIKON_F_CONVEX;
   if (sharp && mesh) flags |= EIKON_F_MESH;
   if (sharp && v.boundary.convex_apart) flags |= EIKON_F_CONVEX_APART;
+  if (sharp && v.boundary.exact) flags |= EIKON_F_EXACT;
   return flags;
 }
 
-int predictVolumeFeatureFlags(const Scene& scene, bool lit) {
-  // The flags come from the materials and the shapes (voxelize's materialValues, the boundary
-  // field's shapes and the media table), not from the grid, except convex_apart: a 4-voxel
-  // voxelisation of the same scene gives them in milliseconds, convex_apart taken at the real h.
+int volumeExactConstant(const VolumeSet& v) {
+  const bool sharp = !v.boundary.empty() && !v.media.empty();
+  return sharp && v.boundary.exact ? exactConstant(v.boundary) : 0;
+}
+
+// The volume's features without voxelising at the scene's resolution. The flags come from the
+// materials and the shapes (voxelize's materialValues, the boundary field's shapes and the media
+// table), not from the grid, except convex_apart and with it exact: a 4-voxel voxelisation of the
+// same scene gives them in milliseconds, convex_apart taken at the real h.
+static VolumeSet predictedVolume(const Scene& scene, bool lit) {
   Scene tiny = scene;
   tiny.environment = Environment{};  // not read by the voxeliser; not copied needlessly
   tiny.volume.resolution = 4;
   VolumeSet v = voxelize(tiny, VoxelizeOptions{{}, 1});
   v.boundary.convex_apart = convexShapesApart(v.boundary.shapes, makeGrid(scene.volume).h);
+  v.boundary.exact = shapesTakeExactPath(v.boundary.shapes, v.boundary.convex_apart);
   if (lit) v.light_fluence.assign(1, glm::vec4(0.0f));
-  return volumeFeatureFlags(v);
+  return v;
+}
+
+int predictVolumeFeatureFlags(const Scene& scene, bool lit) {
+  return volumeFeatureFlags(predictedVolume(scene, lit));
 }
 
 std::shared_ptr<void> startViewPipeline(vk::Context& ctx, const Scene& scene, bool lit,
@@ -321,17 +352,22 @@ std::shared_ptr<void> startViewPipeline(vk::Context& ctx, const Scene& scene, bo
     return nullptr;  // render() refuses them
   }
   if (isPolarisedRender(scene, s)) return nullptr;  // another kernel
-  int volume_flags = 0;
+  int volume_flags = 0, exact = 0;
   try {
-    volume_flags = predictVolumeFeatureFlags(scene, lit);
+    const VolumeSet v = predictedVolume(scene, lit);
+    volume_flags = volumeFeatureFlags(v);
+    exact = volumeExactConstant(v);
   } catch (const std::exception&) {
     return nullptr;  // the voxeliser reports what is wrong with the scene, in its own words
   }
   auto early = std::make_shared<EarlyPipeline>();
   early->ctx = &ctx;
-  early->key = {kViewKernel, volume_flags | renderFlagsOf(s) | marchFlagsOf(s.march),
-                int(s.march.integrator), (volume_flags & EIKON_F_SHARP) ? 1 : 0,
-                s.aov_layer ? 1 : 0};
+  early->key = {kViewKernel,
+                volume_flags | renderFlagsOf(s) | marchFlagsOf(s.march),
+                int(s.march.integrator),
+                (volume_flags & EIKON_F_SHARP) ? 1 : 0,
+                s.aov_layer ? 1 : 0,
+                exact};
   const vk::Context* context = &ctx;
   const PipelineKey key = early->key;
   early->result = std::async(std::launch::async, [context, key] {
@@ -387,6 +423,7 @@ struct ViewRenderer::Impl {
   bool uniaxial = false, scattering = false, lit = false;
   bool sharp = false;    // march region by region (shaders/sharp.glsl), as the CPU twin does
   int volume_flags = 0;  // volumeFeatureFlags: the EIKON_F_* of the volume's features
+  int exact = 0;         // volumeExactConstant: kExact (march.glsl), the shapes of the exact path
   // [oA, oB, oC, (eA, eB, eC), medO, (medE), emission, (axis), (scatter), (fluence, flux)]
   std::vector<vk::Image3D> images;
   size_t scatterImage = 0, fluenceImage = 0,
@@ -399,7 +436,7 @@ struct ViewRenderer::Impl {
   // marches many times faster than one that tests them at run time (docs/performance.md).
   std::vector<vk::BindingSpec> viewBindings, traceBindings, polarisedBindings;
   enum Kernel { kView = 0, kTrace = 1, kPolarised = 2 };
-  using Key = PipelineKey;  // kernel, flags, integrator, sharp, AOV
+  using Key = PipelineKey;  // kernel, flags, integrator, sharp, AOV, kExact
   static_assert(kView == kViewKernel, "startViewPipeline's key names the view kernel");
   std::map<Key, vk::ComputePipeline> pipelines;
   // View pipelines compiled ahead on a thread of their own (prefetch()): the expected render's
@@ -420,6 +457,7 @@ struct ViewRenderer::Impl {
     ambient = v.ambient_index;
     volume_flags = volumeFeatureFlags(v);
     sharp = (volume_flags & EIKON_F_SHARP) != 0;
+    exact = volumeExactConstant(v);
     const std::vector<vk::BindingSpec> common = viewKernelBindings();  // the trace's add rays
     viewBindings = common;
     traceBindings = common;
@@ -486,9 +524,9 @@ struct ViewRenderer::Impl {
   }
 
   // The AOV layer is view.comp's pass.w bit 8 (render()), its kAov constant.
-  static Key keyOf(Kernel kernel, const gpu::ViewParams& p, bool sharp) {
+  Key keyOf(Kernel kernel, const gpu::ViewParams& p, bool sharp) const {
     const int aov = kernel == kView && (p.pass.w & kAovPassBit) != 0 ? 1 : 0;
-    return std::make_tuple(int(kernel), p.grid_dims.w, int(p.march.w), sharp ? 1 : 0, aov);
+    return std::make_tuple(int(kernel), p.grid_dims.w, int(p.march.w), sharp ? 1 : 0, aov, exact);
   }
 
   // The view, trace or polarised-trace kernel specialised for the flags and integrator of a key.

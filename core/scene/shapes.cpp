@@ -275,4 +275,125 @@ ConvexShape makeBrilliant(double diameter, double table_frac, double crown_deg, 
   return s;
 }
 
+// ---- Exact line clipping (Shape::clipLine), in the local frame, normals rotated to world ----
+namespace {
+
+// |p + t q| = r: the two roots of a t² + 2b t + c = 0 without cancellation.
+LineClip clipSphere(const glm::dvec3& p, const glm::dvec3& q, double r) {
+  LineClip c;
+  const double a = glm::dot(q, q), b = glm::dot(p, q), cc = glm::dot(p, p) - r * r;
+  const double disc = b * b - a * cc;
+  if (!(a > 0.0) || disc < 0.0) return c;
+  const double k = -(b + std::copysign(std::sqrt(disc), b));
+  double ta = k / a, tb = k != 0.0 ? cc / k : -ta;
+  if (ta > tb) std::swap(ta, tb);
+  c.hit = true;
+  c.t0 = ta;
+  c.t1 = tb;
+  c.n0 = (p + ta * q) / r;
+  c.n1 = (p + tb * q) / r;
+  return c;
+}
+
+// The slab of one plane n·(p + t q) ≤ d narrows [t0, t1]; false when the line misses it.
+bool clipPlane(const glm::dvec3& n, double d, const glm::dvec3& p, const glm::dvec3& q,
+               LineClip& c) {
+  const double denom = glm::dot(n, q), num = d - glm::dot(n, p);
+  if (denom > 0.0) {
+    const double t = num / denom;
+    if (t < c.t1) c.t1 = t, c.n1 = n;
+  } else if (denom < 0.0) {
+    const double t = num / denom;
+    if (t > c.t0) c.t0 = t, c.n0 = n;
+  } else if (num < 0.0) {
+    return false;  // parallel to the plane and outside it
+  }
+  return true;
+}
+
+LineClip clipBox(const glm::dvec3& p, const glm::dvec3& q, const glm::dvec3& half) {
+  LineClip c;
+  c.t0 = -std::numeric_limits<double>::infinity();
+  c.t1 = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    glm::dvec3 n(0.0);
+    n[a] = 1.0;
+    if (!clipPlane(n, half[a], p, q, c) || !clipPlane(-n, half[a], p, q, c)) return LineClip{};
+  }
+  c.hit = c.t0 <= c.t1 && std::isfinite(c.t0) && std::isfinite(c.t1);
+  return c;
+}
+
+LineClip clipConvex(const glm::dvec3& p, const glm::dvec3& q, const std::vector<Plane>& planes) {
+  LineClip c;
+  c.t0 = -std::numeric_limits<double>::infinity();
+  c.t1 = std::numeric_limits<double>::infinity();
+  for (const Plane& pl : planes)
+    if (!clipPlane(pl.normal, pl.d, p, q, c)) return LineClip{};
+  c.hit = c.t0 <= c.t1 && std::isfinite(c.t0) && std::isfinite(c.t1);
+  return c;
+}
+
+// A rounded box is the box of half size `core` grown by `r`: inside its outer box, the signed
+// distance along the line is convex in t, so its minimum is found by golden-section search and
+// its zeros on either side by bisection (to the doubles' resolution).
+LineClip clipRoundedBox(const glm::dvec3& p, const glm::dvec3& q, const glm::dvec3& core,
+                        double r) {
+  LineClip outer = clipBox(p, q, core + glm::dvec3(r));
+  if (!outer.hit) return outer;
+  auto f = [&](double t) { return boxDistance(p + t * q, core) - r; };
+  double lo = outer.t0, hi = outer.t1;
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = f(x1), f2 = f(x2);
+  for (int it = 0; it < 200 && hi - lo > 1e-15 * (1.0 + std::abs(lo) + std::abs(hi)); ++it) {
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = f(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = f(x2);
+    }
+  }
+  const double tm = f1 < f2 ? x1 : x2;
+  if (f(tm) > 0.0) return LineClip{};
+  auto zero = [&](double inside, double outside) {
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (inside + outside);
+      if (mid == inside || mid == outside) break;
+      (f(mid) <= 0.0 ? inside : outside) = mid;
+    }
+    return inside;
+  };
+  LineClip c;
+  c.hit = true;
+  c.t0 = f(outer.t0) <= 0.0 ? outer.t0 : zero(tm, outer.t0);
+  c.t1 = f(outer.t1) <= 0.0 ? outer.t1 : zero(tm, outer.t1);
+  c.n0 = boxGradient(p + c.t0 * q, core);
+  c.n1 = boxGradient(p + c.t1 * q, core);
+  return c;
+}
+
+}  // namespace
+
+LineClip Shape::clipLine(const glm::dvec3& o, const glm::dvec3& d) const {
+  const glm::dvec3 p = toLocal(o), q = glm::transpose(rotation_) * d;
+  LineClip c = std::visit(
+      [&](const auto& g) -> LineClip {
+        using T = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<T, SphereShape>) {
+          return clipSphere(p, q, g.radius);
+        } else if constexpr (std::is_same_v<T, BoxShape>) {
+          return clipBox(p, q, 0.5 * g.size);
+        } else if constexpr (std::is_same_v<T, RoundedBoxShape>) {
+          return clipRoundedBox(p, q, 0.5 * g.size - glm::dvec3(g.radius), g.radius);
+        } else if constexpr (std::is_same_v<T, MeshShape>) {
+          return LineClip{};
+        } else {
+          return clipConvex(p, q, g.planes);
+        }
+      },
+      geometry_);
+  c.n0 = rotation_ * c.n0;
+  c.n1 = rotation_ * c.n1;
+  return c;
+}
+
 }  // namespace eikon

@@ -53,6 +53,15 @@ struct MeshShape {
 
 using ShapeGeometry = std::variant<SphereShape, BoxShape, RoundedBoxShape, ConvexShape, MeshShape>;
 
+/// Where the line o + t·d lies inside a shape (Shape::clipLine): t ∈ [t0, t1], with the outward
+/// unit normals (world) of the surface at the two ends. Every analytic shape is convex, so one
+/// interval says it all.
+struct LineClip {
+  bool hit = false;
+  double t0 = 0.0, t1 = 0.0;
+  glm::dvec3 n0{0.0}, n1{0.0};
+};
+
 class Shape {
  public:
   Shape() = default;
@@ -67,6 +76,13 @@ class Shape {
   /// ∇ of signedDistance (unit where the distance is exact; the active face's normal for convex
   /// polyhedra). World space.
   glm::dvec3 distanceGradient(const glm::dvec3& world) const;
+  /// The exact interval of the line o + t·d (world; d of any non-zero length, t in its units)
+  /// inside the shape, for the analytic shapes (sphere, box, rounded box, convex polyhedron):
+  /// closed forms, and for the rounded box the two zeros of its signed distance along the line
+  /// (a convex function of t: a golden-section search for its minimum, then bisection).
+  /// `analytic()` is false for a mesh, whose clip is never hit.
+  LineClip clipLine(const glm::dvec3& o, const glm::dvec3& d) const;
+  bool analytic() const { return !std::holds_alternative<MeshShape>(geometry_); }
   /// World-space axis-aligned bounding box {min, max} (conservative).
   std::pair<glm::dvec3, glm::dvec3> bounds() const;
   /// World-space outward normals of a convex shape's faces (empty for curved shapes).

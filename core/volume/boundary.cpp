@@ -218,7 +218,14 @@ BoundaryField boundaryFieldShapes(const Scene& scene, const Grid& g) {
     bf.medium.push_back(material_ids.at(obj.material));
   }
   bf.convex_apart = convexShapesApart(bf.shapes, g.h);
+  bf.exact = shapesTakeExactPath(bf.shapes, bf.convex_apart);
   return bf;
+}
+
+bool shapesTakeExactPath(const std::vector<Shape>& shapes, bool convex_apart) {
+  bool analytic = !shapes.empty();
+  for (const Shape& shape : shapes) analytic = analytic && shape.analytic();
+  return analytic && !convex_apart && exactTableRows(shapes) <= kExactMaxRows;
 }
 
 BoundaryField buildBoundaryField(const Scene& scene, const Grid& g, int threads) {
@@ -451,6 +458,81 @@ BoundaryCrossing convexCrossingOutOf(const BoundaryField& bf, const glm::dvec3& 
   boundaryPhi(bf, out.point, out.from, &grad);
   out.field_normal = glm::length(grad) > 0.0 ? -glm::normalize(grad) : out.normal;
   return out;
+}
+
+}  // namespace eikon
+
+namespace eikon {
+
+int exactTableRows(const std::vector<Shape>& shapes) {
+  size_t rows = 6 * shapes.size();
+  for (const Shape& s : shapes)
+    if (const auto* c = std::get_if<ConvexShape>(&s.geometry())) rows += c->planes.size();
+  return int(std::min(rows, size_t(1) << 30));
+}
+
+int regionAt(const BoundaryField& bf, const glm::dvec3& x) {
+  if (!bf.exact) return boundaryRegion(bf, x);
+  for (size_t i = bf.shapes.size(); i-- > 0;)
+    if (bf.shapes[i].signedDistance(x) <= 0.0) return int(i) + 1;
+  return 0;
+}
+
+BoundaryCrossing exactCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a,
+                                    const glm::dvec3& b, int region) {
+  BoundaryCrossing out;
+  out.from = out.to = region;
+  out.point = b;
+  const glm::dvec3 d = b - a;
+  const double len = glm::length(d);
+  if (!(len > 0.0)) return out;
+  const double eps = kExactMergeVoxels * bf.grid.h / len;
+  const size_t n = bf.shapes.size();
+  // Pass 1: where the line leaves the ray's own shape (clamped to the start: a ray already past
+  // it leaves at once) or first enters a later one. Earlier shapes are painted over by the ray's.
+  double t = 2.0;
+  glm::dvec3 n_own(0.0);
+  for (size_t i = region >= 1 ? size_t(region - 1) : 0; i < n; ++i) {
+    const LineClip c = bf.shapes[i].clipLine(a, d);
+    if (!c.hit) continue;
+    if (int(i) + 1 == region) {
+      t = std::min(t, std::max(c.t1, 0.0));
+      n_own = c.n1;
+    } else if (c.t0 > eps && c.t1 - c.t0 > eps) {
+      t = std::min(t, c.t0);
+    }
+  }
+  if (t > 1.0) return out;
+  // Pass 2: the region just past t (the last shape whose interval holds it) and its entry normal.
+  const double tq = t + eps;
+  int to = 0;
+  glm::dvec3 n_to(0.0);
+  for (size_t i = 0; i < n; ++i) {
+    const LineClip c = bf.shapes[i].clipLine(a, d);
+    if (c.hit && c.t0 <= tq && tq <= c.t1) to = int(i) + 1, n_to = c.n0;
+  }
+  if (to == region) return out;  // (unreachable but for rounding: no change of region)
+  out.found = true;
+  out.t = t;
+  out.to = to;
+  out.owner = std::max(region, to);
+  out.from_medium = bf.medium[size_t(region)];
+  out.to_medium = bf.medium[size_t(to)];
+  out.point = a + t * d;
+  // Entering the owner: its entry face, the normal pointing into it; leaving it (the ray's own
+  // shape): its exit face, outward. Either way from `from` into `to`.
+  const glm::dvec3 nrm = to == out.owner ? -n_to : n_own;
+  out.normal = glm::length(nrm) > 0.0 ? glm::normalize(nrm) : nrm;
+  out.field_normal = out.normal;
+  return out;
+}
+
+BoundaryCrossing crossingOutOf(
+    const BoundaryField& field, const glm::dvec3& a, const glm::dvec3& b, int region,
+    const std::function<void(const glm::dvec3&, const BoundaryCrossing&)>& on_locate) {
+  if (field.convex_apart) return convexCrossingOutOf(field, a, b, region);
+  if (field.exact) return exactCrossingOutOf(field, a, b, region);
+  return nextCrossingOutOf(field, a, b, region, on_locate);
 }
 
 }  // namespace eikon

@@ -49,6 +49,11 @@ struct BoundaryField {
   /// Every shape is a convex polyhedron and their bounding boxes are kCrossingApartVoxels apart:
   /// a region's crossings are then its own planes' (convexCrossingOutOf), no walk needed.
   bool convex_apart = false;
+  /// Every shape is analytic (no mesh), the shape table fits kExactMaxRows and the shapes are not
+  /// convex_apart: crossings and regions are found on the shapes (exactCrossingOutOf, regionAt),
+  /// no voxel read. The one dispatch (crossingOutOf, shaders/sharp.glsl nextCrossing): the planes
+  /// if convex_apart, else the shapes if exact, else the walk (meshes refined on their BVH).
+  bool exact = false;
 
   bool empty() const { return region.empty(); }
 };
@@ -73,6 +78,10 @@ double boundaryPhi(const BoundaryField& field, const glm::dvec3& x, int region,
 /// The region at a world point: of the regions of the 8 voxels around it, the one whose φ is
 /// largest (the one whose φ is positive where two regions meet).
 int boundaryRegion(const BoundaryField& field, const glm::dvec3& x);
+
+/// The region at a world point on the shapes themselves where field.exact (the later of the
+/// objects containing x, as the voxeliser paints them; 0 for none), else boundaryRegion.
+int regionAt(const BoundaryField& field, const glm::dvec3& x);
 
 struct LocateOptions {
   /// The crossing is bracketed on the trilinear field to this width (voxels) along the segment.
@@ -140,5 +149,39 @@ constexpr double kGrazeVoxels = 1e-3;
 /// (plane, point, region entered) where the walk finds one. The field normal is the field's.
 BoundaryCrossing convexCrossingOutOf(const BoundaryField& field, const glm::dvec3& a,
                                      const glm::dvec3& b, int region);
+
+/// The shape table's rows (vec4: 6 per shape and one per plane, core/render/boundary_device.h)
+/// up to which the exact path is taken: the GPU copies them into a private array once per
+/// invocation (boundary.glsl exactLoadShapes), so that the loops over the shapes read registers,
+/// not the storage buffer lane by lane (llvmpipe). 256 rows are 4 KiB per invocation: 42 boxes
+/// or spheres, or calcite_rhomb's 21 shapes (132 rows), or a 49-facet brilliant and 34 boxes.
+constexpr int kExactMaxRows = 256;
+/// The rows of the shape table an analytic field needs (6 per shape, one per plane).
+int exactTableRows(const std::vector<Shape>& shapes);
+/// Whether a field of these shapes takes the exact path (BoundaryField::exact): every shape
+/// analytic, not convex_apart, and the table within kExactMaxRows.
+bool shapesTakeExactPath(const std::vector<Shape>& shapes, bool convex_apart);
+
+/// Ends of shape intervals closer than this (voxels) to a segment's start are not crossings, a
+/// later shape met over less than this is grazed, not entered, and the region past a crossing is
+/// the one this far past it. shaders/boundary.glsl has the same.
+constexpr double kExactMergeVoxels = 1e-4;
+
+/// The first point of [a, b] where the region changes from `region` (the ray's), on the shapes
+/// (field.exact). Every analytic shape is convex, so the line meets each in one interval
+/// (Shape::clipLine); region r is shape r − 1 minus the later shapes, so it changes first where
+/// the line leaves shape r − 1 or enters a later shape (beyond kExactMergeVoxels, not grazing):
+/// one pass over the shapes from r − 1 on finds that t. A second pass takes the region just past
+/// it (the last shape whose interval holds t + ε: faces meeting there within rounding count as
+/// one crossing) and the entered shape's entry normal. The normal is the owner's (the later of
+/// the two regions' objects); the field normal is the same (no voxel is read).
+BoundaryCrossing exactCrossingOutOf(const BoundaryField& field, const glm::dvec3& a,
+                                    const glm::dvec3& b, int region);
+
+/// The crossing search of the sharp marches: convexCrossingOutOf if field.convex_apart, else
+/// exactCrossingOutOf if field.exact, else nextCrossingOutOf (the walk; on_locate as there).
+BoundaryCrossing crossingOutOf(
+    const BoundaryField& field, const glm::dvec3& a, const glm::dvec3& b, int region,
+    const std::function<void(const glm::dvec3&, const BoundaryCrossing&)>& on_locate = {});
 
 }  // namespace eikon

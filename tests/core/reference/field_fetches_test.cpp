@@ -12,7 +12,10 @@
 //    starts on the face (the crossing point), where the trilinear region may be either side's,
 //    and then first finds the face itself (the region at the start, the one cell to it, the two
 //    at it: 4) before the restart's walk. 0, 1 or 2 restarts: 75, 79 or 83, and 79 measured.
-//    A small sphere far from the ray keeps the walk: a lone box (a convex polyhedron apart from
+//    A small sphere far from the ray makes every shape analytic and not convex_apart: the
+//    crossings are then found on the shapes (BoundaryField::exact, crossingOutOf), which read no
+//    cell at all: 0. With exact off (what a scene with a mesh gets) the walk's 75–83 above.
+//    A lone box (a convex polyhedron apart from
 //    any other) takes its crossings from its planes instead (convexCrossingOutOf), which reads
 //    the entry's region (1) and one cell per search (the field normal: 3): 4.
 //  - Smoothed march: at least the index samples of its integration steps (4 per RK4 step).
@@ -28,7 +31,8 @@
 namespace eikon {
 namespace {
 
-RenderImage renderOnePixel(bool sharp, bool lone_box = false) {
+// walk: the field's search even where the shapes' would be taken (BoundaryField::exact off).
+RenderImage renderOnePixel(bool sharp, bool lone_box = false, bool walk = false) {
   const std::string sphere =
       lone_box
           ? ""
@@ -44,17 +48,28 @@ RenderImage renderOnePixel(bool sharp, bool lone_box = false) {
                           "material": "glass"})" +
           sphere + "]}",
       "fetches.json");
-  const VolumeSet volume = voxelize(scene);
+  VolumeSet volume = voxelize(scene);
+  if (sharp) {
+    EXPECT_EQ(volume.boundary.exact, !lone_box);        // a box and a sphere: analytic, not apart
+    EXPECT_EQ(volume.boundary.convex_apart, lone_box);  // a lone box: its planes
+  }
+  if (walk) volume.boundary.exact = false;
   const VolumeField field(volume);
   const ReferenceMarcher ref(field, scene.environment);
   return ref.render(scene.camera, RenderSettings{}, 1);
 }
 
 TEST(FieldFetches, SharpSlabReadsTheCellsItWalks) {
-  const RenderImage img = renderOnePixel(true);
+  const RenderImage img = renderOnePixel(true, false, true);
   const double restarts = (img.mean_fetches - 75.0) / 4.0;
   EXPECT_TRUE(restarts == 0.0 || restarts == 1.0 || restarts == 2.0) << img.mean_fetches;
   EXPECT_EQ(img.mean_steps, 2.0);  // two segments end on a crossing; the third leaves
+}
+
+TEST(FieldFetches, ExactSharpSlabReadsNoCell) {
+  const RenderImage img = renderOnePixel(true);
+  EXPECT_EQ(img.mean_fetches, 0.0);  // regions and crossings on the box itself
+  EXPECT_EQ(img.mean_steps, 2.0);
 }
 
 TEST(FieldFetches, LoneBoxReadsOneCellPerSearch) {

@@ -123,8 +123,9 @@ TEST(Spectral, EqualEnergyEnvironmentIsWhite) {
 }
 
 TEST(Spectral, FlatSpectrumMeanConvergesUnbiased) {
-  // The image mean of a flat environment over P pixels and S samples: |mean − 1| < 5σ/√(P·S) for
-  // spp = 1, 4, 16 (σ from the per-pixel sample variance at spp = 1), and the error shrinks.
+  // The image mean of a flat environment over P pixels (all but the central 6×6) and S samples:
+  // |mean − 1| < 5σ/√(P·S) for spp = 1, 4, 16 (σ from the per-pixel sample variance at spp = 1),
+  // and the error shrinks.
   const char* json = R"({
     "camera": {"position": [0, 0, -40], "look_at": [0, 0, 0], "width": 128, "height": 128},
     "environment": {"type": "constant", "radiance": 1},
@@ -140,12 +141,16 @@ TEST(Spectral, FlatSpectrumMeanConvergesUnbiased) {
       rs.wavelengths = n;
       rs.spp = spp;
       RenderImage img = t.gpu->render(rs);
-      const int P = img.width * img.height;
+      // The 0.01 mm sphere (what makes the scene dispersive) is 1/20 of a pixel across at the
+      // image centre: the crossings on the shapes see it, so the central pixels are left out.
+      int P = 0;
       glm::dvec3 sum(0.0), sum2(0.0);
-      for (int i = 0; i < P; ++i) {
+      for (int i = 0; i < img.width * img.height; ++i) {
+        if (std::abs(i % img.width - 63.5) < 3 && std::abs(i / img.width - 63.5) < 3) continue;
         glm::dvec3 c = px(img, i);
         sum += c;
         sum2 += c * c;
+        ++P;
       }
       glm::dvec3 mean = sum / double(P);
       if (spp == 1) sd1 = glm::sqrt(sum2 / double(P) - mean * mean);

@@ -47,7 +47,8 @@ TEST(ViewPipelineStart, FlagsNameTheVolumesFeatures) {
     "materials": {"g": {"n": 1.5}},
     "objects": [{"shape": "sphere", "radius": 1, "material": "g"}]})";
   Scene s = sceneFromJson(sphere);
-  EXPECT_EQ(predictVolumeFeatureFlags(s, false), EIKON_F_SHARP);
+  // A lone sharp sphere takes the crossings on its shape (BoundaryField::exact).
+  EXPECT_EQ(predictVolumeFeatureFlags(s, false), EIKON_F_SHARP | EIKON_F_EXACT);
   s.interfaces = Scene::Interfaces::Smoothed;
   EXPECT_EQ(predictVolumeFeatureFlags(s, false), 0);
   s.materials.at("g").uniaxial = true;

@@ -52,7 +52,7 @@ TEST(SpecialiseSpirv, TheViewKernelsSpecConstantsAreFrozenAndTheirDeadCodeRemove
   const std::vector<uint32_t> generic(viewSpirv().begin(), viewSpirv().end());
   const Census before = census(generic);
   ASSERT_TRUE(before.well_formed);
-  ASSERT_EQ(before.spec_ids, 4);  // kSharpMarch, kViewFlags, kIntegrator, kAov (march.glsl)
+  ASSERT_EQ(before.spec_ids, 5);  // kSharpMarch, kViewFlags, kIntegrator, kAov, kExact (march.glsl)
   // glass_sphere's render: the sharp march, no other feature, RK4, no aov layer.
   const std::vector<uint32_t> sharp = {1u, uint32_t(EIKON_F_SHARP), 2u, 0u};
   const auto s = specialiseSpirv(viewSpirv(), sharp);
