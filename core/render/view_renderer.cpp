@@ -524,7 +524,7 @@ struct ViewRenderer::Impl {
   }
 
   // The AOV layer is view.comp's pass.w bit 8 (render()), its kAov constant.
-  Key keyOf(Kernel kernel, const gpu::ViewParams& p, bool sharp) const {
+  Key keyOf(Kernel kernel, const gpu::ViewParams& p) const {
     const int aov = kernel == kView && (p.pass.w & kAovPassBit) != 0 ? 1 : 0;
     return std::make_tuple(int(kernel), p.grid_dims.w, int(p.march.w), sharp ? 1 : 0, aov, exact);
   }
@@ -557,12 +557,12 @@ struct ViewRenderer::Impl {
   Key viewKey(const RenderSettings& s) const {
     gpu::ViewParams p = baseParams(s.march, renderFlags(s));
     p.pass.w = s.aov_layer ? kAovPassBit : 0;
-    return keyOf(kView, p, sharp);
+    return keyOf(kView, p);
   }
 
   // The pipeline for a dispatch with parameters p, built (or adopted from prefetch()) on first use.
   vk::ComputePipeline& pipeline(Kernel kernel, const gpu::ViewParams& p) {
-    const Key key = keyOf(kernel, p, sharp);
+    const Key key = keyOf(kernel, p);
     auto it = pipelines.find(key);
     if (it != pipelines.end()) return it->second;
     // Started before this renderer (startViewPipeline), else by prefetch(), else built here;

@@ -83,7 +83,9 @@ double wedgeColours(PolRenderTwins& t, bool gpu, int bins, bool expect) {
         [&](double nm) { return wedgeTransmission(q.n_o.index(nm), q.n_e.index(nm), th, nm); });
     const double dE = deltaE76(got, want);
     worst = std::max(worst, dE);
-    if (expect) EXPECT_LE(dE, 2.0) << (gpu ? "GPU" : "CPU") << " Γ " << G << " nm";
+    if (expect) {
+      EXPECT_LE(dE, 2.0) << (gpu ? "GPU" : "CPU") << " Γ " << G << " nm";
+    }
   }
   return worst;
 }

@@ -32,7 +32,9 @@ TEST(LightDevice, AutoIsTheCpuTwinOnlyOnACpuVulkanDevice) {
   // The device the tests run on: "auto" follows its type (lavapipe here: the CPU twin).
   vk::Context& ctx = context();
   EXPECT_EQ(lightOnCpu("auto", &ctx), lightOnCpuForDeviceType(ctx.deviceTypeName()));
-  if (ctx.deviceTypeName() == "CPU") EXPECT_TRUE(lightOnCpu("auto", &ctx));
+  if (ctx.deviceTypeName() == "CPU") {
+    EXPECT_TRUE(lightOnCpu("auto", &ctx));
+  }
   // The user's choice still wins with a context.
   EXPECT_FALSE(lightOnCpu("gpu", &ctx));
   EXPECT_TRUE(lightOnCpu("cpu", &ctx));

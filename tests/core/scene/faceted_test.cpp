@@ -123,9 +123,15 @@ TEST_P(ShippedDesign, FacetsMatchTheDiagramAndCloseAConvexStone) {
     const double angle = std::acos(std::min(1.0, std::abs(n.y))) / kDeg;
     worst_angle = std::max(worst_angle, std::abs(angle - f.angle_deg));
     EXPECT_NEAR(angle, f.angle_deg, 1e-9) << GetParam() << " facet " << k;
-    if (f.side == "crown" || f.side == "table") EXPECT_GT(n.y, 0.0) << k;
-    if (f.side == "pavilion") EXPECT_LT(n.y, 0.0) << k;
-    if (f.side == "girdle") EXPECT_NEAR(n.y, 0.0, 1e-15) << k;
+    if (f.side == "crown" || f.side == "table") {
+      EXPECT_GT(n.y, 0.0) << k;
+    }
+    if (f.side == "pavilion") {
+      EXPECT_LT(n.y, 0.0) << k;
+    }
+    if (f.side == "girdle") {
+      EXPECT_NEAR(n.y, 0.0, 1e-15) << k;
+    }
     if (f.side == "crown" || f.side == "pavilion" || f.side == "girdle") {
       const double az = std::atan2(n.z, n.x) / kDeg, want = 360.0 * f.index / gear;
       const double diff = std::remainder(az - want, 360.0);

@@ -96,7 +96,9 @@ TEST(Mesh, PlacedLikeTheBoxShape) {
       ++inside;
       EXPECT_NEAR(dm, db, 1e-12) << p.x << " " << p.y << " " << p.z;
     }
-    if (std::abs(db) > 1e-9) EXPECT_EQ(dm < 0, db < 0);
+    if (std::abs(db) > 1e-9) {
+      EXPECT_EQ(dm < 0, db < 0);
+    }
   }
   EXPECT_GT(inside, 200);
 }
@@ -270,7 +272,9 @@ TEST(MeshFirstHit, TorusHitsAreTheBruteForceHitsOfEveryTriangle) {
       EXPECT_NEAR(h.t * glm::length(d), want * glm::length(d), 1e-9) << k;
       EXPECT_NEAR(glm::length(h.normal - want_n), 0.0, 1e-12) << k;
       EXPECT_NEAR(glm::length(h.normal), 1.0, 1e-12);
-      if (facing != 0) EXPECT_GT(glm::dot(h.normal, d) * facing, 0.0);
+      if (facing != 0) {
+        EXPECT_GT(glm::dot(h.normal, d) * facing, 0.0);
+      }
     }
   }
   EXPECT_GT(hits, 2000);
