@@ -102,10 +102,11 @@ bool directUploadSupported(const Context& ctx, std::array<uint32_t, 3> extent, V
 
 /// Image3D::upload of a directUploadSupported image: the texels written through a mapping of its
 /// memory (rows placed at the driver's pitches), then one barrier from the host's writes and the
-/// PREINITIALIZED layout to GENERAL.
+/// PREINITIALIZED layout (the first upload; GENERAL on a later one, which host writes to a linear
+/// image may also use) to GENERAL.
 void uploadDirect(const Context& ctx, VkDevice device, VkImage image, VkDeviceMemory memory,
                   const std::array<uint32_t, 3>& extent, const std::string& name, const void* data,
-                  VkDeviceSize bytes) {
+                  VkDeviceSize bytes, bool again) {
   VkImageSubresource sub{VK_IMAGE_ASPECT_COLOR_BIT, 0, 0};
   VkSubresourceLayout layout;
   vkGetImageSubresourceLayout(device, image, &sub, &layout);
@@ -130,7 +131,7 @@ void uploadDirect(const Context& ctx, VkDevice device, VkImage image, VkDeviceMe
     VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
     b.srcAccessMask = VK_ACCESS_HOST_WRITE_BIT;
     b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-    b.oldLayout = VK_IMAGE_LAYOUT_PREINITIALIZED;
+    b.oldLayout = again ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_PREINITIALIZED;
     b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
     b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     b.image = image;
@@ -207,6 +208,7 @@ Image3D& Image3D::operator=(Image3D&& o) noexcept {
     extent_ = o.extent_;
     format_ = o.format_;
     name_ = std::move(o.name_);
+    uploaded_ = std::exchange(o.uploaded_, false);
   }
   return *this;
 }
@@ -222,8 +224,11 @@ void Image3D::release() noexcept {
 }
 
 void Image3D::upload(const Context& ctx, const void* data, VkDeviceSize bytes) {
-  if (directUploadSupported(ctx, extent_, format_))  // as the constructor decided
-    return uploadDirect(ctx, device_, image_, memory_, extent_, name_, data, bytes);
+  if (directUploadSupported(ctx, extent_, format_)) {  // as the constructor decided
+    uploadDirect(ctx, device_, image_, memory_, extent_, name_, data, bytes, uploaded_);
+    uploaded_ = true;
+    return;
+  }
   Buffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, name_ + " staging");
   staging.write(data, bytes);
   ctx.submitAndWait([&](VkCommandBuffer cmd) {

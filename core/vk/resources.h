@@ -66,7 +66,8 @@ class Image3D {
   Image3D(const Image3D&) = delete;
   Image3D& operator=(const Image3D&) = delete;
 
-  /// Copy tightly packed texels (x fastest) into the image through a staging buffer.
+  /// Copy tightly packed texels (x fastest) into the image (through a staging buffer, or on a CPU
+  /// device through a mapping of the image's own memory); may be called again to replace them.
   void upload(const Context& ctx, const void* data, VkDeviceSize bytes);
   VkImageView view() const { return view_; }
   std::array<uint32_t, 3> extent() const { return extent_; }
@@ -80,6 +81,7 @@ class Image3D {
   std::array<uint32_t, 3> extent_{};
   VkFormat format_ = VK_FORMAT_UNDEFINED;
   std::string name_;
+  bool uploaded_ = false;  // the layout is GENERAL (a direct upload starts from PREINITIALIZED)
 };
 
 struct BindingSpec {
