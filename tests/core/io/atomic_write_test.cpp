@@ -18,17 +18,14 @@
 #include <thread>
 #include <vector>
 
+#include "tests/core/file_support.h"
+
 namespace eikon {
 namespace {
 
-namespace fs = std::filesystem;
+using eikon::test::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+namespace fs = std::filesystem;
 
 FileContent text(const std::string& content) {
   return [content](const fs::path& tmp) { std::ofstream(tmp, std::ios::binary) << content; };

@@ -19,22 +19,15 @@
 #include "core/vk/resources.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/scan.spv.h"
+#include "tests/core/file_support.h"
 
 namespace eikon::vk {
 namespace {
 
+using eikon::test::put;
+using eikon::test::slurp;
+
 namespace fs = std::filesystem;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void put(const fs::path& p, const std::string& bytes) {
-  std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
-}
 
 class PipelineCache : public ::testing::Test {
  protected:

@@ -20,26 +20,19 @@
 #include "core/vk/specialise.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/view.spv.h"
+#include "tests/core/file_support.h"
 #include "tests/core/scene_support.h"
 
 namespace eikon::vk {
 namespace {
 
+using eikon::test::put;
+using eikon::test::slurp;
+
 namespace fs = std::filesystem;
 
 std::span<const uint32_t> viewSpirv() {
   return std::span<const uint32_t>(k_view_spv, sizeof(k_view_spv) / 4);
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void put(const fs::path& p, const std::string& bytes) {
-  std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
 }
 
 class SpirvCache : public ::testing::Test {

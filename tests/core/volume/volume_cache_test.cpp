@@ -18,10 +18,14 @@
 #include <vector>
 
 #include "core/io/build_id.h"
+#include "tests/core/file_support.h"
 #include "tests/core/scene_support.h"
 
 namespace eikon::test {
 namespace {
+
+using eikon::test::put;
+using eikon::test::slurp;
 
 namespace fs = std::filesystem;
 
@@ -43,17 +47,6 @@ constexpr const char* kSmoothed = R"({
   "objects": [{"shape": "sphere", "radius": 1, "material": "g"}]})";
 
 Scene scene(const char* json) { return parseScene(json, "volume-cache-test.json"); }
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void put(const fs::path& p, const std::string& bytes) {
-  std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
-}
 
 template <typename T>
 ::testing::AssertionResult sameBits(const std::vector<T>& a, const std::vector<T>& b,
