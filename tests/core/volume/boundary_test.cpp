@@ -32,6 +32,7 @@
 
 #include "core/scene/scene.h"
 #include "core/volume/volume_set.h"
+#include "tests/core/boundary_support.h"
 
 namespace eikon {
 namespace {
@@ -40,22 +41,10 @@ constexpr double kDeg = 3.14159265358979323846 / 180.0;
 constexpr double kFloat = 4.0 / 16777216.0;  // cap · 2⁻²⁴ (voxels)
 
 Scene sceneOf(const std::vector<std::pair<Shape, std::string>>& objects, int resolution) {
-  Scene s;
-  s.file = "boundary.json";
-  s.volume.bounds_min = glm::dvec3(-1.0);
-  s.volume.bounds_max = glm::dvec3(1.0);
-  s.volume.resolution = resolution;
-  for (const auto& [shape, material] : objects) {
-    s.materials[material].name = material;
-    SceneObject o;
-    o.shape = shape;
-    o.material = material;
-    s.objects.push_back(o);
-  }
-  return s;
+  return test::boundarySceneOf(objects, resolution, "boundary.json");
 }
 
-BoundaryField fieldOf(const Scene& s) { return buildBoundaryField(s, makeGrid(s.volume), 2); }
+BoundaryField fieldOf(const Scene& s) { return test::boundaryFieldOf(s); }
 
 // Local → world rotation of shapes.h's convention: rotation_deg = [rx, ry, rz] applied as Rz·Ry·Rx.
 glm::dmat3 rotation(glm::dvec3 deg) {

@@ -20,6 +20,7 @@
 #include "core/scene/shapes.h"
 #include "core/volume/boundary.h"
 #include "core/volume/volume_set.h"
+#include "tests/core/boundary_support.h"
 
 namespace eikon {
 namespace {
@@ -27,22 +28,10 @@ namespace {
 constexpr double kTol = 1e-12;
 
 Scene sceneOf(const std::vector<std::pair<Shape, std::string>>& objects, int resolution) {
-  Scene s;
-  s.file = "exact.json";
-  s.volume.bounds_min = glm::dvec3(-1.0);
-  s.volume.bounds_max = glm::dvec3(1.0);
-  s.volume.resolution = resolution;
-  for (const auto& [shape, material] : objects) {
-    s.materials[material].name = material;
-    SceneObject o;
-    o.shape = shape;
-    o.material = material;
-    s.objects.push_back(o);
-  }
-  return s;
+  return test::boundarySceneOf(objects, resolution, "exact.json");
 }
 
-BoundaryField fieldOf(const Scene& s) { return buildBoundaryField(s, makeGrid(s.volume), 2); }
+BoundaryField fieldOf(const Scene& s) { return test::boundaryFieldOf(s); }
 
 // A small sphere in a corner, far from every ray below: with it a lone box is no longer a convex
 // polyhedron apart from the others (whose crossings come from its planes), so the shapes' search
