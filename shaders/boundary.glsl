@@ -696,13 +696,19 @@ BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
 #endif
 #define EIKON_EXACT_HAS(kind) ((EIKON_BOUNDARY_EXACT_KINDS & (1 << (kind))) != 0)
 const float kExactMergeVoxels = 1e-4;
-// The loops over the shapes read the table's rows from this private copy, made once per
-// invocation (exactLoadShapes): llvmpipe reads a storage buffer at a varying index inside
-// divergent control flow one lane at a time (a loop over the 8 lanes, each behind a branch), a
-// private array with a gather. kExactMaxRows (core/volume/boundary.h) bounds the copy.
-const int kExactMaxRows = 256;
+// The loops over the shapes read the table's rows through EIKON_EXACT_ROW. The view kernels
+// (march.glsl) define it as their uniform block of the table's first rows (EIKON_B_EXACT_ROWS: a
+// vector gather on llvmpipe); other includers get a private copy made once per invocation
+// (exactLoadShapes): llvmpipe reads a storage buffer at a varying index inside divergent control
+// flow one lane at a time (a loop over the 8 lanes, each behind a branch). kExactMaxRows
+// (core/volume/boundary.h) bounds both.
+const int kExactMaxRows = EIKON_EXACT_MAX_ROWS;
+#ifdef EIKON_EXACT_ROW
+void exactLoadShapes() {}
+#else
 vec4 gShapeRows[kExactMaxRows];
 bool gShapeRowsLoaded = false;
+#define EIKON_EXACT_ROW(i) gShapeRows[i]
 
 void exactLoadShapes() {
   if (gShapeRowsLoaded) return;
@@ -710,6 +716,7 @@ void exactLoadShapes() {
   for (int k = 0; k < min(EIKON_BOUNDARY_EXACT_ROWS, kExactMaxRows); ++k)
     gShapeRows[k] = shapeTable[k];
 }
+#endif
 
 struct LineClip {
   bool hit;
@@ -819,9 +826,9 @@ const int kExactPlanesPerPass = 8;
 // a repeated slab leaves unchanged).
 LineClip exactClip(int s, vec3 o, vec3 d) {
   int off = EIKON_SHAPE_STRIDE * s;
-  vec4 head = gShapeRows[off], par = gShapeRows[off + 5];
-  vec3 R0 = gShapeRows[off + 2].xyz, R1 = gShapeRows[off + 3].xyz, R2 = gShapeRows[off + 4].xyz;
-  vec3 x = o - gShapeRows[off + 1].xyz;
+  vec4 head = EIKON_EXACT_ROW(off), par = EIKON_EXACT_ROW(off + 5);
+  vec3 R0 = EIKON_EXACT_ROW(off + 2).xyz, R1 = EIKON_EXACT_ROW(off + 3).xyz, R2 = EIKON_EXACT_ROW(off + 4).xyz;
+  vec3 x = o - EIKON_EXACT_ROW(off + 1).xyz;
   vec3 p = vec3(dot(R0, x), dot(R1, x), dot(R2, x)), q = vec3(dot(R0, d), dot(R1, d), dot(R2, d));
   int kind = int(head.x);
   if (EIKON_EXACT_HAS(EIKON_SHAPE_SPHERE) && kind == EIKON_SHAPE_SPHERE)
@@ -845,7 +852,7 @@ LineClip exactClip(int s, vec3 o, vec3 d) {
         n[i >> 1] = (i & 1) != 0 ? 1.0 : -1.0;
         pl = vec4(n, half_size[i >> 1]);
       } else {
-        pl = gShapeRows[min(first + i, kExactMaxRows - 1)];
+        pl = EIKON_EXACT_ROW(min(first + i, kExactMaxRows - 1));
       }
       clipPlaneInto(pl.xyz, pl.w, p, q, c);
     }
@@ -860,17 +867,17 @@ LineClip exactClip(int s, vec3 o, vec3 d) {
 // A local normal of shape s in world space.
 vec3 exactToWorld(int s, vec3 n) {
   int off = EIKON_SHAPE_STRIDE * s;
-  return n.x * gShapeRows[off + 2].xyz + n.y * gShapeRows[off + 3].xyz +
-         n.z * gShapeRows[off + 4].xyz;
+  return n.x * EIKON_EXACT_ROW(off + 2).xyz + n.y * EIKON_EXACT_ROW(off + 3).xyz +
+         n.z * EIKON_EXACT_ROW(off + 4).xyz;
 }
 
 // Whether world point x lies in shape s (signed distance ≤ 0, Shape::signedDistance's sign).
 bool exactInside(int s, vec3 x) {
   int off = EIKON_SHAPE_STRIDE * s;
-  vec4 head = gShapeRows[off], par = gShapeRows[off + 5];
-  vec3 y = x - gShapeRows[off + 1].xyz;
-  vec3 p = vec3(dot(gShapeRows[off + 2].xyz, y), dot(gShapeRows[off + 3].xyz, y),
-                dot(gShapeRows[off + 4].xyz, y));
+  vec4 head = EIKON_EXACT_ROW(off), par = EIKON_EXACT_ROW(off + 5);
+  vec3 y = x - EIKON_EXACT_ROW(off + 1).xyz;
+  vec3 p = vec3(dot(EIKON_EXACT_ROW(off + 2).xyz, y), dot(EIKON_EXACT_ROW(off + 3).xyz, y),
+                dot(EIKON_EXACT_ROW(off + 4).xyz, y));
   int kind = int(head.x);
   if (kind == EIKON_SHAPE_SPHERE) return length(p) <= par.x;
   if (kind == EIKON_SHAPE_BOX) return boxDistance(p, par.xyz) <= 0.0;
@@ -880,7 +887,7 @@ bool exactInside(int s, vec3 x) {
   int first = int(head.y), count = int(head.z);
   for (int k = 0; count > 0;) {
     [[unroll]] for (int j = 0; j < kExactPlanesPerPass; ++j) {
-      vec4 pl = gShapeRows[min(first + min(k + j, count - 1), kExactMaxRows - 1)];
+      vec4 pl = EIKON_EXACT_ROW(min(first + min(k + j, count - 1), kExactMaxRows - 1));
       m = max(m, dot(pl.xyz, p) - pl.w);
     }
     k += kExactPlanesPerPass;
@@ -892,9 +899,11 @@ bool exactInside(int s, vec3 x) {
 // The later of the objects containing x (boundary.cpp regionAt); 0 for none.
 int exactRegionAt(vec3 x) {
   exactLoadShapes();
-  int r = 0;
-  for (int i = 0; i < EIKON_BOUNDARY_EXACT_SHAPES; ++i)
+  if (EIKON_BOUNDARY_EXACT_SHAPES == 0) return 0;
+  int r = 0, i = 0;
+  do {  // (a do-while: see exactCrossingOutOf)
     if (exactInside(i, x)) r = i + 1;
+  } while (++i < EIKON_BOUNDARY_EXACT_SHAPES);
   return r;
 }
 
@@ -916,26 +925,39 @@ BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
   float t = 2.0, tq = 0.0;
   int to = 0;
   vec3 nOwn = vec3(0.0), nTo = vec3(0.0);
-  for (int pass = 0; pass < 2; ++pass) {
-    for (int i = pass == 0 ? max(region - 1, 0) : 0; i < EIKON_BOUNDARY_EXACT_SHAPES; ++i) {
+  // Both passes in one do-while over k: shape k of pass 0 for k < S (from the ray's own shape on),
+  // shape k − S of pass 1 after it. llvmpipe leaves a loop only at the end of its body, so a
+  // while-loop of N passes runs its body N + 1 times (the last one masked off): a do-while runs it
+  // N times.
+  const int S = EIKON_BOUNDARY_EXACT_SHAPES;
+  int k = max(region - 1, 0);
+  bool none = false;
+  do {
+    const bool second = k >= S;
+    if (k == S) {  // pass 0 done: no crossing on [a, b], or the point just past it
+      none = t > 1.0;
+      tq = t + eps;
+    }
+    if (!none) {
+      const int i = second ? k - S : k;
       LineClip c = exactClip(i, a, d);
-      if (!c.hit) continue;
-      if (pass == 1) {
-        if (c.t0 <= tq && tq <= c.t1) {
-          to = i + 1;
-          nTo = c.n0;
+      if (c.hit) {
+        if (second) {
+          if (c.t0 <= tq && tq <= c.t1) {
+            to = i + 1;
+            nTo = c.n0;
+          }
+        } else if (i + 1 == region) {
+          t = min(t, max(c.t1, 0.0));
+          nOwn = c.n1;
+        } else if (c.t0 > eps && c.t1 - c.t0 > eps) {
+          t = min(t, c.t0);
         }
-      } else if (i + 1 == region) {
-        t = min(t, max(c.t1, 0.0));
-        nOwn = c.n1;
-      } else if (c.t0 > eps && c.t1 - c.t0 > eps) {
-        t = min(t, c.t0);
       }
     }
-    if (t > 1.0) return out_;
-    tq = t + eps;
-  }
-  if (to == region) return out_;
+    ++k;
+  } while (k < 2 * S && !none);
+  if (none || to == region) return out_;
   int owner = max(region, to);
   vec3 n = exactToWorld(owner - 1, to == owner ? -nTo : nOwn);
   out_.found = true;

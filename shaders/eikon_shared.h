@@ -49,6 +49,15 @@ using uvec4 = glm::uvec4;
 // vec4s per region; flag bits of row 7's w as kMedium* there.
 #define EIKON_B_MEDIA 22
 #define EIKON_MEDIUM_VEC4S 16
+// The same two tables as uniform blocks for the view kernels (march.glsl), padded to fixed sizes
+// within Vulkan's guaranteed 16 KiB: the shape table's first EIKON_EXACT_MAX_ROWS rows (all of it on
+// the exact path) and the medium table when it has at most EIKON_SMALL_MEDIA_REGIONS regions
+// (EIKON_F_SMALL_MEDIA). llvmpipe reads a storage buffer one lane at a time in a loop, a uniform
+// block with a vector gather, or one load where the index is constant.
+#define EIKON_B_EXACT_ROWS 24
+#define EIKON_B_SMALL_MEDIA 25
+#define EIKON_EXACT_MAX_ROWS 256
+#define EIKON_SMALL_MEDIA_REGIONS 64
 #define EIKON_MEDIUM_HOMOGENEOUS 1
 #define EIKON_MEDIUM_UNIAXIAL 2
 #define EIKON_MEDIUM_RADIAL_AXIS 4
@@ -76,6 +85,14 @@ using uvec4 = glm::uvec4;
 // sharp: every shape is analytic and they are not convex_apart (core/volume/boundary.h exact):
 // crossings and regions on the shapes (boundary.glsl exactCrossingOutOf), no voxel read.
 #define EIKON_F_EXACT 32768
+// The scene's environment kind (march.glsl environmentRgb): none of the two is the checkerboard.
+// Scene features like the others, so that a kernel holds the lookup of its own kind only (lavapipe
+// runs every branch: the latlong lookup's four storage-buffer reads cost the others as much).
+#define EIKON_F_ENV_CONSTANT 65536
+#define EIKON_F_ENV_LATLONG 131072
+// sharp: the medium table has at most EIKON_SMALL_MEDIA_REGIONS regions (read from its uniform
+// block, EIKON_B_SMALL_MEDIA)
+#define EIKON_F_SMALL_MEDIA 262144
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0

@@ -39,6 +39,15 @@ layout(binding = EIKON_B_REGION, r32ui) readonly uniform uimage3D regionImg;
 layout(binding = EIKON_B_BOUNDARY_DIST, r32f) readonly uniform image3D boundaryDist;
 layout(std430, binding = EIKON_B_SHAPES) readonly buffer ShapeBuf { vec4 shapeTable[]; };
 layout(std430, binding = EIKON_B_MEDIA) readonly buffer MediaBuf { vec4 mediaTable[]; };
+// The shape table's first rows and the medium table as uniform blocks (eikon_shared.h,
+// EIKON_B_EXACT_ROWS and EIKON_B_SMALL_MEDIA): what the exact path and, with EIKON_F_SMALL_MEDIA,
+// the sharp march read in their loops.
+layout(std140, binding = EIKON_B_EXACT_ROWS) uniform ExactRowsBuf { vec4 exactRows[EIKON_EXACT_MAX_ROWS]; };
+layout(std140, binding = EIKON_B_SMALL_MEDIA) uniform SmallMediaBuf {
+  vec4 smallMedia[EIKON_SMALL_MEDIA_REGIONS * EIKON_MEDIUM_VEC4S];
+};
+#define EIKON_EXACT_ROW(i) exactRows[i]
+#define EIKON_MEDIUM_ROW(i) (hasFlag(EIKON_F_SMALL_MEDIA) ? smallMedia[i] : mediaTable[i])
 
 const float kPi = 3.14159265358979323846;
 
@@ -162,7 +171,9 @@ vec3 environment(vec3 d) { return colourOf(environmentRgb(d)); }
 vec3 environmentRgb(vec3 d) {
   float u = atan(d.x, -d.z) / (2.0 * kPi) + 0.5;
   float v = acos(clamp(d.y, -1.0, 1.0)) / kPi;
-  int type = int(P.env.x);
+  const int type = hasFlag(EIKON_F_ENV_LATLONG)    ? EIKON_ENV_LATLONG
+                   : hasFlag(EIKON_F_ENV_CONSTANT) ? EIKON_ENV_CONSTANT
+                                                   : EIKON_ENV_CHECKER;
   vec3 c;
   if (type == EIKON_ENV_CONSTANT) {
     c = P.env_a.xyz;

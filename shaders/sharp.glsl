@@ -22,7 +22,11 @@ const float kNudgeVoxels = 1e-4;
 
 // ---- The medium table (core/volume/media.h) ----
 
-vec4 mediumRow(int r, int k) { return mediaTable[r * EIKON_MEDIUM_VEC4S + k]; }
+// Through the includer's EIKON_MEDIUM_ROW where it has one (march.glsl: its uniform block).
+#ifndef EIKON_MEDIUM_ROW
+#define EIKON_MEDIUM_ROW(i) mediaTable[i]
+#endif
+vec4 mediumRow(int r, int k) { return EIKON_MEDIUM_ROW(r * EIKON_MEDIUM_VEC4S + k); }
 int mediumFlags(int r) { return int(mediumRow(r, 7).w); }
 bool mediumHomogeneous(int r) { return (mediumFlags(r) & EIKON_MEDIUM_HOMOGENEOUS) != 0; }
 bool mediumUniaxial(int r) { return (mediumFlags(r) & EIKON_MEDIUM_UNIAXIAL) != 0; }

@@ -144,6 +144,11 @@ std::vector<vk::BindingSpec> boundaryBindings() {
           {EIKON_B_MEDIA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}};
 }
 
+std::vector<vk::BindingSpec> uniformTableBindings() {
+  return {{EIKON_B_EXACT_ROWS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+          {EIKON_B_SMALL_MEDIA, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}};
+}
+
 BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& field,
                                const MediaTable& media, const std::string& file) {
   static_assert(kMediumVec4s == EIKON_MEDIUM_VEC4S &&
@@ -178,6 +183,24 @@ BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& fiel
   media_ = vk::Buffer(ctx, packed.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       "medium table");
   media_.write(packed.data(), packed.size() * sizeof(float));
+  // The uniform blocks: fixed sizes (4 KiB and 16 KiB, within every device's 16 KiB range).
+  static_assert(kExactMaxRows == EIKON_EXACT_MAX_ROWS,
+                "the exact path's row cap is declared twice");
+  std::vector<glm::vec4> rows(size_t(EIKON_EXACT_MAX_ROWS), glm::vec4(0.0f));
+  std::copy_n(table.begin(), std::min(table.size(), rows.size()), rows.begin());
+  exact_rows_ = vk::Buffer(ctx, rows.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                           "shape table rows (uniform)");
+  exact_rows_.write(rows.data(), rows.size() * sizeof(glm::vec4));
+  std::vector<float> small(size_t(EIKON_SMALL_MEDIA_REGIONS) * kMediumVec4s * 4, 0.0f);
+  std::copy_n(packed.begin(), std::min(packed.size(), small.size()), small.begin());
+  small_media_ = vk::Buffer(ctx, small.size() * sizeof(float), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                            "medium table (uniform)");
+  small_media_.write(small.data(), small.size() * sizeof(float));
+}
+
+void BoundaryDevice::bindUniformTables(vk::ComputePipeline& p) const {
+  p.bindBuffer(EIKON_B_EXACT_ROWS, exact_rows_);
+  p.bindBuffer(EIKON_B_SMALL_MEDIA, small_media_);
 }
 
 void BoundaryDevice::bind(vk::ComputePipeline& p) const {

@@ -34,17 +34,25 @@ void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field, const
 /// The descriptor bindings of the four resources (add them to a pipeline's binding list).
 std::vector<vk::BindingSpec> boundaryBindings();
 
+/// The bindings of BoundaryDevice::bindUniformTables (the view kernels add them).
+std::vector<vk::BindingSpec> uniformTableBindings();
+
 class BoundaryDevice {
  public:
   BoundaryDevice() = default;
   BoundaryDevice(const vk::Context& ctx, const BoundaryField& field, const MediaTable& media,
                  const std::string& file = "");
   void bind(vk::ComputePipeline& pipeline) const;
+  /// The view kernels' uniform blocks of the same tables (march.glsl; uniformTableBindings()):
+  /// the shape table's first EIKON_EXACT_MAX_ROWS rows and the medium table's first
+  /// EIKON_SMALL_MEDIA_REGIONS regions, zero-padded to the blocks' fixed sizes.
+  void bindUniformTables(vk::ComputePipeline& pipeline) const;
   bool present() const { return present_; }
 
  private:
   vk::Image3D region_, distance_;
   vk::Buffer shapes_, media_;
+  vk::Buffer exact_rows_, small_media_;
   bool present_ = false;
 };
 

@@ -226,6 +226,7 @@ std::vector<vk::BindingSpec> viewKernelBindings() {
                      uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
     common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
   for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
+  for (const vk::BindingSpec& b : uniformTableBindings()) common.push_back(b);
   return common;
 }
 
@@ -256,6 +257,13 @@ std::vector<uint32_t> specialisationOf(const PipelineKey& key) {
 
 /// The EIKON_F_* flags of a render's settings (spectral) and march (no skipping, no Fresnel).
 int renderFlagsOf(const RenderSettings& s) { return s.wavelengths > 0 ? EIKON_F_SPECTRAL : 0; }
+
+/// The EIKON_F_* flag of the scene's environment kind (march.glsl environmentRgb; none: checker).
+int environmentFlagsOf(const Environment& e) {
+  return e.type == Environment::Type::Constant  ? EIKON_F_ENV_CONSTANT
+         : e.type == Environment::Type::LatLong ? EIKON_F_ENV_LATLONG
+                                                : 0;
+}
 int marchFlagsOf(const MarchSettings& m) {
   return (m.skip_empty ? 0 : EIKON_F_NO_SKIP) | (m.fresnel ? 0 : EIKON_F_NO_FRESNEL);
 }
@@ -317,6 +325,8 @@ int volumeFeatureFlags(const VolumeSet& v) {
   if (sharp && mesh) flags |= EIKON_F_MESH;
   if (sharp && v.boundary.convex_apart) flags |= EIKON_F_CONVEX_APART;
   if (sharp && v.boundary.exact) flags |= EIKON_F_EXACT;
+  if (sharp && v.media.regions.size() <= size_t(EIKON_SMALL_MEDIA_REGIONS))
+    flags |= EIKON_F_SMALL_MEDIA;
   return flags;
 }
 
@@ -363,7 +373,8 @@ std::shared_ptr<void> startViewPipeline(vk::Context& ctx, const Scene& scene, bo
   auto early = std::make_shared<EarlyPipeline>();
   early->ctx = &ctx;
   early->key = {kViewKernel,
-                volume_flags | renderFlagsOf(s) | marchFlagsOf(s.march),
+                volume_flags | environmentFlagsOf(scene.environment) | renderFlagsOf(s) |
+                    marchFlagsOf(s.march),
                 int(s.march.integrator),
                 (volume_flags & EIKON_F_SHARP) ? 1 : 0,
                 s.aov_layer ? 1 : 0,
@@ -603,6 +614,7 @@ struct ViewRenderer::Impl {
     p.bindBuffer(EIKON_B_ENV_IMAGE, env);
     p.bindBuffer(EIKON_B_TABLES, tables);
     boundary.bind(p);
+    boundary.bindUniformTables(p);
   }
 
   gpu::ViewParams baseParams(const MarchSettings& m, int flags_extra) const {
@@ -618,7 +630,8 @@ struct ViewRenderer::Impl {
     p.cam_up = glm::vec4(glm::vec3(up), 0.0f);
     p.grid_origin = glm::vec4(glm::vec3(grid.origin), float(grid.h));
     p.grid_extent = glm::vec4(glm::vec3(grid.extent), float(1.0 / grid.h));
-    const int flags = flags_extra | volume_flags | marchFlagsOf(m);
+    const int flags =
+        flags_extra | volume_flags | environmentFlagsOf(scene.environment) | marchFlagsOf(m);
     p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
     p.march = glm::vec4(float(m.step_voxels), float(m.interface_threshold), float(ambient),
                         float(int(m.integrator)));

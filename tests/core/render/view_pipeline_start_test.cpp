@@ -48,7 +48,8 @@ TEST(ViewPipelineStart, FlagsNameTheVolumesFeatures) {
     "objects": [{"shape": "sphere", "radius": 1, "material": "g"}]})";
   Scene s = sceneFromJson(sphere);
   // A lone sharp sphere takes the crossings on its shape (BoundaryField::exact).
-  EXPECT_EQ(predictVolumeFeatureFlags(s, false), EIKON_F_SHARP | EIKON_F_EXACT);
+  EXPECT_EQ(predictVolumeFeatureFlags(s, false),
+            EIKON_F_SHARP | EIKON_F_EXACT | EIKON_F_SMALL_MEDIA);
   s.interfaces = Scene::Interfaces::Smoothed;
   EXPECT_EQ(predictVolumeFeatureFlags(s, false), 0);
   s.materials.at("g").uniaxial = true;

@@ -106,6 +106,8 @@ TEST(SpecialiseSpirv, TheDriverBuildsTheSpecialisedViewKernel) {
     bindings.push_back(
         {b, image ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
   }
+  for (uint32_t b : {uint32_t(EIKON_B_EXACT_ROWS), uint32_t(EIKON_B_SMALL_MEDIA)})
+    bindings.push_back({b, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER});
   for (const std::vector<uint32_t>& spec : {std::vector<uint32_t>{1u, uint32_t(EIKON_F_SHARP), 2u},
                                             std::vector<uint32_t>{0u, 0u, 0u}}) {
     ComputePipeline p(*ctx, viewSpirv(), bindings, 0, "view", spec);
