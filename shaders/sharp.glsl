@@ -34,7 +34,18 @@ bool mediumOpaque(int r) { return (mediumFlags(r) & EIKON_MEDIUM_OPAQUE) != 0; }
 
 // n of a region's dispersion record (mode 0: n_o, 1: n_e) at the march's wavelength: the
 // material's own formula (mediumIndex). Notes dispersion for wavelength sharing (view.comp).
+//
+// The view kernel's RGB renders march at the one render wavelength: there the includer defines
+// EIKON_INDEX_AT_RENDER_WAVELENGTH true and the index is the host's (v15, BoundaryDevice::
+// setRenderWavelength), which folds the formulas away (lavapipe runs all of their code, loops
+// included, at every crossing otherwise).
 float mediumIndex(int r, int mode) {
+#ifdef EIKON_INDEX_AT_RENDER_WAVELENGTH
+  if (EIKON_INDEX_AT_RENDER_WAVELENGTH) {
+    vec4 atRender = mediumRow(r, 15);
+    return mode == 1 ? atRender.y : atRender.x;
+  }
+#endif
   vec4 head = mediumRow(r, 0);
   int kind = int(mode == 1 ? head.z : head.x), terms = min(int(mode == 1 ? head.w : head.y), 6);
   int b = mode == 1 ? 4 : 1;
@@ -64,6 +75,7 @@ float mediumIndex(int r, int mode) {
 // n_o / n_e of region r at x and its gradient (mediumIndexAt): a GRIN profile replaces the index.
 float regionIndex(int r, int mode, vec3 x, out vec3 grad) {
   grad = vec3(0.0);
+  if (!hasFlag(EIKON_F_VARYING)) return mediumIndex(r, mode);  // no GRIN region in the scene
   int grin = int(mediumRow(r, 11).w);
   if (grin == 0) return mediumIndex(r, mode);
   vec4 g = mediumRow(r, 12), c = mediumRow(r, 13);  // (n0, ∇n), (origin, radius)

@@ -18,6 +18,9 @@
 
 layout(local_size_x = EIKON_WG_X, local_size_y = EIKON_WG_Y) in;
 
+// RGB mode marches at P.wavelength.x only: the media's indices there come from the host
+// (sharp.glsl mediumIndex).
+#define EIKON_INDEX_AT_RENDER_WAVELENGTH (!hasFlag(EIKON_F_SPECTRAL))
 #include "march.glsl"
 
 layout(std430, binding = EIKON_B_OUTPUT) writeonly buffer OutBuf { vec4 pixels[]; };

@@ -178,11 +178,11 @@ BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& fiel
   shapes_ = vk::Buffer(ctx, table.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                        "shape table");
   shapes_.write(table.data(), table.size() * sizeof(glm::vec4));
-  std::vector<float> packed = packMediaTable(media);
-  if (packed.empty()) packed.assign(size_t(kMediumVec4s) * 4, 0.0f);
-  media_ = vk::Buffer(ctx, packed.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+  table_ = media;
+  packed_ = packMediaTable(media);
+  if (packed_.empty()) packed_.assign(size_t(kMediumVec4s) * 4, 0.0f);
+  media_ = vk::Buffer(ctx, packed_.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       "medium table");
-  media_.write(packed.data(), packed.size() * sizeof(float));
   // The uniform blocks: fixed sizes (4 KiB and 16 KiB, within every device's 16 KiB range).
   static_assert(kExactMaxRows == EIKON_EXACT_MAX_ROWS,
                 "the exact path's row cap is declared twice");
@@ -191,11 +191,28 @@ BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& fiel
   exact_rows_ = vk::Buffer(ctx, rows.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                            "shape table rows (uniform)");
   exact_rows_.write(rows.data(), rows.size() * sizeof(glm::vec4));
+  small_media_ =
+      vk::Buffer(ctx, size_t(EIKON_SMALL_MEDIA_REGIONS) * kMediumVec4s * 4 * sizeof(float),
+                 VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "medium table (uniform)");
+  writeMedia();
+}
+
+void BoundaryDevice::writeMedia() {
+  media_.write(packed_.data(), packed_.size() * sizeof(float));
   std::vector<float> small(size_t(EIKON_SMALL_MEDIA_REGIONS) * kMediumVec4s * 4, 0.0f);
-  std::copy_n(packed.begin(), std::min(packed.size(), small.size()), small.begin());
-  small_media_ = vk::Buffer(ctx, small.size() * sizeof(float), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
-                            "medium table (uniform)");
+  std::copy_n(packed_.begin(), std::min(packed_.size(), small.size()), small.begin());
   small_media_.write(small.data(), small.size() * sizeof(float));
+}
+
+void BoundaryDevice::setRenderWavelength(double lambda_nm) {
+  if (lambda_nm == render_lambda_nm_ || !media_.handle()) return;
+  render_lambda_nm_ = lambda_nm;
+  for (size_t r = 0; r < table_.regions.size(); ++r) {
+    float* v15 = packed_.data() + (r * kMediumVec4s + 15) * 4;
+    v15[0] = float(mediumIndex(table_.regions[r].n_o, lambda_nm));
+    v15[1] = float(mediumIndex(table_.regions[r].n_e, lambda_nm));
+  }
+  writeMedia();
 }
 
 void BoundaryDevice::bindUniformTables(vk::ComputePipeline& p) const {

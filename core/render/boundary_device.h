@@ -47,12 +47,20 @@ class BoundaryDevice {
   /// the shape table's first EIKON_EXACT_MAX_ROWS rows and the medium table's first
   /// EIKON_SMALL_MEDIA_REGIONS regions, zero-padded to the blocks' fixed sizes.
   void bindUniformTables(vk::ComputePipeline& pipeline) const;
+  /// Write every region's n_o and n_e at λ (nm) into its record's v15 (core/volume/media.h), in
+  /// both copies of the medium table: the index an RGB view render reads (sharp.glsl
+  /// mediumIndex under EIKON_INDEX_AT_RENDER_WAVELENGTH). Nothing is written if λ is unchanged.
+  void setRenderWavelength(double lambda_nm);
   bool present() const { return present_; }
 
  private:
+  void writeMedia();
   vk::Image3D region_, distance_;
   vk::Buffer shapes_, media_;
   vk::Buffer exact_rows_, small_media_;
+  MediaTable table_;           // the regions' dispersion (for setRenderWavelength)
+  std::vector<float> packed_;  // packMediaTable's floats, v15 as last written
+  double render_lambda_nm_ = -1.0;
   bool present_ = false;
 };
 

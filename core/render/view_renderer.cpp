@@ -729,6 +729,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   p.limits.z = std::max(1, s.wavelengths);
   double l = s.wavelength_nm * 1e-3;
   p.wavelength = glm::vec4(float(l), float(1.0 / (l * l)), float(1.0 / (l * l * l * l)), 0.0f);
+  I.boundary.setRenderWavelength(s.wavelength_nm);  // the RGB march's indices (sharp.glsl)
 
   // Passes: one pixel sample at one wavelength (both modes) per dispatch, or at all N where no
   // march depends on λ (view.comp's wavelength sharing: one march serves every wavelength, the

@@ -25,7 +25,8 @@
 //   v12         : (GRIN n0, GRIN gradient xyz)
 //   v13         : (GRIN origin / centre xyz, GRIN radius)
 //   v14         : (radial-axis centre xyz, 0)
-//   v15         : reserved (0)
+//   v15         : (n_o, n_e at the view render's wavelength, 0, 0): written for each render by
+//                 BoundaryDevice::setRenderWavelength; 0 in packMediaTable's output
 //
 //   eikon::MediaTable media = eikon::buildMediaTable(scene);
 //   double n = eikon::mediumIndex(media.regions[r].n_o, 587.5618);
