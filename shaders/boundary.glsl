@@ -703,6 +703,11 @@ const float kExactMergeVoxels = 1e-4;
 // flow one lane at a time (a loop over the 8 lanes, each behind a branch). kExactMaxRows
 // (core/volume/boundary.h) bounds both.
 const int kExactMaxRows = EIKON_EXACT_MAX_ROWS;
+// Scenes of up to kExactUnrollShapes shapes run the loops over the shapes unrolled
+// (exactCrossingOutOf, exactRegionAt): every row index is then a constant, which llvmpipe reads
+// from the uniform block with one scalar load instead of a gather per lane (a loop counter is
+// never "uniform" to it). More shapes take do-while loops.
+const int kExactUnrollShapes = 4;
 #ifdef EIKON_EXACT_ROW
 void exactLoadShapes() {}
 #else
@@ -901,6 +906,11 @@ int exactRegionAt(vec3 x) {
   exactLoadShapes();
   if (EIKON_BOUNDARY_EXACT_SHAPES == 0) return 0;
   int r = 0, i = 0;
+  if (EIKON_BOUNDARY_EXACT_SHAPES <= kExactUnrollShapes) {  // (unrolled: see exactCrossingOutOf)
+    [[unroll]] for (int j = 0; j < EIKON_BOUNDARY_EXACT_SHAPES; ++j)
+      if (exactInside(j, x)) r = j + 1;
+    return r;
+  }
   do {  // (a do-while: see exactCrossingOutOf)
     if (exactInside(i, x)) r = i + 1;
   } while (++i < EIKON_BOUNDARY_EXACT_SHAPES);
@@ -915,6 +925,24 @@ int regionAt(vec3 x) { return EIKON_BOUNDARY_EXACT ? exactRegionAt(x) : boundary
 // its shape or enters a later one, pass 1 over all the region just past that point (the last
 // shape whose interval holds it) and its entry normal. One loop body (exactClip inlined once);
 // ~2 × the shape count loop passes and no voxel read per crossing.
+// One shape's clip folded into pass 0 (the ray's own shape: where the line leaves it; a later one:
+// where it enters) or pass 1 (the last shape holding the point tq just past the crossing).
+void exactPass0(int i, int region, float eps, LineClip c, inout float t, inout vec3 nOwn) {
+  if (!c.hit) return;
+  if (i + 1 == region) {
+    t = min(t, max(c.t1, 0.0));
+    nOwn = c.n1;
+  } else if (c.t0 > eps && c.t1 - c.t0 > eps) {
+    t = min(t, c.t0);
+  }
+}
+void exactPass1(int i, float tq, LineClip c, inout int to, inout vec3 nTo) {
+  if (c.hit && c.t0 <= tq && tq <= c.t1) {
+    to = i + 1;
+    nTo = c.n0;
+  }
+}
+
 BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
   exactLoadShapes();
   BoundaryCrossing out_ = noCrossing(b, region);
@@ -925,38 +953,35 @@ BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
   float t = 2.0, tq = 0.0;
   int to = 0;
   vec3 nOwn = vec3(0.0), nTo = vec3(0.0);
-  // Both passes in one do-while over k: shape k of pass 0 for k < S (from the ray's own shape on),
-  // shape k − S of pass 1 after it. llvmpipe leaves a loop only at the end of its body, so a
-  // while-loop of N passes runs its body N + 1 times (the last one masked off): a do-while runs it
-  // N times.
   const int S = EIKON_BOUNDARY_EXACT_SHAPES;
-  int k = max(region - 1, 0);
   bool none = false;
-  do {
-    const bool second = k >= S;
-    if (k == S) {  // pass 0 done: no crossing on [a, b], or the point just past it
-      none = t > 1.0;
-      tq = t + eps;
-    }
-    if (!none) {
-      const int i = second ? k - S : k;
-      LineClip c = exactClip(i, a, d);
-      if (c.hit) {
-        if (second) {
-          if (c.t0 <= tq && tq <= c.t1) {
-            to = i + 1;
-            nTo = c.n0;
-          }
-        } else if (i + 1 == region) {
-          t = min(t, max(c.t1, 0.0));
-          nOwn = c.n1;
-        } else if (c.t0 > eps && c.t1 - c.t0 > eps) {
-          t = min(t, c.t0);
-        }
+  if (S <= kExactUnrollShapes) {
+    [[unroll]] for (int i = 0; i < S; ++i)
+      if (i >= region - 1) exactPass0(i, region, eps, exactClip(i, a, d), t, nOwn);
+    none = t > 1.0;
+    tq = t + eps;
+    [[unroll]] for (int i = 0; i < S; ++i) exactPass1(i, tq, exactClip(i, a, d), to, nTo);
+  } else {
+    // Both passes in one do-while over k: shape k of pass 0 for k < S (from the ray's own shape
+    // on), shape k − S of pass 1 after it. llvmpipe leaves a loop only at the end of its body, so
+    // a while-loop of N passes runs its body N + 1 times (the last one masked off): a do-while
+    // runs it N times.
+    int k = max(region - 1, 0);
+    do {
+      const bool second = k >= S;
+      if (k == S) {  // pass 0 done: no crossing on [a, b], or the point just past it
+        none = t > 1.0;
+        tq = t + eps;
       }
-    }
-    ++k;
-  } while (k < 2 * S && !none);
+      if (!none) {
+        const int i = second ? k - S : k;
+        LineClip c = exactClip(i, a, d);
+        if (second) exactPass1(i, tq, c, to, nTo);
+        else exactPass0(i, region, eps, c, t, nOwn);
+      }
+      ++k;
+    } while (k < 2 * S && !none);
+  }
   if (none || to == region) return out_;
   int owner = max(region, to);
   vec3 n = exactToWorld(owner - 1, to == owner ? -nTo : nOwn);
