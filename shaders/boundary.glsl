@@ -34,14 +34,19 @@
 #define EIKON_BOUNDARY_CONVEX_APART false
 #endif
 
-int shapeKind(int s) { return int(shapeTable[EIKON_SHAPE_STRIDE * s].x); }
+// The shape table's rows: the includer's EIKON_SHAPE_ROW where it has one (march.glsl: its uniform
+// block when the table is small, EIKON_F_SMALL_SHAPES), else the storage buffer.
+#ifndef EIKON_SHAPE_ROW
+#define EIKON_SHAPE_ROW(i) shapeTable[i]
+#endif
+int shapeKind(int s) { return int(EIKON_SHAPE_ROW(EIKON_SHAPE_STRIDE * s).x); }
 
 // Local coordinates p = Rᵀ(x − c) of world point x in shape s (s = region − 1).
 vec3 shapeLocal(int s, vec3 x) {
   int o = EIKON_SHAPE_STRIDE * s;
-  vec3 d = x - shapeTable[o + 1].xyz;
-  return vec3(dot(shapeTable[o + 2].xyz, d), dot(shapeTable[o + 3].xyz, d),
-              dot(shapeTable[o + 4].xyz, d));
+  vec3 d = x - EIKON_SHAPE_ROW(o + 1).xyz;
+  return vec3(dot(EIKON_SHAPE_ROW(o + 2).xyz, d), dot(EIKON_SHAPE_ROW(o + 3).xyz, d),
+              dot(EIKON_SHAPE_ROW(o + 4).xyz, d));
 }
 
 float boxDistance(vec3 p, vec3 half_size) {
@@ -79,14 +84,14 @@ const int kShapePlanesPerPass = 32;
 
 // Plane k of a convex shape at local point p (k clamped to the last plane).
 float shapePlaneValue(int first, int count, int k, vec3 p) {
-  vec4 pl = shapeTable[first + min(k, count - 1)];
+  vec4 pl = EIKON_SHAPE_ROW(first + min(k, count - 1));
   return dot(pl.xyz, p) - pl.w;
 }
 
 // Signed distance (mm, negative inside) of shape s at world point x: Shape::signedDistance.
 float shapeSignedDistance(int s, vec3 x) {
   int o = EIKON_SHAPE_STRIDE * s;
-  vec4 head = shapeTable[o], par = shapeTable[o + 5];
+  vec4 head = EIKON_SHAPE_ROW(o), par = EIKON_SHAPE_ROW(o + 5);
   vec3 p = shapeLocal(s, x);
   int kind = int(head.x);
   if (kind == EIKON_SHAPE_SPHERE) return length(p) - par.x;
@@ -110,7 +115,7 @@ float shapeSignedDistance(int s, vec3 x) {
 // Shape::distanceGradient.
 vec3 shapeDistanceGradient(int s, vec3 x) {
   int o = EIKON_SHAPE_STRIDE * s;
-  vec4 head = shapeTable[o], par = shapeTable[o + 5];
+  vec4 head = EIKON_SHAPE_ROW(o), par = EIKON_SHAPE_ROW(o + 5);
   vec3 p = shapeLocal(s, x);
   int kind = int(head.x);
   vec3 g = vec3(0.0);
@@ -130,14 +135,14 @@ vec3 shapeDistanceGradient(int s, vec3 x) {
         float v = shapePlaneValue(first, count, k + j, p);
         if (v > m) {
           m = v;
-          g = shapeTable[first + min(k + j, count - 1)].xyz;
+          g = EIKON_SHAPE_ROW(first + min(k + j, count - 1)).xyz;
         }
       }
       k += kShapePlanesPerPass;
       if (k >= count) break;
     }
   }
-  return g.x * shapeTable[o + 2].xyz + g.y * shapeTable[o + 3].xyz + g.z * shapeTable[o + 4].xyz;
+  return g.x * EIKON_SHAPE_ROW(o + 2).xyz + g.y * EIKON_SHAPE_ROW(o + 3).xyz + g.z * EIKON_SHAPE_ROW(o + 4).xyz;
 }
 
 // ---- Triangle meshes (core/scene/mesh.cpp: MeshDistance::firstHit) ----
@@ -181,7 +186,7 @@ bool meshFirstHit(int s, vec3 o, vec3 d, float t0, float t1, float facing, out f
                   out vec3 nHit) {
   tHit = t1;
   nHit = vec3(0.0);
-  vec4 head = shapeTable[EIKON_SHAPE_STRIDE * s];
+  vec4 head = EIKON_SHAPE_ROW(EIKON_SHAPE_STRIDE * s);
   int nodes = int(head.y), tris = int(head.w);
   vec3 ad = abs(d);
   int kz = ad.x >= ad.y && ad.x >= ad.z ? 0 : (ad.y >= ad.z ? 1 : 2);
@@ -199,27 +204,27 @@ bool meshFirstHit(int s, vec3 o, vec3 d, float t0, float t1, float facing, out f
   bool found = false;
   int stack[EIKON_MESH_STACK];
   int top = 0;
-  if (meshBoxEntry(o, inv, t0, t1, shapeTable[nodes], shapeTable[nodes + 1]) < 3.0e38)
+  if (meshBoxEntry(o, inv, t0, t1, EIKON_SHAPE_ROW(nodes), EIKON_SHAPE_ROW(nodes + 1)) < 3.0e38)
     stack[top++] = 0;
   int pass = 0;
   if (top > 0) {
     for (;;) {
       int id = stack[--top];
-      vec4 lo = shapeTable[nodes + 2 * id], hi = shapeTable[nodes + 2 * id + 1];
+      vec4 lo = EIKON_SHAPE_ROW(nodes + 2 * id), hi = EIKON_SHAPE_ROW(nodes + 2 * id + 1);
       int count = int(hi.w), first = int(lo.w);
       if (count == 0) {
         int l = id + 1, r = first;
-        float el = meshBoxEntry(o, inv, t0, tHit, shapeTable[nodes + 2 * l],
-                                shapeTable[nodes + 2 * l + 1]);
-        float er = meshBoxEntry(o, inv, t0, tHit, shapeTable[nodes + 2 * r],
-                                shapeTable[nodes + 2 * r + 1]);
+        float el = meshBoxEntry(o, inv, t0, tHit, EIKON_SHAPE_ROW(nodes + 2 * l),
+                                EIKON_SHAPE_ROW(nodes + 2 * l + 1));
+        float er = meshBoxEntry(o, inv, t0, tHit, EIKON_SHAPE_ROW(nodes + 2 * r),
+                                EIKON_SHAPE_ROW(nodes + 2 * r + 1));
         bool leftFirst = el <= er;
         if ((leftFirst ? er : el) < 3.0e38) stack[top++] = leftFirst ? r : l;
         if ((leftFirst ? el : er) < 3.0e38) stack[top++] = leftFirst ? l : r;
       } else {
         [[unroll]] for (int j = 0; j < EIKON_MESH_LEAF; ++j) {
           int k = tris + 3 * (first + min(j, count - 1));
-          vec4 va = shapeTable[k], vb = shapeTable[k + 1], vc = shapeTable[k + 2];
+          vec4 va = EIKON_SHAPE_ROW(k), vb = EIKON_SHAPE_ROW(k + 1), vc = EIKON_SHAPE_ROW(k + 2);
           vec3 n = vec3(va.w, vb.w, vc.w);
           if (j < count && dot(n, d) * facing > 0.0) {
             float t = meshTriangleHit(sh, op, meshPermute(va.xyz, kx, ky, kz),
@@ -455,7 +460,7 @@ bool boundaryRefineOnShape(int s, bool leavingOwner, vec3 a, vec3 b, float lenVo
 void boundaryMeshCrossing(int s, bool leavingOwner, vec3 a, vec3 b, float lenVox,
                           inout BoundaryCrossing c) {
   int o = EIKON_SHAPE_STRIDE * s;
-  vec3 R0 = shapeTable[o + 2].xyz, R1 = shapeTable[o + 3].xyz, R2 = shapeTable[o + 4].xyz;
+  vec3 R0 = EIKON_SHAPE_ROW(o + 2).xyz, R1 = EIKON_SHAPE_ROW(o + 3).xyz, R2 = EIKON_SHAPE_ROW(o + 4).xyz;
   vec3 ba = b - a;
   vec3 d = vec3(dot(R0, ba), dot(R1, ba), dot(R2, ba));
   float w = 3.2 / lenVox, tHit;
@@ -604,18 +609,18 @@ const float kGrazeVoxels = 1e-3;
 // Plane i of the shape whose record is at o: the table's, or a box's ±x, ±y, ±z
 // (boundary.cpp localPlanes).
 vec4 slabPlane(int o, int i) {
-  if (int(shapeTable[o].x) != EIKON_SHAPE_BOX) return shapeTable[int(shapeTable[o].y) + i];
+  if (int(EIKON_SHAPE_ROW(o).x) != EIKON_SHAPE_BOX) return EIKON_SHAPE_ROW(int(EIKON_SHAPE_ROW(o).y) + i);
   vec3 n = vec3(0.0);
   n[i >> 1] = (i & 1) != 0 ? 1.0 : -1.0;
-  return vec4(n, shapeTable[o + 5][i >> 1]);
+  return vec4(n, EIKON_SHAPE_ROW(o + 5)[i >> 1]);
 }
 
 vec4 convexSlab(int s, vec3 a, vec3 b) {
   int o = EIKON_SHAPE_STRIDE * s;
-  int count = int(shapeTable[o].x) == EIKON_SHAPE_BOX ? 6 : int(shapeTable[o].z);
+  int count = int(EIKON_SHAPE_ROW(o).x) == EIKON_SHAPE_BOX ? 6 : int(EIKON_SHAPE_ROW(o).z);
   vec3 p = shapeLocal(s, a), ab = b - a;
-  vec3 d = vec3(dot(shapeTable[o + 2].xyz, ab), dot(shapeTable[o + 3].xyz, ab),
-                dot(shapeTable[o + 4].xyz, ab));
+  vec3 d = vec3(dot(EIKON_SHAPE_ROW(o + 2).xyz, ab), dot(EIKON_SHAPE_ROW(o + 3).xyz, ab),
+                dot(EIKON_SHAPE_ROW(o + 4).xyz, ab));
   vec4 r = vec4(-3.0e38, 3.0e38, -1.0, -1.0);
   for (int k = 0; count > 0;) {
     [[unroll]] for (int j = 0; j < kShapePlanesPerPass; ++j) {
@@ -653,7 +658,7 @@ BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
   BoundaryCrossing c = noCrossing(b, region);
   float graze = kGrazeVoxels * P.grid_origin.w / length(b - a);
   bool inside = region >= 1;
-  int k0 = inside ? region - 1 : 0, k1 = inside ? region : int(shapeTable[0].w);
+  int k0 = inside ? region - 1 : 0, k1 = inside ? region : int(EIKON_SHAPE_ROW(0).w);
   int shape = -1, face = -1;
   float t = 3.0e38;
   for (int k = k0; k < k1; ++k) {
@@ -670,7 +675,7 @@ BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
   if (shape < 0) return c;
   int o = EIKON_SHAPE_STRIDE * shape;
   vec3 g = slabPlane(o, face).xyz;
-  vec3 n = g.x * shapeTable[o + 2].xyz + g.y * shapeTable[o + 3].xyz + g.z * shapeTable[o + 4].xyz;
+  vec3 n = g.x * EIKON_SHAPE_ROW(o + 2).xyz + g.y * EIKON_SHAPE_ROW(o + 3).xyz + g.z * EIKON_SHAPE_ROW(o + 4).xyz;
   c.found = true;
   c.t = t;
   c.point = mix(a, b, t);

@@ -93,6 +93,9 @@ using uvec4 = glm::uvec4;
 // sharp: the medium table has at most EIKON_SMALL_MEDIA_REGIONS regions (read from its uniform
 // block, EIKON_B_SMALL_MEDIA)
 #define EIKON_F_SMALL_MEDIA 262144
+// sharp: the shape table has at most EIKON_EXACT_MAX_ROWS rows (no mesh): the view kernels read it
+// from its uniform block (EIKON_B_EXACT_ROWS) everywhere, the convex planes' loops included
+#define EIKON_F_SMALL_SHAPES 524288
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0

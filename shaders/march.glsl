@@ -34,7 +34,9 @@ layout(binding = EIKON_B_SCATTER, rgba32f) readonly uniform image3D scatterImg;
 layout(binding = EIKON_B_LIGHT_FLUENCE, rgba32f) readonly uniform image3D lightFluenceImg;
 layout(binding = EIKON_B_LIGHT_FLUX, rgba32f) readonly uniform image3D lightFluxImg;
 layout(std430, binding = EIKON_B_ENV_IMAGE) readonly buffer EnvBuf { vec4 envTexels[]; };
-layout(std430, binding = EIKON_B_TABLES) readonly buffer TableBuf { vec4 tables[]; };
+// A uniform block (8.9 KiB): the CIE and basis tables are read at a varying index in the march,
+// which llvmpipe does with a gather there, one lane at a time for a storage buffer.
+layout(std140, binding = EIKON_B_TABLES) uniform TableBuf { vec4 tables[EIKON_TABLE_COUNT]; };
 layout(binding = EIKON_B_REGION, r32ui) readonly uniform uimage3D regionImg;
 layout(binding = EIKON_B_BOUNDARY_DIST, r32f) readonly uniform image3D boundaryDist;
 layout(std430, binding = EIKON_B_SHAPES) readonly buffer ShapeBuf { vec4 shapeTable[]; };
@@ -47,6 +49,7 @@ layout(std140, binding = EIKON_B_SMALL_MEDIA) uniform SmallMediaBuf {
   vec4 smallMedia[EIKON_SMALL_MEDIA_REGIONS * EIKON_MEDIUM_VEC4S];
 };
 #define EIKON_EXACT_ROW(i) exactRows[i]
+#define EIKON_SHAPE_ROW(i) (hasFlag(EIKON_F_SMALL_SHAPES) ? exactRows[i] : shapeTable[i])
 #define EIKON_MEDIUM_ROW(i) (hasFlag(EIKON_F_SMALL_MEDIA) ? smallMedia[i] : mediaTable[i])
 
 const float kPi = 3.14159265358979323846;

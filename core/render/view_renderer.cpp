@@ -222,9 +222,10 @@ std::vector<vk::BindingSpec> viewKernelBindings() {
   for (uint32_t b :
        {uint32_t(EIKON_B_SCATTER), uint32_t(EIKON_B_LIGHT_FLUENCE), uint32_t(EIKON_B_LIGHT_FLUX)})
     common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-  for (uint32_t b : {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE),
-                     uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_OUTPUT)})
+  for (uint32_t b :
+       {uint32_t(EIKON_B_PARAMS), uint32_t(EIKON_B_ENV_IMAGE), uint32_t(EIKON_B_OUTPUT)})
     common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+  common.push_back({uint32_t(EIKON_B_TABLES), VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER});
   for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
   for (const vk::BindingSpec& b : uniformTableBindings()) common.push_back(b);
   return common;
@@ -327,6 +328,8 @@ int volumeFeatureFlags(const VolumeSet& v) {
   if (sharp && v.boundary.exact) flags |= EIKON_F_EXACT;
   if (sharp && v.media.regions.size() <= size_t(EIKON_SMALL_MEDIA_REGIONS))
     flags |= EIKON_F_SMALL_MEDIA;
+  if (sharp && !mesh && exactTableRows(v.boundary.shapes) <= EIKON_EXACT_MAX_ROWS)
+    flags |= EIKON_F_SMALL_SHAPES;
   return flags;
 }
 
@@ -528,7 +531,7 @@ struct ViewRenderer::Impl {
     for (int r = 0; r < 3; ++r)
       tab[size_t(EIKON_MATRIX_OFFSET + r)] =
           glm::vec4(float(M[0][r]), float(M[1][r]), float(M[2][r]), 0.0f);
-    tables = vk::Buffer(ctx, tab.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+    tables = vk::Buffer(ctx, tab.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                         "spectral tables");
     tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
     timings::mark("volume uploaded");

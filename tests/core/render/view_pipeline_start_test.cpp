@@ -49,7 +49,7 @@ TEST(ViewPipelineStart, FlagsNameTheVolumesFeatures) {
   Scene s = sceneFromJson(sphere);
   // A lone sharp sphere takes the crossings on its shape (BoundaryField::exact).
   EXPECT_EQ(predictVolumeFeatureFlags(s, false),
-            EIKON_F_SHARP | EIKON_F_EXACT | EIKON_F_SMALL_MEDIA);
+            EIKON_F_SHARP | EIKON_F_EXACT | EIKON_F_SMALL_MEDIA | EIKON_F_SMALL_SHAPES);
   s.interfaces = Scene::Interfaces::Smoothed;
   EXPECT_EQ(predictVolumeFeatureFlags(s, false), 0);
   s.materials.at("g").uniaxial = true;

@@ -102,11 +102,12 @@ TEST(SpecialiseSpirv, TheDriverBuildsTheSpecialisedViewKernel) {
   for (uint32_t b = 0; b <= EIKON_B_MEDIA; ++b) {
     const bool image = (b >= EIKON_B_INDEX_O_A && b <= EIKON_B_AXIS) ||
                        (b >= EIKON_B_SCATTER && b <= EIKON_B_BOUNDARY_DIST);
-    if (b == EIKON_B_RAYS || b == EIKON_B_BOUNDARY_QUERIES) continue;
+    if (b == EIKON_B_RAYS || b == EIKON_B_BOUNDARY_QUERIES || b == EIKON_B_TABLES) continue;
     bindings.push_back(
         {b, image ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
   }
-  for (uint32_t b : {uint32_t(EIKON_B_EXACT_ROWS), uint32_t(EIKON_B_SMALL_MEDIA)})
+  for (uint32_t b :
+       {uint32_t(EIKON_B_TABLES), uint32_t(EIKON_B_EXACT_ROWS), uint32_t(EIKON_B_SMALL_MEDIA)})
     bindings.push_back({b, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER});
   for (const std::vector<uint32_t>& spec : {std::vector<uint32_t>{1u, uint32_t(EIKON_F_SHARP), 2u},
                                             std::vector<uint32_t>{0u, 0u, 0u}}) {
