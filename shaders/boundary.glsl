@@ -600,6 +600,20 @@ BoundaryCrossing locateCrossing(vec3 a, vec3 b, float tolVoxels, bool analytic) 
 
 // ---- Convex polyhedra apart from each other (boundary.cpp: convexCrossingOutOf) ----
 
+// march.glsl makes the exact path's four constants (kExact); other kernels have none.
+#ifndef EIKON_BOUNDARY_EXACT
+#define EIKON_BOUNDARY_EXACT false
+#define EIKON_BOUNDARY_EXACT_ROWS 0
+#define EIKON_BOUNDARY_EXACT_SHAPES 0
+#define EIKON_BOUNDARY_EXACT_KINDS 0
+#endif
+// (convexCrossingUnrolled, below)
+#define EIKON_CONVEX_UNROLLED                                                                   \
+  (EIKON_BOUNDARY_CONVEX_APART && EIKON_BOUNDARY_EXACT_SHAPES >= 1 &&                          \
+   EIKON_BOUNDARY_EXACT_SHAPES <= 4 && EIKON_BOUNDARY_EXACT_KINDS == (1 << EIKON_SHAPE_CONVEX) && \
+   EIKON_BOUNDARY_EXACT_SHAPES * (EIKON_BOUNDARY_EXACT_ROWS -                                   \
+                                  EIKON_SHAPE_STRIDE * EIKON_BOUNDARY_EXACT_SHAPES) <= 512)
+
 // A crossing this close to the segment's start (voxels) is a graze at the point the ray is on.
 const float kGrazeVoxels = 1e-3;
 
@@ -654,7 +668,10 @@ BoundaryCrossing noCrossing(vec3 b, int region) {
 // from the others: inside a polyhedron, the first of its planes ahead (into the ambient); in the
 // ambient, the nearest polyhedron the segment passes through (beyond kGrazeVoxels). One loop over
 // the shapes it may cross (its own, or all: the record's w), one pass per 32 planes each.
+BoundaryCrossing convexCrossingUnrolled(vec3 a, vec3 b, int region);
+
 BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
+  if (EIKON_CONVEX_UNROLLED) return convexCrossingUnrolled(a, b, region);
   BoundaryCrossing c = noCrossing(b, region);
   float graze = kGrazeVoxels * P.grid_origin.w / length(b - a);
   bool inside = region >= 1;
@@ -693,14 +710,63 @@ BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
 // one per plane), _SHAPES: the shape count, _KINDS: the kinds present (bit 1 << EIKON_SHAPE_*), so
 // that the clip of a kind the scene lacks is compiled out (a rounded box's is ~100 distances).
 // march.glsl makes all four specialization constants (kExact); other kernels keep the walk.
-#ifndef EIKON_BOUNDARY_EXACT
-#define EIKON_BOUNDARY_EXACT false
-#define EIKON_BOUNDARY_EXACT_ROWS 0
-#define EIKON_BOUNDARY_EXACT_SHAPES 0
-#define EIKON_BOUNDARY_EXACT_KINDS 0
-#endif
 #define EIKON_EXACT_HAS(kind) ((EIKON_BOUNDARY_EXACT_KINDS & (1 << (kind))) != 0)
 const float kExactMergeVoxels = 1e-4;
+
+// convexCrossing unrolled (the view kernels, kExact also set for convex_apart scenes): every shape
+// a convex polyhedron, at most 4 of them and at most 512 (shape, plane row) pairs. Both loops run
+// unrolled over constant counts, so that every shape-table row is read at a constant index: one
+// scalar load on llvmpipe where the pass of 32 planes at a varying index gathered each plane lane
+// by lane. Each shape tests every plane row, keeping its own (first ≤ row < first + count): the
+// same slabs in the same order as convexSlab, so the same crossing.
+BoundaryCrossing convexCrossingUnrolled(vec3 a, vec3 b, int region) {
+  BoundaryCrossing c = noCrossing(b, region);
+  const int S = EIKON_BOUNDARY_EXACT_SHAPES, rows = EIKON_BOUNDARY_EXACT_ROWS;
+  float graze = kGrazeVoxels * P.grid_origin.w / length(b - a);
+  bool inside = region >= 1;
+  int shape = -1, face = -1;
+  float t = 3.0e38;
+  vec3 ab = b - a;
+  [[unroll]] for (int k = 0; k < S; ++k) {
+    const int o = EIKON_SHAPE_STRIDE * k;
+    vec4 head = EIKON_SHAPE_ROW(o);
+    int first = int(head.y), count = int(head.z);
+    vec3 p = shapeLocal(k, a);
+    vec3 d = vec3(dot(EIKON_SHAPE_ROW(o + 2).xyz, ab), dot(EIKON_SHAPE_ROW(o + 3).xyz, ab),
+                  dot(EIKON_SHAPE_ROW(o + 4).xyz, ab));
+    vec4 r = vec4(-3.0e38, 3.0e38, -1.0, -1.0);
+    [[unroll]] for (int q = EIKON_SHAPE_STRIDE * S; q < rows; ++q) {
+      if (q < first || q >= first + count) continue;
+      vec4 pl = EIKON_SHAPE_ROW(q);
+      float i = float(q - first);
+      float nd = dot(pl.xyz, d), v = dot(pl.xyz, p) - pl.w;
+      float tt = -v / (nd != 0.0 ? nd : 1.0);
+      if (nd > 0.0 && tt < r.y) r.yw = vec2(tt, i);
+      else if (nd < 0.0 && tt > r.x) r.xz = vec2(tt, i);
+      else if (nd == 0.0 && v > 0.0) r.xy = vec2(3.0e38, -3.0e38);  // parallel, outside
+    }
+    bool relevant = !inside || region - 1 == k;
+    bool hit = inside ? r.w >= 0.0 && r.y <= 1.0
+                      : r.x <= r.y && r.y > graze && r.x <= 1.0 && r.z >= 0.0;
+    float tk = max(inside ? r.y : r.x, 0.0);
+    if (relevant && hit && tk < t) {
+      t = tk;
+      shape = k;
+      face = int(inside ? r.w : r.z);
+    }
+  }
+  if (shape < 0) return c;
+  int o = EIKON_SHAPE_STRIDE * shape;
+  vec3 g = slabPlane(o, face).xyz;
+  vec3 n = g.x * EIKON_SHAPE_ROW(o + 2).xyz + g.y * EIKON_SHAPE_ROW(o + 3).xyz +
+           g.z * EIKON_SHAPE_ROW(o + 4).xyz;
+  c.found = true;
+  c.t = t;
+  c.point = mix(a, b, t);
+  c.normal = (inside ? 1.0 : -1.0) * normalize(n);
+  c.to = inside ? 0 : shape + 1;
+  return c;
+}
 // The loops over the shapes read the table's rows through EIKON_EXACT_ROW. The view kernels
 // (march.glsl) define it as their uniform block of the table's first rows (EIKON_B_EXACT_ROWS: a
 // vector gather on llvmpipe); other includers get a private copy made once per invocation
