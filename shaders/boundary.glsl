@@ -629,6 +629,15 @@ vec4 slabPlane(int o, int i) {
   return vec4(n, EIKON_SHAPE_ROW(o + 5)[i >> 1]);
 }
 
+// Plane `pl` (number i) of a shape narrows the slab r of the local line p + t d (convexSlab).
+void slabNarrow(vec4 pl, float i, vec3 p, vec3 d, inout vec4 r) {
+  float nd = dot(pl.xyz, d), v = dot(pl.xyz, p) - pl.w;
+  float t = -v / (nd != 0.0 ? nd : 1.0);
+  if (nd > 0.0 && t < r.y) r.yw = vec2(t, i);
+  else if (nd < 0.0 && t > r.x) r.xz = vec2(t, i);
+  else if (nd == 0.0 && v > 0.0) r.xy = vec2(3.0e38, -3.0e38);  // parallel, outside
+}
+
 vec4 convexSlab(int s, vec3 a, vec3 b) {
   int o = EIKON_SHAPE_STRIDE * s;
   int count = int(EIKON_SHAPE_ROW(o).x) == EIKON_SHAPE_BOX ? 6 : int(EIKON_SHAPE_ROW(o).z);
@@ -639,12 +648,7 @@ vec4 convexSlab(int s, vec3 a, vec3 b) {
   for (int k = 0; count > 0;) {
     [[unroll]] for (int j = 0; j < kShapePlanesPerPass; ++j) {
       int i = min(k + j, count - 1);
-      vec4 pl = slabPlane(o, i);
-      float nd = dot(pl.xyz, d), v = dot(pl.xyz, p) - pl.w;
-      float t = -v / (nd != 0.0 ? nd : 1.0);
-      if (nd > 0.0 && t < r.y) r.yw = vec2(t, float(i));
-      else if (nd < 0.0 && t > r.x) r.xz = vec2(t, float(i));
-      else if (nd == 0.0 && v > 0.0) r.xy = vec2(3.0e38, -3.0e38);  // parallel, outside
+      slabNarrow(slabPlane(o, i), float(i), p, d, r);
     }
     k += kShapePlanesPerPass;
     if (k >= count) break;
@@ -670,35 +674,46 @@ BoundaryCrossing noCrossing(vec3 b, int region) {
 // the shapes it may cross (its own, or all: the record's w), one pass per 32 planes each.
 BoundaryCrossing convexCrossingUnrolled(vec3 a, vec3 b, int region);
 
-BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
-  if (EIKON_CONVEX_UNROLLED) return convexCrossingUnrolled(a, b, region);
-  BoundaryCrossing c = noCrossing(b, region);
-  float graze = kGrazeVoxels * P.grid_origin.w / length(b - a);
-  bool inside = region >= 1;
-  int k0 = inside ? region - 1 : 0, k1 = inside ? region : int(EIKON_SHAPE_ROW(0).w);
-  int shape = -1, face = -1;
-  float t = 3.0e38;
-  for (int k = k0; k < k1; ++k) {
-    vec4 sl = convexSlab(k, a, b);
-    bool hit = inside ? sl.w >= 0.0 && sl.y <= 1.0
-                      : sl.x <= sl.y && sl.y > graze && sl.x <= 1.0 && sl.z >= 0.0;
-    float tk = max(inside ? sl.y : sl.x, 0.0);
-    if (hit && tk < t) {
-      t = tk;
-      shape = k;
-      face = int(inside ? sl.w : sl.z);
-    }
+// Shape k's slab sl on the segment: keep it if the segment leaves it (inside) or enters it
+// (outside, beyond the graze) before the crossing kept so far.
+void convexKeep(vec4 sl, int k, bool inside, float graze, inout float t, inout int shape,
+                inout int face) {
+  bool hit = inside ? sl.w >= 0.0 && sl.y <= 1.0
+                    : sl.x <= sl.y && sl.y > graze && sl.x <= 1.0 && sl.z >= 0.0;
+  float tk = max(inside ? sl.y : sl.x, 0.0);
+  if (hit && tk < t) {
+    t = tk;
+    shape = k;
+    face = int(inside ? sl.w : sl.z);
   }
+}
+
+// The crossing kept (shape ≥ 0: at t on face `face` of `shape`), or none.
+BoundaryCrossing convexFound(vec3 a, vec3 b, int region, float t, int shape, int face) {
+  BoundaryCrossing c = noCrossing(b, region);
   if (shape < 0) return c;
+  bool inside = region >= 1;
   int o = EIKON_SHAPE_STRIDE * shape;
   vec3 g = slabPlane(o, face).xyz;
-  vec3 n = g.x * EIKON_SHAPE_ROW(o + 2).xyz + g.y * EIKON_SHAPE_ROW(o + 3).xyz + g.z * EIKON_SHAPE_ROW(o + 4).xyz;
+  vec3 n = g.x * EIKON_SHAPE_ROW(o + 2).xyz + g.y * EIKON_SHAPE_ROW(o + 3).xyz +
+           g.z * EIKON_SHAPE_ROW(o + 4).xyz;
   c.found = true;
   c.t = t;
   c.point = mix(a, b, t);
   c.normal = (inside ? 1.0 : -1.0) * normalize(n);
   c.to = inside ? 0 : shape + 1;
   return c;
+}
+
+BoundaryCrossing convexCrossing(vec3 a, vec3 b, int region) {
+  if (EIKON_CONVEX_UNROLLED) return convexCrossingUnrolled(a, b, region);
+  float graze = kGrazeVoxels * P.grid_origin.w / length(b - a);
+  bool inside = region >= 1;
+  int k0 = inside ? region - 1 : 0, k1 = inside ? region : int(EIKON_SHAPE_ROW(0).w);
+  int shape = -1, face = -1;
+  float t = 3.0e38;
+  for (int k = k0; k < k1; ++k) convexKeep(convexSlab(k, a, b), k, inside, graze, t, shape, face);
+  return convexFound(a, b, region, t, shape, face);
 }
 
 
@@ -720,7 +735,6 @@ const float kExactMergeVoxels = 1e-4;
 // by lane. Each shape tests every plane row, keeping its own (first ≤ row < first + count): the
 // same slabs in the same order as convexSlab, so the same crossing.
 BoundaryCrossing convexCrossingUnrolled(vec3 a, vec3 b, int region) {
-  BoundaryCrossing c = noCrossing(b, region);
   const int S = EIKON_BOUNDARY_EXACT_SHAPES, rows = EIKON_BOUNDARY_EXACT_ROWS;
   float graze = kGrazeVoxels * P.grid_origin.w / length(b - a);
   bool inside = region >= 1;
@@ -735,37 +749,11 @@ BoundaryCrossing convexCrossingUnrolled(vec3 a, vec3 b, int region) {
     vec3 d = vec3(dot(EIKON_SHAPE_ROW(o + 2).xyz, ab), dot(EIKON_SHAPE_ROW(o + 3).xyz, ab),
                   dot(EIKON_SHAPE_ROW(o + 4).xyz, ab));
     vec4 r = vec4(-3.0e38, 3.0e38, -1.0, -1.0);
-    [[unroll]] for (int q = EIKON_SHAPE_STRIDE * S; q < rows; ++q) {
-      if (q < first || q >= first + count) continue;
-      vec4 pl = EIKON_SHAPE_ROW(q);
-      float i = float(q - first);
-      float nd = dot(pl.xyz, d), v = dot(pl.xyz, p) - pl.w;
-      float tt = -v / (nd != 0.0 ? nd : 1.0);
-      if (nd > 0.0 && tt < r.y) r.yw = vec2(tt, i);
-      else if (nd < 0.0 && tt > r.x) r.xz = vec2(tt, i);
-      else if (nd == 0.0 && v > 0.0) r.xy = vec2(3.0e38, -3.0e38);  // parallel, outside
-    }
-    bool relevant = !inside || region - 1 == k;
-    bool hit = inside ? r.w >= 0.0 && r.y <= 1.0
-                      : r.x <= r.y && r.y > graze && r.x <= 1.0 && r.z >= 0.0;
-    float tk = max(inside ? r.y : r.x, 0.0);
-    if (relevant && hit && tk < t) {
-      t = tk;
-      shape = k;
-      face = int(inside ? r.w : r.z);
-    }
+    [[unroll]] for (int q = EIKON_SHAPE_STRIDE * S; q < rows; ++q)
+      if (q >= first && q < first + count) slabNarrow(EIKON_SHAPE_ROW(q), float(q - first), p, d, r);
+    if (!inside || region - 1 == k) convexKeep(r, k, inside, graze, t, shape, face);
   }
-  if (shape < 0) return c;
-  int o = EIKON_SHAPE_STRIDE * shape;
-  vec3 g = slabPlane(o, face).xyz;
-  vec3 n = g.x * EIKON_SHAPE_ROW(o + 2).xyz + g.y * EIKON_SHAPE_ROW(o + 3).xyz +
-           g.z * EIKON_SHAPE_ROW(o + 4).xyz;
-  c.found = true;
-  c.t = t;
-  c.point = mix(a, b, t);
-  c.normal = (inside ? 1.0 : -1.0) * normalize(n);
-  c.to = inside ? 0 : shape + 1;
-  return c;
+  return convexFound(a, b, region, t, shape, face);
 }
 // The loops over the shapes read the table's rows through EIKON_EXACT_ROW. The view kernels
 // (march.glsl) define it as their uniform block of the table's first rows (EIKON_B_EXACT_ROWS: a
