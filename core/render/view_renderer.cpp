@@ -487,9 +487,18 @@ struct ViewRenderer::Impl {
     if (expected) prefetch(*expected);
     std::array<uint32_t, 3> ext{uint32_t(grid.dims[0]), uint32_t(grid.dims[1]),
                                 uint32_t(grid.dims[2])};
+    // On the exact path without light volumes no kernel reads the volume's fields: the view and
+    // trace marches take every index and medium from the medium table and every crossing from the
+    // shapes (sharp.glsl; the polarised trace reads the boundary's region image, uploaded by
+    // BoundaryDevice). One-voxel placeholders are bound instead, which saves the upload (~0.5 s
+    // for a 128³ sphere; docs/performance.md "Start-up").
+    const bool fields_unread = (volume_flags & EIKON_F_EXACT) != 0 && !lit;
+    const std::vector<glm::vec4> placeholder(1, glm::vec4(0.0f));
     auto upload = [&](const std::vector<glm::vec4>& data, const char* name) {
-      vk::Image3D img(ctx, ext, VK_FORMAT_R32G32B32A32_SFLOAT, name);
-      img.upload(ctx, data.data(), data.size() * sizeof(glm::vec4));
+      const auto& d = fields_unread ? placeholder : data;
+      vk::Image3D img(ctx, fields_unread ? std::array<uint32_t, 3>{1, 1, 1} : ext,
+                      VK_FORMAT_R32G32B32A32_SFLOAT, name);
+      img.upload(ctx, d.data(), d.size() * sizeof(glm::vec4));
       images.push_back(std::move(img));
     };
     const char* names[3] = {"index A", "index B", "index C"};
