@@ -259,14 +259,15 @@ std::vector<uint32_t> specialisationOf(const PipelineKey& key) {
 /// The EIKON_F_* flags of a render's settings (spectral) and march (no skipping, no Fresnel).
 int renderFlagsOf(const RenderSettings& s) { return s.wavelengths > 0 ? EIKON_F_SPECTRAL : 0; }
 
+int marchFlagsOf(const MarchSettings& m) {
+  return (m.skip_empty ? 0 : EIKON_F_NO_SKIP) | (m.fresnel ? 0 : EIKON_F_NO_FRESNEL);
+}
+
 /// The EIKON_F_* flag of the scene's environment kind (march.glsl environmentRgb; none: checker).
 int environmentFlagsOf(const Environment& e) {
   return e.type == Environment::Type::Constant  ? EIKON_F_ENV_CONSTANT
          : e.type == Environment::Type::LatLong ? EIKON_F_ENV_LATLONG
                                                 : 0;
-}
-int marchFlagsOf(const MarchSettings& m) {
-  return (m.skip_empty ? 0 : EIKON_F_NO_SKIP) | (m.fresnel ? 0 : EIKON_F_NO_FRESNEL);
 }
 
 /// View pipelines started before their renderer (startViewPipeline): compiled on a thread of their
