@@ -33,7 +33,11 @@
 #define EIKON_FIELD_FLAGS P.grid_dims.w
 #endif
 
-bool hasFlag(int f) { return (EIKON_FIELD_FLAGS & f) != 0; }
+// A macro, not a function: with a specialization constant for EIKON_FIELD_FLAGS every test is a
+// constant expression at its use, which the host's SPIR-V passes fold and whose dead branches
+// they remove before the driver sees the module (core/vk/specialise.h); a function call hid the
+// constant from them.
+#define hasFlag(f) ((EIKON_FIELD_FLAGS & (f)) != 0)
 
 // ---- Sampling: cell-centred trilinear stencil, clamped to the edge voxels ----
 

@@ -90,10 +90,12 @@ vec4 gRecorded[6];
 // Specialization constants (core/render/view_renderer.cpp: one pipeline per feature set). llvmpipe
 // (lavapipe) executes both sides of every branch with a lane mask and every loop body at least
 // once, so a step costs all the code in the march loop whatever the scene uses; constants fold
-// the features away instead (docs/performance.md). −1: read the value from P at run time.
+// the features away instead (docs/performance.md).
 //   kSharpMarch: the sharp march (EIKON_F_SHARP) instead of the smoothed one;
-//   kViewFlags: the EIKON_F_* flags of the scene and the render (P.grid_dims.w);
-//   kIntegrator: EIKON_INT_* (P.march.w);
+//   kViewFlags: the EIKON_F_* flags of the scene and the render (also in P.grid_dims.w), always
+//     given (core/render/view_renderer.cpp specialisationOf): hasFlag tests the constant itself,
+//     so that SPIR-V's own constant folding removes what a flag turns off (core/vk/specialise.h);
+//   kIntegrator: EIKON_INT_* (P.march.w; −1: read from P at run time);
 //   kExact: on the exact path (EIKON_F_EXACT, core/volume/boundary.h exact) the shape table's
 //     rows in bits 0–9, the shape count in bits 10–19 and the kinds present (1 << EIKON_SHAPE_*)
 //     in bits 20–24 (boundary.glsl exactCrossingOutOf); 0 otherwise.
@@ -105,7 +107,7 @@ layout(constant_id = 2) const int kIntegrator = -1;
 layout(constant_id = 3) const bool kAov = false;
 layout(constant_id = 4) const int kExact = 0;
 
-#define EIKON_FIELD_FLAGS (kViewFlags == -1 ? P.grid_dims.w : kViewFlags)
+#define EIKON_FIELD_FLAGS kViewFlags
 #define EIKON_FIELD_INV_H P.grid_extent.w
 #define EIKON_FIELD_LAMBDA_UM gLambdaUm
 #define EIKON_FIELD_IL2 gIl2

@@ -63,7 +63,8 @@ WaveParams P;
 //   kSharpLight: the scene's boundary field applies (sharp interfaces);
 //   kWaveFlags:  EIKON_F_DISPERSIVE | _ATTENUATION | _OPACITY of the volume, _UNIAXIAL for an
 //                e-mode run in a uniaxial volume, _CONVEX when some shape is a convex polyhedron
-//                (sharp: boundary.glsl's plane loops); −1: read from P.grid_dims.w;
+//                (sharp: boundary.glsl's plane loops); always given (GpuWavefront), also in
+//                P.grid_dims.w;
 //   kWaveOptions: EIKON_WO_* bits (straight steps, pass caustics, probe plane); −1: from P.
 layout(constant_id = 0) const bool kSharpLight = false;
 layout(constant_id = 1) const int kWaveFlags = -1;
@@ -116,7 +117,7 @@ void storeOther(uint i, WavePatch p) {
 #define EIKON_FIELD_LAMBDA_UM P.wavelength.x
 #define EIKON_FIELD_IL2 P.wavelength.y
 #define EIKON_FIELD_IL4 P.wavelength.z
-#define EIKON_FIELD_FLAGS (kWaveFlags == -1 ? P.grid_dims.w : kWaveFlags)
+#define EIKON_FIELD_FLAGS kWaveFlags
 #define EIKON_FIELD_HAS_AXIS hasFlag(EIKON_F_UNIAXIAL)
 #include "field.glsl"
 
