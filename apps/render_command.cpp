@@ -273,16 +273,22 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
     });
   session.setProgress({[&](const char* what, double f) { progress.update(what, f); },
                        [&](const char* what) { progress.working(what); }});
+  const bool lit = !scene->lights.empty() && !a.no_light;
   if (!a.reference) {
     session.context();  // what prepare() does first, marked apart from the voxelising
     timings::mark("device created");
     // The view pipeline compiles beside the voxelising and the upload (docs/performance.md).
-    session.startRenderPipeline(rs, !scene->lights.empty() && !a.no_light);
+    session.startRenderPipeline(rs, lit);
   }
-  session.prepare(!a.reference);
+  // Without light volumes a GPU render on the exact path reads no per-voxel field: only the
+  // interfaces are voxelised then (docs/performance.md "Start-up").
+  if (a.reference || lit)
+    session.prepare(!a.reference);
+  else
+    session.prepareGpuRender();
   timings::mark("voxelised");
   LightOutcome light;
-  if (!scene->lights.empty() && !a.no_light) {
+  if (lit) {
     light = session.simulateLight(light_request, a.reference,
                                   a.no_light_cache ? std::filesystem::path() : lightCacheDir(a));
     timings::mark(light.cached ? "light (from the cache)" : "light simulated");

@@ -405,7 +405,7 @@ void main() {
     t0 = max(t0, 0.0);
     applySheets(b, o, d, t0);
     b.x = o + d * t0;
-    b.region = boundaryRegion(b.x);
+    b.region = regionAt(b.x);  // on the shapes on the exact path, else the field's
     if (b.region != 0) res.head.w = 1;
     else {
       push(b);

@@ -30,6 +30,9 @@ LightingSummary simulateLightingWith(const Scene& scene, VolumeSet& volume,
                                      const LightingOptions& options, const SimulateRun& simulate) {
   LightingSummary sum;
   if (scene.lights.empty()) return sum;
+  if (!volume.fields || (!volume.boundary.empty() && !volume.boundary.hasVoxels()))
+    throw std::invalid_argument(
+        "simulateLighting: the volume has no fields (voxelizeInterfaces); voxelise it whole");
   auto runs = planLighting(scene, volume, options.bands);
   auto t0 = std::chrono::steady_clock::now();
   clearLighting(volume);

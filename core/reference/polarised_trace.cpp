@@ -302,7 +302,7 @@ PolarisedTrace tracePolarised(const Field& field, const std::vector<PolarizerShe
     tracer.applySheets(b, b.x, d, t0);
     b.x += d * t0;
     b.opl = field.ambientIndex() * t0;
-    b.region = boundaryRegion(*field.boundary(), b.x);
+    b.region = regionAt(*field.boundary(), b.x);  // exact path: on the shapes
     if (b.region != 0)
       throw std::runtime_error("polarised trace: the ray enters the volume inside an object");
     tracer.run(b, exits, out.truncated);

@@ -94,7 +94,7 @@ void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field, const
                        const std::string& file) {
   const auto& lim = ctx.limits();
   const std::string where = (file.empty() ? std::string("scene") : file) + ": /objects: ";
-  if (!field.empty())
+  if (field.hasVoxels())
     for (int a = 0; a < 3; ++a)
       if (uint32_t(field.grid.dims[size_t(a)]) > lim.max_image_dimension_3d)
         throw std::runtime_error(where + "the boundary field needs " +
@@ -158,7 +158,7 @@ BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& fiel
                     kMediumGrin == EIKON_MEDIUM_GRIN && kMediumOpaque == EIKON_MEDIUM_OPAQUE,
                 "the medium table's layout is declared twice (media.h, eikon_shared.h)");
   checkBoundaryFits(ctx, field, media, file);
-  present_ = !field.empty();
+  present_ = field.hasVoxels();  // else one-voxel placeholders (the exact path reads none)
   std::array<uint32_t, 3> ext{1, 1, 1};
   if (present_)
     ext = {uint32_t(field.grid.dims[0]), uint32_t(field.grid.dims[1]),

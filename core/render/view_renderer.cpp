@@ -488,12 +488,16 @@ struct ViewRenderer::Impl {
     if (expected) prefetch(*expected);
     std::array<uint32_t, 3> ext{uint32_t(grid.dims[0]), uint32_t(grid.dims[1]),
                                 uint32_t(grid.dims[2])};
-    // On the exact path without light volumes no kernel reads the volume's fields: the view and
-    // trace marches take every index and medium from the medium table and every crossing from the
-    // shapes (sharp.glsl; the polarised trace reads the boundary's region image, uploaded by
-    // BoundaryDevice). One-voxel placeholders are bound instead, which saves the upload (~0.5 s
-    // for a 128³ sphere; docs/performance.md "Start-up").
-    const bool fields_unread = (volume_flags & EIKON_F_EXACT) != 0 && !lit;
+    // Without light volumes no kernel of the sharp march reads the volume's fields: the view,
+    // trace and polarised marches take every index and medium from the medium table, every
+    // crossing from the shapes or the boundary field (BoundaryDevice), as the specialised
+    // modules show (tests/core/render/kernel_bindings_test.cpp). One-voxel placeholders are bound
+    // instead, which saves the upload (~0.5 s for a 128³ sphere) and lets the session skip
+    // voxelising the fields (voxelizeInterfaces; docs/performance.md "Start-up").
+    const bool fields_unread = sharp && !lit;
+    if (!v.fields && !fields_unread)
+      throw std::invalid_argument(
+          "the volume has no fields (voxelizeInterfaces) but this render reads them");
     const std::vector<glm::vec4> placeholder(1, glm::vec4(0.0f));
     auto upload = [&](const std::vector<glm::vec4>& data, const char* name) {
       const auto& d = fields_unread ? placeholder : data;

@@ -191,6 +191,7 @@ vk::Context& Session::context() {
 
 VolumeSet& Session::prepare(bool gpu) {
   if (gpu) context();
+  if (volume_ && !volume_->fields) volume_.reset();  // voxelised whole below; gpu_ stays valid
   if (!volume_) {
     VoxelizeOptions vo;
     vo.threads = threads_;
@@ -209,6 +210,20 @@ VolumeSet& Session::prepare(bool gpu) {
     volume_ = std::move(volume);
     voxelized_spec_ = scene_->volume;
   }
+  return *volume_;
+}
+
+const VolumeSet& Session::prepareGpuRender() {
+  context();
+  if (volume_) return *volume_;
+  if (scene_->interfaces != Scene::Interfaces::Sharp) return prepare(true);
+  VoxelizeOptions vo;
+  vo.threads = threads_;
+  auto lean = std::make_unique<VolumeSet>(voxelizeInterfaces(*scene_, vo));
+  if (lean->boundary.empty() || lean->media.empty()) return prepare(true);  // not EIKON_F_SHARP
+  volume_ = std::move(lean);
+  volume_from_cache_ = false;
+  voxelized_spec_ = scene_->volume;
   return *volume_;
 }
 
@@ -267,7 +282,7 @@ void Session::lightChanged() {
 }
 
 ViewRenderer& Session::gpuRenderer(const RenderSettings* expected) {
-  prepare(true);
+  prepareGpuRender();  // the volume made before, with or without its fields
   if (!gpu_) {
     if (progress_.working) progress_.working("preparing the GPU (pipelines, volume upload)");
     gpu_ = std::make_unique<ViewRenderer>(*ctx_, *scene_, *volume_, expected);

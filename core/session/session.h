@@ -156,8 +156,14 @@ class Session {
   /// then (checkVolumeFits), before anything is voxelised.
   vk::Context& context();
   bool hasContext() const { return ctx_ != nullptr; }
-  /// The context (gpu) and the voxelised volume, each made once.
+  /// The context (gpu) and the voxelised volume, each made once (a volume without fields, made
+  /// by prepareGpuRender, is voxelised whole here).
   VolumeSet& prepare(bool gpu);
+  /// What a GPU render without light volumes needs: the context and, for sharp interfaces, only
+  /// the volume's interfaces (voxelizeInterfaces: no fields, no volume cache; docs/performance.md
+  /// "Start-up"), else prepare(true). Renders, polarised renders and GPU traces use either;
+  /// everything else (the CPU twin, a light simulation, prepare) voxelises the fields first.
+  const VolumeSet& prepareGpuRender();
   bool voxelized() const { return volume_ != nullptr; }
   /// The scene's volume settings when it was voxelised.
   const VolumeSpec& voxelizedSpec() const { return voxelized_spec_; }

@@ -55,7 +55,11 @@ struct BoundaryField {
   /// if convex_apart, else the shapes if exact, else the walk (meshes refined on their BVH).
   bool exact = false;
 
-  bool empty() const { return region.empty(); }
+  /// No boundary (the scene's interfaces are smoothed). A field on the exact path may leave out
+  /// its per-voxel arrays (voxelizeInterfaces): nothing there reads them on the GPU.
+  bool empty() const { return region.empty() && !exact; }
+  /// Whether region and distance are there (every field but voxelizeInterfaces' exact ones).
+  bool hasVoxels() const { return !region.empty(); }
 };
 
 /// Host bytes of a boundary field on this grid (the float distance and the 16-bit region).

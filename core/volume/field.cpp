@@ -3,8 +3,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace eikon {
+
+VolumeField::VolumeField(const VolumeSet& v) : v_(v) {
+  if (!v.fields || (!v.boundary.empty() && !v.boundary.hasVoxels()))
+    throw std::invalid_argument(
+        "VolumeField: the volume has no fields (voxelizeInterfaces); voxelise it whole");
+}
 
 glm::dvec4 VolumeField::trilinear(const std::vector<glm::vec4>& f, const glm::dvec3& x) const {
   const Grid& g = v_.grid;

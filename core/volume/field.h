@@ -67,7 +67,7 @@ class Field {
 /// Trilinear sampling of a VolumeSet (same stencil and clamping as the shader).
 class VolumeField : public Field {
  public:
-  explicit VolumeField(const VolumeSet& v) : v_(v) {}
+  explicit VolumeField(const VolumeSet& v);
   void index(const glm::dvec3& x, double il2, double il4, double& n,
              glm::dvec3& grad) const override;
   void indexE(const glm::dvec3& x, double il2, double il4, double& n,

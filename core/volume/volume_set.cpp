@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <variant>
 
@@ -566,4 +567,22 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
   progress(1.0, "done");
   return vs;
 }
+
+VolumeSet voxelizeInterfaces(const Scene& scene, const VoxelizeOptions& opt) {
+  if (scene.interfaces != Scene::Interfaces::Sharp)
+    throw std::invalid_argument("voxelizeInterfaces: the scene's interfaces are smoothed");
+  VolumeSet vs;
+  vs.grid = checkedGrid(scene);
+  vs.uniaxial = scene.anyUniaxial();
+  vs.ambient_index = scene.ambient_index;
+  (void)materialValues(scene, vs);  // the flags
+  // On the exact path every crossing and region comes from the shapes: the field's per-voxel
+  // arrays are left out too (BoundaryField::hasVoxels), else they are made as voxelize() does.
+  vs.boundary = boundaryFieldShapes(scene, vs.grid);
+  if (!vs.boundary.exact) vs.boundary = buildBoundaryField(scene, vs.grid, opt.threads);
+  vs.media = buildMediaTable(scene);
+  vs.fields = false;
+  return vs;
+}
+
 }  // namespace eikon

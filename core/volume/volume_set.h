@@ -69,6 +69,9 @@ struct VolumeSet {
   BoundaryField boundary;
   /// The medium of each boundary-field region (core/volume/media.h), with `boundary`.
   MediaTable media;
+  /// False for a volume made by voxelizeInterfaces: index, medium, emission, axis and scatter are
+  /// empty (only a GPU render of sharp interfaces without light volumes may use it).
+  bool fields = true;
 
   bool lit() const { return !light_fluence.empty(); }
 
@@ -92,6 +95,15 @@ double voxelizeHostBytes(const Scene& scene, const Grid& grid);
 /// Voxelise a scene. Throws SceneError for inconsistent input (e.g. more than 2^31 voxels) and,
 /// before allocating, when voxelizeHostBytes exceeds the host memory available to the process.
 VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& options = {});
+
+/// The part of voxelize() that a GPU render of sharp interfaces without light volumes reads
+/// (core/render/view_renderer.cpp: the sharp march takes every index and medium from the medium
+/// table, every crossing from the shapes or the boundary field): the grid, the feature flags, the
+/// boundary field (on the exact path without its per-voxel arrays: BoundaryField::hasVoxels) and
+/// the media, with `fields` false and the per-voxel fields empty. Milliseconds where voxelize()
+/// or the volume cache takes ~1 s for a 128³ sphere (docs/performance.md "Start-up").
+/// Throws as voxelize(), and std::invalid_argument for a scene with smoothed interfaces.
+VolumeSet voxelizeInterfaces(const Scene& scene, const VoxelizeOptions& options = {});
 
 /// Smooth a scalar field in place with a separable Gaussian of σ voxels (truncated at 3σ,
 /// renormalised, clamp-to-edge). Exposed for tests.

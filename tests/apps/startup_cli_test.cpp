@@ -177,10 +177,28 @@ std::vector<fs::path> volumeEntries(const fs::path& cache) {
   return files;
 }
 
+/// The scene with smoothed interfaces: its render reads the voxelised fields (a sharp one without
+/// light volumes voxelises only its interfaces and uses no volume cache).
+void writeSmoothedScene(const fs::path& file) {
+  std::string text = kScene;
+  text.insert(text.rfind('}'), R"(, "interfaces": "smoothed")");
+  std::ofstream(file) << text;
+}
+
+// A GPU render of sharp interfaces without light volumes voxelises only the interfaces
+// (Session::prepareGpuRender): no volume-cache entry is read or written.
+TEST_F(StartupCli, SharpRenderWithoutLightKeepsNoVolume) {
+  const Outcome r = render("-q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_TRUE(volumeEntries(dir_ / "cache").empty());
+}
+
 // A GPU render stores its voxelised volume in EIKON_CACHE_DIR; the next render of the scene reads
 // it back and writes the same EXR, byte for byte, as the first and as a render that voxelises
 // (--no-volume-cache, which neither reads nor writes an entry).
 TEST_F(StartupCli, VolumeCacheGivesTheSameRender) {
+  writeSmoothedScene(dir_ / "scene.json");
   const Outcome plain = render("-q --no-volume-cache");
   ASSERT_EQ(plain.code, 0) << plain.err;
   EXPECT_TRUE(volumeEntries(dir_ / "cache").empty());
@@ -201,21 +219,28 @@ TEST_F(StartupCli, VolumeCacheGivesTheSameRender) {
 // A damaged entry is ignored with one "eikon: note:" line, the scene voxelised again (the same
 // render), and the entry replaced: the next render is silent.
 TEST_F(StartupCli, ACorruptVolumeCacheIsIgnoredWithOneNote) {
+  writeSmoothedScene(dir_ / "scene.json");
   ASSERT_EQ(render("-q").code, 0);
   const std::string good_render = eikon::test::slurp(dir_ / "out.exr");
   const std::vector<fs::path> files = volumeEntries(dir_ / "cache");
   ASSERT_EQ(files.size(), 1u);
   const std::string good = eikon::test::slurp(files[0]);
   std::string flipped = good;
-  flipped[flipped.size() - 5] ^= 0x20;
+  flipped[flipped.size() / 2] ^= 0x20;
   for (const std::string& bad : {good.substr(0, good.size() / 3), flipped}) {
     std::ofstream(files[0], std::ios::binary | std::ios::trunc) << bad;
     const Outcome r = render("-q");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(r.err.rfind("eikon: note: volume cache '", 0), 0u) << r.err;
-    EXPECT_NE(r.err.find(bad.size() < good.size() ? "ignored: truncated" : "checksum mismatch"),
-              std::string::npos)
-        << r.err;
+    // A flipped byte is found by the checksum in an array's data, by the records' check in an
+    // array's record (a small volume's entry is mostly records: its constant arrays are stored
+    // as one zero flag).
+    if (bad.size() < good.size())
+      EXPECT_NE(r.err.find("ignored: truncated"), std::string::npos) << r.err;
+    else
+      EXPECT_TRUE(r.err.find("ignored: checksum mismatch") != std::string::npos ||
+                  r.err.find("ignored: its arrays do not match its header") != std::string::npos)
+          << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_EQ(eikon::test::slurp(dir_ / "out.exr"), good_render);
     EXPECT_EQ(eikon::test::slurp(files[0]), good);  // replaced by a whole entry

@@ -9,6 +9,8 @@
 #include <memory>
 #include <string>
 
+#include "core/volume/field.h"
+
 namespace eikon {
 namespace {
 
@@ -168,6 +170,83 @@ TEST(Session, SwappedLightVolumesRenderAsASessionOfTheMovedLight) {
   EXPECT_EQ(worst, 0.0);     // the same volumes through the same kernel
   EXPECT_GT(changed, 0.05);  // and the light did move
   EXPECT_THROW(session.setLightVolumes({}, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace eikon
+
+namespace eikon {
+namespace {
+
+// A GPU render of sharp interfaces without light volumes voxelises only the interfaces
+// (Session::prepareGpuRender, voxelizeInterfaces): no per-voxel field, and on the exact path no
+// per-voxel boundary either. The kernels never read them there (kernel_bindings_test.cpp), so the
+// image is the one rendered from the whole volume, bit for bit; anything else the session does
+// afterwards voxelises the whole volume first.
+std::string sharpScene(const std::string& object) {
+  return R"({
+  "camera": {"position": [0, 0, -40], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 30,
+             "width": 16, "height": 12},
+  "volume": {"bounds_min": [-8, -8, -8], "bounds_max": [8, 8, 8], "resolution": 24},
+  "materials": {"glass": {"n": 1.5, "attenuation_per_mm": [0.02, 0.01, 0.03]}},
+  "objects": [)" +
+         object + R"(]
+})";
+}
+
+void checkInterfacesOnly(const std::string& object, bool exact) {
+  auto scene = std::make_shared<Scene>(parseScene(sharpScene(object), "lean.json"));
+  ASSERT_EQ(scene->interfaces, Scene::Interfaces::Sharp);
+  RenderSettings rs;
+  Session lean(scene), whole(scene);
+  const VolumeSet& v = lean.prepareGpuRender();
+  EXPECT_FALSE(v.fields);
+  EXPECT_TRUE(v.index[0][0].empty() && v.medium[0].empty() && v.emission.empty());
+  EXPECT_TRUE(v.attenuating);  // the flags are the materials'
+  EXPECT_EQ(v.boundary.exact, exact);
+  EXPECT_EQ(v.boundary.hasVoxels(), !exact);
+  EXPECT_FALSE(v.boundary.empty());
+  EXPECT_THROW(VolumeField{v}, std::invalid_argument);
+  const VolumeSet& w = whole.prepare(true);
+  EXPECT_TRUE(w.fields);
+  EXPECT_EQ(w.boundary.exact, exact);
+  const RenderImage a = lean.render(rs, true), b = whole.render(rs, true);
+  ASSERT_EQ(a.rgb.size(), size_t(16 * 12 * 3));
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  int differ = 0, lit = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    differ += a.rgb[i] != b.rgb[i] ? 1 : 0;
+    lit += a.rgb[i] != 0.0f ? 1 : 0;
+  }
+  EXPECT_EQ(differ, 0);
+  EXPECT_GT(lit, 0);
+  // The CPU twin needs the fields: prepare() voxelises them, and the GPU renderer made before
+  // still renders the same image.
+  const VolumeSet& full = lean.prepare(false);
+  EXPECT_TRUE(full.fields);
+  EXPECT_EQ(full.index[0][0].size(), full.grid.count());
+  EXPECT_EQ(lean.render(rs, true).rgb, a.rgb);
+  EXPECT_NO_THROW(lean.trace({{{-6, -6, -7}, {0, 0, 1}, 587.56}}, MarchSettings{}, false));
+}
+
+TEST(SessionGpu, SharpSphereRenderVoxelisesOnlyItsShape) {
+  checkInterfacesOnly(
+      R"({"shape": "sphere", "center": [0, 0, 0], "radius": 5, "material": "glass"})", true);
+}
+
+TEST(SessionGpu, LonePrismRenderVoxelisesOnlyTheBoundaryField) {
+  checkInterfacesOnly(R"({"shape": "prism", "apex_deg": 60, "side": 8, "height": 10,
+                          "material": "glass"})",
+                      false);
+}
+
+TEST(SessionGpu, SmoothedInterfacesAreVoxelisedWhole) {
+  std::string text =
+      sharpScene(R"({"shape": "sphere", "center": [0, 0, 0], "radius": 5, "material": "glass"})");
+  text.insert(text.rfind('}'), R"(, "interfaces": "smoothed")");
+  Session s(std::make_shared<Scene>(parseScene(text, "smoothed.json")));
+  EXPECT_TRUE(s.prepareGpuRender().fields);
+  EXPECT_THROW(voxelizeInterfaces(*s.scene()), std::invalid_argument);
 }
 
 }  // namespace

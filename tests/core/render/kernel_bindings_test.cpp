@@ -1,0 +1,138 @@
+// Which resources the specialised view, trace and polarised-trace kernels read (issue 14,
+// start-up). The view renderer binds one-voxel placeholders for the volume's fields, and the
+// session voxelises only the interfaces (voxelizeInterfaces), when the sharp march runs without
+// light volumes (core/render/view_renderer.cpp, fields_unread): that is only right if no such
+// kernel reads a field image then. specialiseSpirv (core/vk/specialise.h) removes the variables
+// nothing reads, with their decorations, so the bindings left in a module are the ones it reads.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <set>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/vk/specialise.h"
+#include "shaders/eikon_shared.h"
+#include "shaders/polarised_trace.spv.h"
+#include "shaders/trace.spv.h"
+#include "shaders/view.spv.h"
+
+namespace eikon {
+namespace {
+
+constexpr uint32_t kOpDecorate = 71, kDecorationBinding = 33;
+
+/// The binding numbers decorated in a module (header of 5 words, then word count << 16 | opcode).
+std::set<int> bindingsOf(const std::vector<uint32_t>& m) {
+  std::set<int> b;
+  for (size_t i = 5; i < m.size();) {
+    const uint32_t words = m[i] >> 16, op = m[i] & 0xffffu;
+    if (words == 0 || i + words > m.size()) {
+      ADD_FAILURE() << "malformed module at word " << i;
+      return b;
+    }
+    if (op == kOpDecorate && words >= 4 && m[i + 2] == kDecorationBinding) b.insert(int(m[i + 3]));
+    i += words;
+  }
+  return b;
+}
+
+struct Kernel {
+  const char* name;
+  std::span<const uint32_t> spirv;
+};
+
+std::vector<Kernel> kernels() {
+  return {{"view", {k_view_spv, sizeof(k_view_spv) / 4}},
+          {"trace", {k_trace_spv, sizeof(k_trace_spv) / 4}},
+          {"polarised trace", {k_polarised_trace_spv, sizeof(k_polarised_trace_spv) / 4}}};
+}
+
+// The volume's per-voxel fields (VolumeSet index, medium, emission, axis, scatter).
+const std::set<int> kFieldBindings = {EIKON_B_INDEX_O_A, EIKON_B_INDEX_O_B, EIKON_B_INDEX_O_C,
+                                      EIKON_B_INDEX_E_A, EIKON_B_INDEX_E_B, EIKON_B_INDEX_E_C,
+                                      EIKON_B_MEDIUM_O,  EIKON_B_MEDIUM_E,  EIKON_B_EMISSION,
+                                      EIKON_B_AXIS,      EIKON_B_SCATTER};
+
+// Every scene feature of the sharp march but light volumes (a flag only adds code, except the
+// environment kinds, which read no field, and NO_SKIP/NO_FRESNEL, left off), in the combinations
+// that select different code: the exact path, the planes or the walk; RGB or spectral; the
+// uniform tables or the storage buffers.
+std::vector<int> sharpFeatureSets() {
+  const int all = EIKON_F_DISPERSIVE | EIKON_F_UNIAXIAL | EIKON_F_ATTENUATION | EIKON_F_EMISSION |
+                  EIKON_F_OPACITY | EIKON_F_SCATTER | EIKON_F_SHARP | EIKON_F_VARYING |
+                  EIKON_F_CONVEX | EIKON_F_MESH | EIKON_F_ENV_LATLONG;
+  std::vector<int> sets;
+  for (int path : {0, EIKON_F_EXACT, EIKON_F_CONVEX_APART})
+    for (int spectral : {0, EIKON_F_SPECTRAL})
+      for (int small : {0, EIKON_F_SMALL_MEDIA | EIKON_F_SMALL_SHAPES})
+        sets.push_back(all | path | spectral | small);
+  return sets;
+}
+
+// kExact for the sets above: one row, one shape, every kind (march.glsl's bit layout).
+uint32_t exactConstant(int flags) {
+  return (flags & (EIKON_F_EXACT | EIKON_F_CONVEX_APART)) != 0 ? (1u | (1u << 10) | (0x1Fu << 20))
+                                                               : 0u;
+}
+
+TEST(KernelBindings, TheSharpMarchWithoutLightReadsNoFieldOfTheVolume) {
+  int checked = 0;
+  for (const Kernel& k : kernels())
+    for (int flags : sharpFeatureSets())
+      for (uint32_t integrator : {0u, 2u}) {  // Euler, RK4 (GRIN regions)
+        const auto m = vk::specialiseSpirv(
+            k.spirv,
+            std::vector<uint32_t>{1u, uint32_t(flags), integrator, 0u, exactConstant(flags)});
+        const std::set<int> b = bindingsOf(m);
+        for (int f : kFieldBindings)
+          EXPECT_EQ(b.count(f), 0u) << k.name << ", flags " << flags << ", integrator "
+                                    << integrator << ": reads binding " << f;
+        ++checked;
+      }
+  EXPECT_EQ(checked, 3 * 12 * 2);
+}
+
+TEST(KernelBindings, TheExactPathReadsNoVoxelOfTheBoundaryField) {
+  // Every crossing and region on the shapes (boundary.glsl exactCrossingOutOf, regionAt): the
+  // region and distance images are not read either, so voxelizeInterfaces leaves them out.
+  int checked = 0;
+  for (const Kernel& k : kernels())
+    for (int flags : sharpFeatureSets()) {
+      if ((flags & EIKON_F_EXACT) == 0) continue;
+      flags &= ~EIKON_F_MESH;  // the exact path is for analytic shapes only
+      const auto m = vk::specialiseSpirv(
+          k.spirv, std::vector<uint32_t>{1u, uint32_t(flags), 2u, 0u, exactConstant(flags)});
+      const std::set<int> b = bindingsOf(m);
+      for (int f : {EIKON_B_REGION, EIKON_B_BOUNDARY_DIST})
+        EXPECT_EQ(b.count(f), 0u) << k.name << ", flags " << flags << ": reads binding " << f;
+      ++checked;
+    }
+  EXPECT_EQ(checked, 3 * 4);
+  // The walk does read them (the census would see a read on the exact path).
+  const int walk = EIKON_F_SHARP | EIKON_F_CONVEX;
+  EXPECT_EQ(bindingsOf(vk::specialiseSpirv(kernels()[0].spirv,
+                                           std::vector<uint32_t>{1u, uint32_t(walk), 2u}))
+                .count(EIKON_B_REGION),
+            1u);
+}
+
+TEST(KernelBindings, TheChecksSeeTheBindingsThatAreRead) {
+  // The same census finds the light volumes of a lit sharp march and the index fields of the
+  // smoothed one: a kernel that read a field would be caught above.
+  const int lit = EIKON_F_SHARP | EIKON_F_SCATTER | EIKON_F_ATTENUATION | EIKON_F_LIT;
+  for (const Kernel& k : kernels()) {
+    if (std::string(k.name) == "polarised trace") continue;  // no light volumes there
+    const std::set<int> b =
+        bindingsOf(vk::specialiseSpirv(k.spirv, std::vector<uint32_t>{1u, uint32_t(lit), 2u}));
+    EXPECT_EQ(b.count(EIKON_B_LIGHT_FLUENCE), 1u) << k.name;
+  }
+  const std::set<int> smoothed = bindingsOf(vk::specialiseSpirv(
+      kernels()[0].spirv, std::vector<uint32_t>{0u, uint32_t(EIKON_F_UNIAXIAL), 2u}));
+  for (int f : {EIKON_B_INDEX_O_A, EIKON_B_INDEX_E_A, EIKON_B_AXIS})
+    EXPECT_EQ(smoothed.count(f), 1u) << "smoothed march, binding " << f;
+}
+
+}  // namespace
+}  // namespace eikon
