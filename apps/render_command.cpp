@@ -127,8 +127,9 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
                 "Simulate the light even if a cached result exists, and store none");
   sub->add_flag("--no-volume-cache", a.no_volume_cache,
                 "Voxelise the scene even if a cached volume exists, and store none (GPU renders "
-                "keep their voxelised volumes in $EIKON_CACHE_DIR, $XDG_CACHE_HOME/eikon or "
-                "~/.cache/eikon)");
+                "that read the volume's fields keep them in $EIKON_CACHE_DIR, "
+                "$XDG_CACHE_HOME/eikon or ~/.cache/eikon; sharp interfaces without light "
+                "voxelise only the interfaces, in milliseconds, and keep nothing)");
   sub->add_flag("--no-light", a.no_light,
                 "Do not simulate the scene's lights (no caustics, in-scatter or lit surfaces)");
   sub->add_flag("--timings", a.timings,
