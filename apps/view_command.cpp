@@ -44,6 +44,7 @@ using Clock = std::chrono::steady_clock;
 struct ViewArgs {
   std::string scene, screenshot;
   int width = 0, height = 0, spp = 16, wavelengths = -1, coarse = 4, exit_after_frames = 0;
+  bool wait_for_input = false;
   double exposure = 0.0;
   std::string integrator = "rk4", modes = "both";
   bool no_light = false, no_prefetch = false;
@@ -75,6 +76,10 @@ void addViewOptions(CLI::App* sub, ViewArgs& a) {
   sub->add_option("--exit-after-frames", a.exit_after_frames,
                   "Exit after N frames of an unchanged view (or once it is fully refined, if that "
                   "takes fewer), for tests and scripts");
+  sub->add_flag("--wait-for-input", a.wait_for_input,
+                "With --exit-after-frames: do not exit before a mouse button is released or a "
+                "key pressed (scripts that drive the window, whose view may refine before their "
+                "input arrives)");
   sub->add_option("--screenshot", a.screenshot,
                   "On exit, write the image on screen (at its rendered size) to this PNG and print "
                   "the camera");
@@ -214,11 +219,13 @@ class Viewer {
         continue;  // a change: start again with a coarse frame
       }
       // Fully refined in fewer frames; a light still being simulated is waited for.
-      if (args_.exit_after_frames > 0 && !lightPending()) break;
+      if (args_.exit_after_frames > 0 && !lightPending() && inputDone()) break;
       while (!changed_ && !resized_ && !quit_ && !glfwWindowShouldClose(window_)) {
         const bool simulating = mover_ && mover_->busy();
         glfwWaitEventsTimeout(simulating ? 0.1 : 0.25);
         handleRequests();
+        // --wait-for-input: the input that ends it may come after the view it changed is refined.
+        if (!changed_ && args_.exit_after_frames > 0 && !lightPending() && inputDone()) return;
         // The view is refined and a moved light is being simulated: the last image is presented
         // again about 10 times a second, its title saying so, until the new light arrives.
         if (simulating && !changed_) presentAgain();
@@ -283,7 +290,7 @@ class Viewer {
   /// Whether spectral renders of this scene sample by hero wavelengths (the renderer decides by
   /// the same test: core/volume/march_types.h).
   bool heroSampling() const {
-    const VolumeSet& v = session_.prepare(true);  // made before the first render
+    const VolumeSet& v = session_.prepareGpuRender();  // made before the first render
     return useHeroSampling(base_.sampling, v.attenuating || v.emissive || v.opaque);
   }
 
@@ -423,7 +430,8 @@ class Viewer {
     while (frame_times_.size() > 2 && now - frame_times_.front() > std::chrono::seconds(2))
       frame_times_.pop_front();
     updateTitle(now);
-    if (args_.exit_after_frames > 0 && frames_since_change_ >= args_.exit_after_frames) {
+    if (args_.exit_after_frames > 0 && frames_since_change_ >= args_.exit_after_frames &&
+        inputDone()) {
       quit_ = true;
       throw Interrupted{};
     }
@@ -532,7 +540,11 @@ class Viewer {
   // Positions come from the motion events themselves, never from glfwGetCursorPos: events
   // queued while a render ran (a whole drag, from a script) are handled later, when the pointer
   // has moved on, and each must see the position it was sent with.
+  /// --wait-for-input: a scripted input has ended (a button released, a key pressed).
+  bool inputDone() const { return !args_.wait_for_input || input_seen_; }
+
   void onButton(int button, int action, int mods) {
+    if (action == GLFW_RELEASE) input_seen_ = true;
     if (action == GLFW_PRESS) {
       drag_button_ = button;
       drag_mods_ = mods;
@@ -573,6 +585,7 @@ class Viewer {
   }
 
   void onKey(int key) {
+    input_seen_ = true;
     switch (key) {
       case GLFW_KEY_R:  // RGB ↔ spectral
         spectral_ = !spectral_;
@@ -644,6 +657,7 @@ class Viewer {
   double longest_compile_ = 0;    ///< the longest such wait, seconds
   int full_wavelengths_ = 0;
   bool changed_ = false, resized_ = false, quit_ = false, save_requested_ = false;
+  bool input_seen_ = false;    // --wait-for-input
   bool refined_ = false;       ///< the view is fully refined (the title says so)
   bool finish_stage_ = false;  ///< poll() does not interrupt the stage (the coarse frame)
   int coarse_ = args_.coarse;  ///< the coarse frame's 1/size per side (adaptCoarse)
@@ -750,7 +764,12 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   // Input is handled from here on: events that arrive while the scene is voxelised (polled by
   // the progress callbacks) already move the camera of the first frame.
   Viewer viewer(a, session, window.handle, chain, base, mover.get());
-  session.prepare(true);
+  // Without light a sharp scene needs only its interfaces voxelised (Session::prepareGpuRender;
+  // docs/performance.md "Start-up"); with light the simulation needs the whole volume.
+  if (mover)
+    session.prepare(true);
+  else
+    session.prepareGpuRender();
   if (mover) {
     LightOutcome light = session.simulateLight(LightRequest{}, false, defaultLightCacheDir());
     for (const std::string& w : light.warnings)

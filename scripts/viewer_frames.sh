@@ -18,7 +18,7 @@ export DISPLAY=:$(head -1 "$tmp/display")
 mkdir -p "$OUT"
 for k in $(seq 0 $((FRAMES - 1))); do
   "$EIKON" view "$SCENE" --width "$W" --height "$H" --spp "$SPP" --exit-after-frames 1000 \
-    --screenshot "$OUT/viewer_orbit_$((k + 1)).png" >"$tmp/out" 2>&1 &
+    --wait-for-input --screenshot "$OUT/viewer_orbit_$((k + 1)).png" >"$tmp/out" 2>&1 &
   viewer=$!
   x=$((W / 4)) y=$((H / 3))
   timeout 300 xdotool search --sync --onlyvisible --name 'eikon view' \

@@ -202,11 +202,13 @@ TEST_F(ViewerTest, DragOrbitsAndRefinedViewMatchesRender) {
   Xvfb server(xvfb);
   ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
   const fs::path shot = dir_ / "shot.png";
-  // The viewer exits once its last view is refined to 4 samples. Once its window shows, a drag
-  // across it with the left button: an orbit about look_at.
+  // The viewer exits once its last view is refined to 4 samples, after the drag
+  // (--wait-for-input: a sphere's view refines faster than xdotool finds the window). Once its
+  // window shows, a drag across it with the left button: an orbit about look_at.
   const ViewerRun run =
       viewWhile(server, xdotool, kGlassSphere,
-                "--width 160 --height 120 --spp 4 --exit-after-frames 100 --screenshot " +
+                "--width 160 --height 120 --spp 4 --exit-after-frames 100 --wait-for-input "
+                "--screenshot " +
                     quote(shot.string()),
                 " mousemove --window %1 60 60 sleep 0.1 mousedown 1 sleep 0.1"
                 " mousemove --window %1 75 64 sleep 0.1 mousemove --window %1 90 68 sleep 0.1"
