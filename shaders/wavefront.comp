@@ -130,6 +130,15 @@ layout(binding = EIKON_B_REGION, r32ui) readonly uniform uimage3D regionImg;
 layout(binding = EIKON_B_BOUNDARY_DIST, r32f) readonly uniform image3D boundaryDist;
 layout(std430, binding = EIKON_B_SHAPES) readonly buffer ShapeBuf { vec4 shapeTable[]; };
 layout(std430, binding = EIKON_B_MEDIA) readonly buffer MediaBuf { vec4 mediaTable[]; };
+// The shape table's first rows and the medium table as uniform blocks, as the view kernel reads
+// them (march.glsl): llvmpipe gathers a uniform block's vec4s where it reads a storage buffer one
+// lane at a time.
+layout(std140, binding = EIKON_B_EXACT_ROWS) uniform ExactRowsBuf { vec4 exactRows[EIKON_EXACT_MAX_ROWS]; };
+layout(std140, binding = EIKON_B_SMALL_MEDIA) uniform SmallMediaBuf {
+  vec4 smallMedia[EIKON_SMALL_MEDIA_REGIONS * EIKON_MEDIUM_VEC4S];
+};
+#define EIKON_SHAPE_ROW(i) (hasFlag(EIKON_F_SMALL_SHAPES) ? exactRows[i] : shapeTable[i])
+#define EIKON_MEDIUM_ROW(i) (hasFlag(EIKON_F_SMALL_MEDIA) ? smallMedia[i] : mediaTable[i])
 float gLambdaUm = 0.5876;      // sharp.glsl's mediumIndex: set to P.wavelength.x in main()
 bool gDispersiveHit = false;  // written by mediumIndex, unused here
 #define EIKON_BOUNDARY_HAS_CONVEX hasFlag(EIKON_F_CONVEX)

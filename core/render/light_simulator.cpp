@@ -208,6 +208,7 @@ struct GpuWavefront::Impl {
           uint32_t(EIKON_WB_PATCHES_B), uint32_t(EIKON_WB_SCAN), uint32_t(EIKON_WB_TALLY)})
       b.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
     for (const vk::BindingSpec& bs : boundaryBindings()) b.push_back(bs);
+    for (const vk::BindingSpec& bs : uniformTableBindings()) b.push_back(bs);
     boundary = sharp ? BoundaryDevice(ctx, vol.boundary, vol.media)
                      : BoundaryDevice(ctx, BoundaryField{}, MediaTable{});
     // The run's feature set as specialisation constants (wavefront.comp: kSharpLight, kWaveFlags,
@@ -219,6 +220,7 @@ struct GpuWavefront::Impl {
         sizeof(gpu::WavePush), sharp ? "wavefront sharp" : "wavefront",
         std::vector<uint32_t>{sharp ? 1u : 0u, uint32_t(featureFlags()), uint32_t(options())});
     boundary.bind(pipe);
+    boundary.bindUniformTables(pipe);
     const size_t med = vol.dispersive ? 3 : 1;
     pipe.bindImage(EIKON_WB_INDEX_A, images[0]);
     pipe.bindImage(EIKON_WB_INDEX_B, images[vol.dispersive ? 1 : 0]);
@@ -256,11 +258,19 @@ struct GpuWavefront::Impl {
     if (vol.attenuating) flags |= EIKON_F_ATTENUATION;
     if (vol.opaque) flags |= EIKON_F_OPACITY;
     if (eMode) flags |= EIKON_F_UNIAXIAL;
-    if (sharp)
+    if (sharp) {
+      bool mesh = false;
       for (const Shape& shape : vol.boundary.shapes) {
         if (std::holds_alternative<ConvexShape>(shape.geometry())) flags |= EIKON_F_CONVEX;
-        if (std::holds_alternative<MeshShape>(shape.geometry())) flags |= EIKON_F_MESH;
+        if (std::holds_alternative<MeshShape>(shape.geometry())) mesh = true;
       }
+      if (mesh) flags |= EIKON_F_MESH;
+      // The tables as uniform blocks where they fit (BoundaryDevice; wavefront.comp).
+      if (vol.media.regions.size() <= size_t(EIKON_SMALL_MEDIA_REGIONS))
+        flags |= EIKON_F_SMALL_MEDIA;
+      if (!mesh && exactTableRows(vol.boundary.shapes) <= EIKON_EXACT_MAX_ROWS)
+        flags |= EIKON_F_SMALL_SHAPES;
+    }
     return flags;
   }
   /// wavefront.comp's kWaveOptions: bit 0 straight steps, bit 1 pass caustics, bit 2 probe plane.
