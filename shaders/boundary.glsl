@@ -976,8 +976,12 @@ int exactRegionAt(vec3 x) {
   return r;
 }
 
-// The region at x: on the shapes on the exact path (regionAt), else the field's.
-int regionAt(vec3 x) { return EIKON_BOUNDARY_EXACT ? exactRegionAt(x) : boundaryRegion(x); }
+// The region at x (boundary.cpp regionAt): on the shapes where the kernel has their constants
+// (the exact path, and convex_apart scenes whose table fits kExact:
+// BoundaryField::regionsOnShapes), else the field's.
+#define EIKON_REGION_ON_SHAPES \
+  (EIKON_BOUNDARY_EXACT || (EIKON_BOUNDARY_CONVEX_APART && EIKON_BOUNDARY_EXACT_SHAPES > 0))
+int regionAt(vec3 x) { return EIKON_REGION_ON_SHAPES ? exactRegionAt(x) : boundaryRegion(x); }
 
 // The first point of [a, b] where the region changes from `region` (boundary.cpp
 // exactCrossingOutOf): pass 0 over the shapes from the ray's own on finds where the line leaves

@@ -158,7 +158,7 @@ BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& fiel
                     kMediumGrin == EIKON_MEDIUM_GRIN && kMediumOpaque == EIKON_MEDIUM_OPAQUE,
                 "the medium table's layout is declared twice (media.h, eikon_shared.h)");
   checkBoundaryFits(ctx, field, media, file);
-  present_ = field.hasVoxels();  // else one-voxel placeholders (the exact path reads none)
+  present_ = field.hasVoxels();  // else placeholders (regions on the shapes: none is read)
   std::array<uint32_t, 3> ext{1, 1, 1};
   if (present_)
     ext = {uint32_t(field.grid.dims[0]), uint32_t(field.grid.dims[1]),

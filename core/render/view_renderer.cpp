@@ -337,12 +337,9 @@ int volumeFeatureFlags(const VolumeSet& v) {
 int volumeExactConstant(const VolumeSet& v) {
   const bool sharp = !v.boundary.empty() && !v.media.empty();
   // Also for convex_apart scenes whose table fits the uniform block: their constants unroll the
-  // planes' loops (boundary.glsl convexCrossingUnrolled); EIKON_F_EXACT alone selects the exact
-  // path.
-  const bool small = exactTableRows(v.boundary.shapes) <= EIKON_EXACT_MAX_ROWS;
-  return sharp && (v.boundary.exact || (v.boundary.convex_apart && small))
-             ? exactConstant(v.boundary)
-             : 0;
+  // planes' loops (boundary.glsl convexCrossingUnrolled) and find regions on the shapes
+  // (regionAt); EIKON_F_EXACT alone selects the exact path.
+  return sharp && v.boundary.regionsOnShapes() ? exactConstant(v.boundary) : 0;
 }
 
 // The volume's features without voxelising at the scene's resolution. The flags come from the

@@ -471,8 +471,12 @@ int exactTableRows(const std::vector<Shape>& shapes) {
   return int(std::min(rows, size_t(1) << 30));
 }
 
+bool BoundaryField::regionsOnShapes() const {
+  return exact || (convex_apart && !shapes.empty() && exactTableRows(shapes) <= kExactMaxRows);
+}
+
 int regionAt(const BoundaryField& bf, const glm::dvec3& x) {
-  if (!bf.exact) return boundaryRegion(bf, x);
+  if (!bf.regionsOnShapes()) return boundaryRegion(bf, x);
   for (size_t i = bf.shapes.size(); i-- > 0;)
     if (bf.shapes[i].signedDistance(x) <= 0.0) return int(i) + 1;
   return 0;

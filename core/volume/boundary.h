@@ -55,10 +55,14 @@ struct BoundaryField {
   /// if convex_apart, else the shapes if exact, else the walk (meshes refined on their BVH).
   bool exact = false;
 
-  /// No boundary (the scene's interfaces are smoothed). A field on the exact path may leave out
-  /// its per-voxel arrays (voxelizeInterfaces): nothing there reads them on the GPU.
-  bool empty() const { return region.empty() && !exact; }
-  /// Whether region and distance are there (every field but voxelizeInterfaces' exact ones).
+  /// Whether regions are found on the shapes (regionAt): on the exact path, and for convex_apart
+  /// shapes whose table fits kExactMaxRows (the GPU kernels have their constants then, march.glsl
+  /// kExact); crossings are the shapes' or the planes' there too.
+  bool regionsOnShapes() const;
+  /// No boundary (the scene's interfaces are smoothed). A field whose regions are on the shapes
+  /// may leave out its per-voxel arrays (voxelizeInterfaces): nothing there reads them on the GPU.
+  bool empty() const { return region.empty() && !regionsOnShapes(); }
+  /// Whether region and distance are there (every field but voxelizeInterfaces').
   bool hasVoxels() const { return !region.empty(); }
 };
 
@@ -83,8 +87,8 @@ double boundaryPhi(const BoundaryField& field, const glm::dvec3& x, int region,
 /// largest (the one whose φ is positive where two regions meet).
 int boundaryRegion(const BoundaryField& field, const glm::dvec3& x);
 
-/// The region at a world point on the shapes themselves where field.exact (the later of the
-/// objects containing x, as the voxeliser paints them; 0 for none), else boundaryRegion.
+/// The region at a world point on the shapes themselves where field.regionsOnShapes() (the later
+/// of the objects containing x, as the voxeliser paints them; 0 for none), else boundaryRegion.
 int regionAt(const BoundaryField& field, const glm::dvec3& x);
 
 struct LocateOptions {

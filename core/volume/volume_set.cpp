@@ -576,10 +576,11 @@ VolumeSet voxelizeInterfaces(const Scene& scene, const VoxelizeOptions& opt) {
   vs.uniaxial = scene.anyUniaxial();
   vs.ambient_index = scene.ambient_index;
   (void)materialValues(scene, vs);  // the flags
-  // On the exact path every crossing and region comes from the shapes: the field's per-voxel
-  // arrays are left out too (BoundaryField::hasVoxels), else they are made as voxelize() does.
+  // Where every crossing and region comes from the shapes (the exact path; convex planes apart)
+  // the field's per-voxel arrays are left out too (BoundaryField::hasVoxels), else they are made
+  // as voxelize() does.
   vs.boundary = boundaryFieldShapes(scene, vs.grid);
-  if (!vs.boundary.exact) vs.boundary = buildBoundaryField(scene, vs.grid, opt.threads);
+  if (!vs.boundary.regionsOnShapes()) vs.boundary = buildBoundaryField(scene, vs.grid, opt.threads);
   vs.media = buildMediaTable(scene);
   vs.fields = false;
   return vs;

@@ -99,7 +99,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& options = {});
 /// The part of voxelize() that a GPU render of sharp interfaces without light volumes reads
 /// (core/render/view_renderer.cpp: the sharp march takes every index and medium from the medium
 /// table, every crossing from the shapes or the boundary field): the grid, the feature flags, the
-/// boundary field (on the exact path without its per-voxel arrays: BoundaryField::hasVoxels) and
+/// boundary field (without its per-voxel arrays where BoundaryField::regionsOnShapes) and
 /// the media, with `fields` false and the per-voxel fields empty. Milliseconds where voxelize()
 /// or the volume cache takes ~1 s for a 128³ sphere (docs/performance.md "Start-up").
 /// Throws as voxelize(), and std::invalid_argument for a scene with smoothed interfaces.

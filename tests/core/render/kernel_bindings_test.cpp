@@ -94,14 +94,16 @@ TEST(KernelBindings, TheSharpMarchWithoutLightReadsNoFieldOfTheVolume) {
   EXPECT_EQ(checked, 3 * 12 * 2);
 }
 
-TEST(KernelBindings, TheExactPathReadsNoVoxelOfTheBoundaryField) {
-  // Every crossing and region on the shapes (boundary.glsl exactCrossingOutOf, regionAt): the
-  // region and distance images are not read either, so voxelizeInterfaces leaves them out.
+TEST(KernelBindings, RegionsOnTheShapesReadNoVoxelOfTheBoundaryField) {
+  // The exact path and convex planes apart with their constants (BoundaryField::regionsOnShapes):
+  // every crossing and region on the shapes or their planes (boundary.glsl exactCrossingOutOf,
+  // convexCrossing, regionAt), so the region and distance images are not read either and
+  // voxelizeInterfaces leaves them out.
   int checked = 0;
   for (const Kernel& k : kernels())
     for (int flags : sharpFeatureSets()) {
-      if ((flags & EIKON_F_EXACT) == 0) continue;
-      flags &= ~EIKON_F_MESH;  // the exact path is for analytic shapes only
+      if ((flags & (EIKON_F_EXACT | EIKON_F_CONVEX_APART)) == 0) continue;
+      flags &= ~EIKON_F_MESH;  // analytic shapes only
       const auto m = vk::specialiseSpirv(
           k.spirv, std::vector<uint32_t>{1u, uint32_t(flags), 2u, 0u, exactConstant(flags)});
       const std::set<int> b = bindingsOf(m);
@@ -109,13 +111,17 @@ TEST(KernelBindings, TheExactPathReadsNoVoxelOfTheBoundaryField) {
         EXPECT_EQ(b.count(f), 0u) << k.name << ", flags " << flags << ": reads binding " << f;
       ++checked;
     }
-  EXPECT_EQ(checked, 3 * 4);
-  // The walk does read them (the census would see a read on the exact path).
-  const int walk = EIKON_F_SHARP | EIKON_F_CONVEX;
-  EXPECT_EQ(bindingsOf(vk::specialiseSpirv(kernels()[0].spirv,
-                                           std::vector<uint32_t>{1u, uint32_t(walk), 2u}))
-                .count(EIKON_B_REGION),
-            1u);
+  EXPECT_EQ(checked, 3 * 8);
+  // The walk does read them, and so do convex planes apart without their constants (a table
+  // beyond the uniform block): the census would see a read.
+  for (int path : {0, EIKON_F_CONVEX_APART}) {
+    const int flags = EIKON_F_SHARP | EIKON_F_CONVEX | path;
+    EXPECT_EQ(bindingsOf(vk::specialiseSpirv(kernels()[0].spirv,
+                                             std::vector<uint32_t>{1u, uint32_t(flags), 2u}))
+                  .count(EIKON_B_REGION),
+              1u)
+        << "flags " << flags;
+  }
 }
 
 TEST(KernelBindings, TheChecksSeeTheBindingsThatAreRead) {

@@ -194,7 +194,7 @@ std::string sharpScene(const std::string& object) {
 })";
 }
 
-void checkInterfacesOnly(const std::string& object, bool exact) {
+void checkInterfacesOnly(const std::string& object, bool exact) {  // else convex planes apart
   auto scene = std::make_shared<Scene>(parseScene(sharpScene(object), "lean.json"));
   ASSERT_EQ(scene->interfaces, Scene::Interfaces::Sharp);
   RenderSettings rs;
@@ -204,7 +204,9 @@ void checkInterfacesOnly(const std::string& object, bool exact) {
   EXPECT_TRUE(v.index[0][0].empty() && v.medium[0].empty() && v.emission.empty());
   EXPECT_TRUE(v.attenuating);  // the flags are the materials'
   EXPECT_EQ(v.boundary.exact, exact);
-  EXPECT_EQ(v.boundary.hasVoxels(), !exact);
+  EXPECT_EQ(v.boundary.convex_apart, !exact);
+  EXPECT_TRUE(v.boundary.regionsOnShapes());
+  EXPECT_FALSE(v.boundary.hasVoxels());  // every region and crossing on the shapes
   EXPECT_FALSE(v.boundary.empty());
   EXPECT_THROW(VolumeField{v}, std::invalid_argument);
   const VolumeSet& w = whole.prepare(true);
@@ -234,7 +236,7 @@ TEST(SessionGpu, SharpSphereRenderVoxelisesOnlyItsShape) {
       R"({"shape": "sphere", "center": [0, 0, 0], "radius": 5, "material": "glass"})", true);
 }
 
-TEST(SessionGpu, LonePrismRenderVoxelisesOnlyTheBoundaryField) {
+TEST(SessionGpu, LonePrismRenderVoxelisesOnlyItsShape) {
   checkInterfacesOnly(R"({"shape": "prism", "apex_deg": 60, "side": 8, "height": 10,
                           "material": "glass"})",
                       false);
