@@ -281,7 +281,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
     // The view pipeline compiles beside the voxelising and the upload (docs/performance.md).
     session.startRenderPipeline(rs, lit);
   }
-  // Without light volumes a GPU render on the exact path reads no per-voxel field: only the
+  // Without light volumes a GPU render of sharp interfaces reads no per-voxel field: only the
   // interfaces are voxelised then (docs/performance.md "Start-up").
   if (a.reference || lit)
     session.prepare(!a.reference);

@@ -30,7 +30,7 @@ LightingSummary simulateLightingWith(const Scene& scene, VolumeSet& volume,
                                      const LightingOptions& options, const SimulateRun& simulate) {
   LightingSummary sum;
   if (scene.lights.empty()) return sum;
-  if (!volume.fields || (!volume.boundary.empty() && !volume.boundary.hasVoxels()))
+  if (!volume.whole())
     throw std::invalid_argument(
         "simulateLighting: the volume has no fields (voxelizeInterfaces); voxelise it whole");
   auto runs = planLighting(scene, volume, options.bands);

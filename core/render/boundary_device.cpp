@@ -149,6 +149,16 @@ std::vector<vk::BindingSpec> uniformTableBindings() {
           {EIKON_B_SMALL_MEDIA, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}};
 }
 
+int uniformTableFlags(const BoundaryField& field, const MediaTable& media) {
+  bool mesh = false;
+  for (const Shape& s : field.shapes)
+    mesh = mesh || std::holds_alternative<MeshShape>(s.geometry());
+  int flags = 0;
+  if (media.regions.size() <= size_t(EIKON_SMALL_MEDIA_REGIONS)) flags |= EIKON_F_SMALL_MEDIA;
+  if (!mesh && exactTableRows(field.shapes) <= EIKON_EXACT_MAX_ROWS) flags |= EIKON_F_SMALL_SHAPES;
+  return flags;
+}
+
 BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& field,
                                const MediaTable& media, const std::string& file) {
   static_assert(kMediumVec4s == EIKON_MEDIUM_VEC4S &&

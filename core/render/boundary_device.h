@@ -34,8 +34,12 @@ void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field, const
 /// The descriptor bindings of the four resources (add them to a pipeline's binding list).
 std::vector<vk::BindingSpec> boundaryBindings();
 
-/// The bindings of BoundaryDevice::bindUniformTables (the view kernels add them).
+/// The bindings of BoundaryDevice::bindUniformTables (the view and light kernels add them).
 std::vector<vk::BindingSpec> uniformTableBindings();
+
+/// EIKON_F_SMALL_MEDIA and EIKON_F_SMALL_SHAPES where the medium table and the shape table fit
+/// the uniform blocks (bindUniformTables; march.glsl and wavefront.comp read them there then).
+int uniformTableFlags(const BoundaryField& field, const MediaTable& media);
 
 class BoundaryDevice {
  public:

@@ -259,17 +259,11 @@ struct GpuWavefront::Impl {
     if (vol.opaque) flags |= EIKON_F_OPACITY;
     if (eMode) flags |= EIKON_F_UNIAXIAL;
     if (sharp) {
-      bool mesh = false;
       for (const Shape& shape : vol.boundary.shapes) {
         if (std::holds_alternative<ConvexShape>(shape.geometry())) flags |= EIKON_F_CONVEX;
-        if (std::holds_alternative<MeshShape>(shape.geometry())) mesh = true;
+        if (std::holds_alternative<MeshShape>(shape.geometry())) flags |= EIKON_F_MESH;
       }
-      if (mesh) flags |= EIKON_F_MESH;
-      // The tables as uniform blocks where they fit (BoundaryDevice; wavefront.comp).
-      if (vol.media.regions.size() <= size_t(EIKON_SMALL_MEDIA_REGIONS))
-        flags |= EIKON_F_SMALL_MEDIA;
-      if (!mesh && exactTableRows(vol.boundary.shapes) <= EIKON_EXACT_MAX_ROWS)
-        flags |= EIKON_F_SMALL_SHAPES;
+      flags |= uniformTableFlags(vol.boundary, vol.media);  // the tables as uniform blocks
     }
     return flags;
   }

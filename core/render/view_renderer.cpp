@@ -327,10 +327,7 @@ int volumeFeatureFlags(const VolumeSet& v) {
   if (sharp && mesh) flags |= EIKON_F_MESH;
   if (sharp && v.boundary.convex_apart) flags |= EIKON_F_CONVEX_APART;
   if (sharp && v.boundary.exact) flags |= EIKON_F_EXACT;
-  if (sharp && v.media.regions.size() <= size_t(EIKON_SMALL_MEDIA_REGIONS))
-    flags |= EIKON_F_SMALL_MEDIA;
-  if (sharp && !mesh && exactTableRows(v.boundary.shapes) <= EIKON_EXACT_MAX_ROWS)
-    flags |= EIKON_F_SMALL_SHAPES;
+  if (sharp) flags |= uniformTableFlags(v.boundary, v.media);
   return flags;
 }
 

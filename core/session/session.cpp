@@ -191,7 +191,7 @@ vk::Context& Session::context() {
 
 VolumeSet& Session::prepare(bool gpu) {
   if (gpu) context();
-  if (volume_ && !volume_->fields) volume_.reset();  // voxelised whole below; gpu_ stays valid
+  if (volume_ && !volume_->whole()) volume_.reset();  // voxelised whole below; gpu_ stays valid
   if (!volume_) {
     VoxelizeOptions vo;
     vo.threads = threads_;

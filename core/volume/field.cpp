@@ -8,7 +8,7 @@
 namespace eikon {
 
 VolumeField::VolumeField(const VolumeSet& v) : v_(v) {
-  if (!v.fields || (!v.boundary.empty() && !v.boundary.hasVoxels()))
+  if (!v.whole())
     throw std::invalid_argument(
         "VolumeField: the volume has no fields (voxelizeInterfaces); voxelise it whole");
 }

@@ -72,6 +72,9 @@ struct VolumeSet {
   /// False for a volume made by voxelizeInterfaces: index, medium, emission, axis and scatter are
   /// empty (only a GPU render of sharp interfaces without light volumes may use it).
   bool fields = true;
+  /// Everything voxelize() makes: the fields and, where there is a boundary, its voxels (false
+  /// only for voxelizeInterfaces' volumes). What the CPU twin and the light simulators need.
+  bool whole() const { return fields && (boundary.empty() || boundary.hasVoxels()); }
 
   bool lit() const { return !light_fluence.empty(); }
 
