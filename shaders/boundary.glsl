@@ -1019,11 +1019,14 @@ BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
   const int S = EIKON_BOUNDARY_EXACT_SHAPES;
   bool none = false;
   if (S <= kExactUnrollShapes) {
+    // Each shape clipped once, both passes reading the clip (constant indices: registers).
+    LineClip clips[kExactUnrollShapes];
+    [[unroll]] for (int i = 0; i < S; ++i) clips[i] = exactClip(i, a, d);
     [[unroll]] for (int i = 0; i < S; ++i)
-      if (i >= region - 1) exactPass0(i, region, eps, exactClip(i, a, d), t, nOwn);
+      if (i >= region - 1) exactPass0(i, region, eps, clips[i], t, nOwn);
     none = t > 1.0;
     tq = t + eps;
-    [[unroll]] for (int i = 0; i < S; ++i) exactPass1(i, tq, exactClip(i, a, d), to, nTo);
+    [[unroll]] for (int i = 0; i < S; ++i) exactPass1(i, tq, clips[i], to, nTo);
   } else {
     // Both passes in one do-while over k: shape k of pass 0 for k < S (from the ray's own shape
     // on), shape k − S of pass 1 after it. llvmpipe leaves a loop only at the end of its body, so
