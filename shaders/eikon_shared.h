@@ -270,7 +270,8 @@ struct PolarisedResult {
 #define EIKON_PATCH_ENERGY 4    // killed: flux below min_energy_fraction of its seed's
 #define EIKON_PATCH_OPAQUE 5    // killed: centre in an opaque voxel (flux counted as absorbed)
 // Splat buffer: per voxel 4 signed 64-bit fixed-point sums as (lo, hi) uint pairs, in the order
-// weight, dir.x, dir.y, dir.z (EIKON_SPLAT_ACC_WORDS words per voxel), then one uint per voxel
+// weight, and the biased weight·(1 + dir.x), ·(1 + dir.y), ·(1 + dir.z) (every term ≥ 0; the host
+// subtracts the weight) (EIKON_SPLAT_ACC_WORDS words per voxel), then one uint per voxel
 // holding the float bits of the highest patch irradiance (atomicMax on non-negative floats).
 #define EIKON_SPLAT_ACC_WORDS 8
 

@@ -65,17 +65,21 @@ WaveParams P;
 //                e-mode run in a uniaxial volume, _CONVEX when some shape is a convex polyhedron
 //                (sharp: boundary.glsl's plane loops); always given (GpuWavefront), also in
 //                P.grid_dims.w;
-//   kWaveOptions: EIKON_WO_* bits (straight steps, pass caustics, probe plane); −1: from P.
+//   kWaveOptions: EIKON_WO_* bits (straight steps, pass caustics, probe plane, the highest-energy
+//                 splat's maximum); −1: from P.
 layout(constant_id = 0) const bool kSharpLight = false;
 layout(constant_id = 1) const int kWaveFlags = -1;
 layout(constant_id = 2) const int kWaveOptions = -1;
+layout(constant_id = 3) const int kExact = 0;
 #define EIKON_WO_SKIP 1
 #define EIKON_WO_PASS_CAUSTICS 2
 #define EIKON_WO_PROBE 4
+#define EIKON_WO_HIGHEST 8
 bool hasOption(int o) {
   if (kWaveOptions != -1) return (kWaveOptions & o) != 0;
   if (o == EIKON_WO_SKIP) return P.options.x != 0;
   if (o == EIKON_WO_PASS_CAUSTICS) return P.options.y != 0;
+  if (o == EIKON_WO_HIGHEST) return true;  // (the maximum costs an atomic; it is always right)
   return P.control.x >= 0;
 }
 layout(binding = EIKON_WB_INDEX_A, rgba32f) readonly uniform image3D idxOA;
@@ -143,9 +147,19 @@ float gLambdaUm = 0.5876;      // sharp.glsl's mediumIndex: set to P.wavelength.
 bool gDispersiveHit = false;  // written by mediumIndex, unused here
 #define EIKON_BOUNDARY_HAS_CONVEX hasFlag(EIKON_F_CONVEX)
 #define EIKON_BOUNDARY_HAS_MESH hasFlag(EIKON_F_MESH)
+#define EIKON_BOUNDARY_CONVEX_APART hasFlag(EIKON_F_CONVEX_APART)
+#define EIKON_BOUNDARY_EXACT (hasFlag(EIKON_F_EXACT) && kExact != 0)
+#define EIKON_BOUNDARY_EXACT_ROWS (kExact & 0x3FF)
+#define EIKON_BOUNDARY_EXACT_SHAPES ((kExact >> 10) & 0x3FF)
+#define EIKON_BOUNDARY_EXACT_KINDS (kExact >> 20)
+#define EIKON_EXACT_ROW(i) exactRows[i]
 #include "boundary.glsl"
 #include "fresnel.glsl"
 #define EIKON_SHARP_NO_MARCH
+// A run is at one wavelength: the media's indices there come from the host (sharp.glsl
+// mediumIndex; GpuWavefront sets BoundaryDevice::setRenderWavelength), which folds the
+// dispersion formulas away.
+#define EIKON_INDEX_AT_RENDER_WAVELENGTH true
 #include "sharp.glsl"
 
 int regionOf(int corner) { return corner & EIKON_CORNER_REGION; }
@@ -259,18 +273,34 @@ void addFixed(uint base, int v) {
 
 int toFixed(float value) { return int(clamp(round(value * P.wavelength.w), -2147483520.0, 2147483520.0)); }
 
+// Voxel i's sums += value (≥ 0) and value·dir. The direction's sums are kept biased, as
+// value·(1 + dir) ≥ 0 (readSplat takes the weight back off), so that no sum ever adds a negative
+// word: its high word then changes only on a carry, which almost no lane of a SIMD group has, and
+// llvmpipe skips a branch that no lane takes (the signed sums added the sign's 0xFFFFFFFF to the
+// high word of every negative component: up to three more atomics a splat).
+void splatVoxel(ivec3 i, float value, vec3 dir) {
+  const uint v = uint((i.z * P.grid_dims.y + i.y) * P.grid_dims.x + i.x);
+  const uint base = v * uint(EIKON_SPLAT_ACC_WORDS);
+  const vec3 biased = max(vec3(1.0) + dir, vec3(0.0));  // (|dir| ≤ 1 but for its rounding)
+  addFixed(base, toFixed(value));
+  addFixed(base + 2u, toFixed(value * biased.x));
+  addFixed(base + 4u, toFixed(value * biased.y));
+  addFixed(base + 6u, toFixed(value * biased.z));
+}
+
+// The highest-energy splat's maximum (Splat::HighestEnergy only: an Accumulate run reads only the
+// sums).
+void splatHighest(ivec3 i, float irr) {
+  const uint v = uint((i.z * P.grid_dims.y + i.y) * P.grid_dims.x + i.x);
+  const uint count = uint(P.grid_dims.x * P.grid_dims.y * P.grid_dims.z);
+  atomicMax(splat[count * uint(EIKON_SPLAT_ACC_WORDS) + v], floatBitsToUint(max(irr, 0.0)));
+}
+
 void splatAt(vec3 m, float value, float irr, vec3 dir) {
   vec3 g = floor((m - P.grid_origin.xyz) * P.grid_max.w);
   if (any(lessThan(g, vec3(0.0))) || any(greaterThanEqual(g, vec3(P.grid_dims.xyz)))) return;
-  ivec3 i = ivec3(g);
-  uint v = uint((i.z * P.grid_dims.y + i.y) * P.grid_dims.x + i.x);
-  uint count = uint(P.grid_dims.x * P.grid_dims.y * P.grid_dims.z);
-  uint base = v * uint(EIKON_SPLAT_ACC_WORDS);
-  addFixed(base, toFixed(value));
-  addFixed(base + 2u, toFixed(value * dir.x));
-  addFixed(base + 4u, toFixed(value * dir.y));
-  addFixed(base + 6u, toFixed(value * dir.z));
-  atomicMax(splat[count * uint(EIKON_SPLAT_ACC_WORDS) + v], floatBitsToUint(max(irr, 0.0)));
+  splatVoxel(ivec3(g), value, dir);
+  if (hasOption(EIKON_WO_HIGHEST)) splatHighest(ivec3(g), irr);
 }
 
 vec3 centreOf(vec3 x[4]) { return 0.25 * (x[0] + x[1] + x[2] + x[3]); }
@@ -321,7 +351,6 @@ void splatSegment(vec3 c0, vec3 u, float L, float E0, float sigma, vec3 dir, flo
       stepI[a] = 0, tDelta[a] = 0.0, tNext[a] = 1e30;
     }
   }
-  const uint count = uint(P.grid_dims.x * P.grid_dims.y * P.grid_dims.z);
   float sCur = sA;
   const int guard = P.grid_dims.x + P.grid_dims.y + P.grid_dims.z + 3;
   for (int it = 0; it < guard; ++it) {
@@ -331,14 +360,11 @@ void splatSegment(vec3 c0, vec3 u, float L, float E0, float sigma, vec3 dir, flo
       const float sm = 0.5 * (sCur + sEnd), flux = E0 * exp(-sigma * sm);
       const float value = flux * (sEnd - sCur) * P.step.w;  // W/mm²; toFixed scales
       const float tau = ds1 > 0.0 ? sm / ds1 : 0.0;
-      const float area = 0.5 * length(cross(dA + tau * dB, dC + tau * dD));
-      const uint v = uint((i.z * P.grid_dims.y + i.y) * P.grid_dims.x + i.x);
-      const uint base = v * uint(EIKON_SPLAT_ACC_WORDS);
-      addFixed(base, toFixed(value));
-      addFixed(base + 2u, toFixed(value * dir.x));
-      addFixed(base + 4u, toFixed(value * dir.y));
-      addFixed(base + 6u, toFixed(value * dir.z));
-      atomicMax(splat[count * uint(EIKON_SPLAT_ACC_WORDS) + v], floatBitsToUint(max(area > 0.0 ? flux / area : 0.0, 0.0)));
+      splatVoxel(i, value, dir);
+      if (hasOption(EIKON_WO_HIGHEST)) {
+        const float area = 0.5 * length(cross(dA + tau * dB, dC + tau * dD));
+        splatHighest(i, area > 0.0 ? flux / area : 0.0);
+      }
       sCur = sEnd;
     }
     if (sCur >= sB) break;
@@ -558,6 +584,54 @@ void sharpCorner(inout vec3 x, inout vec3 w, inout int corner, inout PatchStep s
 }
 
 
+// The four corners' sharp step. A corner that moves at most (D − 1.5)·h from a voxel of skip
+// distance D meets no boundary (the argument of straight steps; the CPU twin's sharpCorner skips
+// its search by the same test) and moves straight; the others take sharpCorner one after another
+// in a loop over a mask. llvmpipe runs a loop's body while any lane of its SIMD group still
+// loops, so a group whose corners are all clear runs the search once (masked) instead of four
+// times (docs/performance.md, "Light simulator").
+// Whether no shape's surface lies within len of x, so that a corner moving len from x crosses
+// none: on the exact path with at most kExactUnrollShapes spheres, boxes and rounded boxes, whose
+// signed distances are Euclidean (with a margin of kExactMergeVoxels for their rounding). The
+// same answer as the search (no crossing), so the CPU twin, whose search costs little, has none.
+bool shapesClear(vec3 x, float len) {
+  if (!EIKON_BOUNDARY_EXACT || EIKON_BOUNDARY_EXACT_SHAPES > kExactUnrollShapes ||
+      EIKON_EXACT_HAS(EIKON_SHAPE_CONVEX))
+    return false;
+  const float margin = len + kExactMergeVoxels * P.grid_origin.w;
+  bool clear = true;
+  [[unroll]] for (int i = 0; i < EIKON_BOUNDARY_EXACT_SHAPES; ++i)
+    clear = clear && abs(shapeSignedDistance(i, x)) > margin;
+  return clear;
+}
+
+void sharpCorners(inout vec3 x[4], inout vec3 w[4], inout ivec4 region, inout PatchStep st) {
+  uint search = 0u;
+  float absorb = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const int r = regionOf(region[k]);
+    const vec3 d = P.step.x * mediumVelocity(r, w[k]);
+    const float len = length(d);
+    if ((hasOption(EIKON_WO_SKIP) && len <= (skipAt(x[k]) - 1.5) * P.grid_origin.w) || shapesClear(x[k], len)) {
+      absorb += mediumSigma(r, w[k]) * len;
+      x[k] += d;
+    } else {
+      search |= 1u << k;
+    }
+  }
+  st.attenuation *= exp(-0.25 * absorb);
+  for (; search != 0u; search &= search - 1u) {
+    const int k = findLSB(search);
+    vec3 xk = x[0], wk = w[0];
+    int rk = region[0];
+    for (int j = 1; j < 4; ++j)
+      if (j == k) xk = x[j], wk = w[j], rk = region[j];
+    sharpCorner(xk, wk, rk, st);
+    for (int j = 0; j < 4; ++j)
+      if (j == k) x[j] = xk, w[j] = wk, region[j] = rk;
+  }
+}
+
 vec3 meanOf(vec3 w[4]) { return 0.25 * (w[0] + w[1] + w[2] + w[3]); }
 
 // Advance the corners by one RK4 time step, or by k time steps along straight lines (w is then
@@ -585,7 +659,7 @@ PatchStep moveStep(inout vec3 x[4], inout vec3 w[4], inout WavePatch p) {
     // Sharp: no boundary on the way (no Fresnel), the corners' attenuation over the path.
     if (kSharpLight) st.attenuation = exp(-sigma1 * length(centreOf(x) - st.c0));
   } else if (kSharpLight) {
-    for (int k = 0; k < 4; ++k) sharpCorner(x[k], w[k], p.region[k], st);
+    sharpCorners(x, w, p.region, st);
     ++p.state.w;
   } else {
     for (int k = 0; k < 4; ++k) rk4(x[k], w[k], dt);
@@ -716,7 +790,7 @@ void propagate(uint id) {
   }
   if (kSharpLight && p.region.x < 0)  // a seed: each corner in its region, on its medium's shell
     for (int k = 0; k < 4; ++k) {
-      p.region[k] = boundaryRegion(x[k]);
+      p.region[k] = regionAt(x[k]);
       w[k] = mediumShell(p.region[k], normalize(w[k]));
     }
   for (int it = 0; it < P.control.y && p.state.w < P.control.z; ++it) {

@@ -177,7 +177,7 @@ class PatchStepper {
 
   /// Sharp interfaces: the region a seed corner starts in and its wave vector along s on that
   /// region's shell (the run's seeds are moved onto the media's shells with it).
-  int regionAt(const glm::dvec3& x) const { return boundaryRegion(*sharp_->boundary, x); }
+  int regionAt(const glm::dvec3& x) const { return eikon::regionAt(*sharp_->boundary, x); }
   glm::dvec3 mediumShell(int region, const glm::dvec3& s) const;
 
   /// One patch's step (propagate in wavefront.comp): advance, splat, count, end it or emit it
@@ -407,9 +407,15 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
     // skip distance D (the argument of straight steps; the sharp path's D counts region changes
     // only) or when every boundary-field cell it touches lies in its region: locateCrossing would
     // find none, so it is not called (issue 14: most corners near a surface are such corners).
+    // Where the regions are on the shapes (BoundaryField::regionsOnShapes) the crossing is the
+    // shapes' own (crossingOutOf, the view march's; the GPU twin's nextCrossing), and the voxels'
+    // regions along the way say nothing about it: only the skip distance is a bound there.
+    const bool onShapes = bf.regionsOnShapes();
     const Along along =
         guard == 0 && s_.skip_empty
-            ? (len <= (skipAt(x) - 1.5) * h_ ? Along::OneRegion : regionsAlong(x, x + d, r))
+            ? (len <= (skipAt(x) - 1.5) * h_ ? Along::OneRegion
+               : onShapes                    ? Along::Others
+                                             : regionsAlong(x, x + d, r))
             : Along::Others;
     if (along == Along::OneRegion) {
       absorb += mediumSigma(r, p.w[size_t(k)]) * len;
@@ -421,8 +427,10 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
     // trilinear field's zero is taken without the refinement on the exact shape.
     LocateOptions opt;
     opt.analytic = along != Along::SameMotion;
-    BoundaryCrossing c = guard < 16 ? locateCrossing(bf, x, x + d, opt) : BoundaryCrossing{};
-    if (c.found && c.from != r && c.to == r) {
+    BoundaryCrossing c = guard >= 16 ? BoundaryCrossing{}
+                         : onShapes  ? crossingOutOf(bf, x, x + d, r)
+                                     : locateCrossing(bf, x, x + d, opt);
+    if (!onShapes && c.found && c.from != r && c.to == r) {
       // The trilinear field's zero lies just past the exact surface where the corner was turned
       // (curved faces: by up to 3h²/8r): not a new boundary, so go on past it.
       const double t = std::min(1.0, c.t + 1e-6 * h_ / std::max(len, 1e-300));

@@ -13,6 +13,7 @@
 #include "core/light/seeding.h"
 #include "core/light/sharp_skip.h"
 #include "core/render/boundary_device.h"
+#include "core/render/view_pipeline_start.h"
 #include "core/vk/resources.h"
 #include "core/volume/media.h"
 #include "shaders/eikon_shared.h"
@@ -211,6 +212,7 @@ struct GpuWavefront::Impl {
     for (const vk::BindingSpec& bs : uniformTableBindings()) b.push_back(bs);
     boundary = sharp ? BoundaryDevice(ctx, vol.boundary, vol.media)
                      : BoundaryDevice(ctx, BoundaryField{}, MediaTable{});
+    boundary.setRenderWavelength(s.wavelength_nm);  // the media's indices at the run's wavelength
     // The run's feature set as specialisation constants (wavefront.comp: kSharpLight, kWaveFlags,
     // kWaveOptions), so that llvmpipe, which runs every branch under masks, compiles out what
     // this run never does (docs/performance.md, "Light simulator"). The settings are fixed for
@@ -218,7 +220,8 @@ struct GpuWavefront::Impl {
     pipe = vk::ComputePipeline(
         ctx, std::span<const uint32_t>(k_wavefront_spv, sizeof(k_wavefront_spv) / 4), b,
         sizeof(gpu::WavePush), sharp ? "wavefront sharp" : "wavefront",
-        std::vector<uint32_t>{sharp ? 1u : 0u, uint32_t(featureFlags()), uint32_t(options())});
+        std::vector<uint32_t>{sharp ? 1u : 0u, uint32_t(featureFlags()), uint32_t(options()),
+                              uint32_t(sharp ? volumeExactConstant(vol) : 0)});
     boundary.bind(pipe);
     boundary.bindUniformTables(pipe);
     const size_t med = vol.dispersive ? 3 : 1;
@@ -264,13 +267,17 @@ struct GpuWavefront::Impl {
         if (std::holds_alternative<MeshShape>(shape.geometry())) flags |= EIKON_F_MESH;
       }
       flags |= uniformTableFlags(vol.boundary, vol.media);  // the tables as uniform blocks
+      if (vol.boundary.convex_apart) flags |= EIKON_F_CONVEX_APART;
+      if (vol.boundary.exact) flags |= EIKON_F_EXACT;
     }
     return flags;
   }
-  /// wavefront.comp's kWaveOptions: bit 0 straight steps, bit 1 pass caustics, bit 2 probe plane.
+  /// wavefront.comp's kWaveOptions: bit 0 straight steps, bit 1 pass caustics, bit 2 probe plane,
+  /// bit 3 the highest-energy maximum (readSplat reads it only for Splat::HighestEnergy).
   int options() const {
     return (s.skip_empty ? 1 : 0) | (s.pass_caustics ? 2 : 0) |
-           (s.probe_axis >= 0 && s.probe_axis < 3 ? 4 : 0);
+           (s.probe_axis >= 0 && s.probe_axis < 3 ? 4 : 0) |
+           (s.splat == WavefrontSettings::Splat::HighestEnergy ? 8 : 0);
   }
 
   // Patch list `which` (0: EIKON_WB_PATCHES, 1: _B) holds at least n patches. Only called between
@@ -366,9 +373,10 @@ struct GpuWavefront::Impl {
 
   /// Fixed-point scale: one splat is flux_mid·Δs/h³ ≤ maxSeed·(dt/n_min)/h³ =: vmax (a patch's flux
   /// never grows; the centre moves at most dt/n_min per step). With scale = 2^29/(2·vmax) a splat
-  /// is ≤ 2^28 units, far inside int32 (the factor 2 covers RK4's overshoot in steep gradients),
+  /// is ≤ 2^28 units and a biased direction term (≤ 2 × the splat) ≤ 2^29, inside int32 (the
+  /// factor 2 covers RK4's overshoot in steep gradients),
   /// and its rounding error is ≤ 0.5/scale = 2^-29·vmax. A 64-bit voxel sum overflows only after
-  /// 2^35 maximal splats into one voxel, i.e. never for runs of ≤ 2^20 patches × 2^14 steps.
+  /// 2^34 maximal splats into one voxel, i.e. never for runs of ≤ 2^20 patches × 2^14 steps.
   /// With straight steps a splat is one voxel's piece of a straight path, at most the voxel
   /// diagonal √3·h long, so that bounds Δs too.
   double splatScale(double max_seed) const {
@@ -396,8 +404,8 @@ struct GpuWavefront::Impl {
     P.probe = glm::vec4(float(s.probe_position), 0.0f, 0.0f, 0.0f);
     P.options = glm::ivec4(s.skip_empty ? 1 : 0, s.pass_caustics ? 1 : 0, 0, 0);
     params.write(&P, sizeof P);
-    std::vector<uint32_t> zero(splatWords(), 0u);
-    splat.write(zero.data(), zero.size() * sizeof(uint32_t));
+    // Zeroed in place (the buffer is mapped): no 50 MB staging vector at 128³.
+    std::memset(splat.mapped(), 0, splatWords() * sizeof(uint32_t));
   }
   size_t splatWords() const { return vol.grid.count() * (EIKON_SPLAT_ACC_WORDS + 1); }
 
@@ -495,21 +503,25 @@ struct GpuWavefront::Impl {
   /// The splat buffer as the result's volumes: fixed point (scale) to W/mm², mean direction.
   void readSplat(double scale, WavefrontResult& res) const {
     const Grid& g = vol.grid;
-    std::vector<uint32_t> words(splatWords());
-    splat.read(words.data(), words.size() * sizeof(uint32_t));
+    // Read in place from the mapped buffer (the device is idle: every submission was waited on).
+    const uint32_t* words = static_cast<const uint32_t*>(splat.mapped());
     res.irradiance.resize(g.count());
     res.direction.resize(g.count());
     const bool highest = s.splat == WavefrontSettings::Splat::HighestEnergy;
-    auto fixedAt = [&](size_t i) {
+    auto rawAt = [&](size_t i) {
       const uint64_t u = (uint64_t(words[i + 1]) << 32) | uint64_t(words[i]);
       int64_t v;
       std::memcpy(&v, &u, sizeof v);
-      return double(v) / scale;
+      return v;
     };
     for (size_t v = 0; v < g.count(); ++v) {
       const size_t b = v * EIKON_SPLAT_ACC_WORDS;
-      const double acc = fixedAt(b);
-      const glm::dvec3 d(fixedAt(b + 2), fixedAt(b + 4), fixedAt(b + 6));
+      // The direction's sums are Σ value·(1 + dir) (wavefront.comp splatVoxel): the weight comes
+      // off in integers, exactly.
+      const int64_t w = rawAt(b);
+      const double acc = double(w) / scale;
+      const glm::dvec3 d(double(rawAt(b + 2) - w) / scale, double(rawAt(b + 4) - w) / scale,
+                         double(rawAt(b + 6) - w) / scale);
       float best;
       std::memcpy(&best, &words[g.count() * EIKON_SPLAT_ACC_WORDS + v], sizeof best);
       res.irradiance[v] = highest ? best : float(acc);

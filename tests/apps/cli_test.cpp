@@ -731,7 +731,9 @@ TEST_F(Cli, LightSummaryReportsTheFluxReflectedAtSharpInterfaces) {
 
 // A lit floor under the tiny glass sphere: the light is simulated once and then read back from
 // the cache (keyed by the medium, the lights and the simulator settings, never the camera), and
-// the cached render is the same picture.
+// the cached render is the same picture. The sphere sits a little off the light's seed lattice,
+// so that no seed corner runs exactly tangent to it, a contact float and double decide
+// differently (tests/core/render/sharp_wavefront_twins_test.cpp, GlassSphereIrradianceAgrees).
 TEST_F(Cli, RenderSimulatesLightOnceThenUsesTheCache) {
   const std::string scene = R"({
   "camera": {"position": [0, 20, -20], "look_at": [0, -2, 0], "up": [0, 1, 0], "fov_deg": 30, "width": 32, "height": 24},
@@ -739,7 +741,7 @@ TEST_F(Cli, RenderSimulatesLightOnceThenUsesTheCache) {
   "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "resolution": 24},
   "materials": {"glass": {"n": 1.5}, "floor": {"n": 1, "opacity": 1, "albedo": 0.8}},
   "objects": [{"shape": "box", "center": [0, -3.5, 0], "size": [8, 1, 8], "material": "floor"},
-              {"shape": "sphere", "center": [0, 0.5, 0], "radius": 2.5, "material": "glass"}],
+              {"shape": "sphere", "center": [0.0123, 0.5, -0.0071], "radius": 2.5, "material": "glass"}],
   "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 2}]
 })";
   const std::string cache = (dir_ / "cache").string();

@@ -264,8 +264,18 @@ TEST(SharpWavefrontTwins, CalcitePlateSeparatesTheSpotsByTheWalkOff) {
 //    splats, each adding twice its value to Σ|g − c|: L1 ≤ 12δ/h, with δ ≤ N·ulp(X) (positions,
 //    above; N = the most steps a patch took, X = 2.4 mm). The total Σ flux·Δs/h³ moves by the
 //    relative rounding of each Δs = |c1 − c0|, ≤ 2·ulp(X)/Δs with Δs ≥ dt/1.5 in the glass.
+//  * Off the seed lattice. Centred at the origin, the sphere has seed corners on lines exactly
+//    tangent to it (y² + z² = R² at lattice points such as (0.6, 0.8) and (0, 1)). Whether such a
+//    line meets the sphere is decided by rounding, and float and double decide it differently: the
+//    chord of a tangent line is √(rounding) long, ~2e-4 mm in float and ~1e-8 mm in double, around
+//    the 1e-5 mm merge length (kExactMergeVoxels). Each such corner takes its patches' subtrees
+//    with it (measured at the origin: splits 35792 vs 37288, reflected 0.0434 vs 0.0405 of the
+//    emitted flux). Moved by a fraction of a seed edge, no corner comes within float rounding of
+//    a tangent line, and what is left to compare is rounding.
 TEST(SharpWavefrontTwins, GlassSphereIrradianceAgrees) {
-  const Scene scene = sceneFromJson(kGlassSphereLightScene);
+  std::string text = kGlassSphereLightScene;
+  text.replace(text.find("[0, 0, 0]"), 9, "[0, 0.0123, 0.0071]");
+  const Scene scene = sceneFromJson(text);
   const VolumeSet vol = voxelize(scene);
   const WavefrontSettings s = sharpSettings(WavefrontSettings{});
   const Light light = directionalLight({1, 0, 0}, 1.0);
