@@ -411,12 +411,11 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
     // shapes' own (crossingOutOf, the view march's; the GPU twin's nextCrossing), and the voxels'
     // regions along the way say nothing about it: only the skip distance is a bound there.
     const bool onShapes = bf.regionsOnShapes();
-    const Along along =
-        guard == 0 && s_.skip_empty
-            ? (len <= (skipAt(x) - 1.5) * h_ ? Along::OneRegion
-               : onShapes                    ? Along::Others
-                                             : regionsAlong(x, x + d, r))
-            : Along::Others;
+    const Along along = guard == 0 && s_.skip_empty
+                            ? (len <= (skipAt(x) - 1.5) * h_ ? Along::OneRegion
+                               : onShapes                    ? Along::Others
+                                                             : regionsAlong(x, x + d, r))
+                            : Along::Others;
     if (along == Along::OneRegion) {
       absorb += mediumSigma(r, p.w[size_t(k)]) * len;
       x += d;

@@ -143,22 +143,8 @@ struct GpuWavefront::Impl {
     const double l = s.wavelength_nm * 1e-3;
     il2 = 1.0 / (l * l);
     il4 = il2 * il2;
-    // Smallest index in the volume (bounds the centre's step length Δs ≤ dt/n_min for the splat
-    // scale). The e-mode's ray speed |M_e p| on the shell is at most 1/min(n_o, n_e) (the ray
-    // velocity surface is an ellipsoid with semi-axes 1/n_o and 1/n_e), so both fields count.
-    n_min = 1e300;
-    for (int md = 0; md <= (eMode ? 1 : 0); ++md)
-      for (size_t i = 0; i < g.count(); ++i) {
-        double n = vol.index[size_t(md)][0][i].x;
-        if (vol.dispersive)
-          n += vol.index[size_t(md)][1][i].x * il2 + vol.index[size_t(md)][2][i].x * il4;
-        n_min = std::min(n_min, n);
-      }
     sharp = s.sharp_interfaces && sharpLightApplies(vol);
-    if (sharp)  // the media's own indices: a corner moves dt/n in its region's medium
-      for (const MediumRecord& r : vol.media.regions)
-        for (const MediumDispersion* d : {&r.n_o, &r.n_e})
-          n_min = std::min(n_min, mediumIndex(*d, s.wavelength_nm));
+    n_min = smallestIndex();
     if (!(n_min > 0)) throw std::invalid_argument("wavefront: the index volume has n <= 0");
 
     std::array<uint32_t, 3> ext{uint32_t(g.dims[0]), uint32_t(g.dims[1]), uint32_t(g.dims[2])};
@@ -249,6 +235,27 @@ struct GpuWavefront::Impl {
         ctx, std::span<const uint32_t>(k_wavefront_count_spv, sizeof(k_wavefront_count_spv) / 4),
         cb, sizeof(gpu::WavePush), "wavefront count");
     countPipe.bindBuffer(EIKON_WB_PARAMS, params);
+  }
+
+  /// Smallest index in the volume (bounds the centre's step length Δs ≤ dt/n_min for the splat
+  /// scale). The e-mode's ray speed |M_e p| on the shell is at most 1/min(n_o, n_e) (the ray
+  /// velocity surface is an ellipsoid with semi-axes 1/n_o and 1/n_e), so both fields count.
+  /// Sharp light: the media's own indices too (a corner moves dt/n in its region's medium).
+  double smallestIndex() const {
+    const Grid& g = vol.grid;
+    double n_lo = 1e300;
+    for (int md = 0; md <= (eMode ? 1 : 0); ++md)
+      for (size_t i = 0; i < g.count(); ++i) {
+        double n = vol.index[size_t(md)][0][i].x;
+        if (vol.dispersive)
+          n += vol.index[size_t(md)][1][i].x * il2 + vol.index[size_t(md)][2][i].x * il4;
+        n_lo = std::min(n_lo, n);
+      }
+    if (sharp)
+      for (const MediumRecord& r : vol.media.regions)
+        for (const MediumDispersion* d : {&r.n_o, &r.n_e})
+          n_lo = std::min(n_lo, mediumIndex(*d, s.wavelength_nm));
+    return n_lo;
   }
 
   /// The EIKON_F_* flags of the run (wavefront.comp's kWaveFlags and WaveParams.grid_dims.w):
