@@ -620,7 +620,7 @@ void sharpCorners(inout vec3 x[4], inout vec3 w[4], inout ivec4 region, inout Pa
     }
   }
   st.attenuation *= exp(-0.25 * absorb);
-  for (; search != 0u; search &= search - 1u) {
+  if (search != 0u) do {
     const int k = findLSB(search);
     vec3 xk = x[0], wk = w[0];
     int rk = region[0];
@@ -629,7 +629,8 @@ void sharpCorners(inout vec3 x[4], inout vec3 w[4], inout ivec4 region, inout Pa
     sharpCorner(xk, wk, rk, st);
     for (int j = 0; j < 4; ++j)
       if (j == k) x[j] = xk, w[j] = wk, region[j] = rk;
-  }
+    search &= search - 1u;
+  } while (search != 0u);
 }
 
 vec3 meanOf(vec3 w[4]) { return 0.25 * (w[0] + w[1] + w[2] + w[3]); }
