@@ -453,7 +453,8 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, ivec4 region, ou
   // A mirror reverses the orientation (endOfStep).
   const int orient = kSharpLight && anyMirrored(region) ? -state.y : state.y;
   bool entered = state.z != 0 || in0;
-  for (int j = 1; j <= K; ++j) {
+  int j = 1;
+  do {  // (K ≥ 1; a do-while: llvmpipe runs a for loop ended by its test one more pass, masked)
     vec3 xj[4];
     for (int k = 0; k < 4; ++k) xj[k] = x[k] + (float(j) * dt) * v[k];
     const float o = dot(0.5 * cross(xj[2] - xj[0], xj[3] - xj[1]), wm);
@@ -466,7 +467,7 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, ivec4 region, ou
     // Sharp: the opacity kill at the step's midpoint (attenuateStep reads it at the same point).
     if (kSharpLight && mediumAt(c0 + (float(j) - 0.5) * dt * vc).w >= 0.5) stop = true;
     if (stop) return j;
-  }
+  } while (++j <= K);
   return K;
 }
 
@@ -794,13 +795,16 @@ void propagate(uint id) {
       p.region[k] = regionAt(x[k]);
       w[k] = mediumShell(p.region[k], normalize(w[k]));
     }
-  for (int it = 0; it < P.control.y && p.state.w < P.control.z; ++it) {
-    PatchStep st = moveStep(x, w, p);
-    const vec4 med = attenuateStep(p, st, w, reflected);
-    splatStep(st, x, w);
-    probeStep(st, probePos, probeDir);
-    if (endOfStep(p, st, med, x, w)) break;
-  }
+  // The steps of this dispatch: a do-while, as a for loop ended by its test runs one more whole
+  // step on llvmpipe, masked, to find that no lane goes on.
+  int it = 0;
+  if (P.control.y > 0 && p.state.w < P.control.z) do {
+      PatchStep st = moveStep(x, w, p);
+      const vec4 med = attenuateStep(p, st, w, reflected);
+      splatStep(st, x, w);
+      probeStep(st, probePos, probeDir);
+      if (endOfStep(p, st, med, x, w)) break;
+    } while (++it < P.control.y && p.state.w < P.control.z);
   p.x[0] = vec4(x[0], probePos.x);
   p.x[1] = vec4(x[1], probePos.y);
   p.x[2] = vec4(x[2], probePos.z);
