@@ -98,7 +98,12 @@ vec4 sampleIndex(vec3 x, int mode) {
   return a;
 }
 
-// (σ_r, σ_g, σ_b band values per mm, opacity) of mode 0 (o) or 1 (e) at x.
+// (σ_r, σ_g, σ_b band values per mm, opacity) of the o-mode at x: a function of its own, so that
+// a kernel that reads only the o-mode's keeps no read of mediumE (the host specialises without
+// inlining, so a constant mode argument does not fold sampleMedium's test).
+vec4 sampleMediumO(vec3 x) { return TRI(mediumO, stencilAt(x)); }
+
+// The same of mode 0 (o) or 1 (e) at x (one stencil for either image).
 vec4 sampleMedium(vec3 x, int mode) {
   Stencil s = stencilAt(x);
   if (mode == 0 || !(EIKON_FIELD_HAS_AXIS)) return TRI(mediumO, s);

@@ -203,7 +203,7 @@ vec3 onShell(vec3 x, vec3 s) {
 // (σ at 612, 549, 465 nm, opacity) of the o-mode; zero when the volume has neither.
 vec4 mediumAt(vec3 x) {
   if (!hasFlag(EIKON_F_ATTENUATION) && !hasFlag(EIKON_F_OPACITY)) return vec4(0.0);
-  return sampleMedium(x, 0);
+  return sampleMediumO(x);
 }
 
 // Constant-time rates: dx/dt = w/n², dw/dt = ∇n/n; in a crystal of the e-mode eModeRates (field.glsl).
@@ -842,10 +842,13 @@ void scatter(uint id) {
       const float w0 = (1.0 - fa) * (1.0 - fb), w1 = fa * (1.0 - fb), w2 = fa * fb, w3 = (1.0 - fa) * fb;
       X[b * 3 + a] = w0 * p.x[0].xyz + w1 * p.x[1].xyz + w2 * p.x[2].xyz + w3 * p.x[3].xyz;
       vec3 ww = w0 * p.w[0].xyz + w1 * p.w[1].xyz + w2 * p.w[2].xyz + w3 * p.w[3].xyz;
-      if ((a == 1 || b == 1) && kSharpLight)
-        ww = mediumShell(regionOf(p.region.x), normalize(ww));  // the region's medium's shell
-      else if (a == 1 || b == 1)
-        ww = onShell(X[b * 3 + a], normalize(ww));  // back onto the mode's shell
+      // Back onto the region's medium's shell (sharp), or the mode's shell in the field (the
+      // test on the constant first, so that a sharp kernel keeps no read of the index fields).
+      if (kSharpLight) {
+        if (a == 1 || b == 1) ww = mediumShell(regionOf(p.region.x), normalize(ww));
+      } else if (a == 1 || b == 1) {
+        ww = onShell(X[b * 3 + a], normalize(ww));
+      }
       W[b * 3 + a] = ww;
     }
   X[0] = p.x[0].xyz, X[2] = p.x[1].xyz, X[8] = p.x[2].xyz, X[6] = p.x[3].xyz;

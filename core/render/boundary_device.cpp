@@ -160,7 +160,7 @@ int uniformTableFlags(const BoundaryField& field, const MediaTable& media) {
 }
 
 BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& field,
-                               const MediaTable& media, const std::string& file) {
+                               const MediaTable& media, const std::string& file, bool voxels_read) {
   static_assert(kMediumVec4s == EIKON_MEDIUM_VEC4S &&
                     kMediumHomogeneous == EIKON_MEDIUM_HOMOGENEOUS &&
                     kMediumUniaxial == EIKON_MEDIUM_UNIAXIAL &&
@@ -168,7 +168,8 @@ BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& fiel
                     kMediumGrin == EIKON_MEDIUM_GRIN && kMediumOpaque == EIKON_MEDIUM_OPAQUE,
                 "the medium table's layout is declared twice (media.h, eikon_shared.h)");
   checkBoundaryFits(ctx, field, media, file);
-  present_ = field.hasVoxels();  // else placeholders (regions on the shapes: none is read)
+  // Else placeholders (regions on the shapes: none is read).
+  present_ = voxels_read && field.hasVoxels();
   std::array<uint32_t, 3> ext{1, 1, 1};
   if (present_)
     ext = {uint32_t(field.grid.dims[0]), uint32_t(field.grid.dims[1]),

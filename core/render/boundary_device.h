@@ -44,8 +44,11 @@ int uniformTableFlags(const BoundaryField& field, const MediaTable& media);
 class BoundaryDevice {
  public:
   BoundaryDevice() = default;
+  /// voxels_read = false: the kernels bound read no voxel of the field (its regions are on the
+  /// shapes, BoundaryField::regionsOnShapes, and the kernels have the exact path's constants):
+  /// one-voxel placeholders instead of the region and distance images.
   BoundaryDevice(const vk::Context& ctx, const BoundaryField& field, const MediaTable& media,
-                 const std::string& file = "");
+                 const std::string& file = "", bool voxels_read = true);
   void bind(vk::ComputePipeline& pipeline) const;
   /// The view kernels' uniform blocks of the same tables (march.glsl; uniformTableBindings()):
   /// the shape table's first EIKON_EXACT_MAX_ROWS rows and the medium table's first

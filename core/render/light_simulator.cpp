@@ -113,9 +113,8 @@ struct GpuWavefront::Impl {
   WavefrontSettings s;
   int steps_per_dispatch;
   VolumeField field;
-  std::vector<vk::Image3D>
-      images;          // o: A, B, C (B, C only when dispersive), medium; e: the same, axis
-  bool eMode = false;  // settings.mode == 1 and the volume is uniaxial
+  std::vector<vk::Image3D> images;  // the fields read and one placeholder (constructor)
+  bool eMode = false;               // settings.mode == 1 and the volume is uniaxial
   // Sharp interfaces (settings.sharp_interfaces and sharpLightApplies): the pipeline is
   // specialised with kSharpLight and the boundary field and media table are uploaded; otherwise
   // 1-voxel placeholders keep those bindings valid.
@@ -149,36 +148,42 @@ struct GpuWavefront::Impl {
 
     std::array<uint32_t, 3> ext{uint32_t(g.dims[0]), uint32_t(g.dims[1]), uint32_t(g.dims[2])};
     auto upload = [&](const std::vector<glm::vec4>& data, const char* name) {
-      vk::Image3D img(ctx, ext, VK_FORMAT_R32G32B32A32_SFLOAT, name);
+      vk::Image3D img(ctx, data.size() == 1 ? std::array<uint32_t, 3>{1, 1, 1} : ext,
+                      VK_FORMAT_R32G32B32A32_SFLOAT, name);
       img.upload(ctx, data.data(), data.size() * sizeof(glm::vec4));
       images.push_back(std::move(img));
+      return images.size() - 1;
     };
-    upload(vol.index[0][0], "wavefront index A");
-    if (vol.dispersive) {
-      upload(vol.index[0][1], "wavefront index B");
-      upload(vol.index[0][2], "wavefront index C");
-    }
-    upload(vol.medium[0], "wavefront medium");
-    if (eMode) {
-      upload(vol.index[1][0], "wavefront index e A");
-      if (vol.dispersive) {
-        upload(vol.index[1][1], "wavefront index e B");
-        upload(vol.index[1][2], "wavefront index e C");
-      }
-      upload(vol.medium[1], "wavefront medium e");
-      upload(vol.axis, "wavefront axis");
-    }
+    // The volume's fields the kernel reads are uploaded; a one-voxel placeholder keeps the other
+    // bindings valid. A sharp run reads no index, axis or e-mode image (its corners move in the
+    // media table's media: KernelBindings.TheSharpLightReadsNoIndexFieldOfTheVolume), an o-mode
+    // run no e-mode one.
+    const size_t none = upload(std::vector<glm::vec4>(1, glm::vec4(0.0f)), "wavefront unread");
+    const bool fields = !sharp, eFields = fields && eMode;
+    const size_t iA = fields ? upload(vol.index[0][0], "wavefront index A") : none;
+    const size_t iB = fields && vol.dispersive ? upload(vol.index[0][1], "wavefront index B") : iA;
+    const size_t iC = fields && vol.dispersive ? upload(vol.index[0][2], "wavefront index C") : iA;
+    const size_t med = upload(vol.medium[0], "wavefront medium");
+    const size_t eA = eFields ? upload(vol.index[1][0], "wavefront index e A") : iA;
+    const size_t eB =
+        eFields && vol.dispersive ? upload(vol.index[1][1], "wavefront index e B") : eA;
+    const size_t eC =
+        eFields && vol.dispersive ? upload(vol.index[1][2], "wavefront index e C") : eA;
+    const size_t eMed = eFields ? upload(vol.medium[1], "wavefront medium e") : med;
+    const size_t axis = eFields ? upload(vol.axis, "wavefront axis") : none;
     // Skip distances for straight steps (w of the emission image; zeros where none was computed).
     // Sharp light reads the sharp path's own, as the CPU twin (core/light/sharp_skip.h).
     std::vector<uint8_t> sharpSkip = sharp ? sharpSkipDistances(vol) : std::vector<uint8_t>{};
+    size_t skipImage;
     if (!sharpSkip.empty()) {
       std::vector<glm::vec4> skip(g.count(), glm::vec4(0.0f));
       for (size_t i = 0; i < skip.size(); ++i) skip[i].w = float(sharpSkip[i]);
-      upload(skip, "wavefront skip");
-    } else if (vol.emission.size() == g.count())
-      upload(vol.emission, "wavefront skip");
-    else
-      upload(std::vector<glm::vec4>(g.count(), glm::vec4(0.0f)), "wavefront skip");
+      skipImage = upload(skip, "wavefront skip");
+    } else if (vol.emission.size() == g.count()) {
+      skipImage = upload(vol.emission, "wavefront skip");
+    } else {
+      skipImage = upload(std::vector<glm::vec4>(g.count(), glm::vec4(0.0f)), "wavefront skip");
+    }
     params = vk::Buffer(ctx, sizeof(gpu::WaveParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                         "wavefront params");
     splat = vk::Buffer(ctx, g.count() * (EIKON_SPLAT_ACC_WORDS + 1) * sizeof(uint32_t),
@@ -196,8 +201,10 @@ struct GpuWavefront::Impl {
       b.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
     for (const vk::BindingSpec& bs : boundaryBindings()) b.push_back(bs);
     for (const vk::BindingSpec& bs : uniformTableBindings()) b.push_back(bs);
-    boundary = sharp ? BoundaryDevice(ctx, vol.boundary, vol.media)
-                     : BoundaryDevice(ctx, BoundaryField{}, MediaTable{});
+    // With the regions on the shapes (and kExact below) the kernel reads no voxel of the field.
+    boundary =
+        sharp ? BoundaryDevice(ctx, vol.boundary, vol.media, "", !vol.boundary.regionsOnShapes())
+              : BoundaryDevice(ctx, BoundaryField{}, MediaTable{});
     boundary.setRenderWavelength(s.wavelength_nm);  // the media's indices at the run's wavelength
     // The run's feature set as specialisation constants (wavefront.comp: kSharpLight, kWaveFlags,
     // kWaveOptions), so that llvmpipe, which runs every branch under masks, compiles out what
@@ -210,20 +217,16 @@ struct GpuWavefront::Impl {
                               uint32_t(sharp ? volumeExactConstant(vol) : 0)});
     boundary.bind(pipe);
     boundary.bindUniformTables(pipe);
-    const size_t med = vol.dispersive ? 3 : 1;
-    pipe.bindImage(EIKON_WB_INDEX_A, images[0]);
-    pipe.bindImage(EIKON_WB_INDEX_B, images[vol.dispersive ? 1 : 0]);
-    pipe.bindImage(EIKON_WB_INDEX_C, images[vol.dispersive ? 2 : 0]);
+    pipe.bindImage(EIKON_WB_INDEX_A, images[iA]);
+    pipe.bindImage(EIKON_WB_INDEX_B, images[iB]);
+    pipe.bindImage(EIKON_WB_INDEX_C, images[iC]);
     pipe.bindImage(EIKON_WB_MEDIUM, images[med]);
-    // e-mode images follow the o-mode ones; an o-mode run binds the o-mode images in their place
-    // (every binding must be valid; the kernel reads them only when control.w = 1).
-    const size_t e0 = eMode ? med + 1 : 0, eMed = eMode ? e0 + (vol.dispersive ? 3 : 1) : med;
-    pipe.bindImage(EIKON_WB_INDEX_E_A, images[e0]);
-    pipe.bindImage(EIKON_WB_INDEX_E_B, images[eMode && vol.dispersive ? e0 + 1 : e0]);
-    pipe.bindImage(EIKON_WB_INDEX_E_C, images[eMode && vol.dispersive ? e0 + 2 : e0]);
+    pipe.bindImage(EIKON_WB_INDEX_E_A, images[eA]);
+    pipe.bindImage(EIKON_WB_INDEX_E_B, images[eB]);
+    pipe.bindImage(EIKON_WB_INDEX_E_C, images[eC]);
     pipe.bindImage(EIKON_WB_MEDIUM_E, images[eMed]);
-    pipe.bindImage(EIKON_WB_AXIS, images[eMode ? eMed + 1 : med]);
-    pipe.bindImage(EIKON_WB_SKIP, images.back());
+    pipe.bindImage(EIKON_WB_AXIS, images[axis]);
+    pipe.bindImage(EIKON_WB_SKIP, images[skipImage]);
     pipe.bindBuffer(EIKON_WB_PARAMS, params);
     pipe.bindBuffer(EIKON_WB_SPLAT, splat);
     std::vector<vk::BindingSpec> cb;

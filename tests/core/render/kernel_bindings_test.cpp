@@ -17,6 +17,7 @@
 #include "shaders/polarised_trace.spv.h"
 #include "shaders/trace.spv.h"
 #include "shaders/view.spv.h"
+#include "shaders/wavefront.spv.h"
 
 namespace eikon {
 namespace {
@@ -138,6 +139,50 @@ TEST(KernelBindings, TheChecksSeeTheBindingsThatAreRead) {
       kernels()[0].spirv, std::vector<uint32_t>{0u, uint32_t(EIKON_F_UNIAXIAL), 2u}));
   for (int f : {EIKON_B_INDEX_O_A, EIKON_B_INDEX_E_A, EIKON_B_AXIS})
     EXPECT_EQ(smoothed.count(f), 1u) << "smoothed march, binding " << f;
+}
+
+// The light simulator's sharp runs (core/render/light_simulator.cpp, GpuWavefront): every corner
+// moves in its region's medium from the media table, so the kernel reads no index, axis or
+// medium-e image of the volume in any mode, nor, with the regions on the shapes, the boundary
+// field's voxels; GpuWavefront binds one-voxel placeholders there instead of uploading them.
+// What it does read: the patches, the splat, the skip distances and the medium-o image (the
+// centre's opacity and attenuation, the CPU twin's f_.medium).
+TEST(KernelBindings, TheSharpLightReadsNoIndexFieldOfTheVolume) {
+  const std::span<const uint32_t> spirv(k_wavefront_spv, sizeof(k_wavefront_spv) / 4);
+  const int all = EIKON_F_DISPERSIVE | EIKON_F_ATTENUATION | EIKON_F_OPACITY | EIKON_F_CONVEX;
+  int checked = 0;
+  for (int mode : {0, EIKON_F_UNIAXIAL})
+    for (int path : {0, EIKON_F_EXACT, EIKON_F_CONVEX_APART})
+      for (int small : {0, EIKON_F_SMALL_MEDIA | EIKON_F_SMALL_SHAPES})
+        for (uint32_t options : {0u, 15u}) {  // none, or straight steps, caustics, probe, maximum
+          const int flags = all | mode | path | small | (path == 0 ? EIKON_F_MESH : 0);
+          const auto m = vk::specialiseSpirv(
+              spirv, std::vector<uint32_t>{1u, uint32_t(flags), options, exactConstant(flags)});
+          const std::set<int> b = bindingsOf(m);
+          for (int f : {EIKON_WB_INDEX_A, EIKON_WB_INDEX_B, EIKON_WB_INDEX_C, EIKON_WB_INDEX_E_A,
+                        EIKON_WB_INDEX_E_B, EIKON_WB_INDEX_E_C, EIKON_WB_MEDIUM_E, EIKON_WB_AXIS})
+            EXPECT_EQ(b.count(f), 0u)
+                << "flags " << flags << ", options " << options << ": reads binding " << f;
+          if (path != 0) {
+            for (int f : {EIKON_B_REGION, EIKON_B_BOUNDARY_DIST})
+              EXPECT_EQ(b.count(f), 0u)
+                  << "flags " << flags << ", options " << options << ": reads binding " << f;
+          }
+          EXPECT_EQ(b.count(EIKON_WB_MEDIUM), 1u) << "flags " << flags;
+          EXPECT_EQ(b.count(EIKON_WB_SPLAT), 1u) << "flags " << flags;
+          ++checked;
+        }
+  EXPECT_EQ(checked, 2 * 3 * 2 * 2);
+  // The smoothed light does read the index fields (and the walk the region image): the census
+  // would see a read.
+  const std::set<int> smoothed = bindingsOf(
+      vk::specialiseSpirv(spirv, std::vector<uint32_t>{0u, uint32_t(EIKON_F_UNIAXIAL), 1u, 0u}));
+  for (int f : {EIKON_WB_INDEX_A, EIKON_WB_INDEX_E_A, EIKON_WB_AXIS})
+    EXPECT_EQ(smoothed.count(f), 1u) << "smoothed light, binding " << f;
+  EXPECT_EQ(bindingsOf(vk::specialiseSpirv(
+                           spirv, std::vector<uint32_t>{1u, uint32_t(EIKON_F_CONVEX), 1u, 0u}))
+                .count(EIKON_B_REGION),
+            1u);
 }
 
 }  // namespace
