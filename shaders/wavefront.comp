@@ -275,9 +275,10 @@ int toFixed(float value) { return int(clamp(round(value * P.wavelength.w), -2147
 
 // Voxel i's sums += value (≥ 0) and value·dir. The direction's sums are kept biased, as
 // value·(1 + dir) ≥ 0 (readSplat takes the weight back off), so that no sum ever adds a negative
-// word: its high word then changes only on a carry, which almost no lane of a SIMD group has, and
-// llvmpipe skips a branch that no lane takes (the signed sums added the sign's 0xFFFFFFFF to the
-// high word of every negative component: up to three more atomics a splat).
+// word: its high word then changes only on a carry, so almost no lane does addFixed's second
+// atomic (llvmpipe runs a buffer atomic as a loop over the active lanes; the signed sums added
+// the sign's 0xFFFFFFFF to the high word of every negative component: up to three more atomics a
+// splat).
 void splatVoxel(ivec3 i, float value, vec3 dir) {
   const uint v = uint((i.z * P.grid_dims.y + i.y) * P.grid_dims.x + i.x);
   const uint base = v * uint(EIKON_SPLAT_ACC_WORDS);
@@ -585,12 +586,6 @@ void sharpCorner(inout vec3 x, inout vec3 w, inout int corner, inout PatchStep s
 }
 
 
-// The four corners' sharp step. A corner that moves at most (D − 1.5)·h from a voxel of skip
-// distance D meets no boundary (the argument of straight steps; the CPU twin's sharpCorner skips
-// its search by the same test) and moves straight; the others take sharpCorner one after another
-// in a loop over a mask. llvmpipe runs a loop's body while any lane of its SIMD group still
-// loops, so a group whose corners are all clear runs the search once (masked) instead of four
-// times (docs/performance.md, "Light simulator").
 // Whether no shape's surface lies within len of x, so that a corner moving len from x crosses
 // none: on the exact path with at most kExactUnrollShapes spheres, boxes and rounded boxes, whose
 // signed distances are Euclidean (with a margin of kExactMergeVoxels for their rounding). The
@@ -606,6 +601,14 @@ bool shapesClear(vec3 x, float len) {
   return clear;
 }
 
+// The four corners' sharp step. A corner that moves at most (D − 1.5)·h from a voxel of skip
+// distance D meets no boundary (the argument of straight steps; the CPU twin's sharpCorner skips
+// its search by the same test), nor one that every exact shape lies farther from than its move
+// (shapesClear): it moves straight. The others take sharpCorner one after another in a do-while
+// over a mask. llvmpipe runs a branch's code under a mask whatever its lanes decide, but a loop's
+// body only while some lane of the SIMD group still loops (a do-while: not once more to find that
+// none does), so a group runs as many searches as its busiest lane needs, at least one (masked),
+// instead of four (docs/performance.md, "Light simulator").
 void sharpCorners(inout vec3 x[4], inout vec3 w[4], inout ivec4 region, inout PatchStep st) {
   uint search = 0u;
   float absorb = 0.0;
