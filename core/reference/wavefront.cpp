@@ -173,7 +173,8 @@ class PatchStepper {
         dt_(s.dt),
         maxEdge_(s.split_span_voxels * grid.h),
         eMode_(s.mode == 1),
-        sharp_(sharp && sharp->active() ? sharp : nullptr) {}
+        sharp_(sharp && sharp->active() ? sharp : nullptr),
+        onShapes_(sharp_ && sharp_->boundary->regionsOnShapes()) {}
 
   /// Sharp interfaces: the region a seed corner starts in and its wave vector along s on that
   /// region's shell (the run's seeds are moved onto the media's shells with it).
@@ -230,6 +231,9 @@ class PatchStepper {
   double h_, h3_, dt_, maxEdge_;
   bool eMode_;
   const SharpInterfaces* sharp_;  ///< null: the smoothed path
+  /// The boundary field's regions are on the shapes (BoundaryField::regionsOnShapes): crossings
+  /// by crossingOutOf (sharpCorner), once per run rather than per corner step.
+  bool onShapes_ = false;
 };
 
 // The skip distance at x (voxels): the sharp path's own (SharpInterfaces::skip, on the boundary
@@ -410,7 +414,7 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
     // Where the regions are on the shapes (BoundaryField::regionsOnShapes) the crossing is the
     // shapes' own (crossingOutOf, the view march's; the GPU twin's nextCrossing), and the voxels'
     // regions along the way say nothing about it: only the skip distance is a bound there.
-    const bool onShapes = bf.regionsOnShapes();
+    const bool onShapes = onShapes_;
     const Along along = guard == 0 && s_.skip_empty
                             ? (len <= (skipAt(x) - 1.5) * h_ ? Along::OneRegion
                                : onShapes                    ? Along::Others

@@ -159,6 +159,10 @@ int uniformTableFlags(const BoundaryField& field, const MediaTable& media) {
   return flags;
 }
 
+int crossingPathFlags(const BoundaryField& field) {
+  return (field.convex_apart ? EIKON_F_CONVEX_APART : 0) | (field.exact ? EIKON_F_EXACT : 0);
+}
+
 BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& field,
                                const MediaTable& media, const std::string& file, bool voxels_read) {
   static_assert(kMediumVec4s == EIKON_MEDIUM_VEC4S &&

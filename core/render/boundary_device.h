@@ -41,6 +41,11 @@ std::vector<vk::BindingSpec> uniformTableBindings();
 /// the uniform blocks (bindUniformTables; march.glsl and wavefront.comp read them there then).
 int uniformTableFlags(const BoundaryField& field, const MediaTable& media);
 
+/// EIKON_F_CONVEX_APART and EIKON_F_EXACT where the field has them: the crossing dispatch of the
+/// view and light kernels (sharp.glsl nextCrossing; with their kExact constant,
+/// volumeExactConstant).
+int crossingPathFlags(const BoundaryField& field);
+
 class BoundaryDevice {
  public:
   BoundaryDevice() = default;

@@ -277,8 +277,7 @@ struct GpuWavefront::Impl {
         if (std::holds_alternative<MeshShape>(shape.geometry())) flags |= EIKON_F_MESH;
       }
       flags |= uniformTableFlags(vol.boundary, vol.media);  // the tables as uniform blocks
-      if (vol.boundary.convex_apart) flags |= EIKON_F_CONVEX_APART;
-      if (vol.boundary.exact) flags |= EIKON_F_EXACT;
+      flags |= crossingPathFlags(vol.boundary);             // with kExact: the crossing dispatch
     }
     return flags;
   }

@@ -325,8 +325,7 @@ int volumeFeatureFlags(const VolumeSet& v) {
   if (sharp && varying) flags |= EIKON_F_VARYING;
   if (sharp && convex) flags |= EIKON_F_CONVEX;
   if (sharp && mesh) flags |= EIKON_F_MESH;
-  if (sharp && v.boundary.convex_apart) flags |= EIKON_F_CONVEX_APART;
-  if (sharp && v.boundary.exact) flags |= EIKON_F_EXACT;
+  if (sharp) flags |= crossingPathFlags(v.boundary);
   if (sharp) flags |= uniformTableFlags(v.boundary, v.media);
   return flags;
 }
