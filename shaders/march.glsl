@@ -295,7 +295,7 @@ void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
     // shell |w| = n this is dx/ds = w/n, dw/ds = ∇n; off it the ray still moves at unit speed and
     // |w|/n is an invariant of the flow, and it is the e-mode's equation with n_o = n_e.
     float lw = length(w);
-    dx = w / lw;
+    dx = w * (1.0 / lw);  // one division, not three
     dw = o.yzw * (lw / o.x);
     return;
   }
@@ -337,9 +337,10 @@ struct MarchState {
   vec3 L;        // radiance gathered so far
   bool stopped;  // at an opaque surface
   int region;    // sharp march: the boundary-field region the ray is in
-  // The interface layer being crossed: where it opened, w before it, Σ∇n·ds over it, its peak.
+  // The interface layer being crossed: where it opened, w before it, Σ∇n·ds over it, its peak
+  // (|∇n|·h)² (layerGradient2).
   bool inLayer;
-  float peak;
+  float peak2;
   vec3 wBefore;
   vec3 gAcc;
   vec3 xOpen;
@@ -507,57 +508,61 @@ void fresnelAtLayer(inout MarchState S, inout MarchResult R, vec3 N, int mode) {
   }
 }
 
-// |∇n|·h at the step's end, the quantity that opens and closes layers.
-float layerGradient(MarchState S, StepEnd E) {
-  return max(length(S.nn.yzw), length(E.ne.yzw)) * P.grid_origin.w;
+// (|∇n|·h)² at the step's end, the quantity that opens and closes layers (squared: no square root
+// per step; the tests compare it with squared thresholds).
+float layerGradient2(MarchState S, StepEnd E) {
+  const float h = P.grid_origin.w;
+  return max(dot(S.nn.yzw, S.nn.yzw), dot(E.ne.yzw, E.ne.yzw)) * (h * h);
 }
 
 const float kLayerOpen = 1e-6;  // |∇n|·h above which a layer opens
+const float kLayerOpen2 = kLayerOpen * kLayerOpen;
 
 // Whether layerStep would open or close a layer here (otherwise it only accumulates, as
 // layerAccumulate does).
 bool layerEvent(MarchState S, StepEnd E) {
-  float g = layerGradient(S, E);
-  return S.inLayer ? g <= kLayerOpen : g > kLayerOpen;
+  float g2 = layerGradient2(S, E);
+  return S.inLayer ? g2 <= kLayerOpen2 : g2 > kLayerOpen2;
 }
 
 // layerStep where it neither opens nor closes a layer.
 void layerAccumulate(inout MarchState S, StepEnd E) {
   if (!S.inLayer) return;
   S.gAcc += E.gradN * (P.march.x * P.grid_origin.w);
-  float g = layerGradient(S, E);
-  if (kAov && g > S.peak) S.xPeak = S.x;
-  S.peak = max(S.peak, g);
+  float g2 = layerGradient2(S, E);
+  if (kAov && g2 > S.peak2) S.xPeak = S.x;
+  S.peak2 = max(S.peak2, g2);
 }
 
 // Interface bookkeeping: a layer opens where |∇n|·h rises above 1e-6 and closes where it falls
 // back; a closed layer whose peak exceeded march.y was an interface (projectOnShell, fresnelAtLayer).
 void layerStep(inout MarchState S, inout MarchResult R, StepEnd E, int mode) {
   const float h = P.grid_origin.w, ds = P.march.x * h;
-  const float thrLow = kLayerOpen, thrIface = P.march.y;
-  float g = layerGradient(S, E);
-  if (!S.inLayer && g > thrLow) {
+  // The thresholds squared, as layerGradient2 (a negative march.y stays below every peak).
+  const float thrLow2 = kLayerOpen2, thrIface2 = P.march.y * abs(P.march.y);
+  float g2 = layerGradient2(S, E);
+  if (!S.inLayer && g2 > thrLow2) {
     S.inLayer = true;
     S.wBefore = E.w0;
     S.gAcc = vec3(0.0);
-    S.peak = 0.0;
+    S.peak2 = 0.0;
     S.xOpen = E.x0;
   }
   if (!S.inLayer) return;
   S.gAcc += E.gradN * ds;
-  if (kAov && g > S.peak) S.xPeak = S.x;
-  S.peak = max(S.peak, g);
-  if (!(g <= thrLow)) return;
+  if (kAov && g2 > S.peak2) S.xPeak = S.x;
+  S.peak2 = max(S.peak2, g2);
+  if (!(g2 <= thrLow2)) return;
   S.inLayer = false;
   vec3 N = dot(S.gAcc, S.gAcc) > 0.0 ? normalize(S.gAcc) : vec3(0.0);
-  if (kAov && !R.hit && S.peak > thrIface && dot(N, N) > 0.0) {
+  if (kAov && !R.hit && S.peak2 > thrIface2 && dot(N, N) > 0.0) {
     R.hit = true;
     R.hitPoint = S.xPeak;
     R.hitNormal = dot(N, S.wBefore) > 0.0 ? -N : N;
     R.hitObject = -1;
   }
   if (dot(N, N) > 0.0 && abs(dot(S.x - S.xOpen, N)) <= 12.0 * h) projectOnShell(S, E, N);
-  if (S.peak > thrIface && !hasFlag(EIKON_F_NO_FRESNEL) && dot(N, N) > 0.0) fresnelAtLayer(S, R, N, mode);
+  if (S.peak2 > thrIface2 && !hasFlag(EIKON_F_NO_FRESNEL) && dot(N, N) > 0.0) fresnelAtLayer(S, R, N, mode);
 }
 
 // Whether x is outside the volume box (clipToVolume's test).
@@ -631,7 +636,7 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   S.stopped = false;
   S.region = 0;
   S.inLayer = false;
-  S.peak = 0.0;
+  S.peak2 = 0.0;
   S.wBefore = S.w;
   S.gAcc = vec3(0.0);
   S.xOpen = S.x;

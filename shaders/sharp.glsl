@@ -404,7 +404,7 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   MarchState S;
   S.nn = vec4(0.0);  // unused by the sharp march, but defined
   S.inLayer = false;
-  S.peak = 0.0;
+  S.peak2 = 0.0;
   S.wBefore = vec3(0.0);
   S.gAcc = vec3(0.0);
   S.xOpen = vec3(0.0);
