@@ -3,8 +3,11 @@
 #include "core/render/light_simulator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
+#include <map>
+#include <optional>
 #include <stdexcept>
 #include <variant>
 #include <vector>
@@ -78,6 +81,21 @@ struct ScanKernel {
 
 }  // namespace
 
+struct GpuWavefrontShared::Impl {
+  vk::Context* ctx = nullptr;         // of the first run given it
+  const VolumeSet* volume = nullptr;  // the volume of the runs
+  // wavefront.comp per specialisation (kSharpLight, kWaveFlags, kWaveOptions, kExact).
+  std::map<std::array<uint32_t, 4>, vk::ComputePipeline> wave;
+  std::optional<vk::ComputePipeline> count;  // wavefront_count.comp
+  std::optional<ScanKernel> scan;
+  std::optional<vk::Image3D> sharpSkip;  // the sharp path's skip distances (w), once computed
+  int built = 0;
+};
+
+GpuWavefrontShared::GpuWavefrontShared() : impl_(std::make_unique<Impl>()) {}
+GpuWavefrontShared::~GpuWavefrontShared() = default;
+int GpuWavefrontShared::pipelinesBuilt() const { return impl_->built; }
+
 struct GpuScan::Impl {
   vk::Context& ctx;
   ScanKernel kernel;
@@ -121,15 +139,36 @@ struct GpuWavefront::Impl {
   bool sharp = false;
   BoundaryDevice boundary;
   vk::Buffer params, splat, patches[2], scan, tally;
-  vk::ComputePipeline pipe, countPipe;  // wavefront.comp (propagate, scatter), wavefront_count.comp
-  ScanKernel scanner;
+  // The pipelines and the sharp skip image: the caller's GpuWavefrontShared, or this run's own.
+  std::unique_ptr<GpuWavefrontShared> ownShared;
+  GpuWavefrontShared::Impl& sh;
+  vk::ComputePipeline* pipe = nullptr;       // wavefront.comp (propagate, scatter)
+  vk::ComputePipeline* countPipe = nullptr;  // wavefront_count.comp
+  ScanKernel* scanner = nullptr;
   size_t list_cap = 0;                  // patches the scan and tally buffers hold
   std::vector<gpu::WaveTally> tallies;  // the last pass's, read back
   double il2 = 0, il4 = 0, n_min = 1.0;
 
-  Impl(vk::Context& c, const VolumeSet& v, WavefrontSettings settings, int k)
-      : ctx(c), vol(v), s(settings), steps_per_dispatch(k), field(v), scanner(c) {
+  Impl(vk::Context& c, const VolumeSet& v, WavefrontSettings settings, int k,
+       GpuWavefrontShared* shared)
+      : ctx(c),
+        vol(v),
+        s(settings),
+        steps_per_dispatch(k),
+        field(v),
+        ownShared(shared ? nullptr : std::make_unique<GpuWavefrontShared>()),
+        sh(*(shared ? shared : ownShared.get())->impl_) {
     const Grid& g = vol.grid;
+    if (sh.volume && (sh.volume != &vol || sh.ctx != &ctx))
+      throw std::invalid_argument(
+          "wavefront: a GpuWavefrontShared serves the runs of one volume and device only");
+    sh.volume = &vol;
+    sh.ctx = &ctx;
+    if (!sh.scan) {
+      sh.scan.emplace(ctx);
+      ++sh.built;
+    }
+    scanner = &*sh.scan;
     if (k < 1) throw std::invalid_argument("wavefront: steps_per_dispatch must be >= 1");
     if (s.max_patches < 1) throw std::invalid_argument("wavefront: max_patches must be >= 1");
     if (!(g.h > 0) || g.count() == 0) throw std::invalid_argument("wavefront: empty volume");
@@ -172,17 +211,22 @@ struct GpuWavefront::Impl {
     const size_t eMed = eFields ? upload(vol.medium[1], "wavefront medium e") : med;
     const size_t axis = eFields ? upload(vol.axis, "wavefront axis") : none;
     // Skip distances for straight steps (w of the emission image; zeros where none was computed).
-    // Sharp light reads the sharp path's own, as the CPU twin (core/light/sharp_skip.h).
-    std::vector<uint8_t> sharpSkip = sharp ? sharpSkipDistances(vol) : std::vector<uint8_t>{};
-    size_t skipImage;
-    if (!sharpSkip.empty()) {
-      std::vector<glm::vec4> skip(g.count(), glm::vec4(0.0f));
-      for (size_t i = 0; i < skip.size(); ++i) skip[i].w = float(sharpSkip[i]);
-      skipImage = upload(skip, "wavefront skip");
+    // Sharp light reads the sharp path's own, as the CPU twin (core/light/sharp_skip.h): they
+    // depend on the regions alone, so the runs of a GpuWavefrontShared compute them once.
+    const vk::Image3D* skipImage = nullptr;
+    if (sharp) {
+      if (!sh.sharpSkip) {
+        const std::vector<uint8_t> d = sharpSkipDistances(vol);
+        std::vector<glm::vec4> skip(g.count(), glm::vec4(0.0f));
+        for (size_t i = 0; i < skip.size(); ++i) skip[i].w = float(d[i]);
+        sh.sharpSkip.emplace(ctx, ext, VK_FORMAT_R32G32B32A32_SFLOAT, "wavefront skip");
+        sh.sharpSkip->upload(ctx, skip.data(), skip.size() * sizeof(glm::vec4));
+      }
+      skipImage = &*sh.sharpSkip;
     } else if (vol.emission.size() == g.count()) {
-      skipImage = upload(vol.emission, "wavefront skip");
+      skipImage = &images[upload(vol.emission, "wavefront skip")];
     } else {
-      skipImage = upload(std::vector<glm::vec4>(g.count(), glm::vec4(0.0f)), "wavefront skip");
+      skipImage = &images[upload(std::vector<glm::vec4>(g.count(), glm::vec4(0.0f)), "wavefront skip")];
     }
     params = vk::Buffer(ctx, sizeof(gpu::WaveParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                         "wavefront params");
@@ -210,34 +254,49 @@ struct GpuWavefront::Impl {
     // kWaveOptions), so that llvmpipe, which runs every branch under masks, compiles out what
     // this run never does (docs/performance.md, "Light simulator"). The settings are fixed for
     // the object's life, so its one pipeline is the one for its feature set.
-    pipe = vk::ComputePipeline(
-        ctx, std::span<const uint32_t>(k_wavefront_spv, sizeof(k_wavefront_spv) / 4), b,
-        sizeof(gpu::WavePush), sharp ? "wavefront sharp" : "wavefront",
-        std::vector<uint32_t>{sharp ? 1u : 0u, uint32_t(featureFlags()), uint32_t(options()),
-                              uint32_t(sharp ? volumeExactConstant(vol) : 0)});
-    boundary.bind(pipe);
-    boundary.bindUniformTables(pipe);
-    pipe.bindImage(EIKON_WB_INDEX_A, images[iA]);
-    pipe.bindImage(EIKON_WB_INDEX_B, images[iB]);
-    pipe.bindImage(EIKON_WB_INDEX_C, images[iC]);
-    pipe.bindImage(EIKON_WB_MEDIUM, images[med]);
-    pipe.bindImage(EIKON_WB_INDEX_E_A, images[eA]);
-    pipe.bindImage(EIKON_WB_INDEX_E_B, images[eB]);
-    pipe.bindImage(EIKON_WB_INDEX_E_C, images[eC]);
-    pipe.bindImage(EIKON_WB_MEDIUM_E, images[eMed]);
-    pipe.bindImage(EIKON_WB_AXIS, images[axis]);
-    pipe.bindImage(EIKON_WB_SKIP, images[skipImage]);
-    pipe.bindBuffer(EIKON_WB_PARAMS, params);
-    pipe.bindBuffer(EIKON_WB_SPLAT, splat);
+    const std::array<uint32_t, 4> key{sharp ? 1u : 0u, uint32_t(featureFlags()), uint32_t(options()),
+                                      uint32_t(sharp ? volumeExactConstant(vol) : 0)};
+    auto it = sh.wave.find(key);
+    if (it == sh.wave.end()) {
+      it = sh.wave
+               .emplace(key, vk::ComputePipeline(
+                                 ctx,
+                                 std::span<const uint32_t>(k_wavefront_spv,
+                                                           sizeof(k_wavefront_spv) / 4),
+                                 b, sizeof(gpu::WavePush), sharp ? "wavefront sharp" : "wavefront",
+                                 std::vector<uint32_t>(key.begin(), key.end())))
+               .first;
+      ++sh.built;
+    }
+    pipe = &it->second;
+    // Every binding is set again: a shared pipeline still holds the previous run's.
+    boundary.bind(*pipe);
+    boundary.bindUniformTables(*pipe);
+    pipe->bindImage(EIKON_WB_INDEX_A, images[iA]);
+    pipe->bindImage(EIKON_WB_INDEX_B, images[iB]);
+    pipe->bindImage(EIKON_WB_INDEX_C, images[iC]);
+    pipe->bindImage(EIKON_WB_MEDIUM, images[med]);
+    pipe->bindImage(EIKON_WB_INDEX_E_A, images[eA]);
+    pipe->bindImage(EIKON_WB_INDEX_E_B, images[eB]);
+    pipe->bindImage(EIKON_WB_INDEX_E_C, images[eC]);
+    pipe->bindImage(EIKON_WB_MEDIUM_E, images[eMed]);
+    pipe->bindImage(EIKON_WB_AXIS, images[axis]);
+    pipe->bindImage(EIKON_WB_SKIP, *skipImage);
+    pipe->bindBuffer(EIKON_WB_PARAMS, params);
+    pipe->bindBuffer(EIKON_WB_SPLAT, splat);
     std::vector<vk::BindingSpec> cb;
     for (uint32_t i :
          {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_PATCHES_B),
           uint32_t(EIKON_WB_SCAN), uint32_t(EIKON_WB_TALLY)})
       cb.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    countPipe = vk::ComputePipeline(
-        ctx, std::span<const uint32_t>(k_wavefront_count_spv, sizeof(k_wavefront_count_spv) / 4),
-        cb, sizeof(gpu::WavePush), "wavefront count");
-    countPipe.bindBuffer(EIKON_WB_PARAMS, params);
+    if (!sh.count) {
+      sh.count.emplace(
+          ctx, std::span<const uint32_t>(k_wavefront_count_spv, sizeof(k_wavefront_count_spv) / 4),
+          cb, sizeof(gpu::WavePush), "wavefront count");
+      ++sh.built;
+    }
+    countPipe = &*sh.count;
+    countPipe->bindBuffer(EIKON_WB_PARAMS, params);
   }
 
   /// Smallest index in the volume (bounds the centre's step length Δs ≤ dt/n_min for the splat
@@ -302,8 +361,8 @@ struct GpuWavefront::Impl {
         std::max<VkDeviceSize>(bytes, std::min<VkDeviceSize>(2 * buf.size(), range));
     buf = vk::Buffer(ctx, grown, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                      which ? "wavefront patches B" : "wavefront patches A");
-    pipe.bindBuffer(which ? EIKON_WB_PATCHES_B : EIKON_WB_PATCHES, buf);
-    countPipe.bindBuffer(which ? EIKON_WB_PATCHES_B : EIKON_WB_PATCHES, buf);
+    pipe->bindBuffer(which ? EIKON_WB_PATCHES_B : EIKON_WB_PATCHES, buf);
+    countPipe->bindBuffer(which ? EIKON_WB_PATCHES_B : EIKON_WB_PATCHES, buf);
   }
 
   // The scan and tally buffers hold any list of this run: the list never exceeds
@@ -315,11 +374,11 @@ struct GpuWavefront::Impl {
                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront scan");
     tally = vk::Buffer(ctx, ((n + EIKON_WAVE_WG - 1) / EIKON_WAVE_WG) * sizeof(gpu::WaveTally),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront tally");
-    pipe.bindBuffer(EIKON_WB_SCAN, scan);
-    pipe.bindBuffer(EIKON_WB_TALLY, tally);
-    countPipe.bindBuffer(EIKON_WB_SCAN, scan);
-    countPipe.bindBuffer(EIKON_WB_TALLY, tally);
-    scanner.bind(scan);
+    pipe->bindBuffer(EIKON_WB_SCAN, scan);
+    pipe->bindBuffer(EIKON_WB_TALLY, tally);
+    countPipe->bindBuffer(EIKON_WB_SCAN, scan);
+    countPipe->bindBuffer(EIKON_WB_TALLY, tally);
+    scanner->bind(scan);
     list_cap = n;
   }
   uint32_t totalSlot() const { return uint32_t(ScanKernel::words(list_cap) - 1); }
@@ -340,14 +399,14 @@ struct GpuWavefront::Impl {
   void pass(VkCommandBuffer c, uint32_t mode, uint32_t n, int src, uint32_t z = 0) const {
     gpu::WavePush push{glm::uvec4(n, mode, z, uint32_t(src))};
     const bool count = mode != EIKON_WM_PROPAGATE && mode != EIKON_WM_SCATTER;
-    (count ? countPipe : pipe).dispatch(c, groups(n), 1, 1, &push);
+    (count ? countPipe : pipe)->dispatch(c, groups(n), 1, 1, &push);
     computeBarrier(c);
   }
   // Propagate list `src` (n patches), count its outputs with the kill tallies, scan the counts.
   void recordStep(VkCommandBuffer c, uint32_t n, int src) const {
     pass(c, EIKON_WM_PROPAGATE, n, src);
     pass(c, EIKON_WM_COUNT, n, src);
-    scanner.record(c, n, totalSlot());
+    scanner->record(c, n, totalSlot());
   }
   uint32_t readTotal() const {
     uint32_t t = 0;
@@ -452,9 +511,9 @@ struct GpuWavefront::Impl {
     const size_t granted = survivors >= budget ? 0 : std::min(want_split, (budget - survivors) / 3);
     ctx.submitAndWait([&](VkCommandBuffer c) {
       pass(c, EIKON_WM_COUNT_SPLITS, n, src);
-      scanner.record(c, n, totalSlot());
+      scanner->record(c, n, totalSlot());
       pass(c, EIKON_WM_COUNT_BUDGET, n, src, uint32_t(granted));
-      scanner.record(c, n, totalSlot());
+      scanner->record(c, n, totalSlot());
     });
     st.splits += granted;
     st.splits_refused += want_split - granted;
@@ -558,8 +617,8 @@ struct GpuWavefront::Impl {
 };
 
 GpuWavefront::GpuWavefront(vk::Context& ctx, const VolumeSet& volume, WavefrontSettings settings,
-                           int steps_per_dispatch)
-    : impl_(std::make_unique<Impl>(ctx, volume, settings, steps_per_dispatch)) {}
+                           int steps_per_dispatch, GpuWavefrontShared* shared)
+    : impl_(std::make_unique<Impl>(ctx, volume, settings, steps_per_dispatch, shared)) {}
 GpuWavefront::~GpuWavefront() = default;
 WavefrontResult GpuWavefront::run(const Light& light) { return impl_->run(light); }
 

@@ -58,6 +58,27 @@ class GpuScan {
   std::unique_ptr<Impl> impl_;
 };
 
+/// What the GPU light runs over one volume share (simulateLighting: every band, mode and light
+/// of a simulation): the wavefront, count and scan pipelines, built once per feature set — lavapipe
+/// spends ~0.15 s of CPU on each, which no pipeline cache of Mesa 22.3 keeps, and a dispersive
+/// scene runs 12 bands — and the sharp path's skip distances, uploaded once. Give the same object
+/// to the GpuWavefront of each run, one run at a time; it must outlive them, and every run given
+/// it must be over the same volume (a run over another throws std::invalid_argument).
+class GpuWavefrontShared {
+ public:
+  GpuWavefrontShared();
+  ~GpuWavefrontShared();
+  GpuWavefrontShared(const GpuWavefrontShared&) = delete;
+  GpuWavefrontShared& operator=(const GpuWavefrontShared&) = delete;
+  /// Pipelines built so far (one per feature set, plus the count and scan kernels): for tests.
+  int pipelinesBuilt() const;
+
+ private:
+  friend class GpuWavefront;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 class GpuWavefront {
  public:
   /// The volume is uploaded (o-mode index A/B/C and medium; for settings.mode = 1 in a uniaxial
@@ -66,8 +87,10 @@ class GpuWavefront {
   /// boundary field and the media table); it is referenced for seeding and
   /// splitting and must outlive this object. Throws std::invalid_argument for bad settings,
   /// std::runtime_error if the splat buffer exceeds the device's storage-buffer range.
+  /// `shared`: the pipelines and skip distances of earlier runs over this volume, reused and
+  /// added to (GpuWavefrontShared); null builds this run's own.
   GpuWavefront(vk::Context& ctx, const VolumeSet& volume, WavefrontSettings settings,
-               int steps_per_dispatch = 16);
+               int steps_per_dispatch = 16, GpuWavefrontShared* shared = nullptr);
   ~GpuWavefront();
   GpuWavefront(const GpuWavefront&) = delete;
   GpuWavefront& operator=(const GpuWavefront&) = delete;

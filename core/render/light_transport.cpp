@@ -20,9 +20,12 @@ LightingSummary simulateLighting(vk::Context& ctx, const Scene& scene, VolumeSet
     o.wave.max_patches = int(fits);
   }
   // The simulator reads the volume's medium fields only, so the light volumes are filled in place.
+  // The runs (bands, modes, lights) share their pipelines and skip distances: a dispersive scene's
+  // 12 bands built the same pipelines 12 times before (docs/performance.md, "Light simulator").
+  GpuWavefrontShared shared;
   LightingSummary sum =
       simulateLightingWith(scene, volume, o, [&](const WavefrontSettings& s, const Light& light) {
-        return GpuWavefront(ctx, volume, s, steps_per_dispatch).run(light);
+        return GpuWavefront(ctx, volume, s, steps_per_dispatch, &shared).run(light);
       });
   sum.notes.insert(sum.notes.begin(), notes.begin(), notes.end());
   return sum;

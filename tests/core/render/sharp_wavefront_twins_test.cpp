@@ -26,6 +26,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 
 #include "core/light/lighting.h"
@@ -383,6 +384,40 @@ TEST(SharpWavefrontTwins, LightingDriversFollowTheInterfaces) {
   const double rim = 2.0 * kPi * 1.0 * (0.5 * a.grid.h) / (3.2 * 3.2);
   EXPECT_NEAR(gpu.flux_reflected, cpu.flux_reflected, rim * cpu.flux_emitted);
   EXPECT_EQ(off.flux_reflected, 0.0);
+}
+
+// The runs of a lighting simulation share their pipelines and skip distances
+// (GpuWavefrontShared): each run over the shared kernels must give what it gives with its own,
+// bit for bit (the same kernel on the same data; the splat sums are integers, the host's sums in
+// a fixed order), whatever ran before it; a feature set builds its pipeline once; and the object
+// refuses a run over another volume. Calcite plate: two wavelengths × both modes (the e-mode's
+// kernel is another specialisation).
+TEST(SharpWavefrontTwins, SharedKernelsGiveWhatOwnKernelsGive) {
+  const Scene scene = sceneFromJson(kSharpCalcitePlateScene);
+  const VolumeSet vol = voxelize(scene);
+  GpuWavefrontShared shared;
+  const Light light = beam({0.55, 0, -5}, {0, 0, 1}, 1.0, 1.0);
+  for (double lambda : {486.1, 656.3})
+    for (int mode : {1, 0}) {
+      WavefrontSettings s = sharpSettings(WavefrontSettings{});
+      s.mode = mode;
+      s.wavelength_nm = lambda;
+      const WavefrontResult own = GpuWavefront(context(), vol, s).run(light);
+      const WavefrontResult sh = GpuWavefront(context(), vol, s, 16, &shared).run(light);
+      SCOPED_TRACE(std::to_string(lambda) + " nm, mode " + std::to_string(mode));
+      EXPECT_GT(own.stats.flux_reflected, 0.0);
+      EXPECT_EQ(sh.irradiance, own.irradiance);
+      ASSERT_EQ(sh.direction.size(), own.direction.size());
+      EXPECT_TRUE(std::equal(sh.direction.begin(), sh.direction.end(), own.direction.begin()));
+      EXPECT_EQ(sh.stats.flux_reflected, own.stats.flux_reflected);
+      EXPECT_EQ(sh.stats.flux_left, own.stats.flux_left);
+      EXPECT_EQ(sh.stats.splits, own.stats.splits);
+    }
+  // scan, count, and the wavefront kernel of each mode: the second wavelength built nothing.
+  EXPECT_EQ(shared.pipelinesBuilt(), 4);
+  const VolumeSet other = voxelize(scene);
+  EXPECT_THROW(GpuWavefront(context(), other, sharpSettings(WavefrontSettings{}), 16, &shared),
+               std::invalid_argument);
 }
 
 // The smoothed path stays the default of GpuWavefront (WavefrontSettings::sharp_interfaces =
