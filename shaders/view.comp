@@ -105,7 +105,12 @@ vec3 cameraRay(int px, int py, int s, uint pixelIndex) {
 
 void main() {
   loadParams();
-  uvec2 gid = gl_GlobalInvocationID.xy;
+  // llvmpipe runs a workgroup 8 invocations at a time (one SIMD vector, an 8-pixel row of the
+  // 8×8 group): each vector takes a 4×2 tile instead, whose rays are more alike (neighbours in
+  // both directions), so fewer lanes idle while the longest ray of the vector marches on.
+  const uint l = gl_LocalInvocationIndex, c = l >> 3u, j = l & 7u;
+  uvec2 gid = gl_WorkGroupID.xy * uvec2(EIKON_WG_X, EIKON_WG_Y) +
+              uvec2((c & 1u) * 4u + (j & 3u), (c >> 1u) * 2u + (j >> 2u));
   int W = P.image.x, H = P.image.y;
   int px = int(gid.x), py = P.image.z + int(gid.y);
   if (px >= W || int(gid.y) >= P.image.w || py >= H) return;
