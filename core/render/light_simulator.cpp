@@ -158,18 +158,32 @@ struct GpuWavefront::Impl {
         field(v),
         ownShared(shared ? nullptr : std::make_unique<GpuWavefrontShared>()),
         sh(*(shared ? shared : ownShared.get())->impl_) {
-    const Grid& g = vol.grid;
     if (sh.volume && (sh.volume != &vol || sh.ctx != &ctx))
       throw std::invalid_argument(
           "wavefront: a GpuWavefrontShared serves the runs of one volume and device only");
+    checkSettings();
     sh.volume = &vol;
     sh.ctx = &ctx;
-    if (!sh.scan) {
-      sh.scan.emplace(ctx);
-      ++sh.built;
-    }
-    scanner = &*sh.scan;
-    if (k < 1) throw std::invalid_argument("wavefront: steps_per_dispatch must be >= 1");
+    const FieldImages f = uploadFields();
+    const Grid& g = vol.grid;
+    params = vk::Buffer(ctx, sizeof(gpu::WaveParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                        "wavefront params");
+    splat = vk::Buffer(ctx, g.count() * (EIKON_SPLAT_ACC_WORDS + 1) * sizeof(uint32_t),
+                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront splat");
+    // With the regions on the shapes (and kExact below) the kernel reads no voxel of the field.
+    boundary =
+        sharp ? BoundaryDevice(ctx, vol.boundary, vol.media, "", !vol.boundary.regionsOnShapes())
+              : BoundaryDevice(ctx, BoundaryField{}, MediaTable{});
+    boundary.setRenderWavelength(s.wavelength_nm);  // the media's indices at the run's wavelength
+    buildKernels();
+    bindKernels(f);
+  }
+
+  /// The settings checked (std::invalid_argument) and what follows from them.
+  void checkSettings() {
+    const Grid& g = vol.grid;
+    if (steps_per_dispatch < 1)
+      throw std::invalid_argument("wavefront: steps_per_dispatch must be >= 1");
     if (s.max_patches < 1) throw std::invalid_argument("wavefront: max_patches must be >= 1");
     if (!(g.h > 0) || g.count() == 0) throw std::invalid_argument("wavefront: empty volume");
     if (s.dt <= 0) s.dt = 0.5 * g.h;
@@ -184,8 +198,19 @@ struct GpuWavefront::Impl {
     sharp = s.sharp_interfaces && sharpLightApplies(vol);
     n_min = smallestIndex();
     if (!(n_min > 0)) throw std::invalid_argument("wavefront: the index volume has n <= 0");
+  }
 
-    std::array<uint32_t, 3> ext{uint32_t(g.dims[0]), uint32_t(g.dims[1]), uint32_t(g.dims[2])};
+  /// The images bound at EIKON_WB_INDEX_A … EIKON_WB_AXIS (indices into `images`) and the skip
+  /// image (this run's, or the shared sharp one).
+  struct FieldImages {
+    size_t iA, iB, iC, med, eA, eB, eC, eMed, axis;
+    const vk::Image3D* skip;
+  };
+
+  FieldImages uploadFields() {
+    const Grid& g = vol.grid;
+    const std::array<uint32_t, 3> ext{uint32_t(g.dims[0]), uint32_t(g.dims[1]),
+                                      uint32_t(g.dims[2])};
     auto upload = [&](const std::vector<glm::vec4>& data, const char* name) {
       vk::Image3D img(ctx, data.size() == 1 ? std::array<uint32_t, 3>{1, 1, 1} : ext,
                       VK_FORMAT_R32G32B32A32_SFLOAT, name);
@@ -197,23 +222,21 @@ struct GpuWavefront::Impl {
     // bindings valid. A sharp run reads no index, axis or e-mode image (its corners move in the
     // media table's media: KernelBindings.TheSharpLightReadsNoIndexFieldOfTheVolume), an o-mode
     // run no e-mode one.
+    FieldImages f{};
     const size_t none = upload(std::vector<glm::vec4>(1, glm::vec4(0.0f)), "wavefront unread");
-    const bool fields = !sharp, eFields = fields && eMode;
-    const size_t iA = fields ? upload(vol.index[0][0], "wavefront index A") : none;
-    const size_t iB = fields && vol.dispersive ? upload(vol.index[0][1], "wavefront index B") : iA;
-    const size_t iC = fields && vol.dispersive ? upload(vol.index[0][2], "wavefront index C") : iA;
-    const size_t med = upload(vol.medium[0], "wavefront medium");
-    const size_t eA = eFields ? upload(vol.index[1][0], "wavefront index e A") : iA;
-    const size_t eB =
-        eFields && vol.dispersive ? upload(vol.index[1][1], "wavefront index e B") : eA;
-    const size_t eC =
-        eFields && vol.dispersive ? upload(vol.index[1][2], "wavefront index e C") : eA;
-    const size_t eMed = eFields ? upload(vol.medium[1], "wavefront medium e") : med;
-    const size_t axis = eFields ? upload(vol.axis, "wavefront axis") : none;
+    const bool fields = !sharp, eFields = fields && eMode, disp = vol.dispersive;
+    f.iA = fields ? upload(vol.index[0][0], "wavefront index A") : none;
+    f.iB = fields && disp ? upload(vol.index[0][1], "wavefront index B") : f.iA;
+    f.iC = fields && disp ? upload(vol.index[0][2], "wavefront index C") : f.iA;
+    f.med = upload(vol.medium[0], "wavefront medium");
+    f.eA = eFields ? upload(vol.index[1][0], "wavefront index e A") : f.iA;
+    f.eB = eFields && disp ? upload(vol.index[1][1], "wavefront index e B") : f.eA;
+    f.eC = eFields && disp ? upload(vol.index[1][2], "wavefront index e C") : f.eA;
+    f.eMed = eFields ? upload(vol.medium[1], "wavefront medium e") : f.med;
+    f.axis = eFields ? upload(vol.axis, "wavefront axis") : none;
     // Skip distances for straight steps (w of the emission image; zeros where none was computed).
     // Sharp light reads the sharp path's own, as the CPU twin (core/light/sharp_skip.h): they
     // depend on the regions alone, so the runs of a GpuWavefrontShared compute them once.
-    const vk::Image3D* skipImage = nullptr;
     if (sharp) {
       if (!sh.sharpSkip) {
         const std::vector<uint8_t> d = sharpSkipDistances(vol);
@@ -222,16 +245,21 @@ struct GpuWavefront::Impl {
         sh.sharpSkip.emplace(ctx, ext, VK_FORMAT_R32G32B32A32_SFLOAT, "wavefront skip");
         sh.sharpSkip->upload(ctx, skip.data(), skip.size() * sizeof(glm::vec4));
       }
-      skipImage = &*sh.sharpSkip;
-    } else if (vol.emission.size() == g.count()) {
-      skipImage = &images[upload(vol.emission, "wavefront skip")];
-    } else {
-      skipImage = &images[upload(std::vector<glm::vec4>(g.count(), glm::vec4(0.0f)), "wavefront skip")];
+      f.skip = &*sh.sharpSkip;
+    } else {  // the last image uploaded: the pointer into `images` stays valid
+      const bool have = vol.emission.size() == g.count();
+      f.skip =
+          &images[upload(have ? vol.emission : std::vector<glm::vec4>(g.count(), glm::vec4(0.0f)),
+                         "wavefront skip")];
     }
-    params = vk::Buffer(ctx, sizeof(gpu::WaveParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                        "wavefront params");
-    splat = vk::Buffer(ctx, g.count() * (EIKON_SPLAT_ACC_WORDS + 1) * sizeof(uint32_t),
-                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront splat");
+    return f;
+  }
+
+  /// The run's pipelines, from the shared object or built into it. The run's feature set is the
+  /// specialisation (wavefront.comp: kSharpLight, kWaveFlags, kWaveOptions, kExact), so that
+  /// llvmpipe, which runs every branch under masks, compiles out what this run never does
+  /// (docs/performance.md, "Light simulator"); the bands of a mode share one.
+  void buildKernels() {
     std::vector<vk::BindingSpec> b;
     for (uint32_t i :
          {uint32_t(EIKON_WB_INDEX_A), uint32_t(EIKON_WB_INDEX_B), uint32_t(EIKON_WB_INDEX_C),
@@ -245,45 +273,19 @@ struct GpuWavefront::Impl {
       b.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
     for (const vk::BindingSpec& bs : boundaryBindings()) b.push_back(bs);
     for (const vk::BindingSpec& bs : uniformTableBindings()) b.push_back(bs);
-    // With the regions on the shapes (and kExact below) the kernel reads no voxel of the field.
-    boundary =
-        sharp ? BoundaryDevice(ctx, vol.boundary, vol.media, "", !vol.boundary.regionsOnShapes())
-              : BoundaryDevice(ctx, BoundaryField{}, MediaTable{});
-    boundary.setRenderWavelength(s.wavelength_nm);  // the media's indices at the run's wavelength
-    // The run's feature set as specialisation constants (wavefront.comp: kSharpLight, kWaveFlags,
-    // kWaveOptions), so that llvmpipe, which runs every branch under masks, compiles out what
-    // this run never does (docs/performance.md, "Light simulator"). The settings are fixed for
-    // the object's life, so its one pipeline is the one for its feature set.
-    const std::array<uint32_t, 4> key{sharp ? 1u : 0u, uint32_t(featureFlags()), uint32_t(options()),
+    const std::array<uint32_t, 4> key{sharp ? 1u : 0u, uint32_t(featureFlags()),
+                                      uint32_t(options()),
                                       uint32_t(sharp ? volumeExactConstant(vol) : 0)};
     auto it = sh.wave.find(key);
     if (it == sh.wave.end()) {
-      it = sh.wave
-               .emplace(key, vk::ComputePipeline(
-                                 ctx,
-                                 std::span<const uint32_t>(k_wavefront_spv,
-                                                           sizeof(k_wavefront_spv) / 4),
-                                 b, sizeof(gpu::WavePush), sharp ? "wavefront sharp" : "wavefront",
-                                 std::vector<uint32_t>(key.begin(), key.end())))
-               .first;
+      const std::span<const uint32_t> code(k_wavefront_spv, sizeof(k_wavefront_spv) / 4);
+      vk::ComputePipeline built(ctx, code, b, sizeof(gpu::WavePush),
+                                sharp ? "wavefront sharp" : "wavefront",
+                                std::vector<uint32_t>(key.begin(), key.end()));
+      it = sh.wave.emplace(key, std::move(built)).first;
       ++sh.built;
     }
     pipe = &it->second;
-    // Every binding is set again: a shared pipeline still holds the previous run's.
-    boundary.bind(*pipe);
-    boundary.bindUniformTables(*pipe);
-    pipe->bindImage(EIKON_WB_INDEX_A, images[iA]);
-    pipe->bindImage(EIKON_WB_INDEX_B, images[iB]);
-    pipe->bindImage(EIKON_WB_INDEX_C, images[iC]);
-    pipe->bindImage(EIKON_WB_MEDIUM, images[med]);
-    pipe->bindImage(EIKON_WB_INDEX_E_A, images[eA]);
-    pipe->bindImage(EIKON_WB_INDEX_E_B, images[eB]);
-    pipe->bindImage(EIKON_WB_INDEX_E_C, images[eC]);
-    pipe->bindImage(EIKON_WB_MEDIUM_E, images[eMed]);
-    pipe->bindImage(EIKON_WB_AXIS, images[axis]);
-    pipe->bindImage(EIKON_WB_SKIP, *skipImage);
-    pipe->bindBuffer(EIKON_WB_PARAMS, params);
-    pipe->bindBuffer(EIKON_WB_SPLAT, splat);
     std::vector<vk::BindingSpec> cb;
     for (uint32_t i :
          {uint32_t(EIKON_WB_PARAMS), uint32_t(EIKON_WB_PATCHES), uint32_t(EIKON_WB_PATCHES_B),
@@ -296,6 +298,30 @@ struct GpuWavefront::Impl {
       ++sh.built;
     }
     countPipe = &*sh.count;
+    if (!sh.scan) {
+      sh.scan.emplace(ctx);
+      ++sh.built;
+    }
+    scanner = &*sh.scan;
+  }
+
+  /// Every binding set again: a shared pipeline still holds the previous run's (the patch lists
+  /// and scan buffers are bound as propagate() makes them).
+  void bindKernels(const FieldImages& f) {
+    boundary.bind(*pipe);
+    boundary.bindUniformTables(*pipe);
+    pipe->bindImage(EIKON_WB_INDEX_A, images[f.iA]);
+    pipe->bindImage(EIKON_WB_INDEX_B, images[f.iB]);
+    pipe->bindImage(EIKON_WB_INDEX_C, images[f.iC]);
+    pipe->bindImage(EIKON_WB_MEDIUM, images[f.med]);
+    pipe->bindImage(EIKON_WB_INDEX_E_A, images[f.eA]);
+    pipe->bindImage(EIKON_WB_INDEX_E_B, images[f.eB]);
+    pipe->bindImage(EIKON_WB_INDEX_E_C, images[f.eC]);
+    pipe->bindImage(EIKON_WB_MEDIUM_E, images[f.eMed]);
+    pipe->bindImage(EIKON_WB_AXIS, images[f.axis]);
+    pipe->bindImage(EIKON_WB_SKIP, *f.skip);
+    pipe->bindBuffer(EIKON_WB_PARAMS, params);
+    pipe->bindBuffer(EIKON_WB_SPLAT, splat);
     countPipe->bindBuffer(EIKON_WB_PARAMS, params);
   }
 
