@@ -56,6 +56,10 @@ using uvec4 = glm::uvec4;
 // block with a vector gather, or one load where the index is constant.
 #define EIKON_B_EXACT_ROWS 24
 #define EIKON_B_SMALL_MEDIA 25
+// view.comp, stratified spectral renders whose passes march one wavelength each (crystals, opaque
+// or attenuating scenes): per pixel of the image, 1 where the pixel sample's first pass found its
+// path independent of λ and added every wavelength from its lookups (the later passes skip it).
+#define EIKON_B_SHARED_PATHS 26
 #define EIKON_EXACT_MAX_ROWS 256
 #define EIKON_SMALL_MEDIA_REGIONS 64
 #define EIKON_MEDIUM_HOMOGENEOUS 1

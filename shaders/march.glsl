@@ -68,10 +68,11 @@ void setWavelength(float lambda_um, bool scalar) {
 }
 
 // Wavelength sharing (view.comp, spectral mode): while marching the first wavelength of a pixel
-// sample, note whether any sample saw dispersion (B or C ≠ 0) and record every environment lookup
-// as (direction, weight). If none did, and nothing else depends on λ (no attenuation, emission,
-// opacity or crystal), the path and every weight are the same at all wavelengths: the others are
-// Σ weight·S_env(λ, direction), without marching.
+// sample, note whether any sample saw dispersion (B or C ≠ 0, a dispersive medium) or a weight
+// that depends on λ (attenuation, emission along the path, in-scatter, a lit surface: each sets
+// gDispersiveHit where it adds something), and record every environment lookup and opaque
+// surface's emission as (linear sRGB radiance, weight). If none did, the path and every weight
+// are the same at all wavelengths: the others are Σ weight·S(λ, rgb), without marching.
 //
 // Hero wavelength sampling (view.comp, docs/spectra.md) uses the same record differently: while
 // gHero is set and the hero's path has met nothing dispersive (gDispersiveHit false), every
@@ -155,20 +156,31 @@ vec3 environment(vec3 d);
 // The same in linear sRGB (before colourOf).
 vec3 environmentRgb(vec3 d);
 
-// Environment radiance times a throughput weight, recorded for wavelength sharing.
-vec3 environmentWeighted(vec3 weight, vec3 d) {
+// Radiance rgb (linear sRGB, the same at every λ of the path) times a throughput weight, recorded
+// for wavelength sharing: the environment's (environmentWeighted) and an opaque surface's own
+// emission (surfaceWeighted).
+vec3 recordedWeighted(vec3 weight, vec3 rgb) {
   if (hasFlag(EIKON_F_SPECTRAL) && gHero && !gDispersiveHit) {
     if (gNumRecorded < 6) {
-      gRecorded[gNumRecorded++] = vec4(environmentRgb(d), weight.x * gRecordWeight);
+      gRecorded[gNumRecorded++] = vec4(rgb, weight.x * gRecordWeight);
       return vec3(0.0);
     }
     gDispersiveHit = true;  // the record is full: from here on the hero's alone
   }
   if (hasFlag(EIKON_F_SPECTRAL) && gRecord) {  // only view.comp's spectral mode records
-    if (gNumRecorded < 6) gRecorded[gNumRecorded++] = vec4(d, weight.x);
+    if (gNumRecorded < 6) gRecorded[gNumRecorded++] = vec4(rgb, weight.x);
     else gRecordOverflow = true;
   }
-  return weight * environment(d);
+  return weight * colourOf(rgb);
+}
+
+vec3 environmentWeighted(vec3 weight, vec3 d) { return recordedWeighted(weight, environmentRgb(d)); }
+
+// An opaque surface's emission rgb seen with weight, plus the light it reflects (diffuse, which
+// depends on λ through the light volumes: a path that sees any is not shared).
+vec3 surfaceWeighted(vec3 weight, vec3 rgb, vec3 diffuse) {
+  if (hasFlag(EIKON_F_LIT) && any(notEqual(diffuse, vec3(0.0)))) gDispersiveHit = true;
+  return recordedWeighted(weight, rgb) + weight * diffuse;
 }
 
 vec3 environment(vec3 d) { return colourOf(environmentRgb(d)); }
@@ -379,7 +391,7 @@ int straightStep(inout MarchState S, inout MarchResult R, int mode) {
   bool leaving = len >= tExit;
   len = min(len, tExit);
   if (hasFlag(EIKON_F_OPACITY) && sampleMedium(S.x, mode).w >= 0.5) {
-    S.L += S.T * (colourOf(em.xyz) / sampleMedium(S.x, mode).w + diffuseSurface(S.x, mode));
+    S.L += surfaceWeighted(S.T, em.xyz / sampleMedium(S.x, mode).w, diffuseSurface(S.x, mode));
     S.stopped = true;
     return kStepStop;
   }
@@ -388,6 +400,7 @@ int straightStep(inout MarchState S, inout MarchResult R, int mode) {
     vec3 e = colourOf(em.xyz);
     // In-scatter with the light at the middle of this straight step, constant over it.
     if (scattering) e += inScatter(S.x + 0.5 * len * dir, dir, sig);
+    if (any(notEqual(sig, vec3(0.0))) || any(notEqual(e, vec3(0.0)))) gDispersiveHit = true;
     vec3 att = exp(-sig * len);
     // ∫₀^len T e^{−σs} e ds = T e (1 − e^{−σ len})/σ  (→ T e len as σ → 0)
     S.L += S.T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
@@ -443,15 +456,20 @@ StepEnd integrateStep(inout MarchState S, inout MarchResult R, int mode) {
 bool mediumAlongStep(inout MarchState S, StepEnd E, int mode) {
   const float ds = P.march.x * P.grid_origin.w;
   vec3 xm = 0.5 * (E.x0 + S.x);
-  if (hasFlag(EIKON_F_EMISSION)) S.L += S.T * colourOf(sampleEmission(xm)) * ds;
+  if (hasFlag(EIKON_F_EMISSION)) {
+    vec3 e = sampleEmission(xm);
+    if (any(notEqual(e, vec3(0.0)))) gDispersiveHit = true;  // λ-dependent (wavelength sharing)
+    S.L += S.T * colourOf(e) * ds;
+  }
   if (hasFlag(EIKON_F_ATTENUATION)) {
     vec3 sig = attenuationAt(xm, 0.5 * (E.w0 + S.w), mode);
+    if (any(notEqual(sig, vec3(0.0)))) gDispersiveHit = true;
     if (hasFlag(EIKON_F_LIT) && hasFlag(EIKON_F_SCATTER)) S.L += S.T * inScatter(xm, normalize(S.x - E.x0), sig) * ds;
     S.T *= exp(-sig * ds);
   }
   if (hasFlag(EIKON_F_OPACITY) && sampleMedium(S.x, mode).w >= 0.5) {
     // Surface emission: the emission field over the coverage (opacity ≥ 0.5 here), as the albedo.
-    S.L += S.T * (colourOf(sampleEmission(S.x)) / sampleMedium(S.x, mode).w + diffuseSurface(S.x, mode));
+    S.L += surfaceWeighted(S.T, sampleEmission(S.x) / sampleMedium(S.x, mode).w, diffuseSurface(S.x, mode));
     S.stopped = true;
     return true;
   }

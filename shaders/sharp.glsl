@@ -224,6 +224,8 @@ void absorbAlong(inout MarchState S, vec3 dir, float len, int mode) {
   vec3 e = colourOf(mediumRow(r, 10).xyz);
   vec3 alb = mediumRow(r, 11).xyz;
   if (hasFlag(EIKON_F_LIT) && alb.x + alb.y + alb.z > 0.0) e += inScatter(S.x + 0.5 * len * dir, dir, sig);
+  // What depends on λ ends wavelength sharing (march.glsl): any attenuation or light added.
+  if (any(notEqual(sig, vec3(0.0))) || any(notEqual(e, vec3(0.0)))) gDispersiveHit = true;
   vec3 att = exp(-sig * len);
   S.L += S.T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
   S.T *= att;
@@ -419,8 +421,8 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   bool cut = false;
   for (; steps < maxSteps; ++steps) {
     if (hasFlag(EIKON_F_OPACITY) && mediumOpaque(S.region)) {  // surface emission over the coverage, as the smoothed path
-      S.L += S.T * (colourOf(mediumRow(S.region, 10).xyz) / mediumRow(S.region, 8).w +
-                    diffuseSurface(S.x, mode));
+      S.L += surfaceWeighted(S.T, mediumRow(S.region, 10).xyz / mediumRow(S.region, 8).w,
+                             diffuseSurface(S.x, mode));
       S.stopped = true;
       break;
     }

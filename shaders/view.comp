@@ -24,6 +24,9 @@ layout(local_size_x = EIKON_WG_X, local_size_y = EIKON_WG_Y) in;
 #include "march.glsl"
 
 layout(std430, binding = EIKON_B_OUTPUT) writeonly buffer OutBuf { vec4 pixels[]; };
+// Sharing across passes (P.pass.w & 64; main below): per pixel of the image, 1 where the pixel
+// sample's first pass added every wavelength.
+layout(std430, binding = EIKON_B_SHARED_PATHS) buffer SharedPathsBuf { uint sharedPaths[]; };
 
 uint pcg_hash(uint v) {
   uint state = v * 747796405u + 2891336453u;
@@ -143,7 +146,19 @@ void main() {
     // Wavelength sharing (march.glsl): only where nothing but the index can depend on λ, and only
     // within one pass (the host makes a pass all N wavelengths when the scene allows sharing).
     const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
-    bool share = spectral && !hasFlag(lambdaDependent);
+    // Sharing across passes (P.pass.w & 64, stratified renders whose passes march one wavelength
+    // each: crystals, attenuating, emitting or opaque scenes; view_renderer.cpp). The pixel
+    // sample's first pass (k0 = 0, told to cover all N) marches λ_0 with the record on; where
+    // nothing on the path turned out to depend on λ it adds the other wavelengths from the record
+    // and notes it in sharedPaths, and the sample's later passes skip the pixel; elsewhere it
+    // stops after λ_0, as a pass of one wavelength does, and the later passes march as before.
+    const bool crossShare = spectral && (P.pass.w & 1) == 0 && (P.pass.w & 64) != 0;
+    if (crossShare && k0 > 0 && sharedPaths[pixelIndex] != 0u) {
+      pixels[int(gid.y) * W + px] = vec4(0.0);
+      if (kAov) aovWrite(int(gid.y) * W + px, vec4(0.0, 0.0, 0.0, -1.0), vec3(0.0), 0.0);
+      return;
+    }
+    bool share = spectral && (!hasFlag(lambdaDependent) || crossShare);
     bool reuse = false;
     // Hero wavelength sampling (P.pass.w & 1; docs/spectra.md, Wilkie et al. 2014): λ_j = 380 +
     // ((k_h + j) mod N + u)·400/N, one shared jitter u, the hero's stratum k_h cycling over the
@@ -181,9 +196,12 @@ void main() {
       } else {
         setWavelength(P.wavelength.x, false);
       }
+      if (crossShare && k > k0 && !reuse) break;  // a pass of one wavelength after all
       if (reuse) {
+        // The records of every mode marched, each carrying its share (modeWeight) of the light.
         float rad = 0.0;
-        for (int j = 0; j < gNumRecorded; ++j) rad += gRecorded[j].w * environment(gRecorded[j].xyz).x;
+        for (int j = 0; j < gNumRecorded; ++j) rad += gRecorded[j].w * rgbToSpectrum(gRecorded[j].xyz);
+        rad *= modeWeight;
         xyz += rad * cmf(lambda) * width;
         if (layers) layerWrite(bandPixel, 0, k, rad);
         continue;
@@ -199,8 +217,8 @@ void main() {
         }
         if (hero) gDispersiveHit = hasFlag(weightDependent);
         MarchResult r = march(P.cam_pos.xyz, d, mode);
-        if (mode == m0 && !hero) {
-          reuse = gRecord && !gDispersiveHit && !gRecordOverflow;
+        if (mode == m1 - 1 && !hero) {  // both modes recorded (a crystal's paths are one path
+          reuse = gRecord && !gDispersiveHit && !gRecordOverflow;  // where they meet no crystal)
           gRecord = false;
         }
         vec3 part = modeWeight * r.radiance;
@@ -232,6 +250,7 @@ void main() {
         }
       }
     }
+    if (crossShare && k0 == 0) sharedPaths[pixelIndex] = reuse ? 1u : 0u;
     if (hero) {
       gHero = false;
       xyz += heroWavelengthsXyz(N, kh, uh, heroCount0, heroMode, layers, bandPixel);

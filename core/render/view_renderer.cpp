@@ -35,6 +35,8 @@ namespace {
 // ViewParams.pass.w bit 5: the aov layer. The kernel reads kAov (a specialisation constant), so the
 // bit only keys the pipeline; bits 0–4 are the kernel's (hero, layers, modes: view.comp).
 constexpr int kAovPassBit = 32;
+// view.comp's sharing across passes (P.pass.w bit 6; render()).
+constexpr int kSharedPassBit = 64;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -214,8 +216,8 @@ class BackgroundCompiler {
 using PipelineKey = std::tuple<int, int, int, int, int, int>;
 constexpr int kViewKernel = 0;
 
-/// The bindings of the view kernel (the trace kernels add theirs).
-std::vector<vk::BindingSpec> viewKernelBindings() {
+/// The bindings every march kernel has (the view kernel adds its shared paths, the traces theirs).
+std::vector<vk::BindingSpec> marchKernelBindings() {
   std::vector<vk::BindingSpec> common;
   for (uint32_t b = EIKON_B_INDEX_O_A; b <= EIKON_B_AXIS; ++b)
     common.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
@@ -229,6 +231,13 @@ std::vector<vk::BindingSpec> viewKernelBindings() {
   for (const vk::BindingSpec& b : boundaryBindings()) common.push_back(b);
   for (const vk::BindingSpec& b : uniformTableBindings()) common.push_back(b);
   return common;
+}
+
+/// The bindings of the view kernel.
+std::vector<vk::BindingSpec> viewKernelBindings() {
+  std::vector<vk::BindingSpec> b = marchKernelBindings();
+  b.push_back({uint32_t(EIKON_B_SHARED_PATHS), VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+  return b;
 }
 
 // kExact (march.glsl): the shape table's rows, the shape count and the kinds present.
@@ -472,8 +481,8 @@ struct ViewRenderer::Impl {
     volume_flags = volumeFeatureFlags(v);
     sharp = (volume_flags & EIKON_F_SHARP) != 0;
     exact = volumeExactConstant(v);
-    const std::vector<vk::BindingSpec> common = viewKernelBindings();  // the trace's add rays
-    viewBindings = common;
+    const std::vector<vk::BindingSpec> common = marchKernelBindings();  // the trace's add rays
+    viewBindings = viewKernelBindings();
     traceBindings = common;
     traceBindings.push_back({EIKON_B_RAYS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
     polarisedBindings = traceBindings;
@@ -784,15 +793,27 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   vk::ComputePipeline& view = I.pipeline(Impl::kView, p);
   view.bindBuffer(EIKON_B_OUTPUT, out);
   const size_t pixels = size_t(img.width) * size_t(img.height);
+  // Sharing across passes (view.comp, P.pass.w & 64): where the passes march one wavelength each
+  // (a crystal, dispersive medium, attenuation, emission or opaque object in the scene), a pixel
+  // sample's first pass also adds the other wavelengths of every pixel whose path met nothing
+  // that depends on λ (from its record), notes it in one word per pixel, and the sample's later
+  // passes skip that pixel. The spectral and modes layers keep the plain passes (their bins are
+  // written pass by pass); an image whose words exceed one storage buffer too.
+  const bool crossShare = s.wavelengths > 1 && !share && !layers.active() &&
+                          pixels * sizeof(uint32_t) <= I.ctx.limits().max_storage_buffer_range;
+  vk::Buffer sharedPaths(I.ctx, (crossShare ? pixels : 1) * sizeof(uint32_t),
+                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "shared paths");
+  view.bindBuffer(EIKON_B_SHARED_PATHS, sharedPaths);
   std::vector<double> acc(pixels * 3, 0.0);
   img.rgb.assign(pixels * 3, 0.0f);
   std::vector<glm::vec4> band(size_t(img.width) * size_t(max_rows) * perPixel);
   double steps = 0.0;
   auto t0 = std::chrono::steady_clock::now();
   for (int pass = 0; pass < passes; ++pass) {
-    p.pass = glm::ivec4(
-        pass / passesPerSample, (pass % passesPerSample) * perPass, perPass,
-        (hero ? 1 : 0) | layerBits | (int(s.modes) << 3) | (s.aov_layer ? kAovPassBit : 0));
+    const int k = pass % passesPerSample;
+    p.pass = glm::ivec4(pass / passesPerSample, k * perPass, crossShare && k == 0 ? N : perPass,
+                        (hero ? 1 : 0) | layerBits | (int(s.modes) << 3) |
+                            (s.aov_layer ? kAovPassBit : 0) | (crossShare ? kSharedPassBit : 0));
     for (int y0 = 0, n = 0; y0 < img.height; y0 += n) {
       n = std::min(rows, img.height - y0);
       const auto band_start = std::chrono::steady_clock::now();

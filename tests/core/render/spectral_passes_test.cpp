@@ -96,6 +96,59 @@ TEST(SpectralPasses, DiamondBrilliantHeroTwinsAgree) {
   expectTwinsAgree("diamond_brilliant", 64, 40, 30, SpectralSampling::Hero);
 }
 
+// Sharing across passes (view.comp, P.pass.w & 64): the rhomb's stratified passes march one
+// wavelength each, but a pixel whose path meets no crystal (the printed grid seen beside the rhomb,
+// the sky) is the same path at every wavelength: the sample's first pass marches it at λ_0 (both
+// modes) and adds the other 15 wavelengths from its lookups. So, with the AOV layer's steps (all
+// of a pixel's marches): where the CPU twin's first interface is not the crystal, the GPU twin
+// marched exactly 1/16 of the twin's steps (the twin marches the same path at all 16 wavelengths);
+// where it is the crystal, all of them (float and double may cut a grazing ray differently: ≥ 95%
+// of those pixels exact); and the pictures agree as the twins' do (expectTwinsAgree's bounds).
+TEST(SpectralPasses, PathsThatMeetNoCrystalAreMarchedOnce) {
+  Scene scene =
+      loadScene(std::filesystem::path(EIKON_SOURCE_DIR) / "scenes" / "calcite_rhomb.json");
+  scene.camera.width = 48;
+  scene.camera.height = 36;
+  scene.lights.clear();
+  const VolumeSet volume = voxelize(scene);
+  ViewRenderer gpu(context(), scene, volume);
+  const VolumeField field(volume);
+  const ReferenceMarcher cpu(field, scene.environment);
+  RenderSettings rs;
+  rs.wavelengths = 16;
+  rs.sampling = SpectralSampling::Stratified;
+  rs.aov_layer = true;
+  const RenderImage g = gpu.render(rs), c = cpu.render(scene.camera, rs);
+  const size_t pixels = size_t(g.width) * size_t(g.height);
+  ASSERT_EQ(g.aov.size(), pixels * kAovChannels);
+  ASSERT_EQ(c.aov.size(), pixels * kAovChannels);
+  int shared = 0, sharedExact = 0, crystal = 0, crystalExact = 0;
+  for (size_t i = 0; i < pixels; ++i) {
+    const float gs = g.aov[i * kAovChannels + 8], cs = c.aov[i * kAovChannels + 8];
+    if (c.aov[i * kAovChannels + 7] == 0.0f) {  // the rhomb is object 0
+      ++crystal;
+      crystalExact += gs == cs;
+    } else {
+      ++shared;
+      sharedExact += gs * 16.0f == cs;
+    }
+  }
+  const ImageDiff d = compare(g, c);
+  std::printf(
+      "[ measured ] calcite rhomb 48x36, 16 wavelengths: %d pixels beside the crystal, %d of them "
+      "marched 1/16 of the twin's steps; %d on the crystal, %d marched all; mean steps per ray "
+      "gpu %.3f, cpu %.3f; mean |d|/mean |RGB| %.3g, 95th percentile |d| %.3g\n",
+      shared, sharedExact, crystal, crystalExact, g.mean_steps, c.mean_steps, d.rel, d.p95);
+  EXPECT_GT(shared, int(pixels) / 4);
+  EXPECT_GT(crystal, int(pixels) / 10);
+  EXPECT_EQ(sharedExact, shared);
+  EXPECT_GE(crystalExact, 0.95 * crystal);
+  EXPECT_EQ(g.cut_samples, 0);
+  EXPECT_LT(d.rel, 0.01);
+  EXPECT_LT(d.p95, 0.02);
+  expectNoValidationMessages();
+}
+
 // Progressive output: with 3 samples per pixel the image so far is handed out after the first and
 // the second sample, and is the mean of the finished samples: the running mean of a constant
 // environment seen through nothing is that constant.
