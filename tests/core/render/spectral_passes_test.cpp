@@ -46,8 +46,13 @@ ImageDiff compare(const RenderImage& g, const RenderImage& c) {
   return {sumDiff / sumVal, diffs[size_t(0.95 * double(diffs.size()))], diffs.back()};
 }
 
-void expectTwinsAgree(const char* name, int resolution, int width, int height,
-                      SpectralSampling sampling) {
+/// Shipped scene `name` at the given resolution and image size, without its lights, rendered
+/// with `rs` by both twins.
+struct ShippedTwins {
+  RenderImage g, c;
+};
+ShippedTwins renderShipped(const char* name, int resolution, int width, int height,
+                           const RenderSettings& rs) {
   Scene scene =
       loadScene(std::filesystem::path(EIKON_SOURCE_DIR) / "scenes" / (std::string(name) + ".json"));
   scene.volume.resolution = resolution;
@@ -58,12 +63,18 @@ void expectTwinsAgree(const char* name, int resolution, int width, int height,
   ViewRenderer gpu(context(), scene, volume);
   const VolumeField field(volume);
   const ReferenceMarcher cpu(field, scene.environment);
+  return {gpu.render(rs), cpu.render(scene.camera, rs)};
+}
+
+void expectTwinsAgree(const char* name, int resolution, int width, int height,
+                      SpectralSampling sampling) {
   RenderSettings rs;
   rs.wavelengths = 16;
   rs.sampling = sampling;
   int passesSeen = 0;
   rs.on_pass = [&](const RenderImage&, int, int) { ++passesSeen; };
-  const RenderImage g = gpu.render(rs), c = cpu.render(scene.camera, rs);
+  const ShippedTwins t = renderShipped(name, resolution, width, height, rs);
+  const RenderImage &g = t.g, &c = t.c;
   const ImageDiff d = compare(g, c);
   std::printf(
       "[ measured ] %s %d^3 %dx%d, 16 wavelengths: %lld cut pixel samples; mean |d|/mean |RGB| "
@@ -105,20 +116,12 @@ TEST(SpectralPasses, DiamondBrilliantHeroTwinsAgree) {
 // where it is the crystal, all of them (float and double may cut a grazing ray differently: ≥ 95%
 // of those pixels exact); and the pictures agree as the twins' do (expectTwinsAgree's bounds).
 TEST(SpectralPasses, PathsThatMeetNoCrystalAreMarchedOnce) {
-  Scene scene =
-      loadScene(std::filesystem::path(EIKON_SOURCE_DIR) / "scenes" / "calcite_rhomb.json");
-  scene.camera.width = 48;
-  scene.camera.height = 36;
-  scene.lights.clear();
-  const VolumeSet volume = voxelize(scene);
-  ViewRenderer gpu(context(), scene, volume);
-  const VolumeField field(volume);
-  const ReferenceMarcher cpu(field, scene.environment);
   RenderSettings rs;
   rs.wavelengths = 16;
   rs.sampling = SpectralSampling::Stratified;
   rs.aov_layer = true;
-  const RenderImage g = gpu.render(rs), c = cpu.render(scene.camera, rs);
+  const ShippedTwins t = renderShipped("calcite_rhomb", 224, 48, 36, rs);
+  const RenderImage &g = t.g, &c = t.c;
   const size_t pixels = size_t(g.width) * size_t(g.height);
   ASSERT_EQ(g.aov.size(), pixels * kAovChannels);
   ASSERT_EQ(c.aov.size(), pixels * kAovChannels);
