@@ -110,8 +110,8 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
       "accumulate (fluence rate, default) or highest (the highest patch irradiance per voxel)");
   sub->add_option("--light-device", a.light_device,
                   "auto (default: the CPU reference when the Vulkan device is a CPU, e.g. "
-                  "lavapipe, where light_bench measures it as fast or faster; else the GPU), gpu "
-                  "or cpu");
+                  "lavapipe, where the two are about even: the CPU faster for one run, the GPU "
+                  "for a 12-band dispersive scene; else the GPU), gpu or cpu");
   sub->add_option("--caustics", a.caustics,
                   "pass (light continues through a focus, default) or kill (Tevs: patches end at a "
                   "fold caustic)");
