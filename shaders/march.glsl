@@ -151,9 +151,8 @@ float rgbToSpectrum(vec3 rgb) {
 vec3 sigmaOf(vec3 bands) { return gScalar ? vec3(bandAt(bands)) : bands; }
 vec3 colourOf(vec3 rgb) { return gScalar ? vec3(rgbToSpectrum(rgb)) : rgb; }
 
-// Environment radiance in direction d (unit). Same formulas as Environment::lookup (scene.cpp).
-vec3 environment(vec3 d);
-// The same in linear sRGB (before colourOf).
+// Environment radiance in direction d (unit), linear sRGB (colourOf turns it into the value at λ).
+// Same formulas as Environment::lookup (scene.cpp).
 vec3 environmentRgb(vec3 d);
 
 // Radiance rgb (linear sRGB, the same at every λ of the path) times a throughput weight, recorded
@@ -183,7 +182,6 @@ vec3 surfaceWeighted(vec3 weight, vec3 rgb, vec3 diffuse) {
   return recordedWeighted(weight, rgb) + weight * diffuse;
 }
 
-vec3 environment(vec3 d) { return colourOf(environmentRgb(d)); }
 
 vec3 environmentRgb(vec3 d) {
   float u = atan(d.x, -d.z) / (2.0 * kPi) + 0.5;
@@ -527,7 +525,7 @@ void fresnelAtLayer(inout MarchState S, inout MarchResult R, vec3 N, int mode) {
 }
 
 // (|∇n|·h)² at the step's end, the quantity that opens and closes layers (squared: no square root
-// per step; the tests compare it with squared thresholds).
+// per step; it is compared with the squared thresholds).
 float layerGradient2(MarchState S, StepEnd E) {
   const float h = P.grid_origin.w;
   return max(dot(S.nn.yzw, S.nn.yzw), dot(E.ne.yzw, E.ne.yzw)) * (h * h);

@@ -143,8 +143,8 @@ void main() {
     const float modeWeight = m1 - m0 == 2 ? 0.5 : 1.0;
     uint seed = pcg_hash(pixelIndex + pcg_hash(uint(s)));
     vec3 xyz = vec3(0.0);
-    // Wavelength sharing (march.glsl): only where nothing but the index can depend on λ, and only
-    // within one pass (the host makes a pass all N wavelengths when the scene allows sharing).
+    // Wavelength sharing (march.glsl) within one pass: where nothing but the index can depend on λ
+    // the host makes a pass all N wavelengths; elsewhere the sharing across passes below.
     const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
     // Sharing across passes (P.pass.w & 64, stratified renders whose passes march one wavelength
     // each: crystals, attenuating, emitting or opaque scenes; view_renderer.cpp). The pixel

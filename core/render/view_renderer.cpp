@@ -33,10 +33,10 @@ namespace eikon {
 namespace {
 
 // ViewParams.pass.w bit 5: the aov layer. The kernel reads kAov (a specialisation constant), so the
-// bit only keys the pipeline; bits 0–4 are the kernel's (hero, layers, modes: view.comp).
+// bit only keys the pipeline; bits 0–4 and 6 are the kernel's (hero, layers, modes, and the
+// sharing across passes: view.comp).
 constexpr int kAovPassBit = 32;
-// view.comp's sharing across passes (P.pass.w bit 6; render()).
-constexpr int kSharedPassBit = 64;
+constexpr int kSharedPassBit = 64;  // view.comp's sharing across passes (render())
 
 constexpr double kPi = 3.14159265358979323846;
 
