@@ -278,8 +278,10 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   if (!a.reference) {
     session.context();  // what prepare() does first, marked apart from the voxelising
     timings::mark("device created");
-    // The view pipeline compiles beside the voxelising and the upload (docs/performance.md).
-    session.startRenderPipeline(rs, lit);
+    // The view pipeline compiles beside the voxelising and the upload (docs/performance.md). A
+    // polarised render runs another kernel: compiling the view kernel would only take a core
+    // from its trace (measured: a third of polariscope_gems_0's render).
+    if (!isPolarisedRender(*scene, rs)) session.startRenderPipeline(rs, lit);
   }
   // Without light volumes a GPU render of sharp interfaces reads no per-voxel field: only the
   // interfaces are voxelised then (docs/performance.md "Start-up").

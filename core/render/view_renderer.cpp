@@ -452,6 +452,10 @@ struct ViewRenderer::Impl {
   size_t scatterImage = 0, fluenceImage = 0,
          fluxImage = 0;  // 0: not present (index A bound instead)
   vk::Buffer params, env, tables;
+  // The polarised trace's ray and result buffers, kept between its calls and grown as needed: a
+  // render calls it once per batch of rays, and fresh buffers cost lavapipe a fault per page of
+  // every batch (0.9 s of a 2.1 s render, with the host copies; docs/performance.md).
+  vk::Buffer polarisedRays, polarisedResults;
   BoundaryDevice boundary;  // the sharp-boundary field (placeholders when smoothed)
   // One pipeline per kernel and feature set, made on first use (specialization constants 0–2 of
   // march.glsl: the march kind, the EIKON_F_* flags, the integrator). lavapipe executes every
@@ -933,39 +937,47 @@ std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<Polar
         "\"interfaces\": \"sharp\")");
   if (rays.empty()) return {};
   const std::vector<glm::vec4> sheetData = packSheets(sheets, settings);
-  std::vector<gpu::PolarisedRay> in(rays.size());
-  for (size_t i = 0; i < rays.size(); ++i) {
+  const size_t n = rays.size();
+  if (I.polarisedRays.size() < n * sizeof(gpu::PolarisedRay)) {
+    I.polarisedRays = {};  // the old buffers go before the new ones are allocated
+    I.polarisedResults = {};
+    I.polarisedRays = vk::Buffer(I.ctx, n * sizeof(gpu::PolarisedRay),
+                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "polarised rays");
+    I.polarisedResults = vk::Buffer(I.ctx, n * sizeof(gpu::PolarisedResult),
+                                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "polarised results");
+  }
+  auto* in = static_cast<gpu::PolarisedRay*>(I.polarisedRays.mapped());
+  for (size_t i = 0; i < n; ++i) {
     in[i].origin = glm::vec4(glm::vec3(rays[i].origin), float(rays[i].wavelength_nm * 1e-3));
     in[i].direction = glm::vec4(glm::vec3(glm::normalize(rays[i].direction)), 0.0f);
     in[i].stokes = glm::vec4(inputs[i]);
   }
   gpu::ViewParams p = I.baseParams(MarchSettings{}, 0);
-  p.image = glm::ivec4(int(rays.size()), 1, 0, 1);
+  // The shape table from its storage buffer, not the uniform block of its first rows: lavapipe
+  // (Mesa 22.3) inlines that block's values into this kernel and compiles it again at every
+  // submit, ~45 ms on one core per batch of rays (docs/performance.md "Polarised renders").
+  p.grid_dims.w &= ~EIKON_F_SMALL_SHAPES;
+  p.image = glm::ivec4(int(n), 1, 0, 1);
   p.pass = glm::ivec4(std::min(settings.max_events, EIKON_POL_MAX_EVENTS),
                       std::min(settings.max_branches, EIKON_POL_MAX_LEAVES),
                       settings.mueller_row ? 1 : 0, 0);
   I.params.write(&p, sizeof p);
-  vk::Buffer rb(I.ctx, in.size() * sizeof(gpu::PolarisedRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                "polarised rays");
-  rb.write(in.data(), in.size() * sizeof(gpu::PolarisedRay));
   vk::Buffer sb(I.ctx, sheetData.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                 "polariser sheets");
   sb.write(sheetData.data(), sheetData.size() * sizeof(glm::vec4));
-  vk::Buffer ob(I.ctx, in.size() * sizeof(gpu::PolarisedResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                "polarised results");
   vk::ComputePipeline& tracer = I.pipeline(Impl::kPolarised, p);
-  tracer.bindBuffer(EIKON_B_RAYS, rb);
+  tracer.bindBuffer(EIKON_B_RAYS, I.polarisedRays);
   tracer.bindBuffer(EIKON_B_SHEETS, sb);
-  tracer.bindBuffer(EIKON_B_OUTPUT, ob);
+  tracer.bindBuffer(EIKON_B_OUTPUT, I.polarisedResults);
   // EIKON_POL_GROUP rays per workgroup (one SIMD group of lavapipe; polarised_trace.comp).
   I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
-    tracer.dispatch(cmd, uint32_t((in.size() + EIKON_POL_GROUP - 1) / EIKON_POL_GROUP), 1, 1,
-                    nullptr);
+    tracer.dispatch(cmd, uint32_t((n + EIKON_POL_GROUP - 1) / EIKON_POL_GROUP), 1, 1, nullptr);
   });
-  std::vector<gpu::PolarisedResult> res(in.size());
-  ob.read(res.data(), res.size() * sizeof(gpu::PolarisedResult));
+  // Read in place: the buffer is host-coherent, and the dispatch has ended.
+  const auto* res = static_cast<const gpu::PolarisedResult*>(I.polarisedResults.mapped());
   std::vector<PolarisedTrace> out;
-  for (size_t i = 0; i < res.size(); ++i)
+  out.reserve(n);
+  for (size_t i = 0; i < n; ++i)
     out.push_back(unpackPolarised(res[i], glm::normalize(rays[i].direction)));
   return out;
 }
