@@ -279,8 +279,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
     session.context();  // what prepare() does first, marked apart from the voxelising
     timings::mark("device created");
     // The view pipeline compiles beside the voxelising and the upload (docs/performance.md). A
-    // polarised render runs another kernel: compiling the view kernel would only take a core
-    // from its trace (measured: a third of polariscope_gems_0's render).
+    // polarised render runs another kernel, which that compile would only compete with for a core.
     if (!isPolarisedRender(*scene, rs)) session.startRenderPipeline(rs, lit);
   }
   // Without light volumes a GPU render of sharp interfaces reads no per-voxel field: only the

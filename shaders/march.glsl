@@ -182,7 +182,6 @@ vec3 surfaceWeighted(vec3 weight, vec3 rgb, vec3 diffuse) {
   return recordedWeighted(weight, rgb) + weight * diffuse;
 }
 
-
 vec3 environmentRgb(vec3 d) {
   float u = atan(d.x, -d.z) / (2.0 * kPi) + 0.5;
   float v = acos(clamp(d.y, -1.0, 1.0)) / kPi;
