@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/io/atomic_write.h"
+#include "core/io/build_id.h"
 #include "core/io/cache_dir.h"
 #include "core/light/lighting.h"
 #include "core/volume/media.h"
@@ -78,6 +79,12 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOpt
                        bool reference) {
   Hasher h;
   h.value(kFormat);
+  // The code that simulated it (as the volume cache keys its entries): a rebuilt eikon whose
+  // simulator changed must not read the former one's light (it did: after torn patches became
+  // pencils, renders kept the fans from the cache).
+  const std::string build = codeBuildId();
+  h.value(build.size());
+  h.bytes(build.data(), build.size());
   h.value(reference);
   h.value(v.grid.dims);
   h.value(v.grid.origin);

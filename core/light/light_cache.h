@@ -5,8 +5,9 @@
 //
 // The key is a 64-bit hash of everything the simulation reads: the volume's grid and fields
 // (index, medium, axis, scatter), every light (type, geometry, power, spectrum), the simulator
-// settings, the band count, which twin ran (GPU or CPU reference) and a format version. A file
-// "light-<key>.bin" in the cache directory holds the key again, the grid dimensions, a 64-bit
+// settings, the band count, which twin ran (GPU or CPU reference), the code that ran it (the
+// binary's build id, core/io/build_id.h, which covers the embedded shaders) and a format version. A
+// file "light-<key>.bin" in the cache directory holds the key again, the grid dimensions, a 64-bit
 // checksum of the payload and the two volumes; anything that does not match is ignored (and
 // overwritten), never half-read. The checksum catches a payload corrupted at the same size
 // (random bytes, NaN, huge values), which would otherwise be rendered as it is.

@@ -384,26 +384,38 @@ struct Slab {
   int face_in = -1, face_out = -1;
 };
 
-/// The local planes of a convex polyhedron or a box (±x, ±y, ±z: boundary.glsl's order).
-std::vector<Plane> localPlanes(const Shape& s) {
-  if (const auto* c = std::get_if<ConvexShape>(&s.geometry())) return c->planes;
-  const glm::dvec3 half = 0.5 * std::get<BoxShape>(s.geometry()).size;
-  std::vector<Plane> planes;
-  for (int a = 0; a < 3; ++a)
-    for (double sign : {-1.0, 1.0}) {
-      glm::dvec3 n(0.0);
-      n[a] = sign;
-      planes.push_back({n, half[a]});
+/// The local planes of a convex polyhedron or a box (±x, ±y, ±z: boundary.glsl's order), without
+/// a copy: a polyhedron's own, or a box's six in `box` (convexSlab runs per corner and step in the
+/// light simulator's sharp path, where copying the planes was a fifth of its time).
+struct LocalPlanes {
+  const Plane* planes = nullptr;
+  size_t count = 0;
+  std::array<Plane, 6> box{};
+  explicit LocalPlanes(const Shape& s) {
+    if (const auto* c = std::get_if<ConvexShape>(&s.geometry())) {
+      planes = c->planes.data(), count = c->planes.size();
+      return;
     }
-  return planes;
-}
+    const glm::dvec3 half = 0.5 * std::get<BoxShape>(s.geometry()).size;
+    for (int a = 0; a < 3; ++a)
+      for (int i = 0; i < 2; ++i) {
+        glm::dvec3 n(0.0);
+        n[a] = i == 0 ? -1.0 : 1.0;
+        box[size_t(2 * a + i)] = {n, half[a]};
+      }
+    planes = box.data(), count = 6;
+  }
+  LocalPlanes(const LocalPlanes&) = delete;
+  LocalPlanes& operator=(const LocalPlanes&) = delete;
+};
 
 Slab convexSlab(const Shape& s, const glm::dvec3& a, const glm::dvec3& b) {
-  const std::vector<Plane> planes = localPlanes(s);
+  const LocalPlanes lp(s);
+  const Plane* planes = lp.planes;
   const glm::dmat3 to_local = glm::transpose(s.rotation());
   const glm::dvec3 p = to_local * (a - s.center()), d = to_local * (b - a);
   Slab out;
-  for (size_t k = 0; k < planes.size(); ++k) {
+  for (size_t k = 0; k < lp.count; ++k) {
     const double nd = glm::dot(planes[k].normal, d),
                  v = glm::dot(planes[k].normal, p) - planes[k].d;
     if (nd > 0.0) {
@@ -446,7 +458,8 @@ BoundaryCrossing convexCrossingOutOf(const BoundaryField& bf, const glm::dvec3& 
     out.to = shape + 1;
   }
   const Shape& s = bf.shapes[size_t(shape)];
-  const glm::dvec3 n = s.rotation() * localPlanes(s)[size_t(face)].normal;
+  const LocalPlanes lp(s);
+  const glm::dvec3 n = s.rotation() * lp.planes[size_t(face)].normal;
   out.found = true;
   out.t = t;
   out.point = a + t * (b - a);

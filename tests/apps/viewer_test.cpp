@@ -391,7 +391,7 @@ TEST_F(ViewerTest, CtrlDragMovesTheLightInTheBackground) {
   const double same = rmsDifference(viewed, moved), unmoved = rmsDifference(viewed, before);
   std::printf("rms: viewer vs render with the moved light %.5f, with the scene's light %.5f\n",
               same, unmoved);
-  EXPECT_LE(same, 2.0 / 255);
+  EXPECT_LE(same, 2.0 / 255) << out;
   EXPECT_GT(unmoved, 2.0 / 255) << "the moved light did not change the view";
 
   // The floor's front corners, out of the glass ball's shadow and caustic: a point light's
