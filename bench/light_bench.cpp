@@ -57,8 +57,9 @@ void print(const char* name, const Run& r) {
   const double ended = s.flux_left + s.flux_caustic + s.flux_energy + s.flux_absorbed +
                        s.flux_reflected + s.flux_live_at_end;
   std::printf(
-      "  %-6s %8.2f s  %10.0f patches  %9.3g patches/s  steps %5d  splits %zu (refused %zu)\n",
-      name, r.s, r.patches(), r.patches() / r.s, s.steps, s.splits, s.splits_refused);
+      "  %-6s %8.2f s  %10.0f patches  %9.3g patches/s  steps %5d  splits %zu (refused %zu, "
+      "tears %zu)\n",
+      name, r.s, r.patches(), r.patches() / r.s, s.steps, s.splits, s.splits_refused, s.tears);
   std::printf(
       "       flux emitted %.9g = left %.9g + caustic %.9g + energy %.9g + absorbed %.9g + "
       "reflected %.9g + live %.9g  (balance %+.2e relative)\n",
@@ -79,6 +80,7 @@ struct Pair {
 
 int gStepsPerDispatch = 16;
 bool gSharp = false;              ///< --sharp
+bool gPassCaustics = false;       ///< --caustics pass
 std::vector<int> gThreads = {0};  ///< CPU reference thread counts (0: hardware concurrency)
 
 Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu) {
@@ -87,6 +89,7 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
   WavefrontSettings s;
   s.skip_empty = skip;
   s.sharp_interfaces = gSharp;
+  s.pass_caustics = gPassCaustics;
   // The CPU twin's set-up (its skip distances and media; the field), timed as the GPU's is.
   const auto tc = std::chrono::steady_clock::now();
   const SharpInterfaces sharp =
@@ -163,6 +166,12 @@ int main(int argc, char** argv) {
                  "Full-resolution runs, comma separated: smoothed, sharp (default: --sharp's)")
       ->delimiter(',')
       ->check(CLI::IsMember({"smoothed", "sharp"}));
+  std::string caustics = "kill";
+  app.add_option(
+         "--caustics", caustics,
+         "kill (Tevs, WavefrontSettings' default) or pass (light continues through a focus, "
+         "as renders simulate it)")
+      ->check(CLI::IsMember({"kill", "pass"}));
   bool lowRuns = true;
   app.add_flag("!--no-low", lowRuns,
                "Skip the runs without straight steps at the lower resolution");
@@ -172,6 +181,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 1024));
   CLI11_PARSE(app, argc, argv);
   if (gThreads.empty()) gThreads = {0};
+  gPassCaustics = caustics == "pass";
   const Scene scene = loadScene(scene_path);
   if (scene.lights.empty()) {
     std::fprintf(stderr, "light_bench: %s has no light\n", scene_path.c_str());

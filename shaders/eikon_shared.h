@@ -273,6 +273,7 @@ struct PolarisedResult {
 #define EIKON_PATCH_CAUSTIC 3   // killed: orientation flip (fold caustic)
 #define EIKON_PATCH_ENERGY 4    // killed: flux below min_energy_fraction of its seed's
 #define EIKON_PATCH_OPAQUE 5    // killed: centre in an opaque voxel (flux counted as absorbed)
+#define EIKON_PATCH_TORN 6      // alive, torn by a boundary (sharp): becomes four pencils, as a split
 // Splat buffer: per voxel 4 signed 64-bit fixed-point sums as (lo, hi) uint pairs, in the order
 // weight, and the biased weight·(1 + dir.x), ·(1 + dir.y), ·(1 + dir.z) (every term ≥ 0; the host
 // subtracts the weight) (EIKON_SPLAT_ACC_WORDS words per voxel), then one uint per voxel
@@ -287,7 +288,8 @@ struct WaveParams {
   vec4 wavelength;   // x: λ (µm); y: 1/λ²; z: 1/λ⁴; w: splat scale (fixed-point units per W/mm²)
   ivec4 control;     // x: probe axis (−1: none); y: steps per dispatch; z: max_steps; w: mode (0 o, 1 e)
   vec4 probe;        // x: probe plane position (mm); yzw: unused
-  ivec4 options;     // x: 1 = straight steps across homogeneous regions (skip_empty); y: 1 = pass_caustics; zw: unused
+  ivec4 options;     // x: 1 = straight steps across homogeneous regions (skip_empty); y: 1 = pass_caustics;
+                     // z: 1 = straight steps up to the next boundary (straight_to_boundary); w: unused
 };
 
 // Push constants of wavefront.comp. control: x: patches in the source list; y: pass (EIKON_WM_*);
@@ -307,7 +309,7 @@ struct ScanPush {
 struct WaveTally {
   vec4 flux_a;    // flux of patches killed: left, caustic, energy, opaque
   vec4 flux_b;    // x: absorbed by attenuation in the last dispatch (Σ flux.w); y: flux live at max_steps
-  vec4 caustic_sum;  // xyz: Σ flux·centre of caustic kills
+  vec4 caustic_sum;  // xyz: Σ flux·centre of caustic kills; w: torn patches asking for pencils
   uvec4 count_a;  // kills: left, caustic, energy, opaque
   uvec4 count_b;  // x: live at max_steps; y: patches asking for a split; z: survivors (count ≥ 1); w: max steps
   vec4 probe_pos;  // probe plane crossings in the last dispatch: xyz: Σ ±flux·crossing point; w: Σ ±flux
@@ -324,11 +326,16 @@ struct WavePatch {
   vec4 w[4];    // xyz: corner wave vector w = p (o-mode |w| = n; e-mode wᵀM_e w = 1)
   vec4 flux;    // x: flux (W); y: area0 (mm²); z: seed flux (W); w: flux absorbed in this dispatch
   ivec4 state;  // x: EIKON_PATCH_*; y: launch orientation (±1, 0); z: entered (0/1); w: steps done
-  ivec4 region; // sharp interfaces: corner k's region (bits 0–15; −1: not located yet) and its
-                // mirror bit EIKON_CORNER_MIRRORED (odd number of total internal reflections)
+  ivec4 region; // sharp interfaces: corner k's region (bits 0–15; −1: not located yet), its
+                // mirror bit EIKON_CORNER_MIRRORED (odd number of total internal reflections) and
+                // its boundary events modulo 256 (bits 17–24: region changes and mirrors; a patch
+                // whose corners disagree is torn, Patch::events)
 };
 #define EIKON_CORNER_REGION 0xFFFF
 #define EIKON_CORNER_MIRRORED 0x10000
+#define EIKON_CORNER_EVENT_SHIFT 17
+#define EIKON_CORNER_EVENT 0x20000
+#define EIKON_CORNER_EVENTS 0x1FE0000
 
 #ifdef __cplusplus
 static_assert(sizeof(ViewParams) == 16 * 16, "ViewParams must be vec4-packed");

@@ -66,7 +66,7 @@ WaveParams P;
 //                (sharp: boundary.glsl's plane loops); always given (GpuWavefront), also in
 //                P.grid_dims.w;
 //   kWaveOptions: EIKON_WO_* bits (straight steps, pass caustics, probe plane, the highest-energy
-//                 splat's maximum); −1: from P.
+//                 splat's maximum, straight steps up to the next boundary); −1: from P.
 layout(constant_id = 0) const bool kSharpLight = false;
 layout(constant_id = 1) const int kWaveFlags = -1;
 layout(constant_id = 2) const int kWaveOptions = -1;
@@ -75,10 +75,12 @@ layout(constant_id = 3) const int kExact = 0;
 #define EIKON_WO_PASS_CAUSTICS 2
 #define EIKON_WO_PROBE 4
 #define EIKON_WO_HIGHEST 8
+#define EIKON_WO_TO_BOUNDARY 16
 bool hasOption(int o) {
   if (kWaveOptions != -1) return (kWaveOptions & o) != 0;
   if (o == EIKON_WO_SKIP) return P.options.x != 0;
   if (o == EIKON_WO_PASS_CAUSTICS) return P.options.y != 0;
+  if (o == EIKON_WO_TO_BOUNDARY) return P.options.z != 0;
   if (o == EIKON_WO_HIGHEST) return true;  // (the maximum costs an atomic; it is always right)
   return P.control.x >= 0;
 }
@@ -384,6 +386,36 @@ bool straddles(ivec4 region) {
 
 bool anyMirrored(ivec4 region) { return any(notEqual(region & EIKON_CORNER_MIRRORED, ivec4(0))); }
 
+// The corners met different boundaries, or one boundary with different outcomes (PatchStepper::torn
+// in wavefront.cpp): event counts (modulo 256) more than one apart, or equal counts with different
+// regions or mirror bits.
+bool torn(ivec4 region) {
+  const ivec4 ev = (region & EIKON_CORNER_EVENTS) >> EIKON_CORNER_EVENT_SHIFT;
+  const ivec4 side = region & (EIKON_CORNER_REGION | EIKON_CORNER_MIRRORED);
+  bool t = false;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) {
+      const int d = (ev[a] - ev[b]) & 0xFF;
+      t = t || (d == 0 ? side[a] != side[b] : d != 1 && d != 0xFF);
+    }
+  return t;
+}
+
+// Corner k's event count + 1 (modulo 256), its region and mirror bit unchanged.
+int addEvent(int corner) {
+  return (corner & ~EIKON_CORNER_EVENTS) | ((corner + EIKON_CORNER_EVENT) & EIKON_CORNER_EVENTS);
+}
+
+// How far (mm) a corner at x moving along v goes in region r before it meets the region's boundary
+// (nextCrossing over the bounds' diagonal), less kStraightMarginVoxels; the diagonal if it meets
+// none. PatchStepper::straightClear in wavefront.cpp.
+const float kStraightMarginVoxels = 1e-3;
+float straightClear(vec3 x, vec3 v, int r) {
+  const float L = length(P.grid_max.xyz - P.grid_origin.xyz);
+  const BoundaryCrossing c = nextCrossing(x, x + L * normalize(v), r);
+  return c.found ? c.t * L - kStraightMarginVoxels * P.grid_origin.w : L;
+}
+
 // How many time steps the patch (corners x, w) may take at once along straight lines (0: take
 // an RK4 step), and the corners' constant velocities v = dx/dt; the rules of straightSteps in
 // wavefront.cpp: centre and corners in voxels of skip distance D ≥ 2, the centre's voxel not
@@ -405,10 +437,15 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, ivec4 region, ou
   // path's own, core/light/sharp_skip.h).
   const float Dc = kSharpLight ? 0.0 : skipAt(c0);
   if (!kSharpLight && Dc < 2.0) return 0;
+  // Sharp, with crossings found on the shapes or their planes (no walk): each corner's way to its
+  // region's boundary is searched exactly (straightClear), so a corner near a surface, whose skip
+  // distance is below 2, may still go straight up to it.
+  const bool exactClear = kSharpLight && hasOption(EIKON_WO_TO_BOUNDARY) &&
+                          (EIKON_BOUNDARY_CONVEX_APART || EIKON_BOUNDARY_EXACT);
   float D[4];
   for (int k = 0; k < 4; ++k) {
     D[k] = skipAt(x[k]);
-    if (D[k] < 2.0) return 0;
+    if (D[k] < 2.0 && !exactClear) return 0;
   }
   if (mediumAt(c0).w >= 0.5) return 0;
   const vec3 wm = 0.25 * (w[0] + w[1] + w[2] + w[3]);
@@ -435,7 +472,10 @@ int straightSteps(vec3 x[4], vec3 w[4], vec4 flux, ivec4 state, ivec4 region, ou
   if (!kSharpLight && sp > 0.0) kmax = min(kmax, floor((Dc - 1.5) * h / sp));
   for (int k = 0; k < 4; ++k) {
     sp = length(v[k]) * dt;
-    if (sp > 0.0) kmax = min(kmax, floor((D[k] - 1.5) * h / sp));
+    if (!(sp > 0.0)) continue;
+    float kk = floor((D[k] - 1.5) * h / sp);
+    if (exactClear) kk = max(kk, floor(straightClear(x[k], v[k], r0) / sp));
+    kmax = min(kmax, kk);
   }
   // Energy: below the threshold already (a split's child): one step; else the first step below it.
   // Sharp: a single step's factor is exp(−¼ Σ σ·length) over the corners (sharpCorner), the same
@@ -512,6 +552,7 @@ bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, i
   const float neA = uA ? mediumIndex(A, 1) : 0.0, neB = uB ? mediumIndex(B, 1) : 0.0;
   const vec3 aA = mediumRow(A, 7).xyz, aB = mediumRow(B, 7).xyz;
   const bool same = noA == noB && neA == neB && (!uA || aA == aB);
+  corner = addEvent(corner);  // every region change or mirror is an event (torn)
   if (same || mediumOpaque(B) || !(length(N) > 0.0)) {
     corner = (corner & ~EIKON_CORNER_REGION) | B;
     return false;
@@ -754,8 +795,8 @@ bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) 
   const float o = dot(0.5 * cross(x[2] - x[0], x[3] - x[1]), wm);
   // Sharp interfaces: a mirror reverses the orientation; a patch torn by a boundary is not tested.
   const int orient = kSharpLight && anyMirrored(p.region) ? -p.state.y : p.state.y;
-  const bool torn = kSharpLight && straddles(p.region);
-  if (!torn && ((o > 0.0 && orient < 0) || (o < 0.0 && orient > 0))) {
+  const bool straddling = kSharpLight && straddles(p.region);
+  if (!straddling && ((o > 0.0 && orient < 0) || (o < 0.0 && orient > 0))) {
     if (!hasOption(EIKON_WO_PASS_CAUSTICS)) {
       p.state.x = EIKON_PATCH_CAUSTIC;
       return true;
@@ -766,7 +807,11 @@ bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) 
     p.state.x = EIKON_PATCH_ENERGY;
     return true;
   }
-  if (maxEdgeOf(x) > P.step.y && !torn) {
+  if (kSharpLight && torn(p.region)) {  // four pencils (the list rebuild, as a split)
+    p.state.x = EIKON_PATCH_TORN;
+    return true;
+  }
+  if (maxEdgeOf(x) > P.step.y && !straddling) {
     p.state.x = EIKON_PATCH_SPLIT;
     return true;
   }
@@ -835,6 +880,23 @@ void scatter(uint id) {
   if (next - o == 1u) {  // kept (a refused split goes on unsplit, as in the reference)
     p.state.x = EIKON_PATCH_ALIVE;
     storeOther(o, p);
+    return;
+  }
+  if (kSharpLight && p.state.x == EIKON_PATCH_TORN) {
+    // Four pencils, one per corner (PatchStepper::emit): all four corners on the corner's ray, in
+    // its region, with its mirror bit and event count; a quarter of the flux each.
+    for (int k = 0; k < 4; ++k) {
+      WavePatch c = p;
+      for (int j = 0; j < 4; ++j) {
+        c.x[j] = vec4(p.x[k].xyz, 0.0);
+        c.w[j] = vec4(p.w[k].xyz, 0.0);
+        c.region[j] = p.region[k];
+      }
+      c.flux.x = 0.25 * p.flux.x;
+      c.flux.y = 0.25 * p.flux.y;
+      c.state.x = EIKON_PATCH_ALIVE;
+      storeOther(o + uint(k), c);
+    }
     return;
   }
   // Four children on the bilinear 3×3 lattice; the parent's corners are kept exactly.

@@ -1,7 +1,7 @@
 #version 450
 // Count passes of the light simulator's list rebuild (see wavefront.comp and
 // docs/light-simulator.md): per patch of the source list, its number of outputs (0 dead or out of
-// steps, 1 kept, 4 split one level) into scan[i], and in the COUNT pass the workgroup's kill
+// steps, 1 kept, 4 split one level or torn into pencils) into scan[i], and in the COUNT pass the workgroup's kill
 // statistics and probe-plane sums reduced in shared memory (a tree of EIKON_WAVE_WG lanes, float sums) into
 // tally[workgroup], which the host adds in double. A separate shader from wavefront.comp so that
 // the propagation shader carries no barrier (llvmpipe implements barriers with coroutines).
@@ -46,6 +46,11 @@ void countPass(uint id, uint lid, uint mode) {
       case EIKON_PATCH_SPLIT:
         keep = 1u;
         wantSplit = true;
+        break;
+      case EIKON_PATCH_TORN:  // four pencils: counted as a split
+        keep = 1u;
+        wantSplit = true;
+        cen.w = 1.0;
         break;
       case EIKON_PATCH_LEFT:
         fa.x = e;

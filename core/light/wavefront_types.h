@@ -87,6 +87,11 @@ struct WavefrontSettings {
   /// SharpInterfaces explicitly (WavefrontSimulator's constructor) and ignores this flag; the
   /// lighting drivers of both twins set it from LightingOptions::sharp_interfaces.
   bool sharp_interfaces = false;
+  /// Sharp interfaces whose crossings are found on the shapes or their planes (BoundaryField::
+  /// exact or convex_apart): a straight step may run each corner up to just before its next
+  /// boundary, searched along its straight line (true), not only (D − 1.5) voxels on the skip
+  /// distances (false: for comparison). Exact either way; it changes how many steps a run takes.
+  bool straight_to_boundary = true;
   /// Called after every time step (CPU) or dispatch of steps (GPU) with an estimate of the run's
   /// fraction done (wavefrontRunFraction), from the thread that called run(); may be empty.
   /// Not part of the physics (not in the light cache key).
@@ -123,6 +128,11 @@ struct Patch {
   /// an odd number of total internal reflections (a mirror reverses the orientation).
   std::array<int, 4> region{};
   unsigned mirrored = 0;
+  /// Sharp interfaces: each corner's count of boundary events (region changes and total internal
+  /// reflections). The corners of a patch that one boundary is crossing differ by at most one, and
+  /// those with equal counts agree on region and mirror; otherwise the patch is torn (see
+  /// WavefrontStats::tears).
+  std::array<int, 4> events{};
 };
 
 struct WavefrontStats {
@@ -133,6 +143,10 @@ struct WavefrontStats {
   size_t max_live = 0;             ///< most live patches at once
   size_t splits = 0;               ///< parents split into four
   size_t splits_refused = 0;       ///< splits not done because max_patches would be exceeded
+  /// Sharp interfaces: torn patches (corners that met different boundaries, or one boundary with
+  /// different outcomes) replaced by four pencils, one along each corner's ray (counted in
+  /// `splits` too: each adds three patches)
+  size_t tears = 0;
   size_t kills_left = 0, kills_caustic = 0, kills_energy = 0, kills_opaque = 0;
   size_t live_at_end = 0;     ///< patches still alive when max_steps ran out (0 if the loop ended)
   double flux_emitted = 0;    ///< Σ seed flux (only seeds whose centre ray meets the volume)

@@ -53,8 +53,8 @@ struct alignas(64) Chunk {
   /// Live count while the step runs: absolute when emitting against the budget (one chunk, or the
   /// serial redo), else relative to the chunk's start (−1 per kill, +3 per split).
   long long live = 0;
-  long long maxAfterSplit = LLONG_MIN;        ///< highest `live` right after a split in this step
-  size_t kills = 0, splits = 0, refused = 0;  ///< this step's
+  long long maxAfterSplit = LLONG_MIN;  ///< highest `live` right after a split in this step
+  size_t kills = 0, splits = 0, refused = 0, tears = 0;  ///< this step's
 };
 
 /// Worker threads for one WavefrontSimulator::run, created once: go(f) calls f(c) for chunk c on
@@ -136,6 +136,9 @@ class ChunkPool {
 /// Steps with fewer patches than this per chunk run their chunks one after another on the calling
 /// thread (the same chunks, so the same results): waking the workers would cost more.
 constexpr size_t kMinPatchesPerChunk = 64;
+/// A straight step ends this far (voxels) before the boundary a corner would meet (straightClear;
+/// wavefront.comp has the same): well above the GPU twin's float rounding of a position.
+constexpr double kStraightMarginVoxels = 1e-3;
 
 /// What a patch's step leaves for the stages after it (wavefront.comp's PatchStep).
 struct PatchStep {
@@ -222,6 +225,8 @@ class PatchStepper {
   void sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& st) const;
   bool crossInterface(const BoundaryCrossing& c, Patch& p, int k, double& transmission) const;
   bool straddles(const Patch& p) const;
+  bool torn(const Patch& p) const;
+  double straightClear(const glm::dvec3& x, const glm::dvec3& v, int r) const;
 
   const Field& f_;
   const Grid& grid_;
@@ -338,6 +343,7 @@ bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k,
   const WavefrontMedium &a = mediumOf(c.from), &b = mediumOf(c.to);
   glm::dvec3 N = glm::length(c.normal) > 0 ? c.normal : c.field_normal;
   const bool same = a.n == b.n && a.n_e == b.n_e && (a.n_e == 0.0 || a.axis == b.axis);
+  ++p.events[size_t(k)];  // every region change or mirror is an event (torn)
   if (same || b.opaque || !(glm::length(N) > 0)) {
     p.region[size_t(k)] = c.to;
     return false;
@@ -464,6 +470,32 @@ bool PatchStepper::straddles(const Patch& p) const {
   const bool oneRegion =
       p.region[1] == p.region[0] && p.region[2] == p.region[0] && p.region[3] == p.region[0];
   return !oneRegion || (p.mirrored != 0u && p.mirrored != 15u);
+}
+
+// Sharp interfaces: the corners met different boundaries, or one boundary with different outcomes
+// (one refracted where another was totally reflected). While one boundary sweeps over a coherent
+// patch the corners' event counts differ by at most one and corners of equal count share region
+// and mirror; a torn patch breaks that. Its corners are exact rays but its interior is not a ray
+// tube: a split would interpolate across the tear (a fan of rays that exist nowhere) and, held
+// together, its centre splats between corners that may be far apart.
+// How far (mm) a corner at x moving along v goes in region r before it meets the region's boundary
+// (crossingOutOf over the bounds' diagonal), less kStraightMarginVoxels (the GPU twin's float
+// positions stay on this side of it); the diagonal if it meets none.
+double PatchStepper::straightClear(const glm::dvec3& x, const glm::dvec3& v, int r) const {
+  const double L = glm::length(hi_ - lo_);
+  const BoundaryCrossing c = crossingOutOf(*sharp_->boundary, x, x + L * glm::normalize(v), r);
+  return c.found ? c.t * L - kStraightMarginVoxels * h_ : L;
+}
+
+bool PatchStepper::torn(const Patch& p) const {
+  const auto [lo, hi] = std::minmax_element(p.events.begin(), p.events.end());
+  if (*hi - *lo > 1) return true;
+  for (size_t a = 0; a < 4; ++a)
+    for (size_t b = a + 1; b < 4; ++b)
+      if (p.events[a] == p.events[b] &&
+          (p.region[a] != p.region[b] || ((p.mirrored >> a) & 1u) != ((p.mirrored >> b) & 1u)))
+        return true;
+  return false;
 }
 
 void PatchStepper::splatAt(Chunk& ch, const glm::dvec3& m, double fluxDs, double irr,
@@ -602,9 +634,14 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1)
   const double Dmin = sharp_ ? 0.0 : skipAt(c0);
   if (!sharp_ && Dmin < 2.0) return 0;
   double D[4];
+  // Sharp, with crossings found on the shapes or their planes (no walk): each corner's way to its
+  // region's boundary is searched exactly (straightClear), so a corner near a surface, whose skip
+  // distance is below 2, may still go straight up to it.
+  const bool exact = sharp_ && s_.straight_to_boundary &&
+                     (sharp_->boundary->convex_apart || sharp_->boundary->exact);
   for (int k = 0; k < 4; ++k) {
     D[k] = skipAt(p.x[size_t(k)]);
-    if (D[k] < 2.0) return 0;
+    if (D[k] < 2.0 && !exact) return 0;
   }
   if (f_.medium(c0).w >= 0.5) return 0;
   const glm::dvec3 wm = meanW(p);
@@ -631,7 +668,13 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1)
     if (sp > 0) kmax = std::min(kmax, std::floor((Dv - 1.5) * h_ / sp));
   };
   if (!sharp_) capBy(Dmin, vc);
-  for (int k = 0; k < 4; ++k) capBy(D[k], v[k]);
+  for (int k = 0; k < 4; ++k) {
+    const double sp = glm::length(v[k]) * dt_;
+    if (!(sp > 0)) continue;
+    double kk = std::floor((D[k] - 1.5) * h_ / sp);
+    if (exact) kk = std::max(kk, std::floor(straightClear(p.x[size_t(k)], v[k], p.region[0]) / sp));
+    kmax = std::min(kmax, kk);
+  }
   // Energy: a patch already below the threshold (a child of a split) is killed after its next
   // step; otherwise the first step at which exp(−σ·j·ds1) takes it below.
   // Sharp interfaces: a single step's factor is exp(−¼ Σ σ·length) over the corners (sharpCorner),
@@ -688,6 +731,37 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
   double e0 = 0;
   for (int k = 0; k < 4; ++k)
     e0 = std::max(e0, glm::length(p0.x[size_t((k + 1) % 4)] - p0.x[size_t(k)]));
+  // One patch becomes four (a split or a tear's pencils) unless that takes ch.live over budget:
+  // then p goes on whole (refused).
+  auto grant = [&](const Patch& p) {
+    if (ch.live + 3 > budget) {
+      ++ch.refused;
+      ch.next->push_back(p);
+      return false;
+    }
+    ch.live += 3;
+    ++ch.splits;
+    ch.maxAfterSplit = std::max(ch.maxAfterSplit, ch.live);
+    return true;
+  };
+  if (sharp_ && torn(p0)) {
+    if (!grant(p0)) return;
+    ++ch.tears;
+    // Four pencils, one per corner: all four corners on the corner's ray (zero width: a pencil
+    // never splits, deposits its flux along its ray and has no irradiance of its own).
+    for (size_t k = 0; k < 4; ++k) {
+      Patch c = p0;
+      c.x.fill(p0.x[k]);
+      c.w.fill(p0.w[k]);
+      c.region.fill(p0.region[k]);
+      c.events.fill(p0.events[k]);
+      c.mirrored = ((p0.mirrored >> k) & 1u) ? 15u : 0u;
+      c.energy = 0.25 * p0.energy;
+      c.area0 = 0.25 * p0.area0;
+      ch.next->push_back(c);
+    }
+    return;
+  }
   if (e0 <= maxEdge_ || (sharp_ && straddles(p0))) {
     ch.next->push_back(p0);
     return;
@@ -705,14 +779,7 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
       ch.next->push_back(p);
       continue;
     }
-    if (ch.live + 3 > budget) {
-      ++ch.refused;
-      ch.next->push_back(p);
-      continue;
-    }
-    ch.live += 3;
-    ++ch.splits;
-    ch.maxAfterSplit = std::max(ch.maxAfterSplit, ch.live);
+    if (!grant(p)) continue;
     // 3×3 lattice of bilinear points; the parent's own corners are kept exactly.
     glm::dvec3 X[3][3], W[3][3];
     for (int b = 0; b < 3; ++b)
@@ -959,7 +1026,7 @@ long long settleStep(std::vector<Chunk>& chunks, const PatchStepper& stepper, lo
   long long live = L0;
   for (Chunk& ch : chunks) {
     ch.out[ping].clear();
-    ch.splits = ch.refused = 0;
+    ch.splits = ch.refused = ch.tears = 0;
     ch.maxAfterSplit = LLONG_MIN;
     size_t seen = 0;
     for (size_t i = 0; i < ch.surv.size(); ++i) {
@@ -986,6 +1053,7 @@ void reduceChunks(std::vector<Chunk>& chunks, WavefrontStats& st, std::vector<do
     st.straight_time_steps += a.straight_time_steps;
     st.splits += a.splits;
     st.splits_refused += a.splits_refused;
+    st.tears += a.tears;
     st.kills_left += a.kills_left;
     st.kills_caustic += a.kills_caustic;
     st.kills_energy += a.kills_energy;
@@ -1158,7 +1226,7 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
       ch.done.clear();
       ch.surv.clear();
       ch.survKills.clear();
-      ch.kills = ch.splits = ch.refused = 0;
+      ch.kills = ch.splits = ch.refused = ch.tears = 0;
       ch.live = nChunks == 1 ? L0 : 0;
       ch.maxAfterSplit = LLONG_MIN;
       const long long budget = nChunks == 1 ? maxPatches : LLONG_MAX;
@@ -1180,6 +1248,7 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     for (Chunk& ch : chunks) {
       ch.st.splits += ch.splits;
       ch.st.splits_refused += ch.refused;
+      ch.st.tears += ch.tears;
       done.insert(done.end(), ch.done.begin(), ch.done.end());
     }
     st.max_live = std::max(st.max_live, size_t(live));

@@ -367,11 +367,13 @@ struct GpuWavefront::Impl {
     return flags;
   }
   /// wavefront.comp's kWaveOptions: bit 0 straight steps, bit 1 pass caustics, bit 2 probe plane,
-  /// bit 3 the highest-energy maximum (readSplat reads it only for Splat::HighestEnergy).
+  /// bit 3 the highest-energy maximum (readSplat reads it only for Splat::HighestEnergy), bit 4
+  /// straight steps up to the next boundary (straight_to_boundary).
   int options() const {
     return (s.skip_empty ? 1 : 0) | (s.pass_caustics ? 2 : 0) |
            (s.probe_axis >= 0 && s.probe_axis < 3 ? 4 : 0) |
-           (s.splat == WavefrontSettings::Splat::HighestEnergy ? 8 : 0);
+           (s.splat == WavefrontSettings::Splat::HighestEnergy ? 8 : 0) |
+           (s.straight_to_boundary ? 16 : 0);
   }
 
   // Patch list `which` (0: EIKON_WB_PATCHES, 1: _B) holds at least n patches. Only called between
@@ -496,7 +498,8 @@ struct GpuWavefront::Impl {
     P.control = glm::ivec4(s.probe_axis >= 0 && s.probe_axis < 3 ? s.probe_axis : -1,
                            steps_per_dispatch, s.max_steps, eMode ? 1 : 0);
     P.probe = glm::vec4(float(s.probe_position), 0.0f, 0.0f, 0.0f);
-    P.options = glm::ivec4(s.skip_empty ? 1 : 0, s.pass_caustics ? 1 : 0, 0, 0);
+    P.options = glm::ivec4(s.skip_empty ? 1 : 0, s.pass_caustics ? 1 : 0,
+                           s.straight_to_boundary ? 1 : 0, 0);
     params.write(&P, sizeof P);
     // Zeroed in place (the buffer is mapped): no 50 MB staging vector at 128³.
     std::memset(splat.mapped(), 0, splatWords() * sizeof(uint32_t));
@@ -514,6 +517,7 @@ struct GpuWavefront::Impl {
       st.flux_absorbed += double(t.flux_a.w) + double(t.flux_b.x);
       st.flux_live_at_end += t.flux_b.y;
       st.caustic_centroid += glm::dvec3(glm::vec3(t.caustic_sum));
+      st.tears += size_t(t.caustic_sum.w);  // asked for (granted unless the budget binds)
       st.kills_left += t.count_a.x, st.kills_caustic += t.count_a.y, st.kills_energy += t.count_a.z;
       st.kills_opaque += t.count_a.w;
       st.live_at_end += t.count_b.x;

@@ -85,6 +85,17 @@ inline const char* kSharpPrismScene = R"({
   "materials": {"glass": {"n": 1.5168}}
 })";
 
+/// A 60° prism of side 3 mm (n = 1.5) whose apex is at (0, √3, 0), h = 0.1 mm: lit along +x by a
+/// beam whose axis passes below the apex, it opens a dark wedge behind the apex
+/// (SharpWavefront.EdgeBehindTheApexIsSharperThanSmoothed, SharpWavefrontTwins.ApexTears…).
+inline const char* kSharpApexPrismScene = R"({
+  "camera": {"width": 8, "height": 8},
+  "environment": {"type": "constant", "radiance": 1},
+  "volume": {"bounds_min": [-2.5, -2.5, -0.3], "bounds_max": [3.0, 3.0, 0.3], "resolution": 55},
+  "objects": [{"shape": "prism", "apex_deg": 60, "side": 3, "height": 20, "material": "glass"}],
+  "materials": {"glass": {"n": 1.5}}
+})";
+
 inline const char* kSharpCalcitePlateScene = R"({
   "camera": {"width": 8, "height": 8},
   "environment": {"type": "constant", "radiance": 1},
@@ -107,11 +118,11 @@ inline void unitLuneburg(const glm::dvec3& x, double& n, glm::dvec3& g) {
 
 inline void printWavefrontStats(const char* name, const WavefrontStats& s) {
   std::printf(
-      "[ measured ] %s: steps %d, seeded %zu, max live %zu, splits %zu (refused %zu), kills "
-      "left/caustic/energy/opaque %zu/%zu/%zu/%zu\n             flux emitted %.12g, left %.12g, "
-      "caustic %.12g, "
+      "[ measured ] %s: steps %d, seeded %zu, max live %zu, splits %zu (refused %zu, tears %zu), "
+      "kills left/caustic/energy/opaque %zu/%zu/%zu/%zu\n             flux emitted %.12g, left "
+      "%.12g, caustic %.12g, "
       "energy %.12g, absorbed %.12g, probe %.12g, ended before probe %.12g\n",
-      name, s.steps, s.seeded, s.max_live, s.splits, s.splits_refused, s.kills_left,
+      name, s.steps, s.seeded, s.max_live, s.splits, s.splits_refused, s.tears, s.kills_left,
       s.kills_caustic, s.kills_energy, s.kills_opaque, s.flux_emitted, s.flux_left, s.flux_caustic,
       s.flux_energy, s.flux_absorbed, s.flux_probe, s.flux_ended_before_probe);
 }

@@ -105,7 +105,9 @@ TEST(Progress, LightingDriverReportsWithinRuns) {
   };
   const LightingSummary sum = simulateLightingReference(scene, vol, o);
   EXPECT_EQ(sum.runs, 2u);
-  EXPECT_GE(f.size(), 2 * 80u);
+  // A report per time step (straight steps cover several): ten a run is already five times the
+  // runs + 1 of before.
+  EXPECT_GE(f.size(), 2 * 10u);
   expectMonotoneToOne(f, "lighting");
   EXPECT_EQ(labels.size(), 1u) << labels.back();
 }
