@@ -17,6 +17,12 @@ struct CliError : std::runtime_error {
   int exit_code;
 };
 
+/// Said on stderr when a scene's lights are left unsimulated because no material has an albedo
+/// (Scene::anyScattering): the light volumes would show nowhere in the picture.
+inline constexpr const char* kLightsNotSimulatedNote =
+    "eikon: note: the lights are not simulated: no material has an albedo, so no medium scatters "
+    "their light and no diffuse surface shows it\n";
+
 void addRenderCommand(CLI::App& app);
 void addTraceCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);

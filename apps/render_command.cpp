@@ -274,7 +274,10 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
     });
   session.setProgress({[&](const char* what, double f) { progress.update(what, f); },
                        [&](const char* what) { progress.working(what); }});
-  const bool lit = !scene->lights.empty() && !a.no_light;
+  // The light volumes show only where a material has an albedo (in-scatter, diffuse surfaces):
+  // without one a simulation (an hour for a lit faceted gem) would change no pixel.
+  const bool lit = !scene->lights.empty() && !a.no_light && scene->anyScattering();
+  if (!scene->lights.empty() && !a.no_light && !lit) std::fputs(kLightsNotSimulatedNote, stderr);
   if (!a.reference) {
     session.context();  // what prepare() does first, marked apart from the voxelising
     timings::mark("device created");

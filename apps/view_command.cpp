@@ -759,7 +759,10 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   glfwGetFramebufferSize(window.handle, &fw, &fh);
   vk::Swapchain chain(ctx, surface, uint32_t(fw), uint32_t(fh));
   std::unique_ptr<LightMover> mover;
-  if (!scene->lights.empty() && !a.no_light)
+  // As eikon render: the light volumes show only where a material has an albedo.
+  if (!scene->lights.empty() && !a.no_light && !scene->anyScattering())
+    std::fputs(kLightsNotSimulatedNote, stderr);
+  if (!scene->lights.empty() && !a.no_light && scene->anyScattering())
     mover = std::make_unique<LightMover>(*scene, lightOnCpu("auto", &ctx), defaultLightCacheDir());
   // Input is handled from here on: events that arrive while the scene is voxelised (polled by
   // the progress callbacks) already move the camera of the first frame.

@@ -828,6 +828,14 @@ bool Scene::anyUniaxial() const {
                      [](const auto& m) { return m.second.uniaxial; });
 }
 
+bool Scene::anyScattering() const {
+  // As the voxeliser sets VolumeSet::scattering: an albedo that is non-zero as a float.
+  return std::any_of(materials.begin(), materials.end(), [](const auto& m) {
+    const glm::dvec3& a = m.second.albedo;
+    return float(a.x) != 0.0f || float(a.y) != 0.0f || float(a.z) != 0.0f;
+  });
+}
+
 bool Scene::anyDispersive() const {
   return std::any_of(materials.begin(), materials.end(), [](const auto& m) {
     return !m.second.n_o.isDispersionless() || !m.second.n_e.isDispersionless();

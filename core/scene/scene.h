@@ -175,6 +175,9 @@ struct Scene {
 
   bool anyUniaxial() const;
   bool anyDispersive() const;
+  /// Some material has an albedo (a translucent medium's in-scatter or a diffuse surface): the
+  /// only places a render shows the light volumes of the scene's lights (VolumeSet::scattering).
+  bool anyScattering() const;
 };
 
 /// Parse a scene file. Material names not defined in the file are looked up in the material

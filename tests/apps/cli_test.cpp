@@ -234,7 +234,9 @@ std::vector<std::string> progressLines(const std::string& err, const std::string
 // --progress always shows each stage with elapsed time and ETA, its first report and its 100%.
 // The lit scene has all three stages: voxelising, light, rendering.
 TEST_F(Cli, RenderProgressOnlyWhenAskedOrOnATerminal) {
-  std::string lit = tinyScene();
+  // A translucent ball with an albedo: its in-scatter shows the light (without one the lights
+  // are not simulated, LightsWithoutAnAlbedoAreNotSimulated); attenuating, it is lit in 3 bands.
+  std::string lit = tinyScene("", R"({"n": 1.5, "attenuation_per_mm": 0.1, "albedo": 0.5})");
   lit.insert(lit.rfind('}'),
              R"(, "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}])");
   const std::string light = " --reference --light-split 8 --light-step 2 --no-light-cache";
@@ -248,7 +250,7 @@ TEST_F(Cli, RenderProgressOnlyWhenAskedOrOnATerminal) {
   EXPECT_EQ(never.err, "");
   const Outcome forced = render(lit, light + " --progress always");
   ASSERT_EQ(forced.code, 0) << forced.err;
-  for (const char* stage : {"voxelising", "light 1 light x 1 band x 1 mode", "rendering"}) {
+  for (const char* stage : {"voxelising", "light 1 light x 3 bands x 1 mode", "rendering"}) {
     const auto lines = progressLines(forced.err, stage);
     ASSERT_FALSE(lines.empty()) << stage << ":\n" << forced.err;
     EXPECT_NE(lines.back().find("100.0%"), std::string::npos) << lines.back();
@@ -791,6 +793,32 @@ TEST_F(Cli, RenderSimulatesLightOnceThenUsesTheCache) {
   double diff = 0;
   for (size_t i = 0; i < a.size(); ++i) diff += std::abs(double(g[i]) - a[i]);
   EXPECT_LT(diff, 1e-3 * lit_sum);
+}
+
+// The light volumes show only where a material has an albedo (in-scatter, a diffuse surface):
+// without one the lights are not simulated (a lit faceted gem took an hour for no pixel), the
+// user is told why, and the picture is the unlit one.
+TEST_F(Cli, LightsWithoutAnAlbedoAreNotSimulated) {
+  const std::string scene = R"({
+  "camera": {"position": [0, 20, -20], "look_at": [0, -2, 0], "up": [0, 1, 0], "fov_deg": 30, "width": 32, "height": 24},
+  "environment": {"type": "constant", "radiance": 0.1},
+  "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "resolution": 24},
+  "materials": {"glass": {"n": 1.5}, "floor": {"n": 1, "opacity": 1}},
+  "objects": [{"shape": "box", "center": [0, -3.5, 0], "size": [8, 1, 8], "material": "floor"},
+              {"shape": "sphere", "center": [0, 0.5, 0], "radius": 2.5, "material": "glass"}],
+  "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 2}]
+})";
+  const Outcome lit = render(scene, "-q --no-light-cache");
+  ASSERT_EQ(lit.code, 0) << lit.err;
+  EXPECT_NE(lit.err.find("the lights are not simulated: no material has an albedo"),
+            std::string::npos)
+      << lit.err;
+  EXPECT_EQ(lit.out.find("simulated"), std::string::npos) << lit.out;
+  const std::vector<float> a = eikon::readExrRgba(outPath(), 64, 64).rgba;
+  const Outcome dark = render(scene, "-q --no-light");
+  ASSERT_EQ(dark.code, 0) << dark.err;
+  EXPECT_EQ(dark.err.find("not simulated"), std::string::npos) << dark.err;
+  EXPECT_EQ(a, eikon::readExrRgba(outPath(), 64, 64).rgba);
 }
 
 TEST_F(Cli, BadLightOptionsFailCleanly) {
