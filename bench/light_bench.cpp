@@ -20,8 +20,14 @@
 // (WavefrontSettings::threads; default 0 = hardware concurrency) and print each one's speed-up
 // over the first; --no-gpu: skip the GPU twin (and Vulkan).
 //
+// --caustics pass: light goes on through fold caustics, as renders simulate it (the default here
+// is the simulator's own, kill). --no-straight-to-boundary: sharp straight steps on the skip
+// distances only (WavefrontSettings::straight_to_boundary), for the before/after of
+// docs/performance.md "Lit gems". Each run prints its tears (torn patches made pencils).
+//
 //   light_bench [--resolution N] [--no-skip-resolution M] [--steps-per-dispatch K] [--no-cpu]
 //               [--no-gpu] [--threads T1,T2,…] [--sharp] [--interfaces smoothed,sharp] [--no-low]
+//               [--caustics kill|pass] [--no-straight-to-boundary]
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -81,6 +87,7 @@ struct Pair {
 int gStepsPerDispatch = 16;
 bool gSharp = false;              ///< --sharp
 bool gPassCaustics = false;       ///< --caustics pass
+bool gToBoundary = true;          ///< !--no-straight-to-boundary
 std::vector<int> gThreads = {0};  ///< CPU reference thread counts (0: hardware concurrency)
 
 Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu) {
@@ -90,6 +97,7 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
   s.skip_empty = skip;
   s.sharp_interfaces = gSharp;
   s.pass_caustics = gPassCaustics;
+  s.straight_to_boundary = gToBoundary;
   // The CPU twin's set-up (its skip distances and media; the field), timed as the GPU's is.
   const auto tc = std::chrono::steady_clock::now();
   const SharpInterfaces sharp =
@@ -172,6 +180,9 @@ int main(int argc, char** argv) {
          "kill (Tevs, WavefrontSettings' default) or pass (light continues through a focus, "
          "as renders simulate it)")
       ->check(CLI::IsMember({"kill", "pass"}));
+  app.add_flag("!--no-straight-to-boundary", gToBoundary,
+               "Sharp: straight steps on the skip distances only, not up to each corner's next "
+               "boundary (WavefrontSettings::straight_to_boundary)");
   bool lowRuns = true;
   app.add_flag("!--no-low", lowRuns,
                "Skip the runs without straight steps at the lower resolution");
