@@ -432,6 +432,7 @@ struct BoundaryCrossing {
   vec3 normal;  // unit, from `from` into `to` (analytic when asked)
   int from;
   int to;
+  int face;  // the owner polyhedron's plane crossed (convexCrossing); −1: not known
 };
 
 // Refine a crossing on the owner shape's exact signed distance: the nearest sign change to t,
@@ -516,6 +517,7 @@ BoundaryCrossing locateCrossing(vec3 a, vec3 b, float tolVoxels, bool analytic) 
   out_.normal = vec3(0.0);
   out_.from = boundaryRegion(a);
   out_.to = 0;
+  out_.face = -1;
   vec3 ua = boundaryToVoxel(a), du = boundaryToVoxel(b) - ua;
   float lenVox = length(du);
   if (!(lenVox > 0.0)) return out_;
@@ -665,6 +667,7 @@ BoundaryCrossing noCrossing(vec3 b, int region) {
   c.normal = vec3(0.0);
   c.from = region;
   c.to = region;
+  c.face = -1;
   return c;
 }
 
@@ -702,6 +705,7 @@ BoundaryCrossing convexFound(vec3 a, vec3 b, int region, float t, int shape, int
   c.point = mix(a, b, t);
   c.normal = (inside ? 1.0 : -1.0) * normalize(n);
   c.to = inside ? 0 : shape + 1;
+  c.face = face;
   return c;
 }
 

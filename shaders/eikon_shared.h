@@ -329,13 +329,17 @@ struct WavePatch {
   ivec4 region; // sharp interfaces: corner k's region (bits 0–15; −1: not located yet), its
                 // mirror bit EIKON_CORNER_MIRRORED (odd number of total internal reflections) and
                 // its boundary events modulo 256 (bits 17–24: region changes and mirrors; a patch
-                // whose corners disagree is torn, Patch::events)
+                // whose corners disagree is torn, Patch::events) and its face digest (bits 25–30)
 };
 #define EIKON_CORNER_REGION 0xFFFF
 #define EIKON_CORNER_MIRRORED 0x10000
 #define EIKON_CORNER_EVENT_SHIFT 17
 #define EIKON_CORNER_EVENT 0x20000
 #define EIKON_CORNER_EVENTS 0x1FE0000
+// Bits 25–30: a 6-bit digest of the polyhedron faces the corner crossed (Patch::faces,
+// faceDigest in core/light/wavefront_types.h and wavefront.comp).
+#define EIKON_CORNER_FACE_SHIFT 25
+#define EIKON_CORNER_FACES 0x7E000000
 
 #ifdef __cplusplus
 static_assert(sizeof(ViewParams) == 16 * 16, "ViewParams must be vec4-packed");

@@ -388,10 +388,10 @@ bool anyMirrored(ivec4 region) { return any(notEqual(region & EIKON_CORNER_MIRRO
 
 // The corners met different boundaries, or one boundary with different outcomes (PatchStepper::torn
 // in wavefront.cpp): event counts (modulo 256) more than one apart, or equal counts with different
-// regions or mirror bits.
+// regions, mirror bits or face digests.
 bool torn(ivec4 region) {
   const ivec4 ev = (region & EIKON_CORNER_EVENTS) >> EIKON_CORNER_EVENT_SHIFT;
-  const ivec4 side = region & (EIKON_CORNER_REGION | EIKON_CORNER_MIRRORED);
+  const ivec4 side = region & (EIKON_CORNER_REGION | EIKON_CORNER_MIRRORED | EIKON_CORNER_FACES);
   bool t = false;
   for (int a = 0; a < 4; ++a)
     for (int b = a + 1; b < 4; ++b) {
@@ -400,6 +400,10 @@ bool torn(ivec4 region) {
     }
   return t;
 }
+
+// The face digest after crossing plane `face` (≥ 0) of region `owner`'s polyhedron (faceDigest in
+// core/light/wavefront_types.h).
+int faceDigest(int h, int owner, int face) { return (h * 17 + 7 * owner + face + 1) & 63; }
 
 // Corner k's event count + 1 (modulo 256), its region and mirror bit unchanged.
 int addEvent(int corner) {
@@ -553,6 +557,11 @@ bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, i
   const vec3 aA = mediumRow(A, 7).xyz, aB = mediumRow(B, 7).xyz;
   const bool same = noA == noB && neA == neB && (!uA || aA == aB);
   corner = addEvent(corner);  // every region change or mirror is an event (torn)
+  if (c.face >= 0) {
+    const int h = (corner & EIKON_CORNER_FACES) >> EIKON_CORNER_FACE_SHIFT;
+    corner = (corner & ~EIKON_CORNER_FACES) |
+             (faceDigest(h, max(A, B), c.face) << EIKON_CORNER_FACE_SHIFT);
+  }
   if (same || mediumOpaque(B) || !(length(N) > 0.0)) {
     corner = (corner & ~EIKON_CORNER_REGION) | B;
     return false;

@@ -133,7 +133,17 @@ struct Patch {
   /// those with equal counts agree on region and mirror; otherwise the patch is torn (see
   /// WavefrontStats::tears).
   std::array<int, 4> events{};
+  /// Sharp interfaces: each corner's digest of the polyhedron faces it crossed (faceDigest, 6
+  /// bits; unchanged by crossings whose face the search does not give).
+  /// Corners of equal event counts but different digests crossed different facets: torn too.
+  std::array<int, 4> faces{};
 };
+
+/// The face digest of a corner (Patch::faces) after it crossed plane `face` (≥ 0) of region
+/// `owner`'s polyhedron: 6 bits, as the GPU twin keeps it in its corner word (wavefront.comp
+/// faceDigest). Faces of one shape differ in their first crossing; later collisions (1 in 64)
+/// only leave a tear unseen.
+inline int faceDigest(int h, int owner, int face) { return (h * 17 + 7 * owner + face + 1) & 63; }
 
 struct WavefrontStats {
   int steps = 0;  ///< most time steps taken by one patch (a straight step of k counts k)

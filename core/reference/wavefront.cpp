@@ -344,6 +344,8 @@ bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k,
   glm::dvec3 N = glm::length(c.normal) > 0 ? c.normal : c.field_normal;
   const bool same = a.n == b.n && a.n_e == b.n_e && (a.n_e == 0.0 || a.axis == b.axis);
   ++p.events[size_t(k)];  // every region change or mirror is an event (torn)
+  if (c.face >= 0)
+    p.faces[size_t(k)] = faceDigest(p.faces[size_t(k)], std::max(c.from, c.to), c.face);
   if (same || b.opaque || !(glm::length(N) > 0)) {
     p.region[size_t(k)] = c.to;
     return false;
@@ -493,7 +495,8 @@ bool PatchStepper::torn(const Patch& p) const {
   for (size_t a = 0; a < 4; ++a)
     for (size_t b = a + 1; b < 4; ++b)
       if (p.events[a] == p.events[b] &&
-          (p.region[a] != p.region[b] || ((p.mirrored >> a) & 1u) != ((p.mirrored >> b) & 1u)))
+          (p.region[a] != p.region[b] || ((p.mirrored >> a) & 1u) != ((p.mirrored >> b) & 1u) ||
+           p.faces[a] != p.faces[b]))
         return true;
   return false;
 }
@@ -755,6 +758,7 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
       c.w.fill(p0.w[k]);
       c.region.fill(p0.region[k]);
       c.events.fill(p0.events[k]);
+      c.faces.fill(p0.faces[k]);
       c.mirrored = ((p0.mirrored >> k) & 1u) ? 15u : 0u;
       c.energy = 0.25 * p0.energy;
       c.area0 = 0.25 * p0.area0;

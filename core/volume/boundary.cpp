@@ -465,6 +465,7 @@ BoundaryCrossing convexCrossingOutOf(const BoundaryField& bf, const glm::dvec3& 
   out.point = a + t * (b - a);
   out.normal = (region >= 1 ? 1.0 : -1.0) * glm::normalize(n);
   out.owner = shape + 1;
+  out.face = face;
   out.from_medium = bf.medium[size_t(out.from)];
   out.to_medium = bf.medium[size_t(out.to)];
   glm::dvec3 grad;

@@ -109,6 +109,9 @@ struct BoundaryCrossing {
   int from = 0, to = 0;          ///< regions on the two sides
   int from_medium = 0, to_medium = 0;
   int owner = 0;  ///< the region whose shape's surface is crossed: max(from, to)
+  /// The plane of the owner's polyhedron crossed (convexCrossingOutOf, boundary.glsl's plane
+  /// order); −1 where the search does not say (curved shapes, the exact path, the walk).
+  int face = -1;
 };
 
 /// The first point where the segment [a, b] (world, mm) leaves the region of `a`: a walk over
