@@ -107,7 +107,10 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
   std::printf("\nvolume %dx%dx%d (h = %.4g mm), straight steps %s, interfaces %s\n",
               vol.grid.dims[0], vol.grid.dims[1], vol.grid.dims[2], vol.grid.h,
               skip ? "on (skip_empty = true)" : "off (skip_empty = false)",
-              sharp.active() ? "sharp" : "smoothed");
+              !sharp.active()             ? "smoothed"
+              : vol.boundary.convex_apart ? "sharp (crossings on the planes: faces known)"
+              : vol.boundary.exact        ? "sharp (crossings on the shapes)"
+                                          : "sharp (crossings by the walk)");
   Pair p;
   if (ctx) {
     // Set-up (uploads, the pipelines' compilation) apart: a render pays it once per scene.
