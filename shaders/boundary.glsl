@@ -790,6 +790,7 @@ struct LineClip {
   bool hit;
   float t0, t1;  // the line o + t·d inside the shape for t ∈ [t0, t1]
   vec3 n0, n1;   // local outward normals at the two ends
+  int f0, f1;    // the polyhedron's planes there (LineClip::f0, f1 in shapes.h); −1: curved, open
 };
 
 LineClip clipOpen() {
@@ -799,19 +800,23 @@ LineClip clipOpen() {
   c.t1 = 3.0e38;
   c.n0 = vec3(0.0);
   c.n1 = vec3(0.0);
+  c.f0 = -1;
+  c.f1 = -1;
   return c;
 }
 
 // The slab of one plane n·(p + t q) ≤ d narrows [t0, t1] (shapes.cpp clipPlane).
-void clipPlaneInto(vec3 n, float d, vec3 p, vec3 q, inout LineClip c) {
+void clipPlaneInto(vec3 n, float d, vec3 p, vec3 q, int face, inout LineClip c) {
   float denom = dot(n, q), num = d - dot(n, p);
   float t = num / (denom != 0.0 ? denom : 1.0);
   if (denom > 0.0 && t < c.t1) {
     c.t1 = t;
     c.n1 = n;
+    c.f1 = face;
   } else if (denom < 0.0 && t > c.t0) {
     c.t0 = t;
     c.n0 = n;
+    c.f0 = face;
   } else if (denom == 0.0 && num < 0.0) {
     c.hit = false;  // parallel to the plane and outside it
   }
@@ -922,13 +927,17 @@ LineClip exactClip(int s, vec3 o, vec3 d) {
       } else {
         pl = EIKON_EXACT_ROW(min(first + i, kExactMaxRows - 1));
       }
-      clipPlaneInto(pl.xyz, pl.w, p, q, c);
+      clipPlaneInto(pl.xyz, pl.w, p, q, i, c);
     }
     k += kExactPlanesPerPass;
     if (k >= count) break;
   }
   c.hit = c.hit && c.t0 <= c.t1;
-  if (rounded && c.hit) return clipRoundedBoxLocal(p, q, par, c);
+  if (rounded && c.hit) {
+    LineClip r = clipRoundedBoxLocal(p, q, par, c);
+    r.f0 = r.f1 = -1;  // curved where it matters
+    return r;
+  }
   return c;
 }
 
@@ -994,19 +1003,22 @@ int regionAt(vec3 x) { return EIKON_REGION_ON_SHAPES ? exactRegionAt(x) : bounda
 // ~2 × the shape count loop passes and no voxel read per crossing.
 // One shape's clip folded into pass 0 (the ray's own shape: where the line leaves it; a later one:
 // where it enters) or pass 1 (the last shape holding the point tq just past the crossing).
-void exactPass0(int i, int region, float eps, LineClip c, inout float t, inout vec3 nOwn) {
+void exactPass0(int i, int region, float eps, LineClip c, inout float t, inout vec3 nOwn,
+                inout int fOwn) {
   if (!c.hit) return;
   if (i + 1 == region) {
     t = min(t, max(c.t1, 0.0));
     nOwn = c.n1;
+    fOwn = c.f1;
   } else if (c.t0 > eps && c.t1 - c.t0 > eps) {
     t = min(t, c.t0);
   }
 }
-void exactPass1(int i, float tq, LineClip c, inout int to, inout vec3 nTo) {
+void exactPass1(int i, float tq, LineClip c, inout int to, inout vec3 nTo, inout int fTo) {
   if (c.hit && c.t0 <= tq && tq <= c.t1) {
     to = i + 1;
     nTo = c.n0;
+    fTo = c.f0;
   }
 }
 
@@ -1018,7 +1030,7 @@ BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
   if (!(len > 0.0)) return out_;
   float eps = kExactMergeVoxels * P.grid_origin.w / len;
   float t = 2.0, tq = 0.0;
-  int to = 0;
+  int to = 0, fOwn = -1, fTo = -1;
   vec3 nOwn = vec3(0.0), nTo = vec3(0.0);
   const int S = EIKON_BOUNDARY_EXACT_SHAPES;
   bool none = false;
@@ -1027,10 +1039,10 @@ BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
     LineClip clips[kExactUnrollShapes];
     [[unroll]] for (int i = 0; i < S; ++i) clips[i] = exactClip(i, a, d);
     [[unroll]] for (int i = 0; i < S; ++i)
-      if (i >= region - 1) exactPass0(i, region, eps, clips[i], t, nOwn);
+      if (i >= region - 1) exactPass0(i, region, eps, clips[i], t, nOwn, fOwn);
     none = t > 1.0;
     tq = t + eps;
-    [[unroll]] for (int i = 0; i < S; ++i) exactPass1(i, tq, clips[i], to, nTo);
+    [[unroll]] for (int i = 0; i < S; ++i) exactPass1(i, tq, clips[i], to, nTo, fTo);
   } else {
     // Both passes in one do-while over k: shape k of pass 0 for k < S (from the ray's own shape
     // on), shape k − S of pass 1 after it. llvmpipe leaves a loop only at the end of its body, so
@@ -1046,8 +1058,8 @@ BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
       if (!none) {
         const int i = second ? k - S : k;
         LineClip c = exactClip(i, a, d);
-        if (second) exactPass1(i, tq, c, to, nTo);
-        else exactPass0(i, region, eps, c, t, nOwn);
+        if (second) exactPass1(i, tq, c, to, nTo, fTo);
+        else exactPass0(i, region, eps, c, t, nOwn, fOwn);
       }
       ++k;
     } while (k < 2 * S && !none);
@@ -1060,6 +1072,7 @@ BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
   out_.point = a + t * d;
   out_.normal = length(n) > 0.0 ? normalize(n) : n;
   out_.to = to;
+  out_.face = to == owner ? fTo : fOwn;
   return out_;
 }
 

@@ -296,15 +296,15 @@ LineClip clipSphere(const glm::dvec3& p, const glm::dvec3& q, double r) {
 }
 
 // The slab of one plane n·(p + t q) ≤ d narrows [t0, t1]; false when the line misses it.
-bool clipPlane(const glm::dvec3& n, double d, const glm::dvec3& p, const glm::dvec3& q,
+bool clipPlane(const glm::dvec3& n, double d, const glm::dvec3& p, const glm::dvec3& q, int face,
                LineClip& c) {
   const double denom = glm::dot(n, q), num = d - glm::dot(n, p);
   if (denom > 0.0) {
     const double t = num / denom;
-    if (t < c.t1) c.t1 = t, c.n1 = n;
+    if (t < c.t1) c.t1 = t, c.n1 = n, c.f1 = face;
   } else if (denom < 0.0) {
     const double t = num / denom;
-    if (t > c.t0) c.t0 = t, c.n0 = n;
+    if (t > c.t0) c.t0 = t, c.n0 = n, c.f0 = face;
   } else if (num < 0.0) {
     return false;  // parallel to the plane and outside it
   }
@@ -318,7 +318,8 @@ LineClip clipBox(const glm::dvec3& p, const glm::dvec3& q, const glm::dvec3& hal
   for (int a = 0; a < 3; ++a) {
     glm::dvec3 n(0.0);
     n[a] = 1.0;
-    if (!clipPlane(n, half[a], p, q, c) || !clipPlane(-n, half[a], p, q, c)) return LineClip{};
+    if (!clipPlane(n, half[a], p, q, 2 * a + 1, c) || !clipPlane(-n, half[a], p, q, 2 * a, c))
+      return LineClip{};
   }
   c.hit = c.t0 <= c.t1 && std::isfinite(c.t0) && std::isfinite(c.t1);
   return c;
@@ -328,8 +329,8 @@ LineClip clipConvex(const glm::dvec3& p, const glm::dvec3& q, const std::vector<
   LineClip c;
   c.t0 = -std::numeric_limits<double>::infinity();
   c.t1 = std::numeric_limits<double>::infinity();
-  for (const Plane& pl : planes)
-    if (!clipPlane(pl.normal, pl.d, p, q, c)) return LineClip{};
+  for (size_t k = 0; k < planes.size(); ++k)
+    if (!clipPlane(planes[k].normal, planes[k].d, p, q, int(k), c)) return LineClip{};
   c.hit = c.t0 <= c.t1 && std::isfinite(c.t0) && std::isfinite(c.t1);
   return c;
 }

@@ -60,6 +60,9 @@ struct LineClip {
   bool hit = false;
   double t0 = 0.0, t1 = 0.0;
   glm::dvec3 n0{0.0}, n1{0.0};
+  /// The polyhedron's planes at the two ends (a box's ±x, ±y, ±z as 0–5, a convex shape's own
+  /// order); −1 on curved surfaces (spheres, rounded boxes) and open ends.
+  int f0 = -1, f1 = -1;
 };
 
 class Shape {

@@ -510,12 +510,14 @@ BoundaryCrossing exactCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a
   // it leaves at once) or first enters a later one. Earlier shapes are painted over by the ray's.
   double t = 2.0;
   glm::dvec3 n_own(0.0);
+  int f_own = -1;
   for (size_t i = region >= 1 ? size_t(region - 1) : 0; i < n; ++i) {
     const LineClip c = bf.shapes[i].clipLine(a, d);
     if (!c.hit) continue;
     if (int(i) + 1 == region) {
       t = std::min(t, std::max(c.t1, 0.0));
       n_own = c.n1;
+      f_own = c.f1;
     } else if (c.t0 > eps && c.t1 - c.t0 > eps) {
       t = std::min(t, c.t0);
     }
@@ -523,11 +525,11 @@ BoundaryCrossing exactCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a
   if (t > 1.0) return out;
   // Pass 2: the region just past t (the last shape whose interval holds it) and its entry normal.
   const double tq = t + eps;
-  int to = 0;
+  int to = 0, f_to = -1;
   glm::dvec3 n_to(0.0);
   for (size_t i = 0; i < n; ++i) {
     const LineClip c = bf.shapes[i].clipLine(a, d);
-    if (c.hit && c.t0 <= tq && tq <= c.t1) to = int(i) + 1, n_to = c.n0;
+    if (c.hit && c.t0 <= tq && tq <= c.t1) to = int(i) + 1, n_to = c.n0, f_to = c.f0;
   }
   if (to == region) return out;  // (unreachable but for rounding: no change of region)
   out.found = true;
@@ -540,6 +542,7 @@ BoundaryCrossing exactCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a
   // Entering the owner: its entry face, the normal pointing into it; leaving it (the ray's own
   // shape): its exit face, outward. Either way from `from` into `to`.
   const glm::dvec3 nrm = to == out.owner ? -n_to : n_own;
+  out.face = to == out.owner ? f_to : f_own;
   out.normal = glm::length(nrm) > 0.0 ? glm::normalize(nrm) : nrm;
   out.field_normal = out.normal;
   return out;

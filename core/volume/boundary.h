@@ -109,8 +109,8 @@ struct BoundaryCrossing {
   int from = 0, to = 0;          ///< regions on the two sides
   int from_medium = 0, to_medium = 0;
   int owner = 0;  ///< the region whose shape's surface is crossed: max(from, to)
-  /// The plane of the owner's polyhedron crossed (convexCrossingOutOf, boundary.glsl's plane
-  /// order); −1 where the search does not say (curved shapes, the exact path, the walk).
+  /// The plane of the owner's polyhedron crossed (convexCrossingOutOf, exactCrossingOutOf;
+  /// boundary.glsl's plane order); −1 on curved surfaces and where the walk found it.
   int face = -1;
 };
 
