@@ -144,12 +144,40 @@ class ViewerTest : public ::testing::Test {
       ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
       ::_exit(127);
     }
-    const std::string send = "DISPLAY=" + quote(server.display()) + " timeout 300 " +
-                             quote(xdotool) + " search --sync --onlyvisible --name 'eikon view'" +
-                             actions + " >/dev/null 2>&1";
-    EXPECT_EQ(std::system(send.c_str()), 0) << send;
     ViewerRun r;
-    EXPECT_EQ(::waitpid(viewer, &r.status, 0), viewer);
+    if (actions.empty()) {
+      // Nothing to send: a small view may converge and exit before a window search would see it.
+      EXPECT_EQ(::waitpid(viewer, &r.status, 0), viewer);
+    } else {
+      const std::string send = "exec env DISPLAY=" + quote(server.display()) + " timeout 300 " +
+                               quote(xdotool) + " search --sync --onlyvisible --name 'eikon view'" +
+                               actions + " >/dev/null 2>&1";
+      const pid_t sender = ::fork();
+      if (sender == 0) {
+        ::execl("/bin/sh", "sh", "-c", send.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+      }
+      // Whichever ends first: a viewer that exits before its window was found fails the test at
+      // once, with its stderr, rather than leaving the search to wait out its timeout.
+      int sent = -1;
+      bool viewer_done = false;
+      for (;;) {
+        if (::waitpid(sender, &sent, WNOHANG) == sender) break;
+        if (::waitpid(viewer, &r.status, WNOHANG) == viewer) {
+          viewer_done = true;
+          ::kill(sender, SIGTERM);
+          ::waitpid(sender, &sent, 0);
+          break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+      EXPECT_FALSE(viewer_done) << "the viewer exited before " << send << " was done:\n"
+                                << eikon::test::slurp(dir_ / "view.err");
+      EXPECT_TRUE(WIFEXITED(sent) && WEXITSTATUS(sent) == 0) << send;
+      if (!viewer_done) {
+        EXPECT_EQ(::waitpid(viewer, &r.status, 0), viewer);
+      }
+    }
     r.out = eikon::test::slurp(dir_ / "view.out");
     r.err = eikon::test::slurp(dir_ / "view.err");
     return r;
