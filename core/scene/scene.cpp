@@ -1217,6 +1217,16 @@ static void warnObjectsNearFaces(Scene& scene, const std::set<size_t>& covering,
   }
 }
 
+/// A material no object uses is left out (it was parsed and checked like the others): the
+/// volume's features (dispersive, attenuating, scattering, uniaxial…) are those of its materials,
+/// so an unused dispersive material would make a render spectral and its light 12 bands. Not a
+/// warning: a scene may keep a palette of materials to switch between, and --strict must pass.
+static void dropUnusedMaterials(Scene& scene) {
+  std::set<std::string> used;
+  for (const SceneObject& o : scene.objects) used.insert(o.material);
+  std::erase_if(scene.materials, [&](const auto& m) { return !used.count(m.first); });
+}
+
 // "interfaces": how material boundaries are represented (docs/scene-format.md).
 static Scene::Interfaces parseInterfaces(const Node& f) {
   const std::string m = f.string();
@@ -1247,6 +1257,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   std::vector<size_t> json_index;
   const std::set<size_t> covering = parseObjects(root.at("objects"), scene, file, json_index);
   warnObjectsNearFaces(scene, covering, json_index, file);
+  dropUnusedMaterials(scene);
   if (auto ls = root.get("lights")) {
     if (!ls->isArray()) ls->fail("expected an array of lights");
     for (size_t i = 0; i < ls->size(); ++i) scene.lights.push_back(parseLight(ls->index(i)));

@@ -399,6 +399,33 @@ TEST(SceneParse, CalciteFromTheLibrary) {
   EXPECT_TRUE(s.anyUniaxial());
 }
 
+// A material no object uses is left out, and nothing is said (a palette of materials is fine
+// under --strict): an unused dispersive, uniaxial or scattering material made the volume
+// dispersive (a spectral render, 12 light bands), uniaxial (two modes) or lit where nothing in it
+// is. It is still checked: a bad one is an error.
+TEST(SceneParse, UnusedMaterialsAreLeftOut) {
+  const std::string text = R"({
+    "volume": {"bounds_min": [-10, -10, -10], "bounds_max": [10, 10, 10], "resolution": 16},
+    "materials": {"plain": {"n": 1.5},
+                  "spare": {"n": {"cauchy": [1.5, 0.004]}, "albedo": 0.5, "opacity": 1},
+                  "crystal": {"n_o": 1.6, "n_e": 1.5, "optic_axis": [0, 0, 1]}},
+    "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "plain"}]
+  })";
+  Scene s;
+  ASSERT_NO_THROW(s = parseScene(text, kOrigin));
+  EXPECT_EQ(s.materials.count("plain"), 1u);
+  EXPECT_EQ(s.materials.count("spare"), 0u);
+  EXPECT_EQ(s.materials.count("crystal"), 0u);
+  EXPECT_FALSE(s.anyDispersive());
+  EXPECT_FALSE(s.anyScattering());
+  EXPECT_FALSE(s.anyUniaxial());
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  std::string bad = text;
+  const std::string diffuse = "\"albedo\": 0.5, \"opacity\": 1";
+  bad.replace(bad.find(diffuse), diffuse.size(), "\"albedo\": 0.5");  // needs an attenuation
+  EXPECT_THROW(parseScene(bad, kOrigin), SceneError);
+}
+
 // Every material in the library loads (the library lookup must not reject its own files).
 TEST(SceneParse, EveryLibraryMaterialLoads) {
   int n = 0;
