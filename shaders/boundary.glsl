@@ -183,9 +183,11 @@ vec3 meshPermute(vec3 v, int kx, int ky, int kz) { return vec3(v[kx], v[ky], v[k
 // test). gMeshPasses counts the passes (boundary_probe reports them).
 int gMeshPasses = 0;
 bool meshFirstHit(int s, vec3 o, vec3 d, float t0, float t1, float facing, out float tHit,
-                  out vec3 nHit) {
+                  out vec3 nHit, out int faceHit) {
   tHit = t1;
   nHit = vec3(0.0);
+  faceHit = -1;
+  int leafHit = 0;  // the hit triangle's place in the leaves' order
   vec4 head = EIKON_SHAPE_ROW(EIKON_SHAPE_STRIDE * s);
   int nodes = int(head.y), tris = int(head.w);
   vec3 ad = abs(d);
@@ -223,7 +225,8 @@ bool meshFirstHit(int s, vec3 o, vec3 d, float t0, float t1, float facing, out f
         if ((leftFirst ? el : er) < 3.0e38) stack[top++] = leftFirst ? l : r;
       } else {
         [[unroll]] for (int j = 0; j < EIKON_MESH_LEAF; ++j) {
-          int k = tris + 3 * (first + min(j, count - 1));
+          int leaf = first + min(j, count - 1);
+          int k = tris + 3 * leaf;
           vec4 va = EIKON_SHAPE_ROW(k), vb = EIKON_SHAPE_ROW(k + 1), vc = EIKON_SHAPE_ROW(k + 2);
           vec3 n = vec3(va.w, vb.w, vc.w);
           if (j < count && dot(n, d) * facing > 0.0) {
@@ -234,6 +237,7 @@ bool meshFirstHit(int s, vec3 o, vec3 d, float t0, float t1, float facing, out f
               found = true;
               tHit = t;
               nHit = n;
+              leafHit = leaf;
             }
           }
         }
@@ -247,6 +251,8 @@ bool meshFirstHit(int s, vec3 o, vec3 d, float t0, float t1, float facing, out f
     }
   }
   gMeshPasses += pass;
+  if (found) faceHit = int(EIKON_SHAPE_ROW(int(EIKON_SHAPE_ROW(EIKON_SHAPE_STRIDE * s + 5).z) +
+                                           leafHit / 4)[leafHit % 4]);
   return found;
 }
 
@@ -432,7 +438,7 @@ struct BoundaryCrossing {
   vec3 normal;  // unit, from `from` into `to` (analytic when asked)
   int from;
   int to;
-  int face;  // the owner polyhedron's plane crossed (convexCrossing); −1: not known
+  int face;  // the owner polyhedron's plane crossed (convexCrossing), a mesh's face colour; −1: not known
 };
 
 // Refine a crossing on the owner shape's exact signed distance: the nearest sign change to t,
@@ -466,10 +472,12 @@ void boundaryMeshCrossing(int s, bool leavingOwner, vec3 a, vec3 b, float lenVox
   vec3 d = vec3(dot(R0, ba), dot(R1, ba), dot(R2, ba));
   float w = 3.2 / lenVox, tHit;
   vec3 n;
+  int face;
   if (!meshFirstHit(s, shapeLocal(s, a), d, max(0.0, c.t - w), min(1.0, c.t + w),
-                    leavingOwner ? 1.0 : -1.0, tHit, n))
+                    leavingOwner ? 1.0 : -1.0, tHit, n, face))
     return;
   c.t = tHit;
+  c.face = face;
   c.point = mix(a, b, tHit);
   c.normal = (leavingOwner ? 1.0 : -1.0) * normalize(n.x * R0 + n.y * R1 + n.z * R2);
 }
@@ -948,7 +956,51 @@ vec3 exactToWorld(int s, vec3 n) {
          n.z * EIKON_EXACT_ROW(off + 4).xyz;
 }
 
-// Whether world point x lies in shape s (signed distance ≤ 0, Shape::signedDistance's sign).
+// A mesh's part in exactCrossingOutOf (boundary.cpp meshClip), as the interval the two passes
+// read of an analytic shape: the ray's own mesh (own): where the line a + t·d first leaves it in
+// (0, 1] (t1, its triangle's local normal and face colour; t0 open, t1 open if it does not
+// leave); a later one: where the line first enters it in (eps, 1] (t0, t1 = t0 + 2·eps: a mesh is
+// not grazed). Only the first change along the line counts.
+LineClip exactMeshClip(int s, vec3 a, vec3 d, bool own, float eps) {
+  int o = EIKON_SHAPE_STRIDE * s;
+  vec3 dl = vec3(dot(EIKON_SHAPE_ROW(o + 2).xyz, d), dot(EIKON_SHAPE_ROW(o + 3).xyz, d),
+                 dot(EIKON_SHAPE_ROW(o + 4).xyz, d));
+  float tHit;
+  vec3 n;
+  int face;
+  bool found = meshFirstHit(s, shapeLocal(s, a), dl, own ? 0.0 : eps, 1.0, own ? 1.0 : -1.0,
+                            tHit, n, face);
+  LineClip c = clipOpen();
+  if (own) {
+    if (found) {
+      c.t1 = tHit;
+      c.n1 = n;
+      c.f1 = face;
+    }
+  } else {
+    c.hit = found;
+    c.t0 = tHit;
+    c.t1 = tHit + 2.0 * eps;
+    c.n0 = n;
+    c.f0 = face;
+  }
+  return c;
+}
+
+// Whether mesh s holds the point o + tq·d of the local line (boundary.cpp meshHolds): the line's
+// first crossing past tq, out to beyond the mesh's bounding sphere (radius: the record's [5].w),
+// leaves it (parity along the line of a closed mesh; the watertight hits let none slip through).
+bool exactMeshHolds(int s, vec3 o, vec3 d, float tq) {
+  float radius = EIKON_SHAPE_ROW(EIKON_SHAPE_STRIDE * s + 5).w;
+  float far = tq + (length(o) + 2.0 * radius + 1.0) / length(d);
+  float tHit;
+  vec3 n;
+  int face;
+  return meshFirstHit(s, o, d, tq, far, 0.0, tHit, n, face) && dot(n, d) > 0.0;
+}
+
+// Whether world point x lies in shape s (signed distance ≤ 0, Shape::signedDistance's sign; a
+// mesh: exactMeshHolds along a fixed direction from x).
 bool exactInside(int s, vec3 x) {
   int off = EIKON_SHAPE_STRIDE * s;
   vec4 head = EIKON_EXACT_ROW(off), par = EIKON_EXACT_ROW(off + 5);
@@ -956,6 +1008,8 @@ bool exactInside(int s, vec3 x) {
   vec3 p = vec3(dot(EIKON_EXACT_ROW(off + 2).xyz, y), dot(EIKON_EXACT_ROW(off + 3).xyz, y),
                 dot(EIKON_EXACT_ROW(off + 4).xyz, y));
   int kind = int(head.x);
+  if (EIKON_EXACT_HAS(EIKON_SHAPE_MESH) && kind == EIKON_SHAPE_MESH)
+    return exactMeshHolds(s, p, vec3(0.5773502, 0.5773503, 0.5773504), 0.0);
   if (kind == EIKON_SHAPE_SPHERE) return length(p) <= par.x;
   if (kind == EIKON_SHAPE_BOX) return boxDistance(p, par.xyz) <= 0.0;
   if (kind == EIKON_SHAPE_ROUNDED_BOX) return boxDistance(p, par.xyz) <= par.w;
@@ -1022,6 +1076,26 @@ void exactPass1(int i, float tq, LineClip c, inout int to, inout vec3 nTo, inout
   }
 }
 
+// Shape i's clip for the passes: exactClip, or a mesh's exactMeshClip (the ray's own or a later
+// one; an earlier mesh is asked in pass 1 whether it holds tq: exactEarlierMeshClip).
+LineClip exactShapeClip(int i, vec3 a, vec3 d, int region, float eps) {
+  if (EIKON_EXACT_HAS(EIKON_SHAPE_MESH) && int(EIKON_EXACT_ROW(EIKON_SHAPE_STRIDE * i).x) == EIKON_SHAPE_MESH)
+    return exactMeshClip(i, a, d, i + 1 == region, eps);
+  return exactClip(i, a, d);
+}
+bool exactEarlierMesh(int i, int region) {
+  return EIKON_EXACT_HAS(EIKON_SHAPE_MESH) && i < region - 1 &&
+         int(EIKON_EXACT_ROW(EIKON_SHAPE_STRIDE * i).x) == EIKON_SHAPE_MESH;
+}
+LineClip exactEarlierMeshClip(int i, vec3 a, vec3 d, float tq) {
+  int o = EIKON_SHAPE_STRIDE * i;
+  vec3 dl = vec3(dot(EIKON_SHAPE_ROW(o + 2).xyz, d), dot(EIKON_SHAPE_ROW(o + 3).xyz, d),
+                 dot(EIKON_SHAPE_ROW(o + 4).xyz, d));
+  LineClip c = clipOpen();
+  c.hit = exactMeshHolds(i, shapeLocal(i, a), dl, tq);
+  return c;
+}
+
 BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
   exactLoadShapes();
   BoundaryCrossing out_ = noCrossing(b, region);
@@ -1037,12 +1111,15 @@ BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
   if (S <= kExactUnrollShapes) {
     // Each shape clipped once, both passes reading the clip (constant indices: registers).
     LineClip clips[kExactUnrollShapes];
-    [[unroll]] for (int i = 0; i < S; ++i) clips[i] = exactClip(i, a, d);
+    [[unroll]] for (int i = 0; i < S; ++i) clips[i] = exactShapeClip(i, a, d, region, eps);
     [[unroll]] for (int i = 0; i < S; ++i)
       if (i >= region - 1) exactPass0(i, region, eps, clips[i], t, nOwn, fOwn);
     none = t > 1.0;
     tq = t + eps;
-    [[unroll]] for (int i = 0; i < S; ++i) exactPass1(i, tq, clips[i], to, nTo, fTo);
+    [[unroll]] for (int i = 0; i < S; ++i) {
+      if (exactEarlierMesh(i, region)) clips[i] = exactEarlierMeshClip(i, a, d, tq);
+      exactPass1(i, tq, clips[i], to, nTo, fTo);
+    }
   } else {
     // Both passes in one do-while over k: shape k of pass 0 for k < S (from the ray's own shape
     // on), shape k − S of pass 1 after it. llvmpipe leaves a loop only at the end of its body, so
@@ -1057,7 +1134,8 @@ BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
       }
       if (!none) {
         const int i = second ? k - S : k;
-        LineClip c = exactClip(i, a, d);
+        LineClip c = second && exactEarlierMesh(i, region) ? exactEarlierMeshClip(i, a, d, tq)
+                                                           : exactShapeClip(i, a, d, region, eps);
         if (second) exactPass1(i, tq, c, to, nTo, fTo);
         else exactPass0(i, region, eps, c, t, nOwn, fOwn);
       }

@@ -126,14 +126,16 @@ using uvec4 = glm::uvec4;
 //   [1] (centre (mm), 0)
 //   [2..4] the columns of the local → world rotation R (local p = Rᵀ(x − c): p_i = col_i · (x − c))
 //   [5] sphere: (radius, 0, 0, 0); box: (size/2, 0); rounded box: (size/2 − radius, radius);
-//       mesh: (triangle count, hierarchy depth, 0, 0)
+//       mesh: (triangle count, hierarchy depth, first face colour (vec4 index), bounding radius)
 // then the planes of the convex shapes, (local unit outward normal, d): inside where n·p ≤ d,
-// and the meshes (a mesh's [0] is (EIKON_SHAPE_MESH, first node, node count, first triangle)):
+// and after every plane the meshes (a mesh's [0] is (EIKON_SHAPE_MESH, first node, node count, first triangle)):
 // its bounding-volume hierarchy (core/scene/mesh.h MeshDistance), node k at first node + 2k:
 //   (box min (local mm, padded outward), inner: the right child k' / leaf: its first triangle),
 //   (box max, 0 for an inner node (the left child is k + 1) / the leaf's triangle count ≤ 4);
 // and its triangles in the leaves' order, triangle j at first triangle + 3j: (corner 0, n.x),
-// (corner 1, n.y), (corner 2, n.z), n the unit outward normal, corners counter-clockwise outside.
+// (corner 1, n.y), (corner 2, n.z), n the unit outward normal, corners counter-clockwise outside;
+// then its triangles' face colours in the same order (MeshDistance::faceColours), four to a vec4:
+// triangle j's at component j % 4 of first face colour + j / 4.
 #define EIKON_SHAPE_STRIDE 6
 #define EIKON_SHAPE_SPHERE 0
 #define EIKON_SHAPE_BOX 1

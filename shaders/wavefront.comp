@@ -641,8 +641,10 @@ void sharpCorner(inout vec3 x, inout vec3 w, inout int corner, inout PatchStep s
 // signed distances are Euclidean (with a margin of kExactMergeVoxels for their rounding). The
 // same answer as the search (no crossing), so the CPU twin, whose search costs little, has none.
 bool shapesClear(vec3 x, float len) {
-  if (!EIKON_BOUNDARY_EXACT || EIKON_BOUNDARY_EXACT_SHAPES > kExactUnrollShapes ||
-      EIKON_EXACT_HAS(EIKON_SHAPE_CONVEX))
+  // (Two tests: glslang 11 makes invalid SPIR-V of a chain of four || over specialisation
+  // constants, an OpSpecConstantOp of the short circuit's OpPhi.)
+  if (!EIKON_BOUNDARY_EXACT || EIKON_BOUNDARY_EXACT_SHAPES > kExactUnrollShapes) return false;
+  if ((EIKON_BOUNDARY_EXACT_KINDS & ((1 << EIKON_SHAPE_CONVEX) | (1 << EIKON_SHAPE_MESH))) != 0)
     return false;
   const float margin = len + kExactMergeVoxels * P.grid_origin.w;
   bool clear = true;

@@ -1,6 +1,7 @@
 #include "core/render/boundary_device.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <type_traits>
@@ -28,7 +29,9 @@ void packMesh(const MeshShape& m, int base, std::vector<glm::vec4>& extra, glm::
   const int first_tri = first_node + 2 * int(nodes.size());
   head =
       glm::vec4(float(EIKON_SHAPE_MESH), float(first_node), float(nodes.size()), float(first_tri));
-  par = glm::vec4(float(d.triangles().size()), float(d.depth()), 0.0f, 0.0f);
+  const int first_colour = first_tri + 3 * int(d.triangles().size());
+  par = glm::vec4(float(d.triangles().size()), float(d.depth()), float(first_colour),
+                  float(d.boundingRadius()));
   const double pad = 2e-5 * std::max(d.boundingRadius(), 1.0);
   for (const MeshDistance::Node& n : nodes) {
     extra.push_back(glm::vec4(glm::vec3(n.lo - pad), float(n.first)));
@@ -39,12 +42,21 @@ void packMesh(const MeshShape& m, int base, std::vector<glm::vec4>& extra, glm::
     for (int k = 0; k < 3; ++k)
       extra.push_back(glm::vec4(glm::vec3(d.vertices()[d.triangles()[t][size_t(k)]]), float(n[k])));
   }
+  const auto& order = d.leafOrder();
+  for (size_t j = 0; j < order.size(); j += 4) {
+    glm::vec4 c(0.0f);
+    for (size_t k = 0; k < 4 && j + k < order.size(); ++k)
+      c[int(k)] = float(d.faceColours()[order[j + k]]);
+    extra.push_back(c);
+  }
 }
 
 // The shape record of one shape (eikon_shared.h): header, centre, rotation columns, parameters.
-// Its planes go to `planes` (vec4 indices counted from the table's start by the caller).
-void packShape(const Shape& shape, int first_plane, std::vector<glm::vec4>& out,
-               std::vector<glm::vec4>& planes) {
+// Its planes go to `planes`, a mesh's hierarchy and triangles to `meshes` (vec4 indices counted
+// from the table's start by the caller: the meshes after every plane, so that the exact path's
+// first rows hold all records and planes).
+void packShape(const Shape& shape, int first_plane, int first_mesh, std::vector<glm::vec4>& out,
+               std::vector<glm::vec4>& planes, std::vector<glm::vec4>& meshes) {
   glm::vec4 head(0.0f), par(0.0f);
   std::visit(
       [&](const auto& g) {
@@ -59,7 +71,7 @@ void packShape(const Shape& shape, int first_plane, std::vector<glm::vec4>& out,
           head.x = EIKON_SHAPE_ROUNDED_BOX;
           par = glm::vec4(glm::vec3(0.5 * g.size - glm::dvec3(g.radius)), float(g.radius));
         } else if constexpr (std::is_same_v<T, MeshShape>) {
-          packMesh(g, first_plane, planes, head, par);
+          packMesh(g, first_mesh, meshes, head, par);
         } else {
           head = glm::vec4(float(EIKON_SHAPE_CONVEX), float(first_plane + int(planes.size())),
                            float(g.planes.size()), 0.0f);
@@ -77,15 +89,17 @@ void packShape(const Shape& shape, int first_plane, std::vector<glm::vec4>& out,
 }  // namespace
 
 std::vector<glm::vec4> packShapeTable(const BoundaryField& field) {
-  std::vector<glm::vec4> table, planes;
+  std::vector<glm::vec4> table, planes, meshes;
   const int first_plane = EIKON_SHAPE_STRIDE * int(field.shapes.size());
-  for (const Shape& s : field.shapes) packShape(s, first_plane, table, planes);
+  const int first_mesh = exactTableRows(field.shapes);  // records and planes
+  for (const Shape& s : field.shapes) packShape(s, first_plane, first_mesh, table, planes, meshes);
   // Every record's header w: the number of shapes (boundary.glsl convexCrossing loops over them),
   // except a mesh's, whose w is its first triangle (convexCrossing never runs with a mesh).
   for (size_t r = 0; r < field.shapes.size(); ++r)
     if (int(table[r * EIKON_SHAPE_STRIDE].x) != EIKON_SHAPE_MESH)
       table[r * EIKON_SHAPE_STRIDE].w = float(field.shapes.size());
   table.insert(table.end(), planes.begin(), planes.end());
+  table.insert(table.end(), meshes.begin(), meshes.end());
   if (table.empty()) table.push_back(glm::vec4(0.0f));
   return table;
 }
@@ -102,14 +116,14 @@ void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field, const
                                  " voxels per side but the device allows at most " +
                                  std::to_string(lim.max_image_dimension_3d));
   // Records, planes and meshes, counted without packing: 6 vec4 per shape, one per plane, two per
-  // mesh node and three per triangle.
+  // mesh node, three per triangle and one per four triangles' face colours.
   double entries = EIKON_SHAPE_STRIDE * double(field.shapes.size());
   for (const Shape& s : field.shapes) {
     if (const auto* c = std::get_if<ConvexShape>(&s.geometry()))
       entries += double(c->planes.size());
     if (const auto* m = std::get_if<MeshShape>(&s.geometry())) {
-      entries +=
-          2.0 * double(m->distance->nodes().size()) + 3.0 * double(m->distance->triangles().size());
+      const double tris = double(m->distance->triangles().size());
+      entries += 2.0 * double(m->distance->nodes().size()) + 3.0 * tris + std::ceil(tris / 4.0);
       if (m->distance->depth() + 1 > EIKON_MESH_STACK)
         throw std::runtime_error(
             where + "a mesh's hierarchy is " + std::to_string(m->distance->depth()) +

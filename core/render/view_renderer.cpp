@@ -251,6 +251,7 @@ int exactConstant(const BoundaryField& bf) {
           if constexpr (std::is_same_v<T, BoxShape>) kinds |= 1 << EIKON_SHAPE_BOX;
           if constexpr (std::is_same_v<T, RoundedBoxShape>) kinds |= 1 << EIKON_SHAPE_ROUNDED_BOX;
           if constexpr (std::is_same_v<T, ConvexShape>) kinds |= 1 << EIKON_SHAPE_CONVEX;
+          if constexpr (std::is_same_v<T, MeshShape>) kinds |= 1 << EIKON_SHAPE_MESH;
         },
         shape.geometry());
   const int rows = exactTableRows(bf.shapes);  // ≤ kExactMaxRows (256) on the exact path

@@ -4,6 +4,7 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <array>
 #include <assimp/Importer.hpp>
 #include <cmath>
 #include <map>
@@ -171,8 +172,7 @@ void checkClosedMesh(const TriangleMesh& m, const std::string& name) {
                    " cubic file units): reverse their winding");
 }
 
-std::vector<Plane> meshFacePlanes(const TriangleMesh& m, const std::string& name,
-                                  size_t max_planes) {
+std::vector<uint32_t> meshFaces(const TriangleMesh& m, size_t* count) {
   const auto& v = m.vertices;
   const double tol = 1e-6 * diagonal(m);
   const size_t nt = m.triangles.size();
@@ -193,14 +193,78 @@ std::vector<Plane> meshFacePlanes(const TriangleMesh& m, const std::string& name
         std::abs(glm::dot(n[b], far(a, e[i]) - p)) <= tol)
       g.join(a, b);
   }
-  // One plane per face: the area-weighted normal, placed through the face's outermost corner.
-  std::map<size_t, size_t> face_of;
-  std::vector<glm::dvec3> sum;
-  for (size_t t = 0; t < nt; ++t) {
-    auto [it, fresh] = face_of.try_emplace(g.find(t), sum.size());
-    if (fresh) sum.emplace_back(0.0);
-    sum[it->second] += areaVector(m, t);
+  // Faces numbered in the order of their first triangle.
+  std::vector<uint32_t> face(nt);
+  std::map<size_t, uint32_t> id;
+  for (size_t t = 0; t < nt; ++t)
+    face[t] = id.try_emplace(g.find(t), uint32_t(id.size())).first->second;
+  if (count) *count = id.size();
+  return face;
+}
+
+std::vector<uint8_t> meshFaceColours(const TriangleMesh& m, const std::vector<uint32_t>& face,
+                                     size_t faces, size_t* clashes) {
+  // The faces around each vertex, then each face's neighbours (faces sharing a vertex with it).
+  std::vector<std::vector<uint32_t>> at(m.vertices.size()), near(faces);
+  for (size_t t = 0; t < m.triangles.size(); ++t)
+    for (uint32_t c : m.triangles[t]) at[c].push_back(face[t]);
+  for (auto& a : at) {
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+    for (uint32_t f : a)
+      for (uint32_t g : a)
+        if (g != f) near[f].push_back(g);
   }
+  for (auto& a : near) {
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+  }
+  // Greedy, most neighbours first (Welsh & Powell 1967). A face's neighbours must differ from it;
+  // the neighbours of its neighbours should (a patch may straddle a facet smaller than itself),
+  // where a colour is left. Each face starts its search at its own hash, so that the faces two
+  // apart that must share a colour do not all share colour 0.
+  constexpr int kColours = 64;
+  constexpr uint8_t kNone = 0xff;
+  std::vector<uint32_t> order(faces);
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t a, uint32_t b) { return near[a].size() > near[b].size(); });
+  std::vector<uint8_t> colour(faces, kNone);
+  size_t clash = 0;
+  for (uint32_t f : order) {
+    std::array<bool, kColours> hard{}, soft{};
+    for (uint32_t g : near[f]) {
+      if (colour[g] != kNone) hard[colour[g]] = true;
+      for (uint32_t h : near[g])
+        if (h != f && colour[h] != kNone) soft[colour[h]] = true;
+    }
+    const int start = int((f * 2654435761u) >> 26);  // Knuth's multiplicative hash, 6 bits
+    int pick = -1;
+    for (int pass = 0; pass < 2 && pick < 0; ++pass)
+      for (int k = 0; k < kColours && pick < 0; ++k) {
+        const int c = (start + k) % kColours;
+        if (!hard[size_t(c)] && (pass == 1 || !soft[size_t(c)])) pick = c;
+      }
+    if (pick < 0) {
+      pick = start;
+      ++clash;
+    }
+    colour[f] = uint8_t(pick);
+  }
+  if (clashes) *clashes = clash;
+  return colour;
+}
+
+std::vector<Plane> meshFacePlanes(const TriangleMesh& m, const std::string& name,
+                                  size_t max_planes) {
+  const auto& v = m.vertices;
+  const double tol = 1e-6 * diagonal(m);
+  const size_t nt = m.triangles.size();
+  size_t faces = 0;
+  const std::vector<uint32_t> face_of = meshFaces(m, &faces);
+  // One plane per face: the area-weighted normal, placed through the face's outermost corner.
+  std::vector<glm::dvec3> sum(faces, glm::dvec3(0.0));
+  for (size_t t = 0; t < nt; ++t) sum[face_of[t]] += areaVector(m, t);
   if (sum.size() > max_planes)
     fail(name, "the mesh has " + std::to_string(sum.size()) +
                    " faces (coplanar triangles count as one), more than a polyhedron's " +
@@ -209,7 +273,7 @@ std::vector<Plane> meshFacePlanes(const TriangleMesh& m, const std::string& name
   for (size_t f = 0; f < sum.size(); ++f) planes[f].normal = glm::normalize(sum[f]);
   std::vector<size_t> a_corner(sum.size(), 0);
   for (size_t t = 0; t < nt; ++t) {
-    const size_t f = face_of[g.find(t)];
+    const size_t f = face_of[t];
     for (uint32_t c : m.triangles[t])
       if (glm::dot(planes[f].normal, v[c]) > planes[f].d) {
         planes[f].d = glm::dot(planes[f].normal, v[c]);
@@ -297,6 +361,10 @@ MeshDistance::MeshDistance(const TriangleMesh& m)
       for (size_t k = 0; k < 3; ++k)
         if (t_[h->tri][k] == h->a) edge_n_[h->tri][k] = n;
   }
+  const std::vector<uint32_t> face = meshFaces(m, &faces_);
+  const std::vector<uint8_t> colour = meshFaceColours(m, face, faces_, &clashes_);
+  colour_.resize(t_.size());
+  for (size_t t = 0; t < t_.size(); ++t) colour_[t] = colour[face[t]];
   for (const auto& x : v_) radius_ = std::max(radius_, glm::length(x));
   std::iota(tri_.begin(), tri_.end(), 0u);
   nodes_.reserve(2 * t_.size());
@@ -467,7 +535,7 @@ MeshDistance::Hit MeshDistance::firstHit(const glm::dvec3& o, const glm::dvec3& 
       const auto& T = t_[tri];
       const double t = watertightHit(f, o, v_[T[0]], v_[T[1]], v_[T[2]]);
       if (t > t0 && t <= t_best && (!best.found || t < best.t)) {
-        best = {true, t, face_n_[tri], tri};
+        best = {true, t, face_n_[tri], tri, int(colour_[tri])};
         t_best = t;
       }
     }

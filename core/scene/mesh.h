@@ -14,10 +14,13 @@
 // the tracer see the same planes as for the `planes` shape — a mesh box is the box. A non-convex
 // mesh becomes a MeshShape whose signed distance is exact (MeshDistance: the nearest triangle
 // through a bounding-volume hierarchy, O(log n) per voxel, signed by angle-weighted
-// pseudo-normals). With sharp interfaces its crossings are the exact ray–triangle hits found
-// through the same hierarchy (MeshDistance::firstHit; the GPU twin in shaders/boundary.glsl
-// traverses the hierarchy as packed by core/render/boundary_device.cpp), so each facet refracts
-// at its own triangle's plane (docs/scene-format.md).
+// pseudo-normals). With sharp interfaces it takes the exact path (core/volume/boundary.h
+// exactCrossingOutOf): its crossings are the exact ray–triangle hits found through the same
+// hierarchy (MeshDistance::firstHit; the GPU twin in shaders/boundary.glsl traverses the
+// hierarchy as packed by core/render/boundary_device.cpp), so each facet refracts at its own
+// triangle's plane and its edges are as sharp as the triangles; each hit names its face's colour
+// (meshFaceColours), which the light simulator's corners use to see a patch torn at an edge
+// (docs/scene-format.md).
 #pragma once
 
 #include <array>
@@ -51,6 +54,20 @@ TriangleMesh readMesh(const std::filesystem::path& file);
 /// Throws std::invalid_argument("NAME: open mesh: edge 3-7 (x, y, z)-(x, y, z) ...") otherwise.
 void checkClosedMesh(const TriangleMesh& mesh, const std::string& name);
 
+/// The faces of a closed mesh (checkClosedMesh first): each triangle's face, adjacent triangles
+/// within 1e-6 of the mesh's bounding-box diagonal of a common plane being one face, numbered in
+/// the order of their first triangle; `count`, if given, gets the number of faces.
+std::vector<uint32_t> meshFaces(const TriangleMesh& mesh, size_t* count = nullptr);
+
+/// A colour in [0, 64) for each of the `faces` faces of meshFaces: faces that share a vertex
+/// differ, and where a colour is left so do faces that share a vertex with a common neighbour.
+/// The light simulator's corners keep a 6-bit digest of the faces they cross (faceDigest): two
+/// corners of one patch that crossed neighbouring facets then see a tear. `clashes`, if given,
+/// gets the number of faces that found no colour apart from their neighbours' (a face with 64 or
+/// more neighbours; it then takes one by hash).
+std::vector<uint8_t> meshFaceColours(const TriangleMesh& mesh, const std::vector<uint32_t>& face,
+                                     size_t faces, size_t* clashes = nullptr);
+
 /// The faces of a closed convex mesh (checkClosedMesh first) as planes in the file's units, one
 /// per face: adjacent triangles within 1e-6 of the mesh's bounding-box diagonal of a common plane
 /// are one face. Throws std::invalid_argument naming a vertex outside a face's plane (by more than
@@ -80,6 +97,7 @@ class MeshDistance {
     double t = 0.0;          ///< along the segment o + t·d
     glm::dvec3 normal{0.0};  ///< the triangle's unit outward normal (its plane's)
     uint32_t triangle = 0;   ///< index into the mesh's triangles
+    int face = -1;           ///< its face's colour (faceColours)
   };
   /// Most triangles in a leaf of the hierarchy (the GPU twin tests a leaf in one unrolled pass).
   static constexpr uint32_t kLeafTriangles = 4;
@@ -112,14 +130,22 @@ class MeshDistance {
   const std::vector<glm::dvec3>& vertices() const { return v_; }
   const std::vector<std::array<uint32_t, 3>>& triangles() const { return t_; }
   const std::vector<glm::dvec3>& faceNormals() const { return face_n_; }
+  /// Each triangle's face colour (meshFaceColours: coplanar neighbours are one face), which
+  /// firstHit reports as Hit::face and the GPU twin packs after the triangles.
+  const std::vector<uint8_t>& faceColours() const { return colour_; }
+  /// Faces (coplanar triangles count as one) and those whose colour equals a neighbour's.
+  size_t faceCount() const { return faces_; }
+  size_t colourClashes() const { return clashes_; }
   /// Levels of the hierarchy (root alone: 1); the GPU's traversal stack holds depth + 1.
   int depth() const { return depth_; }
 
  private:
   uint32_t build(uint32_t begin, uint32_t end, int level);
-  std::vector<glm::dvec3> v_;                      ///< vertices
-  std::vector<std::array<uint32_t, 3>> t_;         ///< triangles
-  std::vector<glm::dvec3> face_n_;                 ///< unit face normals
+  std::vector<glm::dvec3> v_;               ///< vertices
+  std::vector<std::array<uint32_t, 3>> t_;  ///< triangles
+  std::vector<glm::dvec3> face_n_;          ///< unit face normals
+  std::vector<uint8_t> colour_;             ///< face colours (meshFaceColours)
+  size_t faces_ = 0, clashes_ = 0;
   std::vector<std::array<glm::dvec3, 3>> edge_n_;  ///< edge k = (t[k], t[k+1]) pseudo-normals
   std::vector<glm::dvec3> vertex_n_;               ///< angle-weighted vertex pseudo-normals
   std::vector<uint32_t> tri_;                      ///< triangle order of the leaves

@@ -188,6 +188,7 @@ bool meshCrossing(const Shape& s, const MeshShape& m, bool leaving_owner, const 
   out.t = hit.t;
   out.point = a + hit.t * (b - a);
   out.normal = (leaving_owner ? 1.0 : -1.0) * (s.rotation() * hit.normal);
+  out.face = hit.face;
   return true;
 }
 
@@ -223,9 +224,8 @@ BoundaryField boundaryFieldShapes(const Scene& scene, const Grid& g) {
 }
 
 bool shapesTakeExactPath(const std::vector<Shape>& shapes, bool convex_apart) {
-  bool analytic = !shapes.empty();
-  for (const Shape& shape : shapes) analytic = analytic && shape.analytic();
-  return analytic && !convex_apart && exactTableRows(shapes) <= kExactMaxRows;
+  // Every shape qualifies: the analytic ones by their clips, a mesh by its triangle hits.
+  return !shapes.empty() && !convex_apart && exactTableRows(shapes) <= kExactMaxRows;
 }
 
 BoundaryField buildBoundaryField(const Scene& scene, const Grid& g, int threads) {
@@ -496,6 +496,50 @@ int regionAt(const BoundaryField& bf, const glm::dvec3& x) {
   return 0;
 }
 
+namespace {
+
+/// A mesh's part in exactCrossingOutOf, as the interval the two passes read of an analytic shape
+/// (boundary.glsl exactMeshClip): the ray's own mesh (`own`): where the line o + t·d first leaves
+/// it in (0, 1] (t1, its triangle's normal and face colour; t0 open below, t1 open above if it
+/// does not leave); a later one: where the line first enters it in (eps, 1] (t0, with t1 = t0 +
+/// 2·eps: a mesh is not grazed). A non-convex mesh may be left and entered again along the line,
+/// but only the first change counts.
+LineClip meshClip(const Shape& s, const MeshShape& m, const glm::dvec3& a, const glm::dvec3& d,
+                  bool own, double eps) {
+  const glm::dmat3 to_local = glm::transpose(s.rotation());
+  const MeshDistance::Hit h = m.distance->firstHit(to_local * (a - s.center()), to_local * d,
+                                                   own ? 0.0 : eps, 1.0, own ? 1 : -1);
+  LineClip c;
+  if (own) {
+    c.hit = true;
+    c.t0 = -HUGE_VAL;
+    c.t1 = h.found ? h.t : HUGE_VAL;
+    c.n1 = s.rotation() * h.normal;
+    c.f1 = h.face;
+  } else if (h.found) {
+    c.hit = true;
+    c.t0 = h.t;
+    c.t1 = h.t + 2.0 * eps;
+    c.n0 = s.rotation() * h.normal;
+    c.f0 = h.face;
+  }
+  return c;
+}
+
+/// Whether the point o + tq·d lies in the mesh: the line's first crossing past tq, out to beyond
+/// the mesh's bounding sphere, leaves it (parity along the line of a closed mesh; the watertight
+/// hits let no crossing slip between triangles). boundary.glsl exactMeshHolds.
+bool meshHolds(const Shape& s, const MeshShape& m, const glm::dvec3& a, const glm::dvec3& d,
+               double tq) {
+  const glm::dmat3 to_local = glm::transpose(s.rotation());
+  const glm::dvec3 o = to_local * (a - s.center()), dl = to_local * d;
+  const double far = tq + (glm::length(o) + 2.0 * m.bounding_radius + 1.0) / glm::length(d);
+  const MeshDistance::Hit h = m.distance->firstHit(o, dl, tq, far, 0);
+  return h.found && glm::dot(h.normal, dl) > 0.0;
+}
+
+}  // namespace
+
 BoundaryCrossing exactCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a,
                                     const glm::dvec3& b, int region) {
   BoundaryCrossing out;
@@ -511,8 +555,13 @@ BoundaryCrossing exactCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a
   double t = 2.0;
   glm::dvec3 n_own(0.0);
   int f_own = -1;
+  // Pass 2 reads a mesh's pass-1 clip (its entry, or its own exit), or asks whether it holds tq.
+  std::vector<LineClip> mesh_clips(n);
   for (size_t i = region >= 1 ? size_t(region - 1) : 0; i < n; ++i) {
-    const LineClip c = bf.shapes[i].clipLine(a, d);
+    const Shape& sh = bf.shapes[i];
+    const MeshShape* mesh = std::get_if<MeshShape>(&sh.geometry());
+    const LineClip c = mesh ? (mesh_clips[i] = meshClip(sh, *mesh, a, d, int(i) + 1 == region, eps))
+                            : sh.clipLine(a, d);
     if (!c.hit) continue;
     if (int(i) + 1 == region) {
       t = std::min(t, std::max(c.t1, 0.0));
@@ -528,7 +577,18 @@ BoundaryCrossing exactCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a
   int to = 0, f_to = -1;
   glm::dvec3 n_to(0.0);
   for (size_t i = 0; i < n; ++i) {
-    const LineClip c = bf.shapes[i].clipLine(a, d);
+    const Shape& sh = bf.shapes[i];
+    LineClip c;
+    if (const MeshShape* mesh = std::get_if<MeshShape>(&sh.geometry())) {
+      c = mesh_clips[i];
+      if (region >= 1 && i < size_t(region - 1)) {  // an earlier mesh: not clipped in pass 1
+        c.hit = meshHolds(sh, *mesh, a, d, tq);
+        c.t0 = -HUGE_VAL;
+        c.t1 = HUGE_VAL;
+      }
+    } else {
+      c = sh.clipLine(a, d);
+    }
     if (c.hit && c.t0 <= tq && tq <= c.t1) to = int(i) + 1, n_to = c.n0, f_to = c.f0;
   }
   if (to == region) return out;  // (unreachable but for rounding: no change of region)

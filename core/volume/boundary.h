@@ -110,7 +110,9 @@ struct BoundaryCrossing {
   int from_medium = 0, to_medium = 0;
   int owner = 0;  ///< the region whose shape's surface is crossed: max(from, to)
   /// The plane of the owner's polyhedron crossed (convexCrossingOutOf, exactCrossingOutOf;
-  /// boundary.glsl's plane order); −1 on curved surfaces and where the walk found it.
+  /// boundary.glsl's plane order), or the colour of the mesh face crossed (locateCrossing's
+  /// exact triangle hit: MeshDistance::faceColours); −1 on curved surfaces and where the walk
+  /// found it on the field alone.
   int face = -1;
 };
 
@@ -169,8 +171,9 @@ BoundaryCrossing convexCrossingOutOf(const BoundaryField& field, const glm::dvec
 constexpr int kExactMaxRows = 256;
 /// The rows of the shape table an analytic field needs (6 per shape, one per plane).
 int exactTableRows(const std::vector<Shape>& shapes);
-/// Whether a field of these shapes takes the exact path (BoundaryField::exact): every shape
-/// analytic, not convex_apart, and the table within kExactMaxRows.
+/// Whether a field of these shapes takes the exact path (BoundaryField::exact): any shapes (the
+/// analytic ones by their clips, a triangle mesh by its hits), not convex_apart, and the table's
+/// records and planes within kExactMaxRows (a mesh's hierarchy is read from the table past them).
 bool shapesTakeExactPath(const std::vector<Shape>& shapes, bool convex_apart);
 
 /// Ends of shape intervals closer than this (voxels) to a segment's start are not crossings, a
@@ -185,7 +188,11 @@ constexpr double kExactMergeVoxels = 1e-4;
 /// one pass over the shapes from r − 1 on finds that t. A second pass takes the region just past
 /// it (the last shape whose interval holds t + ε: faces meeting there within rounding count as
 /// one crossing) and the entered shape's entry normal. The normal is the owner's (the later of
-/// the two regions' objects); the field normal is the same (no voxel is read).
+/// the two regions' objects); the field normal is the same (no voxel is read). A triangle mesh
+/// (not convex) gives the first pass its first exit (its own region) or entry (a later one) as
+/// the first triangle hit of that orientation (MeshDistance::firstHit), with the hit's normal
+/// and face colour; in the second pass an earlier mesh holds t + ε when the line's next hit
+/// beyond it leaves the mesh.
 BoundaryCrossing exactCrossingOutOf(const BoundaryField& field, const glm::dvec3& a,
                                     const glm::dvec3& b, int region);
 

@@ -284,6 +284,74 @@ TEST(MeshFirstHit, TorusHitsAreTheBruteForceHitsOfEveryTriangle) {
   EXPECT_LE(m.depth() + 1, 24);  // EIKON_MESH_STACK
 }
 
+/// Checks the face colours of `m`: triangles that share a vertex are one face (same colour) when
+/// they share an edge and lie in one plane, and differ in colour when their planes differ (a kink
+/// the light simulator's corners must see). Returns the pairs of faces two apart (sharing a
+/// vertex with a common third) that share a colour.
+size_t checkFaceColours(const MeshDistance& m, const std::string& what) {
+  const auto& T = m.triangles();
+  const auto& c = m.faceColours();
+  EXPECT_EQ(c.size(), T.size());
+  std::map<uint32_t, std::vector<size_t>> at;
+  for (size_t t = 0; t < T.size(); ++t)
+    for (uint32_t v : T[t]) at[v].push_back(t);
+  // Neighbouring triangles of other planes, per triangle.
+  std::vector<std::vector<size_t>> kinked(T.size());
+  for (const auto& [v, ts] : at)
+    for (size_t a : ts)
+      for (size_t b : ts) {
+        if (a >= b) continue;
+        const double cosine = glm::dot(m.faceNormals()[a], m.faceNormals()[b]);
+        int shared = 0;
+        for (uint32_t x : T[a])
+          for (uint32_t y : T[b]) shared += x == y;
+        if (cosine > 1.0 - 1e-12 && shared == 2) {
+          EXPECT_EQ(c[a], c[b]) << what << ": coplanar triangles " << a << ", " << b;
+        } else if (cosine < 1.0 - 1e-9) {
+          EXPECT_NE(c[a], c[b]) << what << ": triangles " << a << ", " << b << " meet at vertex "
+                                << v << " at " << std::acos(cosine) * 180 / M_PI << " deg";
+          kinked[a].push_back(b);
+          kinked[b].push_back(a);
+        }
+      }
+  size_t two_apart = 0;
+  for (size_t a = 0; a < T.size(); ++a)
+    for (size_t b : kinked[a])
+      for (size_t x : kinked[b])
+        if (x > a && c[x] == c[a] && glm::dot(m.faceNormals()[a], m.faceNormals()[x]) < 1 - 1e-9)
+          ++two_apart;
+  EXPECT_EQ(m.colourClashes(), 0u) << what;
+  for (uint8_t x : c) EXPECT_LT(x, 64) << what;
+  return two_apart;
+}
+
+TEST(Mesh, FaceColoursTellNeighbouringFacetsApart) {
+  // The torus's 48 × 24 quads are planar (isosceles trapezoids: each is symmetric about the
+  // plane through the torus axis halfway between its two meridians), so each quad's two
+  // triangles are one face: 1152 faces. The icosphere's 320 triangles are all in different
+  // planes. The notched prism (tests/data/meshes/notched_prism.obj): 6 sides and two caps, each
+  // cap four triangles in one plane: 8 faces.
+  const MeshDistance& torus = torusMesh();
+  EXPECT_EQ(torus.faceCount(), 48u * 24u);
+  const size_t torus_two = checkFaceColours(torus, "torus");
+  const MeshShape ico = makeMeshShape(readMesh(kMeshes / "icosphere2.obj"));
+  EXPECT_EQ(ico.distance->faceCount(), 320u);
+  const size_t ico_two = checkFaceColours(*ico.distance, "icosphere");
+  const MeshShape prism = makeMeshShape(readMesh(kMeshes / "notched_prism.obj"));
+  EXPECT_EQ(prism.distance->faceCount(), 8u);
+  checkFaceColours(*prism.distance, "notched prism");
+  // Faces two apart differ too where 64 colours allow it: the torus has 24 such neighbours per
+  // face, the icosphere at most 18.
+  std::printf("[ measured ] faces two apart sharing a colour: torus %zu, icosphere %zu\n",
+              torus_two, ico_two);
+  EXPECT_EQ(torus_two, 0u);
+  EXPECT_EQ(ico_two, 0u);
+  // firstHit reports the colour of the triangle it hits.
+  const MeshDistance::Hit h = torus.firstHit({0, 20, 5}, {0, -40, 0}, 0.0, 1.0, -1);
+  ASSERT_TRUE(h.found);
+  EXPECT_EQ(h.face, int(torus.faceColours()[h.triangle]));
+}
+
 TEST(MeshFirstHit, RaysThroughSharedEdgesAndVerticesDoNotSlipThrough) {
   // Watertightness: rays aimed exactly (to double rounding) at a point of an edge shared by two
   // triangles, or at a vertex shared by several, that cross the surface there (every triangle at

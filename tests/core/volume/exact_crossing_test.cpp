@@ -209,7 +209,7 @@ TEST(ExactCrossing, MeshesKeepTheFieldsSearch) {
       sceneOf({{Shape("sphere", SphereShape{0.5}, glm::dvec3(0.0), glm::dvec3(0.0)), "glass"}}, 16);
   BoundaryField bf = fieldOf(scene);
   EXPECT_TRUE(bf.exact);
-  bf.exact = false;  // what a scene with a mesh gets: the field's search, within its own bound
+  bf.exact = false;  // what a scene whose shapes overflow kExactMaxRows gets: the field's search
   const BoundaryCrossing c =
       nextCrossingOutOf(bf, glm::dvec3(-0.9, 0.0, 0.0), glm::dvec3(0.9, 0.0, 0.0), 0);
   ASSERT_TRUE(c.found);

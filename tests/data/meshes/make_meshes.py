@@ -12,6 +12,9 @@ it writes next to itself. Every file is generated here, none is downloaded.
   flipped_face.obj   box.obj with the +x face wound clockwise (inconsistent orientation)
   inward_box.obj     box.obj with every face wound clockwise (consistent, but facing inward)
   notched_box.obj    a closed L-shaped prism (non-convex)
+  notched_prism.obj  the equilateral prism of side 3 (apex (0, sqrt 3), base y = -sqrt(3)/2, the
+                     light tests' apex prism) with a notch 0.15 deep in its base at x = 1.25..1.45,
+                     so that it is not convex; z from -10 to 10
   lines.obj          a triangle and a line element (not a surface)
 
 and the meshes of the shipped scenes:
@@ -131,6 +134,14 @@ def main():
     caps = [(0, 2, 1), (0, 3, 2), (0, 5, 3), (3, 5, 4), (6, 7, 8), (6, 8, 9), (6, 9, 11), (9, 10, 11)]
     sides = [(k, (k + 1) % 6, (k + 1) % 6 + 6, k + 6) for k in range(6)]
     write_obj("notched_box.obj", lv, caps + sides)
+    # The apex prism with a notch in its base: profile counter-clockwise seen from +z, the caps
+    # fanned from the apex (index 5), which sees every corner.
+    h = math.sqrt(3.0) / 2
+    prof = [(-1.5, -h), (1.25, -h), (1.35, -h + 0.15), (1.45, -h), (1.5, -h), (0.0, 2 * h)]
+    pv = [(x, y, z) for z in (-10.0, 10.0) for x, y in prof]
+    caps = [(5, k + 1, k) for k in range(4)] + [(11, k + 6, k + 7) for k in range(4)]
+    sides = [(k, (k + 1) % 6, (k + 1) % 6 + 6, k + 6) for k in range(6)]
+    write_obj("notched_prism.obj", pv, caps + sides)
     write_obj("lines.obj", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)], "l 1 2\n")
     scenes = os.path.join(HERE, "..", "..", "..", "scenes", "meshes")
     os.makedirs(scenes, exist_ok=True)
