@@ -9,9 +9,11 @@
 // volume must be positive (normals outward, counter-clockwise seen from outside). Each failure is
 // one line naming the edge or triangle.
 //
-// A closed convex mesh becomes an exact ConvexShape: adjacent coplanar triangles are merged into
+// A closed convex mesh of at most 250 faces becomes an exact ConvexShape (scene.cpp
+// kConvexMeshMaxFaces: more planes than the exact path's table holds run faster as a mesh through
+// its hierarchy): adjacent coplanar triangles are merged into
 // one plane per face, so the voxeliser, the sharp boundaries (GPU plane loops and CPU twin) and
-// the tracer see the same planes as for the `planes` shape — a mesh box is the box. A non-convex
+// the tracer see the same planes as for the `planes` shape — a mesh box is the box. Any other
 // mesh becomes a MeshShape whose signed distance is exact (MeshDistance: the nearest triangle
 // through a bounding-volume hierarchy, O(log n) per voxel, signed by angle-weighted
 // pseudo-normals). With sharp interfaces it takes the exact path (core/volume/boundary.h

@@ -31,6 +31,11 @@ constexpr double kMaxCoordinateMm = 1e12;
 constexpr double kMinVoxelMm = 1e-6;
 constexpr double kMaxOffsetVoxels = 65536.0;
 constexpr size_t kMaxPlanes = 4096;  // planes of one "planes" object
+// Most faces of a convex mesh made a polyhedron: the exact path reads every record and plane of
+// the shape table from its first 256 rows (core/volume/boundary.h kExactMaxRows; 6 rows are the
+// shape's own record), and its plane loops cost a pass per face. A convex mesh of more faces stays
+// a triangle mesh, whose crossings the exact path finds through its hierarchy in O(log n).
+constexpr size_t kConvexMeshMaxFaces = 250;
 
 std::string fmt(double v) {
   std::ostringstream s;
@@ -526,7 +531,7 @@ ShapeGeometry parseMesh(const Node& o) {
   }
   std::vector<Plane> planes;
   try {
-    planes = meshFacePlanes(mesh, p.filename().string(), kMaxPlanes);
+    planes = meshFacePlanes(mesh, p.filename().string(), kConvexMeshMaxFaces);
   } catch (const std::invalid_argument&) {
     // Not convex (or more faces than a polyhedron takes): a MeshShape.
   }
