@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 #include <string>
 
 #include "core/scene/mesh.h"
@@ -555,13 +556,19 @@ BoundaryCrossing exactCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a
   double t = 2.0;
   glm::dvec3 n_own(0.0);
   int f_own = -1;
-  // Pass 2 reads a mesh's pass-1 clip (its entry, or its own exit), or asks whether it holds tq.
-  std::vector<LineClip> mesh_clips(n);
-  for (size_t i = region >= 1 ? size_t(region - 1) : 0; i < n; ++i) {
+  // Pass 2 reads the clips of pass 1 (a mesh's: its entry, or its own exit) and clips only the
+  // shapes before the ray's own (an earlier mesh: whether it holds tq). The exact path holds at
+  // most kExactMaxRows / 6 shapes (shapesTakeExactPath), so they fit a fixed array.
+  constexpr size_t kMaxShapes = size_t(kExactMaxRows) / 6;
+  if (n > kMaxShapes)
+    throw std::logic_error("exactCrossingOutOf: more shapes than the exact path holds");
+  std::array<LineClip, kMaxShapes> clips;
+  const size_t first = region >= 1 ? size_t(region - 1) : 0;
+  for (size_t i = first; i < n; ++i) {
     const Shape& sh = bf.shapes[i];
     const MeshShape* mesh = std::get_if<MeshShape>(&sh.geometry());
-    const LineClip c = mesh ? (mesh_clips[i] = meshClip(sh, *mesh, a, d, int(i) + 1 == region, eps))
-                            : sh.clipLine(a, d);
+    const LineClip& c = clips[i] =
+        mesh ? meshClip(sh, *mesh, a, d, int(i) + 1 == region, eps) : sh.clipLine(a, d);
     if (!c.hit) continue;
     if (int(i) + 1 == region) {
       t = std::min(t, std::max(c.t1, 0.0));
@@ -578,17 +585,17 @@ BoundaryCrossing exactCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a
   glm::dvec3 n_to(0.0);
   for (size_t i = 0; i < n; ++i) {
     const Shape& sh = bf.shapes[i];
-    LineClip c;
-    if (const MeshShape* mesh = std::get_if<MeshShape>(&sh.geometry())) {
-      c = mesh_clips[i];
-      if (region >= 1 && i < size_t(region - 1)) {  // an earlier mesh: not clipped in pass 1
-        c.hit = meshHolds(sh, *mesh, a, d, tq);
-        c.t0 = -HUGE_VAL;
-        c.t1 = HUGE_VAL;
+    if (i < first) {  // not clipped in pass 1
+      if (const MeshShape* mesh = std::get_if<MeshShape>(&sh.geometry())) {
+        clips[i] = LineClip{};
+        clips[i].hit = meshHolds(sh, *mesh, a, d, tq);
+        clips[i].t0 = -HUGE_VAL;
+        clips[i].t1 = HUGE_VAL;
+      } else {
+        clips[i] = sh.clipLine(a, d);
       }
-    } else {
-      c = sh.clipLine(a, d);
     }
+    const LineClip& c = clips[i];
     if (c.hit && c.t0 <= tq && tq <= c.t1) to = int(i) + 1, n_to = c.n0, f_to = c.f0;
   }
   if (to == region) return out;  // (unreachable but for rounding: no change of region)
