@@ -490,10 +490,23 @@ bool BoundaryField::regionsOnShapes() const {
   return exact || (convex_apart && !shapes.empty() && exactTableRows(shapes) <= kExactMaxRows);
 }
 
+namespace {
+bool meshHolds(const Shape& s, const MeshShape& m, const glm::dvec3& a, const glm::dvec3& d,
+               double tq);
+}  // namespace
+
 int regionAt(const BoundaryField& bf, const glm::dvec3& x) {
   if (!bf.regionsOnShapes()) return boundaryRegion(bf, x);
-  for (size_t i = bf.shapes.size(); i-- > 0;)
-    if (bf.shapes[i].signedDistance(x) <= 0.0) return int(i) + 1;
+  for (size_t i = bf.shapes.size(); i-- > 0;) {
+    const Shape& s = bf.shapes[i];
+    // A mesh by the parity of its hits along a fixed direction from x, as the GPU twin
+    // (boundary.glsl exactInside): one ray through the hierarchy, where the signed distance
+    // searches for the nearest triangle.
+    const MeshShape* m = std::get_if<MeshShape>(&s.geometry());
+    if (m ? meshHolds(s, *m, x, glm::dvec3(0.5773502, 0.5773503, 0.5773504), 0.0)
+          : s.signedDistance(x) <= 0.0)
+      return int(i) + 1;
+  }
   return 0;
 }
 
