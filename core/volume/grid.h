@@ -47,6 +47,44 @@ inline bool voxelRange(const glm::dvec3& bmin, const glm::dvec3& bmax, const Gri
   return true;
 }
 
+/// The voxel range [lo, hi] in blocks of kVoxelBlock³ voxels: block(bk) for block slab bk in
+/// [0, voxelBlockSlabs(lo, hi)) visits every block of that z slab as whole(b) or, where whole
+/// declines, voxel by voxel. A block is given as its voxel range, its centre (the mean of its
+/// voxel centres) and the largest distance from that centre to one of its voxel centres, so that
+/// a 1-Lipschitz function f (a signed distance) with |f(centre)| > r + t keeps its sign, and
+/// |f| > t, at every voxel of the block: whole(block) may then settle all of them at once.
+constexpr int kVoxelBlock = 4;
+struct VoxelBlock {
+  int lo[3], hi[3];
+  glm::dvec3 centre;
+  double radius;  ///< mm
+};
+inline int voxelBlockSlabs(const int lo[3], const int hi[3]) {
+  return (hi[2] - lo[2] + kVoxelBlock) / kVoxelBlock;
+}
+/// whole(block) → true if it settled the block; else voxel(i, j, k) for each of its voxels.
+template <typename Whole, typename Voxel>
+void forVoxelBlocks(const Grid& g, const int lo[3], const int hi[3], int slab, Whole&& whole,
+                    Voxel&& voxel) {
+  VoxelBlock b;
+  b.lo[2] = lo[2] + slab * kVoxelBlock;
+  b.hi[2] = std::min(hi[2], b.lo[2] + kVoxelBlock - 1);
+  for (int bj = lo[1]; bj <= hi[1]; bj += kVoxelBlock)
+    for (int bi = lo[0]; bi <= hi[0]; bi += kVoxelBlock) {
+      b.lo[0] = bi, b.lo[1] = bj;
+      b.hi[0] = std::min(hi[0], bi + kVoxelBlock - 1);
+      b.hi[1] = std::min(hi[1], bj + kVoxelBlock - 1);
+      const glm::dvec3 a = g.center(b.lo[0], b.lo[1], b.lo[2]),
+                       z = g.center(b.hi[0], b.hi[1], b.hi[2]);
+      b.centre = 0.5 * (a + z);
+      b.radius = 0.5 * glm::length(z - a);
+      if (whole(b)) continue;
+      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+        for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+          for (int i = b.lo[0]; i <= b.hi[0]; ++i) voxel(i, j, k);
+    }
+}
+
 /// body(i) for i in [0, n) on `threads` threads (0 = hardware concurrency), dealt out one at a
 /// time (slabs of a grid take unequal times).
 template <typename F>

@@ -363,20 +363,35 @@ void compositeObjects(const Scene& scene, const Grid& g,
       progress(0.4 * double(oi + 1) / n_obj, "voxelising");
       continue;
     }
-    const int slabs = hi[2] - lo[2] + 1;
+    const int slabs = voxelBlockSlabs(lo, hi);
     std::atomic<int> slabs_done{0};
-    parallelFor(slabs, threads, [&](int kk) {
-      const int k = lo[2] + kk;
-      for (int j = lo[1]; j <= hi[1]; ++j)
-        for (int i = lo[0]; i <= hi[0]; ++i) {
-          const glm::dvec3 c = g.center(i, j, k);
-          glm::dvec3 gcov(0.0);
-          const double cov = rule(obj.shape, c, g.h, &gcov);
-          if (cov <= 0.0) continue;
-          const size_t idx = g.index(i, j, k);
-          paintVoxel(cp, idx, c, cov, gcov, mat, mv);
-          if (uniaxial && mat.uniaxial) cp.axis[idx] = ax;
-        }
+    // In blocks (grid.h forVoxelBlocks): a block whose voxels all lie beyond the rule's reach
+    // outside the shape gets no paint, as each voxel would (its coverage is 0); one wholly
+    // beyond it inside is painted with coverage 1 and a zero coverage gradient, as each voxel
+    // would be (up to the sign of a zero). One signed distance per such block.
+    const double reach = rule.analytic ? rule.half_width : rule.half_diag;
+    parallelFor(slabs, threads, [&](int slab) {
+      auto paint = [&](int i, int j, int k, double cov, const glm::dvec3& gcov) {
+        const size_t idx = g.index(i, j, k);
+        paintVoxel(cp, idx, g.center(i, j, k), cov, gcov, mat, mv);
+        if (uniaxial && mat.uniaxial) cp.axis[idx] = ax;
+      };
+      forVoxelBlocks(
+          g, lo, hi, slab,
+          [&](const VoxelBlock& b) {
+            const double sd = obj.shape.signedDistance(b.centre);
+            if (sd - b.radius >= reach && (rule.analytic || sd - b.radius > reach)) return true;
+            if (!(sd + b.radius < -reach)) return false;
+            for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+              for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+                for (int i = b.lo[0]; i <= b.hi[0]; ++i) paint(i, j, k, 1.0, glm::dvec3(0.0));
+            return true;
+          },
+          [&](int i, int j, int k) {
+            glm::dvec3 gcov(0.0);
+            const double cov = rule(obj.shape, g.center(i, j, k), g.h, &gcov);
+            if (cov > 0.0) paint(i, j, k, cov, gcov);
+          });
       ++slabs_done;
       progress.report(
           [&] { return 0.4 * (double(oi) + double(slabs_done.load()) / slabs) / n_obj; },
