@@ -287,6 +287,8 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   }
   // Without light volumes a GPU render of sharp interfaces reads no per-voxel field: only the
   // interfaces are voxelised then (docs/performance.md "Start-up").
+  // A light the chosen twin cannot hold is refused before the voxelising.
+  if (lit) (void)session.lightOnCpuTwin(light_request, a.reference);
   if (a.reference || lit)
     session.prepare(!a.reference);
   else

@@ -29,6 +29,30 @@ namespace eikon {
 
 namespace {
 
+/// The accumulation volume's bytes: EIKON_SPLAT_ACC_WORDS + 1 words per voxel.
+size_t splatBytes(const Grid& g) {
+  return g.count() * (EIKON_SPLAT_ACC_WORDS + 1) * sizeof(uint32_t);
+}
+
+}  // namespace
+
+bool gpuLightFits(const vk::Context& ctx, const Grid& grid) {
+  return splatBytes(grid) <= ctx.limits().max_storage_buffer_range;
+}
+
+void requireGpuLightFits(const vk::Context& ctx, const Grid& g) {
+  if (!gpuLightFits(ctx, g))
+    throw std::runtime_error(
+        "the light simulator's GPU accumulation volume for " + std::to_string(g.dims[0]) + "x" +
+        std::to_string(g.dims[1]) + "x" + std::to_string(g.dims[2]) + " voxels needs " +
+        std::to_string(splatBytes(g) >> 20) + " MiB of one storage buffer but the device allows " +
+        std::to_string(ctx.limits().max_storage_buffer_range >> 20) +
+        " MiB: lower the volume's resolution, or simulate the light on the CPU twin "
+        "(--light-device cpu or auto)");
+}
+
+namespace {
+
 /// Compute → compute memory dependency between two dispatches of one command buffer.
 void computeBarrier(VkCommandBuffer c) {
   VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr,
@@ -171,8 +195,8 @@ struct GpuWavefront::Impl {
     const Grid& g = vol.grid;
     params = vk::Buffer(ctx, sizeof(gpu::WaveParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                         "wavefront params");
-    splat = vk::Buffer(ctx, g.count() * (EIKON_SPLAT_ACC_WORDS + 1) * sizeof(uint32_t),
-                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront splat");
+    requireGpuLightFits(ctx, g);
+    splat = vk::Buffer(ctx, splatBytes(g), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "wavefront splat");
     // With the regions on the shapes (and kExact below) the kernel reads no voxel of the field.
     boundary =
         sharp ? BoundaryDevice(ctx, vol.boundary, vol.media, "", !vol.boundary.regionsOnShapes())

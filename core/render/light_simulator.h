@@ -79,6 +79,14 @@ class GpuWavefrontShared {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Whether the GPU twin's accumulation volume for this grid fits one of the device's storage
+/// buffers (lavapipe: 128 MiB, 36 bytes a voxel: ~3.7M voxels); where it does not, GpuWavefront
+/// refuses with one line and `--light-device auto` simulates on the CPU twin.
+bool gpuLightFits(const vk::Context& ctx, const Grid& grid);
+/// Throws std::runtime_error (one line: the grid, the bytes, the limit and the remedy) where
+/// gpuLightFits is false.
+void requireGpuLightFits(const vk::Context& ctx, const Grid& grid);
+
 class GpuWavefront {
  public:
   /// The volume is uploaded (o-mode index A/B/C and medium; for settings.mode = 1 in a uniaxial

@@ -8,6 +8,7 @@
 #include "core/reference/polarised_trace.h"
 #include "core/reference/reference_lighting.h"
 #include "core/reference/reference_marcher.h"
+#include "core/render/light_simulator.h"
 #include "core/render/light_transport.h"
 #include "core/render/render_defaults.h"
 #include "core/render/view_pipeline_start.h"
@@ -237,16 +238,25 @@ void Session::dropRenderers() {
   field_.reset();
 }
 
+bool Session::lightOnCpuTwin(const LightRequest& light, bool cpu_render) {
+  // CPU renders use the CPU throughout; on a CPU Vulkan device (lavapipe) the double-precision
+  // CPU twin is also the faster one (docs/light-simulator.md). auto also takes the CPU twin where
+  // the GPU twin's accumulation volume would not fit the device; gpu is refused there.
+  if (cpu_render || lightOnCpu(light.device, ctx_.get())) return true;
+  const Grid grid = makeGrid(scene_->volume);
+  if (light.device == "auto") return !gpuLightFits(context(), grid);
+  requireGpuLightFits(context(), grid);
+  return false;
+}
+
 LightOutcome Session::simulateLight(const LightRequest& light, bool cpu_render,
                                     const std::filesystem::path& cache_dir) {
   LightOutcome out;
+  out.on_cpu = lightOnCpuTwin(light, cpu_render);
   VolumeSet& volume = prepare(!cpu_render);
   LightingOptions lo = lightingOptions(light, volume.grid.h);
   if (progress_.update)
     lo.progress = [this](double f, const std::string& what) { progress_.update(what.c_str(), f); };
-  // Which twin simulates: CPU renders use the CPU throughout; on a CPU Vulkan device (lavapipe)
-  // the double-precision CPU twin is also the faster one (docs/light-simulator.md).
-  out.on_cpu = cpu_render || lightOnCpu(light.device, ctx_.get());
   const bool use_cache = !cache_dir.empty();
   // The key hashes every field of the volume (~0.3 s at 128³): only when the cache is used.
   const uint64_t key = use_cache ? lightCacheKey(*scene_, volume, lo, out.on_cpu) : 0;

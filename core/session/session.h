@@ -170,8 +170,13 @@ class Session {
   /// "CPU reference (double)" or the Vulkan device's name.
   std::string deviceName(bool gpu);
 
+  /// Whether simulateLight takes the CPU twin: cpu_render, or lightOnCpu(light.device), or "auto"
+  /// where the GPU twin's accumulation volume would not fit the device (gpuLightFits); "gpu"
+  /// there throws std::runtime_error (one line), before anything is voxelised.
+  bool lightOnCpuTwin(const LightRequest& light, bool cpu_render);
+
   /// Simulate the scene's lights into the volume (callers skip scenes without lights): by the CPU
-  /// twin when cpu_render or lightOnCpu(light.device) says so, else the GPU twin; through the light
+  /// twin when lightOnCpuTwin says so, else the GPU twin; through the light
   /// cache in `cache_dir` unless it is empty. A GPU renderer made before with light volumes gets
   /// the new ones written in place (ViewRenderer::updateLight: no pipeline built again); other
   /// renderers made before are rebuilt on their next use.

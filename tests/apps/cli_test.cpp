@@ -821,6 +821,36 @@ TEST_F(Cli, LightsWithoutAnAlbedoAreNotSimulated) {
   EXPECT_EQ(a, eikon::readExrRgba(outPath(), 64, 64).rgba);
 }
 
+// The GPU twin's accumulation volume takes 36 bytes a voxel (EIKON_SPLAT_ACC_WORDS + 1 words) in
+// one storage buffer: a grid larger than the device's limit (`eikon info`) is refused before any
+// work with one line that names the remedy, and `--light-device auto` takes the CPU twin there.
+TEST_F(Cli, LightVolumeLargerThanTheGpuHoldsIsRefusedOrSimulatedOnTheCpu) {
+  const Outcome info = run("info");
+  ASSERT_EQ(info.code, 0) << info.err;
+  const size_t at = info.out.find("max storage buffer:");
+  ASSERT_NE(at, std::string::npos) << info.out;
+  const double mib = std::stod(info.out.substr(at + 19));
+  // A cube of n³ voxels with 36·n³ bytes just over the limit.
+  const int n = int(std::ceil(std::cbrt(mib * 1048576.0 / 36.0))) + 1;
+  if (n > 400) GTEST_SKIP() << "the device holds " << mib << " MiB: a test grid would be too large";
+  const std::string scene = R"({
+  "camera": {"position": [0, 20, -20], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 30, "width": 8, "height": 6},
+  "environment": {"type": "constant", "radiance": 0.1},
+  "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "resolution": )" +
+                            std::to_string(n) + R"(},
+  "materials": {"floor": {"n": 1, "opacity": 1, "albedo": 0.8}},
+  "objects": [{"shape": "box", "center": [0, -4.5, 0], "size": [10, 1, 10], "material": "floor"}],
+  "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}]
+})";
+  const std::string args = "-q --no-light-cache --light-split 8 --light-step 2 --max-patches 1024 ";
+  expectCleanFailure(render(scene, args + "--light-device gpu"),
+                     "voxels needs " + std::to_string(int64_t(36.0 * n * n * n) >> 20) +
+                         " MiB of one storage buffer");
+  const Outcome cpu = render(scene, args + "--light-device auto");
+  ASSERT_EQ(cpu.code, 0) << cpu.err;
+  EXPECT_NE(cpu.out.find("on the CPU reference"), std::string::npos) << cpu.out;
+}
+
 TEST_F(Cli, BadLightOptionsFailCleanly) {
   expectCleanFailure(render(tinyScene(), "--light-bands 100"), "--light-bands");
   expectCleanFailure(render(tinyScene(), "--light-splat brightest"),
