@@ -247,6 +247,28 @@ TEST(SharpWavefrontTwins, ApexTearsIntoPencilsOnBoth) {
   test::expectNoValidationMessages();
 }
 
+/// The beam straight down on the apex of `vol`'s prism through both twins (caustics passed, as
+/// renders: the halves cross below the apex): tears on both, no light in the gap below, the
+/// flux accounted for. Returns the settings used.
+WavefrontSettings expectNoLightInTheGap(const VolumeSet& vol, const char* what) {
+  WavefrontSettings s;
+  s.pass_caustics = true;
+  const Twins tw = runTwins(vol, s, beam({0.0, 2.9, 0.0}, {0, -1, 0}, 1.0, 1.0));
+  auto gap = [&](const WavefrontResult& r) {
+    return shareIn(r, vol.grid, {-0.4, 0.4}, {-2.45, -2.3});
+  };
+  const WavefrontStats &gs = tw.gpu.stats, &cs = tw.cpu.stats;
+  std::printf("[ measured ] %s tears: cpu %zu, gpu %zu; light in the gap cpu %.3e, gpu %.3e\n",
+              what, cs.tears, gs.tears, gap(tw.cpu), gap(tw.gpu));
+  EXPECT_GT(cs.tears, 0u);
+  EXPECT_GT(gs.tears, 0u);
+  EXPECT_EQ(gap(tw.cpu), 0.0);
+  EXPECT_EQ(gap(tw.gpu), 0.0);
+  EXPECT_NEAR(fluxEnded(cs), cs.flux_emitted, 1e-9 * cs.flux_emitted);
+  EXPECT_NEAR(fluxEnded(gs), gs.flux_emitted, 1e-5 * gs.flux_emitted);
+  return s;
+}
+
 // ---------------------------------------------------------------- a kink at an apex
 // The same prism lit from above, straight down on its apex (beam radius 1 mm about x = 0): each
 // half enters through one of the two upper faces (60° incidence, refracted 35.26°), leaves through
@@ -260,20 +282,7 @@ TEST(SharpWavefrontTwins, ApexTearsIntoPencilsOnBoth) {
 TEST(SharpWavefrontTwins, KinkAtAnApexTearsOnBoth) {
   const VolumeSet vol = voxelize(sceneFromJson(kSharpApexPrismScene));
   ASSERT_TRUE(vol.boundary.convex_apart);  // the faces are known: the planes' search
-  WavefrontSettings s;
-  s.pass_caustics = true;  // as renders: the halves cross below the apex
-  const Twins tw = runTwins(vol, s, beam({0.0, 2.9, 0.0}, {0, -1, 0}, 1.0, 1.0));
-  auto gap = [&](const WavefrontResult& r) {
-    return shareIn(r, vol.grid, {-0.4, 0.4}, {-2.45, -2.3});
-  };
-  const WavefrontStats &gs = tw.gpu.stats, &cs = tw.cpu.stats;
-  std::printf("[ measured ] kink tears: cpu %zu, gpu %zu; light in the gap cpu %.3e, gpu %.3e\n",
-              cs.tears, gs.tears, gap(tw.cpu), gap(tw.gpu));
-  EXPECT_GT(cs.tears, 0u);
-  EXPECT_GT(gs.tears, 0u);
-  EXPECT_EQ(gap(tw.cpu), 0.0);
-  EXPECT_EQ(gap(tw.gpu), 0.0);
-  EXPECT_NEAR(fluxEnded(gs), gs.flux_emitted, 1e-5 * gs.flux_emitted);
+  expectNoLightInTheGap(vol, "kink");
   test::expectNoValidationMessages();
 }
 
@@ -303,22 +312,7 @@ TEST(SharpWavefrontTwins, KinkAtAMeshApexTearsOnBoth) {
   const VolumeSet vol = voxelize(sceneFromJson(scene));
   ASSERT_TRUE(std::holds_alternative<MeshShape>(vol.boundary.shapes.at(0).geometry()));
   ASSERT_TRUE(vol.boundary.exact);  // the triangles' hits, not the walk
-  WavefrontSettings s;
-  s.pass_caustics = true;
-  const Twins tw = runTwins(vol, s, beam({0.0, 2.9, 0.0}, {0, -1, 0}, 1.0, 1.0));
-  auto gap = [&](const WavefrontResult& r) {
-    return shareIn(r, vol.grid, {-0.4, 0.4}, {-2.45, -2.3});
-  };
-  const WavefrontStats &gs = tw.gpu.stats, &cs = tw.cpu.stats;
-  std::printf(
-      "[ measured ] mesh kink tears: cpu %zu, gpu %zu; light in the gap cpu %.3e, gpu %.3e\n",
-      cs.tears, gs.tears, gap(tw.cpu), gap(tw.gpu));
-  EXPECT_GT(cs.tears, 0u);
-  EXPECT_GT(gs.tears, 0u);
-  EXPECT_EQ(gap(tw.cpu), 0.0);
-  EXPECT_EQ(gap(tw.gpu), 0.0);
-  EXPECT_NEAR(fluxEnded(cs), cs.flux_emitted, 1e-9 * cs.flux_emitted);
-  EXPECT_NEAR(fluxEnded(gs), gs.flux_emitted, 1e-5 * gs.flux_emitted);
+  const WavefrontSettings s = expectNoLightInTheGap(vol, "mesh kink");
   // The analytic prism's run on the CPU twin (its planes' search) against the mesh's: the
   // mesh's triangles lie in the prism's planes to the rounding of its vertices (Assimp reads
   // them as float: ≤ 2⁻²⁴·1.7 mm ≈ 1e-7 mm, normals within ~1e-7 rad), so the Fresnel
