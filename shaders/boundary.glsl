@@ -41,12 +41,16 @@
 #endif
 int shapeKind(int s) { return int(EIKON_SHAPE_ROW(EIKON_SHAPE_STRIDE * s).x); }
 
-// Local coordinates p = Rᵀ(x − c) of world point x in shape s (s = region − 1).
-vec3 shapeLocal(int s, vec3 x) {
+// Local components Rᵀv of a world vector v in shape s (s = region − 1).
+vec3 shapeLocalDir(int s, vec3 v) {
   int o = EIKON_SHAPE_STRIDE * s;
-  vec3 d = x - EIKON_SHAPE_ROW(o + 1).xyz;
-  return vec3(dot(EIKON_SHAPE_ROW(o + 2).xyz, d), dot(EIKON_SHAPE_ROW(o + 3).xyz, d),
-              dot(EIKON_SHAPE_ROW(o + 4).xyz, d));
+  return vec3(dot(EIKON_SHAPE_ROW(o + 2).xyz, v), dot(EIKON_SHAPE_ROW(o + 3).xyz, v),
+              dot(EIKON_SHAPE_ROW(o + 4).xyz, v));
+}
+
+// Local coordinates p = Rᵀ(x − c) of world point x in shape s.
+vec3 shapeLocal(int s, vec3 x) {
+  return shapeLocalDir(s, x - EIKON_SHAPE_ROW(EIKON_SHAPE_STRIDE * s + 1).xyz);
 }
 
 float boxDistance(vec3 p, vec3 half_size) {
@@ -962,9 +966,7 @@ vec3 exactToWorld(int s, vec3 n) {
 // leave); a later one: where the line first enters it in (eps, 1] (t0, t1 = t0 + 2·eps: a mesh is
 // not grazed). Only the first change along the line counts.
 LineClip exactMeshClip(int s, vec3 a, vec3 d, bool own, float eps) {
-  int o = EIKON_SHAPE_STRIDE * s;
-  vec3 dl = vec3(dot(EIKON_SHAPE_ROW(o + 2).xyz, d), dot(EIKON_SHAPE_ROW(o + 3).xyz, d),
-                 dot(EIKON_SHAPE_ROW(o + 4).xyz, d));
+  vec3 dl = shapeLocalDir(s, d);
   float tHit;
   vec3 n;
   int face;
@@ -1088,11 +1090,8 @@ bool exactEarlierMesh(int i, int region) {
          int(EIKON_EXACT_ROW(EIKON_SHAPE_STRIDE * i).x) == EIKON_SHAPE_MESH;
 }
 LineClip exactEarlierMeshClip(int i, vec3 a, vec3 d, float tq) {
-  int o = EIKON_SHAPE_STRIDE * i;
-  vec3 dl = vec3(dot(EIKON_SHAPE_ROW(o + 2).xyz, d), dot(EIKON_SHAPE_ROW(o + 3).xyz, d),
-                 dot(EIKON_SHAPE_ROW(o + 4).xyz, d));
   LineClip c = clipOpen();
-  c.hit = exactMeshHolds(i, shapeLocal(i, a), dl, tq);
+  c.hit = exactMeshHolds(i, shapeLocal(i, a), shapeLocalDir(i, d), tq);
   return c;
 }
 

@@ -6,6 +6,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "core/scene/mesh.h"
 #include "core/scene/scene.h"
@@ -173,6 +174,13 @@ bool refineOnShape(const Shape& s, bool leaving_owner, const glm::dvec3& a, cons
   return false;
 }
 
+/// The line a + t·d (world) in shape s's local frame: {origin, direction}, t unchanged.
+std::pair<glm::dvec3, glm::dvec3> localLine(const Shape& s, const glm::dvec3& a,
+                                            const glm::dvec3& d) {
+  const glm::dmat3 to_local = glm::transpose(s.rotation());
+  return {to_local * (a - s.center()), to_local * d};
+}
+
 // A crossing of a mesh's surface: the first exact ray–triangle hit (MeshDistance::firstHit) of
 // the right orientation (a triangle facing along the segment when leaving the mesh, against it
 // when entering) within kMeshBracketVoxels of the field's t, with its triangle's plane normal:
@@ -180,8 +188,7 @@ bool refineOnShape(const Shape& s, bool leaving_owner, const glm::dvec3& a, cons
 // which has no signed distance of a mesh to refine on) if there is none.
 bool meshCrossing(const Shape& s, const MeshShape& m, bool leaving_owner, const glm::dvec3& a,
                   const glm::dvec3& b, double len_vox, BoundaryCrossing& out) {
-  const glm::dmat3 to_local = glm::transpose(s.rotation());
-  const glm::dvec3 o = to_local * (a - s.center()), d = to_local * (b - a);
+  const auto [o, d] = localLine(s, a, b - a);
   const double w = kMeshBracketVoxels / len_vox;
   const MeshDistance::Hit hit = m.distance->firstHit(
       o, d, std::max(0.0, out.t - w), std::min(1.0, out.t + w), leaving_owner ? 1 : -1);
@@ -509,26 +516,6 @@ bool BoundaryField::regionsOnShapes() const {
 }
 
 namespace {
-bool meshHolds(const Shape& s, const MeshShape& m, const glm::dvec3& a, const glm::dvec3& d,
-               double tq);
-}  // namespace
-
-int regionAt(const BoundaryField& bf, const glm::dvec3& x) {
-  if (!bf.regionsOnShapes()) return boundaryRegion(bf, x);
-  for (size_t i = bf.shapes.size(); i-- > 0;) {
-    const Shape& s = bf.shapes[i];
-    // A mesh by the parity of its hits along a fixed direction from x, as the GPU twin
-    // (boundary.glsl exactInside): one ray through the hierarchy, where the signed distance
-    // searches for the nearest triangle.
-    const MeshShape* m = std::get_if<MeshShape>(&s.geometry());
-    if (m ? meshHolds(s, *m, x, glm::dvec3(0.5773502, 0.5773503, 0.5773504), 0.0)
-          : s.signedDistance(x) <= 0.0)
-      return int(i) + 1;
-  }
-  return 0;
-}
-
-namespace {
 
 /// A mesh's part in exactCrossingOutOf, as the interval the two passes read of an analytic shape
 /// (boundary.glsl exactMeshClip): the ray's own mesh (`own`): where the line o + t·d first leaves
@@ -538,9 +525,8 @@ namespace {
 /// but only the first change counts.
 LineClip meshClip(const Shape& s, const MeshShape& m, const glm::dvec3& a, const glm::dvec3& d,
                   bool own, double eps) {
-  const glm::dmat3 to_local = glm::transpose(s.rotation());
-  const MeshDistance::Hit h = m.distance->firstHit(to_local * (a - s.center()), to_local * d,
-                                                   own ? 0.0 : eps, 1.0, own ? 1 : -1);
+  const auto [o, dl] = localLine(s, a, d);
+  const MeshDistance::Hit h = m.distance->firstHit(o, dl, own ? 0.0 : eps, 1.0, own ? 1 : -1);
   LineClip c;
   if (own) {
     c.hit = true;
@@ -563,14 +549,28 @@ LineClip meshClip(const Shape& s, const MeshShape& m, const glm::dvec3& a, const
 /// hits let no crossing slip between triangles). boundary.glsl exactMeshHolds.
 bool meshHolds(const Shape& s, const MeshShape& m, const glm::dvec3& a, const glm::dvec3& d,
                double tq) {
-  const glm::dmat3 to_local = glm::transpose(s.rotation());
-  const glm::dvec3 o = to_local * (a - s.center()), dl = to_local * d;
+  const auto [o, dl] = localLine(s, a, d);
   const double far = tq + (glm::length(o) + 2.0 * m.bounding_radius + 1.0) / glm::length(d);
   const MeshDistance::Hit h = m.distance->firstHit(o, dl, tq, far, 0);
   return h.found && glm::dot(h.normal, dl) > 0.0;
 }
 
 }  // namespace
+
+int regionAt(const BoundaryField& bf, const glm::dvec3& x) {
+  if (!bf.regionsOnShapes()) return boundaryRegion(bf, x);
+  for (size_t i = bf.shapes.size(); i-- > 0;) {
+    const Shape& s = bf.shapes[i];
+    // A mesh by the parity of its hits along a fixed direction from x, as the GPU twin
+    // (boundary.glsl exactInside): one ray through the hierarchy, where the signed distance
+    // searches for the nearest triangle.
+    const MeshShape* m = std::get_if<MeshShape>(&s.geometry());
+    if (m ? meshHolds(s, *m, x, glm::dvec3(0.5773502, 0.5773503, 0.5773504), 0.0)
+          : s.signedDistance(x) <= 0.0)
+      return int(i) + 1;
+  }
+  return 0;
+}
 
 BoundaryCrossing exactCrossingOutOf(const BoundaryField& bf, const glm::dvec3& a,
                                     const glm::dvec3& b, int region) {
