@@ -95,8 +95,10 @@ struct MovedLight {
   std::string error;                     ///< the simulation failed: why
 };
 
-/// The first light moved by a drag, simulated again in the background: a Session of its own on a
-/// copy of the scene (voxelised once, at the first move, on the worker thread) simulates the moved
+/// The scene's first light simulated in the background: when the viewer opens and the light cache
+/// does not hold it (the view shows the scene unlit meanwhile), and again whenever a drag moves
+/// it. A Session of its own on a copy of the scene (made from a copy of the viewer's volume, or
+/// voxelised at its first start on the worker thread, and kept for the next moves) simulates the
 /// light through the light cache (the key covers the medium, the lights and the simulator
 /// settings, never the camera: a light put back where it was simulated before is only looked up),
 /// while the viewer keeps rendering with the light volumes it has. The viewer then swaps the new
@@ -104,6 +106,8 @@ struct MovedLight {
 /// again.
 class LightMover {
  public:
+  /// `on_cpu`: the twin the viewer's own session chose (Session::lightOnCpuTwin), so that both
+  /// look up the same light-cache entries.
   LightMover(const Scene& scene, bool on_cpu, std::filesystem::path cache)
       : scene_(std::make_shared<Scene>(scene)), on_cpu_(on_cpu), cache_(std::move(cache)) {}
   ~LightMover() {
@@ -112,20 +116,34 @@ class LightMover {
   bool busy() const { return worker_.joinable() && !done_; }
   /// A simulation has finished and finished() has not reported it yet.
   bool done() const { return worker_.joinable() && done_; }
+  /// The fraction of the running simulation done, [0, 1].
+  double fraction() const { return fraction_; }
   /// Simulate the scene with its first light replaced by `light`, unless a simulation is running.
-  bool start(const Light& light) {
+  /// `volume`: the scene voxelised already (the viewer's), copied on the worker thread into the
+  /// mover's session at its first start instead of voxelising the scene again (mesh_torus_caustic:
+  /// 3.5 s of copying, done while the viewer makes its renderer). The caller leaves it unchanged
+  /// until the simulation has finished.
+  bool start(const Light& light, const VolumeSet* volume = nullptr) {
     if (busy()) return false;
     if (worker_.joinable()) worker_.join();  // the scene and the session are this thread's now
     done_ = false;
+    fraction_ = 0.0;
     scene_->lights.front() = light;
     result_ = MovedLight{};
     result_.light = light;
-    worker_ = std::thread([this] {
+    worker_ = std::thread([this, volume] {
       const auto start = Clock::now();
       try {
-        // Its own Vulkan device, made only if the GPU twin simulates.
-        if (!session_) session_ = std::make_unique<Session>(scene_);
-        const LightOutcome o = session_->simulateLight(LightRequest{}, on_cpu_, cache_);
+        if (!session_) {
+          session_ = std::make_unique<Session>(scene_);
+          session_->setProgress({[this](const char*, double f) { fraction_ = f; }, {}});
+          if (volume) session_->adoptVolume(*volume);
+        }
+        // The viewer's twin, named: "auto" would decide again, without a device. The GPU twin
+        // makes a Vulkan device of the mover's own.
+        LightRequest request;
+        request.device = on_cpu_ ? "cpu" : "gpu";
+        const LightOutcome o = session_->simulateLight(request, on_cpu_, cache_);
         result_.cached = o.cached;
         result_.warnings = o.warnings;
         VolumeSet& v = session_->prepare(false);  // made by simulateLight; refilled by the next
@@ -154,6 +172,7 @@ class LightMover {
   std::unique_ptr<Session> session_;
   std::thread worker_;
   std::atomic<bool> done_{false};
+  std::atomic<double> fraction_{0.0};
   MovedLight result_;
 };
 
@@ -257,6 +276,10 @@ class Viewer {
     return std::string(buf) + compiles;
   }
 
+  /// The mover simulates the scene's own first light (not in the light cache when the viewer
+  /// opened): the view shows the scene unlit until it is swapped in.
+  void awaitFirstLight() { first_light_ = true; }
+
   const RenderImage& shown() const { return shown_; }
   int shownSamples() const { return shown_spp_; }
   int shownWavelengths() const { return shown_wavelengths_; }
@@ -283,7 +306,9 @@ class Viewer {
     std::vector<Stage> s;
     if (c > 1) s.push_back({std::max(1, w / c), std::max(1, h / c), 1, few});
     if (few != full && !heroSampling()) s.push_back({w, h, 1, few});
-    s.push_back({w, h, args_.spp, full});
+    // Unlit, while the first light is simulated: one sample, which leaves the cores to the
+    // simulation (refining an unlit view to --spp delayed the light by half on 2 cores).
+    s.push_back({w, h, firstLightPending() ? 1 : args_.spp, full});
     return s;
   }
 
@@ -327,7 +352,8 @@ class Viewer {
     // The keys' pipelines compile on a core of their own, which a refining view would share (up
     // to half of the machine on lavapipe's 2 cores here): asked for once a view is refined, unless
     // the viewer ends now (--exit-after-frames; the renderer would wait for the compile).
-    if (!prefetched_ && !(args_.exit_after_frames > 0 && !lightPending())) prefetchKeys();
+    if (!prefetched_ && !firstLightPending() && !(args_.exit_after_frames > 0 && !lightPending()))
+      prefetchKeys();
   }
 
   /// A stage whose view pipeline is not compiled yet (a key changed the integrator or RGB ↔
@@ -431,7 +457,7 @@ class Viewer {
       frame_times_.pop_front();
     updateTitle(now);
     if (args_.exit_after_frames > 0 && frames_since_change_ >= args_.exit_after_frames &&
-        inputDone()) {
+        inputDone() && !lightPending()) {
       quit_ = true;
       throw Interrupted{};
     }
@@ -449,6 +475,10 @@ class Viewer {
   }
 
   void updateTitle(Clock::time_point now) {
+    char light[96] = "";
+    if (mover_ && mover_->busy())
+      std::snprintf(light, sizeof light, " | %ssimulating the light (%.0f%%)...",
+                    first_light_ ? "unlit, " : "", 100.0 * mover_->fraction());
     double fps = 0;
     if (frame_times_.size() > 1)
       fps = double(frame_times_.size() - 1) /
@@ -465,7 +495,7 @@ class Viewer {
                   compiling_ ? " | compiling..."
                   : refined_ ? " | refined"
                              : "",
-                  mover_ && mover_->busy() ? " | simulating the light..." : light_note_.c_str());
+                  *light ? light : light_note_.c_str());
     glfwSetWindowTitle(window_, buf);
   }
 
@@ -488,6 +518,8 @@ class Viewer {
         std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
       if (moved_.error.empty()) {
         light_ready_ = changed_ = true;  // swapped in between renders (applyLight)
+      } else if (first_light_) {
+        throw CliError("the scene's light was not simulated: " + moved_.error);
       } else {
         std::fprintf(stderr, "eikon: warning: the moved light was not simulated: %s\n",
                      moved_.error.c_str());
@@ -502,6 +534,9 @@ class Viewer {
     }
   }
 
+  /// The view is unlit until the first light, simulated in the background, arrives.
+  bool firstLightPending() const { return first_light_ && lightPending(); }
+
   bool lightPending() const {
     return mover_ && (light_moved_ || light_ready_ || mover_->busy() || mover_->done());
   }
@@ -513,17 +548,19 @@ class Viewer {
     session_.scene()->lights.front() = moved_.light;
     session_.setLightVolumes(std::move(moved_.fluence), std::move(moved_.flux));
     std::printf(
-        "eikon view: light 0 simulated again in the background (%s, %.2f s; meanwhile %lld frames "
-        "rendered with the former light and %lld presented again): position %s, direction %s\n",
-        moved_.cached ? "from the light cache" : "simulated", moved_.seconds, light_rendered_,
+        "eikon view: light 0 simulated %s the background (%s, %.2f s; meanwhile %lld frames "
+        "rendered %s and %lld presented again): position %s, direction %s\n",
+        first_light_ ? "in" : "again in", moved_.cached ? "from the light cache" : "simulated",
+        moved_.seconds, light_rendered_, first_light_ ? "unlit" : "with the former light",
         light_frames_, vectorJson(moved_.light.position).c_str(),
         vectorJson(moved_.light.direction).c_str());
     std::fflush(stdout);
     light_rendered_ = light_frames_ = 0;
     char note[96];
-    std::snprintf(note, sizeof note, " | light moved (%s, %.2f s)",
+    std::snprintf(note, sizeof note, " | light %s (%s, %.2f s)", first_light_ ? "simulated" : "moved",
                   moved_.cached ? "from the light cache" : "simulated", moved_.seconds);
     light_note_ = note;
+    first_light_ = false;
   }
 
   void resize() {
@@ -644,6 +681,7 @@ class Viewer {
   Light wanted_light_;
   MovedLight moved_;  ///< the last light the mover finished, until applyLight swaps it in
   bool light_moved_ = false, light_ready_ = false;
+  bool first_light_ = false;      ///< the mover simulates the first light (awaitFirstLight)
   long long light_rendered_ = 0;  ///< frames rendered while the mover simulated
   long long light_frames_ = 0;    ///< frames presented again meanwhile (the view was refined)
   std::string light_note_;        ///< the title's word on the last moved light
@@ -763,7 +801,8 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   if (!scene->lights.empty() && !a.no_light && !scene->anyScattering())
     std::fputs(kLightsNotSimulatedNote, stderr);
   if (!scene->lights.empty() && !a.no_light && scene->anyScattering())
-    mover = std::make_unique<LightMover>(*scene, lightOnCpu("auto", &ctx), defaultLightCacheDir());
+    mover = std::make_unique<LightMover>(*scene, session.lightOnCpuTwin(LightRequest{}, false),
+                                         defaultLightCacheDir());
   // Input is handled from here on: events that arrive while the scene is voxelised (polled by
   // the progress callbacks) already move the camera of the first frame.
   Viewer viewer(a, session, window.handle, chain, base, mover.get());
@@ -774,9 +813,16 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   else
     session.prepareGpuRender();
   if (mover) {
-    LightOutcome light = session.simulateLight(LightRequest{}, false, defaultLightCacheDir());
+    // The light from the light cache, else simulated in the background from a copy of this
+    // volume while the view shows the scene unlit (with zeroed light volumes, so the renderer is
+    // made lit and takes the simulated ones in place).
+    LightOutcome light = session.cachedLight(LightRequest{}, false, defaultLightCacheDir());
     for (const std::string& w : light.warnings)
       std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+    if (!light.cached) {
+      mover->start(scene->lights.front(), &session.prepare(true));
+      viewer.awaitFirstLight();
+    }
   }
   viewer.run();
   std::printf("%s\n", viewer.summary().c_str());

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/light/light_cache.h"
+#include "core/light/lighting.h"
 #include "core/reference/polarised_render.h"
 #include "core/reference/polarised_trace.h"
 #include "core/reference/reference_lighting.h"
@@ -251,6 +252,16 @@ bool Session::lightOnCpuTwin(const LightRequest& light, bool cpu_render) {
 
 LightOutcome Session::simulateLight(const LightRequest& light, bool cpu_render,
                                     const std::filesystem::path& cache_dir) {
+  return lightVolumes(light, cpu_render, cache_dir, true);
+}
+
+LightOutcome Session::cachedLight(const LightRequest& light, bool cpu_render,
+                                  const std::filesystem::path& cache_dir) {
+  return lightVolumes(light, cpu_render, cache_dir, false);
+}
+
+LightOutcome Session::lightVolumes(const LightRequest& light, bool cpu_render,
+                                   const std::filesystem::path& cache_dir, bool simulate) {
   LightOutcome out;
   out.on_cpu = lightOnCpuTwin(light, cpu_render);
   VolumeSet& volume = prepare(!cpu_render);
@@ -263,7 +274,9 @@ LightOutcome Session::simulateLight(const LightRequest& light, bool cpu_render,
   std::string notice;
   if (use_cache && loadLightCache(cache_dir, key, volume, &notice)) out.cached = true;
   if (!notice.empty()) out.warnings.push_back("light cache: " + printable(notice));
-  if (!out.cached) {
+  if (!out.cached && !simulate) {
+    clearLighting(volume);
+  } else if (!out.cached) {
     out.summary = out.on_cpu ? simulateLightingReference(*scene_, volume, lo)
                              : simulateLighting(context(), *scene_, volume, lo);
     if (use_cache) {
@@ -273,6 +286,18 @@ LightOutcome Session::simulateLight(const LightRequest& light, bool cpu_render,
   }
   lightChanged();  // renderers made before hold the former light volumes (or none)
   return out;
+}
+
+void Session::adoptVolume(VolumeSet volume) {
+  if (volume_) throw std::invalid_argument("adoptVolume: the session has a volume already");
+  if (!volume.whole())
+    throw std::invalid_argument("adoptVolume: the volume lacks its fields or its boundary voxels");
+  const Grid g = makeGrid(scene_->volume);
+  if (volume.grid.dims != g.dims || volume.grid.origin != g.origin || volume.grid.h != g.h)
+    throw std::invalid_argument("adoptVolume: the volume is not on this scene's grid");
+  volume_ = std::make_unique<VolumeSet>(std::move(volume));
+  volume_from_cache_ = false;
+  voxelized_spec_ = scene_->volume;
 }
 
 void Session::setLightVolumes(std::vector<glm::vec4> fluence, std::vector<glm::vec4> flux) {

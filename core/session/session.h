@@ -182,6 +182,18 @@ class Session {
   /// renderers made before are rebuilt on their next use.
   LightOutcome simulateLight(const LightRequest& light, bool cpu_render,
                              const std::filesystem::path& cache_dir);
+  /// simulateLight without the simulation: the light volumes from the light cache when it holds
+  /// them (out.cached), else zeroed light volumes on the volume's grid (out.cached false), which a
+  /// simulation made elsewhere replaces through setLightVolumes. The viewer simulates its first
+  /// light in the background and shows the scene unlit meanwhile: a renderer made now is made lit,
+  /// so it takes the simulated volumes in place, without a pipeline built again.
+  LightOutcome cachedLight(const LightRequest& light, bool cpu_render,
+                           const std::filesystem::path& cache_dir);
+  /// Take a volume voxelised by another session of the same scene (the viewer's own, copied for
+  /// the session that simulates its light in the background) instead of voxelising the scene
+  /// again. Throws std::invalid_argument when this session has a volume already, or `volume` is
+  /// not whole (VolumeSet::whole) or not on this scene's grid.
+  void adoptVolume(VolumeSet volume);
   /// Light volumes simulated elsewhere for this session's volume (the viewer's background
   /// simulation of a moved light, on a session of its own), swapped in as simulateLight's are.
   /// Throws std::invalid_argument when their size is not the volume's.
@@ -209,6 +221,9 @@ class Session {
 
  private:
   void dropRenderers();
+  /// simulateLight (simulate) and cachedLight (!simulate).
+  LightOutcome lightVolumes(const LightRequest& light, bool cpu_render,
+                            const std::filesystem::path& cache_dir, bool simulate);
   /// The light volumes changed: the GPU renderer takes them in place where it can.
   void lightChanged();
   /// `expected`: the render about to run, whose pipeline then compiles during the upload.

@@ -451,6 +451,55 @@ TEST_F(ViewerTest, CtrlDragMovesTheLightInTheBackground) {
   EXPECT_EQ(cached.position, position) << again.out;
 }
 
+/// A lit scene whose light is not in the light cache: the viewer shows the scene unlit at once
+/// and simulates the light in the background (on a copy of its volume), then swaps it in; a view
+/// ended by --exit-after-frames waits for it. The refined view then equals `eikon render` of the
+/// scene (the same samples: within the 8-bit rounding, as in CtrlDragMovesTheLightInTheBackground)
+/// and differs from the unlit render. A second viewer finds the light in the cache the first
+/// filled, simulates nothing and shows the same picture.
+TEST_F(ViewerTest, FirstLightIsSimulatedInTheBackgroundAndWaitedFor) {
+  const std::string xvfb = findProgram("Xvfb");
+  if (xvfb.empty()) GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb)";
+  Xvfb server(xvfb);
+  ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
+  std::ofstream(dir_ / "lit.json") << kLitScene;
+  extra_env_ = "EIKON_CACHE_DIR=" + quote((dir_ / "cache").string());  // none of it seen before
+  const auto view = [&](const std::string& name) {
+    const fs::path shot = dir_ / (name + ".png");
+    const ViewerRun run =
+        viewWhile(server, "", (dir_ / "lit.json").string(),
+                  "--width 80 --height 60 --spp 8 --exit-after-frames 100 --screenshot " +
+                      quote(shot.string()),
+                  "");
+    EXPECT_TRUE(WIFEXITED(run.status) && WEXITSTATUS(run.status) == 0) << run.err;
+    EXPECT_EQ(run.err.find("validation"), std::string::npos) << run.err;
+    EXPECT_NE(run.out.find("8 samples"), std::string::npos) << run.out;
+    return std::pair{run.out, readPng(shot)};
+  };
+  const auto render80 = [&](const std::string& extra, const std::string& name) {
+    const fs::path out_exr = dir_ / (name + ".exr");
+    const Outcome o = eikon::test::runEikon("render " + quote((dir_ / "lit.json").string()) +
+                                                " -o " + quote(out_exr.string()) +
+                                                " -q --spp 8 --no-light-cache " + extra,
+                                            dir_ / "render_io", "EIKON_VALIDATION=1");
+    EXPECT_EQ(o.code, 0) << o.err;
+    return readPng(fs::path(out_exr).replace_extension(".png"));
+  };
+  const auto [out, viewed] = view("first");
+  EXPECT_NE(out.find("eikon view: light 0 simulated in the background (simulated, "),
+            std::string::npos)
+      << out;
+  const Png lit = render80("", "lit"), unlit = render80("--no-light", "unlit");
+  const double same = rmsDifference(viewed, lit), dark = rmsDifference(viewed, unlit);
+  std::printf("rms: viewer vs the lit render %.5f, vs the unlit render %.5f\n", same, dark);
+  EXPECT_LE(same, 2.0 / 255) << out;
+  EXPECT_GT(dark, 2.0 / 255) << "the view was not lit";
+
+  const auto [again, cached] = view("again");
+  EXPECT_EQ(again.find("simulated in the background"), std::string::npos) << again;
+  EXPECT_EQ(rmsDifference(cached, viewed), 0.0);
+}
+
 /// An N-BK7 (Sellmeier: dispersive, so 16 wavelengths) sphere; `attenuation` per mm in it.
 std::string dispersiveScene(double attenuation) {
   return R"({
