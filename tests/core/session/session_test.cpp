@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/volume/field.h"
+#include "tests/core/scene_support.h"
 
 namespace eikon {
 namespace {
@@ -170,6 +171,48 @@ TEST(Session, SwappedLightVolumesRenderAsASessionOfTheMovedLight) {
   EXPECT_EQ(worst, 0.0);     // the same volumes through the same kernel
   EXPECT_GT(changed, 0.05);  // and the light did move
   EXPECT_THROW(session.setLightVolumes({}, {}), std::invalid_argument);
+}
+
+/// The viewer's first light (apps/view_command.cpp): cachedLight gives zeroed light volumes where
+/// the light cache does not hold the light, a second session on a copy of the volume
+/// (adoptVolume) simulates it through the cache without voxelising, and its volumes, swapped in,
+/// are the ones the first session then finds in the cache and the ones it simulates itself.
+TEST(Session, FirstLightSimulatedOnAnAdoptedVolumeIsTheCachedOne) {
+  test::TempDir cache;
+  auto scene = std::make_shared<Scene>(parseScene(kLitScene, "lit.json"));
+  Session viewer(scene), mover(std::make_shared<Scene>(*scene));
+  const LightOutcome none = viewer.cachedLight(LightRequest{}, false, cache.path());
+  EXPECT_FALSE(none.cached);
+  const VolumeSet& v = viewer.prepare(true);
+  ASSERT_EQ(v.light_fluence.size(), v.grid.count());
+  ASSERT_EQ(v.light_flux.size(), v.grid.count());
+  for (size_t i = 0; i < v.grid.count(); ++i)
+    ASSERT_TRUE(v.light_fluence[i] == glm::vec4(0.0f) && v.light_flux[i] == glm::vec4(0.0f)) << i;
+
+  mover.adoptVolume(v);
+  EXPECT_TRUE(mover.voxelized());
+  EXPECT_THROW(mover.adoptVolume(v), std::invalid_argument);  // it has one
+  const LightOutcome simulated = mover.simulateLight(LightRequest{}, false, cache.path());
+  EXPECT_FALSE(simulated.cached);
+  EXPECT_GT(simulated.summary.runs, 0u);
+  const VolumeSet& m = mover.prepare(false);
+  viewer.setLightVolumes(m.light_fluence, m.light_flux);
+
+  Session later(std::make_shared<Scene>(*scene)), alone(std::make_shared<Scene>(*scene));
+  EXPECT_TRUE(later.cachedLight(LightRequest{}, false, cache.path()).cached);
+  alone.simulateLight(LightRequest{}, false, {});
+  const VolumeSet &l = later.prepare(false), &a = alone.prepare(false);
+  EXPECT_TRUE(l.light_fluence == m.light_fluence && l.light_flux == m.light_flux);
+  EXPECT_TRUE(a.light_fluence == m.light_fluence && a.light_flux == m.light_flux)
+      << "the adopted volume simulates another light than the scene's own";
+
+  // A volume of another grid, or one without its fields, is refused.
+  auto finer = std::make_shared<Scene>(*scene);
+  finer->volume.resolution *= 2;
+  EXPECT_THROW(Session(finer).adoptVolume(v), std::invalid_argument);
+  VolumeSet lean = v;
+  lean.fields = false;
+  EXPECT_THROW(Session(scene).adoptVolume(lean), std::invalid_argument);
 }
 
 }  // namespace
