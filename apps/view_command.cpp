@@ -557,7 +557,8 @@ class Viewer {
     std::fflush(stdout);
     light_rendered_ = light_frames_ = 0;
     char note[96];
-    std::snprintf(note, sizeof note, " | light %s (%s, %.2f s)", first_light_ ? "simulated" : "moved",
+    std::snprintf(note, sizeof note, " | light %s (%s, %.2f s)",
+                  first_light_ ? "simulated" : "moved",
                   moved_.cached ? "from the light cache" : "simulated", moved_.seconds);
     light_note_ = note;
     first_light_ = false;

@@ -478,10 +478,10 @@ TEST_F(ViewerTest, FirstLightIsSimulatedInTheBackgroundAndWaitedFor) {
   };
   const auto render80 = [&](const std::string& extra, const std::string& name) {
     const fs::path out_exr = dir_ / (name + ".exr");
-    const Outcome o = eikon::test::runEikon("render " + quote((dir_ / "lit.json").string()) +
-                                                " -o " + quote(out_exr.string()) +
-                                                " -q --spp 8 --no-light-cache " + extra,
-                                            dir_ / "render_io", "EIKON_VALIDATION=1");
+    const Outcome o =
+        eikon::test::runEikon("render " + quote((dir_ / "lit.json").string()) + " -o " +
+                                  quote(out_exr.string()) + " -q --spp 8 --no-light-cache " + extra,
+                              dir_ / "render_io", "EIKON_VALIDATION=1");
     EXPECT_EQ(o.code, 0) << o.err;
     return readPng(fs::path(out_exr).replace_extension(".png"));
   };
