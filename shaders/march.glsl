@@ -277,7 +277,7 @@ struct MarchResult {
   vec3 throughput;
   float opl;
   bool left;
-  bool cut;  // the driver's loop budget ran out on the way (sharp.glsl loopLimitReached)
+  bool cut;  // the driver's loop budget (sharp.glsl loopLimitReached) or max steps ran out
   int steps;
   float drift;
   int interfaces;
@@ -682,11 +682,15 @@ MarchResult march(vec3 o, vec3 d, int mode) {
     if (clipToVolume(S, R, E)) break;
     ++steps;
   }
+  // Cut short: by the driver's loop budget (lavapipe ends every loop once a group has run out of
+  // it, so the march stops early without a sign: sharp.glsl loopLimitReached tells), or out of
+  // steps. Either way the sample lacks the light it would have reached, and is counted.
+  R.cut = loopLimitReached() || (!S.stopped && steps >= maxSteps);
   R.steps = steps;
   R.exit_point = S.x;
   R.exit_dir = rayDirection(S.x, S.w, mode);
   R.wave_normal = normalize(S.w);
-  R.left = !S.stopped && steps < maxSteps;
+  R.left = !S.stopped && !R.cut;
   if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
   R.radiance = S.L;
   R.throughput = S.T;

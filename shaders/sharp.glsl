@@ -445,7 +445,10 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   R.exit_point = S.x;
   R.exit_dir = sharpDirection(S, mode);
   R.wave_normal = normalize(S.w);
-  R.cut = cut;
+  // The check in the loop sees a budget spent in the loops of a pass; one spent by the march
+  // loop's own last pass stops it silently after that pass, which only a check after it sees.
+  cut = cut || loopLimitReached();
+  R.cut = cut || (!S.stopped && steps >= maxSteps);  // the loop limit, or out of steps
   R.left = !S.stopped && !cut && steps < maxSteps;
   if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
   R.radiance = S.L;

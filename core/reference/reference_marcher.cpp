@@ -67,6 +67,7 @@ struct MarchResult {
   glm::dvec3 radiance{0.0}, throughput{1.0}, exit_point{0.0}, exit_dir{0.0}, wave_normal{0.0};
   double opl = 0.0, drift = 0.0;
   bool left = true;
+  bool ran_out = false;  ///< ended by max_steps alone (march.glsl's cut, RenderImage::cut_samples)
   int steps = 0, interfaces = 0, tir = 0;
   long long fetches = 0;  ///< volume-field reads (CountedField)
   FirstInterface first;   ///< the first interface met (the AOV layer)
@@ -553,6 +554,7 @@ MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
   R.exit_dir = rayDirection(S.x, S.w);
   R.wave_normal = glm::normalize(S.w);
   R.left = !S.stopped && steps < m_.max_steps;
+  R.ran_out = !S.stopped && steps >= m_.max_steps;
   if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
   R.radiance = S.L;
   R.throughput = S.T;
@@ -794,6 +796,7 @@ MarchResult RayMarch::marchSharp(const glm::dvec3& o, const glm::dvec3& d) const
   R.exit_dir = sharpDirection(S);
   R.wave_normal = glm::normalize(S.w);
   R.left = !S.stopped && steps < m_.max_steps;
+  R.ran_out = !S.stopped && steps >= m_.max_steps;
   if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
   R.radiance = S.L;
   R.throughput = S.T;
@@ -846,9 +849,11 @@ struct ReferenceMarcher::SampleTally {
   double steps = 0.0, fetches = 0.0, marchSteps = 0.0;
   FirstInterface first;
   bool marched = false;
+  bool ran_out = false;  ///< a march ran out of max_steps (the sample is cut short)
   void add(const Result& r, double share) {
     if (!marched) first = r.first;
     marched = true;
+    ran_out = ran_out || r.ran_out;
     steps += double(r.steps) / share;
     fetches += double(r.fetches) / share;
     marchSteps += double(r.steps);
@@ -953,7 +958,7 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
   LayerSums layers(s, size_t(img.width) * size_t(img.height), field_.uniaxial());
   if (s.aov_layer) initAov(img);
   std::atomic<int> next{0}, rows_done{0};
-  std::atomic<long long> total_steps{0}, total_fetches{0};
+  std::atomic<long long> total_steps{0}, total_fetches{0}, cut_samples{0};
   std::mutex progress_mutex;  // progress per row, one report at a time (skipped when busy)
   auto worker = [&] {
     long long local_steps = 0, local_fetches = 0;
@@ -980,6 +985,7 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
           sum += sampleRgb(cam.position, d, pixel, uint32_t(sidx), s, hero, tally, layers);
           steps += tally.steps;
           fetches += tally.fetches;
+          if (tally.ran_out) ++cut_samples;
           if (s.aov_layer) {
             if (sidx == 0) setAovGeometry(img, pixel, cam.position, tally.first);
             addAovSteps(img, pixel, tally.marchSteps);
@@ -1005,6 +1011,7 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
   img.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   img.mean_steps = double(total_steps) / (double(img.width) * img.height);
   img.mean_fetches = double(total_fetches) / (double(img.width) * img.height);
+  img.cut_samples = cut_samples;
   return img;
 }
 

@@ -102,8 +102,9 @@ struct RenderImage {
   /// the GPU (core/reference/reference_marcher.cpp CountedField).
   double mean_fetches = 0.0;
   double seconds = 0.0;  ///< wall time of the march itself
-  /// Pixel samples (passes of a pixel) in which a march was stopped by the device's loop budget
-  /// (lavapipe; docs/view-renderer.md) and so lacks the light it would have reached; 0 on the CPU.
+  /// Pixel samples (passes of a pixel) in which a march was cut short, and so lack the light it
+  /// would have reached: by the device's loop budget (lavapipe, GPU twin only;
+  /// docs/view-renderer.md) or by MarchSettings::max_steps (both twins).
   long long cut_samples = 0;
   /// RenderSettings::spectral_layer: spectral radiance per wavelength bin k = [380 + k·400/N,
   /// 380 + (k + 1)·400/N) nm (its mean over the bin, W·m⁻²·sr⁻¹·nm⁻¹ in the environment's units),

@@ -134,6 +134,28 @@ TEST(Lighting, DiffuseFloorFollowsLambertsCosineLaw) {
   expectNoValidationMessages();
 }
 
+/// Light the simulator's step limit ends is missing from the volumes: the summary says how much.
+/// The floor lies 7.75 mm below the volume's top along y, 8.9 mm along the light (30° off the
+/// vertical), so with 10 time steps of half a 1/3 mm voxel (1.7 mm) no patch reaches it and all
+/// the emitted flux is still live at the end; with the default limit none is, and nothing is said.
+TEST(Lighting, FluxEndedByTheStepLimitIsSaid) {
+  Scene scene = sceneFromJson(kFloor);
+  VolumeSet v = voxelize(scene);
+  LightingOptions lo;
+  lo.wave.max_steps = 10;
+  const LightingSummary cut = simulateLightingReference(scene, v, lo);
+  EXPECT_NEAR(cut.flux_live_at_end, cut.flux_emitted, 1e-9 * cut.flux_emitted);
+  ASSERT_EQ(cut.notes.size(), 1u);
+  EXPECT_EQ(cut.notes[0].rfind("1 of the emitted flux was still travelling when the simulator's "
+                               "limit of 10 time steps ended it",
+                               0),
+            0u)
+      << cut.notes[0];
+  const LightingSummary whole = simulateLightingReference(scene, v, {});
+  EXPECT_LT(whole.flux_live_at_end, 1e-3 * whole.flux_emitted);
+  EXPECT_TRUE(whole.notes.empty());
+}
+
 TEST(Lighting, DiffuseFloorIsLitTheSameByTheGpuSimulator) {
   // The GPU simulator's light volumes give the same floor (same bound as above).
   Scene scene = sceneFromJson(kFloor);
