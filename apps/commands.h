@@ -23,6 +23,13 @@ inline constexpr const char* kLightsNotSimulatedNote =
     "eikon: note: the lights are not simulated: no material has an albedo, so no medium scatters "
     "their light and no diffuse surface shows it\n";
 
+/// --exposure of the PNG preview and the viewer: stops in [-64, 64] (2^±64 spans every radiance a
+/// float holds); NaN and infinities are refused, not turned into a black or white image.
+inline void checkExposure(double stops) {
+  if (!(stops >= -64 && stops <= 64))
+    throw CliError("--exposure must be in [-64, 64] stops, got " + std::to_string(stops));
+}
+
 void addRenderCommand(CLI::App& app);
 void addTraceCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);

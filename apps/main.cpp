@@ -1,6 +1,7 @@
 // eikon — eikonal rendering of refractive, dispersive and birefringent objects.
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <string>
 
 #include "apps/commands.h"
@@ -28,6 +29,12 @@ int main(int argc, char** argv) {
   } catch (const eikon::cli::CliError& e) {
     std::fputs(eikon::errorLine(e.what()).c_str(), stderr);
     return e.exit_code;
+  } catch (const std::bad_alloc&) {  // the checks before allocating missed a case: say so
+    std::fputs(eikon::errorLine("out of host memory (std::bad_alloc); lower the image size, the "
+                                "layers or the volume's resolution")
+                   .c_str(),
+               stderr);
+    return 1;
   } catch (const std::exception& e) {
     std::fputs(eikon::errorLine(e.what()).c_str(), stderr);
     return 1;

@@ -37,10 +37,11 @@ enum class ProgressMode { Auto, Always, Never };
 
 /// "auto" (a terminal on stderr decides), "always" or "never"; -q means never.
 inline ProgressMode progressMode(const std::string& option, bool quiet) {
+  // Checked even with --quiet: a bad word is refused, never ignored.
+  if (option != "auto" && option != "always" && option != "never")
+    throw CliError("--progress must be auto, always or never, got '" + option + "'");
   if (quiet || option == "never") return ProgressMode::Never;
-  if (option == "always") return ProgressMode::Always;
-  if (option == "auto") return ProgressMode::Auto;
-  throw CliError("--progress must be auto, always or never, got '" + option + "'");
+  return option == "always" ? ProgressMode::Always : ProgressMode::Auto;
 }
 
 class Progress {

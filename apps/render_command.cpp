@@ -90,8 +90,8 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
   sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4)");
   sub->add_option("--exposure", a.exposure, "PNG preview exposure in stops (default 0)");
   sub->add_option("--threads", a.threads,
-                  "CPU threads for --reference, voxelising and the CPU light simulator (default: "
-                  "all; the simulator at most 8)");
+                  "CPU threads for --reference, voxelising and the CPU light simulator, [1, 1024] "
+                  "(default, or 0: all; the simulator at most 8)");
   sub->add_flag("--reference", a.reference,
                 "Render with the double-precision CPU reference instead of the GPU");
   sub->add_flag("--no-skip", a.no_skip, "Do not cross homogeneous regions in one step");
@@ -104,7 +104,8 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
       "auto (default: progress with ETA on stderr when it is a terminal), always or never");
   sub->add_option(
       "--light-bands", a.light_bands,
-      "Light simulator wavelength bands (default: 12 dispersive, 3 attenuating, else 1)");
+      "Light simulator wavelength bands, [1, 64] (default, or 0: 12 dispersive, 3 attenuating, "
+      "else 1)");
   sub->add_option(
       "--light-splat", a.light_splat,
       "accumulate (fluence rate, default) or highest (the highest patch irradiance per voxel)");
@@ -116,7 +117,7 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
                   "pass (light continues through a focus, default) or kill (Tevs: patches end at a "
                   "fold caustic)");
   sub->add_option("--light-step", a.light_step,
-                  "Light simulator time step in voxels (default 0.5)");
+                  "Light simulator time step in voxels, (0, 2] (default, or 0: 0.5)");
   sub->add_option("--light-split", a.light_split,
                   "Split wavefront patches longer than this many voxels (default 1)");
   sub->add_option("--max-patches", a.max_patches, "Most live wavefront patches (default 1048576)");
@@ -248,6 +249,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
       png = std::filesystem::path(a.output).replace_extension(".png");
   if (out.extension() != ".exr") throw CliError("output must end in .exr: " + a.output);
   (void)progressMode(a.progress, a.quiet);  // a bad --progress fails before any work
+  checkExposure(a.exposure);
   // The range checks are the session's, as Python's (core/session/session.h).
   ViewRequest view = viewRequest(a, sub);
   checkViewRequest(view);
@@ -260,6 +262,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   checkWritable(out);
   checkWritable(png);
   const RenderSettings rs = renderSettings(*scene, view);
+  checkRenderFitsHost(*scene, rs);  // before voxelising: the image's memory, with the numbers
   for (const std::string& w : materialRangeWarnings(*scene, rs)) warn(w, a.strict);
   timings::mark("scene parsed");
 
@@ -312,9 +315,11 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
                   ? " pixel samples were cut short by the polarised trace's limits (max_branches, "
                     "max_events; on the GPU twin also the driver's loop limit) and lack the "
                     "light they would have reached"
-                  : " pixel samples were cut short by the Vulkan driver's loop limit and lack the "
-                    "light they would have reached (docs/view-renderer.md); render them with "
-                    "--reference"),
+                  : " pixel samples were cut short and lack the light they would have reached: "
+                    "a march ran out of its " +
+                        std::to_string(rs.march.max_steps) +
+                        " steps (a larger --step takes fewer) or, on the GPU, of the Vulkan "
+                        "driver's loop limit (docs/view-renderer.md; --reference has none)"),
          a.strict);
   // The pair as a pair (core/io/atomic_write.h): both files or neither replace what is there,
   // and a concurrent render to the same -o cannot interleave its pair with this one. The

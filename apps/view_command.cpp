@@ -763,6 +763,7 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   checkViewRequest(view);
   if (a.coarse < 1 || a.coarse > 16)
     throw CliError("--coarse must be in [1, 16], got " + std::to_string(a.coarse));
+  checkExposure(a.exposure);
   if (a.exit_after_frames < 0)
     throw CliError("--exit-after-frames must be >= 0, got " + std::to_string(a.exit_after_frames));
   const Integrator integrator = parseIntegrator(a.integrator);

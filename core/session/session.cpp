@@ -15,6 +15,7 @@
 #include "core/render/view_pipeline_start.h"
 #include "core/render/view_renderer.h"
 #include "core/vk/context.h"
+#include "core/volume/host_memory.h"
 #include "core/volume/polarised_render.h"
 #include "core/volume/render_layers.h"
 #include "core/volume/volume_cache.h"
@@ -28,6 +29,18 @@ void checkRange(const char* name, int v, int lo, int hi) {
   if (v < lo || v > hi)
     throw SettingError(name, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
                                  "], got " + std::to_string(v));
+}
+}  // namespace
+
+namespace {
+/// Floats per pixel of a render's image and layers (RenderImage).
+int renderChannels(const Scene& scene, const RenderSettings& rs) {
+  int channels = 3;
+  if (rs.spectral_layer) channels += std::max(rs.wavelengths, 1);
+  if (rs.mode_layers) channels += 6;
+  if (rs.aov_layer) channels += kAovChannels;
+  if (rs.stokes_layers || isPolarisedRender(scene, rs)) channels += 12;
+  return channels;
 }
 }  // namespace
 
@@ -72,6 +85,25 @@ void parseLayers(const std::string& list, ViewRequest& view) {
                         name + "' in '" + list + "'");
     start = end + 1;
   }
+}
+
+double renderHostBytes(const Scene& scene, const RenderSettings& rs) {
+  const double w = rs.width > 0 ? rs.width : scene.camera.width,
+               h = rs.height > 0 ? rs.height : scene.camera.height;
+  return w * h * 16.0 * renderChannels(scene, rs);
+}
+
+void checkRenderFitsHost(const Scene& scene, const RenderSettings& rs) {
+  const double need = renderHostBytes(scene, rs);
+  const HostMemory mem = availableHostMemory();
+  if (need <= double(mem.available)) return;
+  const int w = rs.width > 0 ? rs.width : scene.camera.width,
+            h = rs.height > 0 ? rs.height : scene.camera.height;
+  throw std::runtime_error(
+      "a " + std::to_string(w) + "x" + std::to_string(h) + " image of " +
+      std::to_string(renderChannels(scene, rs)) + " channels a pixel needs about " +
+      formatBytes(need) + " of host memory, " + formatBytes(double(mem.available)) +
+      " available (" + mem.limited_by + "); lower the width and height or leave out layers");
 }
 
 void checkMarchStep(double step_voxels) {
@@ -138,7 +170,8 @@ std::vector<std::string> materialRangeWarnings(const Scene& scene, const RenderS
 }
 
 void checkLightRequest(const LightRequest& l) {
-  if (l.bands < 0 || l.bands > 64) throw SettingError("light-bands", "must be in [1, 64]");
+  if (l.bands < 0 || l.bands > 64)
+    throw SettingError("light-bands", "must be in [1, 64], or 0 for the scene's default");
   if (l.splat != "accumulate" && l.splat != "highest")
     throw SettingError("light-splat", "must be accumulate or highest, got '" + l.splat + "'");
   if (l.device != "auto" && l.device != "gpu" && l.device != "cpu")
@@ -146,7 +179,9 @@ void checkLightRequest(const LightRequest& l) {
   if (l.caustics != "pass" && l.caustics != "kill")
     throw SettingError("caustics", "must be pass or kill, got '" + l.caustics + "'");
   if (!(l.step_voxels >= 0 && l.step_voxels <= 2))
-    throw SettingError("light-step", "must be in (0, 2] voxels");
+    throw SettingError("light-step", "must be in (0, 2] voxels, or 0 for the default (0.5)");
+  if (l.threads < 0 || l.threads > 1024)
+    throw SettingError("threads", "must be in [1, 1024], or 0 for all cores");
   if (!(l.split_voxels >= 0.25 && l.split_voxels <= 8))
     throw SettingError("light-split", "must be in [0.25, 8] voxels");
   if (l.max_patches < 1024 || l.max_patches > (1 << 24))
@@ -348,6 +383,7 @@ bool Session::renderReady(const RenderSettings& settings) {
 }
 
 RenderImage Session::render(const RenderSettings& settings, bool gpu) {
+  checkRenderFitsHost(*scene_, settings);
   RenderSettings rs = settings;
   if (progress_.update && !rs.progress)
     rs.progress = [this](double f) { progress_.update("rendering", f); };

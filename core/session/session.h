@@ -89,6 +89,14 @@ void checkMarchStep(double step_voxels);
 void checkViewRequest(const ViewRequest& view);
 /// defaultRenderSettings(scene) with what the request sets.
 RenderSettings renderSettings(const Scene& scene, const ViewRequest& view);
+/// Host memory a render of `settings` holds at its peak, estimated: 16 bytes per image channel
+/// per pixel (the image, its layers and the copies the output files are made from; measured 8–12
+/// bytes at 2048×2048 with and without layers on lavapipe).
+double renderHostBytes(const Scene& scene, const RenderSettings& settings);
+/// std::runtime_error (one line, with the numbers) when renderHostBytes exceeds the host memory
+/// available to the process (availableHostMemory), before anything is allocated; Session::render
+/// checks it too, `eikon render` before voxelising.
+void checkRenderFitsHost(const Scene& scene, const RenderSettings& settings);
 /// One line per material whose measured range the render leaves ("material 'x' is measured over
 /// 400-700 nm; rendering outside that range extrapolates"): spectral renders need 380-780 nm, RGB
 /// renders the index wavelength.

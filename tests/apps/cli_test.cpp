@@ -860,6 +860,51 @@ TEST_F(Cli, BadLightOptionsFailCleanly) {
   expectCleanFailure(render(tinyScene(), "--light-device tpu"),
                      "--light-device must be auto, gpu or cpu");
   expectCleanFailure(render(tinyScene(), "--caustics ignore"), "--caustics must be pass or kill");
+  expectCleanFailure(render(tinyScene(), "--threads -7 --no-light"),
+                     "--threads must be in [1, 1024], or 0 for all cores");
+  expectCleanFailure(render(tinyScene(), "--light-step -1"),
+                     "--light-step must be in (0, 2] voxels, or 0 for the default (0.5)");
+}
+
+// Values that used to pass unchecked: a NaN exposure (a black PNG), a bad --progress beside -q
+// (the word was never read).
+TEST_F(Cli, ExposureAndProgressAreCheckedEvenWhenUnused) {
+  expectCleanFailure(render(tinyScene(), "--exposure nan"), "--exposure must be in [-64, 64]");
+  expectCleanFailure(render(tinyScene(), "--exposure 1e6"), "--exposure must be in [-64, 64]");
+  expectCleanFailure(render(tinyScene(), "-q --progress sometimes"),
+                     "--progress must be auto, always or never");
+  EXPECT_EQ(render(tinyScene(), "-q --exposure -64").code, 0);
+}
+
+// An image the host cannot hold is refused before anything is voxelised, with the numbers, where
+// it used to end in a bare "std::bad_alloc": under a 1 GiB address-space limit a 16384² image
+// (3 channels, about 12 bytes each measured: 9.7 GB) cannot fit.
+TEST_F(Cli, ImageLargerThanTheHostHoldsIsRefusedWithTheNumbers) {
+  const std::string scene = write("scene.json", tinyScene());
+  const Outcome limited = eikon::test::runProgram(
+      "ulimit -v 1048576; " + std::string(EIKON_BINARY),
+      "render " + quote(scene) + " -o " + quote(outPath()) + " --width 16384 --height 16384", io_);
+  expectCleanFailure(limited, "a 16384x16384 image of 3 channels a pixel needs about");
+  EXPECT_NE(limited.err.find("of host memory"), std::string::npos) << limited.err;
+}
+
+// A march cut short (here by a step so small that no ray gets through the object's layer within
+// the march's 20000 steps) is counted and warned about, and --strict makes it an error that
+// leaves no output.
+TEST_F(Cli, MarchesAndLightCutShortAreSaid) {
+  std::string smoothed = tinyScene();
+  smoothed.insert(1, R"("interfaces": "smoothed",)");  // a layer marched step by step
+  const Outcome warned = render(smoothed, "--step 1e-30 --no-light");
+  ASSERT_EQ(warned.code, 0) << warned.err;
+  EXPECT_NE(warned.err.find("pixel samples were cut short and lack the light"), std::string::npos)
+      << warned.err;
+  fs::remove(outPath("render.exr"));
+  fs::remove(outPath("render.png"));
+  expectCleanFailure(render(smoothed, "--step 1e-30 --no-light --strict"),
+                     "pixel samples were cut short");
+  const Outcome clean = render(smoothed, "--no-light");
+  ASSERT_EQ(clean.code, 0) << clean.err;
+  EXPECT_EQ(clean.err.find("cut short"), std::string::npos) << clean.err;
 }
 
 }  // namespace

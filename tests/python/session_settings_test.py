@@ -80,7 +80,7 @@ class SessionSettings(unittest.TestCase):
         self.same(["render", "--caustics", "stop"], "--caustics", lambda: r.simulate_light(caustics="stop"),
                   "caustics", "must be pass or kill, got 'stop'")
         self.same(["render", "--light-step", "3"], "--light-step", lambda: r.simulate_light(step_voxels=3),
-                  "step_voxels", "must be in (0, 2] voxels")
+                  "step_voxels", "must be in (0, 2] voxels, or 0 for the default (0.5)")
         self.assertEqual(eikon.voxelize_count(), 0)
 
     def test_trace_settings(self):

@@ -70,7 +70,18 @@ TEST(Session, LightAndTraceRangesAreTheCliWords) {
             "max-patches|must be in [1024, 16777216]");
   l.max_patches = 1024;
   l.step_voxels = 2.5;
-  EXPECT_EQ(settingErrorOf([&] { checkLightRequest(l); }), "light-step|must be in (0, 2] voxels");
+  EXPECT_EQ(settingErrorOf([&] { checkLightRequest(l); }),
+            "light-step|must be in (0, 2] voxels, or 0 for the default (0.5)");
+  l.step_voxels = 0.0;  // the default
+  l.bands = 65;
+  EXPECT_EQ(settingErrorOf([&] { checkLightRequest(l); }),
+            "light-bands|must be in [1, 64], or 0 for the scene's default");
+  l.bands = 0;
+  l.threads = -7;
+  EXPECT_EQ(settingErrorOf([&] { checkLightRequest(l); }),
+            "threads|must be in [1, 1024], or 0 for all cores");
+  l.threads = 0;
+  EXPECT_NO_THROW(checkLightRequest(l));
 
   TraceRequest ray{{0, 0, 0}, {0, 0, 0}, 587.56};
   EXPECT_EQ(settingErrorOf([&] { checkTraceRequest(ray); }), "dir|must be a non-zero vector");
