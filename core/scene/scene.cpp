@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/io/exr.h"
+#include "core/io/text_file.h"
 #include "core/scene/faceted.h"
 #include "core/scene/mesh.h"
 #include "core/spectrum/illuminants.h"
@@ -655,9 +656,12 @@ SceneObject parseObject(const Node& o) {
 
 /// Parse JSON text, refusing a key that appears twice in one object (nlohmann keeps the last
 /// one silently): the parser callback sees every key event, and a stack of the open containers
-/// gives the JSON path of the duplicate. Syntax errors and numbers that overflow a double
-/// (1e999) are SceneErrors naming the file.
+/// gives the JSON path of the duplicate. Syntax errors, numbers that overflow a double (1e999)
+/// and NUL bytes (where nlohmann's parser stops reading, ignoring the rest) are SceneErrors naming
+/// the file.
 json parseJson(const std::string& text, const std::string& file) {
+  if (const std::string nul = nulByteProblem(text, file, "JSON text"); !nul.empty())
+    throw SceneError(nul);
   struct Open {
     bool array;
     std::set<std::string> keys;
@@ -708,21 +712,18 @@ json parseJson(const std::string& text, const std::string& file) {
   }
 }
 
-/// "FILE: is a directory, expected WHAT" when `path` is one (an ifstream opens a directory and
-/// then reads nothing, which read as an empty or malformed file).
-void refuseDirectory(const std::filesystem::path& path, const std::string& what) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw SceneError(path.string() + ": is a directory, expected " + what);
+/// The text of a scene or material file (core/io/text_file.h: a regular file of at most 64 MiB,
+/// no NUL byte); every refusal a SceneError "FILE: why".
+std::string readSceneText(const std::filesystem::path& path, const std::string& what) {
+  try {
+    return readTextFile(path, what);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(e.what());
+  }
 }
 
 json readJsonFile(const std::filesystem::path& path, const char* what) {
-  refuseDirectory(path, std::string("a ") + what);
-  std::ifstream in(path);
-  if (!in) throw SceneError(path.string() + ": cannot open " + what);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseJson(ss.str(), path.string());
+  return parseJson(readSceneText(path, std::string("a ") + what), path.string());
 }
 
 }  // namespace
@@ -1271,12 +1272,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
 }
 
 Scene loadScene(const std::filesystem::path& path) {
-  refuseDirectory(path, "a scene file");
-  std::ifstream in(path);
-  if (!in) throw SceneError(path.string() + ": cannot open scene file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseScene(ss.str(), path);
+  return parseScene(readSceneText(path, "a scene file"), path);
 }
 
 }  // namespace eikon
