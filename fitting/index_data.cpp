@@ -5,12 +5,11 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
 
+#include "core/io/text_file.h"
 #include "fitting/refractiveindex_formula.h"
 
 namespace eikon {
@@ -47,16 +46,10 @@ std::optional<double> parseNumber(const std::string& s) {
   return v;
 }
 
+// A regular file of at most 64 MiB without NUL bytes (core/io/text_file.h): /dev/zero or a link
+// to it was read without end.
 std::string readFile(const std::string& path) {
-  // An ifstream opens a directory on Linux and reads nothing: say what it is instead of "empty".
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw std::runtime_error(path + ": is a directory, expected a data file (CSV or YAML)");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot open file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return readTextFile(path, "a data file (CSV or YAML)");
 }
 
 std::string fmt(double v) {

@@ -23,12 +23,16 @@
 #include <string>
 #include <utility>
 
+#include "core/io/text_file.h"
+
 namespace eikon {
 
 RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_height) {
   const std::string p = path.string();
-  if (!std::filesystem::is_regular_file(path))
-    throw std::runtime_error("'" + p + "': no such file");
+  std::error_code ec;  // is_regular_file without it throws for a name too long
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw std::runtime_error("'" + shownPath(path) +
+                             "': " + (ec ? errorReason(ec) : std::string("not a regular file")));
   bool tiled = false, deep = false, multipart = false;
   if (!Imf::isOpenExrFile(p.c_str(), tiled, deep, multipart))
     throw std::runtime_error("'" + p + "' is not an OpenEXR file");

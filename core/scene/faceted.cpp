@@ -11,6 +11,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr size_t kMaxFacets = 512;  // cutting is O(n³) in the facet count: ~1 s at this size
+// A .asc distance's bound, the JSON tiers' (scene.cpp kMaxCoordinateMm): the rough block is sized
+// from the largest distance, so 1e300 made every other facet fail on its line instead.
+constexpr double kMaxAscDistanceMm = 1e12;
 
 std::string num(double v) {
   std::ostringstream s;
@@ -284,6 +287,31 @@ double roughScale(const FacetedDesign& d) {
   return 4.0 * s;
 }
 
+/// A design is cut to 1e-9 of its largest length (the rough block's size), so one length far
+/// beyond all others (a distance of 1e12 mm beside 5 mm) leaves the other facets no precision:
+/// they fail on their own lines ("removes the whole stone") though that length is at fault. When
+/// cutting failed, `error` blamed on the largest length if it is more than 1000 times the next
+/// one, `error` itself otherwise.
+FacetError blameOutlier(const FacetedDesign& d, const FacetError& error) {
+  std::string where = "/girdle";
+  double largest = std::max({d.girdle.length, d.girdle.width, d.girdle.thickness}), next = 0.0;
+  for (const auto& t : d.tiers) {
+    const double v = std::abs(t.value);
+    if (v > largest)
+      next = largest, largest = v, where = t.path;
+    else
+      next = std::max(next, v);
+  }
+  for (double g : {d.girdle.length, d.girdle.width, d.girdle.thickness})
+    if (g < largest) next = std::max(next, g);
+  if (!(largest > 1e3 * next) || where == error.where()) return error;
+  return FacetError(where, "the length " + num(largest) + " mm is more than 1000 times the " +
+                               "design's next largest (" + num(next) +
+                               " mm): the facets are cut to 1e-9 of the largest, too coarse for "
+                               "the others (" +
+                               error.where() + ": " + error.what() + ")");
+}
+
 }  // namespace
 
 glm::dvec3 facetNormal(FacetSide side, double angle_deg, int index, int gear) {
@@ -336,8 +364,12 @@ FacetedStone cutFaceted(const FacetedDesign& design) {
   const double S = roughScale(design);
   if (!(S > 0)) throw FacetError("/tiers", "the design has no size (give a girdle or distances)");
   Cutter cutter(design, S);
-  for (size_t t = 0; t < design.tiers.size(); ++t) cutter.cutTier(t);
-  return cutter.finish();
+  try {
+    for (size_t t = 0; t < design.tiers.size(); ++t) cutter.cutTier(t);
+    return cutter.finish();
+  } catch (const FacetError& e) {
+    throw blameOutlier(design, e);
+  }
 }
 
 namespace {
@@ -354,6 +386,9 @@ FacetTier ascFacet(std::istringstream& in, int gear, const std::string& at) {
     throw FacetError("/file", at + ": expected 'a ANGLE DISTANCE INDEX...'");
   if (angle < -90 || angle > 90)
     throw FacetError("/file", at + ": the angle must be in [-90, 90] degrees, got " + num(angle));
+  if (std::abs(t.value) > kMaxAscDistanceMm)
+    throw FacetError("/file", at + ": the distance must be in [-" + num(kMaxAscDistanceMm) + ", " +
+                                  num(kMaxAscDistanceMm) + "] mm, got " + num(t.value));
   if (angle == 0)
     t.side = angle_s[0] == '-' ? FacetSide::Culet : FacetSide::Table;
   else if (std::abs(angle) == 90)

@@ -6,12 +6,19 @@
 #include <algorithm>
 #include <array>
 #include <assimp/Importer.hpp>
+#include <charconv>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <map>
+#include <new>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
+
+#include "core/io/text_file.h"
+#include "core/scene/messages.h"
 
 namespace eikon {
 namespace {
@@ -82,21 +89,103 @@ double diagonal(const TriangleMesh& m) {
   return glm::length(hi - lo);
 }
 
-}  // namespace
+/// Bytes a PLY scalar type takes in a binary file; 0 for an unknown type.
+size_t plyTypeBytes(const std::string& t) {
+  static const std::map<std::string, size_t> sizes = {
+      {"char", 1},  {"uchar", 1},   {"int8", 1},   {"uint8", 1},  {"short", 2}, {"ushort", 2},
+      {"int16", 2}, {"uint16", 2},  {"int", 4},    {"uint", 4},   {"int32", 4}, {"uint32", 4},
+      {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
+  auto it = sizes.find(t);
+  return it == sizes.end() ? 0 : it->second;
+}
 
-TriangleMesh readMesh(const std::filesystem::path& file) {
-  const std::string name = file.filename().string();
-  const std::string ext = lower(file.extension().string());
-  if (ext != ".obj" && ext != ".ply" && ext != ".stl")
-    fail(name, "expected an .obj, .ply or .stl file, got the extension '" + ext + "'");
-  std::error_code ec;
-  if (std::filesystem::is_directory(file, ec)) fail(name, "is a directory, expected a mesh file");
-  if (!std::filesystem::exists(file, ec)) fail(name, "cannot open '" + file.string() + "'");
-  const std::uintmax_t bytes = std::filesystem::file_size(file, ec);
-  if (ec) fail(name, "cannot read '" + file.string() + "'");
-  if (bytes > kMaxMeshFileBytes)
-    fail(name, "the mesh file is larger than " + std::to_string(kMaxMeshFileBytes >> 20) +
-                   " MiB, got " + std::to_string(bytes) + " bytes");
+/// Most PLY header read (a real header is a few hundred bytes).
+constexpr size_t kMaxPlyHeaderBytes = 64u << 10;
+
+/// A PLY element as its header declares it: its count and the least bytes one of them takes.
+struct PlyElement {
+  std::string name;
+  uint64_t count = 0;
+  uint64_t least_bytes = 0;
+  int line = 0;
+};
+
+/// The elements a PLY header declares, and the header's length in bytes. Assimp allocates what
+/// the header declares before it reads the data (a 241-byte file declaring 4e8 vertices took
+/// 4.7 GB), so the header is read here first.
+std::vector<PlyElement> plyHeader(const std::filesystem::path& file, const std::string& name,
+                                  size_t& header_bytes) {
+  std::ifstream in(file, std::ios::binary);
+  std::string head(kMaxPlyHeaderBytes, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  head.resize(size_t(in.gcount()));
+  if (head.rfind("ply\n", 0) != 0 && head.rfind("ply\r\n", 0) != 0)
+    fail(name, "is not a PLY file (its first line is not 'ply')");
+  const size_t end = head.find("end_header");
+  const size_t eol = end == std::string::npos ? end : head.find('\n', end);
+  if (eol == std::string::npos)
+    fail(name, "the PLY header has no end_header line within its first " +
+                   std::to_string(kMaxPlyHeaderBytes >> 10) + " KiB");
+  header_bytes = eol + 1;
+  std::istringstream lines(head.substr(0, header_bytes));
+  std::vector<PlyElement> elements;
+  bool ascii = false;
+  std::string line;
+  for (int no = 1; std::getline(lines, line); ++no) {
+    std::istringstream words(line);
+    std::string key;
+    words >> key;
+    const std::string at = "the PLY header's line " + std::to_string(no);
+    if (key == "format") {
+      std::string f;
+      words >> f;
+      ascii = f == "ascii";
+    } else if (key == "element") {
+      std::string element, count;
+      words >> element >> count;
+      PlyElement e{excerpt(element), 0, 0, no};
+      auto [ptr, ec] = std::from_chars(count.data(), count.data() + count.size(), e.count);
+      if (ec != std::errc() || ptr != count.data() + count.size())
+        fail(name, at + ": the element '" + e.name + "' has no count that a file can hold, got '" +
+                       excerpt(count) + "'");
+      elements.push_back(e);
+    } else if (key == "property") {
+      if (elements.empty()) fail(name, at + ": a property before any element");
+      std::string type;
+      words >> type;
+      if (type == "list") words >> type;  // a list takes at least its count
+      const size_t bytes = plyTypeBytes(type);
+      if (bytes == 0) fail(name, at + ": unknown property type '" + excerpt(type) + "'");
+      elements.back().least_bytes += ascii ? 2 : bytes;  // ASCII: a digit and a separator
+    }
+  }
+  return elements;
+}
+
+/// Refuses a PLY header whose element counts the file cannot hold (each element takes at least
+/// its properties' bytes in binary, two bytes a property in ASCII) or that exceed what a mesh may
+/// have (kMaxMeshTriangles faces, three vertices a triangle).
+void checkPlyCounts(const std::filesystem::path& file, const std::string& name,
+                    std::uintmax_t bytes) {
+  size_t header = 0;
+  const std::vector<PlyElement> elements = plyHeader(file, name, header);
+  uint64_t left = bytes > header ? bytes - header + 1 : 1;  // +1: no newline after the last line
+  for (const PlyElement& e : elements) {
+    const std::string what = "the PLY header (line " + std::to_string(e.line) + ") declares " +
+                             std::to_string(e.count) + " '" + e.name + "' elements";
+    const uint64_t most = e.name == "face" ? kMaxMeshTriangles : 3 * kMaxMeshTriangles;
+    if (e.count > most)
+      fail(name, what + ", more than a mesh may have (at most " + std::to_string(most) + ")");
+    if (e.least_bytes > 0 && e.count > left / e.least_bytes)
+      fail(name, what + " of at least " + std::to_string(e.least_bytes) +
+                     " bytes each, more than the file's " + std::to_string(bytes) +
+                     " bytes can hold");
+    left -= e.count * e.least_bytes;
+  }
+}
+
+/// The mesh Assimp reads from `file` (checked by readMesh), welded.
+TriangleMesh importMesh(const std::filesystem::path& file, const std::string& name) {
   Assimp::Importer importer;
   // Triangulate polygons, bake node transforms into the vertices and validate the result (index
   // ranges, counts). No vertex joining: Assimp's joins only vertices whose normals also agree, so
@@ -104,6 +193,9 @@ TriangleMesh readMesh(const std::filesystem::path& file) {
   const aiScene* sc =
       importer.ReadFile(file.string(), aiProcess_Triangulate | aiProcess_PreTransformVertices |
                                            aiProcess_ValidateDataStructure);
+  // Assimp catches what its readers throw, std::bad_alloc included, and keeps only its what().
+  if (!sc && std::strcmp(importer.GetErrorString(), std::bad_alloc().what()) == 0)
+    throw std::bad_alloc();
   if (!sc) fail(name, std::string("cannot read the mesh: ") + importer.GetErrorString());
   TriangleMesh out;
   std::map<std::tuple<double, double, double>, uint32_t> weld;
@@ -133,6 +225,35 @@ TriangleMesh readMesh(const std::filesystem::path& file) {
   }
   if (out.triangles.empty()) fail(name, "holds no triangles");
   return out;
+}
+
+}  // namespace
+
+TriangleMesh readMesh(const std::filesystem::path& file) {
+  const std::string name = excerpt(file.filename().string());
+  const std::string ext = lower(file.extension().string());
+  if (ext != ".obj" && ext != ".ply" && ext != ".stl")
+    fail(name, "expected an .obj, .ply or .stl file, got the extension '" + excerpt(ext) + "'");
+  std::error_code ec;
+  const std::filesystem::file_type type = std::filesystem::status(file, ec).type();
+  if (type == std::filesystem::file_type::not_found)
+    fail(name, "cannot open '" + shownPath(file) + "': no such file or directory");
+  if (ec) fail(name, "cannot open '" + shownPath(file) + "': " + errorReason(ec));
+  if (type == std::filesystem::file_type::directory)
+    fail(name, "is a directory, expected a mesh file");
+  if (type != std::filesystem::file_type::regular)
+    fail(name, "is not a regular file, expected a mesh file");
+  const std::uintmax_t bytes = std::filesystem::file_size(file, ec);
+  if (ec) fail(name, "cannot read '" + shownPath(file) + "': " + errorReason(ec));
+  if (bytes > kMaxMeshFileBytes)
+    fail(name, "the mesh file is larger than " + std::to_string(kMaxMeshFileBytes >> 20) +
+                   " MiB, got " + std::to_string(bytes) + " bytes");
+  if (ext == ".ply") checkPlyCounts(file, name, bytes);
+  try {
+    return importMesh(file, name);
+  } catch (const std::bad_alloc&) {
+    fail(name, "not enough memory to read the mesh");
+  }
 }
 
 void checkClosedMesh(const TriangleMesh& m, const std::string& name) {

@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <map>
+#include <new>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
 #include "core/io/exr.h"
+#include "core/io/text_file.h"
 #include "core/scene/faceted.h"
 #include "core/scene/mesh.h"
 #include "core/spectrum/illuminants.h"
@@ -170,6 +171,18 @@ class Node {
   std::string path_;
   const std::string& file_;
 };
+
+/// The file a "file" key names (`what`: "an EXR image"), relative to the scene's folder unless
+/// absolute. An empty name and one holding a NUL byte (no file has one) are refused here.
+std::filesystem::path namedFile(const Node& f, const std::string& what) {
+  const std::string name = f.string();
+  if (name.empty()) f.fail("expected the path of " + what + ", got an empty string");
+  if (name.find('\0') != std::string::npos)
+    f.fail("the file name '" + excerpt(name) + "' holds a NUL byte, which no file name can");
+  std::filesystem::path p = name;
+  if (p.is_relative()) p = std::filesystem::path(f.file()).parent_path() / p;
+  return p;
+}
 
 // ------------------------------------------------------------------ materials
 void checkIndexAtLeastOne(const Node& at, const Dispersion& d) {
@@ -478,19 +491,18 @@ ConvexShape parseFaceted(const Node& o) {
   if (auto f = o.get("file")) {
     if (o.has("tiers") || o.has("gear") || o.has("girdle"))
       o.fail("give either file (a GemCad .asc) or gear, girdle and tiers, not both");
-    std::filesystem::path p = f->string();
-    if (p.is_relative()) p = std::filesystem::path(o.file()).parent_path() / p;
-    std::error_code ec;
-    if (std::filesystem::is_directory(p, ec))
-      f->fail("is a directory, expected a GemCad .asc file");
-    if (std::filesystem::exists(p, ec) && std::filesystem::file_size(p, ec) > (1u << 20))
-      f->fail("the .asc file is larger than 1 MiB");
-    std::ifstream in(p);
-    if (!in) f->fail("cannot open '" + excerpt(p.string()) + "'");
+    const std::filesystem::path p = namedFile(*f, "a GemCad .asc file");
+    std::string text;
     try {
-      design = readGemCadAsc(in, p.filename().string());
+      text = readTextFile(p, "a GemCad .asc file", 1u << 20);
+    } catch (const std::runtime_error& e) {
+      f->fail(e.what());
+    }
+    std::istringstream in(text);
+    try {
+      design = readGemCadAsc(in, shownPath(p.filename()));
     } catch (const FacetError& e) {
-      f->fail(printable(e.what(), 300));
+      f->fail(printable(e.what(), 500));
     }
   } else {
     design.gear = o.get("gear") ? o.at("gear").integer(3, 400) : 96;
@@ -503,7 +515,7 @@ ConvexShape parseFaceted(const Node& o) {
   try {
     return cutFaceted(design).shape;
   } catch (const FacetError& e) {
-    throw SceneError(o.file() + ": " + o.path() + e.where() + ": " + printable(e.what(), 300));
+    throw SceneError(o.file() + ": " + o.path() + e.where() + ": " + printable(e.what(), 500));
   }
 }
 
@@ -512,9 +524,7 @@ ConvexShape parseFaceted(const Node& o) {
 /// any other an exact-distance MeshShape (sharp interfaces at its triangles, or smoothed).
 ShapeGeometry parseMesh(const Node& o) {
   const Node f = o.at("file");
-  std::filesystem::path p = f.string();
-  if (p.empty()) f.fail("expected the path of an .obj, .ply or .stl file, got an empty string");
-  if (p.is_relative()) p = std::filesystem::path(o.file()).parent_path() / p;
+  const std::filesystem::path p = namedFile(f, "an .obj, .ply or .stl file");
   glm::dvec3 scale(1.0);
   const std::optional<Node> s = o.get("scale");
   if (s) {
@@ -525,13 +535,15 @@ ShapeGeometry parseMesh(const Node& o) {
   TriangleMesh mesh;
   try {
     mesh = readMesh(p);
-    checkClosedMesh(mesh, p.filename().string());
+    checkClosedMesh(mesh, excerpt(p.filename().string()));
   } catch (const std::invalid_argument& e) {
-    f.fail(printable(e.what(), 400));
+    f.fail(printable(e.what(), 800));  // room for a shortened name, its path and the reason
+  } catch (const std::bad_alloc&) {
+    f.fail(excerpt(p.filename().string()) + ": not enough memory to read the mesh");
   }
   std::vector<Plane> planes;
   try {
-    planes = meshFacePlanes(mesh, p.filename().string(), kConvexMeshMaxFaces);
+    planes = meshFacePlanes(mesh, excerpt(p.filename().string()), kConvexMeshMaxFaces);
   } catch (const std::invalid_argument&) {
     // Not convex (or more faces than a polyhedron takes): a MeshShape.
   }
@@ -655,9 +667,12 @@ SceneObject parseObject(const Node& o) {
 
 /// Parse JSON text, refusing a key that appears twice in one object (nlohmann keeps the last
 /// one silently): the parser callback sees every key event, and a stack of the open containers
-/// gives the JSON path of the duplicate. Syntax errors and numbers that overflow a double
-/// (1e999) are SceneErrors naming the file.
+/// gives the JSON path of the duplicate. Syntax errors, numbers that overflow a double (1e999)
+/// and NUL bytes (where nlohmann's parser stops reading, ignoring the rest) are SceneErrors naming
+/// the file.
 json parseJson(const std::string& text, const std::string& file) {
+  if (const std::string nul = nulByteProblem(text, file, "JSON text"); !nul.empty())
+    throw SceneError(nul);
   struct Open {
     bool array;
     std::set<std::string> keys;
@@ -708,21 +723,18 @@ json parseJson(const std::string& text, const std::string& file) {
   }
 }
 
-/// "FILE: is a directory, expected WHAT" when `path` is one (an ifstream opens a directory and
-/// then reads nothing, which read as an empty or malformed file).
-void refuseDirectory(const std::filesystem::path& path, const std::string& what) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw SceneError(path.string() + ": is a directory, expected " + what);
+/// The text of a scene or material file (core/io/text_file.h: a regular file of at most 64 MiB,
+/// no NUL byte); every refusal a SceneError "FILE: why".
+std::string readSceneText(const std::filesystem::path& path, const std::string& what) {
+  try {
+    return readTextFile(path, what);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(e.what());
+  }
 }
 
 json readJsonFile(const std::filesystem::path& path, const char* what) {
-  refuseDirectory(path, std::string("a ") + what);
-  std::ifstream in(path);
-  if (!in) throw SceneError(path.string() + ": cannot open " + what);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseJson(ss.str(), path.string());
+  return parseJson(readSceneText(path, std::string("a ") + what), path.string());
 }
 
 }  // namespace
@@ -1005,7 +1017,7 @@ static void parseCamera(const Node& c, Camera& cam) {
   }
 }
 
-static void parseEnvironment(const Node& e, const std::filesystem::path& origin, Environment& env) {
+static void parseEnvironment(const Node& e, Environment& env) {
   std::string type = e.at("type").string();
   if (type == "checker") {
     e.allowKeys({"type", "squares", "color_a", "color_b", "intensity", "polarization"});
@@ -1020,12 +1032,14 @@ static void parseEnvironment(const Node& e, const std::filesystem::path& origin,
   } else if (type == "latlong") {
     e.allowKeys({"type", "file", "intensity", "polarization"});
     env.type = Environment::Type::LatLong;
-    std::filesystem::path p = e.at("file").string();
-    if (p.is_relative()) p = origin.parent_path() / p;
+    const std::filesystem::path p = namedFile(e.at("file"), "an EXR image");
     env.image_path = p;
     std::error_code ec;
-    if (std::filesystem::is_directory(p, ec))
-      e.at("file").fail(p.string() + ": is a directory, expected an EXR image");
+    const auto file_type = std::filesystem::status(p, ec).type();
+    if (ec && file_type != std::filesystem::file_type::not_found)
+      e.at("file").fail(shownPath(p) + ": cannot open an EXR image: " + errorReason(ec));
+    if (file_type == std::filesystem::file_type::directory)
+      e.at("file").fail(shownPath(p) + ": is a directory, expected an EXR image");
     try {
       auto img = readExrRgba(p, 16384, 8192);
       env.image_width = img.width;
@@ -1092,7 +1106,13 @@ static void loadLibraryMaterial(const Node& o, const SceneObject& obj, Scene& sc
               "others under /materials");
   for (const auto& dir : materialSearchPath()) {
     auto p = dir / (obj.material + ".json");
-    if (std::filesystem::exists(p)) {
+    std::error_code ec;
+    const bool found = std::filesystem::exists(p, ec);  // not found is no error
+    if (ec)
+      o.at("material")
+          .fail("cannot look up the library material '" + excerpt(name) + "' as " + shownPath(p) +
+                ": " + errorReason(ec));
+    if (found) {
       scene.materials[obj.material] = loadMaterialFile(p);
       return;
     }
@@ -1249,7 +1269,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   root.allowKeys({"camera", "environment", "volume", "materials", "objects", "lights",
                   "ambient_index", "description", "interfaces"});
   if (auto c = root.get("camera")) parseCamera(*c, scene.camera);
-  if (auto e = root.get("environment")) parseEnvironment(*e, origin, scene.environment);
+  if (auto e = root.get("environment")) parseEnvironment(*e, scene.environment);
   if (auto v = root.get("volume")) parseVolume(*v, scene.volume);
   if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
   if (auto f = root.get("interfaces")) scene.interfaces = parseInterfaces(*f);
@@ -1271,12 +1291,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
 }
 
 Scene loadScene(const std::filesystem::path& path) {
-  refuseDirectory(path, "a scene file");
-  std::ifstream in(path);
-  if (!in) throw SceneError(path.string() + ": cannot open scene file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseScene(ss.str(), path);
+  return parseScene(readSceneText(path, "a scene file"), path);
 }
 
 }  // namespace eikon

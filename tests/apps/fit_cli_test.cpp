@@ -185,6 +185,25 @@ TEST_F(FitCli, BadInputFailsWithOneLineAndNoFile) {
   EXPECT_EQ(slurp(path("afile")), "x");
 }
 
+// `eikon fit z.csv` with z.csv a link to /dev/zero read without end (~720 MB after 5 s): data
+// files are read only when they are regular files of at most 64 MiB without NUL bytes.
+TEST_F(FitCli, DataMustBeARegularTextFile) {
+  const std::string out = " -o " + path("out.json");
+  fs::create_symlink("/dev/zero", path("z.csv"));
+  expectCleanFailure(run(path("z.csv") + out),
+                     "z.csv: is not a regular file (a character device), expected a data file");
+  fs::create_symlink("/dev/null", path("n.yml"));
+  expectCleanFailure(run(path("n.yml") + out), "n.yml: is not a regular file");
+  std::ofstream(path("nul.csv"), std::ios::binary) << std::string(
+      "wavelength_nm,n\n500,1.52\n\0"
+      "600,1.51\n",
+      35);
+  expectCleanFailure(run(path("nul.csv") + out), "nul.csv: holds a NUL byte at offset 25 (line 3)");
+  write("big.csv", "");
+  fs::resize_file(path("big.csv"), (64u << 20) + 1);  // sparse
+  expectCleanFailure(run(path("big.csv") + out), "big.csv: is larger than 64 MiB");
+}
+
 // tests/data/fit/calcite_ghosh.csv: Ghosh's calcite formula + Gaussian noise σ = 2e-5, 20 points
 // over 405–690 nm. cauchy3 cannot follow n_o to 2e-5 there (its χ²_red ≈ 6 has p ≪ 1e-3), so the
 // fit must say so (warning; error with --strict); n_e is fine. Conrady describes both modes.

@@ -53,12 +53,16 @@ class InputCli : public ::testing::Test {
 
 TEST_F(InputCli, BinaryFileGivesOnePrintableLine) {
   std::string bytes = "{\"objects\": [\"";
-  for (int b = 0; b < 256; ++b) bytes += char(b);
+  for (int b = 1; b < 256; ++b) bytes += char(b);
   bytes += std::string(50000, 'x');
   const Outcome r = trace(write("binary.json", bytes));
   expectOneCleanLine(r, "malformed JSON");
   EXPECT_LT(r.err.size(), 600u);
   for (unsigned char c : r.err) EXPECT_LT(c, 0x80) << r.err;  // no valid UTF-8 in there either
+  // With a NUL among them the file is refused as text holding one, before it is parsed.
+  bytes.insert(14, 1, '\0');
+  expectOneCleanLine(trace(write("binary.json", bytes)),
+                     "binary.json: holds a NUL byte at offset 14 (line 1)");
 }
 
 // The NUL in the key is shown as \x00 and the rest of the message follows it.
@@ -71,6 +75,38 @@ TEST_F(InputCli, DirectoryAsSceneSaysSo) {
   fs::create_directory(dir_ / "scene.json");
   expectOneCleanLine(trace((dir_ / "scene.json").string()),
                      "scene.json: is a directory, expected a scene file");
+}
+
+// `eikon render /dev/zero` read without end, its memory growing ~300 MB/s; a link to it, and a
+// library material linked to it, the same. Nothing is rendered and nothing written.
+TEST_F(InputCli, DevZeroIsRefusedAsNotARegularFile) {
+  const std::string out = " -o " + quote((dir_ / "out" / "o.exr").string()) + " -q";
+  expectOneCleanLine(
+      run("render /dev/zero" + out),
+      "/dev/zero: is not a regular file (a character device), expected a scene file");
+  fs::create_symlink("/dev/zero", dir_ / "z.json");
+  expectOneCleanLine(run("render " + quote((dir_ / "z.json").string()) + out),
+                     "z.json: is not a regular file (a character device)");
+  fs::create_directory(dir_ / "lib");
+  fs::create_symlink("/dev/zero", dir_ / "lib" / "zz.json");
+  const std::string scene = write("mat.json", R"({"objects": [{"shape": "sphere", "radius": 3,
+      "material": "zz"}]})");
+  expectOneCleanLine(
+      run("render " + quote(scene) + out, "EIKON_MATERIALS_PATH=" + quote((dir_ / "lib").string())),
+      "zz.json: is not a regular file (a character device), expected a material file");
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+// A scene followed by "\0garbage" rendered, everything after the NUL ignored.
+TEST_F(InputCli, NulAfterTheSceneIsRefused) {
+  const std::string scene = R"({"materials": {"g": {"n": 1.5}},
+      "objects": [{"shape": "sphere", "radius": 3, "material": "g"}]})";
+  const std::string file = write("nul.json", scene + std::string("\0garbage {{{ \xff", 14));
+  const Outcome r =
+      run("render " + quote(file) + " -o " + quote((dir_ / "o.exr").string()) + " -q");
+  expectOneCleanLine(r, "nul.json: holds a NUL byte at offset " + std::to_string(scene.size()) +
+                            " (line 2), expected a scene file (text)");
+  EXPECT_FALSE(fs::exists(dir_ / "o.exr"));
 }
 
 // A sphere of 7e8 mm about the volume filled it silently (the traced optical path changed, no

@@ -405,5 +405,47 @@ TEST(Faceted, GemCadAscFileGivesTheBrilliant) {
                                         "/objects/0/file", "junk.asc line 2: unknown record 'q'"));
 }
 
+// `a 20 1e300 5` on line 10 was reported on line 6 ("the facet removes the whole stone"): the
+// rough block is sized from the largest distance, and the other facets lost their precision. A
+// .asc distance is bounded as the JSON tiers' are, and a length that leaves the others no
+// precision is blamed where it stands.
+TEST(Faceted, AscDistancesAreBoundedAndBlamedOnTheirLine) {
+  test::TempDir dir;
+  auto errorFor = [&](const std::string& extra_line) {
+    dir.write("d.asc", brilliantAsc(extra_line));
+    const fs::path s =
+        dir.write("s.json", sceneWith(R"({"shape": "faceted", "file": "d.asc", "material": "g"})"));
+    return test::sceneErrorOf(slurp(s), s);
+  };
+  const std::string scene = (dir.path() / "s.json").string();
+  EXPECT_TRUE(test::isOneLineSceneError(errorFor("a 20 1e300 5\n"), scene, "/objects/0/file",
+                                        "d.asc line 10: the distance must be in [-1e+12, 1e+12] "
+                                        "mm, got 1e+300"));
+  for (const char* d : {"1e12", "-1e12", "1e9"}) {
+    const std::string m = errorFor("a 20 " + std::string(d) + " 5\n");
+    EXPECT_TRUE(test::isOneLineSceneError(m, scene, "/objects/0/file: d.asc line 10",
+                                          "is more than 1000 times the design's next largest"))
+        << m;
+  }
+  // A distance beyond the stone, but not beyond precision, is the facet that cuts nothing.
+  EXPECT_TRUE(test::isOneLineSceneError(
+      errorFor("a 20 1e6 5\n"), scene, "/objects/0/file: d.asc line 10", "the facet cuts nothing"));
+}
+
+// A NUL in a .asc file cut the message at it ("unknown record '"): the file is refused as text
+// holding a NUL, by offset and line.
+TEST(Faceted, AscFileWithANulIsRefused) {
+  test::TempDir dir;
+  using namespace std::string_literals;
+  dir.write("d.asc", brilliantAsc("q\0x\n"s));
+  const fs::path s =
+      dir.write("s.json", sceneWith(R"({"shape": "faceted", "file": "d.asc", "material": "g"})"));
+  const std::string m = test::sceneErrorOf(slurp(s), s);
+  EXPECT_TRUE(test::isOneLineSceneError(m, s.string(), "/objects/0/file",
+                                        "d.asc: holds a NUL byte at offset"))
+      << m;
+  EXPECT_NE(m.find("(line 10), expected a GemCad .asc file (text)"), std::string::npos) << m;
+}
+
 }  // namespace
 }  // namespace eikon

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/scene/scene.h"
+#include "tests/core/scene_support.h"
 
 namespace {
 
@@ -479,6 +480,70 @@ TEST(Mesh, GarbageFilesAreOneLineErrors) {
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
   }
   fs::remove_all(dir);
+}
+
+// A PLY header is read before Assimp sees the file: Assimp allocated what the header declared
+// (a 241-byte binary PLY declaring 4e8 vertices took 4.7 GB for 23 s; 4e9 ended in a bare
+// "std::bad_alloc"). Counts the file cannot hold, or beyond a mesh's limits, are refused by name.
+TEST(Mesh, PlyHeaderCountsAreCheckedAgainstTheFile) {
+  test::TempDir dir;
+  auto ply = [&](const std::string& format, const std::string& vertices, const std::string& tail) {
+    std::string bytes = "ply\nformat " + format + " 1.0\nelement vertex " + vertices +
+                        "\nproperty float x\nproperty float y\nproperty float z\n"
+                        "element face 1\nproperty list uchar int vertex_indices\nend_header\n" +
+                        tail;
+    dir.write("m.ply", bytes);
+    return errorOf(meshScene(R"({"shape": "mesh", "material": "glass", "file": ")" +
+                             (dir.path() / "m.ply").string() + "\"}"));
+  };
+  const std::string zeros(65, '\0');
+  for (const char* count : {"400000000", "4000000000"}) {
+    const std::string e = ply("binary_little_endian", count, zeros);
+    EXPECT_TRUE(test::isOneLineSceneError(
+        e, "scene.json", "/objects/0/file",
+        "m.ply: the PLY header (line 3) declares " + std::string(count) + " 'vertex' elements"))
+        << e;
+  }
+  // Within the mesh limits but more than the bytes after the header: 12 bytes a binary vertex.
+  std::string e = ply("binary_little_endian", "6", zeros);
+  EXPECT_NE(e.find("declares 6 'vertex' elements of at least 12 bytes each, more than the file's"),
+            std::string::npos)
+      << e;
+  e = ply("ascii", "300001", "");
+  EXPECT_NE(e.find("declares 300001 'vertex' elements, more than a mesh may have (at most 300000)"),
+            std::string::npos)
+      << e;
+  e = ply("ascii", "99999999999999999999999", "");
+  EXPECT_NE(e.find("line 3: the element 'vertex' has no count that a file can hold"),
+            std::string::npos)
+      << e;
+  // ASCII: two bytes a value at least (a digit and a separator).
+  e = ply("ascii", "3", "0 0 0\n0 0 1\n");
+  EXPECT_NE(e.find("declares 3 'vertex' elements of at least 6 bytes each"), std::string::npos)
+      << e;
+  dir.write("h.ply", "ply\nformat ascii 1.0\n" + std::string(70000, 'c') + "\n");
+  e = errorOf(meshScene(R"({"shape": "mesh", "material": "glass", "file": ")" +
+                        (dir.path() / "h.ply").string() + "\"}"));
+  EXPECT_NE(e.find("h.ply: the PLY header has no end_header line within its first 64 KiB"),
+            std::string::npos)
+      << e;
+  // The shipped box still reads.
+  EXPECT_EQ(errorOf(meshScene(meshObject("box.ply"))), "(no error)");
+}
+
+// A mesh file name with a NUL cut the message at it ("/objects/0/file: m"); a 5000-byte name lost
+// the reason behind its own length ("mmmm...(10024 bytes)").
+TEST(Mesh, OddFileNamesAreRefusedWithTheirReason) {
+  std::string e =
+      errorOf(meshScene(R"({"shape": "mesh", "material": "glass", "file": "m\u0000.obj"})"));
+  EXPECT_TRUE(test::isOneLineSceneError(e, "scene.json", "/objects/0/file",
+                                        "the file name 'm\\x00.obj' holds a NUL byte"))
+      << e;
+  const std::string name = std::string(5000, 'm') + ".obj";
+  e = errorOf(meshScene(R"({"shape": "mesh", "material": "glass", "file": ")" + name + "\"}"));
+  EXPECT_TRUE(test::isOneLineSceneError(e, "scene.json", "/objects/0/file", "(5004 bytes)")) << e;
+  EXPECT_NE(e.find("file name too long"), std::string::npos) << e;
+  EXPECT_LT(e.size(), 600u) << e;
 }
 
 }  // namespace

@@ -188,11 +188,12 @@ TEST(SceneInput, NulInANameIsEscaped) {
   EXPECT_NE(k.find("unknown shape 'sphere\\x00'"), std::string::npos) << k;
 }
 
-// Raw bytes of a binary file in the malformed-JSON message are escaped, and a long token is cut.
+// Raw bytes of a binary file in the malformed-JSON message are escaped, and a long token is cut
+// (a NUL byte is refused before parsing: NulBytesInJsonAreRefused).
 TEST(SceneInput, BinaryBytesInMessagesAreEscapedAndShort) {
   using namespace std::string_literals;
   const std::string binary =
-      "{\"objects\": [\"\x01\x02\xff\xfe\x80\x00\x1b[31mred"s + std::string(100000, 'z');
+      "{\"objects\": [\"\x01\x02\xff\xfe\x80\x1b[31mred"s + std::string(100000, 'z');
   const std::string m = errorOf(binary);
   EXPECT_EQ(m.rfind(std::string(kOrigin) + ": malformed JSON", 0), 0u) << m;
   EXPECT_LT(m.size(), 600u);
@@ -201,6 +202,84 @@ TEST(SceneInput, BinaryBytesInMessagesAreEscapedAndShort) {
   const std::string key = errorOf(R"({"objects": [], ")" + std::string(100000, 'k') + R"(": 1})");
   EXPECT_LT(key.size(), 600u);
   EXPECT_NE(key.find("... (100000 bytes): unknown key"), std::string::npos) << key.substr(0, 300);
+}
+
+// ------------------------------------------------------------------ what a file is
+
+// `eikon render /dev/zero` read without end (~300 MB/s), /dev/null read as an empty scene, and a
+// library material linked to /dev/zero the same: scenes and material files are read only when they
+// are regular files of at most 64 MiB (core/io/text_file.h).
+TEST(SceneInput, OnlyRegularFilesAreRead) {
+  try {
+    loadScene("/dev/null");
+    ADD_FAILURE() << "/dev/null loaded as a scene";
+  } catch (const SceneError& e) {
+    EXPECT_STREQ(e.what(),
+                 "/dev/null: is not a regular file (a character device), expected a scene file");
+  }
+  TempDir d;
+  fs::create_directory(d.path() / "lib");
+  fs::create_symlink("/dev/null", d.path() / "lib" / "zz.json");
+  ScopedEnv lib("EIKON_MATERIALS_PATH", (d.path() / "lib").string());
+  EXPECT_EQ(errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "zz"}]})"),
+            (d.path() / "lib" / "zz.json").string() +
+                ": is not a regular file (a character device), expected a material file");
+}
+
+// A valid scene followed by "\0garbage" rendered (nlohmann's parser stops at a NUL): a NUL byte in
+// a scene or material file is refused with its offset and line.
+TEST(SceneInput, NulBytesInJsonAreRefused) {
+  using namespace std::string_literals;
+  const std::string scene = R"({"materials": {)" + kGlass + R"(}, "objects": [)" + kSphere + "]}";
+  EXPECT_EQ(errorOf(scene + "\n\0garbage {{{ \xff"s), "input.json: holds a NUL byte at offset " +
+                                                          std::to_string(scene.size() + 1) +
+                                                          " (line 2), expected JSON text (text)");
+  TempDir d;
+  const fs::path file = d.write("s.json", scene + "\0garbage"s);
+  try {
+    loadScene(file);
+    ADD_FAILURE() << "a scene with a NUL loaded";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), file.string() + ": holds a NUL byte at offset " +
+                                         std::to_string(scene.size()) +
+                                         " (line 1), expected a scene file (text)");
+  }
+  fs::create_directory(d.path() / "lib");
+  d.write("lib/nul.json", "{\"n\": 1.5}\0"s);
+  ScopedEnv lib("EIKON_MATERIALS_PATH", (d.path() / "lib").string());
+  EXPECT_NE(errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "nul"}]})")
+                .find("nul.json: holds a NUL byte at offset 10 (line 1)"),
+            std::string::npos);
+}
+
+// A file name holding a NUL cut the message at it ("/objects/0/file: m"): it is refused as such.
+TEST(SceneInput, NulInAFileNameIsRefused) {
+  const std::string env = R"({"materials": {)" + kGlass + R"(}, "objects": [)" + kSphere +
+                          R"(], "environment": {"type": "latlong", "file": "e\u0000.exr"}})";
+  EXPECT_INPUT_ERROR(env, "/environment/file", "the file name 'e\\x00.exr' holds a NUL byte");
+}
+
+// Names too long for the system raised a bare "filesystem error: status: File name too long
+// [...]" with neither scene nor JSON path, or lost the reason behind the name: the message names
+// both, shortens the name and keeps the reason.
+TEST(SceneInput, LongFileNamesKeepTheirReason) {
+  const std::string material =
+      errorOf(R"({"objects": [{"shape": "sphere", "radius": 3, "material": ")" +
+              std::string(100000, 'x') + "\"}]}");
+  EXPECT_TRUE(test::isOneLineSceneError(material, kOrigin, "/objects/0/material",
+                                        "cannot look up the library material 'xxx"))
+      << material.substr(0, 300);
+  EXPECT_NE(material.find("... (100000 bytes)' as "), std::string::npos) << material;
+  EXPECT_NE(material.find(": file name too long"), std::string::npos) << material;
+  EXPECT_LT(material.size(), 600u);
+  const std::string env = errorOf(R"({"materials": {)" + kGlass + R"(}, "objects": [)" + kSphere +
+                                  R"(], "environment": {"type": "latlong", "file": ")" +
+                                  std::string(5000, 'e') + ".exr\"}}");
+  EXPECT_TRUE(test::isOneLineSceneError(env, kOrigin, "/environment/file",
+                                        "... (5004 bytes): cannot open an EXR image: file name "
+                                        "too long"))
+      << env;
+  EXPECT_LT(env.size(), 600u);
 }
 
 }  // namespace
