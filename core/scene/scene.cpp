@@ -11,6 +11,7 @@
 
 #include "core/io/exr.h"
 #include "core/scene/faceted.h"
+#include "core/scene/limits.h"
 #include "core/scene/mesh.h"
 #include "core/spectrum/illuminants.h"
 
@@ -27,7 +28,6 @@ constexpr double kPi = 3.14159265358979323846;
 //   and the gradients the GPU stores are finite in float;
 // - the volume within 65536 voxels of the origin: the GPU marches in single precision, whose
 //   positions there resolve 2^-7 voxel (farther out the grid would be sampled off by whole voxels).
-constexpr double kMaxCoordinateMm = 1e12;
 constexpr double kMinVoxelMm = 1e-6;
 constexpr double kMaxOffsetVoxels = 65536.0;
 constexpr size_t kMaxPlanes = 4096;  // planes of one "planes" object

@@ -526,6 +526,25 @@ TEST_F(Cli, TraceNegativeWavelength) {
                      "--wavelength");
 }
 
+// An origin at z = −1e300 printed an exit at −inf and NaN Stokes with exit code 0 (--json: null):
+// it is bounded as a scene's positions are, ±1e12 mm.
+TEST_F(Cli, TraceOriginBeyondTheCoordinateLimit) {
+  const std::string scene = write("scene.json", tinyScene());
+  for (const char* json : {"", " --json"}) {
+    const Outcome r = run("trace " + quote(scene) + " -q --origin 0,2,-1e300 --dir 0,0,1" + json);
+    expectCleanFailure(r, "--origin must be within ±1e12 mm");
+    EXPECT_EQ(r.out, "");
+  }
+}
+
+// A denormal direction (1e-320 is finite) is refused for being zero, not as "not finite".
+TEST_F(Cli, TraceDenormalDirectionIsZeroNotNonFinite) {
+  const std::string scene = write("scene.json", tinyScene());
+  const Outcome r = run("trace " + quote(scene) + " -q --origin 0,0,-4 --dir 0,0,1e-320");
+  expectCleanFailure(r, "--dir must be a non-zero vector");
+  EXPECT_EQ(r.err.find("finite"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, TraceNonFiniteOrigin) {
   const std::string scene = write("scene.json", tinyScene());
   expectCleanFailure(run("trace " + quote(scene) + " --origin 0,nan,-4 --dir 0,0,1"), "--origin");
