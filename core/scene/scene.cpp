@@ -172,21 +172,59 @@ class Node {
 };
 
 // ------------------------------------------------------------------ materials
-void checkIndexAtLeastOne(const Node& at, const Dispersion& d) {
-  // An index below 1 (or a Sellmeier pole) anywhere in the visible window is an error (never
-  // clamped).
+// Every refractive index a material defines lies in [kMinIndex, kMaxIndex], as ambient_index and
+// a gradient-index n0 do: an index of 1e20 (or an infinite one) makes the Fresnel terms and the
+// march's gradients overflow to NaN in float.
+constexpr double kMinIndex = 1.0;
+constexpr double kMaxIndex = 10.0;
+
+/// Why a Sellmeier model has no real index at `l` nm (n² ≤ 0 or a pole): a negative B, or a C
+/// whose pole λ = √C lies in the checked window.
+std::string sellmeierTrouble(const Dispersion& d, double l) {
+  const std::vector<double>& b = d.coefficients();
+  const std::vector<double>& c = d.sellmeierC();
+  const double l2 = l * l * 1e-6;
+  double n2 = 1.0;
+  for (size_t i = 0; i < b.size(); ++i) n2 += b[i] * l2 / (l2 - c[i]);
+  std::string why = "the Sellmeier sum gives n^2 = " + fmt(n2) + " at " + fmt(l) +
+                    " nm: no real refractive index there";
+  for (size_t i = 0; i < b.size(); ++i)
+    if (c[i] >= 0.380 * 0.380 && c[i] <= 0.780 * 0.780)
+      return why + " (C" + std::to_string(i + 1) + " = " + fmt(c[i]) + " um^2 puts a pole at " +
+             fmt(1e3 * std::sqrt(c[i])) + " nm)";
+  for (size_t i = 0; i < b.size(); ++i)
+    if (b[i] < 0)
+      return why + " (B" + std::to_string(i + 1) + " = " + fmt(b[i]) +
+             " is negative: each B must be >= 0 for n^2 to stay above 1 away from the poles)";
+  return why;
+}
+
+void checkIndexInRange(const Node& at, const Dispersion& d) {
+  // An index outside [1, 10], infinite, or undefined (n² ≤ 0 at a Sellmeier pole or from a
+  // negative term) anywhere in the visible window is an error (never clamped).
   for (double l = 380.0; l <= 780.0; l += 1.0) {
-    double n = d.index(l);
-    if (!(n >= 1.0))
-      at.fail("refractive index " + (std::isfinite(n) ? fmt(n) : std::string("undefined")) +
-              " at " + fmt(l) + " nm is below 1");
+    const double n = d.index(l);
+    if (std::isnan(n))
+      at.fail(d.kind() == Dispersion::Kind::Sellmeier
+                  ? sellmeierTrouble(d, l)
+                  : "refractive index at " + fmt(l) +
+                        " nm is not a number (the formula overflows)");
+    if (std::isinf(n))
+      at.fail("refractive index at " + fmt(l) +
+              " nm is infinite (the formula overflows or has a pole there)");
+    if (n < kMinIndex) at.fail("refractive index " + fmt(n) + " at " + fmt(l) + " nm is below 1");
+    if (n > kMaxIndex)
+      at.fail("refractive index " + fmt(n) + " at " + fmt(l) +
+              " nm is above 10 (indices must be in [1, 10])");
   }
 }
 
 Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
   if (n.isNumber()) {
     double v = n.number();
-    if (v < 1.0) n.fail("refractive index must be >= 1, got " + fmt(v));
+    if (v < kMinIndex) n.fail("refractive index must be >= 1, got " + fmt(v));
+    if (v > kMaxIndex)
+      n.fail("refractive index must be <= 10 (indices are in [1, 10]), got " + fmt(v));
     return Dispersion::constant(v);
   }
   if (!n.isObject())
@@ -205,7 +243,7 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
     if (auto l = n.get("linear")) {
       l->allowKeys({"n0", "gradient_per_mm", "origin"});
       grin->type = GrinProfile::Type::Linear;
-      grin->n0 = l->at("n0").number(1.0, 10.0);
+      grin->n0 = l->at("n0").number(kMinIndex, kMaxIndex);
       grin->gradient = l->at("gradient_per_mm").vec3();
       grin->origin = l->get("origin") ? l->at("origin").position() : glm::dvec3(0.0);
     } else if (auto lu = n.get("luneburg")) {
@@ -219,7 +257,7 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
       grin->type = GrinProfile::Type::MaxwellFisheye;
       grin->origin = f.at("center").position();
       grin->radius = f.at("radius").length();
-      grin->n0 = f.at("n0").number(1.0, 10.0);
+      grin->n0 = f.at("n0").number(kMinIndex, kMaxIndex);
     }
     return Dispersion::constant(grin->type == GrinProfile::Type::Linear ? grin->n0 : 1.0);
   }
@@ -256,7 +294,7 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
   } catch (const std::invalid_argument& e) {
     n.fail(e.what());
   }
-  checkIndexAtLeastOne(n, d);
+  checkIndexInRange(n, d);
   return d;
 }
 
@@ -1128,8 +1166,8 @@ static bool checkObjectInVolume(const Node& o, const SceneObject& obj, Scene& sc
   return covers;
 }
 
-/// A gradient-index profile must give n ≥ 1 wherever the object is inside the volume (sampled on
-/// a 17³ lattice of the overlap of its box with the volume).
+/// A gradient-index profile must give n in [1, 10] wherever the object is inside the volume
+/// (sampled on a 17³ lattice of the overlap of its box with the volume).
 static void checkGrinIndex(const Node& o, const SceneObject& obj, const Material& mat,
                            const VolumeSpec& vol) {
   auto [lo, hi] = obj.shape.bounds();
@@ -1148,11 +1186,14 @@ static void checkGrinIndex(const Node& o, const SceneObject& obj, const Material
                       (mat.grin.radius * mat.grin.radius);
           n = r2 <= 2.0 ? std::sqrt(2.0 - r2) : std::nan("");
         }
-        if (!(n >= 1.0))
+        if (!(n >= kMinIndex && n <= kMaxIndex))
           o.at("material")
               .fail("gradient-index material '" + excerpt(obj.material) + "' gives n = " + fmt(n) +
-                    ", below 1, inside this object at (" + fmt(p.x) + ", " + fmt(p.y) + ", " +
-                    fmt(p.z) + ")");
+                    (n > kMaxIndex   ? ", above 10"
+                     : std::isnan(n) ? ", undefined"
+                                     : ", below 1") +
+                    ", inside this object at (" + fmt(p.x) + ", " + fmt(p.y) + ", " + fmt(p.z) +
+                    ") (indices must be in [1, 10])");
       }
 }
 
@@ -1251,7 +1292,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto c = root.get("camera")) parseCamera(*c, scene.camera);
   if (auto e = root.get("environment")) parseEnvironment(*e, origin, scene.environment);
   if (auto v = root.get("volume")) parseVolume(*v, scene.volume);
-  if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
+  if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(kMinIndex, kMaxIndex);
   if (auto f = root.get("interfaces")) scene.interfaces = parseInterfaces(*f);
   if (auto ms = root.get("materials")) {
     ms->requireObject();
