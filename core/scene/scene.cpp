@@ -28,6 +28,11 @@ constexpr double kPi = 3.14159265358979323846;
 //   and the gradients the GPU stores are finite in float;
 // - the volume within 65536 voxels of the origin: the GPU marches in single precision, whose
 //   positions there resolve 2^-7 voxel (farther out the grid would be sampled off by whole voxels).
+// Colours (emission, environment radiance, attenuation and albedo bands) and an environment's
+// radiance after its intensity are at most 1e9, as an environment's intensity is: a radiance of
+// 1e308 overflows to Inf in the float image (and Inf − Inf to NaN).
+constexpr double kMaxColor = 1e9;
+constexpr const char* kMaxColorText = "1e9";
 constexpr double kMinVoxelMm = 1e-6;
 constexpr double kMaxOffsetVoxels = 65536.0;
 constexpr size_t kMaxPlanes = 4096;  // planes of one "planes" object
@@ -138,9 +143,14 @@ class Node {
     if (!j_.is_array() || j_.size() != 3) fail("expected an array of 3 numbers");
     return {index(0).number(), index(1).number(), index(2).number()};
   }
-  glm::dvec3 color() const {  // a number (grey) or [r, g, b], all ≥ 0
+  /// A number (grey) or [r, g, b], each in [0, kMaxColor].
+  glm::dvec3 color() const {
     glm::dvec3 c = j_.is_number() ? glm::dvec3(number()) : vec3();
     if (c.x < 0 || c.y < 0 || c.z < 0) fail("must be non-negative");
+    for (int k = 0; k < 3; ++k)
+      if (c[k] > kMaxColor)
+        (j_.is_number() ? *this : index(size_t(k)))
+            .fail("must be at most " + std::string(kMaxColorText) + ", got " + fmt(c[k]));
     return c;
   }
   /// A point (mm) within ±kMaxCoordinateMm on every axis.
@@ -312,6 +322,9 @@ Attenuation parseAttenuation(const Node& n) {
             .index(i)
             .fail("wavelengths must be > 0 nm, got " + fmt(a.wavelengths_nm[i]));
       if (a.values[i] < 0) n.fail("attenuation must be >= 0");
+      if (a.values[i] > kMaxColor)
+        n.at("per_mm").index(i).fail("must be at most " + std::string(kMaxColorText) +
+                                     " per mm, got " + fmt(a.values[i]));
       if (i && !(a.wavelengths_nm[i] > a.wavelengths_nm[i - 1]))
         n.fail("wavelength_nm must be strictly increasing");
     }
@@ -1045,16 +1058,27 @@ static void parseCamera(const Node& c, Camera& cam) {
 
 static void parseEnvironment(const Node& e, const std::filesystem::path& origin, Environment& env) {
   std::string type = e.at("type").string();
+  if (auto v = e.get("intensity")) env.intensity = v->number(0.0, 1e9);
+  // A colour times the intensity is the radiance a ray sees: at most kMaxColor.
+  auto radiance = [&](const Node& c) {
+    const glm::dvec3 v = c.color();
+    for (int k = 0; k < 3; ++k)
+      if (v[k] * env.intensity > kMaxColor)
+        (c.isNumber() ? c : c.index(size_t(k)))
+            .fail(fmt(v[k]) + " times the intensity " + fmt(env.intensity) +
+                  " is above the largest environment radiance " + kMaxColorText);
+    return v;
+  };
   if (type == "checker") {
     e.allowKeys({"type", "squares", "color_a", "color_b", "intensity", "polarization"});
     env.type = Environment::Type::Checker;
     if (auto v = e.get("squares")) env.squares = v->integer(1, 4096);
-    if (auto v = e.get("color_a")) env.color_a = v->color();
-    if (auto v = e.get("color_b")) env.color_b = v->color();
+    if (auto v = e.get("color_a")) env.color_a = radiance(*v);
+    if (auto v = e.get("color_b")) env.color_b = radiance(*v);
   } else if (type == "constant") {
     e.allowKeys({"type", "radiance", "intensity", "polarization"});
     env.type = Environment::Type::Constant;
-    if (auto v = e.get("radiance")) env.radiance = v->color();
+    if (auto v = e.get("radiance")) env.radiance = radiance(*v);
   } else if (type == "latlong") {
     e.allowKeys({"type", "file", "intensity", "polarization"});
     env.type = Environment::Type::LatLong;
@@ -1076,7 +1100,6 @@ static void parseEnvironment(const Node& e, const std::filesystem::path& origin,
     e.at("type").fail("unknown environment type '" + excerpt(type) +
                       "' (checker, constant, latlong)");
   }
-  if (auto v = e.get("intensity")) env.intensity = v->number(0.0, 1e9);
   if (auto p = e.get("polarization")) env.polarization = parsePolarization(*p);
 }
 

@@ -2,8 +2,8 @@
 // objects must be representable (finite extents, a voxel edge whose inverse is finite in float,
 // a grid the GPU's single-precision positions resolve), and objects that the volume would cut
 // away entirely, or that fill it entirely, are never a silent change: an error or a warning
-// naming the JSON path. Refractive indices lie in [1, 10] (docs/scene-format.md), so that no
-// accepted value overflows in a render.
+// naming the JSON path. Refractive indices lie in [1, 10] and colours at most 1e9
+// (docs/scene-format.md), so that no accepted value overflows in a render.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -224,6 +224,35 @@ TEST(SceneLimits, NegativeSellmeierBIsNamed) {
   EXPECT_TRUE(test::isOneLineSceneError(m, kOrigin, "/materials/m/n", "B1 = -5 is negative"));
   EXPECT_NE(m.find("at 380 nm"), std::string::npos) << m;
   EXPECT_EQ(m.find("below 1"), std::string::npos) << m;
+}
+
+// ------------------------------------------------------------------ radiances at most 1e9
+
+// Emission 1e308 rendered Inf pixels, an environment radiance of 1e308 an all-Inf image: colours
+// are capped at 1e9 (as the environment's intensity), and an environment colour times its
+// intensity as well.
+TEST(SceneLimits, HugeColoursAreRefused) {
+  EXPECT_LIMIT_ERROR(withMaterial(R"({"n": 1.5, "emission": 1e308})"), "/materials/m/emission",
+                     "at most 1e9");
+  EXPECT_LIMIT_ERROR(withMaterial(R"({"n": 1.5, "emission": [1, 2e9, 0]})"),
+                     "/materials/m/emission/1", "at most 1e9");
+  EXPECT_LIMIT_ERROR(withMaterial(R"({"n": 1.5, "attenuation_per_mm": [0, 0, 1e300]})"),
+                     "/materials/m/attenuation_per_mm/2", "at most 1e9");
+  EXPECT_LIMIT_ERROR(withMaterial(R"({"n": 1.5, "attenuation_per_mm": {"wavelength_nm": [400, 700],
+                                                         "per_mm": [1, 1e300]}})"),
+                     "/materials/m/attenuation_per_mm/per_mm/1", "at most 1e9");
+  EXPECT_LIMIT_ERROR(
+      withMaterial(R"({"n": 1.5})", R"("environment": {"type": "constant", "radiance": 1e308},)"),
+      "/environment/radiance", "at most 1e9");
+  EXPECT_LIMIT_ERROR(withMaterial(R"({"n": 1.5})", R"("environment": {"type": "checker",
+                         "color_a": [1, 1, 2e8], "intensity": 10},)"),
+                     "/environment/color_a/2", "times the intensity 10");
+  // At the limits: emission 1e9, radiance 1e8 × intensity 10 = 1e9.
+  EXPECT_NO_THROW(parseScene(withMaterial(R"({"n": 1.5, "emission": 1e9})"), kOrigin));
+  EXPECT_NO_THROW(parseScene(
+      withMaterial(R"({"n": 1.5})",
+                   R"("environment": {"type": "constant", "radiance": 1e8, "intensity": 10},)"),
+      kOrigin));
 }
 
 }  // namespace
