@@ -1056,6 +1056,25 @@ static void parseCamera(const Node& c, Camera& cam) {
   }
 }
 
+/// An environment map's pixels are radiances: each channel must be >= 0 and at most kMaxColor
+/// after the environment's intensity (the reader has refused NaN and Inf).
+static void checkEnvironmentPixels(const Node& file, const Environment& env) {
+  const double most = kMaxColor / std::max(env.intensity, 1e-300);
+  for (size_t i = 0; i < env.image_rgba.size() / 4; ++i)
+    for (size_t k = 0; k < 3; ++k) {
+      const double v = env.image_rgba[4 * i + k];
+      if (v >= 0 && v <= most) continue;
+      const std::string where = "'" + env.image_path.string() + "': pixel (" +
+                                std::to_string(i % size_t(env.image_width)) + ", " +
+                                std::to_string(i / size_t(env.image_width)) + ") channel " +
+                                "RGB"[k] + " is " + fmt(v);
+      if (v < 0) file.fail(where + "; environment radiance must be >= 0");
+      if (v * env.intensity > kMaxColor)
+        file.fail(where + ": times the intensity " + fmt(env.intensity) +
+                  ", above the largest environment radiance " + kMaxColorText);
+    }
+}
+
 static void parseEnvironment(const Node& e, const std::filesystem::path& origin, Environment& env) {
   std::string type = e.at("type").string();
   if (auto v = e.get("intensity")) env.intensity = v->number(0.0, 1e9);
@@ -1096,6 +1115,7 @@ static void parseEnvironment(const Node& e, const std::filesystem::path& origin,
     } catch (const std::exception& ex) {
       e.at("file").fail(ex.what());
     }
+    checkEnvironmentPixels(e.at("file"), env);
   } else {
     e.at("type").fail("unknown environment type '" + excerpt(type) +
                       "' (checker, constant, latlong)");

@@ -2,14 +2,16 @@
 // objects must be representable (finite extents, a voxel edge whose inverse is finite in float,
 // a grid the GPU's single-precision positions resolve), and objects that the volume would cut
 // away entirely, or that fill it entirely, are never a silent change: an error or a warning
-// naming the JSON path. Refractive indices lie in [1, 10] and colours at most 1e9
-// (docs/scene-format.md), so that no accepted value overflows in a render.
+// naming the JSON path. Refractive indices lie in [1, 10] and radiances (colours, environment
+// maps) at most 1e9 (docs/scene-format.md), so that no accepted value overflows in a render.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
+#include "core/io/exr.h"
 #include "core/scene/scene.h"
 #include "tests/core/scene_support.h"
 
@@ -253,6 +255,33 @@ TEST(SceneLimits, HugeColoursAreRefused) {
       withMaterial(R"({"n": 1.5})",
                    R"("environment": {"type": "constant", "radiance": 1e8, "intensity": 10},)"),
       kOrigin));
+}
+
+// An environment map's pixels are radiances as a JSON colour is: a negative pixel was accepted,
+// and pixels of 3e38 (finite in float) with intensity 10 rendered an all-Inf image. The error
+// names the pixel (x, y from the top left) and the channel.
+TEST(SceneLimits, EnvironmentMapPixelsAreChecked) {
+  test::TempDir d;
+  const int w = 4, h = 2;
+  auto envScene = [&](float value, int x, int y, int channel, const std::string& intensity) {
+    std::vector<float> rgb(size_t(3 * w * h), 0.5f);
+    rgb[size_t(3 * (y * w + x) + channel)] = value;
+    writeExrRgb(d.path() / "env.exr", w, h, rgb);
+    return withMaterial(R"({"n": 1.5})", R"("environment": {"type": "latlong", "file": "env.exr")" +
+                                             intensity + "},");
+  };
+  const auto origin = (d.path() / "s.json").string();
+  auto errorIn = [&](const std::string& text) { return test::sceneErrorOf(text, origin); };
+  EXPECT_TRUE(test::isOneLineSceneError(errorIn(envScene(-1.0f, 2, 1, 1, "")), origin,
+                                        "/environment/file", "pixel (2, 1) channel G is -1"));
+  const std::string huge = errorIn(envScene(3e38f, 3, 0, 0, R"(, "intensity": 10)"));
+  EXPECT_TRUE(
+      test::isOneLineSceneError(huge, origin, "/environment/file", "pixel (3, 0) channel R is "));
+  EXPECT_NE(huge.find(": times the intensity 10, above the largest"), std::string::npos) << huge;
+  // 2e8 × 10 = 2e9 > 1e9; 1e8 × 10 = 1e9 is the limit, allowed.
+  EXPECT_TRUE(test::isOneLineSceneError(errorIn(envScene(2e8f, 0, 0, 2, R"(, "intensity": 10)")),
+                                        origin, "/environment/file", "channel B is 200000000"));
+  EXPECT_NO_THROW(parseScene(envScene(1e8f, 0, 0, 2, R"(, "intensity": 10)"), origin));
 }
 
 }  // namespace
