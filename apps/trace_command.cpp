@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
@@ -32,14 +33,13 @@ std::optional<std::vector<double>> parseNumbers(const std::string& s) {
   std::string part;
   std::vector<double> v;
   while (std::getline(ss, part, ',')) {
-    try {
-      size_t used = 0;
-      double x = std::stod(part, &used);
-      if (used != part.size() || !std::isfinite(x)) return std::nullopt;
-      v.push_back(x);
-    } catch (...) {
-      return std::nullopt;
-    }
+    // strtod, not stod: stod throws on a denormal such as 1e-320 (ERANGE), which is a finite
+    // number (a --dir of 0,0,1e-320 is then refused as zero, not as "not finite").
+    const char* begin = part.c_str();
+    char* end = nullptr;
+    const double x = std::strtod(begin, &end);
+    if (part.empty() || end != begin + part.size() || !std::isfinite(x)) return std::nullopt;
+    v.push_back(x);
   }
   return v;
 }

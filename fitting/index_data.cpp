@@ -262,6 +262,13 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
         throw std::invalid_argument(path + "." + key + ": missing or not a scalar");
       return v.as<std::string>();
     };
+    // "name:LINE: DATA[i].key": the line of the key's value (of the block if the key is absent).
+    auto at = [&](const char* key) {
+      const YAML::Node v = blk.IsMap() ? blk[key] : YAML::Node();
+      const int line = (v ? v.Mark() : blk.Mark()).line;
+      return (line >= 0 ? name + ":" + std::to_string(line + 1) : name) + ": DATA[" +
+             std::to_string(i) + "]." + key;
+    };
     auto numbers = [&](const std::string& s, const std::string& where) {
       std::vector<double> out;
       std::istringstream ss(s);
@@ -297,23 +304,22 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
       const std::string num = trim(type.substr(8));
       auto [ptr, ec] = std::from_chars(num.data(), num.data() + num.size(), k);
       if (ec != std::errc() || ptr != num.data() + num.size() || k < 1 || k > 9)
-        throw std::invalid_argument(path + ".type: unknown formula '" + type +
+        throw std::invalid_argument(at("type") + ": unknown formula '" + type +
                                     "' (expected formula 1 to 9)");
       const char* range_key = blk["wavelength_range"] ? "wavelength_range"
                               : blk["range"]          ? "range"
                                                       : nullptr;
       if (!range_key)
         throw std::invalid_argument(path + ": formula without 'wavelength_range' (or 'range')");
-      auto range = numbers(scalar(range_key), path + "." + range_key);
+      auto range = numbers(scalar(range_key), at(range_key));
       if (range.size() != 2 || !(range[0] > 0 && range[1] > range[0]))
-        throw std::invalid_argument(path + "." + range_key +
-                                    ": expected two wavelengths 0 < lo < hi (µm)");
-      std::vector<double> coeffs = numbers(scalar("coefficients"), path + ".coefficients");
+        throw std::invalid_argument(at(range_key) + ": expected two wavelengths 0 < lo < hi (µm)");
+      std::vector<double> coeffs = numbers(scalar("coefficients"), at("coefficients"));
       std::optional<RefractiveIndexFormula> f;
       try {
         f.emplace(k, coeffs);
       } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(path + ".coefficients: " + e.what());
+        throw std::invalid_argument(at("coefficients") + ": " + e.what());
       }
       double lo = range[0] * 1000.0, hi = range[1] * 1000.0;
       if (opt.window_nm) {

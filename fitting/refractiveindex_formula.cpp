@@ -20,6 +20,44 @@ RefractiveIndexFormula::RefractiveIndexFormula(int type, std::vector<double> coe
     throw std::invalid_argument("formula " + std::to_string(type_) + " takes at most " +
                                 std::to_string(max_terms[type_]) + " coefficients, got " +
                                 std::to_string(c_.size()));
+  // Whole terms may be left out (they count as zero), never part of one: "0 1" for formula 2 is
+  // C1 and the B of a term whose C is missing, which would be read as a pole at 0 (n² = 2).
+  const auto count = std::to_string(c_.size());
+  switch (type_) {
+    case 1:
+    case 2:
+    case 3:
+    case 5:
+    case 6:
+      if (c_.size() % 2 == 0)
+        throw std::invalid_argument("formula " + std::to_string(type_) +
+                                    " takes C1 and whole pairs (C2, C3), (C4, C5), ...: an odd "
+                                    "number of coefficients, got " +
+                                    count + " (the last term is incomplete)");
+      break;
+    case 4:
+      if (!(c_.size() == 1 || c_.size() == 5 || (c_.size() >= 9 && c_.size() % 2 == 1)))
+        throw std::invalid_argument(
+            "formula 4 takes C1, then whole terms C2..C5, C6..C9 and pairs (C10, C11), ...: 1, 5, "
+            "9, 11, ... 17 coefficients, got " +
+            count + " (the last term is incomplete)");
+      break;
+    case 8:
+      if (c_.size() == 2)
+        throw std::invalid_argument(
+            "formula 8 takes C1, the pair (C2, C3) and C4: 1, 3 or 4 coefficients, got 2 (the "
+            "pair is incomplete)");
+      break;
+    case 9:
+      if (c_.size() != 1 && c_.size() != 3 && c_.size() != 6)
+        throw std::invalid_argument(
+            "formula 9 takes C1, then whole terms (C2, C3) and (C4, C5, C6): 1, 3 or 6 "
+            "coefficients, got " +
+            count + " (the last term is incomplete)");
+      break;
+    default:  // 7: every coefficient is a term of its own
+      break;
+  }
 }
 
 double RefractiveIndexFormula::index(double l) const {

@@ -14,8 +14,9 @@
 //   λ⁶ 8 Retro         (n² − 1)/(n² + 2) = C1 + C2 λ²/(λ² − C3) + C4 λ² 9 Exotic        n²     = C1
 //   + C2/(λ² − C3) + C4 (λ − C5) / ((λ − C5)² + C6)
 //
-// Missing trailing coefficients count as zero (the database omits them), so e.g. formula 4 with
-// five coefficients is valid.
+// Missing trailing terms count as zero (the database omits them), so e.g. formula 4 with five
+// coefficients is valid; a term given in part is an error (formula 2 with "0 1": C1 and a B
+// without its C).
 //
 // Example (SCHOTT N-BK7, formula 2):
 //   eikon::RefractiveIndexFormula f(2, {0, 1.03961212, 0.00600069867, 0.231792344,
@@ -35,7 +36,8 @@ namespace eikon {
 class RefractiveIndexFormula {
  public:
   /// `type` is 1..9; `coeffs` the database's C1, C2, …. Throws std::invalid_argument for an
-  /// unknown type, an empty or non-finite list, or too many coefficients for the type.
+  /// unknown type, an empty or non-finite list, too many coefficients for the type, or a last
+  /// term given in part.
   RefractiveIndexFormula(int type, std::vector<double> coeffs);
 
   int type() const { return type_; }

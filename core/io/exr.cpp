@@ -66,9 +66,12 @@ RgbaImage readExrRgba(const std::filesystem::path& path, int max_width, int max_
                                      size_t(4 * w) * sizeof(float), 1, 1, c == 3 ? 1.0 : 0.0));
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
-    for (float v : img.rgba)
-      if (!std::isfinite(v))
-        throw std::runtime_error("'" + p + "' contains NaN or infinite pixels");
+    for (size_t i = 0; i < img.rgba.size(); ++i)
+      if (!std::isfinite(img.rgba[i]))
+        throw std::runtime_error("'" + p + "' contains NaN or infinite pixels: pixel (" +
+                                 std::to_string(i / 4 % size_t(w)) + ", " +
+                                 std::to_string(i / 4 / size_t(w)) + ") channel " + "RGBA"[i % 4] +
+                                 " is " + (std::isnan(img.rgba[i]) ? "NaN" : "infinite"));
     return img;
   } catch (const std::runtime_error&) {
     throw;

@@ -12,6 +12,7 @@
 #include "core/io/exr.h"
 #include "core/io/text_file.h"
 #include "core/scene/faceted.h"
+#include "core/scene/limits.h"
 #include "core/scene/mesh.h"
 #include "core/spectrum/illuminants.h"
 
@@ -28,7 +29,11 @@ constexpr double kPi = 3.14159265358979323846;
 //   and the gradients the GPU stores are finite in float;
 // - the volume within 65536 voxels of the origin: the GPU marches in single precision, whose
 //   positions there resolve 2^-7 voxel (farther out the grid would be sampled off by whole voxels).
-constexpr double kMaxCoordinateMm = 1e12;
+// Colours (emission, environment radiance, attenuation and albedo bands) and an environment's
+// radiance after its intensity are at most 1e9, as an environment's intensity is: a radiance of
+// 1e308 overflows to Inf in the float image (and Inf − Inf to NaN).
+constexpr double kMaxColor = 1e9;
+constexpr const char* kMaxColorText = "1e9";
 constexpr double kMinVoxelMm = 1e-6;
 constexpr double kMaxOffsetVoxels = 65536.0;
 constexpr size_t kMaxPlanes = 4096;  // planes of one "planes" object
@@ -139,9 +144,14 @@ class Node {
     if (!j_.is_array() || j_.size() != 3) fail("expected an array of 3 numbers");
     return {index(0).number(), index(1).number(), index(2).number()};
   }
-  glm::dvec3 color() const {  // a number (grey) or [r, g, b], all ≥ 0
+  /// A number (grey) or [r, g, b], each in [0, kMaxColor].
+  glm::dvec3 color() const {
     glm::dvec3 c = j_.is_number() ? glm::dvec3(number()) : vec3();
     if (c.x < 0 || c.y < 0 || c.z < 0) fail("must be non-negative");
+    for (int k = 0; k < 3; ++k)
+      if (c[k] > kMaxColor)
+        (j_.is_number() ? *this : index(size_t(k)))
+            .fail("must be at most " + std::string(kMaxColorText) + ", got " + fmt(c[k]));
     return c;
   }
   /// A point (mm) within ±kMaxCoordinateMm on every axis.
@@ -185,21 +195,59 @@ std::filesystem::path namedFile(const Node& f, const std::string& what) {
 }
 
 // ------------------------------------------------------------------ materials
-void checkIndexAtLeastOne(const Node& at, const Dispersion& d) {
-  // An index below 1 (or a Sellmeier pole) anywhere in the visible window is an error (never
-  // clamped).
+// Every refractive index a material defines lies in [kMinIndex, kMaxIndex], as ambient_index and
+// a gradient-index n0 do: an index of 1e20 (or an infinite one) makes the Fresnel terms and the
+// march's gradients overflow to NaN in float.
+constexpr double kMinIndex = 1.0;
+constexpr double kMaxIndex = 10.0;
+
+/// Why a Sellmeier model has no real index at `l` nm (n² ≤ 0 or a pole): a negative B, or a C
+/// whose pole λ = √C lies in the checked window.
+std::string sellmeierTrouble(const Dispersion& d, double l) {
+  const std::vector<double>& b = d.coefficients();
+  const std::vector<double>& c = d.sellmeierC();
+  const double l2 = l * l * 1e-6;
+  double n2 = 1.0;
+  for (size_t i = 0; i < b.size(); ++i) n2 += b[i] * l2 / (l2 - c[i]);
+  std::string why = "the Sellmeier sum gives n^2 = " + fmt(n2) + " at " + fmt(l) +
+                    " nm: no real refractive index there";
+  for (size_t i = 0; i < b.size(); ++i)
+    if (c[i] >= 0.380 * 0.380 && c[i] <= 0.780 * 0.780)
+      return why + " (C" + std::to_string(i + 1) + " = " + fmt(c[i]) + " um^2 puts a pole at " +
+             fmt(1e3 * std::sqrt(c[i])) + " nm)";
+  for (size_t i = 0; i < b.size(); ++i)
+    if (b[i] < 0)
+      return why + " (B" + std::to_string(i + 1) + " = " + fmt(b[i]) +
+             " is negative: each B must be >= 0 for n^2 to stay above 1 away from the poles)";
+  return why;
+}
+
+void checkIndexInRange(const Node& at, const Dispersion& d) {
+  // An index outside [1, 10], infinite, or undefined (n² ≤ 0 at a Sellmeier pole or from a
+  // negative term) anywhere in the visible window is an error (never clamped).
   for (double l = 380.0; l <= 780.0; l += 1.0) {
-    double n = d.index(l);
-    if (!(n >= 1.0))
-      at.fail("refractive index " + (std::isfinite(n) ? fmt(n) : std::string("undefined")) +
-              " at " + fmt(l) + " nm is below 1");
+    const double n = d.index(l);
+    if (std::isnan(n))
+      at.fail(d.kind() == Dispersion::Kind::Sellmeier
+                  ? sellmeierTrouble(d, l)
+                  : "refractive index at " + fmt(l) +
+                        " nm is not a number (the formula overflows)");
+    if (std::isinf(n))
+      at.fail("refractive index at " + fmt(l) +
+              " nm is infinite (the formula overflows or has a pole there)");
+    if (n < kMinIndex) at.fail("refractive index " + fmt(n) + " at " + fmt(l) + " nm is below 1");
+    if (n > kMaxIndex)
+      at.fail("refractive index " + fmt(n) + " at " + fmt(l) +
+              " nm is above 10 (indices must be in [1, 10])");
   }
 }
 
 Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
   if (n.isNumber()) {
     double v = n.number();
-    if (v < 1.0) n.fail("refractive index must be >= 1, got " + fmt(v));
+    if (v < kMinIndex) n.fail("refractive index must be >= 1, got " + fmt(v));
+    if (v > kMaxIndex)
+      n.fail("refractive index must be <= 10 (indices are in [1, 10]), got " + fmt(v));
     return Dispersion::constant(v);
   }
   if (!n.isObject())
@@ -218,7 +266,7 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
     if (auto l = n.get("linear")) {
       l->allowKeys({"n0", "gradient_per_mm", "origin"});
       grin->type = GrinProfile::Type::Linear;
-      grin->n0 = l->at("n0").number(1.0, 10.0);
+      grin->n0 = l->at("n0").number(kMinIndex, kMaxIndex);
       grin->gradient = l->at("gradient_per_mm").vec3();
       grin->origin = l->get("origin") ? l->at("origin").position() : glm::dvec3(0.0);
     } else if (auto lu = n.get("luneburg")) {
@@ -232,7 +280,7 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
       grin->type = GrinProfile::Type::MaxwellFisheye;
       grin->origin = f.at("center").position();
       grin->radius = f.at("radius").length();
-      grin->n0 = f.at("n0").number(1.0, 10.0);
+      grin->n0 = f.at("n0").number(kMinIndex, kMaxIndex);
     }
     return Dispersion::constant(grin->type == GrinProfile::Type::Linear ? grin->n0 : 1.0);
   }
@@ -269,7 +317,7 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
   } catch (const std::invalid_argument& e) {
     n.fail(e.what());
   }
-  checkIndexAtLeastOne(n, d);
+  checkIndexInRange(n, d);
   return d;
 }
 
@@ -287,6 +335,9 @@ Attenuation parseAttenuation(const Node& n) {
             .index(i)
             .fail("wavelengths must be > 0 nm, got " + fmt(a.wavelengths_nm[i]));
       if (a.values[i] < 0) n.fail("attenuation must be >= 0");
+      if (a.values[i] > kMaxColor)
+        n.at("per_mm").index(i).fail("must be at most " + std::string(kMaxColorText) +
+                                     " per mm, got " + fmt(a.values[i]));
       if (i && !(a.wavelengths_nm[i] > a.wavelengths_nm[i - 1]))
         n.fail("wavelength_nm must be strictly increasing");
     }
@@ -1017,18 +1068,48 @@ static void parseCamera(const Node& c, Camera& cam) {
   }
 }
 
+/// An environment map's pixels are radiances: each channel must be >= 0 and at most kMaxColor
+/// after the environment's intensity (the reader has refused NaN and Inf).
+static void checkEnvironmentPixels(const Node& file, const Environment& env) {
+  const double most = kMaxColor / std::max(env.intensity, 1e-300);
+  for (size_t i = 0; i < env.image_rgba.size() / 4; ++i)
+    for (size_t k = 0; k < 3; ++k) {
+      const double v = env.image_rgba[4 * i + k];
+      if (v >= 0 && v <= most) continue;
+      const std::string where = "'" + env.image_path.string() + "': pixel (" +
+                                std::to_string(i % size_t(env.image_width)) + ", " +
+                                std::to_string(i / size_t(env.image_width)) + ") channel " +
+                                "RGB"[k] + " is " + fmt(v);
+      if (v < 0) file.fail(where + "; environment radiance must be >= 0");
+      if (v * env.intensity > kMaxColor)
+        file.fail(where + ": times the intensity " + fmt(env.intensity) +
+                  ", above the largest environment radiance " + kMaxColorText);
+    }
+}
+
 static void parseEnvironment(const Node& e, Environment& env) {
   std::string type = e.at("type").string();
+  if (auto v = e.get("intensity")) env.intensity = v->number(0.0, 1e9);
+  // A colour times the intensity is the radiance a ray sees: at most kMaxColor.
+  auto radiance = [&](const Node& c) {
+    const glm::dvec3 v = c.color();
+    for (int k = 0; k < 3; ++k)
+      if (v[k] * env.intensity > kMaxColor)
+        (c.isNumber() ? c : c.index(size_t(k)))
+            .fail(fmt(v[k]) + " times the intensity " + fmt(env.intensity) +
+                  " is above the largest environment radiance " + kMaxColorText);
+    return v;
+  };
   if (type == "checker") {
     e.allowKeys({"type", "squares", "color_a", "color_b", "intensity", "polarization"});
     env.type = Environment::Type::Checker;
     if (auto v = e.get("squares")) env.squares = v->integer(1, 4096);
-    if (auto v = e.get("color_a")) env.color_a = v->color();
-    if (auto v = e.get("color_b")) env.color_b = v->color();
+    if (auto v = e.get("color_a")) env.color_a = radiance(*v);
+    if (auto v = e.get("color_b")) env.color_b = radiance(*v);
   } else if (type == "constant") {
     e.allowKeys({"type", "radiance", "intensity", "polarization"});
     env.type = Environment::Type::Constant;
-    if (auto v = e.get("radiance")) env.radiance = v->color();
+    if (auto v = e.get("radiance")) env.radiance = radiance(*v);
   } else if (type == "latlong") {
     e.allowKeys({"type", "file", "intensity", "polarization"});
     env.type = Environment::Type::LatLong;
@@ -1048,11 +1129,11 @@ static void parseEnvironment(const Node& e, Environment& env) {
     } catch (const std::exception& ex) {
       e.at("file").fail(ex.what());
     }
+    checkEnvironmentPixels(e.at("file"), env);
   } else {
     e.at("type").fail("unknown environment type '" + excerpt(type) +
                       "' (checker, constant, latlong)");
   }
-  if (auto v = e.get("intensity")) env.intensity = v->number(0.0, 1e9);
   if (auto p = e.get("polarization")) env.polarization = parsePolarization(*p);
 }
 
@@ -1148,8 +1229,8 @@ static bool checkObjectInVolume(const Node& o, const SceneObject& obj, Scene& sc
   return covers;
 }
 
-/// A gradient-index profile must give n ≥ 1 wherever the object is inside the volume (sampled on
-/// a 17³ lattice of the overlap of its box with the volume).
+/// A gradient-index profile must give n in [1, 10] wherever the object is inside the volume
+/// (sampled on a 17³ lattice of the overlap of its box with the volume).
 static void checkGrinIndex(const Node& o, const SceneObject& obj, const Material& mat,
                            const VolumeSpec& vol) {
   auto [lo, hi] = obj.shape.bounds();
@@ -1168,11 +1249,14 @@ static void checkGrinIndex(const Node& o, const SceneObject& obj, const Material
                       (mat.grin.radius * mat.grin.radius);
           n = r2 <= 2.0 ? std::sqrt(2.0 - r2) : std::nan("");
         }
-        if (!(n >= 1.0))
+        if (!(n >= kMinIndex && n <= kMaxIndex))
           o.at("material")
               .fail("gradient-index material '" + excerpt(obj.material) + "' gives n = " + fmt(n) +
-                    ", below 1, inside this object at (" + fmt(p.x) + ", " + fmt(p.y) + ", " +
-                    fmt(p.z) + ")");
+                    (n > kMaxIndex   ? ", above 10"
+                     : std::isnan(n) ? ", undefined"
+                                     : ", below 1") +
+                    ", inside this object at (" + fmt(p.x) + ", " + fmt(p.y) + ", " + fmt(p.z) +
+                    ") (indices must be in [1, 10])");
       }
 }
 
@@ -1271,7 +1355,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto c = root.get("camera")) parseCamera(*c, scene.camera);
   if (auto e = root.get("environment")) parseEnvironment(*e, scene.environment);
   if (auto v = root.get("volume")) parseVolume(*v, scene.volume);
-  if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(1.0, 10.0);
+  if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(kMinIndex, kMaxIndex);
   if (auto f = root.get("interfaces")) scene.interfaces = parseInterfaces(*f);
   if (auto ms = root.get("materials")) {
     ms->requireObject();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "core/light/light_cache.h"
 #include "core/light/lighting.h"
@@ -14,6 +15,7 @@
 #include "core/render/render_defaults.h"
 #include "core/render/view_pipeline_start.h"
 #include "core/render/view_renderer.h"
+#include "core/scene/limits.h"
 #include "core/vk/context.h"
 #include "core/volume/host_memory.h"
 #include "core/volume/polarised_render.h"
@@ -203,7 +205,20 @@ LightingOptions lightingOptions(const LightRequest& l, double voxel_mm) {
 }
 
 void checkTraceRequest(const TraceRequest& ray) {
+  // As a scene's positions: within ±1e12 mm, so that the ray's points stay finite (an origin at
+  // z = -1e300 printed an exit at -inf and NaN Stokes).
+  for (int a = 0; a < 3; ++a)
+    if (!(std::abs(ray.origin[a]) <= kMaxCoordinateMm)) {
+      char got[64];
+      std::snprintf(got, sizeof got, "%.10g", ray.origin[a]);
+      throw SettingError("origin", std::string("must be within ±1e12 mm on each axis, got ") + got +
+                                       " on " + "xyz"[a]);
+    }
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(ray.direction[a])) throw SettingError("dir", "must be three finite numbers");
   if (glm::length(ray.direction) < 1e-12) throw SettingError("dir", "must be a non-zero vector");
+  if (!std::isfinite(glm::length(ray.direction)))
+    throw SettingError("dir", "must have a finite length (scale it down)");
   if (!(ray.wavelength_nm >= 100 && ray.wavelength_nm <= 10000))
     throw SettingError("wavelength", "must be in [100, 10000] nm");
 }

@@ -195,6 +195,28 @@ TEST_F(Cli, RenderTinyScene) {
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
 }
 
+// At the documented limits (an index of 10, an emission of 1e9, an environment radiance of 1e8
+// times an intensity of 10 = 1e9; docs/scene-format.md) both twins render finite pixels: the
+// limits are where NaN and Inf stop (n = 1e20, emission or radiance 1e308 rendered them).
+TEST_F(Cli, RenderAtTheInputLimitsIsFinite) {
+  std::string text = tinyScene("", R"({"n": 10, "emission": 1e9, "attenuation_per_mm": 0.1})");
+  const std::string checker = R"({"type": "checker", "squares": 8})";
+  text.replace(text.find(checker), checker.size(),
+               R"({"type": "constant", "radiance": 1e8, "intensity": 10})");
+  for (const char* twin : {"", " --reference"}) {
+    SCOPED_TRACE(twin);
+    const Outcome r = render(text, std::string("-q") + twin);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const eikon::RgbaImage img = eikon::readExrRgba(outPath("render.exr"), 64, 64);
+    double mx = 0;
+    for (size_t i = 0; i < img.rgba.size(); ++i) {
+      ASSERT_TRUE(std::isfinite(img.rgba[i])) << i;
+      mx = std::max(mx, double(img.rgba[i]));
+    }
+    EXPECT_GT(mx, 1e8);
+  }
+}
+
 // Every shipped scene renders clean under --strict (warnings are errors): scenes/diamond_brilliant
 // used to warn that diamond is measured over 226-760 nm only. Tiny renders on the CPU twin (no
 // shader compilation), 4 wavelengths, and the light simulation as small as the flags allow.
@@ -524,6 +546,25 @@ TEST_F(Cli, TraceNegativeWavelength) {
   const std::string scene = write("scene.json", tinyScene());
   expectCleanFailure(run("trace " + quote(scene) + " --origin 0,0,-4 --dir 0,0,1 --wavelength -5"),
                      "--wavelength");
+}
+
+// An origin at z = −1e300 printed an exit at −inf and NaN Stokes with exit code 0 (--json: null):
+// it is bounded as a scene's positions are, ±1e12 mm.
+TEST_F(Cli, TraceOriginBeyondTheCoordinateLimit) {
+  const std::string scene = write("scene.json", tinyScene());
+  for (const char* json : {"", " --json"}) {
+    const Outcome r = run("trace " + quote(scene) + " -q --origin 0,2,-1e300 --dir 0,0,1" + json);
+    expectCleanFailure(r, "--origin must be within ±1e12 mm");
+    EXPECT_EQ(r.out, "");
+  }
+}
+
+// A denormal direction (1e-320 is finite) is refused for being zero, not as "not finite".
+TEST_F(Cli, TraceDenormalDirectionIsZeroNotNonFinite) {
+  const std::string scene = write("scene.json", tinyScene());
+  const Outcome r = run("trace " + quote(scene) + " -q --origin 0,0,-4 --dir 0,0,1e-320");
+  expectCleanFailure(r, "--dir must be a non-zero vector");
+  EXPECT_EQ(r.err.find("finite"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, TraceNonFiniteOrigin) {

@@ -164,6 +164,11 @@ TEST_F(FitCli, BadInputFailsWithOneLineAndNoFile) {
   bad("low.csv", "wavelength_nm,n\n500,1.52\n600,0.5\n700,1.50\n800,1.49\n", "must be >= 1");
   bad("unit.csv", "wavelength,n\n500,1.52\n600,1.51\n700,1.50\n800,1.49\n", "wavelength_nm");
   bad("bad.yml", "DATA: [\n  - type: formula 2\n", "malformed YAML");
+  // Formula 2 with "0 1": C1 and a B without its C. Read as a pole at 0 it gave n = 1.414214 and
+  // V_d = 1.9e15 and wrote the material; the count must be C1 and whole pairs.
+  bad("short.yml",
+      "DATA:\n  - type: formula 2\n    wavelength_range: 0.3 2.5\n    coefficients: 0 1\n",
+      "short.yml:4: DATA[0].coefficients: formula 2 takes C1 and whole pairs");
   write("rank.csv", [] {
     std::ostringstream s;
     s << "wavelength_nm,n\n";

@@ -250,7 +250,7 @@ TEST(RefractiveIndexYaml, BadInputIsOneClearError) {
   expectError(yml("REFERENCES: x\n"), {"bad.yml", "no DATA"});
   expectError(
       yml("DATA:\n  - type: formula 12\n    wavelength_range: 0.4 0.7\n    coefficients: 1\n"),
-      {"bad.yml: DATA[0].type", "formula 12"});
+      {"bad.yml:2: DATA[0].type", "formula 12"});
   expectError(yml("DATA:\n  - type: formula 2\n    coefficients: 0 1 0.01\n"),
               {"DATA[0]", "wavelength_range"});
   expectError(yml("DATA:\n  - type: formula 2\n    wavelength_range: 0.7 0.4\n    coefficients: 0 "
@@ -267,6 +267,36 @@ TEST(RefractiveIndexYaml, BadInputIsOneClearError) {
       yml("DATA:\n  - type: tabulated k\n    data: |\n        0.5 1e-5\n        0.6 1e-5\n"),
       {"bad.yml", "no data points"});
   expectError(yml("DATA:\n  - type: spline\n"), {"DATA[0].type", "unsupported"});
+  // A formula whose last term is given in part names the file and the line of the coefficients.
+  expectError(yml("DATA:\n  - type: formula 2\n    wavelength_range: 0.3 2.5\n    coefficients: 0 "
+                  "1\n"),
+              {"bad.yml:4: DATA[0].coefficients", "odd number of coefficients, got 2"});
+}
+
+// Whole terms may be left out (they count as zero), never part of one: formula 2 with "0 1" was
+// read as n² = 1 + 1·λ²/(λ² − 0), n = √2 at every wavelength.
+TEST(RefractiveIndexFormula, ALastTermGivenInPartIsAnError) {
+  for (int type : {1, 2, 3, 5, 6}) {
+    EXPECT_THROW(RefractiveIndexFormula(type, {0, 1}), std::invalid_argument) << type;
+    EXPECT_THROW(RefractiveIndexFormula(type, {0, 1, 0.01, 0.5}), std::invalid_argument) << type;
+    EXPECT_NO_THROW(RefractiveIndexFormula(type, {1.5})) << type;
+    EXPECT_NO_THROW(RefractiveIndexFormula(type, {0, 1, 0.01})) << type;
+  }
+  for (size_t n : {2, 3, 4, 6, 7, 8, 10})
+    EXPECT_THROW(RefractiveIndexFormula(4, std::vector<double>(n, 0.5)), std::invalid_argument)
+        << n;
+  for (size_t n : {1, 5, 9, 11, 17})
+    EXPECT_NO_THROW(RefractiveIndexFormula(4, std::vector<double>(n, 0.5))) << n;
+  EXPECT_THROW(RefractiveIndexFormula(8, {0.3, 0.01}), std::invalid_argument);
+  for (size_t n : {1, 3, 4})
+    EXPECT_NO_THROW(RefractiveIndexFormula(8, std::vector<double>(n, 0.01))) << n;
+  for (size_t n : {2, 4, 5})
+    EXPECT_THROW(RefractiveIndexFormula(9, std::vector<double>(n, 0.5)), std::invalid_argument)
+        << n;
+  for (size_t n : {1, 3, 6})
+    EXPECT_NO_THROW(RefractiveIndexFormula(9, std::vector<double>(n, 0.5))) << n;
+  for (size_t n = 1; n <= 6; ++n)
+    EXPECT_NO_THROW(RefractiveIndexFormula(7, std::vector<double>(n, 0.01))) << n;
 }
 
 // The writer `eikon fit --export-yaml` uses: free text with YAML's special characters is quoted by

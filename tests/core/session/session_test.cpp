@@ -89,6 +89,18 @@ TEST(Session, LightAndTraceRangesAreTheCliWords) {
   ray.wavelength_nm = 99.0;
   EXPECT_EQ(settingErrorOf([&] { checkTraceRequest(ray); }),
             "wavelength|must be in [100, 10000] nm");
+  // The origin is bounded as a scene's positions are (±1e12 mm): at z = −1e300 the trace printed
+  // an exit at −inf and NaN Stokes with exit code 0.
+  ray.wavelength_nm = 550.0;
+  ray.origin = {0, 2, -1e300};
+  EXPECT_EQ(settingErrorOf([&] { checkTraceRequest(ray); }),
+            "origin|must be within ±1e12 mm on each axis, got -1e+300 on z");
+  ray.origin = {1e12, -1e12, 0};
+  EXPECT_NO_THROW(checkTraceRequest(ray));
+  // A direction whose length overflows would normalise to zero.
+  ray.direction = {1e300, 1e300, 0};
+  EXPECT_EQ(settingErrorOf([&] { checkTraceRequest(ray); }),
+            "dir|must have a finite length (scale it down)");
 }
 
 // A BK7-like sphere (Sellmeier: dispersive) in a 16 mm box; the ray along z at x = y = −6 mm never
