@@ -207,6 +207,7 @@ void runTrace(const TraceArgs& a) {
   req.direction = glm::normalize(req.direction);
   const ProgressMode progress_mode = progressMode(a.progress, a.quiet);
   auto scene = std::make_shared<Scene>(loadScene(a.scene));
+  checkIndicesAt(*scene, req.wavelength_nm);  // before anything is voxelised
   timings::mark("scene parsed");
   if (!a.stokes.empty() && scene->interfaces != Scene::Interfaces::Sharp)
     throw CliError(std::string("--stokes: ") + kNeedsSharp);  // before any voxelising or warning

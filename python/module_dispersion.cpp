@@ -124,10 +124,12 @@ void bindMaterials(py::module_& m) {
       "load_material",
       [](const std::string& name_or_path) {
         std::filesystem::path p(name_or_path);
-        if (p.extension() == ".json" && std::filesystem::exists(p)) return loadMaterialFile(p);
+        std::error_code ec;  // a name too long for the file system is not found, never a raw
+                             // filesystem_error
+        if (p.extension() == ".json" && std::filesystem::exists(p, ec)) return loadMaterialFile(p);
         for (const auto& dir : materialSearchPath()) {
           auto f = dir / (name_or_path + ".json");
-          if (std::filesystem::exists(f)) return loadMaterialFile(f);
+          if (std::filesystem::exists(f, ec)) return loadMaterialFile(f);
         }
         throw std::invalid_argument("no material '" + name_or_path +
                                     "' in the library search path");

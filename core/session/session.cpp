@@ -424,8 +424,25 @@ RenderImage Session::render(const RenderSettings& settings, bool gpu) {
   return img;
 }
 
+void checkIndicesAt(const Scene& scene, double lambda_nm) {
+  for (const auto& [name, m] : scene.materials) {
+    if (m.grin.type != GrinProfile::Type::None) continue;  // checked inside its object on parsing
+    for (const Dispersion* d : {&m.n_o, &m.n_e}) {
+      if (d == &m.n_e && !m.uniaxial) break;
+      const double n = d->index(lambda_nm);
+      if (n >= 1.0 && n <= 10.0) continue;
+      char value[64];
+      std::snprintf(value, sizeof value, "%.6g at %.6g nm", n, lambda_nm);
+      throw SettingError("wavelength", "leaves the index of material '" + name + "'" +
+                                           (m.uniaxial ? d == &m.n_o ? " (n_o)" : " (n_e)" : "") +
+                                           " outside [1, 10]: " + value);
+    }
+  }
+}
+
 std::vector<std::array<TraceOutcome, 2>> Session::trace(const std::vector<TraceRequest>& rays,
                                                         const MarchSettings& ms, bool gpu) {
+  for (const TraceRequest& q : rays) checkIndicesAt(*scene_, q.wavelength_nm);
   const bool uni = scene_->anyUniaxial();
   std::vector<std::array<TraceOutcome, 2>> out;
   if (gpu) {
@@ -453,6 +470,7 @@ std::vector<std::array<TraceOutcome, 2>> Session::trace(const std::vector<TraceR
 PolarisedTrace Session::tracePolarised(const TraceRequest& ray, const Stokes& input,
                                        const PolarisedTraceSettings& settings, bool gpu) {
   checkPolarisedTrace(ray, input, settings);
+  checkIndicesAt(*scene_, ray.wavelength_nm);
   if (gpu)
     return gpuRenderer().tracePolarised(scene_->polarizers, {ray}, {input}, settings).front();
   cpuMarcher();  // the volume and its field

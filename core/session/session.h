@@ -120,6 +120,10 @@ LightingOptions lightingOptions(const LightRequest& light, double voxel_mm);
 
 /// A ray's wavelength in [100, 10000] nm ("wavelength") and a non-zero direction ("dir").
 void checkTraceRequest(const TraceRequest& ray);
+/// Every material's refractive index at the wavelength finite and in [1, 10], as the scene's are
+/// over 380–780 nm; else SettingError("wavelength", ...) naming the material and the value (a
+/// trace at 200 nm through a Sellmeier fit with a pole there). Session::trace checks it.
+void checkIndicesAt(const Scene& scene, double lambda_nm);
 
 /// What simulateLight did.
 struct LightOutcome {

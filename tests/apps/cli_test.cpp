@@ -548,6 +548,24 @@ TEST_F(Cli, TraceNegativeWavelength) {
                      "--wavelength");
 }
 
+// Indices are checked over 380–780 nm when the scene is read, but a trace may ask for any
+// wavelength in [100, 10000] nm. A Sellmeier term B = 1, C = 0.04 µm² has its pole at 200 nm:
+// n² = 1 + λ²/(λ² − 0.04) is −98 at 199 nm (no index) and 102 at 201 nm (n = 10.1), and n = 1.67
+// at 300 nm. The first two used to trace (the GPU twin printed an OPL of ~59 m) or fail inside
+// Fresnel's laws without naming anything.
+TEST_F(Cli, TraceWavelengthWhereAnIndexLeavesItsRangeIsRefused) {
+  const std::string scene =
+      write("scene.json", tinyScene("", R"({"n": {"sellmeier": [1.0, 0.04]}})"));
+  for (const char* nm : {"199", "201"})
+    for (const char* twin : {"", " --reference"})
+      expectCleanFailure(
+          run("trace " + quote(scene) + " --origin 0,0,-4 --dir 0,0,1 --wavelength " + nm + twin),
+          "--wavelength leaves the index of material 'glass' outside [1, 10]");
+  const Outcome fine =
+      run("trace " + quote(scene) + " --origin 0,0,-4 --dir 0,0,1 --wavelength 300 -q");
+  EXPECT_EQ(fine.code, 0) << fine.err;
+}
+
 // An origin at z = −1e300 printed an exit at −inf and NaN Stokes with exit code 0 (--json: null):
 // it is bounded as a scene's positions are, ±1e12 mm.
 TEST_F(Cli, TraceOriginBeyondTheCoordinateLimit) {
