@@ -1034,6 +1034,12 @@ static Light parseLight(const Node& l) {
               .index(k)
               .fail("wavelengths must be > 0 nm, got " + fmt(light.spectrum_nm[k]));
         if (light.spectrum_power[k] < 0) sp->at("power").index(k).fail("must be >= 0");
+        // A relative spectrum: its scale is the light's irradiance or intensity. Bounded so that
+        // its integral cannot overflow (1e308 twice read as "no power").
+        if (light.spectrum_power[k] > kMaxColor)
+          sp->at("power").index(k).fail(std::string("must be at most ") + kMaxColorText +
+                                        " (a relative spectrum), got " +
+                                        fmt(light.spectrum_power[k]));
         if (k && !(light.spectrum_nm[k] > light.spectrum_nm[k - 1]))
           sp->at("wavelength_nm").index(k).fail("wavelength_nm must be strictly increasing");
         total += light.spectrum_power[k];

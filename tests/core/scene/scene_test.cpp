@@ -528,6 +528,9 @@ TEST(SceneParse, BadLights) {
   EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0],
                                    "spectrum": {"wavelength_nm": [400, 500], "power": [1, -1]}})"),
                      "/lights/0/spectrum/power/1", ">= 0");
+  EXPECT_SCENE_ERROR(withLight(R"({"type": "point", "position": [0, 0, 0],
+                                   "spectrum": {"wavelength_nm": [400, 500], "power": [1e308, 1e308]}})"),
+                     "/lights/0/spectrum/power/0", "must be at most 1e9");
 }
 
 TEST(SceneParse, ScatteringMaterials) {
