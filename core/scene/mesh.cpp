@@ -8,8 +8,10 @@
 #include <assimp/Importer.hpp>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <new>
 #include <numeric>
@@ -184,6 +186,61 @@ void checkPlyCounts(const std::filesystem::path& file, const std::string& name,
   }
 }
 
+/// Refuses an OBJ `v` line that is not 3, 4 (x y z w) or 6 (x y z r g b) finite numbers, naming
+/// the line. Assimp skips such a vertex and later fails on the faces that use it ("OBJ: vertex
+/// index out of range"), reads "0.5x" as 0.5 and does not count ".5" as a number; its message
+/// names no line. One pass over the file, which readMesh has capped at kMaxMeshFileBytes.
+void checkObjVertices(const std::filesystem::path& file, const std::string& name) {
+  std::ifstream in(file, std::ios::binary);
+  std::string line;
+  for (size_t no = 1; std::getline(in, line); ++no) {
+    const size_t first = no;
+    // A trailing backslash continues the line (Assimp joins them too).
+    while (!line.empty() && (line.back() == '\\' || line.back() == '\r')) {
+      if (line.back() == '\r') {
+        line.pop_back();
+        continue;
+      }
+      line.pop_back();
+      std::string next;
+      if (!std::getline(in, next)) break;
+      ++no;
+      line += ' ' + next;
+    }
+    if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
+    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    std::istringstream words(line.substr(2));
+    std::vector<std::string> tokens;
+    for (std::string w; words >> w;) tokens.push_back(w);
+    const std::string at = "line " + std::to_string(first);
+    static const char* const kNames[] = {"x", "y", "z", "w or r", "g", "b"};
+    for (size_t k = 0; k < tokens.size() && k < 6; ++k) {
+      const std::string& t = tokens[k];
+      const char* b = t.data() + (t[0] == '+' ? 1 : 0);
+      double v = 0.0;
+      auto [ptr, ec] = std::from_chars(b, t.data() + t.size(), v);
+      const std::string what = "the vertex's " + std::string(kNames[k]) + " '" + excerpt(t) + "'";
+      const bool whole = ptr == t.data() + t.size();
+      // Out of range: too large (refused) or too small, which is read as 0.
+      if (whole &&
+          ((ec == std::errc::result_out_of_range && std::abs(std::strtod(b, nullptr)) >= 1) ||
+           (ec == std::errc() && !std::isfinite(v))))
+        fail(name, at + ": " + what + " is not a finite number");
+      if ((ec != std::errc() && ec != std::errc::result_out_of_range) || !whole)
+        fail(name, at + ": " + what + " is not a number");
+      if (ec == std::errc() && std::abs(v) > double(std::numeric_limits<float>::max()))
+        fail(name, at + ": " + what + " is beyond the 3.4e38 a mesh coordinate (a float) holds");
+      if (t[0] == '.')
+        fail(name, at + ": " + what + " starts with '.', which the OBJ reader does not take " +
+                       "as a number: write a 0 before the point");
+    }
+    if (tokens.size() != 3 && tokens.size() != 4 && tokens.size() != 6)
+      fail(name, at + ": the vertex '" + excerpt(line) + "' has " + std::to_string(tokens.size()) +
+                     (tokens.size() == 1 ? " number" : " numbers") +
+                     "; a vertex takes 3 (x y z), 4 (x y z w) or 6 (x y z r g b)");
+  }
+}
+
 /// The mesh Assimp reads from `file` (checked by readMesh), welded.
 TriangleMesh importMesh(const std::filesystem::path& file, const std::string& name) {
   Assimp::Importer importer;
@@ -249,6 +306,7 @@ TriangleMesh readMesh(const std::filesystem::path& file) {
     fail(name, "the mesh file is larger than " + std::to_string(kMaxMeshFileBytes >> 20) +
                    " MiB, got " + std::to_string(bytes) + " bytes");
   if (ext == ".ply") checkPlyCounts(file, name, bytes);
+  if (ext == ".obj") checkObjVertices(file, name);
   try {
     return importMesh(file, name);
   } catch (const std::bad_alloc&) {

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <random>
 #include <string>
@@ -461,6 +462,42 @@ TEST(Mesh, RefusesBadKeysAndScales) {
   EXPECT_NE(errorOf(meshScene(meshObject("box.obj", R"(, "scale": 1e13)")))
                 .find("/objects/0/scale: the scaled mesh must lie within"),
             std::string::npos);
+}
+
+
+// A vertex line with a non-number or too few coordinates was "OBJ: vertex index out of range"
+// (Assimp skipped the vertex, then failed on a face that used it): the line is named now.
+TEST(Mesh, MalformedObjVertexNamesItsLine) {
+  test::TempDir dir;
+  std::ifstream in(kMeshes / "box.obj");
+  const std::string box((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string last = "v 0.5 0.5 0.5\n";  // line 9, used by three faces
+  ASSERT_NE(box.find(last), std::string::npos);
+  auto with = [&](const std::string& line) {
+    std::string text = box;
+    text.replace(text.find(last), last.size(), line + "\n");
+    dir.write("bad.obj", text);
+    return errorOf(meshScene(R"({"shape": "mesh", "material": "glass", "file": ")" +
+                             (dir.path() / "bad.obj").string() + "\"}"));
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"v abc 0.5 0.5", "bad.obj: line 9: the vertex's x 'abc' is not a number"},
+      {"v 0.5", "bad.obj: line 9: the vertex 'v 0.5' has 1 number; a vertex takes 3 (x y z)"},
+      {"v 0.5 0.5", "line 9: the vertex 'v 0.5 0.5' has 2 numbers"},
+      {"v 0.5 0.5 0.5 1 0", "line 9: the vertex 'v 0.5 0.5 0.5 1 0' has 5 numbers"},
+      {"v 0.5 0.5x 0.5", "line 9: the vertex's y '0.5x' is not a number"},
+      {"v 0.5 0.5 .5", "line 9: the vertex's z '.5' starts with '.'"},
+      {"v 1e999 0.5 0.5", "line 9: the vertex's x '1e999' is not a finite number"},
+      {"v 0.5 nan 0.5", "line 9: the vertex's y 'nan' is not a finite number"},
+      {"v 1e39 0.5 0.5", "line 9: the vertex's x '1e39' is beyond the 3.4e38"},
+  };
+  for (const auto& [line, want] : cases)
+    EXPECT_TRUE(test::isOneLineSceneError(with(line), "scene.json", "/objects/0/file", want))
+        << line;
+  // What Assimp reads: x y z w, x y z r g b, a sign, a comment, tabs.
+  for (const char* line :
+       {"v 0.5 0.5 0.5 1", "v 0.5 0.5 0.5 1 0 0", "v +0.5 0.5 0.5 # corner", "v\t0.5\t0.5\t0.5"})
+    EXPECT_EQ(with(line), "(no error)") << line;
 }
 
 TEST(Mesh, GarbageFilesAreOneLineErrors) {
