@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <new>
 #include <nlohmann/json.hpp>
@@ -50,11 +51,12 @@ std::string fmt(double v) {
   return s.str();
 }
 
+std::string point(const glm::dvec3& x) {
+  return "(" + fmt(x.x) + ", " + fmt(x.y) + ", " + fmt(x.z) + ")";
+}
+
 std::string box(const VolumeSpec& v) {
-  auto p = [](const glm::dvec3& x) {
-    return "(" + fmt(x.x) + ", " + fmt(x.y) + ", " + fmt(x.z) + ")";
-  };
-  return p(v.bounds_min) + " to " + p(v.bounds_max) + " mm";
+  return point(v.bounds_min) + " to " + point(v.bounds_max) + " mm";
 }
 
 /// A JSON value with its location, for error messages that name file and path.
@@ -592,28 +594,38 @@ ShapeGeometry parseMesh(const Node& o) {
   } catch (const std::bad_alloc&) {
     f.fail(excerpt(p.filename().string()) + ": not enough memory to read the mesh");
   }
+  // The scaled mesh, before either path: within ±kMaxCoordinateMm of the centre on each axis and
+  // at least kMinVoxelMm across on each axis (a scale of 1e300 or 1e-300 made the convex path's
+  // planes overflow or collapse: "the planes do not enclose a bounded solid").
+  const Node& at = s ? *s : f;
+  const std::string given = s && s->isNumber() ? fmt(scale.x) : point(scale);
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (const glm::dvec3& v : mesh.vertices) {
+    lo = glm::min(lo, v * scale);
+    hi = glm::max(hi, v * scale);
+  }
+  for (int a = 0; a < 3; ++a) {
+    const double far = std::max(std::abs(lo[a]), std::abs(hi[a]));
+    if (!(far <= kMaxCoordinateMm))
+      at.fail("the scaled mesh must lie within ±" + fmt(kMaxCoordinateMm) +
+              " mm of its centre on each axis, got a point " + fmt(far) + " mm from it along " +
+              "xyz"[a] + " (scale " + given + ")");
+  }
+  for (int a = 0; a < 3; ++a)
+    if (!(hi[a] - lo[a] >= kMinVoxelMm))
+      at.fail("the scaled mesh must be at least " + fmt(kMinVoxelMm) + " mm across on each axis, " +
+              "got " + fmt(hi[a] - lo[a]) + " mm along " + "xyz"[a] + " (scale " + given + ")");
   std::vector<Plane> planes;
   try {
     planes = meshFacePlanes(mesh, excerpt(p.filename().string()), kConvexMeshMaxFaces);
   } catch (const std::invalid_argument&) {
     // Not convex (or more faces than a polyhedron takes): a MeshShape.
   }
-  auto far = [&](double r) {
-    if (!(r <= kMaxCoordinateMm))
-      (s ? *s : f)
-          .fail("the scaled mesh must lie within " + fmt(kMaxCoordinateMm) +
-                " mm of its centre, got a point at " + fmt(r) + " mm");
-  };
   if (planes.empty()) {
-    for (glm::dvec3& v : mesh.vertices) {
-      v *= scale;
-      far(glm::length(v));
-    }
+    for (glm::dvec3& v : mesh.vertices) v *= scale;
     return makeMeshShape(mesh);
   }
-  ConvexShape c = scaledConvex(planes, scale);
-  for (const Plane& pl : c.planes) far(std::abs(pl.d));
-  return c;
+  return scaledConvex(planes, scale);
 }
 
 SceneObject parseObject(const Node& o) {

@@ -171,4 +171,32 @@ TEST_F(MeshCli, OpenMeshFailsWithOneLineNamingTheEdge) {
   EXPECT_FALSE(fs::exists(dir_ / "o.exr"));
 }
 
+// Fuzzing found a malformed OBJ vertex reported as "OBJ: vertex index out of range" and a scale of
+// 1e300 as "the planes do not enclose a bounded solid": each is one line naming what is wrong.
+TEST_F(MeshCli, BadVertexLineAndAbsurdScaleFailWithOneLine) {
+  std::ofstream(dir_ / "bad.obj") << "v 0 0 0\nv 1 0 0\nv abc 0.5 0.5\nv 0 0 1\n"
+                                     "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+  std::ofstream(dir_ / "short.obj") << "v 0 0 0\nv 1 0 0\nv 0.5\nv 0 0 1\n"
+                                       "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"("file": "bad.obj")",
+       "/objects/0/file: bad.obj: line 3: the vertex's x 'abc' is not a number"},
+      {R"("file": "short.obj")",
+       "/objects/0/file: short.obj: line 3: the vertex 'v 0.5' has 1 number"},
+      {R"("file": ")" + (kMeshes / "box.obj").string() + R"(", "scale": 1e300)",
+       "/objects/0/scale: the scaled mesh must lie within ±1e+12 mm of its centre on each axis"},
+      {R"("file": ")" + (kMeshes / "box.obj").string() + R"(", "scale": 1e-300)",
+       "/objects/0/scale: the scaled mesh must be at least 1e-06 mm across on each axis"},
+  };
+  for (const auto& [keys, want] : cases) {
+    const fs::path s = scene("s.json", R"({"shape": "mesh", "material": "glass", )" + keys + "}");
+    const Outcome r =
+        eikon("render " + quote(s.string()) + " -o " + quote((dir_ / "o.exr").string()) + " -q");
+    EXPECT_NE(r.code, 0);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.err.find("eikon: error: " + s.string() + ": " + want), 0u) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "o.exr"));
+  }
+}
+
 }  // namespace

@@ -464,6 +464,29 @@ TEST(Mesh, RefusesBadKeysAndScales) {
             std::string::npos);
 }
 
+// A scale of 1e300 or 1e-300 made the convex path's planes overflow or collapse: "the planes do
+// not enclose a bounded solid". The scaled mesh is checked first, on both paths, naming /scale.
+TEST(Mesh, ScaleKeepsTheMeshFiniteAndNonDegenerate) {
+  for (const char* file : {"box.obj", "notched_box.obj"}) {  // convex and not
+    for (const char* scale : {"1e300", "[1, 1, 1e300]", "1e13"})
+      EXPECT_TRUE(test::isOneLineSceneError(
+          errorOf(meshScene(meshObject(file, std::string(R"(, "scale": )") + scale))), "scene.json",
+          "/objects/0/scale",
+          "the scaled mesh must lie within ±1e+12 mm of its centre on each axis"))
+          << file << " " << scale;
+    for (const char* scale : {"1e-300", "[1, 1e-300, 1]", "1e-7"})
+      EXPECT_TRUE(test::isOneLineSceneError(
+          errorOf(meshScene(meshObject(file, std::string(R"(, "scale": )") + scale))), "scene.json",
+          "/objects/0/scale",
+          "the scaled mesh must be at least 1e-06 mm across on each axis, got "))
+          << file << " " << scale;
+  }
+  EXPECT_NE(errorOf(meshScene(meshObject("box.obj", R"(, "scale": [1, 1e-300, 1])")))
+                .find("got 1e-300 mm along y (scale (1, 1e-300, 1))"),
+            std::string::npos);
+  // The bounds themselves are accepted: 1e-6 mm across, and 1e12 mm from the centre.
+  EXPECT_EQ(errorOf(meshScene(meshObject("box.obj", R"(, "scale": [1e-6, 1, 1])"))), "(no error)");
+}
 
 // A vertex line with a non-number or too few coordinates was "OBJ: vertex index out of range"
 // (Assimp skipped the vertex, then failed on a face that used it): the line is named now.
