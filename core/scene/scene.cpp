@@ -109,11 +109,11 @@ class Node {
     if (!std::isfinite(v)) fail("must be finite");
     return v;
   }
-  double number(double lo, double hi, bool lo_open = false) const {
+  double number(double lo, double hi, bool lo_open = false, bool hi_open = false) const {
     double v = number();
-    if (v < lo || (lo_open && v == lo) || v > hi)
-      fail("must be in " + std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + "], got " +
-           fmt(v));
+    if (v < lo || (lo_open && v == lo) || v > hi || (hi_open && v == hi))
+      fail("must be in " + std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) +
+           (hi_open ? ")" : "]") + ", got " + fmt(v));
     return v;
   }
   double positive() const {
@@ -667,8 +667,17 @@ SceneObject parseObject(const Node& o) {
       g = RoundedBoxShape{s, r};
     } else if (shape == "prism") {
       allow({"apex_deg", "side", "height"});
-      g = makePrism(o.at("apex_deg").number(0.0, 180.0, true), o.at("side").length(),
-                    o.at("height").length());
+      const Node apex = o.at("apex_deg");
+      const double apex_deg = apex.number(0.0, 180.0, true, true), side = o.at("side").length();
+      // The triangle's base and height at least kMinVoxelMm: 1e-300 degrees left a sliver whose
+      // planes "do not enclose a bounded solid".
+      const double half = 0.5 * apex_deg * kPi / 180.0;
+      const double thin = std::min(2.0 * side * std::sin(half), side * std::cos(half));
+      if (!(thin >= kMinVoxelMm))
+        apex.fail("the prism's cross-section would be " + fmt(thin) + " mm thin (side " +
+                  fmt(side) + " mm), less than " + fmt(kMinVoxelMm) +
+                  " mm: move apex_deg away from 0 and 180 or lengthen side");
+      g = makePrism(apex_deg, side, o.at("height").length());
     } else if (shape == "brilliant") {
       allow({"diameter", "table", "crown_deg", "pavilion_deg", "girdle", "facets"});
       g = makeBrilliant(o.at("diameter").length(),

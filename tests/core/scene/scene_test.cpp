@@ -225,6 +225,24 @@ TEST(SceneParse, ZeroBoxSize) {
                      "/objects/0/size", "must be > 0");
 }
 
+// apex_deg 0 said "must be in (0, 180]" and 180 "(0, 180)": both say the open range now, and an
+// angle so near 0 or 180 that the triangle is a sliver says so instead of "the planes do not
+// enclose a bounded solid".
+TEST(SceneParse, PrismApexAngleRange) {
+  auto prism = [](const std::string& apex) {
+    return scene(kGlass, R"({"shape": "prism", "apex_deg": )" + apex +
+                             R"(, "side": 10, "height": 10, "material": "glass"})");
+  };
+  for (const char* apex : {"0", "180", "-1", "200"}) {
+    EXPECT_SCENE_ERROR(prism(apex), "/objects/0/apex_deg",
+                       "must be in (0, 180), got " + std::string(apex));
+    EXPECT_EQ(errorOf(prism(apex)).find('\n'), std::string::npos);
+  }
+  for (const char* apex : {"1e-300", "179.99999999"})
+    EXPECT_SCENE_ERROR(prism(apex), "/objects/0/apex_deg", "the prism's cross-section would be ");
+  EXPECT_NO_THROW(parseScene(prism("179.99"), kOrigin));
+}
+
 // Three planes cannot bound a solid; four planes that all face +x leave −x open.
 TEST(SceneParse, PlanesThatDoNotEncloseASolid) {
   EXPECT_SCENE_ERROR(scene(kGlass, R"({"shape": "planes", "material": "glass",
