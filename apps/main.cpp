@@ -8,6 +8,35 @@
 #include "core/scene/messages.h"
 #include "core/session/session.h"
 
+namespace {
+
+/// The commands, "render, trace, info, fit, view", in the order they were added.
+std::string commandList(const CLI::App& app) {
+  std::string list;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    list += (list.empty() ? "" : ", ") + sub->get_name();
+  return list;
+}
+
+/// Every option that takes a number refuses an empty value ("--width ''"), which CLI11 converts
+/// to 0 and so reported as "--width must be in [1, 16384], got 0" (or, for --exposure, took).
+void refuseEmptyNumbers(CLI::App& app) {
+  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    for (CLI::Option* opt : sub->get_options()) {
+      const std::string type = opt->get_type_name();
+      if (type != "INT" && type != "UINT" && type != "FLOAT" && type != "NUMBER") continue;
+      opt->check(CLI::Validator(
+          [](std::string& value) {
+            return value.find_first_not_of(" \t") == std::string::npos
+                       ? std::string("the value is empty, expected a number")
+                       : std::string();
+          },
+          "", "non-empty number"));
+    }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"eikon: eikonal rendering of gems, prisms and crystals (see README.md)", "eikon"};
   app.require_subcommand(1);
@@ -17,8 +46,27 @@ int main(int argc, char** argv) {
   eikon::cli::addInfoCommand(app);
   eikon::cli::addFitCommand(app);
   eikon::cli::addViewCommand(app);
+  refuseEmptyNumbers(app);
+  // "eikon bogus": CLI11 says only "A subcommand is required".
+  if (argc > 1 && argv[1][0] != '-' &&
+      app.get_subcommands([&](const CLI::App* sub) { return sub->check_name(argv[1]); }).empty()) {
+    std::fputs(eikon::errorLine("'" + std::string(argv[1]) + "' is not an eikon command (" +
+                                commandList(app) + "; run with --help)")
+                   .c_str(),
+               stderr);
+    return 2;
+  }
   try {
     app.parse(argc, argv);
+  } catch (const CLI::RequiredError& e) {
+    if (!app.get_subcommands().empty()) {  // a command's own required option or argument
+      std::fputs(eikon::errorLine(std::string(e.what()) + " (run with --help)").c_str(), stderr);
+      return 2;
+    }
+    std::fputs(eikon::errorLine("a command is required: " + commandList(app) + " (run with --help)")
+                   .c_str(),
+               stderr);
+    return 2;
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::fputs(eikon::errorLine(std::string(e.what()) + " (run with --help)").c_str(), stderr);

@@ -530,6 +530,31 @@ TEST_F(Cli, UnknownOptionIsOneErrorLine) {
                      "--bogus");
 }
 
+// "eikon bogus" said "A subcommand is required", as if none had been given.
+TEST_F(Cli, UnknownCommandIsNamedWithTheCommands) {
+  for (const char* args : {"bogus", "bogus render", "Render x.json"}) {
+    const Outcome r = run(args);
+    const std::string word = std::string(args).substr(0, std::string(args).find(' '));
+    expectCleanFailure(r, "'" + word +
+                              "' is not an eikon command (render, trace, info, fit, view; run "
+                              "with --help)");
+  }
+  expectCleanFailure(run(""), "a command is required: render, trace, info, fit, view");
+}
+
+// An empty number (--width "") was converted to 0: "--width must be in [1, 16384], got 0", and
+// --exposure "" and --threads "" were taken as 0 without a word.
+TEST_F(Cli, EmptyNumberIsSaidToBeEmpty) {
+  const std::string scene = write("scene.json", tinyScene());
+  for (const char* option : {"--width", "--spp", "--exposure", "--threads"})
+    expectCleanFailure(
+        run("render " + quote(scene) + " -o " + quote(outPath()) + " " + option + " ''"),
+        std::string(option) + ": the value is empty, expected a number");
+  expectCleanFailure(run("trace " + quote(scene) + " --origin 0,0,-5 --dir 0,0,1 --wavelength ' '"),
+                     "--wavelength: the value is empty, expected a number");
+  EXPECT_EQ(render(tinyScene(), "--width 16 -q").code, 0);
+}
+
 // ------------------------------------------------------------------ trace
 
 TEST_F(Cli, TraceZeroDirection) {
