@@ -1230,12 +1230,38 @@ static void loadLibraryMaterial(const Node& o, const SceneObject& obj, Scene& sc
             "' (not defined under /materials and not in the material library)");
 }
 
+namespace {
+/// Warnings of one kind after the first kMaxWarningsOfAKind are counted, not kept: a scene of
+/// 70 000 small objects near the volume's faces printed 22 000 lines before its error.
+constexpr size_t kMaxWarningsOfAKind = 10;
+class WarningsOfAKind {
+ public:
+  /// `kind` says what the warnings are about, for the line that counts those left out.
+  WarningsOfAKind(std::vector<std::string>& out, std::string file, std::string kind)
+      : out_(out), file_(std::move(file)), kind_(std::move(kind)) {}
+  void add(const std::string& text) {
+    if (++count_ <= kMaxWarningsOfAKind) out_.push_back(printable(text));
+  }
+  /// The line counting the warnings left out, if any.
+  void finish() {
+    if (count_ > kMaxWarningsOfAKind)
+      out_.push_back(printable(file_ + ": ... and " + std::to_string(count_ - kMaxWarningsOfAKind) +
+                               " more such warnings (" + kind_ + ")"));
+  }
+
+ private:
+  std::vector<std::string>& out_;
+  std::string file_, kind_;
+  size_t count_ = 0;
+};
+}  // namespace
+
 /// An object wholly outside the volume would vanish from the render, and one that covers it
 /// would fill it with no surface inside: neither may happen silently. The shape lies within its
 /// bounding sphere (exact for spheres), and every shape is convex, so it covers the box if it
 /// holds the box's 8 corners. Returns whether it covers the volume (then warned about).
-static bool checkObjectInVolume(const Node& o, const SceneObject& obj, Scene& scene,
-                                const std::string& file) {
+static bool checkObjectInVolume(const Node& o, const SceneObject& obj, const Scene& scene,
+                                const std::string& file, WarningsOfAKind& warnings) {
   const auto& vol = scene.volume;
   auto [lo, hi] = obj.shape.bounds();
   const double r = 0.5 * (hi.x - lo.x);
@@ -1249,10 +1275,9 @@ static bool checkObjectInVolume(const Node& o, const SceneObject& obj, Scene& sc
                                            corner & 2 ? vol.bounds_max.y : vol.bounds_min.y,
                                            corner & 4 ? vol.bounds_max.z : vol.bounds_min.z));
   if (covers)
-    scene.warnings.push_back(
-        printable(file + ": " + o.path() + ": the object covers the whole volume " + box(vol) +
-                  ": it fills the volume and none of its surface is inside, so it bends no ray " +
-                  "(shrink it or enlarge the volume)"));
+    warnings.add(file + ": " + o.path() + ": the object covers the whole volume " + box(vol) +
+                 ": it fills the volume and none of its surface is inside, so it bends no ray " +
+                 "(shrink it or enlarge the volume)");
   return covers;
 }
 
@@ -1293,7 +1318,18 @@ static void checkGrinIndex(const Node& o, const SceneObject& obj, const Material
 static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::string& file,
                                      std::vector<size_t>& json_index) {
   if (!objs.isArray()) objs.fail("expected an array of objects");
+  // The count first, before any object's warnings (70 000 objects printed 22 000 of them first).
+  if (scene.interfaces == Scene::Interfaces::Sharp && objs.size() > kMaxSharpObjects) {
+    size_t count = 0;
+    for (const json& o : objs.raw())
+      count += !(o.is_object() && o.contains("shape") && o.at("shape") == "polarizer");
+    if (count > kMaxSharpObjects)
+      objs.fail("sharp interfaces allow at most " + std::to_string(kMaxSharpObjects) +
+                " objects, got " + std::to_string(count) +
+                " (or set \"interfaces\": \"smoothed\")");
+  }
   std::set<size_t> covering;  // objects that cover the whole volume (warned about once)
+  WarningsOfAKind warnings(scene.warnings, file, "objects that cover the whole volume");
   for (size_t i = 0; i < objs.size(); ++i) {
     Node o = objs.index(i);
     o.requireObject();
@@ -1311,11 +1347,12 @@ static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::
              "' needs an optic_axis (on the object or the material)");
     if (!mat.uniaxial && obj.optic_axis)
       o.at("optic_axis").fail("optic_axis given for an isotropic material");
-    if (checkObjectInVolume(o, obj, scene, file)) covering.insert(scene.objects.size());
+    if (checkObjectInVolume(o, obj, scene, file, warnings)) covering.insert(scene.objects.size());
     if (mat.grin.type != GrinProfile::Type::None) checkGrinIndex(o, obj, mat, scene.volume);
     scene.objects.push_back(std::move(obj));
     json_index.push_back(i);
   }
+  warnings.finish();
   return covering;
 }
 
@@ -1327,6 +1364,7 @@ static void warnObjectsNearFaces(Scene& scene, const std::set<size_t>& covering,
   glm::dvec3 ext = v.bounds_max - v.bounds_min;
   double h = std::max(ext.x, std::max(ext.y, ext.z)) / v.resolution;
   double margin = (3.0 * v.smoothing_voxels + 1.0) * h;
+  WarningsOfAKind warnings(scene.warnings, file, "objects near the volume's boundary");
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     // An object with the ambient index everywhere (a haze, an opaque floor) refracts nothing.
     const Material& mat = scene.materials[scene.objects[i].material];
@@ -1346,11 +1384,12 @@ static void warnObjectsNearFaces(Scene& scene, const std::set<size_t>& covering,
             closest = std::min(closest, scene.objects[i].shape.signedDistance(q));
           }
     if (closest < margin)
-      scene.warnings.push_back(printable(
-          file + ": /objects/" + std::to_string(json_index[i]) + ": the object comes within " +
-          fmt(std::max(closest, 0.0)) + " mm of the volume's boundary (smoothing reach " +
-          fmt(margin) + " mm); rays leaving through it are not refracted there"));
+      warnings.add(file + ": /objects/" + std::to_string(json_index[i]) +
+                   ": the object comes within " + fmt(std::max(closest, 0.0)) +
+                   " mm of the volume's boundary (smoothing reach " + fmt(margin) +
+                   " mm); rays leaving through it are not refracted there");
   }
+  warnings.finish();
 }
 
 /// A material no object uses is left out (it was parsed and checked like the others): the

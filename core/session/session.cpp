@@ -156,11 +156,13 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
 
 std::vector<std::string> materialRangeWarnings(const Scene& scene, const RenderSettings& rs) {
   std::vector<std::string> out;
+  size_t count = 0;  // the first 10 are said, the rest counted (a scene may hold many materials)
   for (const auto& [name, m] : scene.materials)
     for (const Dispersion* d : {&m.n_o, &m.n_e}) {
       bool outside = rs.wavelengths > 0 ? !(d->inRange(380.0) && d->inRange(780.0))
                                         : !d->inRange(rs.wavelength_nm);
       if (outside && d->rangeNm()) {
+        if (++count > 10) break;
         out.push_back("material '" + name + "' is measured over " +
                       std::to_string(int((*d->rangeNm())[0])) + "-" +
                       std::to_string(int((*d->rangeNm())[1])) +
@@ -168,6 +170,9 @@ std::vector<std::string> materialRangeWarnings(const Scene& scene, const RenderS
         break;
       }
     }
+  if (count > 10)
+    out.push_back("... and " + std::to_string(count - 10) +
+                  " more such warnings (materials measured over a narrower range)");
   return out;
 }
 

@@ -8,13 +8,14 @@
 #include <string>
 #include <utility>
 
+#include "core/scene/limits.h"
 #include "core/scene/mesh.h"
 #include "core/scene/scene.h"
 
 namespace eikon {
 namespace {
 
-constexpr size_t kMaxRegions = 65535;  // region ids are 16-bit; 0 is the ambient
+constexpr size_t kMaxRegions = kMaxSharpObjects;  // region ids are 16-bit; 0 is the ambient
 
 // The trilinear cell around a point given in voxel coordinates u (voxel centres at integers):
 // its 8 corners (bit 0: +x, bit 1: +y, bit 2: +z) and, per axis, the lower corner and the

@@ -555,6 +555,19 @@ TEST_F(Cli, EmptyNumberIsSaidToBeEmpty) {
   EXPECT_EQ(render(tinyScene(), "--width 16 -q").code, 0);
 }
 
+// A scene of 70 000 objects printed ~22 000 warnings before the error that 65 535 is the most.
+TEST_F(Cli, TooManyObjectsIsTheOnlyLine) {
+  std::string objects;
+  for (int i = 0; i < 70000; ++i)
+    objects += std::string(i ? ", " : "") +
+               R"({"shape": "sphere", "center": [0, 0, 0], "radius": 50, "material": "glass"})";
+  const std::string text = tinyScene();
+  const size_t at = text.find(R"("objects": [)");
+  ASSERT_NE(at, std::string::npos);
+  expectCleanFailure(render(text.substr(0, at) + R"("objects": [)" + objects + "]}"),
+                     "/objects: sharp interfaces allow at most 65535 objects, got 70000");
+}
+
 // ------------------------------------------------------------------ trace
 
 TEST_F(Cli, TraceZeroDirection) {
