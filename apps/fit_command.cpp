@@ -263,7 +263,16 @@ void run(const FitArgs& a) {
   }
 
   std::vector<FitResult> fits;
-  for (const IndexSeries& s : data.modes) fits.push_back(fitDispersion(s, fo));
+  for (size_t k = 0; k < data.modes.size(); ++k) {
+    // A fit's failure names the data file it came from (two files: o from the first, e from the
+    // second), as a reading error does: "rank-deficient start" alone did not.
+    const std::string& file = a.data[a.data.size() == 2 ? k : 0];
+    try {
+      fits.push_back(fitDispersion(data.modes[k], fo));
+    } catch (const std::exception& e) {
+      throw CliError(file + ": " + e.what());
+    }
+  }
   for (const FitResult& r : fits)
     for (const std::string& w : r.warnings) {
       if (a.strict) throw CliError(w + " (--strict)");

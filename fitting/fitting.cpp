@@ -117,9 +117,15 @@ class AllResiduals final : public ceres::CostFunction {
 };
 
 // Weighted linear least squares min ‖W (X b − y)‖ by column-pivoted QR; NaN-free or throws.
-Eigen::VectorXd linearSolve(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
+Eigen::VectorXd linearSolve(const Eigen::MatrixXd& X, const Eigen::VectorXd& y, DispersionModel m,
+                            const std::string& who) {
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(X);
-  if (qr.rank() < X.cols()) throw std::runtime_error("rank-deficient start (design matrix)");
+  if (qr.rank() < X.cols())
+    throw std::runtime_error(who + ": rank-deficient " + modelName(m) +
+                             " start: the data cannot determine all coefficients (the design "
+                             "matrix has rank " +
+                             std::to_string(qr.rank()) + " of " + std::to_string(X.cols()) +
+                             "); use a model with fewer terms or data over a wider range");
   return qr.solve(y);
 }
 
@@ -142,7 +148,7 @@ std::vector<double> startValues(DispersionModel m, const IndexSeries& d,
       X.row(i) *= w[i];
       y(i) = d.n[i] * w[i];
     }
-    Eigen::VectorXd b = linearSolve(X, y);
+    Eigen::VectorXd b = linearSolve(X, y, m, who);
     return std::vector<double>(b.data(), b.data() + P);
   }
   // Sellmeier: n² − 1 = Σ Bᵢ λ²/(λ² − Cᵢ) is linear in B for fixed C. Weight in n² space is

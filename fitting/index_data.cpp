@@ -75,6 +75,10 @@ struct Pending {
     if (lambda_nm <= 0.0)
       throw std::invalid_argument(at + ": wavelength must be > 0, got " + fmt(lambda_nm));
     if (window_nm && (lambda_nm < (*window_nm)[0] || lambda_nm > (*window_nm)[1])) return;
+    if (!(lambda_nm >= kMinFitWavelengthNm && lambda_nm <= kMaxFitWavelengthNm))
+      throw std::invalid_argument(at + ": wavelength " + fmt(lambda_nm) + " nm is outside [" +
+                                  fmt(kMinFitWavelengthNm) + ", " + fmt(kMaxFitWavelengthNm) +
+                                  "] nm, the wavelengths a fit takes (--range-nm leaves rows out)");
     if (n < 1.0)
       throw std::invalid_argument(at + ": " + series.label + " must be >= 1, got " + fmt(n));
     if (sigma) {

@@ -70,6 +70,13 @@ struct IndexReadOptions {
 /// before any allocation.
 inline constexpr int kMaxFormulaSamples = 100000;
 
+/// The wavelengths a fit takes, nm: 100 nm (vacuum UV) to 100 µm (far IR) holds every optical
+/// measurement the models describe and keeps λ^-2 … λ^-4 (in µm) well scaled; a row outside
+/// (1e-300 nm was reported as "rank-deficient start (design matrix)") is refused with its file
+/// and line when read, after the window (--range-nm) has dropped what it leaves out.
+inline constexpr double kMinFitWavelengthNm = 100.0;
+inline constexpr double kMaxFitWavelengthNm = 100000.0;
+
 /// Strict CSV reader (format above). Throws with "path:line: message".
 IndexData readIndexCsv(const std::string& path, const IndexReadOptions& options = {});
 /// Same, from text already in memory (`name` is used in messages).

@@ -356,6 +356,36 @@ TEST_F(FitCli, FailingCeresFitPrintsOneLine) {
                      "rank-deficient sellmeier2");
 }
 
+// A row at 1e-300 nm reached the fit and came back as "rank-deficient start (design matrix)", which
+// named neither the file nor the row: wavelengths are checked against [100, 100000] nm as read,
+// and a fit's own failure names its data file.
+TEST_F(FitCli, WavelengthOutsideTheFitRangeNamesTheRowAndFailuresTheFile) {
+  const std::string rows = "400,1.53\n500,1.52\n600,1.515\n700,1.512\n";
+  for (const char* lambda : {"1e-300", "99.9", "100000.1"}) {
+    write("tiny.csv", "wavelength_nm,n\n" + std::string(lambda) + ",1.6\n" + rows);
+    for (const char* model : {"cauchy2", "sellmeier1"})
+      expectCleanFailure(
+          run(path("tiny.csv") + " --model " + model + " -o " + path("out.json")),
+          path("tiny.csv") + ":2: wavelength " + lambda + " nm is outside [100, 100000] nm");
+  }
+  write("um.csv", "wavelength_um,n\n0.05,1.6\n0.4,1.53\n0.5,1.52\n0.6,1.515\n");
+  expectCleanFailure(run(path("um.csv") + " -o " + path("out.json")),
+                     path("um.csv") + ":2: wavelength 50 nm is outside");
+  // --range-nm leaves the row out before it is checked; the bounds themselves are taken.
+  write("tiny.csv", "wavelength_nm,n\n1e-300,1.6\n" + rows);
+  EXPECT_EQ(run(path("tiny.csv") + " --model cauchy2 --range-nm 300,800").code, 0);
+  write("edge.csv", "wavelength_nm,n\n100,1.6\n" + rows + "100000,1.4\n");
+  EXPECT_EQ(run(path("edge.csv") + " --model cauchy2").code, 0);
+  // A rank-deficient linear start (four points within 3e-10 nm) names the file and the mode.
+  write("same.csv",
+        "wavelength_nm,n\n500,1.5\n500.0000000001,1.5\n500.0000000002,1.5\n500.0000000003,1.5\n");
+  expectCleanFailure(run(path("same.csv") + " --model cauchy3 -o " + path("out.json")),
+                     path("same.csv") + ": n: rank-deficient cauchy3 start");
+  const std::string csv = std::string(EIKON_SOURCE_DIR) + "/tests/data/fit/calcite_ghosh.csv";
+  expectCleanFailure(run(csv + " --model sellmeier2 -o " + path("out.json")),
+                     csv + ": n_o: rank-deficient sellmeier2");
+}
+
 // Issue 11: --samples is bounded before anything is allocated (2000000000 ran 55 s into
 // std::bad_alloc); the bound itself is accepted.
 TEST_F(FitCli, SamplesAreBounded) {
