@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/io/text_file.h"
+
 namespace eikon {
 namespace {
 
@@ -84,9 +86,28 @@ class FileLock {
 
 }  // namespace
 
-void checkWritable(const std::filesystem::path& path) {
+/// The file an output path names: a symbolic link's final target (so the link stays and shows
+/// the new file), which must be a regular file or not exist yet. A device, pipe or socket there
+/// is refused: the rename over it would replace it with a file (`-o /dev/null` as root did).
+std::filesystem::path outputTarget(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw writeError(path, "it is a directory");
+  fs::path p = path;
+  if (fs::is_symlink(fs::symlink_status(p, ec))) {
+    p = fs::weakly_canonical(p, ec);  // follows every link, to a file that may not exist yet
+    if (ec) throw writeError(path, "cannot follow the symbolic link: " + errorReason(ec));
+  }
+  const fs::file_type t = fs::status(p, ec).type();
+  if (t == fs::file_type::not_found || t == fs::file_type::regular) return p;
+  if (t == fs::file_type::directory) throw writeError(path, "it is a directory");
+  throw writeError(path, std::string("it is ") + fileTypeName(t) +
+                             ", not a regular file: eikon writes a file beside it and renames it "
+                             "over the target, which would replace it");
+}
+
+void checkWritable(const std::filesystem::path& target) {
+  std::error_code ec;
+  const std::filesystem::path path = outputTarget(target);
   // Missing folders are created when writing; here the nearest existing one must take new entries.
   std::filesystem::path dir = path.parent_path();
   while (!dir.empty() && !std::filesystem::exists(dir, ec))
@@ -110,8 +131,10 @@ std::filesystem::path lockPathFor(const std::filesystem::path& first) {
   return first.parent_path() / ("." + first.stem().string() + ".lock");
 }
 
-void writeFilesTogether(const std::vector<OutputFile>& files) {
-  if (files.empty()) return;
+void writeFilesTogether(const std::vector<OutputFile>& outputs) {
+  if (outputs.empty()) return;
+  std::vector<OutputFile> files = outputs;  // each at the file it names (outputTarget)
+  for (OutputFile& f : files) f.path = outputTarget(f.path);
   std::vector<std::filesystem::path> tmps, created;
   auto removeTemporaries = [&] {
     std::error_code ec;

@@ -15,9 +15,7 @@ std::string errorReason(const std::error_code& ec) {
   return r;
 }
 
-namespace {
-
-const char* typeName(std::filesystem::file_type t) {
+const char* fileTypeName(std::filesystem::file_type t) {
   using std::filesystem::file_type;
   switch (t) {
     case file_type::character:
@@ -32,6 +30,8 @@ const char* typeName(std::filesystem::file_type t) {
       return "not a plain file";
   }
 }
+
+namespace {
 
 std::string mib(std::uintmax_t bytes) {
   if (bytes % (1u << 20) == 0) return std::to_string(bytes >> 20) + " MiB";
@@ -73,7 +73,8 @@ std::string readTextFile(const std::filesystem::path& path, const std::string& w
   if (ec) refuse("cannot open " + what + ": " + errorReason(ec));
   if (st.type() == fs::file_type::directory) refuse("is a directory, expected " + what);
   if (st.type() != fs::file_type::regular)
-    refuse("is not a regular file (" + std::string(typeName(st.type())) + "), expected " + what);
+    refuse("is not a regular file (" + std::string(fileTypeName(st.type())) + "), expected " +
+           what);
   const std::uintmax_t size = fs::file_size(path, ec);
   if (ec) refuse("cannot open " + what + ": " + errorReason(ec));
   const std::string too_large = "is larger than " + mib(max_bytes);

@@ -26,6 +26,9 @@ constexpr std::uintmax_t kMaxTextFileBytes = 64u << 20;
 /// its cut).
 std::string shownPath(const std::filesystem::path& path);
 
+/// "a character device", "a block device", "a pipe", "a socket", else "not a plain file".
+const char* fileTypeName(std::filesystem::file_type type);
+
 /// The system's reason in a message's words: "file name too long", not "File name too long".
 std::string errorReason(const std::error_code& ec);
 

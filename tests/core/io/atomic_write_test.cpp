@@ -7,6 +7,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -109,6 +110,36 @@ TEST_F(AtomicWrite, TargetThatIsAFolderFailsBeforeAnyTargetChanges) {
   EXPECT_EQ(slurp(png), "old png");
   EXPECT_TRUE(fs::is_directory(exr));
   expectNoTemporaries(dir_);
+}
+
+// A pipe (or device) at a target is refused, not replaced by a file: as root, `-o /dev/null`
+// turned /dev/null into a regular file. A symbolic link is written through: the link stays and
+// shows the new file.
+TEST_F(AtomicWrite, SpecialFilesAreRefusedAndLinksWrittenThrough) {
+  const fs::path fifo = dir_ / "pipe.exr", other = dir_ / "x.png";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::ofstream(other) << "old png";
+  try {
+    writeFilesTogether({{other, text("new png")}, {fifo, text("new exr")}});
+    ADD_FAILURE() << "a pipe was replaced";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("it is a pipe, not a regular file"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(fs::status(fifo).type(), fs::file_type::fifo);
+  EXPECT_EQ(slurp(other), "old png");
+  EXPECT_THROW(checkWritable(fifo), std::runtime_error);
+  expectNoTemporaries(dir_);
+
+  const fs::path target = dir_ / "real" / "shown.txt", link = dir_ / "link.txt";
+  fs::create_directories(target.parent_path());
+  std::ofstream(target) << "old";
+  fs::create_symlink(target, link);
+  EXPECT_NO_THROW(checkWritable(link));
+  writeBytesAtomically(link, "new");
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+  EXPECT_EQ(slurp(target), "new");
+  EXPECT_EQ(slurp(link), "new");
 }
 
 TEST_F(AtomicWrite, SingleFileAndBytes) {
