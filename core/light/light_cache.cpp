@@ -137,12 +137,17 @@ bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& v
                     std::string* notice) {
   if (dir.empty()) return false;
   const std::filesystem::path path = entryPath(dir, key);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
   auto corrupted = [&](const std::string& why) {
     if (notice) *notice = path.string() + " is corrupted (" + why + "); simulating the light again";
     return false;
   };
+  // Opening a pipe for reading waits for a writer: only a regular file is read.
+  std::error_code ec;
+  const auto type = std::filesystem::status(path, ec).type();
+  if (type == std::filesystem::file_type::not_found) return false;
+  if (type != std::filesystem::file_type::regular) return corrupted("not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
   char magic[8];
   uint64_t format = 0, stored_key = 0, checksum = 0;
   std::array<int, 3> dims{};

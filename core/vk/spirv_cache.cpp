@@ -49,6 +49,14 @@ uint64_t keyOf(std::span<const uint32_t> spirv, std::span<const uint32_t> values
 /// The words of the entry at `path` for `key`; empty when there is none or it is unusable (then
 /// `why` says why, unless the file is simply missing).
 std::vector<uint32_t> load(const fs::path& path, uint64_t key, std::string& why) {
+  // Opening a pipe for reading waits for a writer: only a regular file is read.
+  std::error_code ec;
+  const fs::file_type type = fs::status(path, ec).type();
+  if (type == fs::file_type::not_found) return {};
+  if (type != fs::file_type::regular) {
+    why = "not a regular file";
+    return {};
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) return {};
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -293,14 +293,18 @@ bool loadVolumeCache(const fs::path& dir, uint64_t key, const Scene& scene, Volu
                      std::string* notice) {
   if (dir.empty() || key == 0) return false;
   const fs::path path = volumeCachePath(dir, key);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
   auto ignored = [&](const std::string& why) {
     if (notice)
       *notice = "volume cache '" + path.string() + "' ignored: " + why + "; voxelising again";
     return false;
   };
   std::error_code ec;
+  // Opening a pipe for reading waits for a writer: a pipe put in the cache's place hung renders.
+  const fs::file_type type = fs::status(path, ec).type();
+  if (type == fs::file_type::not_found) return false;
+  if (type != fs::file_type::regular) return ignored("it is not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
   const uint64_t file_bytes = fs::file_size(path, ec);
   if (ec) return ignored("cannot read its size");
   Header h{};

@@ -7,6 +7,7 @@
 #include "core/volume/volume_cache.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstring>
 #include <filesystem>
@@ -239,6 +240,21 @@ TEST_F(VolumeCache, DamagedFilesAreIgnoredWithOneNoticeAndReplaced) {
   std::string notice;
   EXPECT_FALSE(loadVolumeCache(dir_.path(), key, s, v, &notice));
   EXPECT_NE(notice.find("does not match its name"), std::string::npos) << notice;
+}
+
+// A pipe in an entry's place is not opened (a read would wait for a writer: renders hung), and
+// the entry saved after it is refused there rather than replacing the pipe.
+TEST_F(VolumeCache, APipeInPlaceOfAnEntryIsIgnoredNotRead) {
+  const Scene s = scene(kCrystal);
+  const uint64_t key = volumeCacheKey(s);
+  const fs::path file = volumeCachePath(dir_.path(), key);
+  ASSERT_EQ(::mkfifo(file.c_str(), 0600), 0);
+  VolumeSet v;
+  std::string notice;
+  EXPECT_FALSE(loadVolumeCache(dir_.path(), key, s, v, &notice));
+  EXPECT_NE(notice.find("ignored: it is not a regular file"), std::string::npos) << notice;
+  EXPECT_NE(saveVolumeCache(dir_.path(), key, voxelize(s)), "");
+  EXPECT_EQ(fs::status(file).type(), fs::file_type::fifo);
 }
 
 // Another format version is not an error: replaced quietly, as the light cache does.
