@@ -24,11 +24,19 @@ std::atomic<long> g_voxelizations{0};
 
 // A Renderer: a session of its own on the module's shared Vulkan context. Calls into the session
 // release the GIL (it never calls back into Python).
+/// The scene a Renderer or a module-level call is given: None is a TypeError here, where the
+/// session would dereference it (a segmentation fault).
+std::shared_ptr<Scene> requireScene(std::shared_ptr<Scene> s) {
+  if (!s) throw py::type_error("scene must be an eikon.Scene, got None");
+  return s;
+}
+
 struct Prepared {
   std::shared_ptr<Scene> scene;
   Session session;
 
-  explicit Prepared(std::shared_ptr<Scene> s) : scene(s), session(std::move(s), context) {}
+  explicit Prepared(std::shared_ptr<Scene> s)
+      : scene(requireScene(s)), session(std::move(s), context) {}
   template <class F>
   decltype(auto) run(F&& f) {
     const bool voxelized = session.voxelized();
@@ -60,6 +68,7 @@ std::weak_ptr<Scene> g_last_scene;
 std::mutex g_prepared_mutex;
 
 std::shared_ptr<Prepared> cachedPrepared(const std::shared_ptr<Scene>& s) {
+  requireScene(s);
   std::lock_guard<std::mutex> lock(g_prepared_mutex);
   if (g_last_prepared && g_last_scene.lock() == s &&
       (!g_last_prepared->session.voxelized() ||
@@ -176,6 +185,7 @@ py::object render(Prepared& p, int width, int height, int spp, std::optional<int
   view.march = march;
   checkSetting([&] {
     checkViewRequest(view);
+    checkThreads(threads);
     view.sampling = parseSpectralSampling(sampling);
     parseLayers(layers, view);
     view.modes = parseModes(modes);

@@ -121,6 +121,8 @@ void checkViewRequest(const ViewRequest& v) {
   checkRange("spp", v.spp, 1, 4096);
   if (v.wavelengths) checkRange("wavelengths", *v.wavelengths, 0, 256);
   if (v.march) checkMarchStep(v.march->step_voxels);
+  if (!(v.wavelength_nm >= 100 && v.wavelength_nm <= 10000))
+    throw SettingError("wavelength", "must be in [100, 10000] nm");
 }
 
 RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
@@ -176,6 +178,11 @@ std::vector<std::string> materialRangeWarnings(const Scene& scene, const RenderS
   return out;
 }
 
+void checkThreads(int threads) {
+  if (threads < 0 || threads > 1024)
+    throw SettingError("threads", "must be in [1, 1024], or 0 for all cores");
+}
+
 void checkLightRequest(const LightRequest& l) {
   if (l.bands < 0 || l.bands > 64)
     throw SettingError("light-bands", "must be in [1, 64], or 0 for the scene's default");
@@ -187,8 +194,9 @@ void checkLightRequest(const LightRequest& l) {
     throw SettingError("caustics", "must be pass or kill, got '" + l.caustics + "'");
   if (!(l.step_voxels >= 0 && l.step_voxels <= 2))
     throw SettingError("light-step", "must be in (0, 2] voxels, or 0 for the default (0.5)");
-  if (l.threads < 0 || l.threads > 1024)
-    throw SettingError("threads", "must be in [1, 1024], or 0 for all cores");
+  checkThreads(l.threads);
+  if (!(l.smoothing_voxels >= 0 && l.smoothing_voxels <= 8))
+    throw SettingError("smoothing_voxels", "must be in [0, 8] voxels");
   if (!(l.split_voxels >= 0.25 && l.split_voxels <= 8))
     throw SettingError("light-split", "must be in [0.25, 8] voxels");
   if (l.max_patches < 1024 || l.max_patches > (1 << 24))

@@ -63,7 +63,7 @@ struct ViewRequest {
   std::optional<int> width, height;    ///< [1, 16384]; unset: the scene camera's
   int spp = 1;                         ///< [1, 4096] jittered samples per pixel
   std::optional<int> wavelengths;      ///< [0, 256] (0 = RGB); unset: defaultWavelengths(scene)
-  double wavelength_nm = 587.5618;     ///< the index wavelength of the RGB mode
+  double wavelength_nm = 587.5618;     ///< the index wavelength of the RGB mode, [100, 10000] nm
   std::optional<MarchSettings> march;  ///< step in (0, 4] voxels; unset: the render defaults
   SpectralSampling sampling = SpectralSampling::Auto;  ///< spectral renders (docs/spectra.md)
   bool spectral_layer = false, mode_layers = false;    ///< parseLayers; RenderSettings's
@@ -110,11 +110,13 @@ struct LightRequest {
   double split_voxels = 1.0;         ///< split patches longer than this, [0.25, 8]
   int max_patches = 1 << 20;         ///< live patches, [1024, 2^24]
   std::string caustics = "pass";     ///< pass (through a fold caustic) or kill (Tevs)
-  double smoothing_voxels = 1.0;     ///< σ of the final smoothing of the light volumes
+  double smoothing_voxels = 1.0;     ///< σ of the final smoothing of the light volumes, [0, 8]
   std::string device = "auto";       ///< auto (lightOnCpu), gpu or cpu
   int threads = 0;                   ///< CPU twin threads (0: all, at most 8)
 };
 void checkLightRequest(const LightRequest& light);
+/// CPU threads: [1, 1024], or 0 for all cores; else SettingError("threads", ...).
+void checkThreads(int threads);
 /// The simulator options of a request for voxels of `voxel_mm`.
 LightingOptions lightingOptions(const LightRequest& light, double voxel_mm);
 
@@ -152,7 +154,11 @@ class Session {
 
   const std::shared_ptr<Scene>& scene() const { return scene_; }
   void setProgress(SessionProgress progress) { progress_ = std::move(progress); }
-  void setThreads(int threads) { threads_ = threads; }  ///< voxelising and the CPU twin
+  /// Voxelising and the CPU twin; checkThreads (std::invalid_argument) first.
+  void setThreads(int threads) {
+    checkThreads(threads);
+    threads_ = threads;
+  }
   /// Read the voxelised volume from, and store it in, the volume cache in `dir`
   /// (core/volume/volume_cache.h) instead of voxelising on every run; empty (the default): no
   /// cache. `note` gets its one-line notices (an unusable entry ignored, a failed save).

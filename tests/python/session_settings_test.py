@@ -73,6 +73,25 @@ class SessionSettings(unittest.TestCase):
                   "must be in (0, 4] voxels")
         self.assertEqual(eikon.voxelize_count(), 0)
 
+    def test_values_that_crashed_are_refused(self):
+        # None for a scene was a segmentation fault; smoothing_voxels=nan and threads=100000
+        # crashed or aborted; wavelength_nm=nan rendered NaN pixels.
+        with self.assertRaises(TypeError):
+            eikon.Renderer(None)
+        with self.assertRaises(TypeError):
+            eikon.render(None)
+        r = eikon.Renderer(self.scene)
+        for bad in (float("nan"), 1e30, -1):
+            self.assertIn("must be in [0, 8] voxels",
+                          self.py_error(lambda: r.simulate_light(smoothing_voxels=bad)))
+        self.same(["render", "--threads", "100000"], "--threads",
+                  lambda: r.render(device="cpu", threads=100000), "threads",
+                  "must be in [1, 1024], or 0 for all cores")
+        for bad in (float("nan"), -5, 0, float("inf")):
+            self.assertIn("must be in [100, 10000] nm",
+                          self.py_error(lambda: r.render(wavelength_nm=bad)))
+        self.assertEqual(eikon.voxelize_count(), 0)
+
     def test_light_settings(self):
         r = eikon.Renderer(self.scene)
         self.same(["render", "--light-splat", "max"], "--light-splat", lambda: r.simulate_light(splat="max"),
