@@ -37,9 +37,14 @@ inline void orbitCamera(Camera& cam, double yaw, double pitch) {
   cam.position = cam.look_at + offset * (r / glm::length(offset));
 }
 
-/// Move the camera towards look_at (factor < 1) or away (> 1); look_at stays.
+/// Move the camera towards look_at (factor < 1) or away (> 1); look_at stays. The distance stays
+/// in [1e-6, 1e9] mm, so that no number of wheel steps makes a camera the scene checks refuse
+/// (position and look_at closer than 1e-9 mm, or a position beyond ±1e12 mm).
 inline void zoomCamera(Camera& cam, double factor) {
-  cam.position = cam.look_at + (cam.position - cam.look_at) * std::clamp(factor, 1e-3, 1e3);
+  const glm::dvec3 offset = cam.position - cam.look_at;
+  const double r = glm::length(offset);
+  const double to = std::clamp(r * std::clamp(factor, 1e-3, 1e3), 1e-6, 1e9);
+  cam.position = cam.look_at + offset * (to / r);
 }
 
 /// Move camera and look_at together in the image plane: `dx`, `dy` in fractions of the image

@@ -1440,6 +1440,33 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   return scene;
 }
 
+namespace {
+json vec3Json(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
+}  // namespace
+
+void checkCamera(const Camera& cam, const std::filesystem::path& file) {
+  json j = {{"position", vec3Json(cam.position)},
+            {"look_at", vec3Json(cam.look_at)},
+            {"up", vec3Json(cam.up)},
+            {"fov_deg", cam.fov_deg},
+            {"width", cam.width},
+            {"height", cam.height}};
+  if (cam.analyzer) j["analyzer"] = vec3Json(*cam.analyzer);
+  Camera parsed;
+  parseCamera(Node(j, "/camera", file.string()), parsed);
+}
+
+void checkVolumeSpec(const VolumeSpec& vol, const std::filesystem::path& file) {
+  const json j = {{"bounds_min", vec3Json(vol.bounds_min)},
+                  {"bounds_max", vec3Json(vol.bounds_max)},
+                  {"resolution", vol.resolution},
+                  {"smoothing_voxels", vol.smoothing_voxels},
+                  {"smoothing_method",
+                   vol.smoothing == VolumeSpec::Smoothing::Gaussian ? "gaussian" : "analytic"}};
+  VolumeSpec parsed;
+  parseVolume(Node(j, "/volume", file.string()), parsed);
+}
+
 Scene loadScene(const std::filesystem::path& path) {
   return parseScene(readSceneText(path, "a scene file"), path);
 }

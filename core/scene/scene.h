@@ -186,6 +186,11 @@ Scene loadScene(const std::filesystem::path& path);
 /// Parse a scene from JSON text; `origin` names the source in error messages and resolves
 /// relative paths (latlong images).
 Scene parseScene(const std::string& json_text, const std::filesystem::path& origin);
+/// The camera and the volume as a scene file's "camera" and "volume" would be checked (SceneError
+/// "FILE: /camera/width: ..."), for scenes edited after parsing (Python's Scene.camera and
+/// Scene.volume): the session checks them before it voxelises or renders.
+void checkCamera(const Camera& camera, const std::filesystem::path& file);
+void checkVolumeSpec(const VolumeSpec& volume, const std::filesystem::path& file);
 
 /// Load a material file (format: docs/scene-format.md, "Material files").
 Material loadMaterialFile(const std::filesystem::path& path);

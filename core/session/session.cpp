@@ -247,6 +247,7 @@ Session::~Session() = default;
 
 vk::Context& Session::context() {
   if (!ctx_) {
+    checkVolumeSpec(scene_->volume, scene_->file);  // edited since parsing (Python)
     auto ctx = context_source_();
     checkVolumeFits(*ctx, makeGrid(scene_->volume), *scene_);
     ctx_ = std::move(ctx);
@@ -255,6 +256,7 @@ vk::Context& Session::context() {
 }
 
 VolumeSet& Session::prepare(bool gpu) {
+  checkVolumeSpec(scene_->volume, scene_->file);  // edited since parsing (Python)
   if (gpu) context();
   if (volume_ && !volume_->whole()) volume_.reset();  // voxelised whole below; gpu_ stays valid
   if (!volume_) {
@@ -411,6 +413,7 @@ bool Session::renderReady(const RenderSettings& settings) {
 }
 
 RenderImage Session::render(const RenderSettings& settings, bool gpu) {
+  checkCamera(scene_->camera, scene_->file);  // edited since parsing (Python, the viewer)
   checkRenderFitsHost(*scene_, settings);
   RenderSettings rs = settings;
   if (progress_.update && !rs.progress)

@@ -92,6 +92,21 @@ class SessionSettings(unittest.TestCase):
                           self.py_error(lambda: r.render(wavelength_nm=bad)))
         self.assertEqual(eikon.voxelize_count(), 0)
 
+    def test_edited_camera_and_volume_are_checked_as_a_scene_file_is(self):
+        # Scene.camera and Scene.volume are writable: a resolution of 0 gave a voxel of inf mm,
+        # a width of -5 a buffer of 17592186044415 MiB. The session checks them as parsing does.
+        self.scene.volume.resolution = 0
+        with self.assertRaisesRegex(RuntimeError, "/volume/resolution: must be an integer in"):
+            eikon.Renderer(self.scene).grid()
+        self.scene.volume.resolution = 16
+        self.scene.camera.width = -5
+        with self.assertRaisesRegex(RuntimeError, "/camera/width: must be an integer in"):
+            eikon.Renderer(self.scene).render()
+        self.scene.camera.width = 8
+        self.scene.camera.fov_deg = float("nan")
+        with self.assertRaisesRegex(RuntimeError, "/camera/fov_deg"):
+            eikon.Renderer(self.scene).render()
+
     def test_light_settings(self):
         r = eikon.Renderer(self.scene)
         self.same(["render", "--light-splat", "max"], "--light-splat", lambda: r.simulate_light(splat="max"),
