@@ -181,6 +181,21 @@ std::string yamlEntry(const FitResult& r, const std::string& source) {
   return formatRefractiveIndexYaml(entry);
 }
 
+// The scene loader refuses a material whose index anywhere in 380–780 nm (1 nm steps) is not a
+// finite number in [1, 10] (checkIndexInRange, core/scene/scene.cpp); data in [1, 10] can still
+// fit a curve that leaves it there (extrapolated from IR data, say), so the material to be written
+// is checked the same way and refused, naming the data file, rather than written unloadable.
+void checkLoadable(const FitResult& r, const std::string& file) {
+  const Dispersion d = r.dispersion();
+  for (double l = kRenderLoNm; l <= kRenderHiNm; l += 1.0) {
+    const double n = d.index(l);
+    if (!(n >= kMinFitIndex && n <= kMaxFitIndex))
+      throw CliError(file + ": the fitted " + r.label + " is " + fmt("%g", n) + " at " +
+                     fmt("%g", l) + " nm, outside [1, 10] where a scene needs it (380-780 nm); " +
+                     "the material would not load, so it is not written");
+  }
+}
+
 // "calcite.yml" + "o" → "calcite-o.yml".
 std::string withSuffix(const std::string& path, const std::string& suffix) {
   fs::path p(path);
@@ -231,6 +246,10 @@ std::optional<double> parseLoss(const std::string& s) {
   auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), d);
   if (ec != std::errc() || ptr != v.data() + v.size() || !(std::isfinite(d) && d > 0))
     throw CliError("--loss huber:DELTA needs a number DELTA > 0, got '" + v + "'");
+  if (!(d >= kMinHuberDelta && d <= kMaxHuberDelta))
+    throw CliError("--loss huber:DELTA must be in [" + fmt("%g", kMinHuberDelta) + ", " +
+                   fmt("%g", kMaxHuberDelta) +
+                   "] (residual units: sigma with a sigma column, else index), got '" + v + "'");
   return d;
 }
 
@@ -283,6 +302,8 @@ void run(const FitArgs& a) {
   const std::string source = "eikon fit of " + data.source + ", model " + modelName(fo.model);
   std::vector<std::pair<std::string, std::string>> files;
   if (!a.output.empty()) {
+    for (size_t k = 0; k < fits.size(); ++k)
+      checkLoadable(fits[k], a.data[a.data.size() == 2 ? k : 0]);
     json m = {{"name", name}, {"source", source}};
     if (!data.uniaxial()) {
       m["n"] = materialIndex(fits[0]);
@@ -360,7 +381,8 @@ void addFitCommand(CLI::App& app) {
       ->capture_default_str();
   sub->add_option(
       "--loss", args->loss,
-      "robust loss 'huber:DELTA' (DELTA in sigma units with a sigma column, else in index units)");
+      "robust loss 'huber:DELTA' (DELTA in [1e-9, 100]: sigma units with a sigma column, else "
+      "index units)");
   sub->add_flag("--json", args->json_out, "print the fit as one JSON object instead of a table");
   sub->add_option("--export-yaml", args->export_yaml,
                   "also write a refractiveindex.info formula entry (crystals: FILE-o/-e)");

@@ -329,8 +329,13 @@ void checkSeries(const IndexSeries& d, const FitOptions& opt, const std::string&
         who + ": " + std::to_string(N) + " points for " + std::to_string(P) +
         " coefficients leave no degree of freedom to estimate uncertainties; add points or a "
         "sigma column");
-  if (opt.huber_delta && !(std::isfinite(*opt.huber_delta) && *opt.huber_delta > 0.0))
-    throw std::invalid_argument("huber delta must be a finite number > 0");
+  if (opt.huber_delta &&
+      !(*opt.huber_delta >= kMinHuberDelta && *opt.huber_delta <= kMaxHuberDelta)) {
+    std::ostringstream m;
+    m << "huber delta must be in [" << kMinHuberDelta << ", " << kMaxHuberDelta << "], got "
+      << *opt.huber_delta;
+    throw std::invalid_argument(m.str());
+  }
   for (int i = 0; i < N; ++i)
     if (!(std::isfinite(d.lambda_nm[i]) && d.lambda_nm[i] > 0 && std::isfinite(d.n[i])))
       throw std::invalid_argument(who + ": point " + std::to_string(i) +
@@ -446,6 +451,15 @@ void summarize(FitResult& r, const IndexSeries& d, const std::vector<double>& w,
           factor * scale[size_t(a)] * scale[size_t(b)] * cq[size_t(a * P + b)];
   for (int k = 0; k < P; ++k)
     r.sigma.push_back(std::sqrt(std::max(0.0, r.covariance[size_t(k * P + k)])));
+  // A result with an infinite or NaN coefficient or σ would be written as null/"inf" (exit 0):
+  // it is refused instead.
+  const std::vector<std::string> names = parameterNames(r.model);
+  for (int k = 0; k < P; ++k)
+    if (!std::isfinite(r.coeffs[size_t(k)]) || !std::isfinite(r.sigma[size_t(k)]))
+      throw std::runtime_error(who + ": " + modelName(r.model) + " fit gives " + names[size_t(k)] +
+                               " = " + std::to_string(r.coeffs[size_t(k)]) + " +/- " +
+                               std::to_string(r.sigma[size_t(k)]) +
+                               " (not finite): the fit cannot be trusted");
 
   // Goodness of fit (weighted data): with the Wilson–Hilferty cube-root normal approximation of
   // χ²_ν, z = ((χ²/ν)^{1/3} − (1 − 2/(9ν))) / sqrt(2/(9ν)); z > 3.09 means p < 1e-3.

@@ -69,10 +69,17 @@ double modelIndex(DispersionModel m, const double* p, double lambda_nm, double* 
 struct FitOptions {
   DispersionModel model = DispersionModel::Cauchy3;
   /// Huber loss scale δ in units of the residual r (σ units with a σ column, index units
-  /// without). Absent: plain least squares.
+  /// without), in [kMinHuberDelta, kMaxHuberDelta]. Absent: plain least squares.
   std::optional<double> huber_delta;
   int max_iterations = 200;
 };
+
+/// The Huber scales a fit takes. 1e-9 is far below any measured index's precision (1e-6 at
+/// best) or a useful fraction of a σ, and above it the robustified Jacobian stays usable; a
+/// denormal δ (1e-320) made every coefficient's σ infinite. Above 100 (an index residual of 100,
+/// or 100σ) no point is ever down-weighted, so a larger δ is plain least squares.
+inline constexpr double kMinHuberDelta = 1e-9;
+inline constexpr double kMaxHuberDelta = 100.0;
 
 struct FitResult {
   DispersionModel model = DispersionModel::Cauchy3;
@@ -100,8 +107,9 @@ struct FitResult {
 };
 
 /// Weighted (robust) least-squares fit; throws std::invalid_argument for unusable input
-/// (fewer points than parameters, bad δ) and std::runtime_error if the fit fails or is
-/// rank-deficient. Messages name the series label.
+/// (fewer points than parameters, δ outside [kMinHuberDelta, kMaxHuberDelta]) and
+/// std::runtime_error if the fit fails, is rank-deficient, or gives a coefficient or a σ that is
+/// not finite. Messages name the series label.
 FitResult fitDispersion(const IndexSeries& data, const FitOptions& options = {});
 
 }  // namespace eikon

@@ -79,8 +79,11 @@ struct Pending {
       throw std::invalid_argument(at + ": wavelength " + fmt(lambda_nm) + " nm is outside [" +
                                   fmt(kMinFitWavelengthNm) + ", " + fmt(kMaxFitWavelengthNm) +
                                   "] nm, the wavelengths a fit takes (--range-nm leaves rows out)");
-    if (n < 1.0)
+    if (n < kMinFitIndex)
       throw std::invalid_argument(at + ": " + series.label + " must be >= 1, got " + fmt(n));
+    if (n > kMaxFitIndex)
+      throw std::invalid_argument(at + ": " + series.label + " must be <= 10, got " + fmt(n) +
+                                  " (a scene takes indices in [1, 10])");
     if (sigma) {
       if (!std::isfinite(*sigma) || *sigma <= 0.0)
         throw std::invalid_argument(at + ": sigma of " + series.label +
@@ -233,6 +236,25 @@ IndexData readIndexCsv(const std::string& path, const IndexReadOptions& opt) {
   return parseIndexCsv(readFile(path), path, opt);
 }
 
+// The samples of all formula blocks together (blocks × formula_samples), bounded before any
+// block is sampled; every formula block counts, even one the window leaves out.
+static void checkFormulaSampleTotal(const YAML::Node& blocks, const std::string& name,
+                                    const IndexReadOptions& opt) {
+  long long formula_blocks = 0;
+  for (size_t i = 0; i < blocks.size(); ++i)
+    if (const YAML::Node blk = blocks[i];
+        blk.IsMap() && blk["type"] && blk["type"].IsScalar() &&
+        trim(blk["type"].as<std::string>()).rfind("formula", 0) == 0)
+      ++formula_blocks;
+  if (formula_blocks * opt.formula_samples > kMaxFormulaSamplesTotal)
+    throw std::invalid_argument(
+        name + ": " + std::to_string(formula_blocks) + " formula blocks x " +
+        std::to_string(opt.formula_samples) +
+        " samples each = " + std::to_string(formula_blocks * opt.formula_samples) +
+        " samples, more than the " + std::to_string(kMaxFormulaSamplesTotal) +
+        " a file may be sampled to in all; take fewer samples per block (--samples)");
+}
+
 IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& name,
                                    const IndexReadOptions& opt) {
   checkOptions(opt);
@@ -251,6 +273,8 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
     throw std::invalid_argument(name + ": no DATA key (not a refractiveindex.info file?)");
   if (!blocks.IsSequence() || blocks.size() == 0)
     throw std::invalid_argument(name + ": DATA must be a non-empty list of blocks");
+
+  checkFormulaSampleTotal(blocks, name, opt);
 
   IndexData data;
   data.source = name;

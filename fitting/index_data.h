@@ -18,7 +18,7 @@
 // ignored). Database wavelengths are µm. Formulas are sampled uniformly over their range (or the
 // part of it inside the caller's window). All blocks' samples are merged.
 //
-// Validation, common to both: every value finite, λ > 0, n ≥ 1, σ > 0, at least two points,
+// Validation, common to both: every value finite, λ > 0, 1 ≤ n ≤ 10, σ > 0, at least two points,
 // no repeated wavelength (an error naming both lines). Rows out of order are sorted and a warning
 // is recorded in `IndexData::warnings` (the CLI prints it, or fails with --strict).
 // Errors are std::invalid_argument / std::runtime_error whose message starts with
@@ -70,12 +70,25 @@ struct IndexReadOptions {
 /// before any allocation.
 inline constexpr int kMaxFormulaSamples = 100000;
 
+/// Most samples a file's `formula` blocks may be sampled to in all (blocks × formula_samples):
+/// the per-block cap alone did not bound it (300 blocks × 100000 samples in a 31 KB file used
+/// 3.6 GB). Ten blocks at the most samples, or ~5000 at the default 201; a database file has one
+/// or two. Checked, counting every formula block (even one the window leaves out), before any
+/// block is sampled.
+inline constexpr long long kMaxFormulaSamplesTotal = 1000000;
+
 /// The wavelengths a fit takes, nm: 100 nm (vacuum UV) to 100 µm (far IR) holds every optical
 /// measurement the models describe and keeps λ^-2 … λ^-4 (in µm) well scaled; a row outside
 /// (1e-300 nm was reported as "rank-deficient start (design matrix)") is refused with its file
 /// and line when read, after the window (--range-nm) has dropped what it leaves out.
 inline constexpr double kMinFitWavelengthNm = 100.0;
 inline constexpr double kMaxFitWavelengthNm = 100000.0;
+
+/// The indices a fit takes: [1, 10], those a scene's materials may have (core/scene/scene.cpp);
+/// data above 10 made a material that `eikon fit` wrote and the scene loader refused. A row
+/// outside is refused with its file and line (after the window has dropped what it leaves out).
+inline constexpr double kMinFitIndex = 1.0;
+inline constexpr double kMaxFitIndex = 10.0;
 
 /// Strict CSV reader (format above). Throws with "path:line: message".
 IndexData readIndexCsv(const std::string& path, const IndexReadOptions& options = {});

@@ -345,8 +345,14 @@ TEST_F(FitCli, FailingCeresFitPrintsOneLine) {
   const size_t comma = text.find(',', row + 1);
   text.replace(comma + 1, text.find(',', comma + 1) - comma - 1, "1e200");  // n_o at 405 nm
   const std::string bad = write("huge.csv", text);
+  // Since indices above 10 are refused as read, that row no longer reaches Ceres (the library
+  // test DispersionFit.CeresFailureIsAnError keeps the failing fit); Ceres' covariance below
+  // still logs.
   for (const std::string model : {"cauchy3", "conrady"}) {
-    expectCleanFailure(run(bad + " --model " + model + " -o " + path("out.json")), "fit failed");
+    expectCleanFailure(
+        run(bad + " --model " + model + " -o " + path("out.json")),
+        "huge.csv:" + std::to_string(std::count(text.begin(), text.begin() + row + 1, '\n') + 1) +
+            ": n_o must be <= 10, got 1e+200");
     const Outcome r = run(bad + " --model " + model + " --loss huber:2");
     EXPECT_EQ(r.err.find("Logging before"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("trust_region"), std::string::npos) << r.err;
@@ -435,6 +441,53 @@ TEST_F(FitCli, OutputsNeverReplaceInputsAndFoldersAreCreated) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(json::parse(slurp(path("new/deeper/bk7.json"))).contains("n"));
   EXPECT_NE(slurp(path("yaml/bk7.yml")).find("formula 5"), std::string::npos);
+}
+
+// --loss huber:1e-320 fitted with exit 0, printed "+/- inf" and wrote "sigma": [null, ...]: the
+// scale has a range, named with --loss, and nothing is written.
+TEST_F(FitCli, HuberScaleOutsideItsRangeIsRefused) {
+  const std::string outs = " -o " + path("out.json") + " --export-yaml " + path("out.yml");
+  for (const char* d : {"1e-320", "1e-10", "1e3"}) {
+    SCOPED_TRACE(d);
+    expectCleanFailure(run(bk7Csv() + " --loss huber:" + d + outs),
+                       "--loss huber:DELTA must be in [1e-09, 100]");
+    EXPECT_FALSE(fs::exists(path("out.yml")));
+  }
+  const std::string csv = write("ok.csv",
+                                "wavelength_nm,n\n400,1.53\n450,1.525\n500,1.52\n550,1.517\n"
+                                "600,1.515\n650,1.5135\n700,1.512\n800,1.51\n");
+  const Outcome ok = run(csv + " --loss huber:1e-9 --json");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  for (const json& s : json::parse(ok.out)["modes"]["n"]["sigma"]) EXPECT_TRUE(s.is_number());
+}
+
+// 300 formula blocks × --samples 100000 (31 KB of YAML) used 3.6 GB before any check: the total is
+// bounded, and refused before sampling with the file, the block count and the cap.
+TEST_F(FitCli, TotalFormulaSamplesAreBounded) {
+  std::string text = "DATA:\n";
+  for (int i = 0; i < 300; ++i)
+    text += "  - type: formula 2\n    wavelength_range: 0.4 0.7\n    coefficients: 0 1.2 0.01\n";
+  const std::string yml = write("blocks.yml", text);
+  expectCleanFailure(run(yml + " --samples 100000 -o " + path("out.json")),
+                     yml +
+                         ": 300 formula blocks x 100000 samples each = 30000000 samples, more "
+                         "than the 1000000");
+}
+
+// Indices above 10 fitted (exit 0) into a material the scene loader refused: the data row is
+// refused, and so is a curve that leaves [1, 10] in 380-780 nm although its data do not.
+TEST_F(FitCli, MaterialsTheSceneCannotLoadAreRefused) {
+  const std::string out = " -o " + path("out.json");
+  const std::string big =
+      write("big.csv", "wavelength_nm,n\n400,12\n500,11\n600,10.5\n700,10.2\n800,10.1\n");
+  expectCleanFailure(run(big + out), big + ":2: n must be <= 10, got 12");
+  // n = 4 + 20/λ² (λ in µm) measured over 2-5 µm is 142 at 380 nm.
+  std::ostringstream s;
+  s << "wavelength_nm,n\n";
+  for (double l = 2000; l <= 5000; l += 250) s << l << "," << 4 + 20 / (l * l * 1e-6) << "\n";
+  const std::string ir = write("ir.csv", s.str());
+  expectCleanFailure(run(ir + out), ir + ": the fitted n is ");
+  EXPECT_EQ(run(ir).code, 0);  // without -o nothing is written and the fit is reported
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -244,6 +245,32 @@ TEST(DispersionFit, FewerPointsThanParametersIsAnError) {
   EXPECT_LT(r.max_residual, 1e-12);
   EXPECT_THROW(fitDispersion(d, {.model = DispersionModel::Cauchy3, .huber_delta = -1.0}),
                std::invalid_argument);
+}
+
+// A fit Ceres gives up on (one index of 1e200: every trust-region step is invalid) is a
+// runtime_error; the CLI's reader now refuses such a row before the fit.
+TEST(DispersionFit, CeresFailureIsAnError) {
+  const IndexSeries d{
+      "n", {400, 450, 500, 550, 600, 650}, {1.53, 1.525, 1e200, 1.517, 1.515, 1.5135}, {}};
+  for (DispersionModel m : {DispersionModel::Cauchy3, DispersionModel::Conrady})
+    EXPECT_THROW(fitDispersion(d, {.model = m}), std::runtime_error);
+}
+
+// The Huber scale lies in [kMinHuberDelta, kMaxHuberDelta]: a denormal δ (1e-320) gave σ = inf
+// for every coefficient, written as null with exit 0.
+TEST(DispersionFit, HuberDeltaOutsideItsRangeIsRefused) {
+  const IndexSeries d{"n",
+                      {400, 450, 500, 550, 600, 650, 700, 800},
+                      {1.53, 1.525, 1.52, 1.517, 1.515, 1.5135, 1.512, 1.51},
+                      {}};
+  for (double delta : {1e-320, 1e-10, 101.0, std::numeric_limits<double>::infinity()})
+    EXPECT_THROW(fitDispersion(d, {.model = DispersionModel::Cauchy3, .huber_delta = delta}),
+                 std::invalid_argument)
+        << delta;
+  for (double delta : {kMinHuberDelta, kMaxHuberDelta}) {
+    const FitResult r = fitDispersion(d, {.model = DispersionModel::Cauchy3, .huber_delta = delta});
+    for (double s : r.sigma) EXPECT_TRUE(std::isfinite(s) && s > 0) << delta;
+  }
 }
 
 // Conrady n = n0 + A/λ + B/λ^3.5 is linear: exact data gives back exact coefficients.

@@ -273,6 +273,29 @@ TEST(RefractiveIndexYaml, BadInputIsOneClearError) {
               {"bad.yml:4: DATA[0].coefficients", "odd number of coefficients, got 2"});
 }
 
+// The samples of all formula blocks together are bounded (blocks × samples ≤
+// kMaxFormulaSamplesTotal), checked before any block is sampled: 300 blocks × 100000 samples in a
+// 31 KB file used 3.6 GB.
+TEST(RefractiveIndexYaml, TotalFormulaSamplesAreBounded) {
+  std::string text = "DATA:\n";
+  for (int i = 0; i < 300; ++i)
+    text += "  - type: formula 2\n    wavelength_range: 0." + std::to_string(400 + i) + " 0." +
+            std::to_string(700 + i) + "\n    coefficients: 0 1.2 0.01\n";
+  IndexReadOptions o;
+  o.formula_samples = kMaxFormulaSamples;
+  expectError([&] { parseRefractiveIndexYaml(text, "many.yml", o); },
+              {"many.yml: 300 formula blocks x 100000 samples each", "more than the 1000000"});
+  o.formula_samples = 2;  // 600 samples in all: read
+  EXPECT_EQ(parseRefractiveIndexYaml(text, "many.yml", o).modes[0].size(), 600u);
+}
+
+// An index above 10 (which no scene takes) is refused with its file and line, as one below 1 is.
+TEST(IndexCsv, IndexAboveTenIsRefused) {
+  expectError([] { parseIndexCsv("wavelength_nm,n\n500,9.5\n600,12\n", "big.csv"); },
+              {"big.csv:3", "n must be <= 10, got 12"});
+  EXPECT_EQ(parseIndexCsv("wavelength_nm,n\n500,10\n600,9.9\n", "ok.csv").modes[0].size(), 2u);
+}
+
 // Whole terms may be left out (they count as zero), never part of one: formula 2 with "0 1" was
 // read as n² = 1 + 1·λ²/(λ² − 0), n = √2 at every wavelength.
 TEST(RefractiveIndexFormula, ALastTermGivenInPartIsAnError) {
