@@ -414,7 +414,12 @@ bool Session::renderReady(const RenderSettings& settings) {
 
 RenderImage Session::render(const RenderSettings& settings, bool gpu) {
   checkCamera(scene_->camera, scene_->file);  // edited since parsing (Python, the viewer)
-  checkRenderFitsHost(*scene_, settings);
+  // The host's memory is read (several /proc and cgroup files) only for an image larger than
+  // one this session found room for: not on every frame of the viewer.
+  if (renderHostBytes(*scene_, settings) > render_bytes_fitted_) {
+    checkRenderFitsHost(*scene_, settings);
+    render_bytes_fitted_ = renderHostBytes(*scene_, settings);
+  }
   RenderSettings rs = settings;
   if (progress_.update && !rs.progress)
     rs.progress = [this](double f) { progress_.update("rendering", f); };

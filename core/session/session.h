@@ -252,6 +252,7 @@ class Session {
   ContextSource context_source_;
   SessionProgress progress_;
   int threads_ = 0;
+  double render_bytes_fitted_ = 0;  ///< the largest renderHostBytes checkRenderFitsHost passed
   std::shared_ptr<vk::Context> ctx_;
   std::unique_ptr<VolumeSet> volume_;
   std::filesystem::path volume_cache_;
