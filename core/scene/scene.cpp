@@ -1392,6 +1392,38 @@ static void warnObjectsNearFaces(Scene& scene, const std::set<size_t>& covering,
   warnings.finish();
 }
 
+/// A camera or a point or spot light inside an opaque object sees or lights nothing of the scene
+/// (every ray from it starts inside the object and ends at once): legal, but never what is meant,
+/// so it is said (and --strict refuses it). The innermost opaque object named is the first found.
+static void warnInsideOpaque(Scene& scene, const std::vector<size_t>& json_index,
+                             const std::string& file) {
+  auto opaqueAround = [&](const glm::dvec3& p) -> std::optional<size_t> {
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const SceneObject& o = scene.objects[i];
+      if (scene.materials.at(o.material).opacity >= 0.5 && o.shape.contains(p)) return i;
+    }
+    return std::nullopt;
+  };
+  auto where = [&](size_t i) {
+    return "inside the opaque object /objects/" + std::to_string(json_index[i]) + " ('" +
+           excerpt(scene.objects[i].material) + "')";
+  };
+  const glm::dvec3 c = scene.camera.position;
+  if (auto i = opaqueAround(c))
+    scene.warnings.push_back(printable(file + ": /camera/position: the camera at (" + fmt(c.x) +
+                                       ", " + fmt(c.y) + ", " + fmt(c.z) + ") is " + where(*i) +
+                                       ": every ray starts there and the image is black"));
+  for (size_t k = 0; k < scene.lights.size(); ++k) {
+    const Light& l = scene.lights[k];
+    if (l.type == Light::Type::Directional) continue;
+    if (auto i = opaqueAround(l.position))
+      scene.warnings.push_back(
+          printable(file + ": /lights/" + std::to_string(k) + "/position: the light at (" +
+                    fmt(l.position.x) + ", " + fmt(l.position.y) + ", " + fmt(l.position.z) +
+                    ") is " + where(*i) + ": none of its light reaches the rest of the scene"));
+  }
+}
+
 /// A material no object uses is left out (it was parsed and checked like the others): the
 /// volume's features (dispersive, attenuating, scattering, uniaxial…) are those of its materials,
 /// so an unused dispersive material would make a render spectral and its light 12 bands. Not a
@@ -1437,6 +1469,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     if (!ls->isArray()) ls->fail("expected an array of lights");
     for (size_t i = 0; i < ls->size(); ++i) scene.lights.push_back(parseLight(ls->index(i)));
   }
+  warnInsideOpaque(scene, json_index, file);
   return scene;
 }
 

@@ -82,5 +82,45 @@ TEST(SceneWarnings, TooManyObjectsIsRefusedBeforeAnyWarning) {
   }
 }
 
+// A camera, or a point or spot light, inside an opaque object sees or lights nothing: said, with
+// the JSON paths of both. Inside a translucent object, outside the opaque one, or a directional
+// light (no position of its own) is not.
+Scene withOpaqueBox(const std::string& camera, const std::string& lights) {
+  return parseScene(R"({"camera": {"position": )" + camera + R"(, "look_at": [0, 0, 5]},
+          "volume": {"bounds_min": [-10, -10, -10], "bounds_max": [10, 10, 10], "resolution": 32},
+          "materials": {"glass": {"n": 1.5}, "wall": {"n": 1, "opacity": 1, "albedo": 0.5}},
+          "objects": [{"shape": "sphere", "center": [0, 5, 0], "radius": 2, "material": "glass"},
+                      {"shape": "box", "center": [0, -6, 0], "size": [8, 2, 8], "material": "wall"}],
+          "lights": [)" +
+                        lights + "]}",
+                    "opaque.json");
+}
+
+TEST(SceneWarnings, CameraOrLightInsideAnOpaqueObjectIsSaid) {
+  const std::string point_in = R"({"type": "point", "position": [1, -6.5, 1], "intensity": 1})";
+  const std::string spot_in = R"({"type": "spot", "position": [0, -5.5, 0], "direction": [0, 1,
+      0], "cone_half_angle_deg": 20, "intensity": 1})";
+  const std::string directional_in =
+      R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1})";
+
+  Scene clear = withOpaqueBox("[0, -4.9, -9]", R"({"type": "point", "position": [0, -4.9, 0],
+      "intensity": 1}, {"type": "point", "position": [0, 5, 0], "intensity": 1}, )" +
+                                                   directional_in);
+  EXPECT_TRUE(clear.warnings.empty()) << clear.warnings[0];  // just above the box; in the glass
+
+  Scene cam = withOpaqueBox("[0, -6, -3.9]", directional_in);
+  ASSERT_EQ(cam.warnings.size(), 1u);
+  EXPECT_EQ(cam.warnings[0],
+            "opaque.json: /camera/position: the camera at (0, -6, -3.9) is inside the opaque "
+            "object /objects/1 ('wall'): every ray starts there and the image is black");
+
+  Scene lit = withOpaqueBox("[0, 0, -9]", directional_in + ", " + point_in + ", " + spot_in);
+  ASSERT_EQ(lit.warnings.size(), 2u);
+  EXPECT_EQ(lit.warnings[0],
+            "opaque.json: /lights/1/position: the light at (1, -6.5, 1) is inside the opaque "
+            "object /objects/1 ('wall'): none of its light reaches the rest of the scene");
+  EXPECT_NE(lit.warnings[1].find("/lights/2/position"), std::string::npos) << lit.warnings[1];
+}
+
 }  // namespace
 }  // namespace eikon
