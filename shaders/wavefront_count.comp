@@ -1,10 +1,11 @@
 #version 450
 // Count passes of the light simulator's list rebuild (see wavefront.comp and
 // docs/light-simulator.md): per patch of the source list, its number of outputs (0 dead or out of
-// steps, 1 kept, 4 split one level or torn into pencils) into scan[i], and in the COUNT pass the workgroup's kill
-// statistics and probe-plane sums reduced in shared memory (a tree of EIKON_WAVE_WG lanes, float sums) into
-// tally[workgroup], which the host adds in double. A separate shader from wavefront.comp so that
-// the propagation shader carries no barrier (llvmpipe implements barriers with coroutines).
+// steps, 1 kept, 4 split one level or torn into pencils) into scan[i], and in the COUNT and BUDGET
+// passes the workgroup's kill statistics and probe-plane sums reduced in shared memory (a tree of
+// EIKON_WAVE_WG lanes, float sums) into tally[workgroup], which the host adds in double. A separate
+// shader from wavefront.comp so that the propagation shader carries no barrier (llvmpipe
+// implements barriers with coroutines).
 #extension GL_GOOGLE_include_directive : require
 #include "eikon_shared.h"
 
@@ -77,10 +78,16 @@ void countPass(uint id, uint lid, uint mode) {
     cb.w = uint(max(p.state.w, 0));
     uint c = wantSplit ? 4u : keep;
     if (mode == EIKON_WM_COUNT_SPLITS) c = wantSplit ? 1u : 0u;
-    if (mode == EIKON_WM_COUNT_BUDGET && wantSplit) c = scan[id] < pc.control.z ? 4u : 1u;
+    if (mode == EIKON_WM_COUNT_BUDGET && wantSplit) {
+      const bool granted = scan[id] < pc.control.z;
+      c = granted ? 4u : 1u;
+      if (!granted) cen.w = 0.0;  // a refused tear goes on whole: no pencils, not a tear
+    }
     scan[id] = c;
   }
-  if (mode != EIKON_WM_COUNT) return;  // uniform: the push constant
+  // The COUNT pass tallies every patch; the BUDGET pass tallies again so that the host reads the
+  // tears granted (caustic_sum.w), not those asked for. Uniform: the push constant.
+  if (mode == EIKON_WM_COUNT_SPLITS) return;
   sFluxA[lid] = fa;
   sFluxB[lid] = fb;
   sCentroid[lid] = cen;

@@ -174,6 +174,7 @@ struct GpuWavefront::Impl {
   ScanKernel* scanner = nullptr;
   size_t list_cap = 0;                  // patches the scan and tally buffers hold
   std::vector<gpu::WaveTally> tallies;  // the last pass's, read back
+  size_t asked_tears = 0;               // tears asked for in the pass addTallies read last
   double il2 = 0, il4 = 0, n_min = 1.0;
 
   Impl(vk::Context& c, const VolumeSet& v, WavefrontSettings settings, int k,
@@ -540,12 +541,13 @@ struct GpuWavefront::Impl {
     tallies.resize(groups(n));
     tally.read(tallies.data(), tallies.size() * sizeof(gpu::WaveTally));
     survivors = 0, want_split = 0;
+    size_t pass_tears = 0;
     for (const gpu::WaveTally& t : tallies) {
       st.flux_left += t.flux_a.x, st.flux_caustic += t.flux_a.y, st.flux_energy += t.flux_a.z;
       st.flux_absorbed += double(t.flux_a.w) + double(t.flux_b.x);
       st.flux_live_at_end += t.flux_b.y;
       st.caustic_centroid += glm::dvec3(glm::vec3(t.caustic_sum));
-      st.tears += size_t(t.caustic_sum.w);  // asked for (granted unless the budget binds)
+      pass_tears += size_t(t.caustic_sum.w);  // asked for: grantSplits counts those granted
       st.kills_left += t.count_a.x, st.kills_caustic += t.count_a.y, st.kills_energy += t.count_a.z;
       st.kills_opaque += t.count_a.w;
       st.live_at_end += t.count_b.x;
@@ -557,6 +559,8 @@ struct GpuWavefront::Impl {
       st.probe_direction += glm::dvec3(glm::vec3(t.probe_dir));
       st.flux_reflected += t.probe_dir.w;
     }
+    st.tears += pass_tears;
+    asked_tears = pass_tears;
   }
 
   /// The next list's length when the pass over list `src` (n patches) asks for more than the
@@ -575,6 +579,11 @@ struct GpuWavefront::Impl {
     });
     st.splits += granted;
     st.splits_refused += want_split - granted;
+    // The BUDGET pass tallied again, counting only the tears granted (a refused one goes on whole).
+    tally.read(tallies.data(), tallies.size() * sizeof(gpu::WaveTally));
+    size_t granted_tears = 0;
+    for (const gpu::WaveTally& t : tallies) granted_tears += size_t(t.caustic_sum.w);
+    st.tears = st.tears - asked_tears + granted_tears;
     return readTotal();
   }
 

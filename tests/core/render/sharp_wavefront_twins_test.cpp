@@ -247,6 +247,29 @@ TEST(SharpWavefrontTwins, ApexTearsIntoPencilsOnBoth) {
   test::expectNoValidationMessages();
 }
 
+// The same apex with a patch budget that binds: a tear granted becomes four pencils and counts as
+// a split too, a tear refused goes on whole and is no tear. So on both twins tears ≤ splits
+// granted, and refusals happen. (The GPU once counted the tears asked for: with the budget at
+// 40 it reported 15 tears for 12 splits.)
+TEST(SharpWavefrontTwins, ApexTearsRefusedByTheBudgetAreNotCounted) {
+  const VolumeSet vol = voxelize(sceneFromJson(kSharpApexPrismScene));
+  const double yA = std::sqrt(3.0);
+  WavefrontSettings s;
+  const Light light = beam({-2.4, yA - 0.3, 0.0}, {1, 0, 0}, 1.0, 1.0);
+  // The first pass ends with 12 torn patches asking for pencils and every other patch gone
+  // (total 12 + 3·12 = 48): a budget of 40 grants 9, and the 3 refused, still torn, ask again.
+  s.max_patches = 40;
+  const Twins tw = runTwins(vol, s, light);
+  for (const WavefrontStats* st : {&tw.cpu.stats, &tw.gpu.stats}) {
+    std::printf("[ measured ] budget %d: seeded %zu, splits %zu, refused %zu, tears %zu\n",
+                s.max_patches, st->seeded, st->splits, st->splits_refused, st->tears);
+    EXPECT_GT(st->splits_refused, 0u);
+    EXPECT_LE(st->tears, st->splits);
+    EXPECT_LE(st->max_live, std::max(st->seeded, size_t(s.max_patches)));  // seeds: not budgeted
+  }
+  test::expectNoValidationMessages();
+}
+
 /// The beam straight down on the apex of `vol`'s prism through both twins (caustics passed, as
 /// renders: the halves cross below the apex): tears on both, no light in the gap below, the
 /// flux accounted for. Returns the settings used.
