@@ -1056,7 +1056,8 @@ int regionAt(vec3 x) { return EIKON_REGION_ON_SHAPES ? exactRegionAt(x) : bounda
 // exactCrossingOutOf): pass 0 over the shapes from the ray's own on finds where the line leaves
 // its shape or enters a later one, pass 1 over all the region just past that point (the last
 // shape whose interval holds it) and its entry normal. One loop body (exactClip inlined once);
-// ~2 × the shape count loop passes and no voxel read per crossing.
+// at most ~2 × the shape count loop passes (with more than kExactUnrollShapes shapes, pass 1 only
+// over the shapes up to the ray's own) and no voxel read per crossing.
 // One shape's clip folded into pass 0 (the ray's own shape: where the line leaves it; a later one:
 // where it enters) or pass 1 (the last shape holding the point tq just past the crossing).
 void exactPass0(int i, int region, float eps, LineClip c, inout float t, inout vec3 nOwn,
@@ -1123,23 +1124,43 @@ BoundaryCrossing exactCrossingOutOf(vec3 a, vec3 b, int region) {
     // Both passes in one do-while over k: shape k of pass 0 for k < S (from the ray's own shape
     // on), shape k − S of pass 1 after it. llvmpipe leaves a loop only at the end of its body, so
     // a while-loop of N passes runs its body N + 1 times (the last one masked off): a do-while
-    // runs it N times.
-    int k = max(region - 1, 0);
+    // runs it N times. Pass 0 keeps the clip of the last later shape that holds t + ε for the t
+    // found so far (`held`, shape `cand`); t only falls at a later shape that is then the last one
+    // to hold it, so after pass 0 `cand` is the shape pass 1 would end on, and pass 1 runs only
+    // over the shapes before the ray's own and its own (kept: `own`), never clipping a later
+    // shape, or a later mesh's tree, twice. cand = −1: no later shape holds tq; −2: t fell at a
+    // shape that does not hold t + ε (float rounding), so pass 1 asks every shape as before.
+    int k = max(region - 1, 0), end = S, cand = -1;
+    LineClip held = clipOpen(), own = clipOpen();
+    own.hit = false;
     do {
       const bool second = k >= S;
-      if (k == S) {  // pass 0 done: no crossing on [a, b], or the point just past it
+      const int i = second ? k - S : k;
+      LineClip c = second && i + 1 == region ? own
+                   : second && exactEarlierMesh(i, region) ? exactEarlierMeshClip(i, a, d, tq)
+                   : exactShapeClip(i, a, d, region, eps);
+      if (second) {
+        exactPass1(i, tq, c, to, nTo, fTo);
+      } else {
+        const float before = t;
+        exactPass0(i, region, eps, c, t, nOwn, fOwn);
+        const float tNow = t + eps;
+        if (i + 1 == region) {
+          own = c;
+        } else if (c.hit && c.t0 <= tNow && tNow <= c.t1) {
+          cand = i;
+          held = c;
+        } else if (t < before) {
+          cand = -2;
+        }
+      }
+      if (++k == S) {  // pass 0 done: no crossing on [a, b], or the point just past it
         none = t > 1.0;
         tq = t + eps;
+        if (!none && cand >= 0) exactPass1(cand, tq, held, to, nTo, fTo);
+        end = none || cand >= 0 ? S : S + (cand == -2 ? S : region);
       }
-      if (!none) {
-        const int i = second ? k - S : k;
-        LineClip c = second && exactEarlierMesh(i, region) ? exactEarlierMeshClip(i, a, d, tq)
-                                                           : exactShapeClip(i, a, d, region, eps);
-        if (second) exactPass1(i, tq, c, to, nTo, fTo);
-        else exactPass0(i, region, eps, c, t, nOwn, fOwn);
-      }
-      ++k;
-    } while (k < 2 * S && !none);
+    } while (k < end);
   }
   if (none || to == region) return out_;
   int owner = max(region, to);
