@@ -451,7 +451,7 @@ void checkIndicesAt(const Scene& scene, double lambda_nm) {
     for (const Dispersion* d : {&m.n_o, &m.n_e}) {
       if (d == &m.n_e && !m.uniaxial) break;
       const double n = d->index(lambda_nm);
-      if (n >= 1.0 && n <= 10.0) continue;
+      if (n >= kMinIndex && n <= kMaxIndex) continue;
       char value[64];
       std::snprintf(value, sizeof value, "%.6g at %.6g nm", n, lambda_nm);
       throw SettingError("wavelength", "leaves the index of material '" + name + "'" +
