@@ -42,6 +42,9 @@ void checkSetting(F&& check) {
 py::dict outcomeDict(const TraceOutcome& t, const char* mode);
 /// Column-wise arrays of many outcomes of one mode.
 py::dict outcomesArrays(const std::vector<TraceOutcome>& v, const char* mode);
+/// The number of rays makeRequests would make, from the shapes alone (nothing is copied).
+size_t rayCount(const py::handle& origins, const py::handle& directions,
+                const py::handle& wavelengths);
 /// (N,3) rays from origins/directions (each (3,) or (N,3)) and wavelengths (scalar or (N,)).
 std::vector<TraceRequest> makeRequests(const py::handle& origins, const py::handle& directions,
                                        const py::handle& wavelengths);
