@@ -103,6 +103,15 @@ IndexData readRefractiveIndexYaml(const std::string& path, const IndexReadOption
 IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& name,
                                    const IndexReadOptions& options = {});
 
+/// A series given as arrays (Python's fit_dispersion) checked as a file's rows are (the
+/// validation above): equal lengths, every value finite, λ in [kMinFitWavelengthNm,
+/// kMaxFitWavelengthNm], n in [kMinFitIndex, kMaxFitIndex], σ finite and > 0, at least two points,
+/// no repeated wavelength. Errors (std::invalid_argument) name the point, "point 3: n must be >=
+/// 1, got 0.5", or `name` for the whole; points out of order are sorted, with a warning in
+/// `warnings` ("NAME: n points are not in ascending wavelength order; sorted them").
+IndexSeries checkIndexSeries(const IndexSeries& series, const std::string& name,
+                             std::vector<std::string>& warnings);
+
 /// Dispatch on the extension: .csv → CSV; .yml/.yaml → YAML; anything else is an error.
 IndexData readIndexData(const std::string& path, const IndexReadOptions& options = {});
 
