@@ -3,10 +3,13 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <map>
 #include <mutex>
 #include <stdexcept>
 
+#include "core/scene/limits.h"
 #include "core/vk/context.h"
 #include "python/module.h"
 
@@ -36,6 +39,65 @@ std::vector<double> toVector(const py::handle& h) {
   if (!a || a.ndim() != 1) throw std::invalid_argument("expected a 1-D sequence of numbers");
   return {a.data(), a.data() + a.size()};
 }
+std::string fmtNumber(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+glm::dvec3 toFiniteVec3(const py::handle& h, const char* name) {
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
+  if (!a || a.size() != 3)
+    throw std::invalid_argument(std::string(name) + " must be three numbers");
+  const glm::dvec3 v(a.data()[0], a.data()[1], a.data()[2]);
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(v[k]))
+      throw std::invalid_argument(std::string(name) + " must be three finite numbers, got " +
+                                  fmtNumber(v[k]) + " on " + "xyz"[k]);
+  return v;
+}
+
+glm::dvec3 toPosition(const py::handle& h, const char* name) {
+  const glm::dvec3 v = toFiniteVec3(h, name);
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(v[k]) > kMaxCoordinateMm)
+      throw std::invalid_argument(std::string(name) +
+                                  " must be within ±1e12 mm on each axis, got " + fmtNumber(v[k]) +
+                                  " on " + "xyz"[k]);
+  return v;
+}
+
+glm::dvec3 toDirection(const py::handle& h, const char* name) {
+  const glm::dvec3 v = toFiniteVec3(h, name);
+  const double len = glm::length(v);
+  if (!(len > 0)) throw std::invalid_argument(std::string(name) + " must be a non-zero vector");
+  if (!std::isfinite(len))
+    throw std::invalid_argument(std::string(name) + " must have a finite length (scale it down)");
+  return v;
+}
+
+double checkIndex(double n, const char* name) {
+  if (!(n >= kMinIndex && n <= kMaxIndex))
+    throw std::invalid_argument(std::string(name) + " must be a refractive index in [" +
+                                fmtNumber(kMinIndex) + ", " + fmtNumber(kMaxIndex) + "], got " +
+                                fmtNumber(n));
+  return n;
+}
+
+double checkPositive(double v, const char* name) {
+  if (!(v > 0) || !std::isfinite(v))
+    throw std::invalid_argument(std::string(name) + " must be a finite number > 0, got " +
+                                fmtNumber(v));
+  return v;
+}
+
+double checkWavelength(double nm, const char* name, double lo, double hi) {
+  if (!(nm >= lo && nm <= hi))
+    throw std::invalid_argument(std::string(name) + " must be in [" + fmtNumber(lo) + ", " +
+                                fmtNumber(hi) + "] nm, got " + fmtNumber(nm));
+  return nm;
+}
+
 py::array_t<double> fromVector(const std::vector<double>& v) {
   return py::array_t<double>(py::ssize_t(v.size()), v.data());
 }
