@@ -336,6 +336,10 @@ void checkSeries(const IndexSeries& d, const FitOptions& opt, const std::string&
       << *opt.huber_delta;
     throw std::invalid_argument(m.str());
   }
+  if (opt.max_iterations < 1 || opt.max_iterations > kMaxFitIterations)
+    throw std::invalid_argument("max_iterations must be in [1, " +
+                                std::to_string(kMaxFitIterations) + "], got " +
+                                std::to_string(opt.max_iterations));
   for (int i = 0; i < N; ++i)
     if (!(std::isfinite(d.lambda_nm[i]) && d.lambda_nm[i] > 0 && std::isfinite(d.n[i])))
       throw std::invalid_argument(who + ": point " + std::to_string(i) +

@@ -71,8 +71,13 @@ struct FitOptions {
   /// Huber loss scale δ in units of the residual r (σ units with a σ column, index units
   /// without), in [kMinHuberDelta, kMaxHuberDelta]. Absent: plain least squares.
   std::optional<double> huber_delta;
+  /// Levenberg–Marquardt iterations at most, in [1, kMaxFitIterations].
   int max_iterations = 200;
 };
+
+/// The most iterations a fit may be given: 500 times the default, which the fits converge well
+/// within; more only lets a diverging fit run longer.
+inline constexpr int kMaxFitIterations = 100000;
 
 /// The Huber scales a fit takes. 1e-9 is far below any measured index's precision (1e-6 at
 /// best) or a useful fraction of a σ, and above it the robustified Jacobian stays usable; a
@@ -107,7 +112,8 @@ struct FitResult {
 };
 
 /// Weighted (robust) least-squares fit; throws std::invalid_argument for unusable input
-/// (fewer points than parameters, δ outside [kMinHuberDelta, kMaxHuberDelta]) and
+/// (fewer points than parameters, δ outside [kMinHuberDelta, kMaxHuberDelta], max_iterations
+/// outside [1, kMaxFitIterations]) and
 /// std::runtime_error if the fit fails, is rank-deficient, or gives a coefficient or a σ that is
 /// not finite. Messages name the series label.
 FitResult fitDispersion(const IndexSeries& data, const FitOptions& options = {});

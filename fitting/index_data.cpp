@@ -66,6 +66,9 @@ struct Pending {
   IndexSeries series;
   std::vector<std::string> where;
   std::optional<std::array<double, 2>> window_nm;
+  const char* outside_hint =
+      " (--range-nm leaves rows out)";  ///< after "the wavelengths a fit takes"
+  const char* rows = "rows";            ///< what a point is, in messages
 
   void add(double lambda_nm, double n, std::optional<double> sigma, const std::string& at) {
     if (!std::isfinite(lambda_nm))
@@ -78,7 +81,7 @@ struct Pending {
     if (!(lambda_nm >= kMinFitWavelengthNm && lambda_nm <= kMaxFitWavelengthNm))
       throw std::invalid_argument(at + ": wavelength " + fmt(lambda_nm) + " nm is outside [" +
                                   fmt(kMinFitWavelengthNm) + ", " + fmt(kMaxFitWavelengthNm) +
-                                  "] nm, the wavelengths a fit takes (--range-nm leaves rows out)");
+                                  "] nm, the wavelengths a fit takes" + outside_hint);
     if (n < kMinFitIndex)
       throw std::invalid_argument(at + ": " + series.label + " must be >= 1, got " + fmt(n));
     if (n > kMaxFitIndex)
@@ -127,8 +130,8 @@ IndexSeries finish(Pending p, const std::string& name, const IndexReadOptions& o
       out.n.push_back(s.n[i]);
       if (s.weighted()) out.sigma.push_back(s.sigma[i]);
     }
-    warnings.push_back(name + ": " + out.label +
-                       " rows are not in ascending wavelength order; sorted them");
+    warnings.push_back(name + ": " + out.label + " " + p.rows +
+                       " are not in ascending wavelength order; sorted them");
     return out;
   }
   return s;
@@ -144,6 +147,27 @@ void checkOptions(const IndexReadOptions& opt) {
 }
 
 }  // namespace
+
+IndexSeries checkIndexSeries(const IndexSeries& series, const std::string& name,
+                             std::vector<std::string>& warnings) {
+  const size_t N = series.lambda_nm.size();
+  if (series.n.size() != N || (series.weighted() && series.sigma.size() != N))
+    throw std::invalid_argument(name + ": " + std::to_string(N) + " wavelengths, " +
+                                std::to_string(series.n.size()) + " indices" +
+                                (series.weighted()
+                                     ? " and " + std::to_string(series.sigma.size()) + " sigmas"
+                                     : std::string()) +
+                                ": each point needs one of each");
+  Pending p;
+  p.series.label = series.label;
+  p.outside_hint = "";
+  p.rows = "points";
+  for (size_t i = 0; i < N; ++i)
+    p.add(series.lambda_nm[i], series.n[i],
+          series.weighted() ? std::optional<double>(series.sigma[i]) : std::nullopt,
+          "point " + std::to_string(i));
+  return finish(std::move(p), name, IndexReadOptions{}, warnings);
+}
 
 IndexData parseIndexCsv(const std::string& text, const std::string& name,
                         const IndexReadOptions& opt) {

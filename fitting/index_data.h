@@ -38,6 +38,8 @@
 #include <string>
 #include <vector>
 
+#include "core/scene/limits.h"
+
 namespace eikon {
 
 /// One dispersion curve n(λ): wavelengths ascending, in nm.
@@ -84,11 +86,11 @@ inline constexpr long long kMaxFormulaSamplesTotal = 1000000;
 inline constexpr double kMinFitWavelengthNm = 100.0;
 inline constexpr double kMaxFitWavelengthNm = 100000.0;
 
-/// The indices a fit takes: [1, 10], those a scene's materials may have (core/scene/scene.cpp);
+/// The indices a fit takes: [1, 10], those a scene's materials may have (core/scene/limits.h);
 /// data above 10 made a material that `eikon fit` wrote and the scene loader refused. A row
 /// outside is refused with its file and line (after the window has dropped what it leaves out).
-inline constexpr double kMinFitIndex = 1.0;
-inline constexpr double kMaxFitIndex = 10.0;
+inline constexpr double kMinFitIndex = kMinIndex;
+inline constexpr double kMaxFitIndex = kMaxIndex;
 
 /// Strict CSV reader (format above). Throws with "path:line: message".
 IndexData readIndexCsv(const std::string& path, const IndexReadOptions& options = {});
@@ -100,6 +102,15 @@ IndexData parseIndexCsv(const std::string& text, const std::string& name,
 IndexData readRefractiveIndexYaml(const std::string& path, const IndexReadOptions& options = {});
 IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& name,
                                    const IndexReadOptions& options = {});
+
+/// A series given as arrays (Python's fit_dispersion) checked as a file's rows are (the
+/// validation above): equal lengths, every value finite, λ in [kMinFitWavelengthNm,
+/// kMaxFitWavelengthNm], n in [kMinFitIndex, kMaxFitIndex], σ finite and > 0, at least two points,
+/// no repeated wavelength. Errors (std::invalid_argument) name the point, "point 3: n must be >=
+/// 1, got 0.5", or `name` for the whole; points out of order are sorted, with a warning in
+/// `warnings` ("NAME: n points are not in ascending wavelength order; sorted them").
+IndexSeries checkIndexSeries(const IndexSeries& series, const std::string& name,
+                             std::vector<std::string>& warnings);
 
 /// Dispatch on the extension: .csv → CSV; .yml/.yaml → YAML; anything else is an error.
 IndexData readIndexData(const std::string& path, const IndexReadOptions& options = {});

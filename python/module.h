@@ -22,6 +22,21 @@ glm::dvec3 toVec3(const py::handle& h);
 py::array_t<double> fromVec3(const glm::dvec3& v);
 py::array_t<double> fromMat3(const glm::dmat3& M);
 std::vector<double> toVector(const py::handle& h);
+// Arguments checked as the rest of eikon checks them, each ValueError naming the argument:
+/// Three finite numbers.
+glm::dvec3 toFiniteVec3(const py::handle& h, const char* name);
+/// A point within ±kMaxCoordinateMm mm on each axis (core/scene/limits.h), as a scene's.
+glm::dvec3 toPosition(const py::handle& h, const char* name);
+/// A direction: three finite numbers of non-zero, finite length (not normalised).
+glm::dvec3 toDirection(const py::handle& h, const char* name);
+/// A refractive index in [kMinIndex, kMaxIndex] = [1, 10] (core/scene/limits.h).
+double checkIndex(double n, const char* name);
+/// A finite number > 0 (a length in mm, a cell size, ...).
+double checkPositive(double v, const char* name);
+/// A wavelength in [lo, hi] nm.
+double checkWavelength(double nm, const char* name, double lo, double hi);
+/// "%.10g" of a number, for messages.
+std::string fmtNumber(double v);
 py::array_t<double> fromVector(const std::vector<double>& v);
 Mode parseMode(const std::string& s);
 std::string integratorName(Integrator i);
@@ -42,6 +57,9 @@ void checkSetting(F&& check) {
 py::dict outcomeDict(const TraceOutcome& t, const char* mode);
 /// Column-wise arrays of many outcomes of one mode.
 py::dict outcomesArrays(const std::vector<TraceOutcome>& v, const char* mode);
+/// The number of rays makeRequests would make, from the shapes alone (nothing is copied).
+size_t rayCount(const py::handle& origins, const py::handle& directions,
+                const py::handle& wavelengths);
 /// (N,3) rays from origins/directions (each (3,) or (N,3)) and wavelengths (scalar or (N,)).
 std::vector<TraceRequest> makeRequests(const py::handle& origins, const py::handle& directions,
                                        const py::handle& wavelengths);

@@ -3,15 +3,62 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
+#include "core/scene/limits.h"
 #include "core/scene/scene.h"
+#include "fitting/index_data.h"
 #include "optics/dispersion.h"
 #include "python/module.h"
 
 namespace eikon::python {
 
 namespace {
+// The wavelengths a dispersion model is evaluated at: those a fit takes (fitting/index_data.h),
+// which hold every material eikon writes or reads (λ = -5 nm gave an index).
+double checkLambda(double nm) {
+  return checkWavelength(nm, "lambda_nm", kMinFitWavelengthNm, kMaxFitWavelengthNm);
+}
+
+// The approximation's window inside the wavelengths above, and the model a refractive index in
+// [1, 10] on it: a Sellmeier pole there gave coefficients of ~1e15 without a word.
+void checkApproximationWindow(const Dispersion& d, double lo, double hi) {
+  checkWavelength(lo, "lo_nm", kMinFitWavelengthNm, kMaxFitWavelengthNm);
+  checkWavelength(hi, "hi_nm", kMinFitWavelengthNm, kMaxFitWavelengthNm);
+  if (!(lo < hi))
+    throw std::invalid_argument("lo_nm must be below hi_nm, got " + fmtNumber(lo) +
+                                " >= " + fmtNumber(hi));
+  if (d.kind() == Dispersion::Kind::Sellmeier)
+    for (size_t i = 0; i < d.sellmeierC().size(); ++i) {
+      const double pole = 1e3 * std::sqrt(d.sellmeierC()[i]);  // C in µm²
+      if (pole >= lo && pole <= hi)
+        throw std::invalid_argument(
+            "the Sellmeier term " + std::to_string(i + 1) + " has a pole at " + fmtNumber(pole) +
+            " nm (C" + std::to_string(i + 1) + " = " + fmtNumber(d.sellmeierC()[i]) +
+            " um^2), inside [" + fmtNumber(lo) + ", " + fmtNumber(hi) + "] nm");
+    }
+  const int samples = std::max(3, int(std::lround(hi - lo)) + 1);  // as cauchyApproximation
+  for (int i = 0; i < samples; ++i) {
+    const double l = lo + (hi - lo) * i / double(samples - 1), n = d.index(l);
+    if (!(n >= kMinIndex && n <= kMaxIndex))
+      throw std::invalid_argument("the model gives n = " + fmtNumber(n) + " at " + fmtNumber(l) +
+                                  " nm, inside [" + fmtNumber(lo) + ", " + fmtNumber(hi) +
+                                  "] nm: not a refractive index in [1, 10]");
+  }
+}
+
+// A material's index at one wavelength, refused (naming the material) outside [1, 10].
+double materialIndex(const Material& x, const Dispersion& d, const char* which, double nm) {
+  const double n = d.index(nm);
+  if (!(n >= kMinIndex && n <= kMaxIndex))
+    throw std::invalid_argument("material '" + x.name + "' " + which + " = " + fmtNumber(n) +
+                                " at " + fmtNumber(nm) +
+                                " nm is not a refractive index in [1, 10]");
+  return n;
+}
+
 void bindDispersionClass(py::module_& m) {
   py::dict fr;
   fr["F"] = fraunhofer::F;
@@ -21,7 +68,9 @@ void bindDispersionClass(py::module_& m) {
   m.attr("FRAUNHOFER") = fr;
 
   py::class_<Dispersion>(m, "Dispersion", "n(λ) of one material or mode; λ in nm.")
-      .def_static("constant", &Dispersion::constant, py::arg("n"))
+      .def_static(
+          "constant", [](double n) { return Dispersion::constant(checkIndex(n, "n")); },
+          py::arg("n"), "n(λ) = n, n in [1, 10]")
       .def_static(
           "cauchy", [](const py::handle& c) { return Dispersion::cauchy(toVector(c)); },
           py::arg("coeffs"), "n = Σ c_k/λ^{2k}, λ in µm")
@@ -66,19 +115,22 @@ void bindDispersionClass(py::module_& m) {
       .def(
           "index",
           [](const Dispersion& d, py::array_t<double> l) {
-            return py::vectorize([&d](double x) { return d.index(x); })(l);
+            return py::vectorize([&d](double x) { return d.index(checkLambda(x)); })(l);
           },
-          py::arg("lambda_nm"), "n(λ), broadcasting over arrays")
+          py::arg("lambda_nm"),
+          "n(λ), broadcasting over arrays, λ in [100, 100000] nm; NaN where a Sellmeier model has "
+          "no real index (n² ≤ 0 or a pole)")
       .def(
           "derivative",
           [](const Dispersion& d, py::array_t<double> l) {
-            return py::vectorize([&d](double x) { return d.derivative(x); })(l);
+            return py::vectorize([&d](double x) { return d.derivative(checkLambda(x)); })(l);
           },
           py::arg("lambda_nm"), "dn/dλ in 1/nm")
       .def("abbe_number", &Dispersion::abbeNumber, "V_d = (n_d − 1)/(n_F − n_C)")
       .def(
           "cauchy_approximation",
           [](const Dispersion& d, double lo, double hi) {
+            checkApproximationWindow(d, lo, hi);
             auto c = d.cauchyApproximation(lo, hi);
             py::dict r;
             r["coeffs"] = py::make_tuple(c.coeffs[0], c.coeffs[1], c.coeffs[2]);
@@ -86,7 +138,9 @@ void bindDispersionClass(py::module_& m) {
             r["rms_error"] = c.rms_error;
             return r;
           },
-          py::arg("lo_nm"), py::arg("hi_nm"))
+          py::arg("lo_nm"), py::arg("hi_nm"),
+          "Cauchy {A, B, C} over [lo, hi] nm (within [100, 100000], lo < hi); ValueError where "
+          "the model has no index in [1, 10] there (a Sellmeier pole)")
       .def("describe", &Dispersion::describe)
       .def("__repr__",
            [](const Dispersion& d) { return "<eikon.Dispersion " + d.describe() + ">"; });
@@ -111,9 +165,11 @@ void bindMaterials(py::module_& m) {
           "uniaxial_at",
           [](const Material& x, double lambda_nm, py::object axis) {
             if (!x.uniaxial) throw std::invalid_argument(x.name + " is not uniaxial");
-            glm::dvec3 a =
-                axis.is_none() ? x.optic_axis.value_or(glm::dvec3(0, 0, 1)) : toVec3(axis);
-            return Uniaxial(x.n_o.index(lambda_nm), x.n_e.index(lambda_nm), a);
+            checkLambda(lambda_nm);
+            glm::dvec3 a = axis.is_none() ? x.optic_axis.value_or(glm::dvec3(0, 0, 1))
+                                          : toDirection(axis, "axis");
+            return Uniaxial(materialIndex(x, x.n_o, "n_o", lambda_nm),
+                            materialIndex(x, x.n_e, "n_e", lambda_nm), a);
           },
           py::arg("lambda_nm"), py::arg("axis") = py::none(), "the crystal at one wavelength")
       .def("__repr__", [](const Material& x) {

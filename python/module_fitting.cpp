@@ -14,6 +14,14 @@
 
 namespace eikon::python {
 namespace {
+// One column of fit_dispersion: a 1-D sequence of numbers, else ValueError naming it.
+std::vector<double> seriesVector(const py::handle& h, const char* name) {
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
+  if (!a || a.ndim() != 1)
+    throw std::invalid_argument(std::string(name) + " must be a 1-D sequence of numbers");
+  return {a.data(), a.data() + a.size()};
+}
+
 void bindIndexData(py::module_& m) {
   py::class_<IndexSeries>(m, "IndexSeries")
       .def_readonly("label", &IndexSeries::label)
@@ -129,20 +137,29 @@ void bindFitting(py::module_& m) {
          int max_iterations) {
         IndexSeries s;
         s.label = label;
-        s.lambda_nm = toVector(lambda_nm);
-        s.n = toVector(n);
-        if (!sigma.is_none()) s.sigma = toVector(sigma);
+        s.lambda_nm = seriesVector(lambda_nm, "lambda_nm");
+        s.n = seriesVector(n, "n");
+        if (!sigma.is_none()) s.sigma = seriesVector(sigma, "sigma");
         FitOptions o;
         o.model = parseDispersionModel(model);
         o.huber_delta = huber_delta;
         o.max_iterations = max_iterations;
+        // The rules of `eikon fit`'s data files (fitting/index_data.h): out-of-order points are
+        // sorted with a warning (warnings.warn), the rest refused naming the point.
+        std::vector<std::string> warnings;
+        s = checkIndexSeries(s, "lambda_nm", warnings);
+        for (const std::string& w : warnings)
+          if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
         py::gil_scoped_release release;
         return fitDispersion(s, o);
       },
       py::arg("lambda_nm"), py::arg("n"), py::arg("sigma") = py::none(),
       py::arg("model") = "cauchy3", py::arg("huber_delta") = py::none(), py::arg("label") = "n",
       py::arg("max_iterations") = 200,
-      "Weighted (robust) least-squares fit: cauchy2|cauchy3|sellmeier1..3|conrady");
+      "Weighted (robust) least-squares fit: cauchy2|cauchy3|sellmeier1..3|conrady. The data "
+      "follow `eikon fit`'s rules: finite, lambda_nm in [100, 100000], n in [1, 10], sigma > 0, "
+      "no repeated wavelength (ValueError naming the point); unsorted points are sorted with a "
+      "UserWarning; max_iterations in [1, 100000]");
   m.def(
       "fit_series",
       [](const IndexSeries& s, const std::string& model, std::optional<double> huber_delta) {

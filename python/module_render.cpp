@@ -79,11 +79,25 @@ std::shared_ptr<Prepared> cachedPrepared(const std::shared_ptr<Scene>& s) {
   return g_last_prepared;
 }
 
+// light_cache=: True (the CLI's folder), False or None (no cache), or a folder as str or
+// os.PathLike; anything else is a TypeError (light_cache=5 made a folder named "5").
 std::string lightCacheDir(const py::object& light_cache) {
   if (light_cache.is_none()) return {};
   if (py::isinstance<py::bool_>(light_cache))
     return light_cache.cast<bool>() ? defaultLightCacheDir().string() : std::string();
-  return py::str(light_cache).cast<std::string>();
+  const py::object os = py::module_::import("os");
+  if (!py::isinstance<py::str>(light_cache) && !py::isinstance(light_cache, os.attr("PathLike")))
+    throw py::type_error(
+        "light_cache must be True, False, None or a folder (str or os.PathLike), got " +
+        py::str(py::type::of(light_cache).attr("__name__")).cast<std::string>());
+  const py::object path = os.attr("fspath")(light_cache);
+  if (!py::isinstance<py::str>(path))
+    throw py::type_error("light_cache must be a folder path as str, got " +
+                         py::str(py::type::of(path).attr("__name__")).cast<std::string>());
+  const std::string dir = path.cast<std::string>();
+  if (dir.empty())
+    throw std::invalid_argument("light_cache must name a folder, got '' (False: no cache)");
+  return dir;
 }
 
 bool isGpu(const std::string& device) {
@@ -193,7 +207,7 @@ py::object render(Prepared& p, int width, int height, int spp, std::optional<int
   view.polarised = polarised;
   RenderSettings settings;
   checkSetting([&] { settings = renderSettings(*p.scene, view); });
-  const std::string cache_dir = light ? lightCacheDir(light_cache) : std::string();
+  const std::string cache_dir = lightCacheDir(light_cache);  // checked even with light=False
   const RenderImage img = p.run([&](Session& s) {
     s.setThreads(threads);
     if (light && !p.scene->lights.empty() && !s.prepare(gpu).lit()) {
@@ -267,9 +281,20 @@ std::vector<std::array<TraceOutcome, 2>> traceBoth(Prepared& p,
   return p.run([&](Session& s) { return s.trace(req, ms, gpu); });
 }
 
+// Host memory trace_rays holds a ray besides the session's (traceHostBytes): its float64 copies
+// of an origin, a direction and a wavelength; the result arrays of both modes (three (N, 3) and
+// three (N,) float64, three int32 and a bool a ray each) and the wavelengths returned; and the
+// one mode's outcomes gathered at a time.
+constexpr double kTraceRaysBytesPerRay =
+    7 * 8.0 + 2 * (9 * 8.0 + 3 * 8.0 + 3 * 4.0 + 1.0) + 8.0 + double(sizeof(TraceOutcome));
+
 py::dict traceRays(Prepared& p, const py::handle& origins, const py::handle& directions,
                    const py::handle& wavelength_nm, std::optional<MarchSettings> march,
                    const std::string& device) {
+  // Refused with the numbers before any copy (1e9 rays of a broadcast view were copied until the
+  // kernel killed the process; 1e8 under a 6 GB limit raised a bare std::bad_alloc).
+  const size_t rays = rayCount(origins, directions, wavelength_nm);
+  checkTraceFitsHost(rays, double(rays) * kTraceRaysBytesPerRay);
   auto req = makeRequests(origins, directions, wavelength_nm);
   auto both = traceBoth(p, req, march, device);
   py::dict modes;

@@ -3,10 +3,13 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <map>
 #include <mutex>
 #include <stdexcept>
 
+#include "core/scene/limits.h"
 #include "core/vk/context.h"
 #include "python/module.h"
 
@@ -36,6 +39,65 @@ std::vector<double> toVector(const py::handle& h) {
   if (!a || a.ndim() != 1) throw std::invalid_argument("expected a 1-D sequence of numbers");
   return {a.data(), a.data() + a.size()};
 }
+std::string fmtNumber(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+glm::dvec3 toFiniteVec3(const py::handle& h, const char* name) {
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
+  if (!a || a.size() != 3)
+    throw std::invalid_argument(std::string(name) + " must be three numbers");
+  const glm::dvec3 v(a.data()[0], a.data()[1], a.data()[2]);
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(v[k]))
+      throw std::invalid_argument(std::string(name) + " must be three finite numbers, got " +
+                                  fmtNumber(v[k]) + " on " + "xyz"[k]);
+  return v;
+}
+
+glm::dvec3 toPosition(const py::handle& h, const char* name) {
+  const glm::dvec3 v = toFiniteVec3(h, name);
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(v[k]) > kMaxCoordinateMm)
+      throw std::invalid_argument(std::string(name) +
+                                  " must be within ±1e12 mm on each axis, got " + fmtNumber(v[k]) +
+                                  " on " + "xyz"[k]);
+  return v;
+}
+
+glm::dvec3 toDirection(const py::handle& h, const char* name) {
+  const glm::dvec3 v = toFiniteVec3(h, name);
+  const double len = glm::length(v);
+  if (!(len > 0)) throw std::invalid_argument(std::string(name) + " must be a non-zero vector");
+  if (!std::isfinite(len))
+    throw std::invalid_argument(std::string(name) + " must have a finite length (scale it down)");
+  return v;
+}
+
+double checkIndex(double n, const char* name) {
+  if (!(n >= kMinIndex && n <= kMaxIndex))
+    throw std::invalid_argument(std::string(name) + " must be a refractive index in [" +
+                                fmtNumber(kMinIndex) + ", " + fmtNumber(kMaxIndex) + "], got " +
+                                fmtNumber(n));
+  return n;
+}
+
+double checkPositive(double v, const char* name) {
+  if (!(v > 0) || !std::isfinite(v))
+    throw std::invalid_argument(std::string(name) + " must be a finite number > 0, got " +
+                                fmtNumber(v));
+  return v;
+}
+
+double checkWavelength(double nm, const char* name, double lo, double hi) {
+  if (!(nm >= lo && nm <= hi))
+    throw std::invalid_argument(std::string(name) + " must be in [" + fmtNumber(lo) + ", " +
+                                fmtNumber(hi) + "] nm, got " + fmtNumber(nm));
+  return nm;
+}
+
 py::array_t<double> fromVector(const std::vector<double>& v) {
   return py::array_t<double>(py::ssize_t(v.size()), v.data());
 }
@@ -130,6 +192,40 @@ py::dict outcomesArrays(const std::vector<TraceOutcome>& v, const char* mode) {
   return d;
 }
 
+// The rows of one input of makeRequests: -1 for a single (3,) vector (or a scalar wavelength).
+namespace {
+py::ssize_t rows(const py::array& a, const char* what, bool vectors) {
+  if (vectors) {
+    if (a.ndim() == 1 && a.shape(0) == 3) return -1;
+    if (a.ndim() == 2 && a.shape(1) == 3) return a.shape(0);
+    throw std::invalid_argument(std::string(what) + " must have shape (3,) or (N, 3)");
+  }
+  if (a.ndim() == 0) return -1;
+  if (a.ndim() == 1) return a.shape(0);
+  throw std::invalid_argument(std::string(what) + " must be a scalar or 1-D");
+}
+
+py::ssize_t commonRows(py::ssize_t no, py::ssize_t nd, py::ssize_t nl) {
+  const py::ssize_t N = std::max({no, nd, nl, py::ssize_t(1)});
+  for (py::ssize_t n : {no, nd, nl})
+    if (n >= 0 && n != N)
+      throw std::invalid_argument("origins, directions and wavelengths disagree in length");
+  return N;
+}
+}  // namespace
+
+// The shapes alone (numpy arrays are looked at, not copied: a broadcast view of 1e9 rays costs
+// nothing until converted).
+size_t rayCount(const py::handle& origins, const py::handle& directions,
+                const py::handle& wavelengths) {
+  auto O = py::array::ensure(origins), D = py::array::ensure(directions),
+       L = py::array::ensure(wavelengths);
+  if (!O || !D || !L)
+    throw std::invalid_argument("origins, directions and wavelengths must be numeric");
+  return size_t(commonRows(rows(O, "origins", true), rows(D, "directions", true),
+                           rows(L, "wavelengths", false)));
+}
+
 // (N,3) rays from origins/directions (each (3,) or (N,3)) and wavelengths (scalar or (N,)).
 std::vector<TraceRequest> makeRequests(const py::handle& origins, const py::handle& directions,
                                        const py::handle& wavelengths) {
@@ -138,18 +234,9 @@ std::vector<TraceRequest> makeRequests(const py::handle& origins, const py::hand
   auto L = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(wavelengths);
   if (!O || !D || !L)
     throw std::invalid_argument("origins, directions and wavelengths must be numeric");
-  auto rows = [](const py::array_t<double>& a, const char* what) -> py::ssize_t {
-    if (a.ndim() == 1 && a.shape(0) == 3) return -1;
-    if (a.ndim() == 2 && a.shape(1) == 3) return a.shape(0);
-    throw std::invalid_argument(std::string(what) + " must have shape (3,) or (N, 3)");
-  };
-  py::ssize_t no = rows(O, "origins"), nd = rows(D, "directions");
-  py::ssize_t nl = L.ndim() == 0 ? -1 : (L.ndim() == 1 ? L.shape(0) : -2);
-  if (nl == -2) throw std::invalid_argument("wavelengths must be a scalar or 1-D");
-  py::ssize_t N = std::max({no, nd, nl, py::ssize_t(1)});
-  for (py::ssize_t n : {no, nd, nl})
-    if (n >= 0 && n != N)
-      throw std::invalid_argument("origins, directions and wavelengths disagree in length");
+  const py::ssize_t no = rows(O, "origins", true), nd = rows(D, "directions", true),
+                    nl = rows(L, "wavelengths", false);
+  const py::ssize_t N = commonRows(no, nd, nl);
   std::vector<TraceRequest> req(static_cast<size_t>(N));
   for (py::ssize_t i = 0; i < N; ++i) {
     const double* o = O.data() + (no < 0 ? 0 : 3 * i);

@@ -874,52 +874,69 @@ std::vector<TraceOutcome> ViewRenderer::trace(const std::vector<TraceRequest>& r
   return out;
 }
 
+namespace {
+// Rays one trace dispatch takes: their two results must fit one storage buffer (128 MiB on
+// lavapipe: 1 Mi rays; 1.1 Mi rays failed to allocate "trace results") and their workgroups the
+// 65535 of maxComputeWorkGroupCount[0] every Vulkan device offers.
+size_t traceBatchRays(const vk::DeviceLimits& limits) {
+  const uint64_t by_buffer = limits.max_storage_buffer_range / (2 * sizeof(gpu::TraceResult));
+  return size_t(std::max<uint64_t>(1, std::min<uint64_t>(by_buffer, 65535ull * EIKON_TRACE_WG)));
+}
+
+TraceOutcome outcomeOf(const gpu::TraceResult& r) {
+  TraceOutcome o;
+  o.exit_point = glm::dvec3(r.exit_point);
+  o.left_volume = r.exit_point.w > 0.5f;
+  o.exit_direction = glm::normalize(glm::dvec3(r.exit_direction));
+  o.optical_path_mm = r.exit_direction.w;
+  o.wave_normal = glm::normalize(glm::dvec3(r.wave_normal));
+  o.transmittance = r.wave_normal.w;
+  o.steps = int(r.stats.x);
+  o.invariant_drift = r.stats.y;
+  o.interfaces = int(r.stats.z);
+  o.total_internal_reflections = int(r.stats.w);
+  return o;
+}
+}  // namespace
+
 std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(
     const std::vector<TraceRequest>& rays, const MarchSettings& m) {
   validate(m);
   Impl& I = *impl_;
   if (rays.empty()) return {};
-  std::vector<gpu::TraceRay> in(rays.size());
-  for (size_t i = 0; i < rays.size(); ++i) {
-    double len = glm::length(rays[i].direction);
+  for (const TraceRequest& q : rays) {
+    const double len = glm::length(q.direction);
     if (!(len > 0) || !std::isfinite(len))
       throw std::invalid_argument("trace direction must be a non-zero finite vector");
-    if (!(rays[i].wavelength_nm > 0))
-      throw std::invalid_argument("trace wavelength must be > 0 nm");
-    in[i].origin = glm::vec4(glm::vec3(rays[i].origin), float(rays[i].wavelength_nm * 1e-3));
-    in[i].direction = glm::vec4(glm::vec3(rays[i].direction / len), 0.0f);
+    if (!(q.wavelength_nm > 0)) throw std::invalid_argument("trace wavelength must be > 0 nm");
   }
-  gpu::ViewParams p = I.baseParams(m, 0);
-  p.image = glm::ivec4(int(rays.size()), 1, 0, 1);
-  I.params.write(&p, sizeof p);
-  vk::Buffer rb(I.ctx, in.size() * sizeof(gpu::TraceRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                "trace rays");
-  rb.write(in.data(), in.size() * sizeof(gpu::TraceRay));
-  vk::Buffer ob(I.ctx, 2 * in.size() * sizeof(gpu::TraceResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                "trace results");
-  vk::ComputePipeline& tracer = I.pipeline(Impl::kTrace, p);
-  tracer.bindBuffer(EIKON_B_RAYS, rb);
-  tracer.bindBuffer(EIKON_B_OUTPUT, ob);
-  I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
-    tracer.dispatch(cmd, uint32_t((in.size() + EIKON_TRACE_WG - 1) / EIKON_TRACE_WG), 1, 1,
-                    nullptr);
-  });
-  std::vector<gpu::TraceResult> res(2 * in.size());
-  ob.read(res.data(), res.size() * sizeof(gpu::TraceResult));
-  std::vector<std::array<TraceOutcome, 2>> out(in.size());
-  for (size_t i = 0; i < res.size(); ++i) {
-    const auto& r = res[i];
-    TraceOutcome& o = out[i / 2][i % 2];
-    o.exit_point = glm::dvec3(r.exit_point);
-    o.left_volume = r.exit_point.w > 0.5f;
-    o.exit_direction = glm::normalize(glm::dvec3(r.exit_direction));
-    o.optical_path_mm = r.exit_direction.w;
-    o.wave_normal = glm::normalize(glm::dvec3(r.wave_normal));
-    o.transmittance = r.wave_normal.w;
-    o.steps = int(r.stats.x);
-    o.invariant_drift = r.stats.y;
-    o.interfaces = int(r.stats.z);
-    o.total_internal_reflections = int(r.stats.w);
+  std::vector<std::array<TraceOutcome, 2>> out(rays.size());
+  const size_t batch = traceBatchRays(I.ctx.limits());
+  for (size_t first = 0; first < rays.size(); first += batch) {  // one dispatch a batch
+    const size_t count = std::min(batch, rays.size() - first);
+    std::vector<gpu::TraceRay> in(count);
+    for (size_t i = 0; i < count; ++i) {
+      const TraceRequest& q = rays[first + i];
+      in[i].origin = glm::vec4(glm::vec3(q.origin), float(q.wavelength_nm * 1e-3));
+      in[i].direction = glm::vec4(glm::vec3(q.direction / glm::length(q.direction)), 0.0f);
+    }
+    gpu::ViewParams p = I.baseParams(m, 0);
+    p.image = glm::ivec4(int(count), 1, 0, 1);
+    I.params.write(&p, sizeof p);
+    vk::Buffer rb(I.ctx, count * sizeof(gpu::TraceRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                  "trace rays");
+    rb.write(in.data(), count * sizeof(gpu::TraceRay));
+    vk::Buffer ob(I.ctx, 2 * count * sizeof(gpu::TraceResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                  "trace results");
+    vk::ComputePipeline& tracer = I.pipeline(Impl::kTrace, p);
+    tracer.bindBuffer(EIKON_B_RAYS, rb);
+    tracer.bindBuffer(EIKON_B_OUTPUT, ob);
+    I.ctx.submitAndWait([&](VkCommandBuffer cmd) {
+      tracer.dispatch(cmd, uint32_t((count + EIKON_TRACE_WG - 1) / EIKON_TRACE_WG), 1, 1, nullptr);
+    });
+    std::vector<gpu::TraceResult> res(2 * count);
+    ob.read(res.data(), res.size() * sizeof(gpu::TraceResult));
+    for (size_t i = 0; i < res.size(); ++i) out[first + i / 2][i % 2] = outcomeOf(res[i]);
   }
   return out;
 }

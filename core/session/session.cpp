@@ -108,6 +108,25 @@ void checkRenderFitsHost(const Scene& scene, const RenderSettings& rs) {
       " available (" + mem.limited_by + "); lower the width and height or leave out layers");
 }
 
+double traceHostBytes(size_t rays) {
+  // The request; four outcomes of a ray's two modes (the twin's, the session's, an isotropic
+  // scene's single-mode copy); a GPU ray (32 bytes) and its two results (2 × 64 bytes), each in a
+  // mapped buffer and in a host copy.
+  const double per_ray =
+      double(sizeof(TraceRequest)) + 5.0 * double(sizeof(TraceOutcome)) + 2.0 * (32.0 + 2.0 * 64.0);
+  return double(rays) * per_ray;
+}
+
+void checkTraceFitsHost(size_t rays, double caller_bytes) {
+  const double need = traceHostBytes(rays) + caller_bytes;
+  const HostMemory mem = availableHostMemory();
+  if (need <= double(mem.available)) return;
+  throw std::runtime_error("a trace of " + std::to_string(rays) + " rays needs about " +
+                           formatBytes(need) + " of host memory, " +
+                           formatBytes(double(mem.available)) + " available (" + mem.limited_by +
+                           "); trace fewer rays at a time");
+}
+
 void checkMarchStep(double step_voxels) {
   if (!(step_voxels > 0 && step_voxels <= 4))
     throw SettingError("step", "must be in (0, 4] voxels");
@@ -451,7 +470,7 @@ void checkIndicesAt(const Scene& scene, double lambda_nm) {
     for (const Dispersion* d : {&m.n_o, &m.n_e}) {
       if (d == &m.n_e && !m.uniaxial) break;
       const double n = d->index(lambda_nm);
-      if (n >= 1.0 && n <= 10.0) continue;
+      if (n >= kMinIndex && n <= kMaxIndex) continue;
       char value[64];
       std::snprintf(value, sizeof value, "%.6g at %.6g nm", n, lambda_nm);
       throw SettingError("wavelength", "leaves the index of material '" + name + "'" +
@@ -463,6 +482,10 @@ void checkIndicesAt(const Scene& scene, double lambda_nm) {
 
 std::vector<std::array<TraceOutcome, 2>> Session::trace(const std::vector<TraceRequest>& rays,
                                                         const MarchSettings& ms, bool gpu) {
+  if (rays.size() > trace_rays_fitted_) {  // the host's memory is read for a larger batch only
+    checkTraceFitsHost(rays.size());
+    trace_rays_fitted_ = rays.size();
+  }
   for (const TraceRequest& q : rays) checkIndicesAt(*scene_, q.wavelength_nm);
   const bool uni = scene_->anyUniaxial();
   std::vector<std::array<TraceOutcome, 2>> out;

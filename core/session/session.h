@@ -122,6 +122,16 @@ LightingOptions lightingOptions(const LightRequest& light, double voxel_mm);
 
 /// A ray's wavelength in [100, 10000] nm ("wavelength") and a non-zero direction ("dir").
 void checkTraceRequest(const TraceRequest& ray);
+/// Host memory Session::trace of `rays` rays holds at its peak, estimated: the requests, the
+/// outcomes of both modes (held by the twin, by the session and, for an isotropic scene, once
+/// more while they are paired), and the GPU twin's staging of each ray and its two results
+/// (host memory on a CPU Vulkan device such as lavapipe): about 0.9 KB a ray.
+double traceHostBytes(size_t rays);
+/// std::runtime_error (one line, with the numbers) when traceHostBytes(rays) plus `caller_bytes`
+/// (what the caller holds for the same rays besides: Python's trace_rays counts its input copies
+/// and result arrays) exceeds the host memory available to the process (availableHostMemory),
+/// before anything is allocated; Session::trace checks it too.
+void checkTraceFitsHost(size_t rays, double caller_bytes = 0.0);
 /// Every material's refractive index at the wavelength finite and in [1, 10], as the scene's are
 /// over 380–780 nm; else SettingError("wavelength", ...) naming the material and the value (a
 /// trace at 200 nm through a Sellmeier fit with a pole there). Session::trace checks it.
@@ -253,6 +263,7 @@ class Session {
   SessionProgress progress_;
   int threads_ = 0;
   double render_bytes_fitted_ = 0;  ///< the largest renderHostBytes checkRenderFitsHost passed
+  size_t trace_rays_fitted_ = 0;    ///< the most rays checkTraceFitsHost passed
   std::shared_ptr<vk::Context> ctx_;
   std::unique_ptr<VolumeSet> volume_;
   std::filesystem::path volume_cache_;

@@ -1,9 +1,15 @@
 #include "core/volume/polarised.h"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
+#include <string>
 
 namespace eikon {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
 
 void checkPolarisedTrace(const TraceRequest& ray, const Stokes& in,
                          const PolarisedTraceSettings& s) {
@@ -16,7 +22,23 @@ void checkPolarisedTrace(const TraceRequest& ray, const Stokes& in,
     throw std::invalid_argument("input Stokes vector needs S0 > 0 and finite S1..S3");
   if (degreeOfPolarisation(in) > 1.0 + 1e-9)
     throw std::invalid_argument("input Stokes vector has sqrt(S1² + S2² + S3²) > S0");
-  if (!(s.bandwidth_nm > 0) || !(s.source_angle_rad > 0) || s.max_branches < 1 || s.max_events < 1)
+  char got[64];
+  if (!(s.bandwidth_nm > 0) || !std::isfinite(s.bandwidth_nm)) {
+    std::snprintf(got, sizeof got, "%.10g", s.bandwidth_nm);
+    throw std::invalid_argument(std::string("bandwidth_nm must be a finite number > 0 nm, got ") +
+                                got);
+  }
+  // The angular size of a source sample: exit directions at most this far apart are one beam,
+  // and no two directions are more than pi apart, so (0, pi] holds every source (100 rad used to
+  // merge every beam silently).
+  if (!(s.source_angle_rad > 0 && s.source_angle_rad <= kPi)) {
+    std::snprintf(got, sizeof got, "%.10g", s.source_angle_rad);
+    throw std::invalid_argument(
+        std::string("source_angle_rad must be in (0, pi] (the angular size of one light or "
+                    "environment sample), got ") +
+        got);
+  }
+  if (s.max_branches < 1 || s.max_events < 1)
     throw std::invalid_argument("polarised trace settings must be positive");
 }
 

@@ -52,7 +52,8 @@ struct PolarisedTrace {
 };
 
 /// Throws std::invalid_argument (one line) on a bad ray (zero or non-finite direction,
-/// wavelength ≤ 0), input Stokes vector (S0 ≤ 0, non-finite, √(S1² + S2² + S3²) > S0) or settings.
+/// wavelength ≤ 0), input Stokes vector (S0 ≤ 0, non-finite, √(S1² + S2² + S3²) > S0) or settings
+/// (bandwidth_nm finite > 0, source_angle_rad in (0, π], each named).
 void checkPolarisedTrace(const TraceRequest& ray, const Stokes& input,
                          const PolarisedTraceSettings& settings);
 

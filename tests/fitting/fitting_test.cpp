@@ -273,6 +273,25 @@ TEST(DispersionFit, HuberDeltaOutsideItsRangeIsRefused) {
   }
 }
 
+// max_iterations lies in [1, kMaxFitIterations]: -1 surfaced Ceres' own option text.
+TEST(DispersionFit, MaxIterationsOutsideItsRangeIsRefused) {
+  const IndexSeries d{"n", {400, 500, 600, 700, 800}, {1.53, 1.52, 1.515, 1.512, 1.51}, {}};
+  for (int it : {-1, 0, kMaxFitIterations + 1}) {
+    FitOptions o;
+    o.max_iterations = it;
+    try {
+      fitDispersion(d, o);
+      ADD_FAILURE() << it;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()),
+                "max_iterations must be in [1, 100000], got " + std::to_string(it));
+    }
+  }
+  FitOptions one;
+  one.max_iterations = 1;
+  EXPECT_NO_THROW(fitDispersion(d, one));  // Cauchy-3 is linear: it starts at its solution
+}
+
 // Conrady n = n0 + A/λ + B/λ^3.5 is linear: exact data gives back exact coefficients.
 TEST(DispersionFit, ConradyRecoversExactCoefficients) {
   const double p[3] = {1.49, 0.012, 1.5e-4};

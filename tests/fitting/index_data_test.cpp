@@ -361,5 +361,37 @@ TEST(IndexData, CombineOrdinaryExtraordinary) {
   EXPECT_DOUBLE_EQ(c.modes[1].n[0], 1.49);
 }
 
+// Arrays (Python's fit_dispersion) go through the files' rules: each point named by its index,
+// sorted with one warning, the same complaints as a file's rows.
+TEST(IndexSeries, ArraysAreCheckedAsAFilesRows) {
+  std::vector<std::string> warnings;
+  const IndexSeries s = checkIndexSeries(
+      {"n", {600, 400, 500}, {1.51, 1.53, 1.52}, {1e-4, 2e-4, 3e-4}}, "data", warnings);
+  EXPECT_EQ(s.lambda_nm, (std::vector<double>{400, 500, 600}));
+  EXPECT_EQ(s.n, (std::vector<double>{1.53, 1.52, 1.51}));
+  EXPECT_EQ(s.sigma, (std::vector<double>{2e-4, 3e-4, 1e-4}));
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0], "data: n points are not in ascending wavelength order; sorted them");
+  auto check = [](IndexSeries s) {
+    return [s] {
+      std::vector<std::string> w;
+      checkIndexSeries(s, "data", w);
+    };
+  };
+  expectError(check({"n", {400, 500}, {1.5, 0.9}, {}}), {"point 1: n must be >= 1, got 0.9"});
+  expectError(check({"n", {400, 500}, {1.5, 10.5}, {}}), {"point 1: n must be <= 10"});
+  expectError(check({"n", {400, 500}, {1.5, 1.4}, {1e-4, 0}}),
+              {"point 1: sigma of n must be a finite number > 0"});
+  expectError(check({"n", {400, 500}, {1.5, 1.4}, {-1, 1e-4}}), {"point 0: sigma of n"});
+  expectError(check({"n", {50, 500}, {1.5, 1.4}, {}}),
+              {"point 0: wavelength 50 nm is outside [100, 100000] nm"});
+  expectError(check({"n", {400, NAN}, {1.5, 1.4}, {}}), {"point 1: wavelength is not a finite"});
+  expectError(check({"n", {400, 500, 400}, {1.5, 1.4, 1.5}, {}}),
+              {"point 2: duplicate wavelength 400 nm (also at point 0)"});
+  expectError(check({"n", {400}, {1.5}, {}}), {"data: only one data point"});
+  expectError(check({"n", {400, 500}, {1.5}, {}}), {"data: 2 wavelengths, 1 indices"});
+  expectError(check({"n", {400, 500}, {1.5, 1.4}, {1e-4}}), {"and 1 sigmas"});
+}
+
 }  // namespace
 }  // namespace eikon
