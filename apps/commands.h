@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace eikon::cli {
 
@@ -29,6 +30,14 @@ inline void checkExposure(double stops) {
   if (!(stops >= -64 && stops <= 64))
     throw CliError("--exposure must be in [-64, 64] stops, got " + std::to_string(stops));
 }
+
+/// The value of a comma-separated number option (--origin x,y,z, --stokes S0,S1,S2,S3,
+/// --range-nm LO,HI): exactly `count` finite decimal numbers ("-1.5", "2e-3", blanks around each
+/// allowed), separated by single commas. Anything else is refused, never read in part: an empty
+/// value, an empty field ("1,,0"), a trailing comma, hexadecimal, inf or nan, words. Throws
+/// CliError "OPTION must be COUNT finite numbers NAMES, got 'VALUE'".
+std::vector<double> parseNumberList(const std::string& value, const std::string& option,
+                                    size_t count, const std::string& names);
 
 void addRenderCommand(CLI::App& app);
 void addTraceCommand(CLI::App& app);

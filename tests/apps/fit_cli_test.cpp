@@ -490,4 +490,17 @@ TEST_F(FitCli, MaterialsTheSceneCannotLoadAreRefused) {
   EXPECT_EQ(run(ir).code, 0);  // without -o nothing is written and the fit is reported
 }
 
+// --range-nm was CLI11's list of numbers: '400,,700' (an empty field dropped), '400,700,' and
+// hexadecimal passed; it takes --stokes's parser now.
+TEST_F(FitCli, RangeIsTwoDecimalNumbersAndNothingElse) {
+  const std::string csv = bk7Csv();
+  for (const char* bad : {"", "400,700,", "400,,700", "0x190,700", "400", "400,700,800", "inf,700"})
+    expectCleanFailure(
+        run(csv + " --range-nm " + eikon::test::quote(bad) + " -o " + path("out.json")),
+        "--range-nm must be two finite numbers LO,HI (nm), got '" + std::string(bad) + "'");
+  expectCleanFailure(run(csv + " --range-nm 700,400 -o " + path("out.json")),
+                     "--range-nm must satisfy 0 < LO < HI (nm), got '700,400'");
+  EXPECT_EQ(run(csv + " --range-nm 450,650").code, 0);
+}
+
 }  // namespace
