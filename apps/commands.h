@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "core/scene/messages.h"
+
 namespace eikon::cli {
 
 /// A user-facing error: printed as one line, exit status `code`.
@@ -28,7 +30,7 @@ inline constexpr const char* kLightsNotSimulatedNote =
 /// float holds); NaN and infinities are refused, not turned into a black or white image.
 inline void checkExposure(double stops) {
   if (!(stops >= -64 && stops <= 64))
-    throw CliError("--exposure must be in [-64, 64] stops, got " + std::to_string(stops));
+    throw CliError("--exposure must be in [-64, 64] stops, got " + formatNumber(stops));
 }
 
 /// The value of a comma-separated number option (--origin x,y,z, --stokes S0,S1,S2,S3,

@@ -767,7 +767,8 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   if (a.exit_after_frames < 0)
     throw CliError("--exit-after-frames must be >= 0, got " + std::to_string(a.exit_after_frames));
   const Integrator integrator = parseIntegrator(a.integrator);
-  if (!a.screenshot.empty()) {
+  if (sub.count("--screenshot")) {  // given: an empty name is refused, not taken as no screenshot
+    if (a.screenshot.empty()) throw CliError("--screenshot must name a .png file, got ''");
     if (std::filesystem::path(a.screenshot).extension() != ".png")
       throw CliError("--screenshot must end in .png: " + a.screenshot);
     checkWritable(a.screenshot);

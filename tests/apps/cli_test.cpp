@@ -984,6 +984,10 @@ TEST_F(Cli, ExposureAndProgressAreCheckedEvenWhenUnused) {
   expectCleanFailure(render(tinyScene(), "--exposure 1e6"), "--exposure must be in [-64, 64]");
   expectCleanFailure(render(tinyScene(), "-q --progress sometimes"),
                      "--progress must be auto, always or never");
+  // The value as it was given, not std::to_string's 301 digits of 1e300.
+  const Outcome huge = render(tinyScene(), "--exposure 1e300");
+  expectCleanFailure(huge, "--exposure must be in [-64, 64] stops, got 1e+300");
+  EXPECT_LT(huge.err.size(), 80u) << huge.err;
   EXPECT_EQ(render(tinyScene(), "-q --exposure -64").code, 0);
 }
 
