@@ -38,6 +38,8 @@
 #include <string>
 #include <vector>
 
+#include "core/scene/limits.h"
+
 namespace eikon {
 
 /// One dispersion curve n(λ): wavelengths ascending, in nm.
@@ -84,11 +86,12 @@ inline constexpr long long kMaxFormulaSamplesTotal = 1000000;
 inline constexpr double kMinFitWavelengthNm = 100.0;
 inline constexpr double kMaxFitWavelengthNm = 100000.0;
 
-/// The indices a fit takes: [1, 10], those a scene's materials may have (core/scene/scene.cpp);
-/// data above 10 made a material that `eikon fit` wrote and the scene loader refused. A row
-/// outside is refused with its file and line (after the window has dropped what it leaves out).
-inline constexpr double kMinFitIndex = 1.0;
-inline constexpr double kMaxFitIndex = 10.0;
+/// The indices a fit takes: [1, 10], those a scene's materials may have (kMinIndex, kMaxIndex of
+/// core/scene/limits.h); data above 10 made a material that `eikon fit` wrote and the scene loader
+/// refused. A row outside is refused with its file and line (after the window has dropped what it
+/// leaves out).
+inline constexpr double kMinFitIndex = kMinIndex;
+inline constexpr double kMaxFitIndex = kMaxIndex;
 
 /// Strict CSV reader (format above). Throws with "path:line: message".
 IndexData readIndexCsv(const std::string& path, const IndexReadOptions& options = {});

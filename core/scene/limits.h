@@ -11,6 +11,13 @@ namespace eikon {
 /// 1e12 mm from the origin is still placed to ~1e-4 mm.
 inline constexpr double kMaxCoordinateMm = 1e12;
 
+/// Every refractive index a material defines (at every wavelength of 380-780 nm), as an
+/// ambient_index and a gradient-index n0, lies in [kMinIndex, kMaxIndex]: an index of 1e20 (or an
+/// infinite one) makes the Fresnel terms and the march's gradients overflow to NaN in float.
+/// `eikon fit` takes data in the same range (fitting/index_data.h), so that what it writes loads.
+inline constexpr double kMinIndex = 1.0;
+inline constexpr double kMaxIndex = 10.0;
+
 /// Most objects (polarisers not counted) a scene with sharp interfaces may hold: the boundary
 /// field's region ids are 16-bit and 0 is the ambient medium.
 inline constexpr size_t kMaxSharpObjects = 65535;

@@ -197,11 +197,7 @@ std::filesystem::path namedFile(const Node& f, const std::string& what) {
 }
 
 // ------------------------------------------------------------------ materials
-// Every refractive index a material defines lies in [kMinIndex, kMaxIndex], as ambient_index and
-// a gradient-index n0 do: an index of 1e20 (or an infinite one) makes the Fresnel terms and the
-// march's gradients overflow to NaN in float.
-constexpr double kMinIndex = 1.0;
-constexpr double kMaxIndex = 10.0;
+// Every refractive index a material defines lies in [kMinIndex, kMaxIndex] (core/scene/limits.h).
 
 /// Why a Sellmeier model has no real index at `l` nm (n² ≤ 0 or a pole): a negative B, or a C
 /// whose pole λ = √C lies in the checked window.
