@@ -19,6 +19,7 @@
 
 #include "apps/commands.h"
 #include "apps/progress.h"
+#include "core/render/view_renderer.h"
 #include "core/session/session.h"
 #include "core/vk/timings.h"
 
@@ -191,6 +192,9 @@ void runTrace(const TraceArgs& a) {
   timings::mark("scene parsed");
   if (a.stokes_given && scene->interfaces != Scene::Interfaces::Sharp)
     throw CliError(std::string("--stokes: ") + kNeedsSharp);  // before any voxelising or warning
+  // An explicit --stokes on the GPU: a scene with more polariser sheets than its polarised trace
+  // takes is refused before voxelising (without --stokes the trace runs and says why not).
+  if (a.stokes_given && !a.reference) checkGpuPolariserSheets(*scene);
   // Voxelising a 128³ scene takes seconds; the trace itself is instant.
   Progress progress(progress_mode);
   MarchSettings ms;
