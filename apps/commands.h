@@ -7,6 +7,9 @@
 #include <CLI/CLI.hpp>
 #include <stdexcept>
 #include <string>
+#include <vector>
+
+#include "core/scene/messages.h"
 
 namespace eikon::cli {
 
@@ -27,8 +30,16 @@ inline constexpr const char* kLightsNotSimulatedNote =
 /// float holds); NaN and infinities are refused, not turned into a black or white image.
 inline void checkExposure(double stops) {
   if (!(stops >= -64 && stops <= 64))
-    throw CliError("--exposure must be in [-64, 64] stops, got " + std::to_string(stops));
+    throw CliError("--exposure must be in [-64, 64] stops, got " + formatNumber(stops));
 }
+
+/// The value of a comma-separated number option (--origin x,y,z, --stokes S0,S1,S2,S3,
+/// --range-nm LO,HI): exactly `count` finite decimal numbers ("-1.5", "2e-3", blanks around each
+/// allowed), separated by single commas. Anything else is refused, never read in part: an empty
+/// value, an empty field ("1,,0"), a trailing comma, hexadecimal, inf or nan, words. Throws
+/// CliError "OPTION must be COUNT finite numbers NAMES, got 'VALUE'".
+std::vector<double> parseNumberList(const std::string& value, const std::string& option,
+                                    size_t count, const std::string& names);
 
 void addRenderCommand(CLI::App& app);
 void addTraceCommand(CLI::App& app);

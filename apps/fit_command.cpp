@@ -36,7 +36,8 @@ struct FitArgs {
   std::string export_yaml;
   bool strict = false;
   std::string output;
-  std::vector<double> range_nm;
+  std::string range_nm;
+  bool range_given = false;  ///< --range-nm was given, with any value (an empty one is refused)
   int samples = 201;
   std::string name;
 };
@@ -268,9 +269,11 @@ void run(const FitArgs& a) {
                    "] (samples per refractiveindex.info formula block), got " +
                    std::to_string(a.samples));
   ro.formula_samples = a.samples;
-  if (!a.range_nm.empty()) {
-    if (a.range_nm.size() != 2) throw CliError("--range-nm takes LO,HI in nm");
-    ro.window_nm = std::array<double, 2>{a.range_nm[0], a.range_nm[1]};
+  if (a.range_given) {
+    const std::vector<double> r = parseNumberList(a.range_nm, "--range-nm", 2, "LO,HI (nm)");
+    if (!(r[0] > 0 && r[1] > r[0]))
+      throw CliError("--range-nm must satisfy 0 < LO < HI (nm), got '" + a.range_nm + "'");
+    ro.window_nm = std::array<double, 2>{r[0], r[1]};
   }
   IndexData data = readIndexData(a.data[0], ro);
   if (a.data.size() == 2) {
@@ -388,14 +391,14 @@ void addFitCommand(CLI::App& app) {
                   "also write a refractiveindex.info formula entry (crystals: FILE-o/-e)");
   sub->add_flag("--strict", args->strict, "treat warnings (e.g. unsorted rows) as errors");
   sub->add_option("-o,--output", args->output, "material JSON file for the renderer");
-  sub->add_option("--range-nm", args->range_nm,
-                  "fit only LO,HI nm (formulas are sampled inside it)")
-      ->delimiter(',');
+  CLI::Option* range = sub->add_option("--range-nm", args->range_nm,
+                                       "fit only LO,HI nm (formulas are sampled inside it)");
   sub->add_option("--samples", args->samples,
                   "samples per refractiveindex.info formula block (2 to 100000)")
       ->capture_default_str();
   sub->add_option("--name", args->name, "material name (default: the DATA file's stem)");
-  sub->callback([args] {
+  sub->callback([args, range] {
+    args->range_given = range->count() > 0;
     try {
       run(*args);
     } catch (const CliError&) {

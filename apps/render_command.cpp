@@ -16,6 +16,7 @@
 #include "core/io/exr.h"
 #include "core/light/light_cache.h"
 #include "core/render/render_defaults.h"
+#include "core/render/view_renderer.h"
 #include "core/session/session.h"
 #include "core/vk/context.h"
 #include "core/vk/timings.h"
@@ -262,6 +263,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   checkWritable(out);
   checkWritable(png);
   const RenderSettings rs = renderSettings(*scene, view);
+  if (!a.reference && isPolarisedRender(*scene, rs)) checkGpuPolariserSheets(*scene);
   checkRenderFitsHost(*scene, rs);  // before voxelising: the image's memory, with the numbers
   for (const std::string& w : materialRangeWarnings(*scene, rs)) warn(w, a.strict);
   timings::mark("scene parsed");

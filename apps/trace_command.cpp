@@ -13,44 +13,22 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 #include <vector>
 
 #include "apps/commands.h"
 #include "apps/progress.h"
+#include "core/render/view_renderer.h"
 #include "core/session/session.h"
 #include "core/vk/timings.h"
 
 namespace eikon::cli {
 namespace {
 
-/// The comma-separated numbers of `s`, or nothing when a part is not one finite number.
-std::optional<std::vector<double>> parseNumbers(const std::string& s) {
-  std::stringstream ss(s);
-  std::string part;
-  std::vector<double> v;
-  while (std::getline(ss, part, ',')) {
-    // strtod, not stod: stod throws on a denormal such as 1e-320 (ERANGE), which is a finite
-    // number (a --dir of 0,0,1e-320 is then refused as zero, not as "not finite").
-    const char* begin = part.c_str();
-    char* end = nullptr;
-    const double x = std::strtod(begin, &end);
-    if (part.empty() || end != begin + part.size() || !std::isfinite(x)) return std::nullopt;
-    v.push_back(x);
-  }
-  return v;
-}
-
 glm::dvec3 parseVec(const std::string& s, const char* what) {
-  const std::optional<std::vector<double>> v = parseNumbers(s);
-  if (!v)
-    throw CliError(std::string(what) + " must be three finite numbers x,y,z, got '" + s + "'");
-  if (v->size() != 3)
-    throw CliError(std::string(what) + " must be three numbers x,y,z, got '" + s + "'");
-  return {(*v)[0], (*v)[1], (*v)[2]};
+  const std::vector<double> v = parseNumberList(s, what, 3, "x,y,z");
+  return {v[0], v[1], v[2]};
 }
 
 /// --stokes: four finite numbers with S0 > 0 and a degree of polarisation ≤ 1.
@@ -58,10 +36,8 @@ Stokes parseStokes(const std::string& s) {
   auto bad = [&](const std::string& why) {
     return CliError("--stokes " + why + ", got '" + s + "'");
   };
-  const std::optional<std::vector<double>> v = parseNumbers(s);
-  if (!v) throw bad("must be four finite numbers S0,S1,S2,S3");
-  if (v->size() != 4) throw bad("must be four numbers S0,S1,S2,S3");
-  const Stokes st((*v)[0], (*v)[1], (*v)[2], (*v)[3]);
+  const std::vector<double> v = parseNumberList(s, "--stokes", 4, "S0,S1,S2,S3");
+  const Stokes st(v[0], v[1], v[2], v[3]);
   if (!(st[0] > 0)) throw bad("needs S0 > 0");
   if (degreeOfPolarisation(st) > 1.0 + 1e-9)
     throw bad("has a degree of polarisation sqrt(S1² + S2² + S3²)/S0 above 1");
@@ -70,6 +46,7 @@ Stokes parseStokes(const std::string& s) {
 
 struct TraceArgs {
   std::string scene, origin, dir, stokes;
+  bool stokes_given = false;  ///< --stokes was given, with any value (an empty one is refused)
   double wavelength = 587.5618, step = 0.25;
   bool json = false, reference = false, quiet = false, strict = false;
   std::string integrator = "rk4", progress = "auto";
@@ -181,9 +158,10 @@ void addTraceCommand(CLI::App& app) {
   sub->add_option("--dir", a->dir, "Ray direction x,y,z (any non-zero length)")->required();
   sub->add_option("--wavelength", a->wavelength, "Wavelength in nm (default 587.5618, the d line)");
   sub->add_option("--step", a->step, "Integration step in voxels (default 0.25)");
-  sub->add_option("--stokes", a->stokes,
-                  "Input Stokes vector S0,S1,S2,S3 of the polarised trace, in Mitsuba 3's "
-                  "stokesBasis of --dir (default 1,0,0,0: unpolarised); needs sharp interfaces");
+  CLI::Option* stokes = sub->add_option(
+      "--stokes", a->stokes,
+      "Input Stokes vector S0,S1,S2,S3 of the polarised trace, in Mitsuba 3's "
+      "stokesBasis of --dir (default 1,0,0,0: unpolarised); needs sharp interfaces");
   sub->add_flag("--json", a->json, "Print JSON");
   sub->add_flag("--reference", a->reference,
                 "Use the double-precision CPU reference instead of the GPU");
@@ -192,7 +170,10 @@ void addTraceCommand(CLI::App& app) {
   sub->add_option("--progress", a->progress,
                   "auto (default: voxelising progress with ETA on stderr when it is a terminal), "
                   "always or never");
-  sub->callback([a] { runTrace(*a); });
+  sub->callback([a, stokes] {
+    a->stokes_given = stokes->count() > 0;
+    runTrace(*a);
+  });
 }
 
 namespace {
@@ -203,14 +184,17 @@ void runTrace(const TraceArgs& a) {
   // The range checks are the session's, as Python's (core/session/session.h).
   checkTraceRequest(req);
   checkMarchStep(a.step);
-  const Stokes stokes_in = a.stokes.empty() ? Stokes(1, 0, 0, 0) : parseStokes(a.stokes);
+  const Stokes stokes_in = a.stokes_given ? parseStokes(a.stokes) : Stokes(1, 0, 0, 0);
   req.direction = glm::normalize(req.direction);
   const ProgressMode progress_mode = progressMode(a.progress, a.quiet);
   auto scene = std::make_shared<Scene>(loadScene(a.scene));
   checkIndicesAt(*scene, req.wavelength_nm);  // before anything is voxelised
   timings::mark("scene parsed");
-  if (!a.stokes.empty() && scene->interfaces != Scene::Interfaces::Sharp)
+  if (a.stokes_given && scene->interfaces != Scene::Interfaces::Sharp)
     throw CliError(std::string("--stokes: ") + kNeedsSharp);  // before any voxelising or warning
+  // An explicit --stokes on the GPU: a scene with more polariser sheets than its polarised trace
+  // takes is refused before voxelising (without --stokes the trace runs and says why not).
+  if (a.stokes_given && !a.reference) checkGpuPolariserSheets(*scene);
   // Voxelising a 128³ scene takes seconds; the trace itself is instant.
   Progress progress(progress_mode);
   MarchSettings ms;
@@ -235,7 +219,7 @@ void runTrace(const TraceArgs& a) {
     try {
       pol = session.tracePolarised(req, stokes_in, {}, !a.reference);
     } catch (const std::runtime_error& e) {
-      if (!a.stokes.empty()) throw CliError(std::string("--stokes: ") + e.what());
+      if (a.stokes_given) throw CliError(std::string("--stokes: ") + e.what());
       why_not = e.what();
     }
   }

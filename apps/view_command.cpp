@@ -31,9 +31,11 @@
 #include "core/io/exr.h"
 #include "core/light/light_cache.h"
 #include "core/render/render_defaults.h"
+#include "core/render/view_renderer.h"
 #include "core/session/session.h"
 #include "core/vk/context.h"
 #include "core/vk/swapchain.h"
+#include "core/volume/polarised_render.h"
 
 namespace eikon::cli {
 
@@ -767,7 +769,8 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   if (a.exit_after_frames < 0)
     throw CliError("--exit-after-frames must be >= 0, got " + std::to_string(a.exit_after_frames));
   const Integrator integrator = parseIntegrator(a.integrator);
-  if (!a.screenshot.empty()) {
+  if (sub.count("--screenshot")) {  // given: an empty name is refused, not taken as no screenshot
+    if (a.screenshot.empty()) throw CliError("--screenshot must name a .png file, got ''");
     if (std::filesystem::path(a.screenshot).extension() != ".png")
       throw CliError("--screenshot must end in .png: " + a.screenshot);
     checkWritable(a.screenshot);
@@ -776,6 +779,7 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   for (const std::string& w : scene->warnings)
     std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
   RenderSettings base = renderSettings(*scene, view);
+  if (isPolarisedRender(*scene, base)) checkGpuPolariserSheets(*scene);  // before any window
   base.march.integrator = integrator;
   const int width = view.width.value_or(scene->camera.width),
             height = view.height.value_or(scene->camera.height);

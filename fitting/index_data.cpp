@@ -1,10 +1,12 @@
 #include "fitting/index_data.h"
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -57,6 +59,13 @@ std::string fmt(double v) {
   s.precision(10);
   s << v;
   return s.str();
+}
+
+// `text` without a leading UTF-8 byte order mark (Excel's "CSV UTF-8"): readTextFile leaves it out
+// of a file, and text given as it is (Python's parse_index_csv) is read the same. Left in, it
+// stuck to the first word (a CSV header's, a YAML key's).
+std::string withoutByteOrderMark(const std::string& text) {
+  return text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? text.substr(3) : text;
 }
 
 // A series under construction: values plus where each point came from, for messages.
@@ -174,7 +183,7 @@ IndexData parseIndexCsv(const std::string& text, const std::string& name,
   checkOptions(opt);
   IndexData data;
   data.source = name;
-  std::istringstream in(text);
+  std::istringstream in(withoutByteOrderMark(text));
   std::string raw;
   int line_no = 0;
   std::vector<std::string> header;
@@ -260,6 +269,74 @@ IndexData readIndexCsv(const std::string& path, const IndexReadOptions& opt) {
   return parseIndexCsv(readFile(path), path, opt);
 }
 
+namespace {
+
+// yaml-cpp keeps every pair of a map whose key repeats and answers blk["type"] with one of them:
+// the other value was dropped without a word (a scene's JSON refuses a repeated key). The file's
+// events are walked once (an alias is one event, not the tree it names), and the second key of a
+// map that repeats one is refused with its line: "name:LINE: duplicate key 'type' (first on line
+// L)".
+class DuplicateKeyCheck final : public YAML::EventHandler {
+ public:
+  explicit DuplicateKeyCheck(const std::string& name) : name_(name) {}
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override { node(nullptr, {}); }
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override { node(nullptr, {}); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string& value) override {
+    node(&value, mark);
+  }
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    open_.push_back({false, true, {}});
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    open_.push_back({true, true, {}});
+  }
+  void OnMapEnd() override { close(); }
+
+ private:
+  struct Collection {
+    bool map;
+    bool key_next;                     ///< a map's next node is a key (else a value)
+    std::map<std::string, int> lines;  ///< a map's scalar keys so far, with their lines
+  };
+  /// A node has ended (a scalar, null or alias, or a collection just closed): a key or a value of
+  /// the enclosing map.
+  void node(const std::string* scalar, const YAML::Mark& mark) {
+    if (open_.empty() || !open_.back().map) return;
+    Collection& m = open_.back();
+    if (m.key_next && scalar) {
+      const int line = mark.line + 1;
+      const auto [it, fresh] = m.lines.emplace(*scalar, line);
+      if (!fresh)
+        throw std::invalid_argument(name_ + ":" + std::to_string(line) + ": duplicate key '" +
+                                    *scalar + "' (first on line " + std::to_string(it->second) +
+                                    "); a key may appear once in a map");
+    }
+    m.key_next = !m.key_next;
+  }
+  void close() {
+    open_.pop_back();
+    node(nullptr, {});
+  }
+  const std::string& name_;
+  std::vector<Collection> open_;
+};
+
+void checkDuplicateKeys(const std::string& text, const std::string& name) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  DuplicateKeyCheck check(name);
+  while (parser.HandleNextDocument(check)) {
+  }
+}
+
+}  // namespace
+
 // The samples of all formula blocks together (blocks × formula_samples), bounded before any
 // block is sampled; every formula block counts, even one the window leaves out.
 static void checkFormulaSampleTotal(const YAML::Node& blocks, const std::string& name,
@@ -284,7 +361,8 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
   checkOptions(opt);
   YAML::Node root;
   try {
-    root = YAML::Load(text);
+    root = YAML::Load(withoutByteOrderMark(text));
+    checkDuplicateKeys(withoutByteOrderMark(text), name);
   } catch (const YAML::Exception& e) {
     throw std::invalid_argument(name + ":" + std::to_string(e.mark.line + 1) +
                                 ": malformed YAML: " + e.msg);

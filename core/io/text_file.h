@@ -3,7 +3,8 @@
 // Before reading it checks that the path is a regular file after following links (not a
 // directory, /dev/zero, a FIFO or a socket) of at most a stated size (kMaxTextFileBytes unless the
 // caller gives a smaller cap); after reading, that the text holds no NUL byte (a scene followed by
-// "\0garbage" was read up to the NUL and the rest ignored). Each refusal is one
+// "\0garbage" was read up to the NUL and the rest ignored). A leading UTF-8 byte order mark (as
+// Excel and Notepad write) is left out of the text it returns. Each refusal is one
 // std::runtime_error "FILE: why" whose FILE is shownPath(path).
 //
 //   std::string text = eikon::readTextFile("scene.json", "a scene file");
@@ -32,7 +33,8 @@ const char* fileTypeName(std::filesystem::file_type type);
 /// The system's reason in a message's words: "file name too long", not "File name too long".
 std::string errorReason(const std::error_code& ec);
 
-/// The bytes of the text file `path`, which the messages call `what` ("a scene file"). Throws
+/// The bytes of the text file `path`, without a leading UTF-8 byte order mark (EF BB BF), which
+/// the messages call `what` ("a scene file"). Throws
 /// std::runtime_error "FILE: why" when the name holds a NUL byte, the file cannot be looked up or
 /// opened (the system's reason: "no such file or directory", "file name too long"), is not a
 /// regular file after following links, is larger than `max_bytes`, or holds a NUL byte (its

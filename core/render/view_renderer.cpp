@@ -47,6 +47,22 @@ void validate(const MarchSettings& m) {
   if (!(m.interface_threshold > 0)) throw std::invalid_argument("interface threshold must be > 0");
 }
 
+}  // namespace
+
+void checkGpuPolariserSheets(const Scene& scene) {
+  const size_t most = EIKON_POL_MAX_SHEETS;
+  if (scene.polarizers.size() <= most) return;
+  throw std::runtime_error(
+      scene.file.string() + ": /objects/" + std::to_string(scene.polarizers[most].object_index) +
+      ": the GPU polarised render and trace take at most " + std::to_string(most) +
+      " polariser sheets; this is sheet " + std::to_string(most + 1) + " of " +
+      std::to_string(scene.polarizers.size()) +
+      " (the CPU reference takes any number: eikon render or trace --reference, device=\"cpu\" "
+      "in Python)");
+}
+
+namespace {
+
 /// The sheets buffer of polarised_trace.comp: a header (count, bandwidth, source angle, reflect_at
 /// bit mask), then three vec4s per sheet (eikon_shared.h).
 std::vector<glm::vec4> packSheets(const std::vector<PolarizerSheet>& sheets,

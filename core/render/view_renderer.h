@@ -29,6 +29,14 @@ namespace eikon {
 /// (3D image side limit, heap size). Call before voxelising.
 void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scene);
 
+/// The GPU twin's polarised render and trace take at most EIKON_POL_MAX_SHEETS (8) polariser
+/// sheets (shaders/polarised_trace.comp looks through every sheet for the next one along each
+/// straight piece of a path); the CPU twin takes any number. Throws a one-line std::runtime_error
+/// "FILE: /objects/N: ..." naming the first sheet beyond the limit and the CPU twin as the remedy
+/// when the scene has more. Call before voxelising; Session::render and Session::tracePolarised
+/// call it for the GPU twin.
+void checkGpuPolariserSheets(const Scene& scene);
+
 class ViewRenderer {
  public:
   /// `expected`: the settings of the render that will follow, if known; its view pipeline is then

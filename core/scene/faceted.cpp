@@ -304,7 +304,8 @@ FacetError blameOutlier(const FacetedDesign& d, const FacetError& error) {
   }
   for (double g : {d.girdle.length, d.girdle.width, d.girdle.thickness})
     if (g < largest) next = std::max(next, g);
-  if (!(largest > 1e3 * next) || where == error.where()) return error;
+  // A design of one length (next = 0) has nothing that length could be too coarse for.
+  if (!(next > 0) || !(largest > 1e3 * next) || where == error.where()) return error;
   return FacetError(where, "the length " + num(largest) + " mm is more than 1000 times the " +
                                "design's next largest (" + num(next) +
                                " mm): the facets are cut to 1e-9 of the largest, too coarse for "
@@ -351,6 +352,10 @@ FacetedStone cutFaceted(const FacetedDesign& design) {
         : tier.place == FacetTier::Place::MeetPoint
             ? std::vector<std::string>{tier.meet[0].tier, tier.meet[1].tier, tier.meet[2].tier}
             : std::vector<std::string>{};
+    // Before cutting: a cut that failed on it was blamed on a length instead (blameOutlier).
+    if (tier.place == FacetTier::Place::MeetGirdle &&
+        design.girdle.kind == GirdleOutline::Kind::None)
+      throw FacetError(tier.path + "/meet", "meets the girdle, but the object has no girdle");
     for (const auto& r : refs) {
       auto it = names.find(r);
       if (it == names.end() || it->second == t)

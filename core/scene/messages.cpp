@@ -1,6 +1,7 @@
 #include "core/scene/messages.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 
 namespace eikon {
@@ -64,6 +65,12 @@ std::string printable(std::string_view text, size_t max_bytes) {
 
 std::string errorLine(std::string_view message) {
   return "eikon: error: " + printable(message) + "\n";
+}
+
+std::string formatNumber(double v) {
+  char buf[32];  // the shortest round trip of a double takes at most 24 characters
+  const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
 }
 
 }  // namespace eikon

@@ -1332,6 +1332,7 @@ static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::
     o.requireObject();
     if (o.has("shape") && o.at("shape").isString() && o.at("shape").string() == "polarizer") {
       scene.polarizers.push_back(parsePolarizer(o));
+      scene.polarizers.back().object_index = i;
       continue;
     }
     SceneObject obj = parseObject(o);

@@ -86,6 +86,7 @@ struct PolarizerSheet {
   glm::dvec3 normal{0, 0, 1};  ///< unit
   glm::dvec3 axis{1, 0, 0};    ///< unit, ⊥ normal: the transmission axis
   double width = 1.0, height = 1.0;
+  size_t object_index = 0;  ///< its index in the scene file's /objects (messages)
 };
 
 struct Camera {

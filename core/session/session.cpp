@@ -433,6 +433,7 @@ bool Session::renderReady(const RenderSettings& settings) {
 
 RenderImage Session::render(const RenderSettings& settings, bool gpu) {
   checkCamera(scene_->camera, scene_->file);  // edited since parsing (Python, the viewer)
+  if (gpu && isPolarisedRender(*scene_, settings)) checkGpuPolariserSheets(*scene_);
   // The host's memory is read (several /proc and cgroup files) only for an image larger than
   // one this session found room for: not on every frame of the viewer.
   if (renderHostBytes(*scene_, settings) > render_bytes_fitted_) {
@@ -515,6 +516,7 @@ PolarisedTrace Session::tracePolarised(const TraceRequest& ray, const Stokes& in
                                        const PolarisedTraceSettings& settings, bool gpu) {
   checkPolarisedTrace(ray, input, settings);
   checkIndicesAt(*scene_, ray.wavelength_nm);
+  if (gpu) checkGpuPolariserSheets(*scene_);  // before the volume is made
   if (gpu)
     return gpuRenderer().tracePolarised(scene_->polarizers, {ray}, {input}, settings).front();
   cpuMarcher();  // the volume and its field

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/scene/messages.h"
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
@@ -108,8 +109,8 @@ void checkPolarisedScene(const Scene& scene, const RenderSettings& s) {
     throw std::runtime_error(scene.file.string() + ": /environment/polarization: " + why +
                              " takes an unpolarised environment (docs/polarisation.md), got "
                              "stokes [" +
-                             std::to_string(p[0]) + ", " + std::to_string(p[1]) + ", " +
-                             std::to_string(p[2]) + ", " + std::to_string(p[3]) + "]");
+                             formatNumber(p[0]) + ", " + formatNumber(p[1]) + ", " +
+                             formatNumber(p[2]) + ", " + formatNumber(p[3]) + "]");
 }
 
 Stokes cameraStokes(const Stokes& row, const glm::dvec3& v, const glm::dvec3& x_in) {

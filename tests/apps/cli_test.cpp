@@ -623,6 +623,20 @@ TEST_F(Cli, TraceDenormalDirectionIsZeroNotNonFinite) {
   EXPECT_EQ(r.err.find("finite"), std::string::npos) << r.err;
 }
 
+// --origin and --dir take --stokes's parser (parseNumberList): a trailing comma, an empty field,
+// hexadecimal and an empty value were accepted or read in part.
+TEST_F(Cli, TraceOriginAndDirAreThreeDecimalNumbersAndNothingElse) {
+  const std::string scene = write("scene.json", tinyScene());
+  for (const char* bad : {"", "0,0,-4,", "0,,0,-4", "0x0,0,-4", "0,0,-4;", "0,0,-4e"}) {
+    expectCleanFailure(
+        run("trace " + quote(scene) + " -q --origin " + quote(bad) + " --dir 0,0,1"),
+        "--origin must be three finite numbers x,y,z, got '" + std::string(bad) + "'");
+    expectCleanFailure(run("trace " + quote(scene) + " -q --origin 0,0,-4 --dir " + quote(bad)),
+                       "--dir must be three finite numbers x,y,z, got '" + std::string(bad) + "'");
+  }
+  EXPECT_EQ(run("trace " + quote(scene) + " -q --origin ' 0, 0,-4.0e0' --dir +0,-0,1.").code, 0);
+}
+
 TEST_F(Cli, TraceNonFiniteOrigin) {
   const std::string scene = write("scene.json", tinyScene());
   expectCleanFailure(run("trace " + quote(scene) + " --origin 0,nan,-4 --dir 0,0,1"), "--origin");
@@ -970,6 +984,10 @@ TEST_F(Cli, ExposureAndProgressAreCheckedEvenWhenUnused) {
   expectCleanFailure(render(tinyScene(), "--exposure 1e6"), "--exposure must be in [-64, 64]");
   expectCleanFailure(render(tinyScene(), "-q --progress sometimes"),
                      "--progress must be auto, always or never");
+  // The value as it was given, not std::to_string's 301 digits of 1e300.
+  const Outcome huge = render(tinyScene(), "--exposure 1e300");
+  expectCleanFailure(huge, "--exposure must be in [-64, 64] stops, got 1e+300");
+  EXPECT_LT(huge.err.size(), 80u) << huge.err;
   EXPECT_EQ(render(tinyScene(), "-q --exposure -64").code, 0);
 }
 

@@ -490,4 +490,45 @@ TEST_F(FitCli, MaterialsTheSceneCannotLoadAreRefused) {
   EXPECT_EQ(run(ir).code, 0);  // without -o nothing is written and the fit is reported
 }
 
+// A CSV from Excel ("CSV UTF-8") starts with a byte order mark, which stuck to the first header
+// word: "first column must be 'wavelength_nm' ..., got 'wavelength_nm'" (the mark invisible). It
+// is skipped, in CSV and YAML alike.
+TEST_F(FitCli, ByteOrderMarkIsSkipped) {
+  std::string csv = "\xEF\xBB\xBF" + slurp(bk7Csv());
+  const std::string bom = write("bom.csv", csv);
+  const Outcome r = run(bom + " -o " + path("out.json"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(path("out.json")));
+  const std::string yml = write("bom.yml",
+                                "\xEF\xBB\xBF"
+                                "DATA:\n  - type: tabulated n\n    data: |\n"
+                                "        0.4 1.53\n        0.5 1.52\n        0.6 1.515\n"
+                                "        0.7 1.512\n");
+  const Outcome y = run(yml + " --model cauchy2");
+  EXPECT_EQ(y.code, 0) << y.err;
+}
+
+// A YAML block with a key twice kept one of the values without a word (a scene's JSON refuses a
+// repeated key): refused with the line of the second and of the first.
+TEST_F(FitCli, DuplicateYamlKeyIsRefusedWithItsLine) {
+  const std::string yml = write("dup.yml",
+                                "DATA:\n  - type: formula 2\n    type: tabulated n\n"
+                                "    wavelength_range: 0.3 2.5\n    coefficients: 0 1 0.01\n");
+  expectCleanFailure(run(yml + " -o " + path("out.json")),
+                     yml + ":3: duplicate key 'type' (first on line 2)");
+}
+
+// --range-nm was CLI11's list of numbers: '400,,700' (an empty field dropped), '400,700,' and
+// hexadecimal passed; it takes --stokes's parser now.
+TEST_F(FitCli, RangeIsTwoDecimalNumbersAndNothingElse) {
+  const std::string csv = bk7Csv();
+  for (const char* bad : {"", "400,700,", "400,,700", "0x190,700", "400", "400,700,800", "inf,700"})
+    expectCleanFailure(
+        run(csv + " --range-nm " + eikon::test::quote(bad) + " -o " + path("out.json")),
+        "--range-nm must be two finite numbers LO,HI (nm), got '" + std::string(bad) + "'");
+  expectCleanFailure(run(csv + " --range-nm 700,400 -o " + path("out.json")),
+                     "--range-nm must satisfy 0 < LO < HI (nm), got '700,400'");
+  EXPECT_EQ(run(csv + " --range-nm 450,650").code, 0);
+}
+
 }  // namespace

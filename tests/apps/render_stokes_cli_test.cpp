@@ -186,4 +186,56 @@ TEST(RenderStokesCli, WedgeRenderedAlongItsSideFacesHasNoNan) {
     }
 }
 
+// The GPU's polarised render and trace take at most 8 polariser sheets (EIKON_POL_MAX_SHEETS);
+// a scene with more loaded, then failed after the voxelising with a message naming neither the file
+// nor the sheet. Now the 9th sheet (/objects/9: a sphere comes first) is named with the file and
+// the CPU reference as the remedy, before any work: with --progress always the error is the only
+// line (it followed "preparing the GPU (pipelines, volume upload)"), and nothing lands in the cache
+// folder. The reference renders and traces the scene.
+TEST(RenderStokesCli, MoreSheetsThanTheGpuTakesNamesTheNinthBeforeVoxelising) {
+  Dir d;
+  std::string text = kScene;
+  const std::string sheet = R"({"shape": "polarizer", "center": [0, 0, 20], "normal": [0, 0, 1],
+               "transmission_axis": [1, 0, 0], "size": [40, 40]})";
+  std::string more;
+  for (int k = 0; k < 8; ++k) more += ",\n" + sheet;  // 9 sheets in all, /objects/1 to /objects/9
+  text.insert(text.rfind("}]") + 1, more);            // after the last object
+  std::ofstream(d.path / "many.json") << text;
+  const std::string scene = quote((d.path / "many.json").string());
+  const fs::path out = d.path / "out.exr", cache = d.path / "cache";
+  const std::string env = "EIKON_CACHE_DIR=" + quote(cache.string());
+  auto expectRefused = [&](const Outcome& r, const std::string& what) {
+    EXPECT_NE(r.code, 0) << what;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << what << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("eikon: error: " + (d.path / "many.json").string() + ": /objects/9: ", 0),
+              0u)
+        << what << ": " << r.err;
+    EXPECT_NE(r.err.find("at most 8 polariser sheets; this is sheet 9 of 9"), std::string::npos)
+        << what << ": " << r.err;
+    EXPECT_NE(r.err.find("--reference"), std::string::npos) << what << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << what << ": " << r.out;
+    EXPECT_FALSE(fs::exists(out)) << what;
+    EXPECT_FALSE(fs::exists(d.path / "out.png")) << what;
+    EXPECT_FALSE(fs::exists(cache)) << what;
+  };
+  expectRefused(
+      eikon::test::runEikon("render " + scene + " -o " + quote(out.string()) + " --progress always",
+                            d.path, env),
+      "render");
+  expectRefused(
+      eikon::test::runEikon(
+          "trace " + scene + " --origin 0,0,-20 --dir 0,0,1 --stokes 1,0,0,0 --progress always",
+          d.path, env),
+      "trace --stokes");
+  const Outcome trace = eikon::test::runEikon(
+      "trace " + scene + " --origin 0,0,-20 --dir 0,0,1 --stokes 1,0,0,0 -q --reference", d.path,
+      env);
+  EXPECT_EQ(trace.code, 0) << trace.err;
+  EXPECT_NE(trace.out.find("stokes_out ("), std::string::npos) << trace.out;
+  const Outcome render = eikon::test::runEikon(
+      "render " + scene + " -o " + quote(out.string()) + " -q --reference", d.path, env);
+  EXPECT_EQ(render.code, 0) << render.err;
+  EXPECT_TRUE(fs::exists(out));
+}
+
 }  // namespace

@@ -120,12 +120,30 @@ TEST_F(TraceStokesCli, QuarterWaveQuartzPlateMakesLeftCircularLight) {
 TEST_F(TraceStokesCli, BadStokesIsOneErrorLine) {
   const std::string scene = write("aside.json", sceneJson(kAside));
   const std::string base = "trace " + quote(scene) + " --origin 0,0,-20 --dir 0,0,1 --stokes ";
-  expectCleanFailure(run(base + "1,0,0"), "--stokes must be four numbers");
+  expectCleanFailure(run(base + "1,0,0"), "--stokes must be four finite numbers");
   expectCleanFailure(run(base + "0,0,0,0"), "--stokes needs S0 > 0");
   expectCleanFailure(run(base + "-1,0,0,0"), "--stokes needs S0 > 0");
   expectCleanFailure(run(base + "1,1,1,0"), "degree of polarisation");
   expectCleanFailure(run(base + "1,x,0,0"), "--stokes must be four finite numbers");
   expectCleanFailure(run(base + "1,nan,0,0"), "--stokes must be four finite numbers");
+}
+
+// An empty --stokes was silently the default 1,0,0,0, and a trailing comma and hexadecimal were
+// accepted, while '1,,0,0' was refused: exactly four finite decimal numbers, or one error line.
+TEST_F(TraceStokesCli, StokesIsFourDecimalNumbersAndNothingElse) {
+  const std::string scene = write("aside.json", sceneJson(kAside));
+  const std::string base = "trace " + quote(scene) + " --origin 0,0,-20 --dir 0,0,1 -q --stokes ";
+  for (const char* bad : {"", "1,0,0,0,", ",1,0,0,0", "1,,0,0", "0x1,0,0,0", "1,0,0,0x0",
+                          "1,0,0,inf", "1,0,0,1e999", "1,0,0,0 x", "1,0,0,.", "1,0,0,1e"})
+    expectCleanFailure(run(base + quote(bad)),
+                       "--stokes must be four finite numbers S0,S1,S2,S3, "
+                       "got '" +
+                           std::string(bad) + "'");
+  // Decimal forms and blanks around a number are numbers.
+  const Outcome r = run(base + quote(" +1.0, 0, -0.5e-0 ,.5") + " --json --reference");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out).at("stokes_in").get<std::vector<double>>(),
+            (std::vector<double>{1, 0, -0.5, 0.5}));
 }
 
 TEST_F(TraceStokesCli, StokesOnASmoothedSceneIsOneErrorLine) {

@@ -20,6 +20,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "tests/apps/cli_support.h"
@@ -219,6 +220,23 @@ TEST_F(ViewerTest, BadOptionsAreOneLineBeforeAnyWindow) {
     EXPECT_NE(o.code, 0) << bad;
     EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << bad << ": " << o.err;
     EXPECT_EQ(o.err.find("DISPLAY"), std::string::npos) << bad << ": " << o.err;
+  }
+}
+
+// --screenshot "" passed as no screenshot at all (a name ending in '/' is refused), and
+// --exposure 1e300 was refused with the value printed as a 301-digit decimal.
+TEST_F(ViewerTest, EmptyScreenshotAndHugeExposureAreOneShortLine) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"--screenshot ''", "eikon: error: --screenshot must name a .png file, got ''\n"},
+      {"--exposure 1e300", "eikon: error: --exposure must be in [-64, 64] stops, got 1e+300\n"},
+      {"--exposure -64.5", "eikon: error: --exposure must be in [-64, 64] stops, got -64.5\n"}};
+  for (const auto& [bad, message] : cases) {
+    const Outcome o = eikon::test::runEikon("view " + quote(kGlassSphere) + " " + bad, dir_ / "io",
+                                            "env -u DISPLAY");
+    EXPECT_NE(o.code, 0) << bad;
+    EXPECT_EQ(o.err.rfind(message, 0), 0u) << bad << ": " << o.err;
+    EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << bad << ": " << o.err;
+    EXPECT_TRUE(o.out.empty()) << o.out;
   }
 }
 

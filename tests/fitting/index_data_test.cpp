@@ -289,6 +289,45 @@ TEST(RefractiveIndexYaml, TotalFormulaSamplesAreBounded) {
   EXPECT_EQ(parseRefractiveIndexYaml(text, "many.yml", o).modes[0].size(), 600u);
 }
 
+// yaml-cpp keeps every pair of a map whose key repeats and answers one: the other value was lost
+// without a word. A repeated key is refused with its line and the first's, in any map of the file;
+// keys repeated across maps, and an alias used twice, are not repeats.
+TEST(RefractiveIndexYaml, DuplicateKeyIsRefusedWithItsLine) {
+  auto yml = [](const std::string& text) {
+    return [text] { parseRefractiveIndexYaml(text, "dup.yml"); };
+  };
+  expectError(yml("DATA:\n  - type: formula 2\n    type: tabulated n\n"
+                  "    wavelength_range: 0.3 2.5\n    coefficients: 0 1 0.01\n"),
+              {"dup.yml:3: duplicate key 'type' (first on line 2)"});
+  expectError(yml("DATA:\n  - type: tabulated n\n    data: |\n        0.5 1.5\n        0.6 1.4\n"
+                  "DATA:\n  - type: tabulated k\n"),
+              {"dup.yml:6: duplicate key 'DATA' (first on line 1)"});
+  expectError(yml("SPECS:\n  temperature: 20\n  temperature: 25\nDATA:\n  - type: tabulated n\n"
+                  "    data: |\n        0.5 1.5\n        0.6 1.4\n"),
+              {"dup.yml:3: duplicate key 'temperature' (first on line 2)"});
+  expectError(yml("DATA: [{type: tabulated n, data: '0.5 1.5', type: x}]\n"),
+              {"dup.yml:1: duplicate key 'type'"});
+  const std::string fine =
+      "SPECS: &s {a: 1, b: {a: 2}}\nMORE: *s\nALSO: *s\nDATA:\n  - type: tabulated n\n"
+      "    data: |\n        0.5 1.5\n        0.6 1.4\n  - type: tabulated n\n"
+      "    data: |\n        0.7 1.3\n        0.8 1.2\n";
+  EXPECT_EQ(parseRefractiveIndexYaml(fine, "fine.yml").modes[0].size(), 4u);
+}
+
+// A byte order mark at the start of CSV text (Python's parse_index_csv) is skipped, as
+// readTextFile skips it in a file.
+TEST(IndexCsv, LeadingByteOrderMarkIsSkipped) {
+  const IndexData d = parseIndexCsv("\xEF\xBB\xBFwavelength_nm,n\n500,1.5\n600,1.4\n", "bom.csv");
+  EXPECT_EQ(d.modes[0].size(), 2u);
+  EXPECT_EQ(parseRefractiveIndexYaml("\xEF\xBB\xBF"
+                                     "DATA:\n  - type: tabulated n\n    data: |\n"
+                                     "        0.5 1.5\n        0.6 1.4\n",
+                                     "bom.yml")
+                .modes[0]
+                .size(),
+            2u);
+}
+
 // An index above 10 (which no scene takes) is refused with its file and line, as one below 1 is.
 TEST(IndexCsv, IndexAboveTenIsRefused) {
   expectError([] { parseIndexCsv("wavelength_nm,n\n500,9.5\n600,12\n", "big.csv"); },

@@ -6,7 +6,8 @@ module, from both twins, against closed forms, and the same numbers as `eikon tr
   - a 31¼-wave quartz plate with its axis at 45° turns x-polarised light left circular,
     S3/S0 ≤ −0.999;
   - `eikon trace --stokes 1,1,0,0 --json --reference` prints the module's CPU stokes_out (1e-12);
-  - bad input (three Stokes numbers, S0 ≤ 0, DoP > 1, unknown device) raises ValueError.
+  - bad input (three Stokes numbers, S0 ≤ 0, DoP > 1, unknown device) raises ValueError;
+  - nine polariser sheets on the GPU twin (which takes 8) raise RuntimeError naming the 9th.
 Run by CTest (python.polarised_trace) with EIKON_BINARY and EIKON_PYTHON_DIR.
 """
 import json
@@ -82,6 +83,19 @@ class PolarisedTrace(unittest.TestCase):
                    {"device": "tpu"}]:
             with self.assertRaises(ValueError, msg=str(kw)):
                 eikon.trace_polarised(sc, [0, 0, -20], [0, 0, 1], 550.0, **kw)
+
+    def test_more_sheets_than_the_gpu_takes_name_the_ninth(self):
+        # The GPU twin takes at most 8 polariser sheets; the 9th (/objects/9 after the sphere) is
+        # named with the remedy, and the CPU twin traces the scene.
+        sc = eikon.Scene.parse(scene_dict([ASIDE] + [sheet(-8, 0)] * 9), "nine.json")
+        with self.assertRaises(RuntimeError) as e:
+            eikon.trace_polarised(sc, [0, 0, -20], [0, 0, 1], 550.0, device="gpu")
+        msg = str(e.exception)
+        self.assertTrue(msg.startswith("nine.json: /objects/9: "), msg)
+        self.assertIn("at most 8 polariser sheets; this is sheet 9 of 9", msg)
+        self.assertIn('device="cpu"', msg)
+        t = eikon.trace_polarised(sc, [0, 0, -20], [0, 0, 1], 550.0, device="cpu")
+        self.assertAlmostEqual(t["stokes_out"][0], 0.5, delta=1e-9)  # one axis: Malus at 0°
 
 
 if __name__ == "__main__":

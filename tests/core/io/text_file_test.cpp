@@ -95,6 +95,20 @@ TEST_F(TextFile, NulBytesAreRefusedWithTheirOffsetAndLine) {
   EXPECT_EQ(nulByteProblem("no nul", "f.json", "JSON text"), "");
 }
 
+// A UTF-8 byte order mark (Excel's "CSV UTF-8", Notepad) is no part of the text: left in, it stuck
+// to the first word of a CSV header, which a message quoted looking just like the expected word.
+// Only a leading one is left out; one further on is text.
+TEST_F(TextFile, LeadingByteOrderMarkIsLeftOut) {
+  test::put(dir_ / "bom.csv", "\xEF\xBB\xBFwavelength_nm,n\n");
+  EXPECT_EQ(readTextFile(dir_ / "bom.csv", "a data file"), "wavelength_nm,n\n");
+  test::put(dir_ / "only.json", "\xEF\xBB\xBF");
+  EXPECT_EQ(readTextFile(dir_ / "only.json", "a scene file"), "");
+  test::put(dir_ / "inner.csv", "a\xEF\xBB\xBF\n");
+  EXPECT_EQ(readTextFile(dir_ / "inner.csv", "a data file"), "a\xEF\xBB\xBF\n");
+  test::put(dir_ / "part.csv", "\xEF\xBBx");  // not a whole mark
+  EXPECT_EQ(readTextFile(dir_ / "part.csv", "a data file"), "\xEF\xBBx");
+}
+
 // A NUL in the name is shown as \x00 (what() is a C string: the message stopped at it), a name
 // too long for the system is shortened and keeps the reason.
 TEST_F(TextFile, OddNamesAreShownWhole) {

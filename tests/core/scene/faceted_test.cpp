@@ -351,6 +351,28 @@ TEST(Faceted, RefusesBadDiagramsWithTheirPath) {
                      "/objects/0/tiers/0/symmetry", "must divide");
 }
 
+// Tiers that meet "girdle" in a stone without one: the error led with a length 1000 times the
+// design's "next largest (0 mm)" at /tiers/3 and put the cause in parentheses. The first tier that
+// meets the missing girdle is named, before any cut, and nothing is said about precision.
+TEST(Faceted, MeetingAMissingGirdleNamesTheFirstTierThatDoes) {
+  const char* no_girdle = R"("shape": "faceted", "material": "g", "gear": 96)";
+  const std::string tiers = "[" + kPav + "," + kGirdle + "," + kCrown + "," + kTable + "]";
+  const std::string m = test::sceneErrorOf(
+      sceneWith(std::string("{") + no_girdle + ", \"tiers\": " + tiers + "}"), "t.json");
+  EXPECT_TRUE(test::isOneLineSceneError(m, "t.json", "/objects/0/tiers/0/meet",
+                                        "meets the girdle, but the object has no girdle"))
+      << m;
+  EXPECT_EQ(m.find("1000 times"), std::string::npos) << m;
+  // The repro: a girdle tier and a table of 1.58 mm, the one length of the design.
+  const std::string m2 = test::sceneErrorOf(
+      sceneWith(std::string("{") + no_girdle + ", \"tiers\": [" + kGirdle + "," + kPav + "," +
+                kCrown + R"(, {"name": "T", "side": "table", "distance": 1.5776540609934684}]})"),
+      "t.json");
+  EXPECT_TRUE(test::isOneLineSceneError(m2, "t.json", "/objects/0/tiers/0/meet",
+                                        "meets the girdle, but the object has no girdle"))
+      << m2;
+}
+
 // ------------------------------------------------------------------ GemCad .asc
 
 std::string slurp(const fs::path& p) {

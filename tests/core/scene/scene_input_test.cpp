@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 
 #include "core/scene/messages.h"
@@ -173,6 +174,20 @@ TEST(Printable, TruncatesAtACharacterBoundary) {
   EXPECT_EQ(printable("λλλλλλλ", 11), "λλλλλ... (14 bytes)");
   EXPECT_EQ(printable("\x01\x01\x01", 9), "\\x01\\x01... (3 bytes)");  // escapes are not split
   EXPECT_EQ(printable("short", 10), "short");
+}
+
+// Numbers in messages: the shortest text that reads back as the value. std::to_string printed
+// 1e300 as 301 digits and 1e-7 as "0.000000".
+TEST(FormatNumber, IsTheShortestRoundTrip) {
+  EXPECT_EQ(formatNumber(1e300), "1e+300");
+  EXPECT_EQ(formatNumber(-1e-7), "-1e-07");
+  EXPECT_EQ(formatNumber(64.5), "64.5");
+  EXPECT_EQ(formatNumber(0.1), "0.1");
+  EXPECT_EQ(formatNumber(-0.0), "-0");
+  EXPECT_EQ(formatNumber(1.0 / 3.0), "0.3333333333333333");
+  EXPECT_EQ(formatNumber(4.9406564584124654e-324), "5e-324");
+  EXPECT_EQ(formatNumber(std::numeric_limits<double>::infinity()), "inf");
+  EXPECT_EQ(std::stod(formatNumber(1.5776540609934684)), 1.5776540609934684);
 }
 
 // A NUL inside a key or a name would cut the C string of the message (what(), printf): it is
