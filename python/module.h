@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/scene/messages.h"  // formatNumber, for messages
 #include "core/session/session.h"
 #include "core/volume/march_types.h"
 #include "optics/uniaxial.h"
@@ -35,8 +36,6 @@ double checkIndex(double n, const char* name);
 double checkPositive(double v, const char* name);
 /// A wavelength in [lo, hi] nm.
 double checkWavelength(double nm, const char* name, double lo, double hi);
-/// "%.10g" of a number, for messages.
-std::string fmtNumber(double v);
 py::array_t<double> fromVector(const std::vector<double>& v);
 Mode parseMode(const std::string& s);
 std::string integratorName(Integrator i);

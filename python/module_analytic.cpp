@@ -29,7 +29,7 @@ struct Box {
 };
 
 std::string point(const glm::dvec3& x) {
-  return "(" + fmtNumber(x.x) + ", " + fmtNumber(x.y) + ", " + fmtNumber(x.z) + ")";
+  return "(" + formatNumber(x.x) + ", " + formatNumber(x.y) + ", " + formatNumber(x.z) + ")";
 }
 
 Box checkedBox(const py::handle& bmin, const py::handle& bmax, double cell) {
@@ -38,7 +38,7 @@ Box checkedBox(const py::handle& bmin, const py::handle& bmax, double cell) {
   for (int k = 0; k < 3; ++k)
     if (!(b.lo[k] < b.hi[k]))
       throw std::invalid_argument("bounds_min must be below bounds_max on every axis, got " +
-                                  fmtNumber(b.lo[k]) + " >= " + fmtNumber(b.hi[k]) + " on " +
+                                  formatNumber(b.lo[k]) + " >= " + formatNumber(b.hi[k]) + " on " +
                                   "xyz"[k]);
   return b;
 }
@@ -46,14 +46,14 @@ Box checkedBox(const py::handle& bmin, const py::handle& bmax, double cell) {
 double checkedRadius(double R) {
   checkPositive(R, "radius");
   if (R > kMaxCoordinateMm)
-    throw std::invalid_argument("radius must be at most 1e12 mm, got " + fmtNumber(R));
+    throw std::invalid_argument("radius must be at most 1e12 mm, got " + formatNumber(R));
   return R;
 }
 
 // The index `what` gives at x must be a refractive index, as a scene's everywhere in its object.
 void checkFieldIndex(double n, const glm::dvec3& x, const std::string& what) {
   if (!(n >= kMinIndex && n <= kMaxIndex))
-    throw std::invalid_argument(what + " gives n = " + fmtNumber(n) + " at " + point(x) +
+    throw std::invalid_argument(what + " gives n = " + formatNumber(n) + " at " + point(x) +
                                 ": indices must be in [1, 10]");
 }
 

@@ -28,24 +28,24 @@ void checkApproximationWindow(const Dispersion& d, double lo, double hi) {
   checkWavelength(lo, "lo_nm", kMinFitWavelengthNm, kMaxFitWavelengthNm);
   checkWavelength(hi, "hi_nm", kMinFitWavelengthNm, kMaxFitWavelengthNm);
   if (!(lo < hi))
-    throw std::invalid_argument("lo_nm must be below hi_nm, got " + fmtNumber(lo) +
-                                " >= " + fmtNumber(hi));
+    throw std::invalid_argument("lo_nm must be below hi_nm, got " + formatNumber(lo) +
+                                " >= " + formatNumber(hi));
   if (d.kind() == Dispersion::Kind::Sellmeier)
     for (size_t i = 0; i < d.sellmeierC().size(); ++i) {
       const double pole = 1e3 * std::sqrt(d.sellmeierC()[i]);  // C in µm²
       if (pole >= lo && pole <= hi)
         throw std::invalid_argument(
-            "the Sellmeier term " + std::to_string(i + 1) + " has a pole at " + fmtNumber(pole) +
-            " nm (C" + std::to_string(i + 1) + " = " + fmtNumber(d.sellmeierC()[i]) +
-            " um^2), inside [" + fmtNumber(lo) + ", " + fmtNumber(hi) + "] nm");
+            "the Sellmeier term " + std::to_string(i + 1) + " has a pole at " + formatNumber(pole) +
+            " nm (C" + std::to_string(i + 1) + " = " + formatNumber(d.sellmeierC()[i]) +
+            " um^2), inside [" + formatNumber(lo) + ", " + formatNumber(hi) + "] nm");
     }
   const int samples = std::max(3, int(std::lround(hi - lo)) + 1);  // as cauchyApproximation
   for (int i = 0; i < samples; ++i) {
     const double l = lo + (hi - lo) * i / double(samples - 1), n = d.index(l);
     if (!(n >= kMinIndex && n <= kMaxIndex))
-      throw std::invalid_argument("the model gives n = " + fmtNumber(n) + " at " + fmtNumber(l) +
-                                  " nm, inside [" + fmtNumber(lo) + ", " + fmtNumber(hi) +
-                                  "] nm: not a refractive index in [1, 10]");
+      throw std::invalid_argument("the model gives n = " + formatNumber(n) + " at " +
+                                  formatNumber(l) + " nm, inside [" + formatNumber(lo) + ", " +
+                                  formatNumber(hi) + "] nm: not a refractive index in [1, 10]");
   }
 }
 
@@ -53,8 +53,8 @@ void checkApproximationWindow(const Dispersion& d, double lo, double hi) {
 double materialIndex(const Material& x, const Dispersion& d, const char* which, double nm) {
   const double n = d.index(nm);
   if (!(n >= kMinIndex && n <= kMaxIndex))
-    throw std::invalid_argument("material '" + x.name + "' " + which + " = " + fmtNumber(n) +
-                                " at " + fmtNumber(nm) +
+    throw std::invalid_argument("material '" + x.name + "' " + which + " = " + formatNumber(n) +
+                                " at " + formatNumber(nm) +
                                 " nm is not a refractive index in [1, 10]");
   return n;
 }

@@ -24,7 +24,7 @@ PleochroismModel parsePleo(const std::string& s) {
 double checkAngle(double t, const char* name) {
   if (!std::isfinite(t))
     throw std::invalid_argument(std::string(name) + " must be a finite angle (rad), got " +
-                                fmtNumber(t));
+                                formatNumber(t));
   return t;
 }
 
@@ -32,7 +32,7 @@ double checkAngle(double t, const char* name) {
 // through; cos_i = 5 was taken for 1.
 double checkCosine(double c) {
   if (!(std::abs(c) <= 1.0 + 1e-9))
-    throw std::invalid_argument("cos_i must be in [-1, 1], got " + fmtNumber(c));
+    throw std::invalid_argument("cos_i must be in [-1, 1], got " + formatNumber(c));
   return c;
 }
 
@@ -222,7 +222,7 @@ void bindInterfaces(py::module_& m) {
         checkIndex(n2, "n2");
         if (!(n1 > n2))
           throw std::invalid_argument(
-              "no critical angle for n1 = " + fmtNumber(n1) + " <= n2 = " + fmtNumber(n2) +
+              "no critical angle for n1 = " + formatNumber(n1) + " <= n2 = " + formatNumber(n2) +
               ": total internal reflection needs the denser medium first (n1 > n2)");
         return criticalAngle(n1, n2);
       },

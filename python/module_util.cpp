@@ -39,12 +39,6 @@ std::vector<double> toVector(const py::handle& h) {
   if (!a || a.ndim() != 1) throw std::invalid_argument("expected a 1-D sequence of numbers");
   return {a.data(), a.data() + a.size()};
 }
-std::string fmtNumber(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-
 glm::dvec3 toFiniteVec3(const py::handle& h, const char* name) {
   auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
   if (!a || a.size() != 3)
@@ -53,7 +47,7 @@ glm::dvec3 toFiniteVec3(const py::handle& h, const char* name) {
   for (int k = 0; k < 3; ++k)
     if (!std::isfinite(v[k]))
       throw std::invalid_argument(std::string(name) + " must be three finite numbers, got " +
-                                  fmtNumber(v[k]) + " on " + "xyz"[k]);
+                                  formatNumber(v[k]) + " on " + "xyz"[k]);
   return v;
 }
 
@@ -62,8 +56,8 @@ glm::dvec3 toPosition(const py::handle& h, const char* name) {
   for (int k = 0; k < 3; ++k)
     if (std::abs(v[k]) > kMaxCoordinateMm)
       throw std::invalid_argument(std::string(name) +
-                                  " must be within ±1e12 mm on each axis, got " + fmtNumber(v[k]) +
-                                  " on " + "xyz"[k]);
+                                  " must be within ±1e12 mm on each axis, got " +
+                                  formatNumber(v[k]) + " on " + "xyz"[k]);
   return v;
 }
 
@@ -79,22 +73,22 @@ glm::dvec3 toDirection(const py::handle& h, const char* name) {
 double checkIndex(double n, const char* name) {
   if (!(n >= kMinIndex && n <= kMaxIndex))
     throw std::invalid_argument(std::string(name) + " must be a refractive index in [" +
-                                fmtNumber(kMinIndex) + ", " + fmtNumber(kMaxIndex) + "], got " +
-                                fmtNumber(n));
+                                formatNumber(kMinIndex) + ", " + formatNumber(kMaxIndex) +
+                                "], got " + formatNumber(n));
   return n;
 }
 
 double checkPositive(double v, const char* name) {
   if (!(v > 0) || !std::isfinite(v))
     throw std::invalid_argument(std::string(name) + " must be a finite number > 0, got " +
-                                fmtNumber(v));
+                                formatNumber(v));
   return v;
 }
 
 double checkWavelength(double nm, const char* name, double lo, double hi) {
   if (!(nm >= lo && nm <= hi))
-    throw std::invalid_argument(std::string(name) + " must be in [" + fmtNumber(lo) + ", " +
-                                fmtNumber(hi) + "] nm, got " + fmtNumber(nm));
+    throw std::invalid_argument(std::string(name) + " must be in [" + formatNumber(lo) + ", " +
+                                formatNumber(hi) + "] nm, got " + formatNumber(nm));
   return nm;
 }
 

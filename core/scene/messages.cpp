@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 
 namespace eikon {
@@ -69,7 +70,11 @@ std::string errorLine(std::string_view message) {
 
 std::string formatNumber(double v) {
   char buf[32];  // the shortest round trip of a double takes at most 24 characters
-  const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, v);
+  // A whole number below 1e15 in full ("100000", not the shorter "1e+05"), as a limit reads.
+  const bool whole = std::isfinite(v) && std::abs(v) < 1e15 && v == std::trunc(v);
+  const std::to_chars_result r =
+      whole ? std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed)
+            : std::to_chars(buf, buf + sizeof buf, v);
   return std::string(buf, r.ptr);
 }
 

@@ -30,8 +30,8 @@ inline std::string excerpt(std::string_view text) { return printable(text, 80); 
 std::string errorLine(std::string_view message);
 
 /// A number as a message shows it: the shortest text that reads back as `v` ("0.1", "64.5",
-/// "1e+300", "-1e-07", "inf", "nan"), never std::to_string's 300 digits of 1e300 nor its
-/// "0.000000" for 1e-7.
+/// "1e+300", "-1e-07", "inf", "nan"; a whole number below 1e15 in full, "100000"), never
+/// std::to_string's 300 digits of 1e300 nor its "0.000000" for 1e-7.
 std::string formatNumber(double v);
 
 }  // namespace eikon

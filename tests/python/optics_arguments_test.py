@@ -99,7 +99,7 @@ class Dispersion(Refused):
                      "the Sellmeier term 1 has a pole at 590 nm (C1 = 0.3481 um^2), inside "
                      "[400, 800] nm")
         self.refused(lambda: pole.cauchy_approximation(100, 200),
-                     "the model gives n = 0.985100478 at 100 nm")
+                     "the model gives n = 0.98510047801704")
         bk7 = eikon.load_material("N-BK7").n
         self.refused(lambda: bk7.cauchy_approximation(780, 380), "lo_nm must be below hi_nm")
         self.refused(lambda: bk7.cauchy_approximation(10, 780), "lo_nm must be in [100, 100000] nm")
@@ -133,7 +133,7 @@ class AnalyticField(Refused):
         self.refused(lambda: eikon.AnalyticField.maxwell_fisheye(2, 0, [0, 0, 0], *BOX, 0.5),
                      "radius must be a finite number > 0, got 0")
         self.refused(lambda: eikon.AnalyticField.maxwell_fisheye(2, 1, [0, 0, 0], *BOX, 0.5),
-                     "the Maxwell fish-eye n0/(1 + r²/R²) gives n = 0.02631578947 at (-5, -5, -5)")
+                     "the Maxwell fish-eye n0/(1 + r²/R²) gives n = 0.02631578947368421 at (-5, -5, -5)")
         self.refused(lambda: eikon.AnalyticField.maxwell_fisheye(-2, 10, [0, 0, 0], *BOX, 0.5),
                      "n0 must be a refractive index")
         self.refused(lambda: eikon.AnalyticField.luneburg(NAN, [0, 0, 0], *BOX, 0.5),

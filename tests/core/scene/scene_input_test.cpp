@@ -182,6 +182,9 @@ TEST(FormatNumber, IsTheShortestRoundTrip) {
   EXPECT_EQ(formatNumber(1e300), "1e+300");
   EXPECT_EQ(formatNumber(-1e-7), "-1e-07");
   EXPECT_EQ(formatNumber(64.5), "64.5");
+  EXPECT_EQ(formatNumber(100000.0), "100000");  // a whole number in full, not "1e+05"
+  EXPECT_EQ(formatNumber(-65536.0), "-65536");
+  EXPECT_EQ(formatNumber(1e15), "1e+15");
   EXPECT_EQ(formatNumber(0.1), "0.1");
   EXPECT_EQ(formatNumber(-0.0), "-0");
   EXPECT_EQ(formatNumber(1.0 / 3.0), "0.3333333333333333");
