@@ -19,9 +19,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -35,6 +37,7 @@
 #include "core/session/session.h"
 #include "core/vk/context.h"
 #include "core/vk/swapchain.h"
+#include "core/vk/timings.h"
 #include "core/volume/polarised_render.h"
 
 namespace eikon::cli {
@@ -91,23 +94,43 @@ void addViewOptions(CLI::App* sub, ViewArgs& a) {
 struct MovedLight {
   Light light;                           ///< the light simulated
   std::vector<glm::vec4> fluence, flux;  ///< its light volumes (VolumeSet's)
-  bool cached = false;                   ///< they came from the light cache
-  double seconds = 0;                    ///< the simulation's (or the cache lookup's) time
-  std::vector<std::string> warnings;     ///< "light cache: ..."
-  std::string error;                     ///< the simulation failed: why
+  /// The first light: the lit renderer made from them (Session::makeRendererFor), which replaces
+  /// the viewer's unlit one.
+  std::unique_ptr<ViewRenderer> renderer;
+  bool cached = false;                ///< they came from the light cache
+  double seconds = 0;                 ///< the simulation's (or the cache lookup's) time, all told
+  double voxelise_seconds = 0;        ///< the first light: the whole volume made meanwhile
+  bool volume_copied = false;         ///< it was the viewer's copied (LitView::whole)
+  std::vector<std::string> warnings;  ///< "light cache: ..."
+  std::string error;                  ///< the simulation failed: why
 };
 
-/// The scene's first light simulated in the background: when the viewer opens and the light cache
-/// does not hold it (the view shows the scene unlit meanwhile), and again whenever a drag moves
-/// it. A Session of its own on a copy of the scene (made from a copy of the viewer's volume, or
-/// voxelised at its first start on the worker thread, and kept for the next moves) simulates the
-/// light through the light cache (the key covers the medium, the lights and the simulator
+/// What the first light's renderer is made for: the viewer's context and scene, and the render
+/// that will follow (its pipeline compiles on the mover's thread too).
+struct LitView {
+  vk::Context* ctx = nullptr;
+  const Scene* scene = nullptr;
+  RenderSettings expected;
+  /// The viewer's volume where it is whole already (smoothed interfaces: its first frame needed
+  /// it), copied on the worker thread instead of voxelising the scene again (mesh_torus_caustic:
+  /// 3.5 s of copying against 5–6 s of voxelising); the viewer leaves it unchanged meanwhile.
+  const VolumeSet* whole = nullptr;
+};
+
+/// The scene's first light simulated in the background, and again whenever a drag moves it. A
+/// Session of its own on a copy of the scene (voxelised whole at its first start, on the worker
+/// thread, or a copy of the viewer's volume where that is whole; kept for the next moves) simulates
+/// the light through the light cache (the key covers the medium, the lights and the simulator
 /// settings, never the camera: a light put back where it was simulated before is only looked up),
-/// while the viewer keeps rendering with the light volumes it has. The viewer then swaps the new
-/// volumes into its renderer in place (Session::setLightVolumes): no renderer or pipeline is made
-/// again.
+/// while the viewer keeps rendering: unlit from a volume of interfaces only until the first light
+/// arrives, then with the light volumes it has. The first light comes with the lit renderer, made
+/// on the worker thread on the viewer's context (uploads and the pipeline's compile included),
+/// which the viewer adopts (Session::adoptRenderer); a moved light's volumes are swapped into that
+/// renderer in place (Session::setLightVolumes): no renderer or pipeline is made again.
 class LightMover {
  public:
+  /// What the worker is doing (the title says it).
+  enum class Stage { Voxelising, Simulating, Preparing };
   /// `on_cpu`: the twin the viewer's own session chose (Session::lightOnCpuTwin), so that both
   /// look up the same light-cache entries.
   LightMover(const Scene& scene, bool on_cpu, std::filesystem::path cache)
@@ -118,28 +141,45 @@ class LightMover {
   bool busy() const { return worker_.joinable() && !done_; }
   /// A simulation has finished and finished() has not reported it yet.
   bool done() const { return worker_.joinable() && done_; }
-  /// The fraction of the running simulation done, [0, 1].
+  /// The fraction of the running stage done, [0, 1].
   double fraction() const { return fraction_; }
+  Stage stage() const { return stage_; }
+  /// The mover's volume is voxelised whole (its first start voxelised it).
+  bool voxelised() const { return voxelised_; }
   /// Simulate the scene with its first light replaced by `light`, unless a simulation is running.
-  /// `volume`: the scene voxelised already (the viewer's), copied on the worker thread into the
-  /// mover's session at its first start instead of voxelising the scene again (mesh_torus_caustic:
-  /// 3.5 s of copying, done while the viewer makes its renderer). The caller leaves it unchanged
-  /// until the simulation has finished.
-  bool start(const Light& light, const VolumeSet* volume = nullptr) {
+  /// `first`: the first light, whose lit renderer is made too, on the worker thread (the mover's
+  /// volume is voxelised there first).
+  bool start(const Light& light, const LitView* first = nullptr) {
     if (busy()) return false;
     if (worker_.joinable()) worker_.join();  // the scene and the session are this thread's now
     done_ = false;
     fraction_ = 0.0;
+    stage_ = Stage::Simulating;
     scene_->lights.front() = light;
     result_ = MovedLight{};
     result_.light = light;
-    worker_ = std::thread([this, volume] {
+    std::optional<LitView> view;
+    if (first) view = *first;
+    worker_ = std::thread([this, view = std::move(view)] {
       const auto start = Clock::now();
       try {
         if (!session_) {
           session_ = std::make_unique<Session>(scene_);
-          session_->setProgress({[this](const char*, double f) { fraction_ = f; }, {}});
-          if (volume) session_->adoptVolume(*volume);
+          session_->setProgress({[this](const char* what, double f) {
+                                   stage_ = std::strcmp(what, "voxelising") == 0
+                                                ? Stage::Voxelising
+                                                : Stage::Simulating;
+                                   fraction_ = f;
+                                 },
+                                 {}});
+          stage_ = Stage::Voxelising;
+          result_.volume_copied = view && view->whole;
+          if (result_.volume_copied)
+            session_->adoptVolume(*view->whole);
+          else
+            session_->prepare(false);
+          voxelised_ = true;
+          result_.voxelise_seconds = std::chrono::duration<double>(Clock::now() - start).count();
         }
         // The viewer's twin, named: "auto" would decide again, without a device. The GPU twin
         // makes a Vulkan device of the mover's own.
@@ -148,6 +188,10 @@ class LightMover {
         const LightOutcome o = session_->simulateLight(request, on_cpu_, cache_);
         result_.cached = o.cached;
         result_.warnings = o.warnings;
+        if (view) {
+          stage_ = Stage::Preparing;
+          result_.renderer = session_->makeRendererFor(*view->ctx, *view->scene, &view->expected);
+        }
         VolumeSet& v = session_->prepare(false);  // made by simulateLight; refilled by the next
         result_.fluence = std::move(v.light_fluence);
         result_.flux = std::move(v.light_flux);
@@ -173,8 +217,9 @@ class LightMover {
   const std::filesystem::path cache_;
   std::unique_ptr<Session> session_;
   std::thread worker_;
-  std::atomic<bool> done_{false};
+  std::atomic<bool> done_{false}, voxelised_{false};
   std::atomic<double> fraction_{0.0};
+  std::atomic<Stage> stage_{Stage::Simulating};
   MovedLight result_;
 };
 
@@ -278,9 +323,10 @@ class Viewer {
     return std::string(buf) + compiles;
   }
 
-  /// The mover simulates the scene's own first light (not in the light cache when the viewer
-  /// opened): the view shows the scene unlit until it is swapped in.
-  void awaitFirstLight() { first_light_ = true; }
+  /// The mover voxelises the whole volume, simulates the scene's own first light (or finds it in
+  /// the light cache) and makes the lit renderer, started once the first frame is shown: the view
+  /// shows the scene unlit, from a volume of interfaces only, until the lit renderer is swapped in.
+  void awaitFirstLight() { first_light_ = light_moved_ = true; }
 
   const RenderImage& shown() const { return shown_; }
   int shownSamples() const { return shown_spp_; }
@@ -321,6 +367,18 @@ class Viewer {
     return useHeroSampling(base_.sampling, v.attenuating || v.emissive || v.opaque);
   }
 
+  /// The render of one stage of the refinement, with the keys' choices.
+  RenderSettings settingsOf(const Stage& st) const {
+    RenderSettings rs = base_;
+    rs.width = st.width;
+    rs.height = st.height;
+    rs.spp = st.spp;
+    rs.wavelengths = st.wavelengths;
+    rs.march.integrator = integrator_;
+    rs.modes = modes_;
+    return rs;
+  }
+
   void refine() {
     const int full_width = fullWidth();
     for (const Stage& st : stages()) {
@@ -328,13 +386,8 @@ class Viewer {
       // continuous drag still shows a frame per coarse render (a restart at every motion event
       // would show none).
       finish_stage_ = st.width < full_width;
-      RenderSettings rs = base_;
-      rs.width = st.width;
-      rs.height = st.height;
-      rs.spp = st.spp;
-      rs.wavelengths = st.wavelengths;
-      rs.march.integrator = integrator_;
-      rs.modes = stage_modes_ = modes_;
+      RenderSettings rs = settingsOf(st);
+      stage_modes_ = modes_;
       if (st.width <= 0 || st.height <= 0) return;
       waitForPipeline(rs);
       const auto start = Clock::now();
@@ -438,7 +491,10 @@ class Viewer {
         previewPixels(img.width, img.height, img.rgb, args_.exposure);
     if (!chain_.present(px.data(), img.width, img.height)) resized_ = true;
     const auto now = Clock::now();
-    if (frames_ == 0) first_frame_seconds_ = std::chrono::duration<double>(now - opened_).count();
+    if (frames_ == 0) {
+      first_frame_seconds_ = std::chrono::duration<double>(now - opened_).count();
+      timings::mark("first frame shown");  // EIKON_TIMINGS=1
+    }
     if (samples == 1 && wavelengths == (spectral_ ? full_wavelengths_ : 0) && !coarse)
       full_quality_seconds_ = std::chrono::duration<double>(now - change_time_).count();
     if (wavelengths != (spectral_ ? full_wavelengths_ : 0) && !coarse) ++few_frames_;
@@ -452,6 +508,9 @@ class Viewer {
     shown_wavelengths_ = wavelengths;
     shown_modes_ = stage_modes_;
     if (mover_ && mover_->busy()) ++light_rendered_;
+    if (first_light_) ++unlit_frames_;
+    if (first_light_ && !mover_->voxelised() && !session_.prepareGpuRender().fields)
+      ++unlit_unvoxelised_;  // neither session has the whole volume (it was not waited for)
     ++frames_;
     ++frames_since_change_;
     frame_times_.push_back(now);
@@ -478,9 +537,16 @@ class Viewer {
 
   void updateTitle(Clock::time_point now) {
     char light[96] = "";
-    if (mover_ && mover_->busy())
-      std::snprintf(light, sizeof light, " | %ssimulating the light (%.0f%%)...",
-                    first_light_ ? "unlit, " : "", 100.0 * mover_->fraction());
+    if (mover_ && mover_->busy()) {
+      const LightMover::Stage stage = mover_->stage();
+      if (stage == LightMover::Stage::Preparing)
+        std::snprintf(light, sizeof light, " | unlit, preparing the lit view...");
+      else
+        std::snprintf(light, sizeof light, " | %s%s (%.0f%%)...", first_light_ ? "unlit, " : "",
+                      stage == LightMover::Stage::Voxelising ? "voxelising for the light"
+                                                             : "simulating the light",
+                      100.0 * mover_->fraction());
+    }
     double fps = 0;
     if (frame_times_.size() > 1)
       fps = double(frame_times_.size() - 1) /
@@ -528,12 +594,30 @@ class Viewer {
         light_rendered_ = light_frames_ = 0;
       }
     }
-    if (light_moved_ && !mover_->busy()) {
-      if (mover_->start(wanted_light_)) {
+    // The first light starts once the first frame is shown: the cores go to that frame first
+    // (started at once, the mover's voxelising delayed the lit view as much; docs/viewer.md).
+    if (light_moved_ && !mover_->busy() && !(first_light_ && frames_ == 0)) {
+      const bool first = first_light_ && !first_light_started_;
+      LitView view;
+      if (first) view = litView();
+      if (mover_->start(wanted_light_, first ? &view : nullptr)) {
+        first_light_started_ = first_light_started_ || first;
         light_moved_ = false;
         updateTitle(Clock::now());
       }
     }
+  }
+
+  /// The first light's renderer is made on the viewer's context and scene, for the render the view
+  /// restarts with (its first stage, with the keys' choices now).
+  LitView litView() {
+    LitView v;
+    v.ctx = &session_.context();
+    v.scene = session_.scene().get();
+    v.expected = settingsOf(stages().front());
+    const VolumeSet& volume = session_.prepareGpuRender();  // made before the first frame
+    if (volume.whole()) v.whole = &volume;
+    return v;
   }
 
   /// The view is unlit until the first light, simulated in the background, arrives.
@@ -543,18 +627,35 @@ class Viewer {
     return mover_ && (light_moved_ || light_ready_ || mover_->busy() || mover_->done());
   }
 
-  /// The light volumes simulated in the background into the view: written into the renderer's
-  /// images in place (no renderer or pipeline made again); the view then restarts.
+  /// The light simulated in the background into the view: the first light's lit renderer
+  /// replaces the unlit one; a moved light's volumes are written into the renderer's images in
+  /// place (no renderer or pipeline made again). The view then restarts.
   void applyLight() {
     light_ready_ = false;
     session_.scene()->lights.front() = moved_.light;
-    session_.setLightVolumes(std::move(moved_.fluence), std::move(moved_.flux));
+    timings::mark(first_light_ ? "first light swapped in" : "moved light swapped in");
+    if (moved_.renderer)
+      session_.adoptRenderer(std::move(moved_.renderer), std::move(moved_.fluence),
+                             std::move(moved_.flux));
+    else
+      session_.setLightVolumes(std::move(moved_.fluence), std::move(moved_.flux));
+    // The first light: how long the mover's voxelising took, and the frames shown unlit before
+    // it ended (the first frame never waits for the whole volume).
+    char meanwhile[200];
+    if (first_light_)
+      std::snprintf(meanwhile, sizeof meanwhile,
+                    ", the volume %s there in %.2f s; %lld frames rendered unlit, %lld of them "
+                    "before the volume was voxelised,",
+                    moved_.volume_copied ? "copied" : "voxelised", moved_.voxelise_seconds,
+                    unlit_frames_, unlit_unvoxelised_);
+    else
+      std::snprintf(meanwhile, sizeof meanwhile,
+                    "; meanwhile %lld frames rendered with the former light", light_rendered_);
     std::printf(
-        "eikon view: light 0 simulated %s the background (%s, %.2f s; meanwhile %lld frames "
-        "rendered %s and %lld presented again): position %s, direction %s\n",
+        "eikon view: light 0 simulated %s the background (%s, %.2f s%s and %lld presented "
+        "again): position %s, direction %s\n",
         first_light_ ? "in" : "again in", moved_.cached ? "from the light cache" : "simulated",
-        moved_.seconds, light_rendered_, first_light_ ? "unlit" : "with the former light",
-        light_frames_, vectorJson(moved_.light.position).c_str(),
+        moved_.seconds, meanwhile, light_frames_, vectorJson(moved_.light.position).c_str(),
         vectorJson(moved_.light.direction).c_str());
     std::fflush(stdout);
     light_rendered_ = light_frames_ = 0;
@@ -684,11 +785,14 @@ class Viewer {
   Light wanted_light_;
   MovedLight moved_;  ///< the last light the mover finished, until applyLight swaps it in
   bool light_moved_ = false, light_ready_ = false;
-  bool first_light_ = false;      ///< the mover simulates the first light (awaitFirstLight)
-  long long light_rendered_ = 0;  ///< frames rendered while the mover simulated
-  long long light_frames_ = 0;    ///< frames presented again meanwhile (the view was refined)
-  std::string light_note_;        ///< the title's word on the last moved light
-  Clock::time_point last_again_;  ///< presentAgain's last frame
+  bool first_light_ = false;          ///< the mover simulates the first light (awaitFirstLight)
+  bool first_light_started_ = false;  ///< the mover was started on it (after the first frame)
+  long long unlit_frames_ = 0;        ///< frames shown before the first light arrived
+  long long unlit_unvoxelised_ = 0;   ///< of which before any whole volume was made
+  long long light_rendered_ = 0;      ///< frames rendered while the mover simulated
+  long long light_frames_ = 0;        ///< frames presented again meanwhile (the view was refined)
+  std::string light_note_;            ///< the title's word on the last moved light
+  Clock::time_point last_again_;      ///< presentAgain's last frame
   Integrator integrator_;
   Modes modes_, stage_modes_ = modes_, shown_modes_ = modes_;
   bool spectral_ = false;
@@ -812,24 +916,13 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   // Input is handled from here on: events that arrive while the scene is voxelised (polled by
   // the progress callbacks) already move the camera of the first frame.
   Viewer viewer(a, session, window.handle, chain, base, mover.get());
-  // Without light a sharp scene needs only its interfaces voxelised (Session::prepareGpuRender;
-  // docs/performance.md "Start-up"); with light the simulation needs the whole volume.
-  if (mover)
-    session.prepare(true);
-  else
-    session.prepareGpuRender();
-  if (mover) {
-    // The light from the light cache, else simulated in the background from a copy of this
-    // volume while the view shows the scene unlit (with zeroed light volumes, so the renderer is
-    // made lit and takes the simulated ones in place).
-    LightOutcome light = session.cachedLight(LightRequest{}, false, defaultLightCacheDir());
-    for (const std::string& w : light.warnings)
-      std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
-    if (!light.cached) {
-      mover->start(scene->lights.front(), &session.prepare(true));
-      viewer.awaitFirstLight();
-    }
-  }
+  // A sharp scene is shown first from its interfaces alone (Session::prepareGpuRender;
+  // docs/performance.md "Start-up"), unlit: with light, the mover voxelises the whole volume,
+  // simulates the light (or finds it in the light cache: its key covers the whole volume) and
+  // makes the lit renderer in the background, once the first frame is shown (docs/viewer.md "The
+  // first light").
+  session.prepareGpuRender();
+  if (mover) viewer.awaitFirstLight();
   viewer.run();
   std::printf("%s\n", viewer.summary().c_str());
   const RenderImage& img = viewer.shown();

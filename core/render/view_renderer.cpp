@@ -611,8 +611,12 @@ struct ViewRenderer::Impl {
     if (!pipelines.count(key) && !earlyPending(&ctx, key)) compiler.request(key);
   }
 
+  // Reads no camera: a renderer made on another thread (the viewer's lit renderer) asks for its
+  // pipeline while the window's thread moves the camera.
   Key viewKey(const RenderSettings& s) const {
-    gpu::ViewParams p = baseParams(s.march, renderFlags(s));
+    gpu::ViewParams p{};
+    p.grid_dims.w = flagsOf(s.march, renderFlags(s));
+    p.march.w = float(int(s.march.integrator));
     p.pass.w = s.aov_layer ? kAovPassBit : 0;
     return keyOf(kView, p);
   }
@@ -663,6 +667,11 @@ struct ViewRenderer::Impl {
     boundary.bindUniformTables(p);
   }
 
+  // The EIKON_F_* of a dispatch: the volume's, the environment's, the march's and `extra`.
+  int flagsOf(const MarchSettings& m, int extra) const {
+    return extra | volume_flags | environmentFlagsOf(scene.environment) | marchFlagsOf(m);
+  }
+
   gpu::ViewParams baseParams(const MarchSettings& m, int flags_extra) const {
     gpu::ViewParams p{};
     const Camera& cam = scene.camera;
@@ -676,9 +685,7 @@ struct ViewRenderer::Impl {
     p.cam_up = glm::vec4(glm::vec3(up), 0.0f);
     p.grid_origin = glm::vec4(glm::vec3(grid.origin), float(grid.h));
     p.grid_extent = glm::vec4(glm::vec3(grid.extent), float(1.0 / grid.h));
-    const int flags =
-        flags_extra | volume_flags | environmentFlagsOf(scene.environment) | marchFlagsOf(m);
-    p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flags);
+    p.grid_dims = glm::ivec4(grid.dims[0], grid.dims[1], grid.dims[2], flagsOf(m, flags_extra));
     p.march = glm::vec4(float(m.step_voxels), float(m.interface_threshold), float(ambient),
                         float(int(m.integrator)));
     p.limits = glm::ivec4(m.max_steps, 1, 1, skip_cap);

@@ -277,7 +277,12 @@ vk::Context& Session::context() {
 VolumeSet& Session::prepare(bool gpu) {
   checkVolumeSpec(scene_->volume, scene_->file);  // edited since parsing (Python)
   if (gpu) context();
-  if (volume_ && !volume_->whole()) volume_.reset();  // voxelised whole below; gpu_ stays valid
+  std::vector<glm::vec4> fluence, flux;  // a volume of interfaces only: its adopted light kept
+  if (volume_ && !volume_->whole()) {    // voxelised whole below; gpu_ stays valid
+    fluence = std::move(volume_->light_fluence);
+    flux = std::move(volume_->light_flux);
+    volume_.reset();
+  }
   if (!volume_) {
     VoxelizeOptions vo;
     vo.threads = threads_;
@@ -293,6 +298,8 @@ VolumeSet& Session::prepare(bool gpu) {
       const std::string err = key != 0 ? saveVolumeCache(volume_cache_, key, *volume) : "";
       if (!err.empty() && volume_note_) volume_note_("volume cache: " + printable(err));
     }
+    volume->light_fluence = std::move(fluence);
+    volume->light_flux = std::move(flux);
     volume_ = std::move(volume);
     voxelized_spec_ = scene_->volume;
   }
@@ -336,16 +343,6 @@ bool Session::lightOnCpuTwin(const LightRequest& light, bool cpu_render) {
 
 LightOutcome Session::simulateLight(const LightRequest& light, bool cpu_render,
                                     const std::filesystem::path& cache_dir) {
-  return lightVolumes(light, cpu_render, cache_dir, true);
-}
-
-LightOutcome Session::cachedLight(const LightRequest& light, bool cpu_render,
-                                  const std::filesystem::path& cache_dir) {
-  return lightVolumes(light, cpu_render, cache_dir, false);
-}
-
-LightOutcome Session::lightVolumes(const LightRequest& light, bool cpu_render,
-                                   const std::filesystem::path& cache_dir, bool simulate) {
   LightOutcome out;
   out.on_cpu = lightOnCpuTwin(light, cpu_render);
   VolumeSet& volume = prepare(!cpu_render);
@@ -358,9 +355,7 @@ LightOutcome Session::lightVolumes(const LightRequest& light, bool cpu_render,
   std::string notice;
   if (use_cache && loadLightCache(cache_dir, key, volume, &notice)) out.cached = true;
   if (!notice.empty()) out.warnings.push_back("light cache: " + printable(notice));
-  if (!out.cached && !simulate) {
-    clearLighting(volume);
-  } else if (!out.cached) {
+  if (!out.cached) {
     out.summary = out.on_cpu ? simulateLightingReference(*scene_, volume, lo)
                              : simulateLighting(context(), *scene_, volume, lo);
     if (use_cache) {
@@ -384,8 +379,31 @@ void Session::adoptVolume(VolumeSet volume) {
   voxelized_spec_ = scene_->volume;
 }
 
+std::unique_ptr<ViewRenderer> Session::makeRendererFor(vk::Context& ctx, const Scene& scene,
+                                                       const RenderSettings* expected) {
+  if (!volume_ || !volume_->whole() || !volume_->lit())
+    throw std::logic_error("makeRendererFor: the session's volume is not whole and lit");
+  return std::make_unique<ViewRenderer>(ctx, scene, *volume_, expected);
+}
+
+void Session::adoptRenderer(std::unique_ptr<ViewRenderer> renderer, std::vector<glm::vec4> fluence,
+                            std::vector<glm::vec4> flux) {
+  if (!renderer) throw std::invalid_argument("adoptRenderer: no renderer");
+  if (!volume_) throw std::invalid_argument("adoptRenderer: the session has no volume yet");
+  if (fluence.size() != volume_->grid.count() || flux.size() != volume_->grid.count())
+    throw std::invalid_argument("light volumes of " + std::to_string(fluence.size()) +
+                                " voxels for a volume of " + std::to_string(volume_->grid.count()));
+  volume_->light_fluence = std::move(fluence);
+  volume_->light_flux = std::move(flux);
+  cpu_.reset();
+  field_.reset();
+  gpu_ = std::move(renderer);
+}
+
 void Session::setLightVolumes(std::vector<glm::vec4> fluence, std::vector<glm::vec4> flux) {
-  VolumeSet& volume = prepare(false);
+  // A volume of interfaces only that holds light volumes (adoptRenderer) takes the new ones as it
+  // is: its renderer was made lit, and takes them in place.
+  VolumeSet& volume = volume_ && volume_->lit() ? *volume_ : prepare(false);
   if (fluence.size() != volume.grid.count() || flux.size() != volume.grid.count())
     throw std::invalid_argument("light volumes of " + std::to_string(fluence.size()) +
                                 " voxels for a volume of " + std::to_string(volume.grid.count()));
@@ -403,6 +421,7 @@ void Session::lightChanged() {
 ViewRenderer& Session::gpuRenderer(const RenderSettings* expected) {
   prepareGpuRender();  // the volume made before, with or without its fields
   if (!gpu_) {
+    if (volume_->lit() && !volume_->fields) prepare(true);  // a lit render reads the fields
     if (progress_.working) progress_.working("preparing the GPU (pipelines, volume upload)");
     gpu_ = std::make_unique<ViewRenderer>(*ctx_, *scene_, *volume_, expected);
   }

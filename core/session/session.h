@@ -185,7 +185,8 @@ class Session {
   vk::Context& context();
   bool hasContext() const { return ctx_ != nullptr; }
   /// The context (gpu) and the voxelised volume, each made once (a volume without fields, made
-  /// by prepareGpuRender, is voxelised whole here).
+  /// by prepareGpuRender, is voxelised whole here, keeping the light volumes adoptRenderer gave
+  /// it).
   VolumeSet& prepare(bool gpu);
   /// What a GPU render without light volumes needs: the context and, for sharp interfaces, only
   /// the volume's interfaces (voxelizeInterfaces: no fields, no volume cache; docs/performance.md
@@ -210,18 +211,30 @@ class Session {
   /// renderers made before are rebuilt on their next use.
   LightOutcome simulateLight(const LightRequest& light, bool cpu_render,
                              const std::filesystem::path& cache_dir);
-  /// simulateLight without the simulation: the light volumes from the light cache when it holds
-  /// them (out.cached), else zeroed light volumes on the volume's grid (out.cached false), which a
-  /// simulation made elsewhere replaces through setLightVolumes. The viewer simulates its first
-  /// light in the background and shows the scene unlit meanwhile: a renderer made now is made lit,
-  /// so it takes the simulated volumes in place, without a pipeline built again.
-  LightOutcome cachedLight(const LightRequest& light, bool cpu_render,
-                           const std::filesystem::path& cache_dir);
-  /// Take a volume voxelised by another session of the same scene (the viewer's own, copied for
-  /// the session that simulates its light in the background) instead of voxelising the scene
-  /// again. Throws std::invalid_argument when this session has a volume already, or `volume` is
-  /// not whole (VolumeSet::whole) or not on this scene's grid.
+  /// Take a volume voxelised by another session of the same scene (the viewer's own, where its
+  /// first frame needed the whole volume: smoothed interfaces; copied for the session that
+  /// simulates its light in the background) instead of voxelising the scene again. Throws
+  /// std::invalid_argument when this session has a volume already, or `volume` is not whole
+  /// (VolumeSet::whole) or not on this scene's grid.
   void adoptVolume(VolumeSet volume);
+  /// A GPU renderer of this session's volume, whole and lit (simulateLight before; else
+  /// std::logic_error), for another session of the same scene to adopt (adoptRenderer): made on
+  /// `ctx`, that session's context, and rendering `scene`, that session's scene. The viewer makes
+  /// its lit renderer so, on the thread that simulated its first light, while its window renders
+  /// the scene unlit (docs/viewer.md "The first light"): until it renders, the renderer reads no
+  /// part of `scene` the viewer changes (the camera), and `ctx`'s queue is shared under its lock
+  /// (vk::Context::submitAndWait). `expected`: the render that will follow, whose pipeline then
+  /// compiles during the upload.
+  std::unique_ptr<ViewRenderer> makeRendererFor(vk::Context& ctx, const Scene& scene,
+                                                const RenderSettings* expected);
+  /// A GPU renderer another session made for this one (makeRendererFor) from the light volumes
+  /// `fluence` and `flux`, which this session's volume takes as they are (a volume of interfaces
+  /// only as well: nothing is voxelised here, and setLightVolumes later writes into the renderer
+  /// in place). It replaces the renderer made before (the viewer's unlit one). Throws
+  /// std::invalid_argument when the session has no volume yet (prepareGpuRender) or the light
+  /// volumes are not its size.
+  void adoptRenderer(std::unique_ptr<ViewRenderer> renderer, std::vector<glm::vec4> fluence,
+                     std::vector<glm::vec4> flux);
   /// Light volumes simulated elsewhere for this session's volume (the viewer's background
   /// simulation of a moved light, on a session of its own), swapped in as simulateLight's are.
   /// Throws std::invalid_argument when their size is not the volume's.
@@ -249,9 +262,6 @@ class Session {
 
  private:
   void dropRenderers();
-  /// simulateLight (simulate) and cachedLight (!simulate).
-  LightOutcome lightVolumes(const LightRequest& light, bool cpu_render,
-                            const std::filesystem::path& cache_dir, bool simulate);
   /// The light volumes changed: the GPU renderer takes them in place where it can.
   void lightChanged();
   /// `expected`: the render about to run, whose pipeline then compiles during the upload.

@@ -355,8 +355,11 @@ void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record) 
   ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   ai.commandBufferCount = 1;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
-  VK_CHECK(vkAllocateCommandBuffers(device_, &ai, &cmd));
   VkFence fence = VK_NULL_HANDLE;
+  // The pool (allocating, recording, freeing) and the queue under the lock; the wait without it,
+  // so that another thread's submission is queued behind this one meanwhile.
+  std::unique_lock<std::mutex> lock(queue_mutex_);
+  VK_CHECK(vkAllocateCommandBuffers(device_, &ai, &cmd));
   try {
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -369,12 +372,15 @@ void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record) 
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cmd;
     VK_CHECK(vkQueueSubmit(queue_, 1, &si, fence));
+    lock.unlock();
     VK_CHECK(vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX));
   } catch (...) {
+    if (!lock.owns_lock()) lock.lock();
     if (fence) vkDestroyFence(device_, fence, nullptr);
     vkFreeCommandBuffers(device_, pool_, 1, &cmd);
     throw;
   }
+  lock.lock();
   vkDestroyFence(device_, fence, nullptr);
   vkFreeCommandBuffers(device_, pool_, 1, &cmd);
 }

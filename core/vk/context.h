@@ -79,8 +79,15 @@ class Context {
   /// Index of a memory type with all `required` flags among `type_bits`; throws if none.
   uint32_t findMemoryType(uint32_t type_bits, VkMemoryPropertyFlags required) const;
 
-  /// Record commands into a fresh primary command buffer, submit, and wait (fence).
+  /// Record commands into a fresh primary command buffer, submit, and wait (fence). Safe to call
+  /// from several threads at once (the viewer makes its lit renderer on a thread of its own while
+  /// it renders and presents): the command pool and the queue are used under queueLock(), which
+  /// is not held while the fence is waited for.
   void submitAndWait(const std::function<void(VkCommandBuffer)>& record) const;
+  /// Held around every other use of the queue (vkQueueSubmit, vkQueuePresentKHR,
+  /// vkDeviceWaitIdle: core/vk/swapchain.cpp), which Vulkan requires to be externally
+  /// synchronised.
+  std::unique_lock<std::mutex> queueLock() const { return std::unique_lock(queue_mutex_); }
 
   /// The cache every pipeline is built through (never VK_NULL_HANDLE).
   VkPipelineCache pipelineCache() const { return pipeline_cache_; }
@@ -126,6 +133,7 @@ class Context {
   bool validation_ = false;
   bool echo_ = true;
   mutable std::mutex mutex_;
+  mutable std::mutex queue_mutex_;  // the queue and pool_ (submitAndWait, queueLock)
   std::vector<std::string> messages_;
 };
 

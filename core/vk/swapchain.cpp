@@ -84,7 +84,10 @@ Swapchain::~Swapchain() { release(); }
 
 void Swapchain::release() noexcept {
   VkDevice d = ctx_.device();
-  if (d) vkDeviceWaitIdle(d);
+  if (d) {
+    auto lock = ctx_.queueLock();
+    vkDeviceWaitIdle(d);
+  }
   destroySwapchain();
   staging_ = Buffer();
   if (done_) vkDestroyFence(d, done_, nullptr);
@@ -152,7 +155,10 @@ void Swapchain::create(uint32_t width, uint32_t height) {
 }
 
 void Swapchain::resize(uint32_t width, uint32_t height) {
-  VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
+  {
+    auto lock = ctx_.queueLock();
+    VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
+  }
   destroySwapchain();
   create(width, height);
 }
@@ -217,7 +223,10 @@ bool Swapchain::present(const unsigned char* rgb, int width, int height) {
   si.signalSemaphoreCount = 1;
   si.pSignalSemaphores = &presentable_[image];
   VK_CHECK(vkResetFences(ctx_.device(), 1, &done_));
-  VK_CHECK(vkQueueSubmit(ctx_.queue(), 1, &si, done_));
+  {
+    auto lock = ctx_.queueLock();  // another thread may submit meanwhile (Context::submitAndWait)
+    VK_CHECK(vkQueueSubmit(ctx_.queue(), 1, &si, done_));
+  }
   VK_CHECK(vkWaitForFences(ctx_.device(), 1, &done_, VK_TRUE, UINT64_MAX));
   VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
   pi.waitSemaphoreCount = 1;
@@ -225,7 +234,10 @@ bool Swapchain::present(const unsigned char* rgb, int width, int height) {
   pi.swapchainCount = 1;
   pi.pSwapchains = &swapchain_;
   pi.pImageIndices = &image;
-  r = vkQueuePresentKHR(ctx_.queue(), &pi);
+  {
+    auto lock = ctx_.queueLock();
+    r = vkQueuePresentKHR(ctx_.queue(), &pi);
+  }
   if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) return false;
   VK_CHECK(r);
   return true;

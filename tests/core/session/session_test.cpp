@@ -5,10 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <string>
+#include <thread>
 
+#include "core/render/view_renderer.h"
 #include "core/volume/field.h"
 #include "tests/core/scene_support.h"
 
@@ -196,46 +201,86 @@ TEST(Session, SwappedLightVolumesRenderAsASessionOfTheMovedLight) {
   EXPECT_THROW(session.setLightVolumes({}, {}), std::invalid_argument);
 }
 
-/// The viewer's first light (apps/view_command.cpp): cachedLight gives zeroed light volumes where
-/// the light cache does not hold the light, a second session on a copy of the volume
-/// (adoptVolume) simulates it through the cache without voxelising, and its volumes, swapped in,
-/// are the ones the first session then finds in the cache and the ones it simulates itself.
-TEST(Session, FirstLightSimulatedOnAnAdoptedVolumeIsTheCachedOne) {
-  test::TempDir cache;
+/// The viewer's first light (apps/view_command.cpp, docs/viewer.md "The first light"): the viewer's
+/// session renders the scene unlit from its interfaces alone while a second session, on another
+/// thread, voxelises the whole volume, simulates the light and makes the lit renderer on the
+/// viewer's context (makeRendererFor); adopted, it renders what a session that simulated the
+/// light itself renders, with its pipeline compiled already, and the viewer's session never
+/// voxelised its fields. A moved light's volumes then go into that renderer in place.
+TEST(Session, LitRendererMadeOnAnotherThreadIsAdoptedWithoutVoxelising) {
   auto scene = std::make_shared<Scene>(parseScene(kLitScene, "lit.json"));
-  Session viewer(scene), mover(std::make_shared<Scene>(*scene));
-  const LightOutcome none = viewer.cachedLight(LightRequest{}, false, cache.path());
-  EXPECT_FALSE(none.cached);
-  const VolumeSet& v = viewer.prepare(true);
-  ASSERT_EQ(v.light_fluence.size(), v.grid.count());
-  ASSERT_EQ(v.light_flux.size(), v.grid.count());
-  for (size_t i = 0; i < v.grid.count(); ++i)
-    ASSERT_TRUE(v.light_fluence[i] == glm::vec4(0.0f) && v.light_flux[i] == glm::vec4(0.0f)) << i;
+  Session viewer(scene), mover(std::make_shared<Scene>(*scene)), alone(scene);
+  const RenderSettings rs = renderSettings(*scene, ViewRequest{});
+  ASSERT_FALSE(viewer.prepareGpuRender().fields);  // interfaces only
+  const RenderImage unlit = viewer.render(rs, true);
+  EXPECT_THROW(mover.makeRendererFor(viewer.context(), *scene, &rs), std::logic_error);
 
-  mover.adoptVolume(v);
-  EXPECT_TRUE(mover.voxelized());
-  EXPECT_THROW(mover.adoptVolume(v), std::invalid_argument);  // it has one
-  const LightOutcome simulated = mover.simulateLight(LightRequest{}, false, cache.path());
-  EXPECT_FALSE(simulated.cached);
-  EXPECT_GT(simulated.summary.runs, 0u);
-  const VolumeSet& m = mover.prepare(false);
-  viewer.setLightVolumes(m.light_fluence, m.light_flux);
+  // The mover's work on a thread of its own while the viewer keeps rendering on its context.
+  std::unique_ptr<ViewRenderer> lit;
+  std::string error;
+  std::atomic<bool> done{false};
+  std::thread worker([&] {
+    try {
+      mover.simulateLight(LightRequest{}, false, {});
+      lit = mover.makeRendererFor(viewer.context(), *scene, &rs);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    done = true;
+  });
+  int renders = 0;
+  do {
+    viewer.render(rs, true);
+    ++renders;
+  } while (!done);
+  worker.join();
+  ASSERT_TRUE(error.empty()) << error;
+  ASSERT_TRUE(lit);
+  std::printf("%d unlit renders while the mover worked\n", renders);
 
-  Session later(std::make_shared<Scene>(*scene)), alone(std::make_shared<Scene>(*scene));
-  EXPECT_TRUE(later.cachedLight(LightRequest{}, false, cache.path()).cached);
+  VolumeSet& m = mover.prepare(false);
+  EXPECT_THROW(viewer.adoptRenderer(nullptr, m.light_fluence, m.light_flux), std::invalid_argument);
+  EXPECT_THROW(
+      viewer.adoptRenderer(mover.makeRendererFor(viewer.context(), *scene, nullptr), {}, {}),
+      std::invalid_argument);
+  viewer.adoptRenderer(std::move(lit), m.light_fluence, m.light_flux);
+  // Its pipeline was asked for with it (`expected`): it becomes ready without a render asking.
+  const auto asked = std::chrono::steady_clock::now();
+  while (!viewer.renderReady(rs) &&
+         std::chrono::steady_clock::now() - asked < std::chrono::minutes(2))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_TRUE(viewer.renderReady(rs)) << "the lit pipeline was not compiled with the renderer";
+  const RenderImage adopted = viewer.render(rs, true);
+  EXPECT_FALSE(viewer.prepareGpuRender().fields) << "the viewer's session voxelised its fields";
   alone.simulateLight(LightRequest{}, false, {});
-  const VolumeSet &l = later.prepare(false), &a = alone.prepare(false);
-  EXPECT_TRUE(l.light_fluence == m.light_fluence && l.light_flux == m.light_flux);
-  EXPECT_TRUE(a.light_fluence == m.light_fluence && a.light_flux == m.light_flux)
-      << "the adopted volume simulates another light than the scene's own";
+  const RenderImage expected = alone.render(rs, true);
+  ASSERT_EQ(adopted.rgb.size(), expected.rgb.size());
+  double worst = 0, lighter = 0;
+  for (size_t i = 0; i < adopted.rgb.size(); ++i) {
+    worst = std::max(worst, double(std::abs(adopted.rgb[i] - expected.rgb[i])));
+    lighter = std::max(lighter, double(adopted.rgb[i] - unlit.rgb[i]));
+  }
+  EXPECT_EQ(worst, 0.0);     // the same volumes through the same kernel
+  EXPECT_GT(lighter, 0.05);  // and the light is on
 
-  // A volume of another grid, or one without its fields, is refused.
-  auto finer = std::make_shared<Scene>(*scene);
-  finer->volume.resolution *= 2;
-  EXPECT_THROW(Session(finer).adoptVolume(v), std::invalid_argument);
-  VolumeSet lean = v;
-  lean.fields = false;
-  EXPECT_THROW(Session(scene).adoptVolume(lean), std::invalid_argument);
+  // A moved light: its volumes into the adopted renderer, in place, still without voxelising.
+  auto moved = std::make_shared<Scene>(*scene);
+  moved->lights.front().position = {-4, 7, 0};
+  Session other(moved);
+  other.simulateLight(LightRequest{}, false, {});
+  const VolumeSet& o = other.prepare(true);
+  viewer.setLightVolumes(o.light_fluence, o.light_flux);
+  EXPECT_TRUE(viewer.renderReady(rs)) << "the renderer was made again";
+  const RenderImage after = viewer.render(rs, true), wanted = other.render(rs, true);
+  EXPECT_FALSE(viewer.prepareGpuRender().fields);
+  ASSERT_EQ(after.rgb.size(), wanted.rgb.size());
+  for (size_t i = 0; i < after.rgb.size(); ++i) ASSERT_EQ(after.rgb[i], wanted.rgb[i]) << i;
+  EXPECT_EQ(viewer.context().validationMessageCount(), 0u);
+
+  // Whatever later needs the whole volume voxelises it, and keeps the light it was given.
+  const VolumeSet& whole = viewer.prepare(false);
+  EXPECT_TRUE(whole.whole());
+  EXPECT_TRUE(whole.light_fluence == o.light_fluence && whole.light_flux == o.light_flux);
 }
 
 }  // namespace
