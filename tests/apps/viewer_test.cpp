@@ -395,7 +395,12 @@ TEST_F(ViewerTest, CtrlDragMovesTheLightInTheBackground) {
   ASSERT_FALSE(xdotool.empty()) << "xdotool is not installed (Debian package xdotool)";
   Xvfb server(xvfb);
   ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
-  std::ofstream(dir_ / "lit.json") << kLitScene;
+  // At 64 voxels a side the moved light takes 0.5-1 s to simulate, longer than the view takes to
+  // refine after the first light is swapped in, so frames are rendered meanwhile on any load (at
+  // kLitScene's 32 it took 0.11 s, and under load the window's thread rendered none in it).
+  nlohmann::json scene = nlohmann::json::parse(kLitScene);
+  scene["volume"]["resolution"] = 64;
+  std::ofstream(dir_ / "lit.json") << scene.dump();
   const fs::path shot = dir_ / "lit.png";
   extra_env_ = "EIKON_CACHE_DIR=" + quote((dir_ / "cache").string());  // none of it seen before
   // Once the first frame shows (the view then refines to 32 samples), the light is dragged 12
@@ -419,7 +424,6 @@ TEST_F(ViewerTest, CtrlDragMovesTheLightInTheBackground) {
   const nlohmann::json position = light.position;
   // 12 pixels of a 60-pixel window to the right: 0.2 of the image height at the light's depth.
   EXPECT_LT(position[0].get<double>(), -1.0) << position.dump();  // the image's right is -x
-  nlohmann::json scene = nlohmann::json::parse(kLitScene);
   scene["lights"][0]["position"] = position;
   std::ofstream(dir_ / "moved.json") << scene.dump();
   const auto render80 = [&](const fs::path& s, const std::string& name) {
