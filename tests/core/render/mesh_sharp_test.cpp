@@ -21,6 +21,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/render/boundary_device.h"
@@ -300,6 +301,19 @@ TEST(MeshSharp, TorusCrossingsOfTheTwinsAgreeAndCostFewPasses) {
   EXPECT_LT(most, 256.0);  // EIKON_MESH_MAX_PASSES: no search was cut
 }
 
+/// Channels of two twins' images that differ by more than 1e-3 (relative above 1), and the
+/// largest difference.
+std::pair<size_t, double> channelsApart(const RenderImage& g, const RenderImage& c) {
+  size_t off = 0;
+  double worst = 0;
+  for (size_t i = 0; i < g.rgb.size(); ++i) {
+    const double e = std::abs(double(g.rgb[i]) - double(c.rgb[i]));
+    worst = std::max(worst, e);
+    off += e > 1e-3 * std::max(1.0, double(c.rgb[i]));
+  }
+  return {off, worst};
+}
+
 TEST(MeshSharp, MeshAmongManyShapesRendersAsOnTheCpu) {
   // More shapes than the march's exact path unrolls (boundary.glsl kExactUnrollShapes = 4) take
   // its do-while loop, whose pass 1 keeps the clip of the last later shape that holds the point
@@ -324,13 +338,7 @@ TEST(MeshSharp, MeshAmongManyShapesRendersAsOnTheCpu) {
   const RenderImage g = t.gpu->render(rs);
   const RenderImage c = t.cpu->render(t.scene.camera, rs);
   ASSERT_EQ(g.rgb.size(), c.rgb.size());
-  size_t off = 0;
-  double worst = 0;
-  for (size_t i = 0; i < g.rgb.size(); ++i) {
-    const double e = std::abs(double(g.rgb[i]) - double(c.rgb[i]));
-    worst = std::max(worst, e);
-    off += e > 1e-3 * std::max(1.0, double(c.rgb[i]));
-  }
+  const auto [off, worst] = channelsApart(g, c);
   std::printf(
       "[ measured ] six shapes %dx%d: %.2f%% of channels differ by > 1e-3 (largest %.3g); GPU "
       "%.2f s, CPU %.2f s; cut samples %lld\n",
@@ -353,13 +361,7 @@ TEST(MeshSharp, TorusImagesOfTheTwinsAgree) {
   const RenderImage c = t.cpu->render(t.scene.camera, rs);
   const double pixels = double(c.width) * double(c.height);
   ASSERT_EQ(g.rgb.size(), c.rgb.size());
-  size_t off = 0;
-  double worst = 0;
-  for (size_t i = 0; i < g.rgb.size(); ++i) {
-    const double e = std::abs(double(g.rgb[i]) - double(c.rgb[i]));
-    worst = std::max(worst, e);
-    off += e > 1e-3 * std::max(1.0, double(c.rgb[i]));
-  }
+  const auto [off, worst] = channelsApart(g, c);
   std::printf(
       "[ measured ] torus %dx%d: %.2f%% of channels differ by > 1e-3 (largest %.3g); GPU %.2f s, "
       "CPU %.2f s; mesh traversal passes per pixel %.1f; cut samples %lld\n",
