@@ -135,7 +135,12 @@ class LightMover {
   /// look up the same light-cache entries.
   LightMover(const Scene& scene, bool on_cpu, std::filesystem::path cache)
       : scene_(std::make_shared<Scene>(scene)), on_cpu_(on_cpu), cache_(std::move(cache)) {}
-  ~LightMover() {
+  ~LightMover() { stop(); }
+  /// Stop the work in flight at its next progress report, for good (the window closed):
+  /// voxelising and simulating end there and nothing is cached; the lit renderer's compile, if
+  /// begun, runs out.
+  void stop() {
+    cancel_ = true;
     if (worker_.joinable()) worker_.join();
   }
   bool busy() const { return worker_.joinable() && !done_; }
@@ -166,12 +171,15 @@ class LightMover {
         if (!session_) {
           session_ = std::make_unique<Session>(scene_);
           session_->setProgress({[this](const char* what, double f) {
+                                   if (cancel_) throw Stopped();
                                    stage_ = std::strcmp(what, "voxelising") == 0
                                                 ? Stage::Voxelising
                                                 : Stage::Simulating;
                                    fraction_ = f;
                                  },
-                                 {}});
+                                 [this](const char*) {
+                                   if (cancel_) throw Stopped();
+                                 }});
           stage_ = Stage::Voxelising;
           result_.volume_copied = view && view->whole;
           if (result_.volume_copied)
@@ -195,6 +203,8 @@ class LightMover {
         VolumeSet& v = session_->prepare(false);  // made by simulateLight; refilled by the next
         result_.fluence = std::move(v.light_fluence);
         result_.flux = std::move(v.light_flux);
+      } catch (const Stopped&) {
+        result_.error = "stopped";
       } catch (const std::exception& e) {
         result_.error = e.what();
       }
@@ -217,7 +227,9 @@ class LightMover {
   const std::filesystem::path cache_;
   std::unique_ptr<Session> session_;
   std::thread worker_;
-  std::atomic<bool> done_{false}, voxelised_{false};
+  /// Thrown out of the mover's progress callbacks by stop().
+  struct Stopped {};
+  std::atomic<bool> done_{false}, voxelised_{false}, cancel_{false};
   std::atomic<double> fraction_{0.0};
   std::atomic<Stage> stage_{Stage::Simulating};
   MovedLight result_;
@@ -924,6 +936,20 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
   session.prepareGpuRender();
   if (mover) viewer.awaitFirstLight();
   viewer.run();
+  if (mover && mover->busy()) {  // closed before the light arrived: not waited for
+    const LightMover::Stage stage = mover->stage();
+    const double percent = 100.0 * mover->fraction();
+    mover->stop();
+    if (stage == LightMover::Stage::Preparing)
+      std::printf(
+          "eikon view: the window closed while the lit view was made (its light is in the "
+          "light cache)\n");
+    else
+      std::printf(
+          "eikon view: the window closed while the light was %s (%.0f%%): stopped there, "
+          "nothing cached\n",
+          stage == LightMover::Stage::Voxelising ? "voxelised" : "simulated", percent);
+  }
   std::printf("%s\n", viewer.summary().c_str());
   const RenderImage& img = viewer.shown();
   if (!a.screenshot.empty() && !img.rgb.empty()) {

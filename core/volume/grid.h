@@ -11,7 +11,9 @@
 #include <atomic>
 #include <cmath>
 #include <cstddef>
+#include <exception>
 #include <glm/glm.hpp>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -86,7 +88,10 @@ void forVoxelBlocks(const Grid& g, const int lo[3], const int hi[3], int slab, W
 }
 
 /// body(i) for i in [0, n) on `threads` threads (0 = hardware concurrency), dealt out one at a
-/// time (slabs of a grid take unequal times).
+/// time (slabs of a grid take unequal times). An exception thrown by body (a bad_alloc, or a
+/// progress callback that stops the work) ends the dealing: the threads finish the items they
+/// hold and the first exception is rethrown here (an exception leaving a std::thread would end
+/// the process).
 template <typename F>
 void parallelFor(int n, int threads, F&& body) {
   int t = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
@@ -96,12 +101,21 @@ void parallelFor(int n, int threads, F&& body) {
     return;
   }
   std::atomic<int> next{0};
+  std::exception_ptr failed;
+  std::mutex failed_mutex;
   std::vector<std::thread> pool;
   for (int w = 0; w < t; ++w)
     pool.emplace_back([&] {
-      for (int i = next++; i < n; i = next++) body(i);
+      try {
+        for (int i = next++; i < n; i = next++) body(i);
+      } catch (...) {
+        next = n;  // deal no more
+        std::lock_guard<std::mutex> lock(failed_mutex);
+        if (!failed) failed = std::current_exception();
+      }
     });
   for (auto& th : pool) th.join();
+  if (failed) std::rethrow_exception(failed);
 }
 
 }  // namespace eikon

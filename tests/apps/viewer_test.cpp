@@ -554,6 +554,36 @@ TEST_F(ViewerTest, FirstFrameIsShownBeforeTheWholeVolumeIsVoxelised) {
   }
 }
 
+/// A window closed before its first light arrived does not wait for it: the light's voxelising or
+/// simulation stops at its next progress report (a 160-voxel volume: seconds of work, against
+/// the key pressed at the first frame), the viewer says so and exits cleanly, and nothing is
+/// written to the light cache.
+TEST_F(ViewerTest, ClosingBeforeTheLightArrivesStopsItAndCachesNothing) {
+  const std::string xvfb = findProgram("Xvfb"), xdotool = findProgram("xdotool");
+  if (xvfb.empty()) GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb)";
+  ASSERT_FALSE(xdotool.empty()) << "xdotool is not installed (Debian package xdotool)";
+  Xvfb server(xvfb);
+  ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
+  nlohmann::json scene = nlohmann::json::parse(kLitScene);
+  scene["volume"]["resolution"] = 160;
+  std::ofstream(dir_ / "lit.json") << scene.dump();
+  extra_env_ = "EIKON_CACHE_DIR=" + quote((dir_ / "cache").string());
+  const ViewerRun run =
+      viewWhile(server, xdotool, (dir_ / "lit.json").string(), "--width 80 --height 60 --spp 1",
+                " search --sync --onlyvisible --name 'samples' key q");
+  ASSERT_TRUE(WIFEXITED(run.status) && WEXITSTATUS(run.status) == 0) << run.err;
+  EXPECT_EQ(run.err.find("validation"), std::string::npos) << run.err;
+  EXPECT_NE(run.out.find("eikon view: the window closed while the light was "), std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("stopped there, nothing cached"), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("light 0 simulated in the background"), std::string::npos) << run.out;
+  size_t lights = 0;
+  if (fs::exists(dir_ / "cache"))
+    for (const auto& e : fs::recursive_directory_iterator(dir_ / "cache"))
+      lights += e.path().filename().string().rfind("light-", 0) == 0;
+  EXPECT_EQ(lights, 0u) << "a light was cached";
+}
+
 /// An N-BK7 (Sellmeier: dispersive, so 16 wavelengths) sphere; `attenuation` per mm in it.
 std::string dispersiveScene(double attenuation) {
   return R"({

@@ -5,13 +5,16 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "core/scene/scene.h"
+#include "core/volume/grid.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {
@@ -36,6 +39,25 @@ double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 // O(R^{3/2}) = 850 points gives 2.8e-4. We allow 1e-3 relative. (The rigorous worst case — every
 // straddling cell wrong — is a shell of thickness √3·s: 6%, too loose to be useful.) Missing a
 // whole layer of boundary voxels, or counting them as full, is off by ≈ 4πr²·h/2 ⇒ 7%.
+// An exception thrown on one of parallelFor's threads (a bad_alloc, a progress callback that stops
+// the voxelising when the viewer closes) reaches the caller: once it ended the process (an
+// exception leaving a std::thread calls std::terminate).
+TEST(ParallelFor, AnExceptionOnAWorkerReachesTheCaller) {
+  for (int thrower : {0, 10, 999}) {
+    try {
+      parallelFor(1000, 4, [&](int i) {
+        if (i == thrower) throw std::runtime_error("stop at " + std::to_string(i));
+      });
+      ADD_FAILURE() << "no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), "stop at " + std::to_string(thrower));
+    }
+  }
+  std::atomic<long> total{0};  // without an exception every item runs once
+  parallelFor(1000, 4, [&](int i) { total += i; });
+  EXPECT_EQ(total.load(), 999L * 1000 / 2);
+}
+
 TEST(Voxelize, SphereVolumeFromCoverage) {
   const double r = 0.7;
   const glm::dvec3 c0(0.013, -0.021, 0.007);  // off the voxel lattice: no symmetric coincidences
