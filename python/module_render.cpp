@@ -277,6 +277,7 @@ std::vector<std::array<TraceOutcome, 2>> traceBoth(Prepared& p,
   checkSetting([&] {
     for (const TraceRequest& q : req) checkTraceRequest(q);
     checkMarchStep(ms.step_voxels);
+    checkMarchSettings(ms);
   });
   return p.run([&](Session& s) { return s.trace(req, ms, gpu); });
 }

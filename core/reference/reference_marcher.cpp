@@ -40,11 +40,7 @@ bool boxHit(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& bmin,
   return t1 >= std::max(t0, 0.0);
 }
 
-void validate(const MarchSettings& m) {
-  if (!(m.step_voxels > 0 && m.step_voxels <= 4))
-    throw std::invalid_argument("march step must be in (0, 4] voxels");
-  if (m.max_steps < 1) throw std::invalid_argument("max_steps must be >= 1");
-}
+void validate(const MarchSettings& m) { checkMarchSettings(m); }
 
 }  // namespace
 

@@ -40,12 +40,7 @@ constexpr int kSharedPassBit = 64;  // view.comp's sharing across passes (render
 
 constexpr double kPi = 3.14159265358979323846;
 
-void validate(const MarchSettings& m) {
-  if (!(m.step_voxels > 0 && m.step_voxels <= 4))
-    throw std::invalid_argument("march step must be in (0, 4] voxels");
-  if (m.max_steps < 1) throw std::invalid_argument("max_steps must be >= 1");
-  if (!(m.interface_threshold > 0)) throw std::invalid_argument("interface threshold must be > 0");
-}
+void validate(const MarchSettings& m) { checkMarchSettings(m); }
 
 }  // namespace
 

@@ -140,6 +140,7 @@ void checkViewRequest(const ViewRequest& v) {
   checkRange("spp", v.spp, 1, 4096);
   if (v.wavelengths) checkRange("wavelengths", *v.wavelengths, 0, 256);
   if (v.march) checkMarchStep(v.march->step_voxels);
+  if (v.march) checkMarchSettings(*v.march);  // the rest, as both twins check them
   if (!(v.wavelength_nm >= 100 && v.wavelength_nm <= 10000))
     throw SettingError("wavelength", "must be in [100, 10000] nm");
 }

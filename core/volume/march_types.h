@@ -2,8 +2,10 @@
 // core/reference), so that both are driven and compared through the same plain structs.
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <glm/glm.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -19,6 +21,17 @@ struct MarchSettings {
   double interface_threshold = 0.02;  ///< |∇n|·h peak that makes a layer an interface
   int max_steps = 20000;              ///< per ray; a ray that runs out is reported as stopped
 };
+
+/// The settings both twins refuse alike (std::invalid_argument), before any work: the step in
+/// (0, 4] voxels, max_steps ≥ 1, the interface threshold finite and > 0 (the GPU twin alone used
+/// to check it, so a NaN threshold rendered on the CPU twin and was refused on the GPU).
+inline void checkMarchSettings(const MarchSettings& m) {
+  if (!(m.step_voxels > 0 && m.step_voxels <= 4))
+    throw std::invalid_argument("march step must be in (0, 4] voxels");
+  if (m.max_steps < 1) throw std::invalid_argument("max_steps must be >= 1");
+  if (!(m.interface_threshold > 0 && std::isfinite(m.interface_threshold)))
+    throw std::invalid_argument("interface threshold must be a finite number > 0");
+}
 
 struct RenderImage;
 

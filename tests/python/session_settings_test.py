@@ -92,6 +92,18 @@ class SessionSettings(unittest.TestCase):
                           self.py_error(lambda: r.render(wavelength_nm=bad)))
         self.assertEqual(eikon.voxelize_count(), 0)
 
+    def test_interface_threshold_is_refused_alike_by_both_twins(self):
+        # The GPU twin alone checked it: a NaN or negative threshold rendered on the CPU twin.
+        # Both refuse it before any voxelising, as the other settings.
+        r = eikon.Renderer(self.scene)
+        for bad in (float("nan"), -1.0, 0.0, float("inf")):
+            for device in ("cpu", "gpu"):
+                with self.assertRaisesRegex(ValueError,
+                                            "interface threshold must be a finite number > 0"):
+                    r.render(width=8, height=6, device=device,
+                             march=eikon.MarchSettings(interface_threshold=bad))
+        self.assertEqual(eikon.voxelize_count(), 0)
+
     def test_edited_camera_and_volume_are_checked_as_a_scene_file_is(self):
         # Scene.camera and Scene.volume are writable: a resolution of 0 gave a voxel of inf mm,
         # a width of -5 a buffer of 17592186044415 MiB. The session checks them as parsing does.
