@@ -337,6 +337,14 @@ constexpr const char* kLitScene = R"({
   "lights": [{"type": "point", "position": [0, 7, 0], "intensity": 40}]
 })";
 
+/// kLitScene voxelised at `resolution` voxels a side, written to DIR/lit.json: its path.
+fs::path writeLitScene(const fs::path& dir, int resolution) {
+  nlohmann::json scene = nlohmann::json::parse(kLitScene);
+  scene["volume"]["resolution"] = resolution;
+  std::ofstream(dir / "lit.json") << scene.dump();
+  return dir / "lit.json";
+}
+
 /// The brightness (mean of the 8-bit channels over a 5×5 patch) of the screenshot where `point`
 /// shows through the camera of kLitScene at 80×60 (a vertical field of view; the image's right is
 /// the camera's forward × up).
@@ -398,9 +406,7 @@ TEST_F(ViewerTest, CtrlDragMovesTheLightInTheBackground) {
   // At 64 voxels a side the moved light takes 0.5-1 s to simulate, longer than the view takes to
   // refine after the first light is swapped in, so frames are rendered meanwhile on any load (at
   // kLitScene's 32 it took 0.11 s, and under load the window's thread rendered none in it).
-  nlohmann::json scene = nlohmann::json::parse(kLitScene);
-  scene["volume"]["resolution"] = 64;
-  std::ofstream(dir_ / "lit.json") << scene.dump();
+  writeLitScene(dir_, 64);
   const fs::path shot = dir_ / "lit.png";
   extra_env_ = "EIKON_CACHE_DIR=" + quote((dir_ / "cache").string());  // none of it seen before
   // Once the first frame shows (the view then refines to 32 samples), the light is dragged 12
@@ -424,6 +430,8 @@ TEST_F(ViewerTest, CtrlDragMovesTheLightInTheBackground) {
   const nlohmann::json position = light.position;
   // 12 pixels of a 60-pixel window to the right: 0.2 of the image height at the light's depth.
   EXPECT_LT(position[0].get<double>(), -1.0) << position.dump();  // the image's right is -x
+  nlohmann::json scene = nlohmann::json::parse(kLitScene);
+  scene["volume"]["resolution"] = 64;
   scene["lights"][0]["position"] = position;
   std::ofstream(dir_ / "moved.json") << scene.dump();
   const auto render80 = [&](const fs::path& s, const std::string& name) {
@@ -564,9 +572,7 @@ TEST_F(ViewerTest, ClosingBeforeTheLightArrivesStopsItAndCachesNothing) {
   ASSERT_FALSE(xdotool.empty()) << "xdotool is not installed (Debian package xdotool)";
   Xvfb server(xvfb);
   ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
-  nlohmann::json scene = nlohmann::json::parse(kLitScene);
-  scene["volume"]["resolution"] = 160;
-  std::ofstream(dir_ / "lit.json") << scene.dump();
+  writeLitScene(dir_, 160);
   extra_env_ = "EIKON_CACHE_DIR=" + quote((dir_ / "cache").string());
   const ViewerRun run =
       viewWhile(server, xdotool, (dir_ / "lit.json").string(), "--width 80 --height 60 --spp 1",
