@@ -65,7 +65,7 @@ std::string fmt(double v) {
 // of a file, and text given as it is (Python's parse_index_csv) is read the same. Left in, it
 // stuck to the first word (a CSV header's, a YAML key's).
 std::string withoutByteOrderMark(const std::string& text) {
-  return text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? text.substr(3) : text;
+  return startsWithByteOrderMark(text) ? text.substr(3) : text;
 }
 
 // A series under construction: values plus where each point came from, for messages.

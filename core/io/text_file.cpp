@@ -96,9 +96,7 @@ std::string readTextFile(const std::filesystem::path& path, const std::string& w
   if (in.bad()) refuse("cannot read " + what);
   const std::string nul = nulByteProblem(text, name, what);
   if (!nul.empty()) throw std::runtime_error(nul);
-  // A UTF-8 byte order mark (Excel's "CSV UTF-8", Notepad) is no part of the text: left in, it
-  // stuck to the first word, which a message then quoted looking exactly like the expected one.
-  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
+  if (startsWithByteOrderMark(text)) text.erase(0, 3);
   return text;
 }
 

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <system_error>
 
 namespace eikon {
@@ -32,6 +33,13 @@ const char* fileTypeName(std::filesystem::file_type type);
 
 /// The system's reason in a message's words: "file name too long", not "File name too long".
 std::string errorReason(const std::error_code& ec);
+
+/// True when `text` begins with a UTF-8 byte order mark (EF BB BF: Excel's "CSV UTF-8",
+/// Notepad), which is no part of the text: left in, it stuck to the first word (a CSV header's, a
+/// YAML key's), which a message then quoted looking exactly like the expected one.
+inline bool startsWithByteOrderMark(std::string_view text) {
+  return text.substr(0, 3) == "\xEF\xBB\xBF";
+}
 
 /// The bytes of the text file `path`, without a leading UTF-8 byte order mark (EF BB BF), which
 /// the messages call `what` ("a scene file"). Throws
