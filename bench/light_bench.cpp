@@ -1,4 +1,4 @@
-// Light-simulator benchmark (issue 6): scenes/caustic_sphere.json (a glass ball over an opaque
+// Light-simulator benchmark: scenes/caustic_sphere.json (a glass ball over an opaque
 // floor under a directional light covering the whole volume), voxelised at its own resolution
 // (128 on the long side), simulated with WavefrontSettings defaults by the GPU twin
 // (GpuWavefront, shaders/wavefront.comp) and by the double-precision CPU reference
@@ -9,7 +9,7 @@
 // minutes per twin on a 2-core lavapipe machine), and the speed-up of skipping at that resolution.
 // Timings are not asserted anywhere (they vary ±20% on a shared machine).
 //
-// --sharp: every run at the scene's sharp interfaces (issue 13; WavefrontSettings::
+// --sharp: every run at the scene's sharp interfaces (WavefrontSettings::
 // sharp_interfaces on the GPU, sharpInterfacesFor on the CPU), where they apply.
 //
 // --interfaces smoothed,sharp: run the full resolution once per listed kind (e.g. both in one

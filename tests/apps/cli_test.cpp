@@ -238,7 +238,7 @@ TEST_F(Cli, EveryShippedSceneRendersCleanUnderStrict) {
   }
 }
 
-// ------------------------------------------------------------------ progress (issue 11)
+// ------------------------------------------------------------------ progress
 
 /// Lines of `err` (progress lines end in '\n' when stderr is not a terminal) that look like
 /// "eikon: STAGE  42.0%  1.2 s, ETA ..." for STAGE starting with `stage`.
@@ -806,9 +806,9 @@ TEST_F(Cli, TraceGpuAgreesWithReference) {
   EXPECT_GT(std::abs(pc[1] - 1.5), 0.1);
 }
 
-// ------------------------------------------------------------------ lights (issue 6)
+// ------------------------------------------------------------------ lights
 
-// Sharp interfaces (issue 13): the light follows the scene's "interfaces" on both twins. A sharp
+// Sharp interfaces: the light follows the scene's "interfaces" on both twins. A sharp
 // scene loses flux to Fresnel reflection, which the summary reports as a share of the emitted
 // flux: at least the normal-incidence loss of the lit disc's two passes, 1 − (1 − R₀)² = 0.0784
 // times the disc's share πR²/(10 mm)² = 0.196 of the light over the box, and at most that share;

@@ -1,5 +1,5 @@
-// `eikon trace` through the table facet of a stone given as a faceting diagram (shape "faceted",
-// issue 16 item 2): a plate cut on the machine — 8 girdle facets, a table and a flat culet — of
+// `eikon trace` through the table facet of a stone given as a faceting diagram (shape "faceted"):
+// a plate cut on the machine — 8 girdle facets, a table and a flat culet — of
 // n = 2. A ray at 30° from the table's normal refracts to θt with sin θt = sin 30° / 2 (Snell),
 // crosses the 2 mm plate, leaves the parallel culet at 30° again and reaches the volume's floor:
 // its exit point there is displaced by 2·tan θt against the straight line, which fixes θt.

@@ -1,4 +1,4 @@
-// `eikon trace --stokes S0,S1,S2,S3` (issue 15; docs/polarisation.md): the Stokes vector of the
+// `eikon trace --stokes S0,S1,S2,S3` (docs/polarisation.md): the Stokes vector of the
 // light leaving along the traced path, "stokes_out" in --json and in the text, from both twins
 // (the GPU's by default, the CPU's with --reference), against closed forms:
 //  - Malus: sheets at 0° and 60° pass ½cos²60° = 0.125 of unpolarised light, linear at 60°

@@ -1,4 +1,4 @@
-// `eikon view` (issue 17) as a user runs it: the real binary in a virtual X server (Xvfb, started
+// `eikon view` as a user runs it: the real binary in a virtual X server (Xvfb, started
 // here on a display number it picks itself, -displayfd), a mouse drag sent with xdotool, the
 // screenshot it writes on exit compared with `eikon render` of the camera it prints. The
 // tolerance comes from the renderer's own sample noise, measured from two renders with different
@@ -295,7 +295,7 @@ TEST_F(ViewerTest, DragOrbitsAndRefinedViewMatchesRender) {
   EXPECT_GT(before, tolerance) << "the screenshot did not change with the drag";
 }
 
-/// Keys (issue 17 items 1–3): M selects the o-mode, R switches to spectral. With --no-prefetch
+/// Keys: M selects the o-mode, R switches to spectral. With --no-prefetch
 /// the spectral pipeline is compiled only after the key, on the renderer's thread, while the
 /// window keeps presenting the last image under a "compiling..." title and handling events: the
 /// viewer reports the frames it presented meanwhile, which a viewer that froze for the compile
@@ -390,7 +390,7 @@ LightReport lastLightReport(const std::string& out) {
   return r;
 }
 
-/// Ctrl + drag moves the first light (issue 17 item 3). The moved light is simulated on a thread
+/// Ctrl + drag moves the first light. The moved light is simulated on a thread
 /// of the viewer's own while the view keeps refining with the former light volumes (the viewer
 /// reports the frames it rendered or presented meanwhile: a viewer that simulated in its event
 /// loop would report none), then swapped into the renderer; the view then shows what `eikon

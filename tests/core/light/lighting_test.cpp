@@ -1,4 +1,4 @@
-// Simulated light in the view renderer (issue 6, docs/design.md §2 image formation): the band/mode
+// Simulated light in the view renderer (docs/design.md §2 image formation): the band/mode
 // plan, a diffuse floor under a directional light (Lambert's cosine law), single scattering in a
 // slab of haze against its closed form, and the two twins rendering the same lit volume. The light
 // volumes come from the simulator (GPU or CPU reference); both view twins then read the same ones.

@@ -1,4 +1,4 @@
-// The light simulator's CPU twin at sharp interfaces (issue 13; docs/light-simulator.md, "Sharp
+// The light simulator's CPU twin at sharp interfaces (docs/light-simulator.md, "Sharp
 // interfaces"): collimated beams through a plane-parallel slab, a 90° prism used for total
 // internal reflection and a 60° prism at minimum deviation, against closed forms written here
 // (Snell and the Fresnel equations, Born & Wolf §1.5). Positions and directions are measured on a

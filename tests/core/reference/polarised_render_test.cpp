@@ -103,7 +103,7 @@ TEST(PolarisedRender, ReciprocityIdentitiesOfMuellerMatrices) {
     const Mueller M = muellerOf(J), MT = transposed(M);
     EXPECT_LT(maxDiff(muellerOf(Jt), diag(1, 1, 1, -1) * MT * diag(1, 1, 1, -1)), 1e-12);
     EXPECT_LT(maxDiff(muellerOf(D * Jt * D), diag(1, 1, -1, 1) * MT * diag(1, 1, -1, 1)), 1e-12);
-    // and the one the brief of issue 15 suggested for plain transposition does not hold:
+    // and the rule of plain transposition does not hold:
     EXPECT_GT(maxDiff(muellerOf(Jt), diag(1, 1, -1, 1) * MT * diag(1, 1, -1, 1)), 1e-3);
   }
 }

@@ -1,4 +1,4 @@
-// Light simulator, CPU reference (issue 6): energy bookkeeping, uniform beams, absorption, the
+// Light simulator, CPU reference: energy bookkeeping, uniform beams, absorption, the
 // Luneburg focus, patch budget and termination. The GPU kernel will be tested against this.
 #include "core/reference/wavefront.h"
 

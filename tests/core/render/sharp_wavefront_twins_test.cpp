@@ -1,4 +1,4 @@
-// The light simulator's GPU twin at sharp interfaces (issue 13; shaders/wavefront.comp with
+// The light simulator's GPU twin at sharp interfaces (shaders/wavefront.comp with
 // kSharpLight, GpuWavefront with WavefrontSettings::sharp_interfaces) against the closed forms of
 // tests/core/light/sharp_wavefront_test.cpp (same scenes, tests/core/light_fixtures.h) and against
 // the CPU twin (WavefrontSimulator with sharpInterfacesFor, double precision).

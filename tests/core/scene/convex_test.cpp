@@ -1,6 +1,6 @@
 // Convex polyhedra from planes (core/scene/shapes.cpp, finishConvex): the bounding radius from the
 // vertices, and the refusal of empty, unbounded and flat plane sets, for plane counts where the
-// old all-triples vertex search (O(n⁴): 52 s for 1000 planes) was unusable (issue 11, item 4).
+// old all-triples vertex search (O(n⁴): 52 s for 1000 planes) would be unusable.
 #include <gtest/gtest.h>
 
 #include <cmath>

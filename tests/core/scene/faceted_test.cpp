@@ -1,4 +1,4 @@
-// Faceted gems from faceting diagrams (core/scene/faceted.cpp, issue 16 item 2). Every facet of the
+// Faceted gems from faceting diagrams (core/scene/faceted.cpp). Every facet of the
 // three shipped designs has the normal its diagram line says — the angle from the girdle plane
 // acos|n_y| and the azimuth index·360°/gear — to 1e-9, every listed facet has a face of non-zero
 // area, and the polyhedron is closed (its faces' vector areas sum to zero) and convex (every

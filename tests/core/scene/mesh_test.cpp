@@ -1,4 +1,4 @@
-// The "mesh" shape (issue 16, item 1): OBJ, PLY and STL files read through Assimp, checked closed
+// The "mesh" shape: OBJ, PLY and STL files read through Assimp, checked closed
 // and outward, and a convex mesh turned into its exact polyhedron. The test meshes are self-made
 // (tests/data/meshes/make_meshes.py). Expected values are closed forms: the box's six planes, and
 // for the icosphere the facetting error δ = R − √(R² − ℓ²/3) of a level-2 icosphere (its faces
