@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <numbers>
 #include <random>
 #include <string>
 #include <thread>
@@ -170,8 +171,8 @@ int main(int argc, char** argv) {
     }
     std::printf("%-34s %10.3f %10.3g %11.1f %10.3g %11.2e° %11.2e°\n", v.name, img.seconds,
                 width * height / img.seconds, img.mean_steps,
-                img.mean_steps * width * height / img.seconds, mean * 180 / 3.14159265358979,
-                mx * 180 / 3.14159265358979);
+                img.mean_steps * width * height / img.seconds, mean * 180 / std::numbers::pi,
+                mx * 180 / std::numbers::pi);
     if (v.name[0] == 'n') naive_s = img.seconds;
     if (std::string(v.name).find("(default)") != std::string::npos) default_s = img.seconds;
   }

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -833,7 +834,7 @@ TEST_F(Cli, LightSummaryReportsTheFluxReflectedAtSharpInterfaces) {
     EXPECT_NE(at, std::string::npos) << o.out;
     return at == std::string::npos ? -1.0 : std::strtod(o.out.c_str() + at + 10, nullptr);
   };
-  const double disc = 3.14159265358979 * 2.5 * 2.5 / 100.0;
+  const double disc = std::numbers::pi * 2.5 * 2.5 / 100.0;
   for (const char* device : {"cpu", "gpu"}) {
     const double r = reflected("sharp", device);
     EXPECT_GT(r, 0.0784 * disc * 0.99) << device;

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -36,7 +37,7 @@ TEST(FacetedCli, TraceThroughTheTableRefractsAsSnellSays) {
               {"name": "T", "side": "table", "distance": 1},
               {"name": "K", "side": "culet", "distance": 1}]}]
 })";
-  const double kDeg = 3.14159265358979323846 / 180.0;
+  const double kDeg = std::numbers::pi / 180.0;
   const double c30 = std::cos(30 * kDeg), s30 = std::sin(30 * kDeg);
   // From the volume's top face y = 5 to the table at (0, 1, −1): 4 mm down, 4 tan 30° along z.
   const double z0 = -1.0 - 4.0 * std::tan(30 * kDeg);

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -48,7 +49,7 @@ class TraceStokesCli : public ::testing::Test {
 };
 
 std::string sheetJson(double z, double deg) {
-  const double r = deg * 3.14159265358979323846 / 180.0;
+  const double r = deg * std::numbers::pi / 180.0;
   return R"({"shape": "polarizer", "center": [0, 0, )" + std::to_string(z) +
          R"(], "normal": [0, 0, 1], "transmission_axis": [)" + std::to_string(std::cos(r)) + ", " +
          std::to_string(std::sin(r)) + R"(, 0], "size": [20, 20]})";

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -353,7 +354,7 @@ double patchAt(const Png& img, const glm::dvec3& point) {
   const glm::dvec3 fwd = glm::normalize(look - eye),
                    right = glm::normalize(glm::cross(fwd, {0, 1, 0}));
   const glm::dvec3 up = glm::cross(right, fwd), d = point - eye;
-  const double t = std::tan(0.5 * 40.0 * 3.14159265358979323846 / 180.0), z = glm::dot(d, fwd);
+  const double t = std::tan(0.5 * 40.0 * std::numbers::pi / 180.0), z = glm::dot(d, fwd);
   const double u = glm::dot(d, right) / (z * t * (80.0 / 60.0)), v = glm::dot(d, up) / (z * t);
   const int px = int(std::lround(0.5 * (u + 1.0) * 80.0 - 0.5)),
             py = int(std::lround(0.5 * (1.0 - v) * 60.0 - 0.5));

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -29,8 +30,7 @@ namespace eikon {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 
 const ConvexShape& convexOf(const Scene& s) {
   return std::get<ConvexShape>(s.objects.at(0).shape.geometry());
@@ -244,14 +244,14 @@ TEST(Faceted, StarFacetThroughAMeetPointOfThreeFacets) {
                        std::sin(35 * kDeg) * std::sin(phi));
     return Plane{n, 4.0 * std::sin(35 * kDeg) + 0.1 * std::cos(35 * kDeg)};
   };
-  const Plane a = crown(0), b = crown(kPi / 4);
+  const Plane a = crown(0), b = crown(std::numbers::pi / 4);
   // With y = 1.6 the two crown planes are lines in (x, z): solve the 2×2 system.
   const double ra = a.d - a.normal.y * 1.6, rb = b.d - b.normal.y * 1.6;
   const double det = a.normal.x * b.normal.z - a.normal.z * b.normal.x;
   const glm::dvec3 p((ra * b.normal.z - rb * a.normal.z) / det, 1.6,
                      (a.normal.x * rb - b.normal.x * ra) / det);
-  const glm::dvec3 ns(std::sin(45 * kDeg) * std::cos(kPi / 8), std::cos(45 * kDeg),
-                      std::sin(45 * kDeg) * std::sin(kPi / 8));
+  const glm::dvec3 ns(std::sin(45 * kDeg) * std::cos(std::numbers::pi / 8), std::cos(45 * kDeg),
+                      std::sin(45 * kDeg) * std::sin(std::numbers::pi / 8));
   ASSERT_EQ(c.planes.size(), 33u);
   EXPECT_NEAR(glm::length(c.planes[25].normal - ns), 0.0, 1e-12);
   EXPECT_NEAR(c.planes[25].d, glm::dot(ns, p), 1e-12);

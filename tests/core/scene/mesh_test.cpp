@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <numbers>
 #include <random>
 #include <string>
 #include <variant>
@@ -325,7 +326,8 @@ size_t checkFaceColours(const MeshDistance& m, const std::string& what) {
           EXPECT_EQ(c[a], c[b]) << what << ": coplanar triangles " << a << ", " << b;
         } else if (cosine < 1.0 - 1e-9) {
           EXPECT_NE(c[a], c[b]) << what << ": triangles " << a << ", " << b << " meet at vertex "
-                                << v << " at " << std::acos(cosine) * 180 / M_PI << " deg";
+                                << v << " at " << std::acos(cosine) * 180 / std::numbers::pi
+                                << " deg";
           kinked[a].push_back(b);
           kinked[b].push_back(a);
         }
