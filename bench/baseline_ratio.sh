@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Throughput of eikon's GPU march against a lean baseline, measured in one sitting (issue 14;
-# docs/performance.md "Throughput"). Prints, from one run:
+# Throughput of eikon's GPU march against a lean baseline, measured in one sitting
+# (docs/performance.md "Figures"). Prints, from one run:
 #   - steps/s of eikon's naive Euler march (smoothed interfaces, 1-voxel steps, no skipping, no
 #     Fresnel: two trilinear field fetches per step) against the baseline's Euler march (also two
 #     per step), glass_sphere at 800x600 from a 128³ volume;

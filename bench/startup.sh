@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Time to the first dispatch of a repeated small render (issue 14, start-up: "a repeated render of
-# a 64x48 image starts its first dispatch within 0.5 s of the process start"; docs/performance.md
+# Time to the first dispatch of a repeated small render (the aim: a repeated render of a 64x48
+# image starts its first dispatch within 0.5 s of the process start; docs/performance.md
 # "Start-up"). For each scene, runs
 #   eikon render SCENE --width 64 --height 48 -q --timings -o TMP/out.exr
 # once to warm the caches (light cache, pipeline cache, Mesa's shader cache), then --reps times,

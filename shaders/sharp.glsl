@@ -1,4 +1,4 @@
-// The sharp march (issue 13; docs/view-renderer.md "Sharp interfaces: the march"): the GPU twin of
+// The sharp march (docs/view-renderer.md "Sharp interfaces: the march"): the GPU twin of
 // RayMarch::marchSharp and its stages in core/reference/reference_marcher.cpp, under the same
 // names (docs/twins.md). Included by march.glsl after MarchState/MarchResult and the medium
 // helpers; reads the boundary field and shape table (boundary.glsl) and the medium table

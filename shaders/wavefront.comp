@@ -31,7 +31,7 @@
 //     their offset; a child whose edge still exceeds the split span is written as SPLIT and is
 //     split again by the next rebuild without propagating (the reference's recursive split).
 //
-// Sharp interfaces (issue 13; specialisation constant kSharpLight, set by the host only when the
+// Sharp interfaces (specialisation constant kSharpLight, set by the host only when the
 // scene's boundary field applies, as the view renderer's kSharpMarch): every corner crosses its
 // region's homogeneous medium on a straight line in constant time, is stopped at the first
 // boundary (nextCrossing of sharp.glsl, locateCrossing of boundary.glsl), refracted or totally

@@ -121,7 +121,7 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOpt
   h.value(s.skip_empty);
   h.value(s.pass_caustics);
   h.value(s.beam_min_cells);
-  // Sharp interfaces (issue 13): which path the light took, and what it refracted at (the
+  // Sharp interfaces: which path the light took, and what it refracted at (the
   // boundary field and the media); a smoothed entry must not serve a sharp scene.
   const bool sharp = o.sharp_interfaces && sharpLightApplies(v);
   h.value(sharp);

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
+#include <numbers>
 #include <stdexcept>
 #include <thread>
 
@@ -24,9 +25,6 @@
 
 namespace eikon {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
 bool boxHit(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& bmin,
             const glm::dvec3& bmax, double& t0, double& t1) {
   t0 = -1e300;
@@ -298,7 +296,7 @@ glm::dvec3 RayMarch::attenuationAt(const glm::dvec3& x, const glm::dvec3& w) con
 // and the mean-direction phase model are those of march.glsl inScatter/diffuseSurface.
 double phaseHG(double cosTheta, double g) {
   const double dd = 1.0 + g * g - 2.0 * g * cosTheta;
-  return (1.0 - g * g) / (4.0 * kPi * dd * std::sqrt(dd));
+  return (1.0 - g * g) / (4.0 * std::numbers::pi * dd * std::sqrt(dd));
 }
 
 glm::dvec3 RayMarch::inScatter(const glm::dvec3& x, const glm::dvec3& dir,
@@ -309,7 +307,7 @@ glm::dvec3 RayMarch::inScatter(const glm::dvec3& x, const glm::dvec3& dir,
   if (phi.w <= 0.0) return glm::dvec3(0.0);
   const glm::dvec3 mdir = f_.lightFlux(x) / phi.w;
   const double lm = std::min(glm::length(mdir), 1.0);
-  double p = (1.0 - lm) / (4.0 * kPi);
+  double p = (1.0 - lm) / (4.0 * std::numbers::pi);
   if (lm > 1e-6) p += lm * phaseHG(glm::dot(glm::normalize(mdir), -dir), sc.w);
   return sigmaOf(glm::dvec3(sc)) * sigmaT * colourOf(glm::dvec3(phi)) * p;
 }
@@ -332,7 +330,7 @@ glm::dvec3 RayMarch::diffuseSurface(const glm::dvec3& x) const {
   const glm::dvec4 phi = f_.lightFluence(xs);
   if (phi.w <= 0.0) return glm::dvec3(0.0);
   const double cosFactor = std::max(0.0, -glm::dot(f_.lightFlux(xs), N)) / phi.w;
-  return sigmaOf(glm::dvec3(sc)) * colourOf(glm::dvec3(phi)) * (cosFactor / kPi);
+  return sigmaOf(glm::dvec3(sc)) * colourOf(glm::dvec3(phi)) * (cosFactor / std::numbers::pi);
 }
 
 /// Fresnel (Rs, Rp) weights of a mode at an interface: the share of its D field along the
@@ -1005,7 +1003,7 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
   const glm::dvec3 fwd = glm::normalize(cam.look_at - cam.position);
   const glm::dvec3 right = glm::normalize(glm::cross(fwd, cam.up));
   const glm::dvec3 up = glm::cross(right, fwd);
-  const double tanh = std::tan(0.5 * cam.fov_deg * kPi / 180.0),
+  const double tanh = std::tan(0.5 * cam.fov_deg * std::numbers::pi / 180.0),
                aspect = double(img.width) / img.height;
   const bool hero = useHeroSampling(s.sampling, field_.weightsDependOnLambda());
   LayerSums layers(s, size_t(img.width) * size_t(img.height), field_.uniaxial());

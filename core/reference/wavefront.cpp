@@ -418,7 +418,7 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
     // No boundary can lie on the corner's way when it moves at most (D − 1.5)·h from a voxel of
     // skip distance D (the argument of straight steps; the sharp path's D counts region changes
     // only) or when every boundary-field cell it touches lies in its region: locateCrossing would
-    // find none, so it is not called (issue 14: most corners near a surface are such corners).
+    // find none, so it is not called (most corners near a surface are such corners).
     // Where the regions are on the shapes (BoundaryField::regionsOnShapes) the crossing is the
     // shapes' own (crossingOutOf, the view march's; the GPU twin's nextCrossing), and the voxels'
     // regions along the way say nothing about it: only the skip distance is a bound there.

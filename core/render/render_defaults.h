@@ -1,8 +1,8 @@
 // What a render does when the user chooses nothing, in one place for both front ends: the CLI
 // (`eikon render`, apps/render_command.cpp) and Python (`eikon.render`, `Renderer.render`,
 // python/eikon_module.cpp) call these functions, so the same scene renders the same from both by
-// default (issue 11: Python rendered dispersive scenes in RGB where the CLI took 16 wavelengths,
-// marched with 0.25-voxel steps where the CLI took 0.5, and left lit scenes unlit).
+// default: the same wavelengths (16 for a dispersive scene), the same step (0.5 voxel) and the
+// same light simulation.
 //
 //   RenderSettings rs = eikon::defaultRenderSettings(scene);  // then apply the user's choices
 //   LightingOptions lo = eikon::defaultLightingOptions();

@@ -1,4 +1,4 @@
-// Triangle meshes as scene objects (issue 16, item 1): {"shape": "mesh", "file": "x.obj"}.
+// Triangle meshes as scene objects: {"shape": "mesh", "file": "x.obj"}.
 //
 // Files are read with Assimp (Debian's libassimp-dev), which reads OBJ, PLY (ASCII and binary)
 // and STL (ASCII and binary) through one interface; tinyobjloader reads OBJ only. Only these

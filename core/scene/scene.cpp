@@ -7,6 +7,7 @@
 #include <map>
 #include <new>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -21,8 +22,6 @@ namespace eikon {
 namespace {
 
 using json = nlohmann::json;
-constexpr double kPi = 3.14159265358979323846;
-
 // Limits on what the scene may ask for, so that every derived quantity is representable:
 // - positions and lengths within ±1e12 mm: distances are computed in double (squares ≤ 1e24, no
 //   overflow) and a surface 1e12 mm from the origin is still placed to ~1e-4 mm;
@@ -668,7 +667,7 @@ SceneObject parseObject(const Node& o) {
       const double apex_deg = apex.number(0.0, 180.0, true, true), side = o.at("side").length();
       // The triangle's base and height at least kMinVoxelMm: 1e-300 degrees left a sliver whose
       // planes "do not enclose a bounded solid".
-      const double half = 0.5 * apex_deg * kPi / 180.0;
+      const double half = 0.5 * apex_deg * std::numbers::pi / 180.0;
       const double thin = std::min(2.0 * side * std::sin(half), side * std::cos(half));
       if (!(thin >= kMinVoxelMm))
         apex.fail("the prism's cross-section would be " + fmt(thin) + " mm thin (side " +
@@ -881,8 +880,8 @@ bool Attenuation::isZero() const {
 
 glm::dvec3 Environment::lookup(const glm::dvec3& d) const {
   // Latitude-longitude parameterisation: y is up; u = atan2(x, -z)/(2π) + 0.5, v = acos(y)/π.
-  double u = std::atan2(d.x, -d.z) / (2.0 * kPi) + 0.5;
-  double v = std::acos(std::clamp(d.y, -1.0, 1.0)) / kPi;
+  double u = std::atan2(d.x, -d.z) / (2.0 * std::numbers::pi) + 0.5;
+  double v = std::acos(std::clamp(d.y, -1.0, 1.0)) / std::numbers::pi;
   switch (type) {
     case Type::Constant:
       return radiance * intensity;

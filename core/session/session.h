@@ -177,8 +177,6 @@ class Session {
     volume_cache_ = std::move(dir);
     volume_note_ = std::move(note);
   }
-  /// Whether the volume came from the volume cache.
-  bool volumeFromCache() const { return volume_from_cache_; }
 
   /// The Vulkan context, made on first use; the scene's volume is checked against its limits
   /// then (checkVolumeFits), before anything is voxelised.
@@ -278,7 +276,6 @@ class Session {
   std::unique_ptr<VolumeSet> volume_;
   std::filesystem::path volume_cache_;
   std::function<void(const std::string&)> volume_note_;
-  bool volume_from_cache_ = false;
   VolumeSpec voxelized_spec_;
   std::unique_ptr<ViewRenderer> gpu_;
   std::unique_ptr<VolumeField> field_;

@@ -1,4 +1,4 @@
-// On-disk cache of voxelised volumes (issue 14, start-up), beside the light cache and the
+// On-disk cache of voxelised volumes (start-up), beside the light cache and the
 // pipeline cache (core/io/cache_dir.h): a repeated render of a scene reads its VolumeSet back
 // instead of voxelising it again (0.4 s for a 128³ sphere on a quiet 2-core machine, tens of
 // seconds for large crystals on a loaded one).

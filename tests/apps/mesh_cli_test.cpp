@@ -1,4 +1,4 @@
-// The "mesh" shape through the real binary (issue 16, item 1): a convex mesh is its exact
+// The "mesh" shape through the real binary: a convex mesh is its exact
 // polyhedron, so the self-made cube (tests/data/meshes/box.obj) scaled to 6 × 4 × 5 mm and the
 // `box` shape of that size, placed and turned alike, must leave the same exit points under
 // `eikon trace` with sharp interfaces (to 1e-4 mm, GPU and CPU twin) and render the same image.

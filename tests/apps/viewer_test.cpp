@@ -1,4 +1,4 @@
-// `eikon view` (issue 17) as a user runs it: the real binary in a virtual X server (Xvfb, started
+// `eikon view` as a user runs it: the real binary in a virtual X server (Xvfb, started
 // here on a display number it picks itself, -displayfd), a mouse drag sent with xdotool, the
 // screenshot it writes on exit compared with `eikon render` of the camera it prints. The
 // tolerance comes from the renderer's own sample noise, measured from two renders with different
@@ -17,6 +17,7 @@
 #include <fstream>
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -295,7 +296,7 @@ TEST_F(ViewerTest, DragOrbitsAndRefinedViewMatchesRender) {
   EXPECT_GT(before, tolerance) << "the screenshot did not change with the drag";
 }
 
-/// Keys (issue 17 items 1–3): M selects the o-mode, R switches to spectral. With --no-prefetch
+/// Keys: M selects the o-mode, R switches to spectral. With --no-prefetch
 /// the spectral pipeline is compiled only after the key, on the renderer's thread, while the
 /// window keeps presenting the last image under a "compiling..." title and handling events: the
 /// viewer reports the frames it presented meanwhile, which a viewer that froze for the compile
@@ -353,7 +354,7 @@ double patchAt(const Png& img, const glm::dvec3& point) {
   const glm::dvec3 fwd = glm::normalize(look - eye),
                    right = glm::normalize(glm::cross(fwd, {0, 1, 0}));
   const glm::dvec3 up = glm::cross(right, fwd), d = point - eye;
-  const double t = std::tan(0.5 * 40.0 * 3.14159265358979323846 / 180.0), z = glm::dot(d, fwd);
+  const double t = std::tan(0.5 * 40.0 * std::numbers::pi / 180.0), z = glm::dot(d, fwd);
   const double u = glm::dot(d, right) / (z * t * (80.0 / 60.0)), v = glm::dot(d, up) / (z * t);
   const int px = int(std::lround(0.5 * (u + 1.0) * 80.0 - 0.5)),
             py = int(std::lround(0.5 * (1.0 - v) * 60.0 - 0.5));
@@ -390,7 +391,7 @@ LightReport lastLightReport(const std::string& out) {
   return r;
 }
 
-/// Ctrl + drag moves the first light (issue 17 item 3). The moved light is simulated on a thread
+/// Ctrl + drag moves the first light. The moved light is simulated on a thread
 /// of the viewer's own while the view keeps refining with the former light volumes (the viewer
 /// reports the frames it rendered or presented meanwhile: a viewer that simulated in its event
 /// loop would report none), then swapped into the renderer; the view then shows what `eikon

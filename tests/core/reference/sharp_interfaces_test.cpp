@@ -18,6 +18,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 
 #include "core/reference/reference_marcher.h"
@@ -28,7 +29,7 @@
 namespace eikon {
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 
 /// One voxelised scene and the CPU twin over it.
 struct Cpu {

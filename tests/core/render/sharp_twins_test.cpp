@@ -1,5 +1,5 @@
 // The sharp march of both twins on the same rays (GPU: shaders/sharp.glsl through trace.comp;
-// CPU: RayMarch::marchSharp), on the done-when scenes of issue 13, and the GPU against the same
+// CPU: RayMarch::marchSharp), on the sharp march's reference scenes, and the GPU against the same
 // closed forms as tests/core/reference/sharp_interfaces_test.cpp:
 //  - slab at 0–80°: displacement t·sin(θ − θ_t)/cos θ_t within 1e-4 mm, direction 1e-5 rad;
 //  - calcite plates, optic axis at 0–90° to the normal: o/e separation t·tan ρ within 1e-4 mm;

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "core/reference/wavefront.h"
 #include "core/render/light_simulator.h"
@@ -246,8 +247,7 @@ TEST(WavefrontGpu, PointLightIsIndependentOfStepsPerDispatch) {
       std::chrono::duration<double>(t2 - t1).count());
   for (const WavefrontResult* g : {&g1, &g16}) {
     EXPECT_EQ(g->stats.seeded, size_t(6 * 64));
-    EXPECT_NEAR(g->stats.flux_left, 4 * 3.14159265358979323846 * I,
-                1e-6 * 4 * 3.14159265358979323846 * I);
+    EXPECT_NEAR(g->stats.flux_left, 4 * std::numbers::pi * I, 1e-6 * 4 * std::numbers::pi * I);
     EXPECT_EQ(g->stats.kills_caustic + g->stats.kills_energy, 0u);
     EXPECT_LE(std::abs(double(g->stats.splits) - double(c.stats.splits)),
               2e-3 * double(c.stats.splits));

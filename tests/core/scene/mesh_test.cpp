@@ -1,4 +1,4 @@
-// The "mesh" shape (issue 16, item 1): OBJ, PLY and STL files read through Assimp, checked closed
+// The "mesh" shape: OBJ, PLY and STL files read through Assimp, checked closed
 // and outward, and a convex mesh turned into its exact polyhedron. The test meshes are self-made
 // (tests/data/meshes/make_meshes.py). Expected values are closed forms: the box's six planes, and
 // for the icosphere the facetting error δ = R − √(R² − ℓ²/3) of a level-2 icosphere (its faces
@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <numbers>
 #include <random>
 #include <string>
 #include <variant>
@@ -325,7 +326,8 @@ size_t checkFaceColours(const MeshDistance& m, const std::string& what) {
           EXPECT_EQ(c[a], c[b]) << what << ": coplanar triangles " << a << ", " << b;
         } else if (cosine < 1.0 - 1e-9) {
           EXPECT_NE(c[a], c[b]) << what << ": triangles " << a << ", " << b << " meet at vertex "
-                                << v << " at " << std::acos(cosine) * 180 / M_PI << " deg";
+                                << v << " at " << std::acos(cosine) * 180 / std::numbers::pi
+                                << " deg";
           kinked[a].push_back(b);
           kinked[b].push_back(a);
         }

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes the self-made test meshes of tests/data/meshes (issue 16, item 1): run it from anywhere,
+"""Writes the self-made test meshes of tests/data/meshes: run it from anywhere,
 it writes next to itself. Every file is generated here, none is downloaded.
 
   box.obj            the cube [-0.5, 0.5]^3 as 6 quads (Assimp triangulates them), outward
