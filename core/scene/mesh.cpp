@@ -119,9 +119,11 @@ std::string meshBytes(const std::filesystem::path& file, const std::string& name
                    " MiB, got " + std::to_string(got) + " bytes");
   };
   if (std::uintmax_t(st.st_size) > kMaxMeshFileBytes) too_large(std::uintmax_t(st.st_size));
-  std::string bytes(size_t(st.st_size) + 1, '\0');  // one more: a file that grew is seen
+  // Room for one byte more than its size, grown (to the cap and a byte) if the file grows.
+  std::string bytes(size_t(st.st_size) + 1, '\0');
   size_t got = 0;
-  while (got < bytes.size()) {
+  while (got <= kMaxMeshFileBytes) {
+    if (got == bytes.size()) bytes.resize(std::min<size_t>(2 * got, kMaxMeshFileBytes + 1));
     const ssize_t r = ::read(fd, bytes.data() + got, bytes.size() - got);
     if (r < 0 && errno == EINTR) continue;
     if (r < 0)
@@ -130,7 +132,7 @@ std::string meshBytes(const std::filesystem::path& file, const std::string& name
     if (r == 0) break;
     got += size_t(r);
   }
-  if (got > size_t(st.st_size)) too_large(got);
+  if (got > kMaxMeshFileBytes) too_large(got);
   bytes.resize(got);
   return bytes;
 }
