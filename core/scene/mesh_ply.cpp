@@ -186,6 +186,16 @@ void checkCounts(const Header& h, const std::string& name, size_t bytes) {
   }
 }
 
+/// The element being read, for messages ("the face 3"), put in words only for one.
+struct Item {
+  const std::string& element;
+  uint64_t index;
+};
+
+std::string str(const Item& i) {
+  return "the " + excerpt(i.element) + " " + std::to_string(i.index);
+}
+
 /// The data after the header, one scalar at a time, ASCII or binary.
 class Data {
  public:
@@ -201,7 +211,7 @@ class Data {
   Where last() const { return last_; }
 
   /// The next scalar of type t, of the element `what` ("the face 3").
-  double value(Scalar t, const std::string& what) {
+  double value(Scalar t, const Item& what) {
     if (format_ != Format::ascii) last_ = where();
     const double v = format_ == Format::ascii ? textValue(t, what) : binaryValue(t, what);
     if (format_ == Format::ascii) last_ = where();
@@ -209,39 +219,39 @@ class Data {
   }
 
   /// Skips n scalars of type t (n at most the bytes left: a list's count is checked first).
-  void skip(Scalar t, uint64_t n, const std::string& what) {
+  void skip(Scalar t, uint64_t n, const Item& what) {
     if (format_ != Format::ascii) {
       const uint64_t bytes = n * info(t).bytes;
-      if (bytes > s_.size() - pos_) refuse(name_, where(), "the file ends inside " + what);
+      if (bytes > s_.size() - pos_) refuse(name_, where(), "the file ends inside " + str(what));
       pos_ += size_t(bytes);
       return;
     }
     std::string_view tok;
     for (uint64_t k = 0; k < n; ++k)
-      if (!tokens_.next(tok)) refuse(name_, where(), "the file ends inside " + what);
+      if (!tokens_.next(tok)) refuse(name_, where(), "the file ends inside " + str(what));
   }
 
  private:
-  double textValue(Scalar t, const std::string& what) {
+  double textValue(Scalar t, const Item& what) {
     std::string_view tok;
-    if (!tokens_.next(tok)) refuse(name_, where(), "the file ends inside " + what);
+    if (!tokens_.next(tok)) refuse(name_, where(), "the file ends inside " + str(what));
     const ScalarInfo& i = info(t);
     double v = 0.0;
     if (i.integer) {
       int64_t n = 0;
       if (!mesh_io::parseInteger(tok, n) || double(n) < i.lo || double(n) > i.hi)
         refuse(name_, where(),
-               what + ": '" + excerpt(tok) + "' is not an integer of the type " + i.names[0]);
+               str(what) + ": '" + excerpt(tok) + "' is not an integer of the type " + i.names[0]);
       v = double(n);
     } else if (!mesh_io::parseReal(tok, v)) {
-      refuse(name_, where(), what + ": '" + excerpt(tok) + "' is not a number");
+      refuse(name_, where(), str(what) + ": '" + excerpt(tok) + "' is not a number");
     }
     return v;
   }
 
-  double binaryValue(Scalar t, const std::string& what) {
+  double binaryValue(Scalar t, const Item& what) {
     const size_t n = info(t).bytes;
-    if (s_.size() - pos_ < n) refuse(name_, where(), "the file ends inside " + what);
+    if (s_.size() - pos_ < n) refuse(name_, where(), "the file ends inside " + str(what));
     unsigned char b[8];
     std::memcpy(b, s_.data() + pos_, n);
     pos_ += n;
@@ -311,19 +321,19 @@ std::array<size_t, 3> coordinates(const Element& e, const std::string& name) {
 
 /// A list's count, checked against the bytes left: each item takes its bytes in binary, at least
 /// two (a digit and a separator, the last one's newline may be missing) in ASCII.
-uint64_t listCount(Data& d, const Property& p, bool ascii, const std::string& what,
+uint64_t listCount(Data& d, const Property& p, bool ascii, const Item& what,
                    const std::string& name) {
   const double n = d.value(p.count, what);
   const Where at = d.last();
   if (n < 0)
     refuse(name, at,
-           what + " declares a list '" + excerpt(p.name) + "' of " + std::to_string(int64_t(n)) +
-               " items");
+           str(what) + " declares a list '" + excerpt(p.name) + "' of " +
+               std::to_string(int64_t(n)) + " items");
   const uint64_t count = uint64_t(n);
   const uint64_t each = ascii ? 2 : info(p.type).bytes;
   if (count > (d.left() + (ascii ? 1 : 0)) / each)
     refuse(name, at,
-           what + " declares a list '" + excerpt(p.name) + "' of " + std::to_string(count) +
+           str(what) + " declares a list '" + excerpt(p.name) + "' of " + std::to_string(count) +
                " items, more than the " + std::to_string(d.left()) +
                " bytes left in the file can hold");
   return count;
@@ -351,8 +361,14 @@ TriangleMesh parsePly(std::string_view s, const std::string& name) {
   Data d(s, h, name);
   for (const Element& e : h.elements) {
     if (e.props.empty()) continue;  // takes no bytes
+    const bool fixed =
+        std::none_of(e.props.begin(), e.props.end(), [](const Property& p) { return p.list; });
+    if (!ascii && fixed && &e != vertex) {  // skipped whole: count × least_bytes (checkCounts)
+      d.skip(Scalar::u8, e.count * e.least_bytes, Item{e.name, e.count});
+      continue;
+    }
     for (uint64_t i = 0; i < e.count; ++i) {
-      const std::string what = "the " + excerpt(e.name) + " " + std::to_string(i);
+      const Item what{e.name, i};
       glm::dvec3 p(0.0);
       for (size_t k = 0; k < e.props.size(); ++k) {
         const Property& pr = e.props[k];
@@ -363,7 +379,7 @@ TriangleMesh parsePly(std::string_view s, const std::string& name) {
           for (size_t a = 0; a < 3; ++a)
             if (k == xyz[a]) {
               if (!std::isfinite(x))
-                refuse(name, d.last(), what + "'s " + "xyz"[a] + " is not a finite number");
+                refuse(name, d.last(), str(what) + "'s " + "xyz"[a] + " is not a finite number");
               p[int(a)] = x;
             }
         } else {
