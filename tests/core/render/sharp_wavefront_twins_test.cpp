@@ -336,13 +336,13 @@ TEST(SharpWavefrontTwins, KinkAtAMeshApexTearsOnBoth) {
   ASSERT_TRUE(vol.boundary.exact);  // the triangles' hits, not the walk
   const WavefrontSettings s = expectNoLightInTheGap(vol, "mesh kink");
   // The analytic prism's run on the CPU twin (its planes' search) against the mesh's: the
-  // mesh's triangles lie in the prism's planes to the rounding of its vertices (Assimp reads
-  // them as float: ≤ 2⁻²⁴·1.7 mm ≈ 1e-7 mm, normals within ~1e-7 rad), so the Fresnel
-  // factors agree to ~1e-7 (flux left bound 1e-7 of emitted) and the light to that and the float
-  // volumes' rounding (each voxel sums ~10 splats: ≤ 10·2⁻²⁴ ≈ 6e-7; L1 bound 1e-6). The beam is
-  // moved off the seed lattice by a fraction of a seed edge: on it, corners at x = ±1 and on the
-  // faces' edges meet ties that rounding settles, and the two searches settle them as mirror images
-  // (5% L1, same flux).
+  // mesh's triangles lie in the prism's planes to the rounding of its vertices (read in double
+  // from 17 digits; bounded here as if float: ≤ 2⁻²⁴·1.7 mm ≈ 1e-7 mm, normals within ~1e-7 rad),
+  // so the Fresnel factors agree to ~1e-7 (flux left bound 1e-7 of emitted) and the light to that
+  // and the float volumes' rounding (each voxel sums ~10 splats: ≤ 10·2⁻²⁴ ≈ 6e-7; L1 bound 1e-6).
+  // The beam is moved off the seed lattice by a fraction of a seed edge: on it, corners at x = ±1
+  // and on the faces' edges meet ties that rounding settles, and the two searches settle them as
+  // mirror images (5% L1, same flux).
   const glm::dvec3 off(0.0123, 2.9, 0.0071);
   const WavefrontSettings ps = sharpSettings(s);
   const VolumeSet pvol = voxelize(sceneFromJson(kSharpApexPrismScene));
