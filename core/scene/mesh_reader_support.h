@@ -4,6 +4,7 @@
 // vertex written after it, a PLY's face element may come before its vertex element).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <glm/glm.hpp>
@@ -77,5 +78,13 @@ class Polygons {
   std::vector<Where> where_;
   size_t triangles_ = 0;
 };
+
+/// The triangles (corner positions 0..n-1 of the polygon) of a flat polygon of n ≥ 3 corners
+/// `c` (indices into `v`, in range): a fan when it is convex, else ear clipping in the plane of
+/// its Newell normal (the triangles keep the polygon's winding). Empty, with `why` set, for a
+/// polygon that crosses itself, one too far from flat for ear clipping to finish, and a concave
+/// one of more than 256 corners.
+std::vector<std::array<size_t, 3>> triangulatePolygon(const std::vector<glm::dvec3>& v,
+                                                      const int64_t* c, size_t n, std::string* why);
 
 }  // namespace eikon::mesh_io

@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <functional>
 #include <future>
+#include <numbers>
 #include <random>
 #include <sstream>
 #include <string>
@@ -556,3 +557,65 @@ TEST(MeshReaders, DoubleCoordinatesReachTheCpuTwinsHits) {
 }
 
 }  // namespace
+
+namespace {
+
+/// The area vector ½ Σ (b − a) × (c − a) of triangles, and whether each one faces along `up`.
+glm::dvec3 areaOf(const eikon::TriangleMesh& m, glm::dvec3 up, bool& all_along) {
+  glm::dvec3 sum(0.0);
+  all_along = true;
+  for (const auto& t : m.triangles) {
+    const glm::dvec3 a = m.vertices[t[0]], b = m.vertices[t[1]], c = m.vertices[t[2]];
+    const glm::dvec3 n = 0.5 * glm::cross(b - a, c - a);
+    if (glm::dot(n, up) <= 0.0) all_along = false;
+    sum += n;
+  }
+  return sum;
+}
+
+}  // namespace
+
+// A concave face of more than four corners is cut into triangles that cover it exactly: the
+// L-shaped hexagon (0,0) (3,0) (3,1) (1,1) (1,2) (0,2), area 3·1 + 1·1 = 4, written starting at
+// the corner (3,1), from which a fan would fold over the reflex corner (1,1) (two of its four
+// triangles would face down and the signed areas would still sum to 4, so both are checked: every
+// triangle faces +z, and their areas sum to 4 exactly in binary arithmetic). A self-crossing
+// pentagram is refused naming its line, and so is a concave face past the corner limit.
+TEST(MeshReaders, ConcavePolygonsAreEarClipped) {
+  const std::string L = "v 3 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 3 0 0\nf 1 2 3 4 5 6\n";
+  const TriangleMesh m = parseObj(L, "l.obj");
+  ASSERT_EQ(m.triangles.size(), 4u);
+  bool along = false;
+  const glm::dvec3 a = areaOf(m, {0, 0, 1}, along);
+  EXPECT_TRUE(along) << "a triangle of the L faces down: the face was folded";
+  EXPECT_EQ(a, glm::dvec3(0, 0, 4));
+  // Tilted out of every coordinate plane, the same L still triangulates facing its normal.
+  std::string tilted;
+  const glm::dvec3 u = glm::normalize(glm::dvec3(1, 1, 0)),
+                   w = glm::normalize(glm::dvec3(-1, 1, 2));
+  for (glm::dvec2 p : {glm::dvec2(3, 1), {1, 1}, {1, 2}, {0, 2}, {0, 0}, {3, 0}}) {
+    const glm::dvec3 q = p.x * u + p.y * w;
+    tilted += "v " + g17(q.x) + " " + g17(q.y) + " " + g17(q.z) + "\n";
+  }
+  const glm::dvec3 up = glm::cross(u, w);
+  const glm::dvec3 b = areaOf(parseObj(tilted + "f 1 2 3 4 5 6\n", "t.obj"), up, along);
+  EXPECT_TRUE(along);
+  EXPECT_NEAR(glm::dot(b, up), 4.0, 1e-12);
+  std::string star;
+  for (int k = 0; k < 5; ++k) {
+    const double t = 2.0 * std::numbers::pi * (2 * k) / 5.0;
+    star += "v " + g17(std::cos(t)) + " " + g17(std::sin(t)) + " 0\n";
+  }
+  EXPECT_EQ(errorOf([&] { parseObj(star + "f 1 2 3 4 5\n", "s.obj"); }),
+            "s.obj: line 6: a face of 5 corners that crosses itself");
+  std::string comb;  // a concave comb of 2·130 corners
+  for (int k = 0; k < 130; ++k)
+    comb += "v " + std::to_string(k) + " " + (k % 2 ? "1" : "2") + " 0\n";
+  for (int k = 129; k >= 0; --k) comb += "v " + std::to_string(k) + " 0 0\n";
+  comb += "f";
+  for (int k = 1; k <= 260; ++k) comb += " " + std::to_string(k);
+  EXPECT_EQ(errorOf([&] {
+              parseObj(comb + "\n", "c.obj");
+            }).find("c.obj: line 261: a concave face of 260 corners (at most 256"),
+            0u);
+}
