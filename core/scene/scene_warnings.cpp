@@ -50,7 +50,8 @@ void warnUnlit(Scene& scene, const std::vector<size_t>& json_index, const std::s
   Capped warn(scene, file, "objects with an albedo in a scene without lights");
   for (size_t k = 0; k < scene.objects.size(); ++k) {
     const Material& m = scene.materials.at(scene.objects[k].material);
-    if (!hasAlbedo(m)) continue;
+    // One that emits shows its emission: not black, and maybe meant so.
+    if (!hasAlbedo(m) || m.emission != glm::dvec3(0.0)) continue;
     warn.add(objectName(scene, json_index, k) +
              ": its material has an albedo, which shows only "
              "the light of the scene's lights, and the scene has none (no \"lights\"): " +

@@ -2,8 +2,8 @@
 // `eikon render --strict` makes them errors): mistakes that used to render a black or empty image
 // with no word said.
 //
-//   - an object with an albedo (a diffuse surface, a scattering medium) in a scene without lights:
-//     it shows only simulated light, so an opaque one renders black;
+//   - an object with an albedo (a diffuse surface, a scattering medium) and no emission in a scene
+//     without lights: it shows only simulated light, so an opaque one renders black;
 //   - an object smaller than a voxel of the volume, or than a pixel's footprint at its distance
 //     from the camera (a radius of 0.009 typed for 9 mm): nothing of it is seen;
 //   - a light whose beam or cone misses every object: it lights nothing, and `eikon render` skips

@@ -27,6 +27,7 @@ std::vector<std::string> shippedMaterials() {
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(fs::path(EIKON_SOURCE_DIR) / "materials"))
     if (e.path().extension() == ".json") names.push_back(e.path().stem().string());
+  std::sort(names.begin(), names.end());  // as the library lists them
   return names;
 }
 

@@ -45,6 +45,12 @@ TEST(SceneUnseen, AnAlbedoWithoutLightsIsWarnedAbout) {
   const Scene lit =
       floorScene(R"(, "lights": [{"type": "directional", "direction": [0.25, -1, 0.15]}])");
   EXPECT_TRUE(lit.warnings.empty()) << allWarnings(lit);
+  // A glowing floor shows its emission: no warning.
+  const Scene glowing = parseScene(
+      R"({"materials": {"lamp": {"n": 1.0, "opacity": 1, "albedo": 0.8, "emission": 0.5}},
+          "objects": [{"shape": "box", "size": [10, 1, 10], "material": "lamp"}]})",
+      "glow.json");
+  EXPECT_TRUE(glowing.warnings.empty()) << allWarnings(glowing);
 }
 
 // 0.009 mm typed for 9 mm: 0.018 mm across against 24/128 = 0.1875 mm voxels.
