@@ -184,11 +184,11 @@ py::dict layerArrays(const RenderImage& img) {
   return d;
 }
 
-py::object render(Prepared& p, int width, int height, int spp, std::optional<int> wavelengths,
-                  double wavelength_nm, std::optional<MarchSettings> march,
-                  const std::string& device, int threads, bool light, const py::object& light_cache,
-                  const std::string& sampling, const std::string& layers, bool polarised,
-                  const std::string& modes) {
+py::object render(Prepared& p, int width, int height, std::optional<int> spp,
+                  std::optional<int> wavelengths, double wavelength_nm,
+                  std::optional<MarchSettings> march, const std::string& device, int threads,
+                  bool light, const py::object& light_cache, const std::string& sampling,
+                  const std::string& layers, bool polarised, const std::string& modes) {
   const bool gpu = isGpu(device);
   ViewRequest view;  // the CLI's defaults (core/session/session.h), then what the caller chose
   if (width != 0) view.width = width;
@@ -442,13 +442,15 @@ void bindRenderer(py::module_& m) {
            py::arg("scene"))
       .def_property_readonly("scene", [](const Prepared& p) { return p.scene; })
       .def("grid", &grid, "voxel grid facts (voxelises on first call)")
-      .def("render", &render, py::arg("width") = 0, py::arg("height") = 0, py::arg("spp") = 1,
-           py::arg("wavelengths") = py::none(), py::arg("wavelength_nm") = 587.5618,
-           py::arg("march") = py::none(), py::arg("device") = "gpu", py::arg("threads") = 0,
-           py::arg("light") = true, py::arg("light_cache") = true, py::arg("sampling") = "auto",
-           py::arg("layers") = "", py::arg("polarised") = false, py::arg("modes") = "both",
-           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: wavelengths=None "
-           "is 16 for a "
+      .def("render", &render, py::arg("width") = 0, py::arg("height") = 0,
+           py::arg("spp") = py::none(), py::arg("wavelengths") = py::none(),
+           py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(),
+           py::arg("device") = "gpu", py::arg("threads") = 0, py::arg("light") = true,
+           py::arg("light_cache") = true, py::arg("sampling") = "auto", py::arg("layers") = "",
+           py::arg("polarised") = false, py::arg("modes") = "both",
+           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: spp=None and "
+           "wavelengths=None are the scene's \"render\" spp and wavelengths where it gives them, "
+           "else 1 and 16 for a "
            "dispersive scene, else 0 (RGB; > 0 = spectral with that many samples); march=None is "
            "0.5-voxel RK4 "
            "steps; light=True simulates a lit scene's lights before its first render (unless "

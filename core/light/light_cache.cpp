@@ -9,6 +9,7 @@
 #include "core/io/atomic_write.h"
 #include "core/io/build_id.h"
 #include "core/io/cache_dir.h"
+#include "core/io/cache_limit.h"
 #include "core/light/lighting.h"
 #include "core/volume/media.h"
 
@@ -169,6 +170,7 @@ bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& v
   if (payloadChecksum(fluence, flux) != checksum) return corrupted("checksum mismatch");
   volume.light_fluence = std::move(fluence);
   volume.light_flux = std::move(flux);
+  touchCacheEntry(path);  // recently used: evicted last
   return true;
 }
 
@@ -200,6 +202,7 @@ std::string saveLightCache(const std::filesystem::path& dir, uint64_t key,
   } catch (const std::exception& e) {
     return e.what();
   }
+  trimCacheDir(dir, final_path);  // the cache folder's cap (core/io/cache_limit.h)
   return {};
 }
 

@@ -28,9 +28,9 @@ inline constexpr double kDefaultRenderStepVoxels = 0.5;
 /// kDefaultDispersiveWavelengths when any material's index depends on λ, else 0 (RGB mode).
 int defaultWavelengths(const Scene& scene);
 
-/// The scene camera's size (0 = the camera's), 1 spp, defaultWavelengths(scene), the d line for
-/// RGB mode, and the march: kDefaultRenderStepVoxels, RK4, straight steps across homogeneous
-/// regions, Fresnel on.
+/// The scene camera's size (0 = the camera's), the scene's "render" spp and wavelengths where it
+/// gives them (else 1 spp and defaultWavelengths(scene)), the d line for RGB mode, and the march:
+/// kDefaultRenderStepVoxels, RK4, straight steps across homogeneous regions, Fresnel on.
 RenderSettings defaultRenderSettings(const Scene& scene);
 
 /// The light simulator as a render runs it: bands chosen per scene (0 → defaultLightBands),

@@ -15,7 +15,9 @@
 #include "core/io/text_file.h"
 #include "core/scene/faceted.h"
 #include "core/scene/limits.h"
+#include "core/scene/material_library.h"
 #include "core/scene/mesh.h"
+#include "core/scene/scene_warnings.h"
 #include "core/spectrum/illuminants.h"
 
 namespace eikon {
@@ -1208,22 +1210,24 @@ static void loadLibraryMaterial(const Node& o, const SceneObject& obj, Scene& sc
               "' is not a plain name (no '/', '\\' or NUL, not '.' or " +
               "'..'): library materials are looked up inside the material library only; define " +
               "others under /materials");
-  for (const auto& dir : materialSearchPath()) {
-    auto p = dir / (obj.material + ".json");
-    std::error_code ec;
-    const bool found = std::filesystem::exists(p, ec);  // not found is no error
-    if (ec)
-      o.at("material")
-          .fail("cannot look up the library material '" + excerpt(name) + "' as " + shownPath(p) +
-                ": " + errorReason(ec));
-    if (found) {
-      scene.materials[obj.material] = loadMaterialFile(p);
-      return;
-    }
+  std::optional<std::filesystem::path> file;
+  try {
+    file = findLibraryMaterial(name);
+  } catch (const std::filesystem::filesystem_error& e) {  // a name the system cannot look up
+    o.at("material")
+        .fail("cannot look up the library material '" + excerpt(name) + "' as " +
+              shownPath(e.path1()) + ": " + errorReason(e.code()));
   }
+  if (file) {
+    scene.materials[obj.material] = loadMaterialFile(*file);
+    return;
+  }
+  std::vector<std::string> defined;
+  for (const auto& m : scene.materials) defined.push_back(m.first);
   o.at("material")
       .fail("unknown material '" + excerpt(obj.material) +
-            "' (not defined under /materials and not in the material library)");
+            "': not defined under /materials and not in the material library; " +
+            unknownMaterialHint(name, defined));
 }
 
 namespace {
@@ -1431,6 +1435,17 @@ static void dropUnusedMaterials(Scene& scene) {
   std::erase_if(scene.materials, [&](const auto& m) { return !used.count(m.first); });
 }
 
+// "render": the scene's intended quality (docs/scene-format.md), as `eikon render` checks its
+// options (--spp, --wavelengths, --exposure).
+static RenderHints parseRenderHints(const Node& r) {
+  r.allowKeys({"spp", "wavelengths", "exposure"});
+  RenderHints h;
+  if (auto s = r.get("spp")) h.spp = s->integer(1, 4096);
+  if (auto w = r.get("wavelengths")) h.wavelengths = w->integer(0, 256);
+  if (auto e = r.get("exposure")) h.exposure = e->number(-64.0, 64.0);
+  return h;
+}
+
 // "interfaces": how material boundaries are represented (docs/scene-format.md).
 static Scene::Interfaces parseInterfaces(const Node& f) {
   const std::string m = f.string();
@@ -1446,12 +1461,13 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   scene.file = origin;
   Node root(j, "", file);
   root.allowKeys({"camera", "environment", "volume", "materials", "objects", "lights",
-                  "ambient_index", "description", "interfaces"});
+                  "ambient_index", "description", "interfaces", "render"});
   if (auto c = root.get("camera")) parseCamera(*c, scene.camera);
   if (auto e = root.get("environment")) parseEnvironment(*e, scene.environment);
   if (auto v = root.get("volume")) parseVolume(*v, scene.volume);
   if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(kMinIndex, kMaxIndex);
   if (auto f = root.get("interfaces")) scene.interfaces = parseInterfaces(*f);
+  if (auto r = root.get("render")) scene.render = parseRenderHints(*r);
   if (auto ms = root.get("materials")) {
     ms->requireObject();
     for (auto it = ms->raw().begin(); it != ms->raw().end(); ++it)
@@ -1467,6 +1483,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     for (size_t i = 0; i < ls->size(); ++i) scene.lights.push_back(parseLight(ls->index(i)));
   }
   warnInsideOpaque(scene, json_index, file);
+  warnUnseenScene(scene, json_index, file);
   return scene;
 }
 

@@ -137,7 +137,7 @@ void checkMarchStep(double step_voxels) {
 void checkViewRequest(const ViewRequest& v) {
   if (v.width) checkRange("width", *v.width, 1, 16384);
   if (v.height) checkRange("height", *v.height, 1, 16384);
-  checkRange("spp", v.spp, 1, 4096);
+  if (v.spp) checkRange("spp", *v.spp, 1, 4096);
   if (v.wavelengths) checkRange("wavelengths", *v.wavelengths, 0, 256);
   if (v.march) checkMarchStep(v.march->step_voxels);
   if (v.march) checkMarchSettings(*v.march);  // the rest, as both twins check them
@@ -149,7 +149,7 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
   RenderSettings rs = defaultRenderSettings(scene);
   rs.width = v.width.value_or(0);
   rs.height = v.height.value_or(0);
-  rs.spp = v.spp;
+  if (v.spp) rs.spp = *v.spp;
   if (v.wavelengths) rs.wavelengths = *v.wavelengths;
   rs.wavelength_nm = v.wavelength_nm;
   if (v.march) rs.march = *v.march;

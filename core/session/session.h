@@ -61,7 +61,7 @@ class SettingError : public std::invalid_argument {
 /// What a render is asked for; an unset value takes the default of core/render/render_defaults.h.
 struct ViewRequest {
   std::optional<int> width, height;    ///< [1, 16384]; unset: the scene camera's
-  int spp = 1;                         ///< [1, 4096] jittered samples per pixel
+  std::optional<int> spp;              ///< [1, 4096] jittered samples; unset: the scene's or 1
   std::optional<int> wavelengths;      ///< [0, 256] (0 = RGB); unset: defaultWavelengths(scene)
   double wavelength_nm = 587.5618;     ///< the index wavelength of the RGB mode, [100, 10000] nm
   std::optional<MarchSettings> march;  ///< step in (0, 4] voxels; unset: the render defaults

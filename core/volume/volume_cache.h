@@ -20,7 +20,8 @@
 // with one notice and replaced by the next save; an entry of another format version is replaced
 // quietly. Entries over kMaxVolumeEntryBytes are neither written nor read; after a save the
 // oldest volume entries (by modification time; a hit refreshes it) are removed until those left
-// take at most kMaxVolumeCacheBytes.
+// take at most kMaxVolumeCacheBytes, and then the least recently used entries of every cache in
+// the folder until all take at most its cap (core/io/cache_limit.h, 1 GiB by default).
 //
 //   const uint64_t key = eikon::volumeCacheKey(scene);      // 0: no build id, cache nothing
 //   std::string notice;

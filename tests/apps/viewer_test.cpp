@@ -626,4 +626,49 @@ TEST_F(ViewerTest, HeroSpectralViewGoesFromCoarseStraightToFullQuality) {
   }
 }
 
+/// S saves into ~/Pictures/eikon (HOME here a temporary folder), never over a file that is there:
+/// with glass_sphere-view-1.png present, two saves write -2 and -3 (both files each), leave the
+/// PNG as it was and print the absolute paths. A --save-dir that cannot be written is refused
+/// before any window.
+TEST_F(ViewerTest, SaveGoesToThePicturesFolderAndNeverOverwrites) {
+  const std::string xvfb = findProgram("Xvfb"), xdotool = findProgram("xdotool");
+  if (xvfb.empty()) GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb)";
+  ASSERT_FALSE(xdotool.empty()) << "xdotool is not installed (Debian package xdotool)";
+  Xvfb server(xvfb);
+  ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
+  const fs::path home = dir_ / "home", pictures = home / "Pictures" / "eikon";
+  fs::create_directories(pictures);
+  std::ofstream(pictures / "glass_sphere-view-1.png") << "not the viewer's";
+  extra_env_ = "HOME=" + quote(home.string());
+  const ViewerRun run = viewWhile(
+      server, xdotool, kGlassSphere, "--width 40 --height 30 --spp 1 --no-prefetch",
+      " search --sync --onlyvisible --name 'refined' windowfocus %1 sleep 0.2 key s sleep 0.6"
+      " key s sleep 0.6 key q");
+  ASSERT_TRUE(WIFEXITED(run.status) && WEXITSTATUS(run.status) == 0) << run.err;
+  EXPECT_EQ(run.err.find("validation"), std::string::npos) << run.err;
+  EXPECT_EQ(eikon::test::slurp(pictures / "glass_sphere-view-1.png"), "not the viewer's");
+  EXPECT_FALSE(fs::exists(pictures / "glass_sphere-view-1.exr"));
+  for (const char* k : {"2", "3"}) {
+    const fs::path exr = pictures / (std::string("glass_sphere-view-") + k + ".exr");
+    const fs::path png = fs::path(exr).replace_extension(".png");
+    EXPECT_GT(fs::file_size(exr), 0u) << exr;
+    EXPECT_EQ(readPng(png).width, 40) << png;
+    EXPECT_NE(run.out.find("eikon view: saved " + exr.string() + " and " + png.string()),
+              std::string::npos)
+        << run.out;
+  }
+  EXPECT_FALSE(fs::exists(pictures / "glass_sphere-view-4.exr"));
+  // Not the current folder.
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find("-view-"), std::string::npos) << e.path();
+  // A folder below a file cannot be made: refused before the window, in one line.
+  std::ofstream(dir_ / "file") << "x";
+  const Outcome bad = eikon::test::runEikon(
+      "view " + quote(kGlassSphere) + " --save-dir " + quote((dir_ / "file" / "sub").string()),
+      dir_ / "render_io", "EIKON_VALIDATION=1 DISPLAY=" + quote(server.display()));
+  EXPECT_NE(bad.code, 0);
+  EXPECT_EQ(bad.err.rfind("eikon: error: ", 0), 0u) << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+}
+
 }  // namespace
