@@ -17,6 +17,7 @@
 #include "core/light/light_cache.h"
 #include "core/render/render_defaults.h"
 #include "core/render/view_renderer.h"
+#include "core/session/render_cost.h"
 #include "core/session/session.h"
 #include "core/vk/context.h"
 #include "core/vk/timings.h"
@@ -243,6 +244,10 @@ struct Preview {
   }
 };
 
+/// Renders said to be long before they start: by their time (the trial's estimate) or their
+/// host memory.
+constexpr double kLongRenderSeconds = 10.0, kLongRenderBytes = 1e9;
+
 void runRender(const RenderArgs& a, const CLI::App& sub) {
   if (a.timings) timings::enable(true);
   timings::mark("command line");
@@ -269,6 +274,8 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   timings::mark("scene parsed");
 
   Progress progress(progressMode(a.progress, a.quiet));
+  RenderCost cost = renderWork(*scene, rs);
+  if (cost.host_bytes >= kLongRenderBytes) progress.note("cost: " + describeRenderCost(cost), true);
   Session session(scene);
   session.setThreads(a.threads);
   // The GPU render's start-up (docs/performance.md "Start-up"); the CPU twin takes far longer to
@@ -307,6 +314,12 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   }
   for (const std::string& w : light.warnings)
     std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+  // Long renders say their time first, from a trial (core/session/render_cost.h).
+  if (!a.quiet && a.progress != "never" && worthATrial(cost)) {
+    timeRenderTrial(session, rs, !a.reference, cost);
+    if (cost.seconds + cost.write_seconds >= kLongRenderSeconds)
+      progress.note("cost: " + describeRenderCost(cost), true);
+  }
   Preview preview{png, a.exposure};
   RenderImage img = session.render(preview.attach(rs), !a.reference);
   progress.finish();
