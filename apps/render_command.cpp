@@ -319,6 +319,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
     timeRenderTrial(session, rs, !a.reference, cost);
     if (cost.seconds + cost.write_seconds >= kLongRenderSeconds)
       progress.note("cost: " + describeRenderCost(cost), true);
+    progress.update("rendering", 0.0);  // the trial's stage ("preparing the GPU") has ended
   }
   Preview preview{png, a.exposure};
   RenderImage img = session.render(preview.attach(rs), !a.reference);
