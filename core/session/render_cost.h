@@ -12,7 +12,7 @@
 //
 // The estimate's uncertainty (kRenderCostLow/High) is measured, not modelled: the ratio of the
 // render's time to the estimate lay in [0.74, 1.58] on the README's scenes, both twins, on a
-// shared 2-core machine (docs/performance.md "Cost estimates"); a machine busier during the
+// shared 2-core machine (docs/cost-estimates.md); a machine busier during the
 // trial than during the render (or the reverse) moves it further.
 #pragma once
 
