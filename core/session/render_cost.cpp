@@ -40,24 +40,37 @@ void timeRenderTrial(Session& session, const RenderSettings& settings, bool gpu,
   RenderSettings trial = settings;
   trial.progress = [](double) {};  // the session's progress is the real render's
   trial.on_pass = nullptr;
-  // A few pixels first: on the GPU the first render builds the pipelines and uploads the volume
-  // (not the march's cost); the next gives the fixed cost of a render (dispatches, read-back,
-  // threads), which the trial would otherwise scale up 64 times (twice the time of a GPU render
-  // of calcite_rhomb on lavapipe).
+  // A few pixels at one sample first: on the GPU the first render builds the pipelines and
+  // uploads the volume (not the march's cost); the next gives the fixed cost of a render
+  // (dispatches, read-back, threads), which the trial would otherwise scale up 64 times (twice
+  // the time of a GPU render of calcite_rhomb on lavapipe).
   trial.width = std::min(cost.width, 8);
   trial.height = std::min(cost.height, 8);
+  trial.spp = 1;
   if (gpu) (void)session.render(trial, true);
   const double fixed = timedRender(session, trial, gpu);
-  // An eighth of each side, rounded so that the trial keeps the image's aspect.
+  const double fixed_samples = double(trial.width) * trial.height;
+  // An eighth of each side, rounded so that the trial keeps the image's aspect; an image too
+  // small for that (a few pixels at thousands of samples) keeps its size and takes 1/64 of the
+  // samples instead.
   trial.width = std::max(1, int(std::lround(cost.width / 8.0)));
   trial.height = std::max(1, int(std::lround(cost.height / 8.0)));
+  trial.spp = settings.spp;
+  if (16.0 * trial.width * trial.height > double(cost.width) * cost.height) {
+    trial.width = cost.width;
+    trial.height = cost.height;
+    trial.spp = std::max(1, settings.spp / 64);
+  }
   cost.on_gpu = gpu;
   cost.trial_width = trial.width;
   cost.trial_height = trial.height;
   cost.trial_seconds = timedRender(session, trial, gpu);
-  const double scale =
-      double(cost.width) * cost.height / (double(trial.width) * double(trial.height));
-  cost.seconds = fixed + std::max(0.0, cost.trial_seconds - fixed) * scale;
+  const double trial_samples = double(trial.width) * trial.height * trial.spp;
+  const double scale = double(cost.width) * cost.height * settings.spp / trial_samples;
+  // The fixed cost is taken out only where it is a small part of the trial's work.
+  const double base =
+      trial_samples >= 16.0 * fixed_samples ? std::min(fixed, cost.trial_seconds) : 0.0;
+  cost.seconds = base + (cost.trial_seconds - base) * scale;
   cost.low = kRenderCostLow * cost.seconds;
   cost.high = kRenderCostHigh * cost.seconds;
 }

@@ -82,6 +82,22 @@ TEST(RenderCost, TrialIsAnEighthOfEachSideAndScaledBy64) {
   EXPECT_FALSE(stages.empty());
 }
 
+// An image too small for an eighth of each side keeps its size and takes 1/64 of the samples:
+// the trial never renders as much as the render.
+TEST(RenderCost, ATinyImageIsTimedOnFewerSamples) {
+  auto scene = std::make_shared<Scene>(parseScene(kSphere, "sphere.json"));
+  Session session(scene);
+  RenderSettings rs = renderSettings(*scene, ViewRequest{});
+  rs.width = 4;
+  rs.height = 3;
+  rs.spp = 256;
+  RenderCost c = renderWork(*scene, rs);
+  timeRenderTrial(session, rs, /*gpu=*/false, c);
+  EXPECT_EQ(c.trial_width, 4);
+  EXPECT_EQ(c.trial_height, 3);
+  EXPECT_GT(c.seconds, c.trial_seconds);  // 64 times the trial's samples
+}
+
 TEST(RenderCost, DurationsReadAsPeopleSayThem) {
   EXPECT_EQ(formatDuration(4.26), "4.3 s");
   EXPECT_EQ(formatDuration(400), "6 min 40 s");
