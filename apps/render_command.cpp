@@ -18,6 +18,7 @@
 #include "core/render/render_defaults.h"
 #include "core/render/view_renderer.h"
 #include "core/scene/scene_warnings.h"
+#include "core/session/render_cost.h"
 #include "core/session/session.h"
 #include "core/vk/context.h"
 #include "core/vk/timings.h"
@@ -248,6 +249,10 @@ struct Preview {
   }
 };
 
+/// Renders said to be long before they start: by their time (the trial's estimate) or their
+/// host memory.
+constexpr double kLongRenderSeconds = 10.0, kLongRenderBytes = 1e9;
+
 void runRender(const RenderArgs& a, const CLI::App& sub) {
   if (a.timings) timings::enable(true);
   timings::mark("command line");
@@ -276,6 +281,8 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   timings::mark("scene parsed");
 
   Progress progress(progressMode(a.progress, a.quiet));
+  RenderCost cost = renderWork(*scene, rs);
+  if (cost.host_bytes >= kLongRenderBytes) progress.note("cost: " + describeRenderCost(cost), true);
   Session session(scene);
   session.setThreads(a.threads);
   // The GPU render's start-up (docs/performance.md "Start-up"); the CPU twin takes far longer to
@@ -317,6 +324,13 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   }
   for (const std::string& w : light.warnings)
     std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+  // Long renders say their time first, from a trial (core/session/render_cost.h).
+  if (!a.quiet && a.progress != "never" && worthATrial(cost)) {
+    timeRenderTrial(session, rs, !a.reference, cost);
+    if (cost.seconds + cost.write_seconds >= kLongRenderSeconds)
+      progress.note("cost: " + describeRenderCost(cost), true);
+    progress.update("rendering", 0.0);  // the trial's stage ("preparing the GPU") has ended
+  }
   Preview preview{png, exposure};
   RenderImage img = session.render(preview.attach(rs), !a.reference);
   progress.finish();

@@ -11,3 +11,6 @@ cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" >/dev/nul
 cmake --build "$BUILD_DIR" -j"$(nproc)"
 # Not fatal here (a non-root build still builds); CTest's python.install_module fails instead.
 ./scripts/install_python.sh "$BUILD_DIR" || echo "eikon: warning: Python module not registered (above); the build is done"
+# The python3 on PATH, when it is another interpreter (pyenv, conda): registered too where its ABI
+# is the module's, else a note naming /usr/bin/python3 (scripts/register_path_python.sh).
+./scripts/register_path_python.sh "$BUILD_DIR" || true

@@ -258,6 +258,31 @@ TEST(Wavefront, PatchBudgetHoldsAndTheLoopEnds) {
               1e-9 * st.flux_emitted);
 }
 
+// 4'. A patch is split only while its quarters keep the energy threshold (mayBeSplit): with
+// min_energy_fraction = 0.3 a seed's quarters (0.25 of its flux) would be killed after one step
+// each, so no patch splits at all; a patch stretched past the split span ends as a kill by energy
+// where it would have split, and the flux is still all accounted for. With the default threshold
+// the same run splits.
+TEST(Wavefront, NoSplitMakesQuartersBelowTheEnergyThreshold) {
+  const Scene scene = sceneFromJson(kGlassSphereLightScene);
+  const VolumeSet vol = voxelize(scene);
+  VolumeField field(vol);
+  WavefrontSettings s;
+  s.min_energy_fraction = 0.3;
+  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0));
+  const WavefrontStats& st = r.stats;
+  printWavefrontStats("no doomed quarters", st);
+  EXPECT_EQ(st.splits, 0u);
+  EXPECT_GT(st.kills_energy, 0u);
+  EXPECT_EQ(st.live_at_end, 0u);
+  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted,
+              1e-9 * st.flux_emitted);
+  s.min_energy_fraction = 0.2;  // quarters at 0.25 keep the threshold: the first split is made
+  EXPECT_GT(
+      WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0)).stats.splits,
+      0u);
+}
+
 // 4a. Threads (WavefrontSettings::threads): each step's patch list is cut into contiguous chunks,
 // each with its own volumes and statistics, reduced in chunk order at the end, with children and
 // survivors concatenated in chunk order, and a step in which the patch budget binds redoes its
