@@ -11,6 +11,7 @@
 
 #include "core/io/exr.h"
 #include "core/light/light_cache.h"
+#include "core/render/render_defaults.h"
 #include "core/vk/context.h"
 #include "core/volume/polarised_render.h"
 #include "python/module.h"
@@ -189,7 +190,7 @@ py::object render(Prepared& p, int width, int height, int spp, std::optional<int
                   const std::string& device, int threads, bool light, const py::object& light_cache,
                   const std::string& sampling, const std::string& layers, bool polarised,
                   const std::string& modes) {
-  const bool gpu = isGpu(device);
+  checkSetting([&] { checkRenderDevice(device); });  // auto, gpu or cpu (renderTwin)
   ViewRequest view;  // the CLI's defaults (core/session/session.h), then what the caller chose
   if (width != 0) view.width = width;
   if (height != 0) view.height = height;
@@ -210,6 +211,8 @@ py::object render(Prepared& p, int width, int height, int spp, std::optional<int
   const std::string cache_dir = lightCacheDir(light_cache);  // checked even with light=False
   const RenderImage img = p.run([&](Session& s) {
     s.setThreads(threads);
+    const bool gpu =
+        !renderTwin(device, *p.scene, settings, [&] { return s.context().deviceTypeName(); }).cpu;
     if (light && !p.scene->lights.empty() && !s.prepare(gpu).lit()) {
       LightRequest l;
       l.threads = threads;
@@ -395,7 +398,7 @@ void bindModuleCalls(py::module_& m) {
       },
       py::arg("scene"),
       "render(scene, width=, height=, spp=, wavelengths=, wavelength_nm=, march=, "
-      "device='gpu'|'cpu', light=, "
+      "device='auto'|'gpu'|'cpu', light=, "
       "light_cache=) — Renderer.render on the module's cached prepared scene (voxelised once per "
       "Scene object "
       "and volume settings)");
@@ -444,11 +447,12 @@ void bindRenderer(py::module_& m) {
       .def("grid", &grid, "voxel grid facts (voxelises on first call)")
       .def("render", &render, py::arg("width") = 0, py::arg("height") = 0, py::arg("spp") = 1,
            py::arg("wavelengths") = py::none(), py::arg("wavelength_nm") = 587.5618,
-           py::arg("march") = py::none(), py::arg("device") = "gpu", py::arg("threads") = 0,
+           py::arg("march") = py::none(), py::arg("device") = "auto", py::arg("threads") = 0,
            py::arg("light") = true, py::arg("light_cache") = true, py::arg("sampling") = "auto",
            py::arg("layers") = "", py::arg("polarised") = false, py::arg("modes") = "both",
-           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: wavelengths=None "
-           "is 16 for a "
+           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: device='auto' "
+           "(--device: the faster twin, the GPU on a GPU; 'gpu' or 'cpu' forces one); "
+           "wavelengths=None is 16 for a "
            "dispersive scene, else 0 (RGB; > 0 = spectral with that many samples); march=None is "
            "0.5-voxel RK4 "
            "steps; light=True simulates a lit scene's lights before its first render (unless "
