@@ -208,9 +208,10 @@ TEST_F(MeshCli, BadVertexLineAndAbsurdScaleFailWithOneLine) {
 // GPU twin shows forming) on the GPU twin; gpu and cpu (and --reference) force one; both twins
 // give the same picture.
 TEST_F(MeshCli, DeviceAutoRendersMeshScenesOnTheCpuTwinOfACpuDevice) {
+  // The L-shaped prism (a convex mesh is its polyhedron, which auto leaves on the GPU twin).
   const fs::path mesh = scene("mesh.json", R"({"shape": "mesh", "material": "glass", "file": ")" +
-                                               (kMeshes / "box.obj").string() +
-                                               R"(", "scale": [6, 4, 5], )" + kPlace + "}");
+                                               (kMeshes / "notched_box.obj").string() +
+                                               R"(", "scale": 3, "center": [-3, -3, -1.5]})");
   const fs::path sphere =
       scene("sphere.json", R"({"shape": "sphere", "material": "glass", "radius": 4})");
   auto render = [&](const fs::path& s, const std::string& args) {
@@ -231,7 +232,7 @@ TEST_F(MeshCli, DeviceAutoRendersMeshScenesOnTheCpuTwinOfACpuDevice) {
             std::string::npos)
       << autoBig.out;
   // The twins' pictures: a ray's crossings agree to ~1e-5 mm (float against double), so a pixel
-  // differs only where its ray passes that close to an edge of the box and takes the other face.
+  // differs only where its ray passes that close to an edge of the prism and takes the other face.
   const std::vector<float> auto_img = eikon::readExrRgba(dir_ / "mesh.exr", 400, 330).rgba;
   ASSERT_EQ(auto_img.size(), gpu_img.size());
   size_t differ = 0;
