@@ -49,7 +49,8 @@ bool lightOnCpuForDeviceType(const std::string& device_type) { return device_typ
 std::string cpuTwinFasterBecause(const Scene& scene, const RenderSettings& rs) {
   // Measured at 200×150 on lavapipe (docs/view-renderer.md "Which twin renders"): the CPU twin
   // marches a mesh scene ~10× faster than the GPU twin (its triangle hits in double precision
-  // against llvmpipe's per-lane traversal of the hierarchy), and every other scene at 0.6–1.3×.
+  // against llvmpipe's per-lane traversal of the hierarchy), other unpolarised scenes at 0.8–1.7×
+  // of the GPU twin's time, polarised ones at 0.5–1.7× with no scene feature that tells which.
   if (scene.interfaces != Scene::Interfaces::Sharp || isPolarisedRender(scene, rs)) return "";
   if (rs.spp > 1) return "";  // the GPU twin shows the picture forming sample by sample
   bool mesh = false;
