@@ -1,5 +1,6 @@
-// eikon render SCENE.json -o OUT.exr [options]: voxelise, march on the GPU (or --reference on the
-// CPU), write the linear-sRGB EXR and a tone-mapped PNG preview beside it.
+// eikon render SCENE.json -o OUT.exr [options]: voxelise, march on the GPU twin or the CPU twin
+// (--device: auto picks the faster, renderTwin in core/render/render_defaults.h), write the
+// linear-sRGB EXR and a tone-mapped PNG preview beside it.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -32,7 +33,7 @@ struct RenderArgs {
   int width = 0, height = 0, spp = 1, wavelengths = -1, threads = 0;
   double step = kDefaultRenderStepVoxels, exposure = 0.0;
   std::string integrator = "rk4", progress = "auto", spectral_sampling = "auto", layers,
-              modes = "both";
+              modes = "both", device = "auto";
   bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
   bool polarised = false;
   // Light simulator (scenes with "lights").
@@ -99,8 +100,11 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
   sub->add_option("--threads", a.threads,
                   "CPU threads for --reference, voxelising and the CPU light simulator, [1, 1024] "
                   "(default, or 0: all; the simulator at most 8)");
-  sub->add_flag("--reference", a.reference,
-                "Render with the double-precision CPU reference instead of the GPU");
+  sub->add_option("--device", a.device,
+                  "auto (default: the faster twin; the GPU on a GPU, on a CPU Vulkan device such "
+                  "as lavapipe the CPU reference for mesh scenes of at least 131072 rays at 1 spp; "
+                  "docs/view-renderer.md), gpu or cpu (the double-precision CPU reference)");
+  sub->add_flag("--reference", a.reference, "Same as --device cpu");
   sub->add_flag("--no-skip", a.no_skip, "Do not cross homogeneous regions in one step");
   sub->add_flag("--no-fresnel", a.no_fresnel, "Disable Fresnel reflection and transmission losses");
   sub->add_flag("--strict", a.strict,
@@ -195,8 +199,8 @@ void warn(const std::string& w, bool strict) {
 }
 
 /// The light summary and the render summary on stdout, the simulator's notes on stderr.
-void printSummary(const RenderArgs& a, Session& session, const LightOutcome& light,
-                  const RenderSettings& rs, const RenderImage& img,
+void printSummary(const RenderArgs& a, Session& session, const RenderTwin& twin,
+                  const LightOutcome& light, const RenderSettings& rs, const RenderImage& img,
                   const std::filesystem::path& out, const std::filesystem::path& png) {
   for (const std::string& n : light.summary.notes)
     std::fprintf(stderr, "eikon: note: %s\n", n.c_str());
@@ -215,13 +219,13 @@ void printSummary(const RenderArgs& a, Session& session, const LightOutcome& lig
                                        : 0.0);
   double rays = double(img.width) * img.height * rs.spp * std::max(1, rs.wavelengths);
   std::printf(
-      "eikon: rendered %s (%dx%d, %s%s, %d spp) on %s in %.2f s: %.3g rays/s, %.1f steps/ray -> "
-      "%s, %s\n",
+      "eikon: rendered %s (%dx%d, %s%s, %d spp) on %s (%s twin: %s) in %.2f s: %.3g rays/s, %.1f "
+      "steps/ray -> %s, %s\n",
       a.scene.c_str(), img.width, img.height,
       rs.wavelengths > 0 ? (std::to_string(rs.wavelengths) + " wavelengths").c_str() : "RGB",
       isPolarisedRender(*session.scene(), rs) ? ", polarised" : "", rs.spp,
-      a.reference ? "CPU reference" : session.context().deviceName().c_str(), img.seconds,
-      rays / img.seconds, img.mean_steps, out.c_str(), png.c_str());
+      twin.cpu ? "CPU reference" : session.context().deviceName().c_str(), twin.cpu ? "CPU" : "GPU",
+      twin.why.c_str(), img.seconds, rays / img.seconds, img.mean_steps, out.c_str(), png.c_str());
 }
 
 /// Progressive output: the PNG preview rewritten (atomically) as pixel samples finish, at most
@@ -266,6 +270,10 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   checkViewRequest(view);
   const LightRequest light_request = lightRequest(a);
   checkLightRequest(light_request);
+  checkRenderDevice(a.device);
+  if (a.reference && a.device != "cpu" && sub.count("--device"))
+    throw CliError("--reference is --device cpu; it does not go with --device " + a.device);
+  const std::string device = a.reference ? "cpu" : a.device;
   view.march->integrator = parseIntegrator(a.integrator);
   auto scene = std::make_shared<Scene>(loadScene(a.scene));
   for (const std::string& w : scene->warnings) warn(w, a.strict);
@@ -275,7 +283,8 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   const RenderSettings rs = renderSettings(*scene, view);  // the scene's "render" under options
   const double exposure =
       sub.count("--exposure") ? a.exposure : scene->render.exposure.value_or(0.0);
-  if (!a.reference && isPolarisedRender(*scene, rs)) checkGpuPolariserSheets(*scene);
+  // (auto renders every polarised render on the GPU twin: cpuTwinFasterBecause)
+  if (device != "cpu" && isPolarisedRender(*scene, rs)) checkGpuPolariserSheets(*scene);
   checkRenderFitsHost(*scene, rs);  // before voxelising: the image's memory, with the numbers
   for (const std::string& w : materialRangeWarnings(*scene, rs)) warn(w, a.strict);
   timings::mark("scene parsed");
@@ -285,9 +294,12 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   if (cost.host_bytes >= kLongRenderBytes) progress.note("cost: " + describeRenderCost(cost), true);
   Session session(scene);
   session.setThreads(a.threads);
+  const RenderTwin twin =
+      renderTwin(device, *scene, rs, [&] { return session.context().deviceTypeName(); });
+  const bool cpu = twin.cpu;
   // The GPU render's start-up (docs/performance.md "Start-up"); the CPU twin takes far longer to
   // render than to voxelise, and voxelises every time.
-  if (!a.reference && !a.no_volume_cache)
+  if (!cpu && !a.no_volume_cache)
     session.setVolumeCache(defaultCacheDir(), [](const std::string& note) {
       std::fprintf(stderr, "eikon: note: %s\n", note.c_str());
     });
@@ -300,7 +312,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
                    anyLightReachesAnObject(*scene);
   if (!scene->lights.empty() && !a.no_light && !scene->anyScattering())
     std::fputs(kLightsNotSimulatedNote, stderr);
-  if (!a.reference) {
+  if (!cpu) {
     session.context();  // what prepare() does first, marked apart from the voxelising
     timings::mark("device created");
     // The view pipeline compiles beside the voxelising and the upload (docs/performance.md). A
@@ -310,15 +322,15 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   // Without light volumes a GPU render of sharp interfaces reads no per-voxel field: only the
   // interfaces are voxelised then (docs/performance.md "Start-up").
   // A light the chosen twin cannot hold is refused before the voxelising.
-  if (lit) (void)session.lightOnCpuTwin(light_request, a.reference);
-  if (a.reference || lit)
-    session.prepare(!a.reference);
+  if (lit) (void)session.lightOnCpuTwin(light_request, cpu);
+  if (cpu || lit)
+    session.prepare(!cpu);
   else
     session.prepareGpuRender();
   timings::mark("voxelised");
   LightOutcome light;
   if (lit) {
-    light = session.simulateLight(light_request, a.reference,
+    light = session.simulateLight(light_request, cpu,
                                   a.no_light_cache ? std::filesystem::path() : lightCacheDir(a));
     timings::mark(light.cached ? "light (from the cache)" : "light simulated");
   }
@@ -326,13 +338,13 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
     std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
   // Long renders say their time first, from a trial (core/session/render_cost.h).
   if (!a.quiet && a.progress != "never" && worthATrial(cost)) {
-    timeRenderTrial(session, rs, !a.reference, cost);
+    timeRenderTrial(session, rs, !cpu, cost);
     if (cost.seconds + cost.write_seconds >= kLongRenderSeconds)
       progress.note("cost: " + describeRenderCost(cost), true);
     progress.update("rendering", 0.0);  // the trial's stage ("preparing the GPU") has ended
   }
   Preview preview{png, exposure};
-  RenderImage img = session.render(preview.attach(rs), !a.reference);
+  RenderImage img = session.render(preview.attach(rs), !cpu);
   progress.finish();
   timings::mark("rendered");
   if (img.cut_samples > 0)
@@ -359,7 +371,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
                                 : exrRgbContent(img.width, img.height, img.rgb)}});
   preview.finished = true;
   timings::mark("written");
-  printSummary(a, session, light, rs, img, out, png);
+  printSummary(a, session, twin, light, rs, img, out, png);
 }
 }  // namespace
 

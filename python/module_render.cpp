@@ -11,6 +11,7 @@
 
 #include "core/io/exr.h"
 #include "core/light/light_cache.h"
+#include "core/render/render_defaults.h"
 #include "core/vk/context.h"
 #include "core/volume/polarised_render.h"
 #include "python/module.h"
@@ -191,7 +192,7 @@ py::object render(Prepared& p, int width, int height, std::optional<int> spp,
                   bool light, const py::object& light_cache, const std::string& sampling,
                   const std::string& layers, bool polarised, const std::string& modes,
                   const py::object& progress) {
-  const bool gpu = isGpu(device);
+  checkSetting([&] { checkRenderDevice(device); });  // auto, gpu or cpu (renderTwin)
   ViewRequest view;  // the CLI's defaults (core/session/session.h), then what the caller chose
   if (width != 0) view.width = width;
   if (height != 0) view.height = height;
@@ -214,6 +215,8 @@ py::object render(Prepared& p, int width, int height, std::optional<int> spp,
   const RenderImage img = p.run([&](Session& s) {
     return withProgress(s, printer, [&] {
       s.setThreads(threads);
+      const bool gpu =
+          !renderTwin(device, *p.scene, settings, [&] { return s.context().deviceTypeName(); }).cpu;
       if (light && !p.scene->lights.empty() && !s.prepare(gpu).lit()) {
         LightRequest l;
         l.threads = threads;
@@ -404,7 +407,7 @@ void bindModuleCalls(py::module_& m) {
       },
       py::arg("scene"),
       "render(scene, width=, height=, spp=, wavelengths=, wavelength_nm=, march=, "
-      "device='gpu'|'cpu', light=, "
+      "device='auto'|'gpu'|'cpu', light=, "
       "light_cache=) — Renderer.render on the module's cached prepared scene (voxelised once per "
       "Scene object "
       "and volume settings)");
@@ -454,11 +457,12 @@ void bindRenderer(py::module_& m) {
       .def("render", &render, py::arg("width") = 0, py::arg("height") = 0,
            py::arg("spp") = py::none(), py::arg("wavelengths") = py::none(),
            py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(),
-           py::arg("device") = "gpu", py::arg("threads") = 0, py::arg("light") = true,
+           py::arg("device") = "auto", py::arg("threads") = 0, py::arg("light") = true,
            py::arg("light_cache") = true, py::arg("sampling") = "auto", py::arg("layers") = "",
            py::arg("polarised") = false, py::arg("modes") = "both",
            py::arg("progress") = py::none(),
-           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: spp=None and "
+           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: device='auto' "
+           "(--device: the faster twin, the GPU on a GPU; 'gpu' or 'cpu' forces one); spp=None and "
            "wavelengths=None are the scene's \"render\" spp and wavelengths where it gives them, "
            "else 1 and 16 for a "
            "dispersive scene, else 0 (RGB; > 0 = spectral with that many samples); march=None is "

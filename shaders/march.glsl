@@ -97,7 +97,8 @@ vec4 gRecorded[6];
 //   kIntegrator: EIKON_INT_* (P.march.w; −1: read from P at run time);
 //   kExact: on the exact path (EIKON_F_EXACT, core/volume/boundary.h exact) the shape table's
 //     rows in bits 0–9, the shape count in bits 10–19 and the kinds present (1 << EIKON_SHAPE_*)
-//     in bits 20–24 (boundary.glsl exactCrossingOutOf); 0 otherwise.
+//     in bits 20–24 (boundary.glsl exactCrossingOutOf) and bit 25 set, so that a scene without
+//     shapes (whose counts are 0) is on the exact path too; 0 otherwise.
 //   kAov: the march notes its first interface (MarchResult.hit…; view.comp's AOV layer). Off, the
 //     notes fold away and a render without the layer runs the code it ran before.
 layout(constant_id = 0) const bool kSharpMarch = false;
@@ -120,7 +121,7 @@ layout(constant_id = 4) const int kExact = 0;
 #define EIKON_BOUNDARY_EXACT (hasFlag(EIKON_F_EXACT) && kExact != 0)
 #define EIKON_BOUNDARY_EXACT_ROWS (kExact & 0x3FF)
 #define EIKON_BOUNDARY_EXACT_SHAPES ((kExact >> 10) & 0x3FF)
-#define EIKON_BOUNDARY_EXACT_KINDS (kExact >> 20)
+#define EIKON_BOUNDARY_EXACT_KINDS ((kExact >> 20) & 0x1F)
 #include "field.glsl"
 #include "boundary.glsl"
 

@@ -153,7 +153,7 @@ bool gDispersiveHit = false;  // written by mediumIndex, unused here
 #define EIKON_BOUNDARY_EXACT (hasFlag(EIKON_F_EXACT) && kExact != 0)
 #define EIKON_BOUNDARY_EXACT_ROWS (kExact & 0x3FF)
 #define EIKON_BOUNDARY_EXACT_SHAPES ((kExact >> 10) & 0x3FF)
-#define EIKON_BOUNDARY_EXACT_KINDS (kExact >> 20)
+#define EIKON_BOUNDARY_EXACT_KINDS ((kExact >> 20) & 0x1F)
 #define EIKON_EXACT_ROW(i) exactRows[i]
 #include "boundary.glsl"
 #include "fresnel.glsl"

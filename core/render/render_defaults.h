@@ -9,6 +9,7 @@
 //   bool cpu = eikon::lightOnCpu("auto", ctx);                // which twin simulates the light
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "core/light/lighting_driver.h"
@@ -51,5 +52,33 @@ bool lightOnCpu(const std::string& device, const vk::Context* ctx);
 /// kernel on the same cores, where the double-precision twin measured faster for light), the GPU
 /// twin on every real GPU ("discrete GPU", "integrated GPU", "virtual GPU") and on "other".
 bool lightOnCpuForDeviceType(const std::string& device_type);
+
+/// Which twin renders a view (`eikon render --device`, Python's render(device=)), and why, in
+/// words for the render's summary line ("auto on a CPU device, mesh scene, 480000 rays").
+struct RenderTwin {
+  bool cpu = false;
+  std::string why;
+};
+
+/// Rays of at least this many (pixels × spp) make the CPU twin the faster renderer of a mesh scene
+/// on a CPU Vulkan device, its whole-volume voxelising (~2–3 s for a mesh at 128³, which the GPU
+/// twin's interfaces-only start-up skips) paid back by its march, ~10× the GPU twin's there
+/// (docs/view-renderer.md "Which twin renders").
+inline constexpr double kCpuTwinMeshRays = 131072.0;
+
+/// The "auto" rule on a CPU Vulkan device (lavapipe): why the CPU twin renders this scene faster
+/// (a non-empty reason: sharp interfaces with a triangle mesh, unpolarised, one sample per pixel,
+/// at least kCpuTwinMeshRays rays), or "" where the GPU twin is as fast or faster (analytic and
+/// faceted shapes, spectral scenes), the CPU twin lacks an output the render asks for (the
+/// progressive previews of a render of several samples per pixel), or it was not measured
+/// (smoothed interfaces, polarised renders).
+std::string cpuTwinFasterBecause(const Scene& scene, const RenderSettings& settings);
+
+/// device "cpu": the CPU twin; "gpu": the GPU twin; "auto": the GPU twin on a Vulkan device that
+/// is not a CPU, else cpuTwinFasterBecause decides. `device_type` (vk::Context::deviceTypeName)
+/// is called only where the scene could go to the CPU twin, so that no device is made for
+/// nothing. Throws std::invalid_argument for any other device name.
+RenderTwin renderTwin(const std::string& device, const Scene& scene, const RenderSettings& settings,
+                      const std::function<std::string()>& device_type);
 
 }  // namespace eikon

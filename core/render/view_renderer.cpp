@@ -249,7 +249,8 @@ std::vector<vk::BindingSpec> viewKernelBindings() {
   return b;
 }
 
-// kExact (march.glsl): the shape table's rows, the shape count and the kinds present.
+// kExact (march.glsl): the shape table's rows, the shape count, the kinds present and bit 25,
+// which makes it non-zero for a scene without shapes (on the exact path too: shapesTakeExactPath).
 int exactConstant(const BoundaryField& bf) {
   int kinds = 0;
   for (const Shape& shape : bf.shapes)
@@ -264,7 +265,7 @@ int exactConstant(const BoundaryField& bf) {
         },
         shape.geometry());
   const int rows = exactTableRows(bf.shapes);  // ≤ kExactMaxRows (256) on the exact path
-  return rows | int(bf.shapes.size()) << 10 | kinds << 20;
+  return rows | int(bf.shapes.size()) << 10 | kinds << 20 | 1 << 25;
 }
 
 /// The specialisation constants of a key: constant_id 0: kSharpMarch, 1: kViewFlags,

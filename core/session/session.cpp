@@ -223,6 +223,11 @@ void checkLightRequest(const LightRequest& l) {
     throw SettingError("max-patches", "must be in [1024, 16777216]");
 }
 
+void checkRenderDevice(const std::string& device) {
+  if (device != "auto" && device != "gpu" && device != "cpu")
+    throw SettingError("device", "must be auto, gpu or cpu, got '" + device + "'");
+}
+
 LightingOptions lightingOptions(const LightRequest& l, double voxel_mm) {
   LightingOptions lo = defaultLightingOptions();
   lo.bands = l.bands;

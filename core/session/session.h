@@ -115,6 +115,9 @@ struct LightRequest {
   int threads = 0;                   ///< CPU twin threads (0: all, at most 8)
 };
 void checkLightRequest(const LightRequest& light);
+/// The twin a render is asked for: "auto" (renderTwin), "gpu" or "cpu"; else
+/// SettingError("device", ...).
+void checkRenderDevice(const std::string& device);
 /// CPU threads: [1, 1024], or 0 for all cores; else SettingError("threads", ...).
 void checkThreads(int threads);
 /// The simulator options of a request for voxels of `voxel_mm`.

@@ -172,7 +172,8 @@ constexpr int kExactMaxRows = 256;
 /// The rows of the shape table an analytic field needs (6 per shape, one per plane).
 int exactTableRows(const std::vector<Shape>& shapes);
 /// Whether a field of these shapes takes the exact path (BoundaryField::exact): any shapes (the
-/// analytic ones by their clips, a triangle mesh by its hits), not convex_apart, and the table's
+/// analytic ones by their clips, a triangle mesh by its hits; none, where the whole volume is the
+/// ambient region and nothing is voxelised), not convex_apart, and the table's
 /// records and planes within kExactMaxRows (a mesh's hierarchy is read from the table past them).
 bool shapesTakeExactPath(const std::vector<Shape>& shapes, bool convex_apart);
 

@@ -265,3 +265,64 @@ TEST_F(MeshCli, HostileMeshFilesFailAtOnceOrLoadWithoutOpeningAnythingElse) {
 }
 
 }  // namespace
+
+// `eikon render --device`: auto renders a mesh scene of at least 131072 rays at 1 spp on the CPU
+// twin where the Vulkan device is a CPU (lavapipe: the rule of renderTwin, core/render/
+// render_defaults.h, measured in docs/view-renderer.md "Which twin renders"), and says so; every
+// other scene, a smaller image and a render of several samples per pixel (whose previews only the
+// GPU twin shows forming) on the GPU twin; gpu and cpu (and --reference) force one; both twins
+// give the same picture.
+TEST_F(MeshCli, DeviceAutoRendersMeshScenesOnTheCpuTwinOfACpuDevice) {
+  // The L-shaped prism (a convex mesh is its polyhedron, which auto leaves on the GPU twin).
+  const fs::path mesh = scene("mesh.json", R"({"shape": "mesh", "material": "glass", "file": ")" +
+                                               (kMeshes / "notched_box.obj").string() +
+                                               R"(", "scale": 3, "center": [-3, -3, -1.5]})");
+  const fs::path sphere =
+      scene("sphere.json", R"({"shape": "sphere", "material": "glass", "radius": 4})");
+  auto render = [&](const fs::path& s, const std::string& args) {
+    const fs::path exr = dir_ / (s.stem().string() + ".exr");
+    return eikon("render " + quote(s.string()) + " -o " + quote(exr.string()) + " -q " + args);
+  };
+  const std::string big = "--width 400 --height 330";  // 132000 rays ≥ 131072
+  const Outcome gpu = render(mesh, big + " --device gpu");
+  ASSERT_EQ(gpu.code, 0) << gpu.err;
+  EXPECT_NE(gpu.out.find("(GPU twin: asked for)"), std::string::npos) << gpu.out;
+  const std::vector<float> gpu_img = eikon::readExrRgba(dir_ / "mesh.exr", 400, 330).rgba;
+  const bool cpu_device = gpu.out.find("llvmpipe") != std::string::npos;
+  const Outcome autoBig = render(mesh, big);
+  ASSERT_EQ(autoBig.code, 0) << autoBig.err;
+  EXPECT_NE(autoBig.out.find(cpu_device ? "on CPU reference (CPU twin: auto on a CPU device, mesh "
+                                          "scene, 132000 rays)"
+                                        : "(GPU twin: auto on a GPU)"),
+            std::string::npos)
+      << autoBig.out;
+  // The twins' pictures: a ray's crossings agree to ~1e-5 mm (float against double), so a pixel
+  // differs only where its ray passes that close to an edge of the prism and takes the other face.
+  const std::vector<float> auto_img = eikon::readExrRgba(dir_ / "mesh.exr", 400, 330).rgba;
+  ASSERT_EQ(auto_img.size(), gpu_img.size());
+  size_t differ = 0;
+  for (size_t i = 0; i < gpu_img.size(); ++i)
+    differ += std::abs(auto_img[i] - gpu_img[i]) > 1e-3f * (1.0f + std::abs(gpu_img[i])) ? 1 : 0;
+  EXPECT_LE(double(differ), 1e-3 * double(gpu_img.size()));
+  // The GPU twin where the rule says so: a smaller image, several samples per pixel, no mesh.
+  for (const auto& [s, args] : std::vector<std::pair<fs::path, std::string>>{
+           {mesh, ""}, {mesh, "--width 300 --height 220 --spp 2"}, {sphere, big}}) {
+    const Outcome r = render(s, args + " --device auto");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("(GPU twin: auto"), std::string::npos) << args << ": " << r.out;
+  }
+  for (const std::string cpu : {"--device cpu", "--reference", "--reference --device cpu"}) {
+    const Outcome r = render(mesh, cpu);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("on CPU reference (CPU twin: asked for)"), std::string::npos) << r.out;
+  }
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {"--device tpu", "--device must be auto, gpu or cpu, got 'tpu'"},
+           {"--reference --device gpu", "--reference is --device cpu"}}) {
+    const Outcome r = render(mesh, args);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}

@@ -71,6 +71,9 @@ class SessionSettings(unittest.TestCase):
         self.same(["render", "--step", "5"], "--step",
                   lambda: r.render(march=eikon.MarchSettings(step_voxels=5)), "march.step_voxels",
                   "must be in (0, 4] voxels")
+        # The twin (`--device`, Python's device=): auto (the default), gpu or cpu.
+        self.same(["render", "--device", "tpu"], "--device", lambda: r.render(device="tpu"),
+                  "device", "must be auto, gpu or cpu, got 'tpu'")
         self.assertEqual(eikon.voxelize_count(), 0)
 
     def test_values_that_crashed_are_refused(self):

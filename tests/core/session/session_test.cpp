@@ -13,8 +13,10 @@
 #include <string>
 #include <thread>
 
+#include "core/render/view_pipeline_start.h"
 #include "core/render/view_renderer.h"
 #include "core/volume/field.h"
+#include "shaders/eikon_shared.h"
 #include "tests/core/scene_support.h"
 
 namespace eikon {
@@ -313,7 +315,7 @@ void checkInterfacesOnly(const std::string& object, bool exact) {  // else conve
   const VolumeSet& v = lean.prepareGpuRender();
   EXPECT_FALSE(v.fields);
   EXPECT_TRUE(v.index[0][0].empty() && v.medium[0].empty() && v.emission.empty());
-  EXPECT_TRUE(v.attenuating);  // the flags are the materials'
+  EXPECT_EQ(v.attenuating, !object.empty());  // the flags are the used materials'
   EXPECT_EQ(v.boundary.exact, exact);
   EXPECT_EQ(v.boundary.convex_apart, !exact);
   EXPECT_TRUE(v.boundary.regionsOnShapes());
@@ -351,6 +353,27 @@ TEST(SessionGpu, LonePrismRenderVoxelisesOnlyItsShape) {
   checkInterfacesOnly(R"({"shape": "prism", "apex_deg": 60, "side": 8, "height": 10,
                           "material": "glass"})",
                       false);
+}
+
+// A scene without objects is on the exact path too: no voxel of the boundary is made or read,
+// and its view pipeline is the specialised one of the exact path (kExact non-zero, EIKON_F_EXACT)
+// where it took the general walk through the voxels (and cost 3x the sphere's start-up).
+TEST(SessionGpu, SceneWithoutObjectsVoxelisesNothingAndTakesTheExactPipeline) {
+  checkInterfacesOnly("", true);
+  auto scene = std::make_shared<Scene>(parseScene(sharpScene(""), "empty.json"));
+  Session s(scene);
+  const VolumeSet& v = s.prepareGpuRender();
+  EXPECT_TRUE(v.boundary.shapes.empty());
+  EXPECT_NE(volumeFeatureFlags(v) & EIKON_F_EXACT, 0);
+  EXPECT_NE(volumeExactConstant(v), 0);
+  EXPECT_EQ(predictVolumeFeatureFlags(*scene, false), volumeFeatureFlags(v));
+  // Nothing to cross: every pixel is the environment seen along its camera ray, on both twins.
+  RenderSettings rs;
+  const RenderImage gpu = s.render(rs, true), cpu = s.render(rs, false);
+  ASSERT_EQ(gpu.rgb.size(), cpu.rgb.size());
+  for (size_t i = 0; i < gpu.rgb.size(); ++i)
+    EXPECT_NEAR(gpu.rgb[i], cpu.rgb[i], 1e-5 + 1e-5 * std::abs(cpu.rgb[i])) << i;
+  EXPECT_EQ(gpu.mean_steps, 0.0);
 }
 
 TEST(SessionGpu, SmoothedInterfacesAreVoxelisedWhole) {
