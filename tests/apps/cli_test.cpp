@@ -18,6 +18,7 @@
 
 #include "core/io/exr.h"
 #include "tests/apps/cli_support.h"
+#include "tests/sanitizers.h"
 
 namespace {
 
@@ -995,6 +996,7 @@ TEST_F(Cli, ExposureAndProgressAreCheckedEvenWhenUnused) {
 // it used to end in a bare "std::bad_alloc": under a 1 GiB address-space limit a 16384² image
 // (3 channels, about 12 bytes each measured: 9.7 GB) cannot fit.
 TEST_F(Cli, ImageLargerThanTheHostHoldsIsRefusedWithTheNumbers) {
+  if (eikon::test::kAddressSanitizer) GTEST_SKIP() << eikon::test::kNoAddressSpaceLimitUnderAsan;
   const std::string scene = write("scene.json", tinyScene());
   const Outcome limited = eikon::test::runProgram(
       "ulimit -v 1048576; " + std::string(EIKON_BINARY),
