@@ -542,8 +542,8 @@ ConvexShape parseFaceted(const Node& o) {
     if (o.has("tiers") || o.has("gear") || o.has("girdle"))
       o.fail("give either file (a GemCad .asc) or gear, girdle and tiers, not both");
     const std::filesystem::path p = namedFile(*f, "a GemCad .asc file");
-    // Any file was read as one (/etc/passwd gave "unknown record 'root:x:0:0:...'"): the name
-    // must say GemCad's text export.
+    // The name must say GemCad's text export: a file of another kind is not read as one (its
+    // lines would be quoted in the messages, a line of /etc/passwd say).
     std::string ext = p.extension().string();
     for (char& c : ext)
       if (c >= 'A' && c <= 'Z') c = char(c - 'A' + 'a');

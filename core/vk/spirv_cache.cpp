@@ -84,8 +84,8 @@ std::vector<uint32_t> parseSpirvCacheEntry(std::string_view bytes, uint64_t key,
 }
 
 // The size is taken before anything is read: an entry larger than any eikon writes (a sparse
-// 50 GB file was read whole, 68 s and 4 GB) is ignored unread, and no more than its size and a
-// byte is read from one that grows meanwhile.
+// 50 GB file would take a minute and gigabytes to read whole) is ignored unread, and no more than
+// its size and a byte is read from one that grows meanwhile.
 std::vector<uint32_t> readSpirvCacheEntry(const fs::path& path, uint64_t key, std::string& why) {
   // Opening a pipe for reading waits for a writer: only a regular file is read.
   std::error_code ec;
