@@ -76,10 +76,8 @@ for h in "${harnesses[@]}"; do
     -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1
   set -e
   after="$(find "$findings" -type f | wc -l)"
-  execs="$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | awk '{s += $2} END {print s + 0}')"
-  if [ "$execs" = 0 ]; then  # -fork prints its progress lines instead: the last "#N" is the count
-    execs="$(grep -o '^#[0-9]*' "$log" | tail -1 | tr -d '#')"
-  fi
+  # -fork prints progress lines "#N: cov: ..." with the running count of executions: the last.
+  execs="$(grep -o '^#[0-9]*' "$log" | tail -1 | tr -d '#' || true)"
   new=$((after - before))
   [ "$new" -eq 0 ] || found_any=1
   printf 'eikon: fuzz %-15s %4d s  %10s execs  corpus %5d  new findings %d%s\n' "$h" "$seconds" \
