@@ -3,12 +3,15 @@
 #include <string>
 
 #include "apps/commands.h"
+#include "core/scene/material_library.h"
+#include "core/scene/scene.h"
 #include "core/vk/context.h"
 
 namespace eikon::cli {
 
 void addInfoCommand(CLI::App& app) {
-  auto* sub = app.add_subcommand("info", "Show the Vulkan device, its limits and the build");
+  auto* sub = app.add_subcommand(
+      "info", "Show the Vulkan device, its limits, the build and the material library");
   sub->callback([] {
     auto ctx = vk::Context::create();
     const auto& l = ctx->limits();
@@ -31,6 +34,13 @@ void addInfoCommand(CLI::App& app) {
     row("shader float64", l.shader_float64 ? "yes" : "no");
     row("validation layers",
         std::string(ctx->validationEnabled() ? "on" : "off") + " (EIKON_VALIDATION=1 enables)");
+    // The library a scene's "material" names (docs/scene-format.md "materials").
+    std::string names, folders;
+    for (const std::string& n : libraryMaterialNames()) names += (names.empty() ? "" : ", ") + n;
+    for (const auto& dir : materialSearchPath())
+      folders += (folders.empty() ? "" : ":") + dir.string();
+    row("materials",
+        printable((names.empty() ? std::string("none") : names) + " (" + folders + ")"));
   });
 }
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "apps/commands.h"
+#include "core/io/cache_limit.h"
 #include "core/scene/messages.h"
 #include "core/session/session.h"
 
@@ -54,6 +55,11 @@ int main(int argc, char** argv) {
                                 commandList(app) + "; run with --help)")
                    .c_str(),
                stderr);
+    return 2;
+  }
+  // A bad cache cap is refused before any work, not met when the first entry is saved.
+  if (std::string error; !eikon::cacheMaxBytesSetting(&error)) {
+    std::fputs(eikon::errorLine(error).c_str(), stderr);
     return 2;
   }
   try {

@@ -17,6 +17,8 @@
 #include "core/light/light_cache.h"
 #include "core/render/render_defaults.h"
 #include "core/render/view_renderer.h"
+#include "core/scene/scene_warnings.h"
+#include "core/session/render_cost.h"
 #include "core/session/session.h"
 #include "core/vk/context.h"
 #include "core/vk/timings.h"
@@ -71,10 +73,12 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
       ->required();
   sub->add_option("--width", a.width, "Image width in [1, 16384] (default: the scene camera's)");
   sub->add_option("--height", a.height, "Image height in [1, 16384] (default: the scene camera's)");
-  sub->add_option("--spp", a.spp, "Jittered samples per pixel in [1, 4096] (default 1)");
+  sub->add_option(
+      "--spp", a.spp,
+      "Jittered samples per pixel in [1, 4096] (default: the scene's \"render\" spp, else 1)");
   sub->add_option("--wavelengths", a.wavelengths,
-                  "Spectral samples per pixel sample in [1, 256], or 0 for RGB mode (default: 16 "
-                  "for dispersive scenes, else 0)");
+                  "Spectral samples per pixel sample in [1, 256], or 0 for RGB mode (default: the "
+                  "scene's \"render\" wavelengths, else 16 for dispersive scenes, else 0)");
   sub->add_option("--spectral-sampling", a.spectral_sampling,
                   "Spectral renders: hero (one march per pixel sample, the other wavelengths "
                   "share its path until it disperses), stratified (one march per wavelength) or "
@@ -94,7 +98,9 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
   sub->add_option("--step", a.step,
                   "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
   sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4)");
-  sub->add_option("--exposure", a.exposure, "PNG preview exposure in stops (default 0)");
+  sub->add_option(
+      "--exposure", a.exposure,
+      "PNG preview exposure in stops (default: the scene's \"render\" exposure, else 0)");
   sub->add_option("--threads", a.threads,
                   "CPU threads for --reference, voxelising and the CPU light simulator, [1, 1024] "
                   "(default, or 0: all; the simulator at most 8)");
@@ -150,7 +156,7 @@ ViewRequest viewRequest(const RenderArgs& a, const CLI::App& sub) {
   ViewRequest v;
   if (sub.count("--width")) v.width = a.width;
   if (sub.count("--height")) v.height = a.height;
-  v.spp = a.spp;
+  if (sub.count("--spp")) v.spp = a.spp;
   if (sub.count("--wavelengths")) v.wavelengths = a.wavelengths;
   MarchSettings ms;  // the integrator is parsed after the range checks, as before
   ms.step_voxels = a.step;
@@ -212,13 +218,13 @@ void printSummary(const RenderArgs& a, Session& session, const LightOutcome& lig
         light.summary.conservationError(),
         light.summary.flux_emitted > 0 ? light.summary.flux_reflected / light.summary.flux_emitted
                                        : 0.0);
-  double rays = double(img.width) * img.height * a.spp * std::max(1, rs.wavelengths);
+  double rays = double(img.width) * img.height * rs.spp * std::max(1, rs.wavelengths);
   std::printf(
       "eikon: rendered %s (%dx%d, %s%s, %d spp) on %s in %.2f s: %.3g rays/s, %.1f steps/ray -> "
       "%s, %s\n",
       a.scene.c_str(), img.width, img.height,
       rs.wavelengths > 0 ? (std::to_string(rs.wavelengths) + " wavelengths").c_str() : "RGB",
-      isPolarisedRender(*session.scene(), rs) ? ", polarised" : "", a.spp,
+      isPolarisedRender(*session.scene(), rs) ? ", polarised" : "", rs.spp,
       a.reference ? "CPU reference" : session.context().deviceName().c_str(), img.seconds,
       rays / img.seconds, img.mean_steps, out.c_str(), png.c_str());
 }
@@ -249,6 +255,10 @@ struct Preview {
   }
 };
 
+/// Renders said to be long before they start: by their time (the trial's estimate) or their
+/// host memory.
+constexpr double kLongRenderSeconds = 10.0, kLongRenderBytes = 1e9;
+
 void runRender(const RenderArgs& a, const CLI::App& sub) {
   if (a.timings) timings::enable(true);
   timings::mark("command line");
@@ -272,13 +282,17 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   checkWritable(out);
   checkWritable(png);
   checkWritable(partial);
-  const RenderSettings rs = renderSettings(*scene, view);
+  const RenderSettings rs = renderSettings(*scene, view);  // the scene's "render" under options
+  const double exposure =
+      sub.count("--exposure") ? a.exposure : scene->render.exposure.value_or(0.0);
   if (!a.reference && isPolarisedRender(*scene, rs)) checkGpuPolariserSheets(*scene);
   checkRenderFitsHost(*scene, rs);  // before voxelising: the image's memory, with the numbers
   for (const std::string& w : materialRangeWarnings(*scene, rs)) warn(w, a.strict);
   timings::mark("scene parsed");
 
   Progress progress(progressMode(a.progress, a.quiet));
+  RenderCost cost = renderWork(*scene, rs);
+  if (cost.host_bytes >= kLongRenderBytes) progress.note("cost: " + describeRenderCost(cost), true);
   Session session(scene);
   session.setThreads(a.threads);
   // The GPU render's start-up (docs/performance.md "Start-up"); the CPU twin takes far longer to
@@ -291,8 +305,11 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
                        [&](const char* what) { progress.working(what); }});
   // The light volumes show only where a material has an albedo (in-scatter, diffuse surfaces):
   // without one a simulation (an hour for a lit faceted gem) would change no pixel.
-  const bool lit = !scene->lights.empty() && !a.no_light && scene->anyScattering();
-  if (!scene->lights.empty() && !a.no_light && !lit) std::fputs(kLightsNotSimulatedNote, stderr);
+  // Nor where every light's beam or cone misses every object (a scene warning says so).
+  const bool lit = !scene->lights.empty() && !a.no_light && scene->anyScattering() &&
+                   anyLightReachesAnObject(*scene);
+  if (!scene->lights.empty() && !a.no_light && !scene->anyScattering())
+    std::fputs(kLightsNotSimulatedNote, stderr);
   if (!a.reference) {
     session.context();  // what prepare() does first, marked apart from the voxelising
     timings::mark("device created");
@@ -317,7 +334,14 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   }
   for (const std::string& w : light.warnings)
     std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
-  Preview preview{partial, a.exposure};
+  // Long renders say their time first, from a trial (core/session/render_cost.h).
+  if (!a.quiet && a.progress != "never" && worthATrial(cost)) {
+    timeRenderTrial(session, rs, !a.reference, cost);
+    if (cost.seconds + cost.write_seconds >= kLongRenderSeconds)
+      progress.note("cost: " + describeRenderCost(cost), true);
+    progress.update("rendering", 0.0);  // the trial's stage ("preparing the GPU") has ended
+  }
+  Preview preview{partial, exposure};
   RenderImage img = session.render(preview.attach(rs), !a.reference);
   progress.finish();
   timings::mark("rendered");
@@ -336,7 +360,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   // The pair as a pair (core/io/atomic_write.h): both files or neither replace what is there,
   // and a concurrent render to the same -o cannot interleave its pair with this one. The
   // preview first: it is the smaller, so a full disk is usually met before the EXR is encoded.
-  writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, a.exposure)},
+  writeFilesTogether({{png, pngPreviewContent(img.width, img.height, img.rgb, exposure)},
                       {out, !img.stokes.empty() ? exrStokesContent(img.width, img.height, img.rgb,
                                                                    img.stokes, kStokesFrame)
                             : rs.spectral_layer || rs.mode_layers || rs.aov_layer

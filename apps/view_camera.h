@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <glm/glm.hpp>
+#include <numbers>
 #include <string>
 
 #include "core/scene/scene.h"
@@ -28,9 +29,9 @@ inline void orbitCamera(Camera& cam, double yaw, double pitch) {
            axis * glm::dot(axis, v) * (1.0 - std::cos(a));
   };
   offset = rotate(offset, up, yaw);
-  const double kLimit = 1.0 * 3.14159265358979323846 / 180.0;
+  const double kLimit = 1.0 * std::numbers::pi / 180.0;
   const double elevation = std::asin(std::clamp(glm::dot(offset / r, up), -1.0, 1.0));
-  const double half_pi = 0.5 * 3.14159265358979323846;
+  const double half_pi = 0.5 * std::numbers::pi;
   pitch = std::clamp(elevation + pitch, -half_pi + kLimit, half_pi - kLimit) - elevation;
   glm::dvec3 right = glm::cross(up, offset);  // horizontal, perpendicular to the view
   if (glm::length(right) > 1e-12) offset = rotate(offset, glm::normalize(right), -pitch);
@@ -55,7 +56,7 @@ inline void panCamera(Camera& cam, double dx, double dy) {
   const glm::dvec3 right = glm::normalize(glm::cross(fwd, cam.up));
   const glm::dvec3 up = glm::cross(right, fwd);
   const double height = 2.0 * glm::length(cam.look_at - cam.position) *
-                        std::tan(0.5 * cam.fov_deg * 3.14159265358979323846 / 180.0);
+                        std::tan(0.5 * cam.fov_deg * std::numbers::pi / 180.0);
   const glm::dvec3 move = (right * dx + up * dy) * height;
   cam.position += move;
   cam.look_at += move;
@@ -79,7 +80,7 @@ inline void moveLight(Light& light, const Camera& cam, double dx, double dy) {
     return;
   }
   const double depth = std::max(glm::dot(light.position - cam.position, fwd), 1e-6);
-  const double height = 2.0 * depth * std::tan(0.5 * cam.fov_deg * 3.14159265358979323846 / 180.0);
+  const double height = 2.0 * depth * std::tan(0.5 * cam.fov_deg * std::numbers::pi / 180.0);
   light.position += (right * dx + up * dy) * height;
 }
 

@@ -26,10 +26,12 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "apps/commands.h"
 #include "apps/view_camera.h"
+#include "apps/view_save.h"
 #include "core/io/exr.h"
 #include "core/light/light_cache.h"
 #include "core/render/render_defaults.h"
@@ -47,7 +49,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct ViewArgs {
-  std::string scene, screenshot;
+  std::string scene, screenshot, save_dir;
   int width = 0, height = 0, spp = 16, wavelengths = -1, coarse = 4, exit_after_frames = 0;
   bool wait_for_input = false;
   double exposure = 0.0;
@@ -76,7 +78,9 @@ void addViewOptions(CLI::App* sub, ViewArgs& a) {
   sub->add_flag("--no-prefetch", a.no_prefetch,
                 "Do not compile the pipelines of the R and I keys ahead in the background (a key "
                 "then shows 'compiling' while its pipeline compiles)");
-  sub->add_option("--exposure", a.exposure, "Exposure in stops, as eikon render's PNG (default 0)");
+  sub->add_option("--exposure", a.exposure,
+                  "Exposure in stops, as eikon render's PNG (default: the scene's \"render\" "
+                  "exposure, else 0)");
   sub->add_flag("--no-light", a.no_light, "Do not simulate the scene's lights");
   sub->add_option("--exit-after-frames", a.exit_after_frames,
                   "Exit after N frames of an unchanged view (or once it is fully refined, if that "
@@ -88,6 +92,9 @@ void addViewOptions(CLI::App* sub, ViewArgs& a) {
   sub->add_option("--screenshot", a.screenshot,
                   "On exit, write the image on screen (at its rendered size) to this PNG and print "
                   "the camera");
+  sub->add_option("--save-dir", a.save_dir,
+                  "Folder the S key saves the view into, as SCENE-view-N.exr and .png, never "
+                  "over an existing file (default ~/Pictures/eikon)");
 }
 
 /// A light simulated in the background (LightMover): its light volumes, ready to be swapped in.
@@ -764,21 +771,26 @@ class Viewer {
     }
   }
 
-  /// The view as a render's pair (EXR + PNG, `eikon render`'s formats) beside the scene's name in
-  /// the current folder, and the camera as the scene file spells it.
+  /// The view as a render's pair (EXR + PNG, `eikon render`'s formats) named after the scene in
+  /// the save folder (apps/view_save.h), and the camera as the scene file spells it. A save that
+  /// fails says why on stderr and leaves the window open.
   void save() {
     if (shown_.rgb.empty()) return;
-    const std::string stem = session_.scene()->file.stem().string() + "-view-";
-    std::filesystem::path exr;
-    for (int k = 1;; ++k) {
-      exr = stem + std::to_string(k) + ".exr";
+    std::filesystem::path exr, png;
+    try {
+      std::tie(exr, png) = reserveViewSave(
+          args_.save_dir.empty() ? defaultViewSaveDir() : std::filesystem::path(args_.save_dir),
+          session_.scene()->file.stem().string());
+      writeFilesTogether(
+          {{png, pngPreviewContent(shown_.width, shown_.height, shown_.rgb, args_.exposure)},
+           {exr, exrRgbContent(shown_.width, shown_.height, shown_.rgb)}});
+    } catch (const std::exception& e) {
       std::error_code ec;
-      if (!std::filesystem::exists(exr, ec)) break;
+      if (!exr.empty() && std::filesystem::file_size(exr, ec) == 0)
+        std::filesystem::remove(exr, ec);
+      std::fprintf(stderr, "eikon view: cannot save the view: %s\n", printable(e.what()).c_str());
+      return;
     }
-    std::filesystem::path png = std::filesystem::path(exr).replace_extension(".png");
-    writeFilesTogether(
-        {{png, pngPreviewContent(shown_.width, shown_.height, shown_.rgb, args_.exposure)},
-         {exr, exrRgbContent(shown_.width, shown_.height, shown_.rgb)}});
     std::printf("eikon view: saved %s and %s (%dx%d, %d samples, %s)\n\"camera\": %s\n",
                 exr.c_str(), png.c_str(), shown_.width, shown_.height, shown_spp_,
                 shown_wavelengths_ > 0
@@ -871,7 +883,8 @@ struct Window {
   ~Window() { glfwDestroyWindow(handle); }
 };
 
-void runView(const ViewArgs& a, const CLI::App& sub) {
+void runView(const ViewArgs& given, const CLI::App& sub) {
+  ViewArgs a = given;  // with the scene's "render" exposure where --exposure is not given
   ViewRequest view;
   if (sub.count("--width")) view.width = a.width;
   if (sub.count("--height")) view.height = a.height;
@@ -891,9 +904,11 @@ void runView(const ViewArgs& a, const CLI::App& sub) {
       throw CliError("--screenshot must end in .png: " + a.screenshot);
     checkWritable(a.screenshot);
   }
+  if (!a.save_dir.empty()) checkWritable(std::filesystem::path(a.save_dir) / "x-view-1.exr");
   auto scene = std::make_shared<Scene>(loadScene(a.scene));
   for (const std::string& w : scene->warnings)
     std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
+  if (!sub.count("--exposure") && scene->render.exposure) a.exposure = *scene->render.exposure;
   RenderSettings base = renderSettings(*scene, view);
   if (isPolarisedRender(*scene, base)) checkGpuPolariserSheets(*scene);  // before any window
   base.march.integrator = integrator;

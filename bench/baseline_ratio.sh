@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Throughput of eikon's GPU march against a lean baseline, measured in one sitting (issue 14;
-# docs/performance.md "Throughput"). Prints, from one run:
+# Throughput of eikon's GPU march against a lean baseline, measured in one sitting
+# (docs/performance.md "Figures"). Prints, from one run:
 #   - steps/s of eikon's naive Euler march (smoothed interfaces, 1-voxel steps, no skipping, no
 #     Fresnel: two trilinear field fetches per step) against the baseline's Euler march (also two
 #     per step), glass_sphere at 800x600 from a 128³ volume;
@@ -85,9 +85,9 @@ naive_rays=$(row "naive Euler" 8 <"$work/naive.txt")
 gpu_s=$(row "RK4, 0.25 voxel, skip (default)" 6 <"$work/default.txt")
 cpu_s=$(sed -n 's/^CPU reference.*: \([0-9.]*\) s,.*/\1/p' "$work/default.txt")
 
-# 3. eikon's whole process at the scene's size and default settings.
+# 3. eikon's whole process at the scene's size, 1 sample per pixel, default settings otherwise.
 t0=$(now)
-"$eikon" render "$scene" -o "$work/eikon.exr" -q >"$work/render.txt" 2>&1
+"$eikon" render "$scene" -o "$work/eikon.exr" -q --spp 1 >"$work/render.txt" 2>&1
 eikon_whole=$(awk -v a="$t0" -v b="$(now)" 'BEGIN { printf "%.2f", b - a }')
 
 echo "glass_sphere, 800x600, 128³, $(sed -n 's/.*device \(.*\)$/\1/p' "$work/naive.txt" | head -1)"

@@ -1,4 +1,4 @@
-// Light-simulator benchmark (issue 6): scenes/caustic_sphere.json (a glass ball over an opaque
+// Light-simulator benchmark: scenes/caustic_sphere.json (a glass ball over an opaque
 // floor under a directional light covering the whole volume), voxelised at its own resolution
 // (128 on the long side), simulated with WavefrontSettings defaults by the GPU twin
 // (GpuWavefront, shaders/wavefront.comp) and by the double-precision CPU reference
@@ -9,11 +9,11 @@
 // minutes per twin on a 2-core lavapipe machine), and the speed-up of skipping at that resolution.
 // Timings are not asserted anywhere (they vary ±20% on a shared machine).
 //
-// --sharp: every run at the scene's sharp interfaces (issue 13; WavefrontSettings::
+// --sharp: every run at the scene's sharp interfaces (WavefrontSettings::
 // sharp_interfaces on the GPU, sharpInterfacesFor on the CPU), where they apply.
 //
 // --interfaces smoothed,sharp: run the full resolution once per listed kind (e.g. both in one
-// run, for the ratios of docs/performance.md's "Light simulator" table); --no-low: skip the runs
+// run, for the ratios of docs/performance.md's "Figures"); --no-low: skip the runs
 // without straight steps at the lower resolution.
 //
 // --threads T1,T2,…: run the CPU reference once per listed thread count
@@ -22,8 +22,9 @@
 //
 // --caustics pass: light goes on through fold caustics, as renders simulate it (the default here
 // is the simulator's own, kill). --no-straight-to-boundary: sharp straight steps on the skip
-// distances only (WavefrontSettings::straight_to_boundary), for the before/after of
-// docs/performance.md "Lit gems". Each run prints its tears (torn patches made pencils).
+// distances only (WavefrontSettings::straight_to_boundary), to measure what running up to the
+// boundary gains (docs/performance.md "Light simulator"). Each run prints its tears (torn patches
+// made pencils).
 //
 //   light_bench [--resolution N] [--no-skip-resolution M] [--steps-per-dispatch K] [--no-cpu]
 //               [--no-gpu] [--threads T1,T2,…] [--sharp] [--interfaces smoothed,sharp] [--no-low]

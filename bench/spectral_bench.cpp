@@ -12,7 +12,8 @@
 //
 //   spectral_bench [WIDTH HEIGHT]     # default 800 600 (the scene camera); lavapipe on few cores
 //                                     # needs minutes there: pass e.g. 160 120 and say so.
-//   spectral_bench --only-hero --diamond-size 200 150 --diamond-resolution 128 --reference-spp 32
+//   spectral_bench --only-hero --diamond-width 200 --diamond-height 150 --diamond-resolution 128
+//                  --reference-spp 32
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>

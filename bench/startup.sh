@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Time to the first dispatch of a repeated small render (issue 14, start-up: "a repeated render of
-# a 64x48 image starts its first dispatch within 0.5 s of the process start"; docs/performance.md
+# Time to the first dispatch of a repeated small render (the aim: a repeated render of a 64x48
+# image starts its first dispatch within 0.5 s of the process start; docs/performance.md
 # "Start-up"). For each scene, runs
-#   eikon render SCENE --width 64 --height 48 -q --timings -o TMP/out.exr
+#   eikon render SCENE --width 64 --height 48 --spp 1 -q --timings -o TMP/out.exr
 # once to warm the caches (light cache, pipeline cache, Mesa's shader cache), then --reps times,
 # and prints per scene the median over the repeats of each --timings stage (seconds since the
 # process started; "first dispatch" is the criterion) and of the process CPU time (user + sys,
@@ -37,7 +37,7 @@ fi
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 run() {  # run SCENE LOG: one render, its --timings lines and "cpu T" in LOG
-  if ! /usr/bin/time -f 'cpu %U %S' -o "$tmp/time" "$eikon" render "$1" --width 64 --height 48 -q \
+  if ! /usr/bin/time -f 'cpu %U %S' -o "$tmp/time" "$eikon" render "$1" --width 64 --height 48 --spp 1 -q \
        --timings -o "$tmp/out.exr" >/dev/null 2>"$2"; then
     echo "startup.sh: error: eikon render $1 failed:" >&2; cat "$2" >&2; exit 1
   fi

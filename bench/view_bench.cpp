@@ -1,4 +1,4 @@
-// View-renderer benchmark (issue 2): glass_sphere at 800×600 from a 128³ volume. Prints, from one
+// View-renderer benchmark: glass_sphere at 800×600 from a 128³ volume. Prints, from one
 // run: rays/s and steps/ray of the GPU path for several integrators/steps, of the naive fixed-step
 // Euler march (no skipping), and of the multi-threaded CPU reference, their ratios, and each
 // variant's accuracy: mean and max exit-direction error of 2000 rays through the sphere against
@@ -13,7 +13,7 @@
 // (timing only). --repeat: render each variant N times after the warm-up and report the median.
 // Steps/s is the rendered steps (the `w` of every pixel) per second of the render.
 //
-// --interfaces: only the sharp vs smoothed comparison (issue 13): the scene voxelised both ways
+// --interfaces: only the sharp vs smoothed comparison: the scene voxelised both ways
 // ("interfaces": "sharp" / "smoothed"), rendered at the default settings; time and steps per ray
 // (sharp: one step per straight segment or RK4 step; smoothed: per integration step) and the ratio;
 // for the CPU twin also the volume-field reads per ray (every trilinear sample of the index,
@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <numbers>
 #include <random>
 #include <string>
 #include <thread>
@@ -170,8 +171,8 @@ int main(int argc, char** argv) {
     }
     std::printf("%-34s %10.3f %10.3g %11.1f %10.3g %11.2e° %11.2e°\n", v.name, img.seconds,
                 width * height / img.seconds, img.mean_steps,
-                img.mean_steps * width * height / img.seconds, mean * 180 / 3.14159265358979,
-                mx * 180 / 3.14159265358979);
+                img.mean_steps * width * height / img.seconds, mean * 180 / std::numbers::pi,
+                mx * 180 / std::numbers::pi);
     if (v.name[0] == 'n') naive_s = img.seconds;
     if (std::string(v.name).find("(default)") != std::string::npos) default_s = img.seconds;
   }

@@ -65,9 +65,8 @@ class BMMapping {
   glm::dvec3 unmapWaveNormal(glm::dvec3 s_mapped) const;
   /// Surface normal n̂ (a covector, either orientation) → n' = γn̂/|γn̂| (same orientation).
   glm::dvec3 mapNormal(glm::dvec3 n) const;
-  /// Point (or displacement) x → x' = γ⁻¹x, and back x = γx'.
+  /// Point (or displacement) x → x' = γ⁻¹x.
   glm::dvec3 mapPoint(glm::dvec3 x) const { return gamma_inv_ * x; }
-  glm::dvec3 unmapPoint(glm::dvec3 x_mapped) const { return gamma_ * x_mapped; }
   /// Mapped ray direction (= mapped wave normal) back to a world unit ray direction t ∝ γt'.
   glm::dvec3 unmapRayDirection(glm::dvec3 t_mapped) const;
 

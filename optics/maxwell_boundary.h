@@ -48,10 +48,6 @@ inline CV cross(CV a, CV b) {
 }
 /// Bilinear (no conjugation) product with a real vector.
 inline cd dot(CV a, glm::dvec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-/// Hermitian product Σ conj(a_i) b_i.
-inline cd hdot(CV a, CV b) {
-  return std::conj(a.x) * b.x + std::conj(a.y) * b.y + std::conj(a.z) * b.z;
-}
 inline CV conj(CV a) { return {std::conj(a.x), std::conj(a.y), std::conj(a.z)}; }
 inline double norm(CV a) { return std::sqrt(std::norm(a.x) + std::norm(a.y) + std::norm(a.z)); }
 /// The real part (a propagating wave's p is real).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -12,8 +13,6 @@ namespace {
 
 using maxwell::CV;
 using maxwell::Wave;
-constexpr double kPi = 3.14159265358979323846;
-
 void requirePositive(double n, const char* what) {
   if (!(n > 0.0) || !std::isfinite(n))
     throw std::invalid_argument(std::string("polarisation: ") + what + " must be finite and > 0");
@@ -313,7 +312,7 @@ JonesMatrix plateJones(double n_outside, const Uniaxial& plate, double thickness
   const OpticalMedium out = OpticalMedium::isotropic(n_outside),
                       in = OpticalMedium::uniaxial(plate);
   const InterfaceMap entry = interfaceMap(out, Mode::Ordinary, kk, m, in);
-  const double k0 = 2.0 * kPi / (lambda_nm * 1e-6);  // per mm
+  const double k0 = 2.0 * std::numbers::pi / (lambda_nm * 1e-6);  // per mm
   const glm::dvec3 p_t = n_outside * (kk - glm::dot(kk, m) * m);
   const Complex retard =
       std::exp(Complex(0.0, k0 * extraordinaryMinusOrdinaryQ(p_t, m, plate) * thickness_mm));

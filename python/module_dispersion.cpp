@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "core/scene/limits.h"
+#include "core/scene/material_library.h"
 #include "core/scene/scene.h"
 #include "fitting/index_data.h"
 #include "optics/dispersion.h"
@@ -183,12 +185,17 @@ void bindMaterials(py::module_& m) {
         std::error_code ec;  // a name too long for the file system is not found, never a raw
                              // filesystem_error
         if (p.extension() == ".json" && std::filesystem::exists(p, ec)) return loadMaterialFile(p);
-        for (const auto& dir : materialSearchPath()) {
-          auto f = dir / (name_or_path + ".json");
-          if (std::filesystem::exists(f, ec)) return loadMaterialFile(f);
+        const bool plain = !name_or_path.empty() && name_or_path != "." && name_or_path != ".." &&
+                           name_or_path.find_first_of(std::string("/\\\0", 3)) == std::string::npos;
+        std::optional<std::filesystem::path> f;
+        try {
+          if (plain) f = findLibraryMaterial(name_or_path);   // case, spaces, '_' forgiven
+        } catch (const std::filesystem::filesystem_error&) {  // a name too long: not found
         }
-        throw std::invalid_argument("no material '" + name_or_path +
-                                    "' in the library search path");
+        if (f) return loadMaterialFile(*f);
+        throw std::invalid_argument("no material '" + excerpt(name_or_path) +
+                                    "' in the library search path; " +
+                                    unknownMaterialHint(name_or_path, {}));
       },
       py::arg("name_or_path"),
       "a library material by name (materials/<name>.json) or a material file");

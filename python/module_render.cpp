@@ -14,6 +14,7 @@
 #include "core/vk/context.h"
 #include "core/volume/polarised_render.h"
 #include "python/module.h"
+#include "python/progress.h"
 
 namespace eikon::python {
 namespace {
@@ -184,11 +185,12 @@ py::dict layerArrays(const RenderImage& img) {
   return d;
 }
 
-py::object render(Prepared& p, int width, int height, int spp, std::optional<int> wavelengths,
-                  double wavelength_nm, std::optional<MarchSettings> march,
-                  const std::string& device, int threads, bool light, const py::object& light_cache,
-                  const std::string& sampling, const std::string& layers, bool polarised,
-                  const std::string& modes) {
+py::object render(Prepared& p, int width, int height, std::optional<int> spp,
+                  std::optional<int> wavelengths, double wavelength_nm,
+                  std::optional<MarchSettings> march, const std::string& device, int threads,
+                  bool light, const py::object& light_cache, const std::string& sampling,
+                  const std::string& layers, bool polarised, const std::string& modes,
+                  const py::object& progress) {
   const bool gpu = isGpu(device);
   ViewRequest view;  // the CLI's defaults (core/session/session.h), then what the caller chose
   if (width != 0) view.width = width;
@@ -208,15 +210,19 @@ py::object render(Prepared& p, int width, int height, int spp, std::optional<int
   RenderSettings settings;
   checkSetting([&] { settings = renderSettings(*p.scene, view); });
   const std::string cache_dir = lightCacheDir(light_cache);  // checked even with light=False
+  PyProgress printer(pyProgressMode(progress));
   const RenderImage img = p.run([&](Session& s) {
-    s.setThreads(threads);
-    if (light && !p.scene->lights.empty() && !s.prepare(gpu).lit()) {
-      LightRequest l;
-      l.threads = threads;
-      s.simulateLight(l, !gpu, cache_dir);  // an unwritable cache only costs time next time
-    }
-    return s.render(settings, gpu);
+    return withProgress(s, printer, [&] {
+      s.setThreads(threads);
+      if (light && !p.scene->lights.empty() && !s.prepare(gpu).lit()) {
+        LightRequest l;
+        l.threads = threads;
+        s.simulateLight(l, !gpu, cache_dir);  // an unwritable cache only costs time next time
+      }
+      return s.render(settings, gpu);
+    });
   });
+  printer.close();
   if (settings.spectral_layer || settings.mode_layers || settings.aov_layer ||
       settings.stokes_layers)
     return layerArrays(img);
@@ -225,7 +231,7 @@ py::object render(Prepared& p, int width, int height, int spp, std::optional<int
 
 py::dict simulateLight(Prepared& p, int bands, const std::string& splat, double step_voxels,
                        double smoothing_voxels, const std::string& caustics,
-                       const std::string& device) {
+                       const std::string& device, const py::object& progress) {
   const bool gpu = isGpu(device);
   LightRequest l;
   l.bands = bands;
@@ -235,8 +241,11 @@ py::dict simulateLight(Prepared& p, int bands, const std::string& splat, double 
   l.caustics = caustics;
   l.device = device;
   checkSetting([&] { checkLightRequest(l); });
-  const LightingSummary sum =
-      p.run([&](Session& s) { return s.simulateLight(l, !gpu, {}).summary; });
+  PyProgress printer(pyProgressMode(progress));
+  const LightingSummary sum = p.run([&](Session& s) {
+    return withProgress(s, printer, [&] { return s.simulateLight(l, !gpu, {}).summary; });
+  });
+  printer.close();
   py::dict d;
   d["runs"] = sum.runs;
   d["seconds"] = sum.seconds;
@@ -442,13 +451,16 @@ void bindRenderer(py::module_& m) {
            py::arg("scene"))
       .def_property_readonly("scene", [](const Prepared& p) { return p.scene; })
       .def("grid", &grid, "voxel grid facts (voxelises on first call)")
-      .def("render", &render, py::arg("width") = 0, py::arg("height") = 0, py::arg("spp") = 1,
-           py::arg("wavelengths") = py::none(), py::arg("wavelength_nm") = 587.5618,
-           py::arg("march") = py::none(), py::arg("device") = "gpu", py::arg("threads") = 0,
-           py::arg("light") = true, py::arg("light_cache") = true, py::arg("sampling") = "auto",
-           py::arg("layers") = "", py::arg("polarised") = false, py::arg("modes") = "both",
-           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: wavelengths=None "
-           "is 16 for a "
+      .def("render", &render, py::arg("width") = 0, py::arg("height") = 0,
+           py::arg("spp") = py::none(), py::arg("wavelengths") = py::none(),
+           py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(),
+           py::arg("device") = "gpu", py::arg("threads") = 0, py::arg("light") = true,
+           py::arg("light_cache") = true, py::arg("sampling") = "auto", py::arg("layers") = "",
+           py::arg("polarised") = false, py::arg("modes") = "both",
+           py::arg("progress") = py::none(),
+           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: spp=None and "
+           "wavelengths=None are the scene's \"render\" spp and wavelengths where it gives them, "
+           "else 1 and 16 for a "
            "dispersive scene, else 0 (RGB; > 0 = spectral with that many samples); march=None is "
            "0.5-voxel RK4 "
            "steps; light=True simulates a lit scene's lights before its first render (unless "
@@ -464,13 +476,15 @@ void bindRenderer(py::module_& m) {
            "polarised=True, polariser sheets or a camera analyzer, which return the plain "
            "(H, W, 3) S0 without it) adds stokes (H, W, 4, 3: S0..S3 x RGB) and stokes_frame "
            "(docs/polarisation.md); modes='both'|'o'|'e' (--modes): a crystal's two modes, each "
-           "carrying half of the light, or one mode alone at the whole of it, so o + e = 2·both")
+           "carrying half of the light, or one mode alone at the whole of it, so o + e = 2·both; "
+           "progress=None|True|False: a tqdm bar per stage on stderr (plain lines without tqdm), "
+           "None shows stages that run over a second unless $EIKON_PROGRESS=never (or always)")
       .def(
           "simulate_light", &simulateLight, py::arg("bands") = 0, py::arg("splat") = "accumulate",
           py::arg("step_voxels") = 0.5, py::arg("smoothing_voxels") = 1.0,
-          py::arg("caustics") = "pass", py::arg("device") = "gpu",
+          py::arg("caustics") = "pass", py::arg("device") = "gpu", py::arg("progress") = py::none(),
           "simulate the scene's lights (docs/lighting.md) into the volume that later renders read; "
-          "returns the summed run statistics")
+          "returns the summed run statistics; progress= as render's")
       .def("light_volumes", &lightVolumes,
            "{'fluence': (Z, Y, X, 4) φ_r, φ_g, φ_b, φ_Y (W/mm²), 'flux': (Z, Y, X, 4) net flux "
            "vector} "

@@ -91,6 +91,18 @@ void bindScene(py::module_& m) {
       .def_readwrite("volume", &Scene::volume)
       .def_readonly("warnings", &Scene::warnings)
       .def_readonly("ambient_index", &Scene::ambient_index)
+      .def_property_readonly(
+          "render",
+          [](const Scene& s) {
+            auto value = [](const auto& v) { return v ? py::cast(*v) : py::none(); };
+            py::dict d;
+            d["spp"] = value(s.render.spp);
+            d["wavelengths"] = value(s.render.wavelengths);
+            d["exposure"] = value(s.render.exposure);
+            return d;
+          },
+          "the scene's \"render\" (its intended spp, wavelengths and exposure; None where it "
+          "gives none): render()'s defaults")
       .def_property_readonly("materials", [](const Scene& s) { return s.materials; })
       .def_property_readonly("any_uniaxial", &Scene::anyUniaxial)
       .def_property_readonly("any_dispersive", &Scene::anyDispersive)

@@ -6,9 +6,9 @@ PKGS=(
   build-essential cmake pkg-config git
   libvulkan-dev mesa-vulkan-drivers vulkan-tools glslang-tools spirv-tools vulkan-validationlayers
   libglm-dev libceres-dev libopenexr-dev libpng-dev
-  nlohmann-json3-dev libcli11-dev libyaml-cpp-dev libassimp-dev
+  nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
   googletest libgtest-dev libbenchmark-dev universal-ctags clang-format
-  pybind11-dev python3-pybind11 python3-dev python3-numpy python3-scipy python3-matplotlib
+  pybind11-dev python3-pybind11 python3-dev python3-numpy python3-scipy python3-matplotlib python3-tqdm
   jupyter-nbconvert python3-nbformat python3-ipykernel
   libglfw3-dev xvfb xdotool
   openimageio-tools

@@ -11,7 +11,9 @@ cd "$(dirname "$0")/.."
 EIKON="${EIKON:-build/apps/eikon}"
 [[ -x "$EIKON" ]] || { echo "render_pictures: error: $EIKON not built (run ./scripts/build.sh)" >&2; exit 1; }
 
-# name | width×height | extra arguments (the scene's own aspect ratio, at least 800×600).
+# name | width×height | extra arguments (the scene's own aspect ratio, at least 800×600). The
+# samples, wavelengths and exposure of each picture are the scene's own "render" settings
+# (docs/scene-format.md), so that `eikon render scenes/NAME.json` alone gives its picture.
 # Spectral scenes use 16 wavelengths per sample (the default), by hero sampling where the
 # path weights do not depend on λ (docs/spectra.md): one wavelength carries a sample past the
 # first dispersive facet, so the jittered samples per pixel are what take the colour noise out
@@ -27,38 +29,38 @@ EIKON="${EIKON:-build/apps/eikon}"
 # against 279 s), but there lavapipe cuts 5 samples short at its loop limit and draws the prism's
 # edge lines fainter than the twin does, so that picture is the twin's.
 pictures=(
-  "glass_sphere|800x600|--spp 4"
-  "prism_bk7|800x600|--spp 512"
-  "diamond_brilliant|800x600|--spp 64"
-  "faceted_round_brilliant|800x600|--spp 48 --exposure 2"
-  "faceted_emerald_cut|800x600|--spp 16 --exposure 2"
-  "faceted_oval|800x600|--spp 64 --exposure 2"
-  "faceted_pear|800x600|--spp 32 --exposure 2"
+  "glass_sphere|800x600|"
+  "prism_bk7|800x600|"
+  "diamond_brilliant|800x600|"
+  "faceted_round_brilliant|800x600|"
+  "faceted_emerald_cut|800x600|"
+  "faceted_oval|800x600|"
+  "faceted_pear|800x600|"
   # The oval's fire on a table: the light through its sharp facets in 12 bands (~50 s), then the
   # view; 32 samples take the grain off the table and the spots in the shadow.
-  "faceted_oval_fire|800x600|--spp 32"
-  "mesh_icosphere|800x600|--spp 4"
-  "mesh_torus|800x600|--spp 4"
+  "faceted_oval_fire|800x600|"
+  "mesh_icosphere|800x600|"
+  "mesh_torus|800x600|"
   # The ring lit over a table (the light through its triangles, ~15 s, then the view): 32 samples
   # converge the table (128 change it by 0.13 of 255 on average); the ring's glitter is its
   # facets' images, the same at 128 samples.
-  "mesh_torus_caustic|800x600|--spp 32"
+  "mesh_torus_caustic|800x600|"
   # calcite_rhomb: crossings on the shapes (BoundaryField::exact), so the ink lines' edges are
   # straight at any size; 8 samples take the hero sampling's colour grain off the paper.
-  "calcite_rhomb|800x600|--spp 8"
-  "tourmaline|800x600|--spp 16"
-  "caustic_sphere|800x600|--spp 16"
-  "prism_rainbow|960x600|--spp 4 --wavelengths 0"
-  "smoke_sphere|960x600|--spp 8"
+  "calcite_rhomb|800x600|"
+  "tourmaline|800x600|"
+  "caustic_sphere|800x600|"
+  "prism_rainbow|960x600|"
+  "smoke_sphere|960x600|"
   # Polarised (polariser sheets): deterministic, so 1 sample (the pixel centres). The conoscope
   # and the gems in monochromatic light (RGB mode: one trace per pixel at 587.56 nm; a quartz
   # brilliant's retardation is of high order, white in white light anyway), the wedge at 32
   # wavelengths per pixel, at one sample the 32 bins' centres for every pixel (no colour grain;
   # fewer bins miss the third order's period). The CPU twin (--reference) renders them.
-  "conoscope_calcite|800x600|--wavelengths 0"
-  "polariscope_gems_0|800x600|--wavelengths 0 --reference"
-  "polariscope_gems_45|800x600|--wavelengths 0 --reference"
-  "polariscope_quartz_wedge|800x600|--wavelengths 32 --reference"
+  "conoscope_calcite|800x600|"
+  "polariscope_gems_0|800x600|--reference"
+  "polariscope_gems_45|800x600|--reference"
+  "polariscope_quartz_wedge|800x600|--reference"
 )
 
 want=("$@")

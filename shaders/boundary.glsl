@@ -1,4 +1,4 @@
-// The sharp-boundary field on the GPU (issue 13): the GLSL twin of core/volume/boundary.{h,cpp}
+// The sharp-boundary field on the GPU: the GLSL twin of core/volume/boundary.{h,cpp}
 // under the same names — boundaryPhi, boundaryRegion, locateCrossing — and of the analytic shapes'
 // signed distance and gradient (core/scene/shapes.cpp), in single precision. docs/twins.md lists
 // the pairs; tests/core/volume/boundary_gpu_test.cpp holds them to each other.

@@ -355,6 +355,9 @@ static_assert(sizeof(WavePush) == 16 && sizeof(ScanPush) == 16 && sizeof(WaveTal
               "wavefront push/tally records must be vec4-packed");
 static_assert(sizeof(WaveParams) == 8 * 16 && sizeof(WavePatch) == 11 * 16, "wavefront records must be vec4-packed");
 }  // namespace eikon::gpu
+#else
+// π for every kernel (C++ takes std::numbers::pi).
+const float kPi = 3.14159265358979323846;
 #endif
 
 #endif  // EIKON_SHARED_H

@@ -52,8 +52,6 @@ layout(std140, binding = EIKON_B_SMALL_MEDIA) uniform SmallMediaBuf {
 #define EIKON_SHAPE_ROW(i) (hasFlag(EIKON_F_SMALL_SHAPES) ? exactRows[i] : shapeTable[i])
 #define EIKON_MEDIUM_ROW(i) (hasFlag(EIKON_F_SMALL_MEDIA) ? smallMedia[i] : mediaTable[i])
 
-const float kPi = 3.14159265358979323846;
-
 // Per-wavelength state set before a march.
 float gLambdaUm = 0.5876;
 float gIl2 = 1.0 / (0.5876 * 0.5876);

@@ -1,5 +1,5 @@
 #version 450
-// The polarised trace of the GPU twin (issue 15; docs/polarisation.md): the twin of
+// The polarised trace of the GPU twin (docs/polarisation.md): the twin of
 // core/reference/polarised_trace.cpp under the same names (Tracer::run, segment, cross,
 // applySheets, recombine), in single precision. One invocation follows one ray forwards through
 // the sharp march's regions, splitting it into o and e branches at crystal faces (a bounded ray

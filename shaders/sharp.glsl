@@ -1,12 +1,13 @@
-// The sharp march (issue 13; docs/view-renderer.md "Sharp interfaces: the march"): the GPU twin of
+// The sharp march (docs/view-renderer.md "Sharp interfaces: the march"): the GPU twin of
 // RayMarch::marchSharp and its stages in core/reference/reference_marcher.cpp, under the same
 // names (docs/twins.md). Included by march.glsl after MarchState/MarchResult and the medium
 // helpers; reads the boundary field and shape table (boundary.glsl) and the medium table
 // (mediaTable: core/volume/media.h packMediaTable, EIKON_MEDIUM_VEC4S vec4s per region).
 //
 // The ray carries its region; a homogeneous region is crossed in one straight segment, a varying
-// one (GRIN, radial optic axis) is integrated with RK4 on the region's own analytic medium; each
-// segment or step chord is tested with locateCrossing, and at a crossing the exact interface laws
+// one (GRIN, radial optic axis) is integrated with RK4 on the region's own analytic medium, the
+// optical path with it; each segment or step chord is tested with nextCrossing, a step that meets
+// a face ends on it on its own path (sharpLand), and at a crossing the exact interface laws
 // (optics/interface.h, optics/fresnel.h) are applied.
 //
 // The light simulator (wavefront.comp) defines EIKON_SHARP_NO_MARCH before including this file: it
@@ -256,35 +257,80 @@ void sharpDeriv(int region, vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) 
 }
 
 // Classical RK4 as a loop over its four stages (one inlined sharpDeriv: lavapipe compiles every
-// inlined copy), summed in the CPU's order k1 + 2k2 + 2k3 + k4.
-void sharpRk4(int region, float ds, int mode, inout vec3 x, inout vec3 w) {
+// inlined copy), summed in the CPU's order k1 + 2k2 + 2k3 + k4, on (x, w) and the optical path L
+// with dL/ds = w·dx/ds (n for the o-mode, p·t for the e-mode): one more component of the same
+// ODE, so L keeps the integrator's fourth order. `tangent` is the last stage's dx/ds (sharpLand's
+// rate).
+void sharpRk4(int region, float ds, int mode, inout vec3 x, inout vec3 w, inout float opl,
+              out vec3 tangent) {
   vec3 kx = vec3(0.0), kw = vec3(0.0), sx = vec3(0.0), sw = vec3(0.0);
+  float sl = 0.0;
   for (int st = 0; st < 4; ++st) {
     float c = st == 0 ? 0.0 : (st == 3 ? 1.0 : 0.5);
-    vec3 dx, dw;
-    sharpDeriv(region, x + c * ds * kx, w + c * ds * kw, mode, dx, dw);
+    vec3 dx, dw, ws = w + c * ds * kw;
+    sharpDeriv(region, x + c * ds * kx, ws, mode, dx, dw);
     float b = (st == 0 || st == 3) ? 1.0 : 2.0;
     sx += b * dx;
     sw += b * dw;
+    sl += b * dot(ws, dx);
     kx = dx;
     kw = dw;
   }
   x += ds / 6.0 * sx;
   w += ds / 6.0 * sw;
+  opl += ds / 6.0 * sl;
+  tangent = kx;
+}
+
+// The outward normal of the side of the box by which the line o + t·d leaves it: the axis whose
+// exit parameter is boxHit's t1 (reference_marcher.cpp volumeSide).
+vec3 volumeSide(vec3 o, vec3 d, vec3 bmin, vec3 bmax) {
+  vec3 inv = 1.0 / mix(d, vec3(1e-30), equal(d, vec3(0.0)));
+  vec3 hi = max((bmin - o) * inv, (bmax - o) * inv);
+  int k = hi.x <= hi.y && hi.x <= hi.z ? 0 : (hi.y <= hi.z ? 1 : 2);
+  vec3 n = vec3(0.0);
+  n[k] = d[k] < 0.0 ? -1.0 : 1.0;
+  return n;
+}
+
+// The RK4 step from (x0, w0) that ends on the plane through q with normal N (along the ray: the
+// face crossed, or the volume's side), by Newton's method on its length s from the chord's guess:
+// f(s) = (x(s) − q)·N, f'(s) ≈ tangent·N (the last stage's dx/ds, within O(s²) of the end's, so
+// each pass cuts f by O((κs)²) or better), s kept in [0, ds]. A graze (tangent·N ≤ kLandMinRate)
+// keeps the s it has. The end is then put on the plane (a move of the last residual), so x1, w1
+// and the step's optical path belong to the one point of the integrator's path on the plane.
+// Called once, from sharpAdvance (one inlined copy of its sharpRk4).
+const int kLandPasses = 3;
+const float kLandMinRate = 1e-3;
+void sharpLand(int region, int mode, vec3 x0, vec3 w0, float s, float ds, vec3 q, vec3 N,
+               out vec3 x1, out vec3 w1, out float opl) {
+  for (int pass = 0;; ++pass) {
+    vec3 tangent;
+    x1 = x0;
+    w1 = w0;
+    opl = 0.0;
+    sharpRk4(region, s, mode, x1, w1, opl, tangent);
+    float rate = dot(tangent, N);
+    if (pass == kLandPasses || !(rate > kLandMinRate)) break;
+    s = clamp(s - dot(x1 - q, N) / rate, 0.0, ds);
+  }
+  x1 -= dot(x1 - q, N) * N;
 }
 
 // One piece of the march in the ray's region, the CPU's two stages in one function so that
 // nextCrossing and absorbAlong are inlined once:
 //   sharpSegment (homogeneous region): one straight segment to the volume's exit (a voxel at a
 //     time in a lit scattering medium) or to the first crossing on it;
-//   sharpStep (varying region): one RK4 step, cut at the volume's exit or at the first crossing
-//     of its chord (the step is redone shorter so that w belongs to where it ends).
+//   sharpStep (varying region): one RK4 step of ds; where its chord leaves the volume or crosses
+//     a face first, the step is shortened to the one that ends on that plane (sharpLand), so that
+//     x, w and the optical path belong to where it ends, and the crossing is that point of the
+//     path.
 int sharpAdvance(inout MarchState S, inout MarchResult R, out BoundaryCrossing c, int mode) {
   const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
   const float h = P.grid_origin.w;
   bool straight = !hasFlag(EIKON_F_VARYING) || mediumHomogeneous(S.region);
   vec3 x0 = S.x, w0 = S.w, x1 = x0, w1 = w0, dir;
-  float len = 0.0, ds = P.march.x * h, keep = 1.0;
+  float len = 0.0, ds = P.march.x * h, keep = 1.0, opl = 0.0;
   bool leaving = true;
   if (straight) {  // sharpSegment
     dir = sharpDirection(S, mode);
@@ -298,10 +344,12 @@ int sharpAdvance(inout MarchState S, inout MarchResult R, out BoundaryCrossing c
     }
     x1 = S.x + dir * len;
   } else {  // sharpStep
-    sharpRk4(S.region, ds, mode, x1, w1);
+    vec3 tangent;
+    sharpRk4(S.region, ds, mode, x1, w1, opl, tangent);
     vec3 chord = x1 - x0;
     float a0, a1;
-    leaving = !boxHit(x0, normalize(chord), bmin, bmax, a0, a1) || a1 < length(chord);
+    dir = normalize(chord);
+    leaving = !boxHit(x0, dir, bmin, bmax, a0, a1) || a1 < length(chord);
     keep = leaving ? clamp(max(a1, 0.0) / length(chord), 0.0, 1.0) : 1.0;
     x1 = x0 + keep * chord;
   }
@@ -313,15 +361,13 @@ int sharpAdvance(inout MarchState S, inout MarchResult R, out BoundaryCrossing c
   } else {
     if (c.found) keep *= c.t;
     if (keep < 1.0) {
-      x1 = x0;
-      w1 = w0;
-      ds *= keep;
-      sharpRk4(S.region, ds, mode, x1, w1);
-      if (c.found) x1 = c.point;
+      vec3 onPlane = c.found ? c.point : x1;  // x1: the chord's exit from the volume
+      vec3 N = c.found ? c.normal : volumeSide(x0, dir, bmin, bmax);
+      sharpLand(S.region, mode, x0, w0, keep * ds, ds, onPlane, N, x1, w1, opl);
+      if (c.found) c.point = x1;
     }
-    float n0 = regionIndex(S.region, 0, x0), n1 = regionIndex(S.region, 0, x1);
-    R.opl += mode == 0 ? 0.5 * (n0 + n1) * ds : 0.5 * dot(w0 + w1, x1 - x0);
-    if (mode == 0) R.drift = max(R.drift, abs(length(w1) - n1));
+    R.opl += opl;
+    if (mode == 0) R.drift = max(R.drift, abs(length(w1) - regionIndex(S.region, 0, x1)));
     S.x = 0.5 * (x0 + x1);
     S.w = 0.5 * (w0 + w1);
     dir = normalize(x1 - x0 + 1e-30);

@@ -31,7 +31,7 @@
 //     their offset; a child whose edge still exceeds the split span is written as SPLIT and is
 //     split again by the next rebuild without propagating (the reference's recursive split).
 //
-// Sharp interfaces (issue 13; specialisation constant kSharpLight, set by the host only when the
+// Sharp interfaces (specialisation constant kSharpLight, set by the host only when the
 // scene's boundary field applies, as the view renderer's kSharpMarch): every corner crosses its
 // region's homogeneous medium on a straight line in constant time, is stopped at the first
 // boundary (nextCrossing of sharp.glsl, locateCrossing of boundary.glsl), refracted or totally
@@ -307,6 +307,14 @@ void splatAt(vec3 m, float value, float irr, vec3 dir) {
 }
 
 vec3 centreOf(vec3 x[4]) { return 0.25 * (x[0] + x[1] + x[2] + x[3]); }
+
+// Whether a patch of flux `flux`, descended from a seed of `seedFlux`, may be split: only while
+// its quarters keep at least the energy threshold (min_energy_fraction of the seed's flux). A
+// patch due a split it may not make ends as a kill by energy (endOfStep), as its quarters would
+// have after one step each; a child of a split that would need another is stepped once first
+// (scatter). Near grazing incidence on a smoothed interface a stretched patch split 2×2 until
+// then made thousands of such quarters per seed (PatchStepper::mayBeSplit).
+bool mayBeSplit(float flux, float seedFlux) { return 0.25 * flux >= P.step.z * seedFlux; }
 
 float maxEdgeOf(vec3 x[4]) {
   float e = 0.0;
@@ -814,7 +822,9 @@ bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) 
     }
     p.state.y = -p.state.y;  // pass_caustics: through the focal line, orientation reversed
   }
-  if (p.flux.x < P.step.z * p.flux.z) {
+  // Energy: below the threshold, or due a split whose quarters would be (mayBeSplit).
+  const bool stretched = maxEdgeOf(x) > P.step.y && !straddling;
+  if (p.flux.x < P.step.z * p.flux.z || (stretched && !mayBeSplit(p.flux.x, p.flux.z))) {
     p.state.x = EIKON_PATCH_ENERGY;
     return true;
   }
@@ -822,7 +832,7 @@ bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) 
     p.state.x = EIKON_PATCH_TORN;
     return true;
   }
-  if (maxEdgeOf(x) > P.step.y && !straddling) {
+  if (stretched) {
     p.state.x = EIKON_PATCH_SPLIT;
     return true;
   }
@@ -942,7 +952,8 @@ void scatter(uint id) {
       }
       c.flux.x = 0.25 * p.flux.x;
       c.flux.y = 0.25 * p.flux.y;
-      c.state.x = maxEdgeOf(cx) > maxEdge ? EIKON_PATCH_SPLIT : EIKON_PATCH_ALIVE;
+      c.state.x = maxEdgeOf(cx) > maxEdge && mayBeSplit(c.flux.x, c.flux.z) ? EIKON_PATCH_SPLIT
+                                                                            : EIKON_PATCH_ALIVE;
       storeOther(o + uint(cb * 2 + ca), c);
     }
 }

@@ -9,6 +9,7 @@
 #include "core/io/atomic_write.h"
 #include "core/io/build_id.h"
 #include "core/io/cache_dir.h"
+#include "core/io/cache_limit.h"
 #include "core/light/lighting.h"
 #include "core/volume/media.h"
 
@@ -121,7 +122,7 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOpt
   h.value(s.skip_empty);
   h.value(s.pass_caustics);
   h.value(s.beam_min_cells);
-  // Sharp interfaces (issue 13): which path the light took, and what it refracted at (the
+  // Sharp interfaces: which path the light took, and what it refracted at (the
   // boundary field and the media); a smoothed entry must not serve a sharp scene.
   const bool sharp = o.sharp_interfaces && sharpLightApplies(v);
   h.value(sharp);
@@ -175,6 +176,7 @@ bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& v
   if (payloadChecksum(fluence, flux) != checksum) return corrupted("checksum mismatch");
   volume.light_fluence = std::move(fluence);
   volume.light_flux = std::move(flux);
+  touchCacheEntry(path);  // recently used: evicted last
   return true;
 }
 
@@ -206,6 +208,7 @@ std::string saveLightCache(const std::filesystem::path& dir, uint64_t key,
   } catch (const std::exception& e) {
     return e.what();
   }
+  trimCacheDir(dir, final_path);  // the cache folder's cap (core/io/cache_limit.h)
   return {};
 }
 

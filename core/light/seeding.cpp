@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace eikon {
@@ -14,9 +15,6 @@ using light::meanW;
 using light::orientationOf;
 using light::rayHitsBox;
 using light::vectorArea;
-
-constexpr double kPi = 3.14159265358979323846;
-
 /// Solid angle of the spherical triangle with unit vertices a, b, c (Van Oosterom & Strackee).
 double triangleSolidAngle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
   double num = std::abs(glm::dot(a, glm::cross(b, c)));
@@ -111,11 +109,11 @@ void Seeder::point(const Light& light, std::vector<Patch>& out) const {
     if (!(light.cone_half_angle_deg > 0))
       throw std::invalid_argument("wavefront: spot light cone must be > 0");
     axis = light.direction / len;
-    const double half = light.cone_half_angle_deg * kPi / 180.0;
+    const double half = light.cone_half_angle_deg * std::numbers::pi / 180.0;
     cosCone = std::cos(half);
     // The cone meets a cube face (at distance 1) in a disc of radius ≈ tan(half); a cell edge
     // there is 2/N, so N ≥ 2·beam_min_cells/tan(half) puts beam_min_cells cells across it.
-    if (half < 0.25 * kPi)
+    if (half < 0.25 * std::numbers::pi)
       N = std::max(N, std::min(4096, int(std::ceil(2.0 * s.beam_min_cells / std::tan(half)))));
   }
   const double eps = s.point_radius;

@@ -80,7 +80,7 @@ struct WavefrontSettings {
   /// order (a sum of m terms by up to ~2m·2⁻⁵³ relative; glass-sphere test: ≤ 5e-12). The Field
   /// must allow concurrent calls (VolumeField does; an AnalyticField's function must too).
   int threads = 0;
-  /// Sharp interfaces (issue 13; docs/light-simulator.md, "Sharp interfaces"): GpuWavefront
+  /// Sharp interfaces (docs/light-simulator.md, "Sharp interfaces"): GpuWavefront
   /// refracts at the volume's exact boundaries where they apply (a boundary field, i.e.
   /// "interfaces": "sharp", and a homogeneous medium in every region: sharpLightApplies,
   /// core/light/lighting.h) instead of bending through the smoothed field. The CPU twin takes its

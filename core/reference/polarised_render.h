@@ -1,4 +1,4 @@
-// The CPU twin of polarised renders (issue 15; docs/polarisation.md "Polarised renders"): the
+// The CPU twin of polarised renders (docs/polarisation.md "Polarised renders"): the
 // shared driver core/volume/polarised_render.h over this twin's polarised trace (tracePolarised,
 // core/reference/polarised_trace.h, in double precision), the pixel samples' rays spread over
 // threads. The GPU twin is ViewRenderer::renderPolarised.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -13,7 +14,6 @@ namespace eikon {
 namespace {
 
 using maxwell::CV;
-constexpr double kPi = 3.14159265358979323846;
 /// "To infinity": how far a ray leaving the volume is followed for polariser sheets (mm).
 constexpr double kFarMm = 1e9;
 
@@ -234,7 +234,7 @@ PolarisedBeam recombine(const std::vector<const Branch*>& group, const Stokes& i
   beam.exit_point = first.x;
   beam.frame_x = stokesBasis(beam.direction);
   const glm::dvec3 x = beam.frame_x, y = glm::cross(beam.direction, x);
-  const double k0 = 2.0 * kPi / (lambda_nm * 1e-6);
+  const double k0 = 2.0 * std::numbers::pi / (lambda_nm * 1e-6);
   const double width = lambda_nm * 1e-6 / s.source_angle_rad,
                length = lambda_nm * lambda_nm * 1e-6 / s.bandwidth_nm;
   // The phase difference of two branches' plane waves at ONE point, the reference branch's exit

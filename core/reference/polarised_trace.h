@@ -1,4 +1,4 @@
-// The polarised trace of the CPU twin (issue 15; docs/polarisation.md): one ray of light followed
+// The polarised trace of the CPU twin (docs/polarisation.md): one ray of light followed
 // forwards through the sharp march's regions carrying its field coherently — a Jones vector per
 // input basis state, as a 3D complex field — and the Stokes vector of the light leaving along the
 // path for a given input Stokes vector.

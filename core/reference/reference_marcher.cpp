@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
+#include <numbers>
 #include <stdexcept>
 #include <thread>
 
@@ -24,9 +25,6 @@
 
 namespace eikon {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
 bool boxHit(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& bmin,
             const glm::dvec3& bmax, double& t0, double& t1) {
   t0 = -1e300;
@@ -38,6 +36,21 @@ bool boxHit(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& bmin,
     t1 = std::min(t1, std::max(ta, tb));
   }
   return t1 >= std::max(t0, 0.0);
+}
+
+/// The outward normal of the side of the box by which the line o + t·d leaves it: the axis whose
+/// exit parameter is boxHit's t1 (sharp.glsl volumeSide).
+glm::dvec3 volumeSide(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& bmin,
+                      const glm::dvec3& bmax) {
+  glm::dvec3 hi;
+  for (int a = 0; a < 3; ++a) {
+    const double inv = 1.0 / (d[a] == 0.0 ? 1e-30 : d[a]);
+    hi[a] = std::max((bmin[a] - o[a]) * inv, (bmax[a] - o[a]) * inv);
+  }
+  const int k = hi.x <= hi.y && hi.x <= hi.z ? 0 : (hi.y <= hi.z ? 1 : 2);
+  glm::dvec3 n(0.0);
+  n[k] = d[k] < 0.0 ? -1.0 : 1.0;
+  return n;
 }
 
 void validate(const MarchSettings& m) { checkMarchSettings(m); }
@@ -224,7 +237,11 @@ class RayMarch {
   SharpEvent sharpSegment(MarchState& S, MarchResult& R, BoundaryCrossing& c) const;
   void sharpDeriv(int region, const glm::dvec3& x, const glm::dvec3& w, glm::dvec3& dx,
                   glm::dvec3& dw) const;
-  void sharpRk4(int region, double ds, glm::dvec3& x, glm::dvec3& w) const;
+  void sharpRk4(int region, double ds, glm::dvec3& x, glm::dvec3& w, double& opl,
+                glm::dvec3& tangent) const;
+  void sharpLand(int region, const glm::dvec3& x0, const glm::dvec3& w0, double s, double ds,
+                 const glm::dvec3& q, const glm::dvec3& N, glm::dvec3& x1, glm::dvec3& w1,
+                 double& opl) const;
   SharpEvent sharpStep(MarchState& S, MarchResult& R, BoundaryCrossing& c) const;
   void crossInterface(MarchState& S, MarchResult& R, const BoundaryCrossing& c) const;
 
@@ -279,7 +296,7 @@ glm::dvec3 RayMarch::attenuationAt(const glm::dvec3& x, const glm::dvec3& w) con
 // and the mean-direction phase model are those of march.glsl inScatter/diffuseSurface.
 double phaseHG(double cosTheta, double g) {
   const double dd = 1.0 + g * g - 2.0 * g * cosTheta;
-  return (1.0 - g * g) / (4.0 * kPi * dd * std::sqrt(dd));
+  return (1.0 - g * g) / (4.0 * std::numbers::pi * dd * std::sqrt(dd));
 }
 
 glm::dvec3 RayMarch::inScatter(const glm::dvec3& x, const glm::dvec3& dir,
@@ -290,7 +307,7 @@ glm::dvec3 RayMarch::inScatter(const glm::dvec3& x, const glm::dvec3& dir,
   if (phi.w <= 0.0) return glm::dvec3(0.0);
   const glm::dvec3 mdir = f_.lightFlux(x) / phi.w;
   const double lm = std::min(glm::length(mdir), 1.0);
-  double p = (1.0 - lm) / (4.0 * kPi);
+  double p = (1.0 - lm) / (4.0 * std::numbers::pi);
   if (lm > 1e-6) p += lm * phaseHG(glm::dot(glm::normalize(mdir), -dir), sc.w);
   return sigmaOf(glm::dvec3(sc)) * sigmaT * colourOf(glm::dvec3(phi)) * p;
 }
@@ -313,7 +330,7 @@ glm::dvec3 RayMarch::diffuseSurface(const glm::dvec3& x) const {
   const glm::dvec4 phi = f_.lightFluence(xs);
   if (phi.w <= 0.0) return glm::dvec3(0.0);
   const double cosFactor = std::max(0.0, -glm::dot(f_.lightFlux(xs), N)) / phi.w;
-  return sigmaOf(glm::dvec3(sc)) * colourOf(glm::dvec3(phi)) * (cosFactor / kPi);
+  return sigmaOf(glm::dvec3(sc)) * colourOf(glm::dvec3(phi)) * (cosFactor / std::numbers::pi);
 }
 
 /// Fresnel (Rs, Rp) weights of a mode at an interface: the share of its D field along the
@@ -558,10 +575,11 @@ MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
 }
 
 // ------------------------------------------------------------------ the sharp march
-// Stages of the same names in shaders/march.glsl (docs/twins.md). The ray carries its region;
+// Stages of the same names in shaders/sharp.glsl (docs/twins.md). The ray carries its region;
 // homogeneous regions are crossed in one straight segment, varying ones (GRIN, radial axis) are
-// integrated with RK4 on the region's own analytic medium; every segment or step chord is tested
-// with locateCrossing, and at a crossing the exact interface laws of optics/ are applied.
+// integrated with RK4 on the region's own analytic medium, the optical path with it; every segment
+// or step chord is tested with nextCrossing, a step that meets a face ends on it on its own path
+// (sharpLand), and at a crossing the exact interface laws of optics/ are applied.
 
 // Box entry: the region there, and the wave vector of the mode in its medium along d.
 void RayMarch::sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& d) const {
@@ -672,37 +690,74 @@ void RayMarch::sharpDeriv(int region, const glm::dvec3& x, const glm::dvec3& w, 
   dw = dp / L;
 }
 
-void RayMarch::sharpRk4(int region, double ds, glm::dvec3& x, glm::dvec3& w) const {
+// Classical RK4 on (x, w) and the optical path L with dL/ds = w·dx/ds (n for the o-mode, p·t for
+// the e-mode): one more component of the same ODE, so L keeps the integrator's fourth order.
+// `tangent` is the last stage's dx/ds (sharpLand's rate).
+void RayMarch::sharpRk4(int region, double ds, glm::dvec3& x, glm::dvec3& w, double& opl,
+                        glm::dvec3& tangent) const {
   glm::dvec3 k1x, k1w, k2x, k2w, k3x, k3w, k4x, k4w;
   sharpDeriv(region, x, w, k1x, k1w);
-  sharpDeriv(region, x + 0.5 * ds * k1x, w + 0.5 * ds * k1w, k2x, k2w);
-  sharpDeriv(region, x + 0.5 * ds * k2x, w + 0.5 * ds * k2w, k3x, k3w);
-  sharpDeriv(region, x + ds * k3x, w + ds * k3w, k4x, k4w);
+  const glm::dvec3 w2 = w + 0.5 * ds * k1w;
+  sharpDeriv(region, x + 0.5 * ds * k1x, w2, k2x, k2w);
+  const glm::dvec3 w3 = w + 0.5 * ds * k2w;
+  sharpDeriv(region, x + 0.5 * ds * k2x, w3, k3x, k3w);
+  const glm::dvec3 w4 = w + ds * k3w;
+  sharpDeriv(region, x + ds * k3x, w4, k4x, k4w);
+  const double l1 = glm::dot(w, k1x), l2 = glm::dot(w2, k2x), l3 = glm::dot(w3, k3x),
+               l4 = glm::dot(w4, k4x);
   x += ds / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
   w += ds / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+  opl += ds / 6.0 * (l1 + 2.0 * l2 + 2.0 * l3 + l4);
+  tangent = k4x;
 }
 
-// Varying region: one RK4 step, cut at the volume's exit or at the first crossing of its chord.
+// The RK4 step from (x0, w0) that ends on the plane through q with normal N (along the ray: the
+// face crossed, or the volume's side), by Newton's method on its length s from the chord's guess:
+// f(s) = (x(s) − q)·N, f'(s) ≈ tangent·N (the last stage's dx/ds, within O(s²) of the end's, so
+// each pass cuts f by O((κs)²) or better, κ the ray's curvature), s kept in [0, ds]. A graze
+// (tangent·N ≤ kLandMinRate) keeps the s it has. The end is then put on the plane (a move of the
+// last residual, ~1e-16 of the coordinates), so x1, w1 and the step's optical path all belong to
+// the one point of the integrator's path on the plane (a curved face's tangent plane at the
+// chord's crossing: off the surface by O(κ²s⁴/R) for radius of curvature R).
+void RayMarch::sharpLand(int region, const glm::dvec3& x0, const glm::dvec3& w0, double s,
+                         double ds, const glm::dvec3& q, const glm::dvec3& N, glm::dvec3& x1,
+                         glm::dvec3& w1, double& opl) const {
+  constexpr int kLandPasses = 3;
+  constexpr double kLandMinRate = 1e-3;
+  for (int pass = 0;; ++pass) {
+    glm::dvec3 tangent;
+    x1 = x0, w1 = w0, opl = 0.0;
+    sharpRk4(region, s, x1, w1, opl, tangent);
+    const double rate = glm::dot(tangent, N);
+    if (pass == kLandPasses || !(rate > kLandMinRate)) break;
+    s = std::clamp(s - glm::dot(x1 - q, N) / rate, 0.0, ds);
+  }
+  x1 -= glm::dot(x1 - q, N) * N;
+}
+
+// Varying region: one RK4 step of ds; where its chord leaves the volume or crosses a face first,
+// the step is shortened to the one that ends on that plane (sharpLand), so that x, w and the
+// optical path belong to where it ends, and the crossing is that point of the path.
 SharpEvent RayMarch::sharpStep(MarchState& S, MarchResult& R, BoundaryCrossing& c) const {
   const glm::dvec3 x0 = S.x, w0 = S.w;
-  glm::dvec3 x1 = x0, w1 = w0;
-  double ds = ds_;
-  sharpRk4(S.region, ds, x1, w1);
+  glm::dvec3 x1 = x0, w1 = w0, tangent;
+  double opl = 0.0;
+  sharpRk4(S.region, ds_, x1, w1, opl, tangent);
   double a0, a1;
-  const glm::dvec3 chord = x1 - x0;
-  const bool out =
-      !boxHit(x0, glm::normalize(chord), bmin_, bmax_, a0, a1) || a1 < glm::length(chord);
+  const glm::dvec3 chord = x1 - x0, dir = glm::normalize(chord);
+  const bool out = !boxHit(x0, dir, bmin_, bmax_, a0, a1) || a1 < glm::length(chord);
   double keep = out ? std::clamp(std::max(a1, 0.0) / glm::length(chord), 0.0, 1.0) : 1.0;
   c = nextCrossing(x0, x0 + keep * chord, S.region);
   if (c.found) keep *= c.t;
-  if (keep < 1.0) {  // redo the shorter step so that w belongs to where it ends
-    x1 = x0, w1 = w0, ds *= keep;
-    sharpRk4(S.region, ds, x1, w1);
-    if (c.found) x1 = c.point;
+  if (keep < 1.0) {
+    const glm::dvec3 q = c.found ? c.point : x0 + keep * chord;
+    const glm::dvec3 N = c.found ? c.normal : volumeSide(x0, dir, bmin_, bmax_);
+    sharpLand(S.region, x0, w0, keep * ds_, ds_, q, N, x1, w1, opl);
+    if (c.found) c.point = x1;
   }
-  const double n0 = regionIndex(S.region, 0, x0), n1 = regionIndex(S.region, 0, x1);
-  R.opl += mode_ == 0 ? 0.5 * (n0 + n1) * ds : 0.5 * glm::dot(w0 + w1, x1 - x0);
-  if (mode_ == 0) R.drift = std::max(R.drift, std::abs(glm::length(w1) - n1));
+  R.opl += opl;
+  if (mode_ == 0)
+    R.drift = std::max(R.drift, std::abs(glm::length(w1) - regionIndex(S.region, 0, x1)));
   S.x = 0.5 * (x0 + x1);
   S.w = 0.5 * (w0 + w1);
   absorbAlong(S, glm::normalize(x1 - x0 + 1e-300), glm::length(x1 - x0));
@@ -948,7 +1003,7 @@ RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,
   const glm::dvec3 fwd = glm::normalize(cam.look_at - cam.position);
   const glm::dvec3 right = glm::normalize(glm::cross(fwd, cam.up));
   const glm::dvec3 up = glm::cross(right, fwd);
-  const double tanh = std::tan(0.5 * cam.fov_deg * kPi / 180.0),
+  const double tanh = std::tan(0.5 * cam.fov_deg * std::numbers::pi / 180.0),
                aspect = double(img.width) / img.height;
   const bool hero = useHeroSampling(s.sampling, field_.weightsDependOnLambda());
   LayerSums layers(s, size_t(img.width) * size_t(img.height), field_.uniaxial());

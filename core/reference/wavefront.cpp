@@ -226,6 +226,20 @@ class PatchStepper {
   bool crossInterface(const BoundaryCrossing& c, Patch& p, int k, double& transmission) const;
   bool straddles(const Patch& p) const;
   bool torn(const Patch& p) const;
+  /// Whether p may be split: only while its quarters keep at least the energy threshold
+  /// (min_energy_fraction of its seed's flux). A patch due a split it may not make ends as a kill
+  /// by energy (endOfStep), as its quarters would have after one step each; a child of a split
+  /// that would need another is stepped once first (emit). Near grazing incidence on a smoothed
+  /// interface a stretched patch split 2×2 until then made thousands of such quarters per seed
+  /// (wavefront.comp mayBeSplit).
+  static double maxEdgeOf(const Patch& p) {
+    double e = 0;
+    for (size_t k = 0; k < 4; ++k) e = std::max(e, glm::length(p.x[(k + 1) % 4] - p.x[k]));
+    return e;
+  }
+  bool mayBeSplit(const Patch& p) const {
+    return 0.25 * p.energy >= s_.min_energy_fraction * p.seed_energy;
+  }
   double straightClear(const glm::dvec3& x, const glm::dvec3& v, int r) const;
 
   const Field& f_;
@@ -418,7 +432,7 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
     // No boundary can lie on the corner's way when it moves at most (D − 1.5)·h from a voxel of
     // skip distance D (the argument of straight steps; the sharp path's D counts region changes
     // only) or when every boundary-field cell it touches lies in its region: locateCrossing would
-    // find none, so it is not called (issue 14: most corners near a surface are such corners).
+    // find none, so it is not called (most corners near a surface are such corners).
     // Where the regions are on the shapes (BoundaryField::regionsOnShapes) the crossing is the
     // shapes' own (crossingOutOf, the view march's; the GPU twin's nextCrossing), and the voxels'
     // regions along the way say nothing about it: only the skip distance is a bound there.
@@ -779,7 +793,7 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
     double e = 0;
     for (int k = 0; k < 4; ++k)
       e = std::max(e, glm::length(p.x[size_t((k + 1) % 4)] - p.x[size_t(k)]));
-    if (e <= maxEdge_ || (sharp_ && straddles(p))) {
+    if (e <= maxEdge_ || (sharp_ && straddles(p)) || !mayBeSplit(p)) {
       ch.next->push_back(p);
       continue;
     }
@@ -957,7 +971,9 @@ bool PatchStepper::endOfStep(Chunk& ch, Patch& p, const PatchStep& st,
     ended(ch, p);
     return true;
   }
-  if (p.energy < s_.min_energy_fraction * p.seed_energy) {
+  // Energy: below the threshold, or due a split whose quarters would be (mayBeSplit).
+  if (p.energy < s_.min_energy_fraction * p.seed_energy ||
+      (!(sharp_ && straddles(p)) && maxEdgeOf(p) > maxEdge_ && !mayBeSplit(p))) {
     ++ch.st.kills_energy;
     ch.st.flux_energy += p.energy;
     ended(ch, p);

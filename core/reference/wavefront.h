@@ -1,4 +1,4 @@
-// The double-precision CPU reference of the light simulator (issue 6, docs/design.md §2 "Light
+// The double-precision CPU reference of the light simulator (docs/design.md §2 "Light
 // simulator", Tevs ch. 4 and 6). The GPU kernel (core/render/light_simulator.h) is tested against
 // it.
 //
@@ -24,7 +24,7 @@
 // patch takes k steps at once along straight lines, the exact solution there
 // (docs/light-simulator.md).
 //
-// Sharp interfaces (issue 13; docs/light-simulator.md, "Sharp interfaces"): given the scene's
+// Sharp interfaces (docs/light-simulator.md, "Sharp interfaces"): given the scene's
 // boundary field and one medium per region (SharpInterfaces), every corner crosses its region's
 // homogeneous medium along a straight line in constant time, is stopped at the first boundary
 // (locateCrossing), refracted or totally reflected there with the exact laws of optics/ (Snell,

@@ -1,4 +1,4 @@
-// The sharp-boundary field on the device (issue 13): the VolumeSet's BoundaryField
+// The sharp-boundary field on the device: the VolumeSet's BoundaryField
 // (core/volume/boundary.h) as a region image (R32_UINT), a distance image (R32_SFLOAT, voxels) and
 // the shape table (vec4 records, layout in shaders/eikon_shared.h), bound at EIKON_B_REGION,
 // EIKON_B_BOUNDARY_DIST and EIKON_B_SHAPES for the GLSL twins in shaders/boundary.glsl, and the

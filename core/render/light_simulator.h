@@ -1,4 +1,4 @@
-// The GPU light simulator (issue 6, docs/design.md §2): the wavefront of patches of
+// The GPU light simulator (docs/design.md §2): the wavefront of patches of
 // core/light/wavefront_types.h propagated by a Vulkan compute kernel (shaders/wavefront.comp), one
 // thread per patch, RK4 in constant time on the four corners, attenuation, fixed-point atomic
 // splat into the irradiance/direction volumes. Same settings, seeds, kill rules, split rule and
@@ -9,7 +9,7 @@
 //   eikon::GpuWavefront gpu(ctx, vol, settings);
 //   eikon::WavefrontResult r = gpu.run(scene.lights[0]);   // r.irradiance in W/mm², r.stats
 //
-// Sharp interfaces (issue 13; WavefrontSettings::sharp_interfaces, where sharpLightApplies): the
+// Sharp interfaces (WavefrontSettings::sharp_interfaces, where sharpLightApplies): the
 // corners refract at the scene's exact boundaries as the CPU twin's do given sharpInterfacesFor
 // (the pipeline is specialised with kSharpLight; docs/light-simulator.md, "Sharp interfaces"),
 // with one difference: a crystal face takes the D-projection Fresnel split (the CPU: exact).

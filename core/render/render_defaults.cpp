@@ -14,8 +14,8 @@ RenderSettings defaultRenderSettings(const Scene& scene) {
   RenderSettings rs;
   rs.width = 0;
   rs.height = 0;
-  rs.spp = 1;
-  rs.wavelengths = defaultWavelengths(scene);
+  rs.spp = scene.render.spp.value_or(1);  // the scene's "render", if it says
+  rs.wavelengths = scene.render.wavelengths.value_or(defaultWavelengths(scene));
   rs.march = MarchSettings{};
   rs.march.step_voxels = kDefaultRenderStepVoxels;
   rs.march.integrator = Integrator::RK4;

@@ -1,8 +1,8 @@
 // What a render does when the user chooses nothing, in one place for both front ends: the CLI
 // (`eikon render`, apps/render_command.cpp) and Python (`eikon.render`, `Renderer.render`,
 // python/eikon_module.cpp) call these functions, so the same scene renders the same from both by
-// default (issue 11: Python rendered dispersive scenes in RGB where the CLI took 16 wavelengths,
-// marched with 0.25-voxel steps where the CLI took 0.5, and left lit scenes unlit).
+// default: the same wavelengths (16 for a dispersive scene), the same step (0.5 voxel) and the
+// same light simulation.
 //
 //   RenderSettings rs = eikon::defaultRenderSettings(scene);  // then apply the user's choices
 //   LightingOptions lo = eikon::defaultLightingOptions();
@@ -28,9 +28,9 @@ inline constexpr double kDefaultRenderStepVoxels = 0.5;
 /// kDefaultDispersiveWavelengths when any material's index depends on λ, else 0 (RGB mode).
 int defaultWavelengths(const Scene& scene);
 
-/// The scene camera's size (0 = the camera's), 1 spp, defaultWavelengths(scene), the d line for
-/// RGB mode, and the march: kDefaultRenderStepVoxels, RK4, straight steps across homogeneous
-/// regions, Fresnel on.
+/// The scene camera's size (0 = the camera's), the scene's "render" spp and wavelengths where it
+/// gives them (else 1 spp and defaultWavelengths(scene)), the d line for RGB mode, and the march:
+/// kDefaultRenderStepVoxels, RK4, straight steps across homogeneous regions, Fresnel on.
 RenderSettings defaultRenderSettings(const Scene& scene);
 
 /// The light simulator as a render runs it: bands chosen per scene (0 → defaultLightBands),

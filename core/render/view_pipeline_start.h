@@ -1,4 +1,4 @@
-// The view pipeline compiled before the volume exists (issue 14, start-up; docs/performance.md
+// The view pipeline compiled before the volume exists (start-up; docs/performance.md
 // "Start-up"). On lavapipe, building the view kernel's pipeline is SPIR-V → NIR work that no cache
 // of Mesa 22.3 keeps (~1 s of CPU for glass_sphere's sharp kernel, every run), the longest stage
 // before the first dispatch. Its specialisation (the EIKON_F_* flags) depends on the volume's

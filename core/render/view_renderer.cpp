@@ -10,6 +10,7 @@
 #include <future>
 #include <map>
 #include <mutex>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <thread>
@@ -37,9 +38,6 @@ namespace {
 // sharing across passes: view.comp).
 constexpr int kAovPassBit = 32;
 constexpr int kSharedPassBit = 64;  // view.comp's sharing across passes (render())
-
-constexpr double kPi = 3.14159265358979323846;
-
 void validate(const MarchSettings& m) { checkMarchSettings(m); }
 
 }  // namespace
@@ -673,8 +671,8 @@ struct ViewRenderer::Impl {
     glm::dvec3 fwd = glm::normalize(cam.look_at - cam.position);
     glm::dvec3 right = glm::normalize(glm::cross(fwd, cam.up));
     glm::dvec3 up = glm::cross(right, fwd);
-    p.cam_pos =
-        glm::vec4(glm::vec3(cam.position), float(std::tan(0.5 * cam.fov_deg * kPi / 180.0)));
+    p.cam_pos = glm::vec4(glm::vec3(cam.position),
+                          float(std::tan(0.5 * cam.fov_deg * std::numbers::pi / 180.0)));
     p.cam_forward = glm::vec4(glm::vec3(fwd), float(double(cam.width) / cam.height));
     p.cam_right = glm::vec4(glm::vec3(right), 0.0f);
     p.cam_up = glm::vec4(glm::vec3(up), 0.0f);

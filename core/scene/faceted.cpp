@@ -4,12 +4,11 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <sstream>
 
 namespace eikon {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 constexpr size_t kMaxFacets = 512;  // cutting is O(n³) in the facet count: ~1 s at this size
 // A .asc distance's bound, the JSON tiers' (scene.cpp kMaxCoordinateMm): the rough block is sized
 // from the largest distance, so 1e300 made every other facet fail on its line instead.
@@ -218,7 +217,7 @@ class Cutter {
       throw FacetError(at, "cannot be met: no facet of an earlier tier '" + tier.level_tier +
                                "' at index " + std::to_string(index));
     const Plane& prev = planes_[it->second];
-    const double phi = 2.0 * kPi * index / design_.gear;
+    const double phi = 2.0 * std::numbers::pi * index / design_.gear;
     const glm::dvec3 u(std::cos(phi), 0.0, std::sin(phi));
     const double h = tier.value;
     const double nu = glm::dot(prev.normal, u);
@@ -316,7 +315,8 @@ FacetError blameOutlier(const FacetedDesign& d, const FacetError& error) {
 }  // namespace
 
 glm::dvec3 facetNormal(FacetSide side, double angle_deg, int index, int gear) {
-  const double phi = 2.0 * kPi * index / gear, th = angle_deg * kPi / 180.0;
+  const double phi = 2.0 * std::numbers::pi * index / gear,
+               th = angle_deg * std::numbers::pi / 180.0;
   const glm::dvec3 u(std::cos(phi), 0.0, std::sin(phi));
   switch (side) {
     case FacetSide::Crown:

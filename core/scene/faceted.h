@@ -1,4 +1,4 @@
-// Faceted gems from a faceting diagram (issue 16, item 2): tiers of facets given as a cutter gives
+// Faceted gems from a faceting diagram: tiers of facets given as a cutter gives
 // them — the angle from the girdle plane, the index-gear positions and where the facet is cut to
 // (a distance, cut to centre, meeting the girdle line, meeting a level line of an earlier tier or
 // an earlier meet point) — cut in order from a rough block into a convex polyhedron, which then

@@ -1,25 +1,23 @@
 #include "core/scene/mesh.h"
 
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
-#include <assimp/Importer.hpp>
-#include <charconv>
+#include <cerrno>
 #include <cmath>
-#include <cstdlib>
-#include <cstring>
-#include <fstream>
-#include <limits>
 #include <map>
 #include <new>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
 #include <tuple>
 
 #include "core/io/text_file.h"
+#include "core/scene/mesh_readers.h"
 #include "core/scene/messages.h"
 
 namespace eikon {
@@ -91,196 +89,70 @@ double diagonal(const TriangleMesh& m) {
   return glm::length(hi - lo);
 }
 
-/// Bytes a PLY scalar type takes in a binary file; 0 for an unknown type.
-size_t plyTypeBytes(const std::string& t) {
-  static const std::map<std::string, size_t> sizes = {
-      {"char", 1},  {"uchar", 1},   {"int8", 1},   {"uint8", 1},  {"short", 2}, {"ushort", 2},
-      {"int16", 2}, {"uint16", 2},  {"int", 4},    {"uint", 4},   {"int32", 4}, {"uint32", 4},
-      {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
-  auto it = sizes.find(t);
-  return it == sizes.end() ? 0 : it->second;
-}
-
-/// Most PLY header read (a real header is a few hundred bytes).
-constexpr size_t kMaxPlyHeaderBytes = 64u << 10;
-
-/// A PLY element as its header declares it: its count and the least bytes one of them takes.
-struct PlyElement {
-  std::string name;
-  uint64_t count = 0;
-  uint64_t least_bytes = 0;
-  int line = 0;
-};
-
-/// The elements a PLY header declares, and the header's length in bytes. Assimp allocates what
-/// the header declares before it reads the data (a 241-byte file declaring 4e8 vertices took
-/// 4.7 GB), so the header is read here first.
-std::vector<PlyElement> plyHeader(const std::filesystem::path& file, const std::string& name,
-                                  size_t& header_bytes) {
-  std::ifstream in(file, std::ios::binary);
-  std::string head(kMaxPlyHeaderBytes, '\0');
-  in.read(head.data(), std::streamsize(head.size()));
-  head.resize(size_t(in.gcount()));
-  if (head.rfind("ply\n", 0) != 0 && head.rfind("ply\r\n", 0) != 0)
-    fail(name, "is not a PLY file (its first line is not 'ply')");
-  const size_t end = head.find("end_header");
-  const size_t eol = end == std::string::npos ? end : head.find('\n', end);
-  if (eol == std::string::npos)
-    fail(name, "the PLY header has no end_header line within its first " +
-                   std::to_string(kMaxPlyHeaderBytes >> 10) + " KiB");
-  header_bytes = eol + 1;
-  std::istringstream lines(head.substr(0, header_bytes));
-  std::vector<PlyElement> elements;
-  bool ascii = false;
-  std::string line;
-  for (int no = 1; std::getline(lines, line); ++no) {
-    std::istringstream words(line);
-    std::string key;
-    words >> key;
-    const std::string at = "the PLY header's line " + std::to_string(no);
-    if (key == "format") {
-      std::string f;
-      words >> f;
-      ascii = f == "ascii";
-    } else if (key == "element") {
-      std::string element, count;
-      words >> element >> count;
-      PlyElement e{excerpt(element), 0, 0, no};
-      auto [ptr, ec] = std::from_chars(count.data(), count.data() + count.size(), e.count);
-      if (ec != std::errc() || ptr != count.data() + count.size())
-        fail(name, at + ": the element '" + e.name + "' has no count that a file can hold, got '" +
-                       excerpt(count) + "'");
-      elements.push_back(e);
-    } else if (key == "property") {
-      if (elements.empty()) fail(name, at + ": a property before any element");
-      std::string type;
-      words >> type;
-      if (type == "list") words >> type;  // a list takes at least its count
-      const size_t bytes = plyTypeBytes(type);
-      if (bytes == 0) fail(name, at + ": unknown property type '" + excerpt(type) + "'");
-      elements.back().least_bytes += ascii ? 2 : bytes;  // ASCII: a digit and a separator
-    }
+/// The bytes of the mesh file `file`, a regular file of at most kMaxMeshFileBytes. The checks
+/// are made again on the open descriptor (opened without blocking, so that a FIFO put in the
+/// file's place after the first look cannot hang the read), and no more than the cap is read
+/// if the file grows meanwhile.
+std::string meshBytes(const std::filesystem::path& file, const std::string& name) {
+  std::error_code ec;
+  const std::filesystem::file_type type = std::filesystem::status(file, ec).type();
+  if (type == std::filesystem::file_type::not_found)
+    fail(name, "cannot open '" + shownPath(file) + "': no such file or directory");
+  if (ec) fail(name, "cannot open '" + shownPath(file) + "': " + errorReason(ec));
+  if (type == std::filesystem::file_type::directory)
+    fail(name, "is a directory, expected a mesh file");
+  if (type != std::filesystem::file_type::regular)
+    fail(name, "is not a regular file, expected a mesh file");
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0)
+    fail(name, "cannot open '" + shownPath(file) +
+                   "': " + errorReason(std::error_code(errno, std::generic_category())));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
+    fail(name, "is not a regular file, expected a mesh file");
+  const auto too_large = [&](std::uintmax_t got) {
+    fail(name, "the mesh file is larger than " + std::to_string(kMaxMeshFileBytes >> 20) +
+                   " MiB, got " + std::to_string(got) + " bytes");
+  };
+  if (std::uintmax_t(st.st_size) > kMaxMeshFileBytes) too_large(std::uintmax_t(st.st_size));
+  // Room for one byte more than its size, grown (to the cap and a byte) if the file grows.
+  std::string bytes(size_t(st.st_size) + 1, '\0');
+  size_t got = 0;
+  while (got <= kMaxMeshFileBytes) {
+    if (got == bytes.size()) bytes.resize(std::min<size_t>(2 * got, kMaxMeshFileBytes + 1));
+    const ssize_t r = ::read(fd, bytes.data() + got, bytes.size() - got);
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0)
+      fail(name, "cannot read '" + shownPath(file) +
+                     "': " + errorReason(std::error_code(errno, std::generic_category())));
+    if (r == 0) break;
+    got += size_t(r);
   }
-  return elements;
+  if (got > kMaxMeshFileBytes) too_large(got);
+  bytes.resize(got);
+  return bytes;
 }
 
-/// Refuses a PLY header whose element counts the file cannot hold (each element takes at least
-/// its properties' bytes in binary, two bytes a property in ASCII) or that exceed what a mesh may
-/// have (kMaxMeshTriangles faces, three vertices a triangle).
-void checkPlyCounts(const std::filesystem::path& file, const std::string& name,
-                    std::uintmax_t bytes) {
-  size_t header = 0;
-  const std::vector<PlyElement> elements = plyHeader(file, name, header);
-  uint64_t left = bytes > header ? bytes - header + 1 : 1;  // +1: no newline after the last line
-  for (const PlyElement& e : elements) {
-    const std::string what = "the PLY header (line " + std::to_string(e.line) + ") declares " +
-                             std::to_string(e.count) + " '" + e.name + "' elements";
-    const uint64_t most = e.name == "face" ? kMaxMeshTriangles : 3 * kMaxMeshTriangles;
-    if (e.count > most)
-      fail(name, what + ", more than a mesh may have (at most " + std::to_string(most) + ")");
-    if (e.least_bytes > 0 && e.count > left / e.least_bytes)
-      fail(name, what + " of at least " + std::to_string(e.least_bytes) +
-                     " bytes each, more than the file's " + std::to_string(bytes) +
-                     " bytes can hold");
-    left -= e.count * e.least_bytes;
-  }
-}
-
-/// Refuses an OBJ `v` line that is not 3, 4 (x y z w) or 6 (x y z r g b) finite numbers, naming
-/// the line. Assimp skips such a vertex and later fails on the faces that use it ("OBJ: vertex
-/// index out of range"), reads "0.5x" as 0.5 and does not count ".5" as a number; its message
-/// names no line. One pass over the file, which readMesh has capped at kMaxMeshFileBytes.
-void checkObjVertices(const std::filesystem::path& file, const std::string& name) {
-  std::ifstream in(file, std::ios::binary);
-  std::string line;
-  for (size_t no = 1; std::getline(in, line); ++no) {
-    const size_t first = no;
-    // A trailing backslash continues the line (Assimp joins them too).
-    while (!line.empty() && (line.back() == '\\' || line.back() == '\r')) {
-      if (line.back() == '\r') {
-        line.pop_back();
-        continue;
-      }
-      line.pop_back();
-      std::string next;
-      if (!std::getline(in, next)) break;
-      ++no;
-      line += ' ' + next;
-    }
-    if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
-    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    std::istringstream words(line.substr(2));
-    std::vector<std::string> tokens;
-    for (std::string w; words >> w;) tokens.push_back(w);
-    const std::string at = "line " + std::to_string(first);
-    static const char* const kNames[] = {"x", "y", "z", "w or r", "g", "b"};
-    for (size_t k = 0; k < tokens.size() && k < 6; ++k) {
-      const std::string& t = tokens[k];
-      const char* b = t.data() + (t[0] == '+' ? 1 : 0);
-      double v = 0.0;
-      auto [ptr, ec] = std::from_chars(b, t.data() + t.size(), v);
-      const std::string what = "the vertex's " + std::string(kNames[k]) + " '" + excerpt(t) + "'";
-      const bool whole = ptr == t.data() + t.size();
-      // Out of range: too large (refused) or too small, which is read as 0.
-      if (whole &&
-          ((ec == std::errc::result_out_of_range && std::abs(std::strtod(b, nullptr)) >= 1) ||
-           (ec == std::errc() && !std::isfinite(v))))
-        fail(name, at + ": " + what + " is not a finite number");
-      if ((ec != std::errc() && ec != std::errc::result_out_of_range) || !whole)
-        fail(name, at + ": " + what + " is not a number");
-      if (ec == std::errc() && std::abs(v) > double(std::numeric_limits<float>::max()))
-        fail(name, at + ": " + what + " is beyond the 3.4e38 a mesh coordinate (a float) holds");
-      if (t[0] == '.')
-        fail(name, at + ": " + what + " starts with '.', which the OBJ reader does not take " +
-                       "as a number: write a 0 before the point");
-    }
-    if (tokens.size() != 3 && tokens.size() != 4 && tokens.size() != 6)
-      fail(name, at + ": the vertex '" + excerpt(line) + "' has " + std::to_string(tokens.size()) +
-                     (tokens.size() == 1 ? " number" : " numbers") +
-                     "; a vertex takes 3 (x y z), 4 (x y z w) or 6 (x y z r g b)");
-  }
-}
-
-/// The mesh Assimp reads from `file` (checked by readMesh), welded.
-TriangleMesh importMesh(const std::filesystem::path& file, const std::string& name) {
-  Assimp::Importer importer;
-  // Triangulate polygons, bake node transforms into the vertices and validate the result (index
-  // ranges, counts). No vertex joining: Assimp's joins only vertices whose normals also agree, so
-  // the welding below (equal positions) is done here.
-  const aiScene* sc =
-      importer.ReadFile(file.string(), aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                                           aiProcess_ValidateDataStructure);
-  // Assimp catches what its readers throw, std::bad_alloc included, and keeps only its what().
-  if (!sc && std::strcmp(importer.GetErrorString(), std::bad_alloc().what()) == 0)
-    throw std::bad_alloc();
-  if (!sc) fail(name, std::string("cannot read the mesh: ") + importer.GetErrorString());
+/// The vertices the triangles of `raw` use, equal positions welded into one (numbered by first
+/// use).
+TriangleMesh weld(const TriangleMesh& raw) {
   TriangleMesh out;
-  std::map<std::tuple<double, double, double>, uint32_t> weld;
-  size_t tris = 0;
-  for (unsigned mi = 0; mi < sc->mNumMeshes; ++mi) tris += sc->mMeshes[mi]->mNumFaces;
-  if (tris > kMaxMeshTriangles)
-    fail(name, "at most " + std::to_string(kMaxMeshTriangles) + " triangles, got " +
-                   std::to_string(tris));
-  for (unsigned mi = 0; mi < sc->mNumMeshes; ++mi) {
-    const aiMesh* m = sc->mMeshes[mi];
-    std::vector<uint32_t> id(m->mNumVertices);
-    for (unsigned v = 0; v < m->mNumVertices; ++v) {
-      const glm::dvec3 p(m->mVertices[v].x, m->mVertices[v].y, m->mVertices[v].z);
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        fail(name, "a vertex is not finite, got " + point(p));
-      auto [it, fresh] = weld.try_emplace({p.x, p.y, p.z}, uint32_t(out.vertices.size()));
+  std::map<std::tuple<double, double, double>, uint32_t> ids;
+  out.triangles.reserve(raw.triangles.size());
+  for (const auto& t : raw.triangles) {
+    std::array<uint32_t, 3> w{};
+    for (size_t k = 0; k < 3; ++k) {
+      const glm::dvec3& p = raw.vertices[t[k]];
+      auto [it, fresh] = ids.try_emplace({p.x, p.y, p.z}, uint32_t(out.vertices.size()));
       if (fresh) out.vertices.push_back(p);
-      id[v] = it->second;
+      w[k] = it->second;
     }
-    for (unsigned f = 0; f < m->mNumFaces; ++f) {
-      const aiFace& face = m->mFaces[f];
-      if (face.mNumIndices != 3)
-        fail(name, "holds points or lines (a face with " + std::to_string(face.mNumIndices) +
-                       " corners): a mesh must be a closed surface of triangles");
-      out.triangles.push_back({id[face.mIndices[0]], id[face.mIndices[1]], id[face.mIndices[2]]});
-    }
+    out.triangles.push_back(w);
   }
-  if (out.triangles.empty()) fail(name, "holds no triangles");
   return out;
 }
 
@@ -291,24 +163,11 @@ TriangleMesh readMesh(const std::filesystem::path& file) {
   const std::string ext = lower(file.extension().string());
   if (ext != ".obj" && ext != ".ply" && ext != ".stl")
     fail(name, "expected an .obj, .ply or .stl file, got the extension '" + excerpt(ext) + "'");
-  std::error_code ec;
-  const std::filesystem::file_type type = std::filesystem::status(file, ec).type();
-  if (type == std::filesystem::file_type::not_found)
-    fail(name, "cannot open '" + shownPath(file) + "': no such file or directory");
-  if (ec) fail(name, "cannot open '" + shownPath(file) + "': " + errorReason(ec));
-  if (type == std::filesystem::file_type::directory)
-    fail(name, "is a directory, expected a mesh file");
-  if (type != std::filesystem::file_type::regular)
-    fail(name, "is not a regular file, expected a mesh file");
-  const std::uintmax_t bytes = std::filesystem::file_size(file, ec);
-  if (ec) fail(name, "cannot read '" + shownPath(file) + "': " + errorReason(ec));
-  if (bytes > kMaxMeshFileBytes)
-    fail(name, "the mesh file is larger than " + std::to_string(kMaxMeshFileBytes >> 20) +
-                   " MiB, got " + std::to_string(bytes) + " bytes");
-  if (ext == ".ply") checkPlyCounts(file, name, bytes);
-  if (ext == ".obj") checkObjVertices(file, name);
   try {
-    return importMesh(file, name);
+    const std::string bytes = meshBytes(file, name);
+    return weld(ext == ".obj"   ? parseObj(bytes, name)
+                : ext == ".ply" ? parsePly(bytes, name)
+                                : parseStl(bytes, name));
   } catch (const std::bad_alloc&) {
     fail(name, "not enough memory to read the mesh");
   }

@@ -1,9 +1,9 @@
-// Triangle meshes as scene objects (issue 16, item 1): {"shape": "mesh", "file": "x.obj"}.
+// Triangle meshes as scene objects: {"shape": "mesh", "file": "x.obj"}.
 //
-// Files are read with Assimp (Debian's libassimp-dev), which reads OBJ, PLY (ASCII and binary)
-// and STL (ASCII and binary) through one interface; tinyobjloader reads OBJ only. Only these
-// three formats are accepted (by extension), so a scene cannot steer Assimp's other 40 parsers.
-// Vertices with equal positions are welded (STL stores every triangle's corners separately), then
+// Files are read by eikon's own readers (core/scene/mesh_readers.h: OBJ, PLY ascii and binary,
+// STL ascii and binary), in double, written for hostile input (every declared count checked
+// against the bytes left before any allocation). The vertices the triangles use are kept; those
+// with equal positions are welded (STL stores every triangle's corners separately), then
 // the surface is checked: every edge must be shared by exactly two triangles that run it in
 // opposite directions (closed, edge-manifold, consistently oriented) and the enclosed signed
 // volume must be positive (normals outward, counter-clockwise seen from outside). Each failure is
@@ -45,11 +45,15 @@ struct TriangleMesh {
 
 /// Most triangles a mesh file may hold (checked after reading, before any O(n log n) work).
 constexpr size_t kMaxMeshTriangles = 100000;
-/// Largest mesh file read (Assimp holds it in memory while parsing).
+/// Most vertices a mesh file may declare (three for each of kMaxMeshTriangles, as an STL has).
+constexpr size_t kMaxMeshVertices = 3 * kMaxMeshTriangles;
+/// Largest mesh file read (it is held in memory while parsing).
 constexpr std::uintmax_t kMaxMeshFileBytes = 64u << 20;
 
-/// Read an .obj, .ply or .stl file (its own units; the scene scales them) and weld equal
-/// positions. Throws std::invalid_argument with a message that starts with the file's name.
+/// Read an .obj, .ply or .stl file (its own units; the scene scales them): a regular file of at
+/// most kMaxMeshFileBytes, read whole, then parsed by the reader of its extension; the vertices
+/// its triangles use are kept and equal positions welded (numbered by first use). Throws
+/// std::invalid_argument with a message that starts with the file's name.
 TriangleMesh readMesh(const std::filesystem::path& file);
 
 /// Check that the mesh is a closed, edge-manifold, consistently and outwardly oriented surface.

@@ -7,6 +7,7 @@
 #include <map>
 #include <new>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -14,15 +15,15 @@
 #include "core/io/text_file.h"
 #include "core/scene/faceted.h"
 #include "core/scene/limits.h"
+#include "core/scene/material_library.h"
 #include "core/scene/mesh.h"
+#include "core/scene/scene_warnings.h"
 #include "core/spectrum/illuminants.h"
 
 namespace eikon {
 namespace {
 
 using json = nlohmann::json;
-constexpr double kPi = 3.14159265358979323846;
-
 // Limits on what the scene may ask for, so that every derived quantity is representable:
 // - positions and lengths within ±1e12 mm: distances are computed in double (squares ≤ 1e24, no
 //   overflow) and a surface 1e12 mm from the origin is still placed to ~1e-4 mm;
@@ -676,7 +677,7 @@ SceneObject parseObject(const Node& o) {
       const double apex_deg = apex.number(0.0, 180.0, true, true), side = o.at("side").length();
       // The triangle's base and height at least kMinVoxelMm: 1e-300 degrees left a sliver whose
       // planes "do not enclose a bounded solid".
-      const double half = 0.5 * apex_deg * kPi / 180.0;
+      const double half = 0.5 * apex_deg * std::numbers::pi / 180.0;
       const double thin = std::min(2.0 * side * std::sin(half), side * std::cos(half));
       if (!(thin >= kMinVoxelMm))
         apex.fail("the prism's cross-section would be " + fmt(thin) + " mm thin (side " +
@@ -889,8 +890,8 @@ bool Attenuation::isZero() const {
 
 glm::dvec3 Environment::lookup(const glm::dvec3& d) const {
   // Latitude-longitude parameterisation: y is up; u = atan2(x, -z)/(2π) + 0.5, v = acos(y)/π.
-  double u = std::atan2(d.x, -d.z) / (2.0 * kPi) + 0.5;
-  double v = std::acos(std::clamp(d.y, -1.0, 1.0)) / kPi;
+  double u = std::atan2(d.x, -d.z) / (2.0 * std::numbers::pi) + 0.5;
+  double v = std::acos(std::clamp(d.y, -1.0, 1.0)) / std::numbers::pi;
   switch (type) {
     case Type::Constant:
       return radiance * intensity;
@@ -1217,22 +1218,24 @@ static void loadLibraryMaterial(const Node& o, const SceneObject& obj, Scene& sc
               "' is not a plain name (no '/', '\\' or NUL, not '.' or " +
               "'..'): library materials are looked up inside the material library only; define " +
               "others under /materials");
-  for (const auto& dir : materialSearchPath()) {
-    auto p = dir / (obj.material + ".json");
-    std::error_code ec;
-    const bool found = std::filesystem::exists(p, ec);  // not found is no error
-    if (ec)
-      o.at("material")
-          .fail("cannot look up the library material '" + excerpt(name) + "' as " + shownPath(p) +
-                ": " + errorReason(ec));
-    if (found) {
-      scene.materials[obj.material] = loadMaterialFile(p);
-      return;
-    }
+  std::optional<std::filesystem::path> file;
+  try {
+    file = findLibraryMaterial(name);
+  } catch (const std::filesystem::filesystem_error& e) {  // a name the system cannot look up
+    o.at("material")
+        .fail("cannot look up the library material '" + excerpt(name) + "' as " +
+              shownPath(e.path1()) + ": " + errorReason(e.code()));
   }
+  if (file) {
+    scene.materials[obj.material] = loadMaterialFile(*file);
+    return;
+  }
+  std::vector<std::string> defined;
+  for (const auto& m : scene.materials) defined.push_back(m.first);
   o.at("material")
       .fail("unknown material '" + excerpt(obj.material) +
-            "' (not defined under /materials and not in the material library)");
+            "': not defined under /materials and not in the material library; " +
+            unknownMaterialHint(name, defined));
 }
 
 namespace {
@@ -1440,6 +1443,17 @@ static void dropUnusedMaterials(Scene& scene) {
   std::erase_if(scene.materials, [&](const auto& m) { return !used.count(m.first); });
 }
 
+// "render": the scene's intended quality (docs/scene-format.md), as `eikon render` checks its
+// options (--spp, --wavelengths, --exposure).
+static RenderHints parseRenderHints(const Node& r) {
+  r.allowKeys({"spp", "wavelengths", "exposure"});
+  RenderHints h;
+  if (auto s = r.get("spp")) h.spp = s->integer(1, 4096);
+  if (auto w = r.get("wavelengths")) h.wavelengths = w->integer(0, 256);
+  if (auto e = r.get("exposure")) h.exposure = e->number(-64.0, 64.0);
+  return h;
+}
+
 // "interfaces": how material boundaries are represented (docs/scene-format.md).
 static Scene::Interfaces parseInterfaces(const Node& f) {
   const std::string m = f.string();
@@ -1455,12 +1469,13 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   scene.file = origin;
   Node root(j, "", file);
   root.allowKeys({"camera", "environment", "volume", "materials", "objects", "lights",
-                  "ambient_index", "description", "interfaces"});
+                  "ambient_index", "description", "interfaces", "render"});
   if (auto c = root.get("camera")) parseCamera(*c, scene.camera);
   if (auto e = root.get("environment")) parseEnvironment(*e, scene.environment);
   if (auto v = root.get("volume")) parseVolume(*v, scene.volume);
   if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(kMinIndex, kMaxIndex);
   if (auto f = root.get("interfaces")) scene.interfaces = parseInterfaces(*f);
+  if (auto r = root.get("render")) scene.render = parseRenderHints(*r);
   if (auto ms = root.get("materials")) {
     ms->requireObject();
     for (auto it = ms->raw().begin(); it != ms->raw().end(); ++it)
@@ -1476,6 +1491,7 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
     for (size_t i = 0; i < ls->size(); ++i) scene.lights.push_back(parseLight(ls->index(i)));
   }
   warnInsideOpaque(scene, json_index, file);
+  warnUnseenScene(scene, json_index, file);
   return scene;
 }
 

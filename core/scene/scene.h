@@ -123,6 +123,15 @@ struct VolumeSpec {
   enum class Smoothing { Analytic, Gaussian } smoothing = Smoothing::Analytic;
 };
 
+/// "render": the quality a scene is meant to be rendered at (docs/scene-format.md "render"), the
+/// defaults of `eikon render` and Python's render; options given there override them. Unset: the
+/// renderer's own defaults (1 sample, 16 wavelengths for dispersive scenes, exposure 0).
+struct RenderHints {
+  std::optional<int> spp;          ///< [1, 4096] jittered samples per pixel
+  std::optional<int> wavelengths;  ///< [0, 256] spectral samples per pixel sample (0 = RGB)
+  std::optional<double> exposure;  ///< [-64, 64] stops of the PNG preview (and the viewer)
+};
+
 struct SceneObject {
   Shape shape;
   std::string material;                  ///< key into Scene::materials
@@ -167,6 +176,7 @@ struct Scene {
   std::vector<Light> lights;
   std::vector<PolarizerSheet> polarizers;  ///< ideal sheets, not voxelised
   double ambient_index = 1.0;              ///< index of the medium around the objects (air)
+  RenderHints render;                      ///< "render": its intended quality
   /// "interfaces": how boundaries between media are marched. Sharp (default): located on the
   /// boundary field (core/volume/boundary.h) and crossed with exact Snell/Fresnel; Smoothed: the
   /// smoothed layer is integrated (the fields are built either way).

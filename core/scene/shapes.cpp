@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -12,7 +13,7 @@
 namespace eikon {
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 
 glm::dmat3 rotationFromEuler(glm::dvec3 deg) {
   glm::dvec3 r = deg * kDeg;
@@ -258,7 +259,7 @@ ConvexShape makeBrilliant(double diameter, double table_frac, double crown_deg, 
   ConvexShape s;
   s.planes.push_back({{0, 1, 0}, girdle_half + crown_h});  // table
   for (int k = 0; k < facets; ++k) {
-    double phi = 2.0 * 3.14159265358979323846 * (k + 0.5) / facets;
+    double phi = 2.0 * std::numbers::pi * (k + 0.5) / facets;
     glm::dvec3 radial(std::cos(phi), 0, std::sin(phi));
     // Girdle: a vertical facet at radius R.
     s.planes.push_back({radial, R});

@@ -137,7 +137,7 @@ void checkMarchStep(double step_voxels) {
 void checkViewRequest(const ViewRequest& v) {
   if (v.width) checkRange("width", *v.width, 1, 16384);
   if (v.height) checkRange("height", *v.height, 1, 16384);
-  checkRange("spp", v.spp, 1, 4096);
+  if (v.spp) checkRange("spp", *v.spp, 1, 4096);
   if (v.wavelengths) checkRange("wavelengths", *v.wavelengths, 0, 256);
   if (v.march) checkMarchStep(v.march->step_voxels);
   if (v.march) checkMarchSettings(*v.march);  // the rest, as both twins check them
@@ -149,7 +149,7 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
   RenderSettings rs = defaultRenderSettings(scene);
   rs.width = v.width.value_or(0);
   rs.height = v.height.value_or(0);
-  rs.spp = v.spp;
+  if (v.spp) rs.spp = *v.spp;
   if (v.wavelengths) rs.wavelengths = *v.wavelengths;
   rs.wavelength_nm = v.wavelength_nm;
   if (v.march) rs.march = *v.march;
@@ -292,9 +292,10 @@ VolumeSet& Session::prepare(bool gpu) {
     auto volume = std::make_unique<VolumeSet>();
     const uint64_t key = volume_cache_.empty() ? 0 : volumeCacheKey(*scene_);
     std::string notice;
-    volume_from_cache_ = key != 0 && loadVolumeCache(volume_cache_, key, *scene_, *volume, &notice);
+    const bool from_cache =
+        key != 0 && loadVolumeCache(volume_cache_, key, *scene_, *volume, &notice);
     if (!notice.empty() && volume_note_) volume_note_(printable(notice));
-    if (!volume_from_cache_) {
+    if (!from_cache) {
       *volume = voxelize(*scene_, vo);
       const std::string err = key != 0 ? saveVolumeCache(volume_cache_, key, *volume) : "";
       if (!err.empty() && volume_note_) volume_note_("volume cache: " + printable(err));
@@ -316,7 +317,6 @@ const VolumeSet& Session::prepareGpuRender() {
   auto lean = std::make_unique<VolumeSet>(voxelizeInterfaces(*scene_, vo));
   if (lean->boundary.empty() || lean->media.empty()) return prepare(true);  // not EIKON_F_SHARP
   volume_ = std::move(lean);
-  volume_from_cache_ = false;
   voxelized_spec_ = scene_->volume;
   return *volume_;
 }
@@ -376,7 +376,6 @@ void Session::adoptVolume(VolumeSet volume) {
   if (volume.grid.dims != g.dims || volume.grid.origin != g.origin || volume.grid.h != g.h)
     throw std::invalid_argument("adoptVolume: the volume is not on this scene's grid");
   volume_ = std::make_unique<VolumeSet>(std::move(volume));
-  volume_from_cache_ = false;
   voxelized_spec_ = scene_->volume;
 }
 

@@ -61,7 +61,7 @@ class SettingError : public std::invalid_argument {
 /// What a render is asked for; an unset value takes the default of core/render/render_defaults.h.
 struct ViewRequest {
   std::optional<int> width, height;    ///< [1, 16384]; unset: the scene camera's
-  int spp = 1;                         ///< [1, 4096] jittered samples per pixel
+  std::optional<int> spp;              ///< [1, 4096] jittered samples; unset: the scene's or 1
   std::optional<int> wavelengths;      ///< [0, 256] (0 = RGB); unset: defaultWavelengths(scene)
   double wavelength_nm = 587.5618;     ///< the index wavelength of the RGB mode, [100, 10000] nm
   std::optional<MarchSettings> march;  ///< step in (0, 4] voxels; unset: the render defaults
@@ -177,8 +177,6 @@ class Session {
     volume_cache_ = std::move(dir);
     volume_note_ = std::move(note);
   }
-  /// Whether the volume came from the volume cache.
-  bool volumeFromCache() const { return volume_from_cache_; }
 
   /// The Vulkan context, made on first use; the scene's volume is checked against its limits
   /// then (checkVolumeFits), before anything is voxelised.
@@ -278,7 +276,6 @@ class Session {
   std::unique_ptr<VolumeSet> volume_;
   std::filesystem::path volume_cache_;
   std::function<void(const std::string&)> volume_note_;
-  bool volume_from_cache_ = false;
   VolumeSpec voxelized_spec_;
   std::unique_ptr<ViewRenderer> gpu_;
   std::unique_ptr<VolumeField> field_;

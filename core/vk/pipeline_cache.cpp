@@ -7,6 +7,7 @@
 
 #include "core/io/atomic_write.h"
 #include "core/io/cache_dir.h"
+#include "core/io/cache_limit.h"
 
 namespace eikon::vk {
 namespace {
@@ -113,6 +114,7 @@ std::optional<std::string> loadPipelineCacheFile(const std::filesystem::path& fi
   std::string why;
   std::optional<std::string> payload = unpackPipelineCache(data, props, &why);
   if (!payload) return ignored(why);
+  touchCacheEntry(file);  // recently used: evicted last
   return payload;
 }
 
@@ -125,6 +127,7 @@ std::string savePipelineCacheFile(const std::filesystem::path& file, std::string
   } catch (const std::exception& e) {
     return e.what();
   }
+  trimCacheDir(file.parent_path(), file);  // the cache folder's cap (core/io/cache_limit.h)
   return {};
 }
 

@@ -1,4 +1,4 @@
-// The persistent VkPipelineCache (issue 14, start-up): what the driver learnt building eikon's
+// The persistent VkPipelineCache: what the driver learnt building eikon's
 // compute pipelines, kept on disk between runs so that a repeated render does not compile its
 // shaders again. The Context loads it when it creates the device and saves it after pipelines are
 // built (core/vk/context.h); these are the file format and its checks.

@@ -79,7 +79,7 @@ void Buffer::read(void* dst, VkDeviceSize bytes, VkDeviceSize offset) const {
 // tiling in host-visible memory where the device allows it for the format, and upload() writes
 // the texels straight into it: one copy instead of three (into a staging buffer, then the
 // device's copy into the image, each into freshly faulted pages) and no staging allocation
-// (issue 14 start-up: a 128³ RGBA32F volume is 32 MiB per image). Elsewhere: optimal tiling in
+// (a 128³ RGBA32F volume is 32 MiB per image). Elsewhere: optimal tiling in
 // device-local memory and a staging copy, as GPUs want.
 namespace {
 

@@ -1,5 +1,5 @@
-// Specialising a compute kernel's SPIR-V on the host before the driver sees it (issue 14,
-// start-up). eikon's kernels fold the scene's features and the march settings in through
+// Specialising a compute kernel's SPIR-V on the host before the driver sees it
+// (start-up). eikon's kernels fold the scene's features and the march settings in through
 // specialisation constants (march.glsl: kSharpMarch, kViewFlags, kIntegrator; wavefront.comp:
 // kSharpLight), so most of the code in view.spv is dead for any one render. Handing the driver
 // the generic module with a VkSpecializationInfo leaves the dead code to its compiler, and Mesa

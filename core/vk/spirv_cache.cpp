@@ -13,6 +13,7 @@
 
 #include "core/io/atomic_write.h"
 #include "core/io/build_id.h"
+#include "core/io/cache_limit.h"
 #include "core/vk/specialise.h"
 
 namespace eikon::vk {
@@ -46,8 +47,8 @@ uint64_t keyOf(std::span<const uint32_t> spirv, std::span<const uint32_t> values
   return key == 0 ? 1 : key;
 }
 
-/// At most kMaxEntries entries stay: the least recently written go first (a rebuilt eikon keys
-/// new ones, and the old ones would pile up).
+/// At most kMaxEntries entries stay: the least recently used (written or read) go first (a rebuilt
+/// eikon keys new ones, and the old ones would pile up).
 constexpr size_t kMaxEntries = 64;
 void trim(const fs::path& dir) {
   std::error_code ec;
@@ -124,7 +125,10 @@ std::vector<uint32_t> specialiseSpirvCached(std::span<const uint32_t> spirv,
   const uint64_t key = keyOf(spirv, values);
   std::string why;
   std::vector<uint32_t> words = readSpirvCacheEntry(path, key, why);
-  if (!words.empty()) return words;
+  if (!words.empty()) {
+    touchCacheEntry(path);  // recently used: evicted last (its own trim and the folder's cap)
+    return words;
+  }
   if (!why.empty())
     std::fprintf(stderr, "eikon: note: SPIR-V cache '%s' ignored: %s; specialising again\n",
                  path.c_str(), why.c_str());
@@ -141,6 +145,7 @@ std::vector<uint32_t> specialiseSpirvCached(std::span<const uint32_t> spirv,
     fs::create_directories(dir, ec);
     writeBytesAtomically(path, bytes);  // a reader sees the old entry or the whole new one
     trim(dir);
+    trimCacheDir(dir, path);  // the cache folder's cap (core/io/cache_limit.h)
   } catch (const std::exception&) {
     // Not written: the next run specialises again (a full disk is reported by what fills it).
   }

@@ -1,4 +1,4 @@
-// A file cache of specialised kernels (issue 14, start-up): specialiseSpirv (core/vk/specialise.h)
+// A file cache of specialised kernels: specialiseSpirv (core/vk/specialise.h)
 // costs SPIRV-Tools 0.1-0.4 s of CPU per pipeline, on the compile thread that the first dispatch
 // waits for, and gives the same words for the same module, constants and build every run. So
 // its result is kept as "spirv-<key>.bin" beside the pipeline cache (core/vk/pipeline_cache.h).

@@ -1,5 +1,5 @@
 // A process-wide start-up timeline, to see where the time before the first dispatch goes
-// (issue 14: a small render should start its first dispatch within 0.5 s of the process start).
+// (the aim: a small repeated render starts its first dispatch within 0.5 s of the process start).
 // `eikon render --timings` (and `trace`), or EIKON_TIMINGS=1 in the environment of any program
 // (the Python module, the benchmarks), prints one line per stage on stderr as the stage ends:
 //

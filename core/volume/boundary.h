@@ -1,4 +1,4 @@
-// Sharp material boundaries (issue 13): where the media of a scene meet, located to sub-voxel
+// Sharp material boundaries: where the media of a scene meet, located to sub-voxel
 // accuracy, so that a march can cross homogeneous media in straight segments and apply exact
 // Snell/Fresnel at the crossing instead of integrating through a smoothed layer.
 //
@@ -153,8 +153,8 @@ bool convexShapesApart(const std::vector<Shape>& shapes, double h);
 /// (an edge, or the face it just left), not a crossing: convexCrossingOutOf skips it.
 constexpr double kGrazeVoxels = 1e-3;
 
-/// nextCrossingOutOf for a field with convex_apart, exactly from the planes (issue 17, the
-/// viewer's speed): inside region r ≥ 1 the ray leaves its polyhedron where it first meets a
+/// nextCrossingOutOf for a field with convex_apart, exactly from the planes (one pass,
+/// not a walk): inside region r ≥ 1 the ray leaves its polyhedron where it first meets a
 /// plane it moves towards (t_exit = min over planes with n·d > 0 of (d_k − n_k·a)/(n_k·d)), into
 /// the ambient; in the ambient it enters the polyhedron of the nearest slab hit (max over planes
 /// with n·d < 0, below the min over those with n·d > 0, beyond kGrazeVoxels). One pass over the

@@ -1,4 +1,4 @@
-// The medium table of the sharp march (issue 13; docs/view-renderer.md "Sharp interfaces: the
+// The medium table of the sharp march (docs/view-renderer.md "Sharp interfaces: the
 // march"): one record per region of the boundary field (core/volume/boundary.h; region 0 = the
 // ambient medium, region r = scene object r − 1), built once per scene, that both twins read.
 //

@@ -2,14 +2,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
 namespace eikon {
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}  // namespace
+namespace {}  // namespace
 
 void checkPolarisedTrace(const TraceRequest& ray, const Stokes& in,
                          const PolarisedTraceSettings& s) {
@@ -31,7 +30,7 @@ void checkPolarisedTrace(const TraceRequest& ray, const Stokes& in,
   // The angular size of a source sample: exit directions at most this far apart are one beam,
   // and no two directions are more than pi apart, so (0, pi] holds every source (100 rad used to
   // merge every beam silently).
-  if (!(s.source_angle_rad > 0 && s.source_angle_rad <= kPi)) {
+  if (!(s.source_angle_rad > 0 && s.source_angle_rad <= std::numbers::pi)) {
     std::snprintf(got, sizeof got, "%.10g", s.source_angle_rad);
     throw std::invalid_argument(
         std::string("source_angle_rad must be in (0, pi] (the angular size of one light or "

@@ -1,4 +1,4 @@
-// What both twins of the polarised trace take and give (issue 15; docs/polarisation.md): the
+// What both twins of the polarised trace take and give (docs/polarisation.md): the
 // settings, the beams leaving the scene and the check of a request. The CPU twin is
 // core/reference/polarised_trace.h (tracePolarised), the GPU twin ViewRenderer::tracePolarised
 // (shaders/polarised_trace.comp); both fill these plain structs so that tests and front ends

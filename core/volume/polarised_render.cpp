@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -15,8 +16,6 @@
 
 namespace eikon {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 /// Rays per call of the batch: bounds the GPU twin's result buffer (~340 bytes a ray) and sets
 /// how often progress is reported.
 constexpr size_t kBatchRays = 1 << 15;
@@ -30,7 +29,7 @@ struct CameraRays {
       : fwd(glm::normalize(cam.look_at - cam.position)),
         right(glm::normalize(glm::cross(fwd, cam.up))),
         up(glm::cross(right, fwd)),
-        tanh(std::tan(0.5 * cam.fov_deg * kPi / 180.0)),
+        tanh(std::tan(0.5 * cam.fov_deg * std::numbers::pi / 180.0)),
         aspect(double(w) / h),
         width(w),
         height(h),

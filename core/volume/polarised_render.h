@@ -1,4 +1,4 @@
-// Polarised renders (issue 15; docs/polarisation.md "Polarised renders"), shared by both twins:
+// Polarised renders (docs/polarisation.md "Polarised renders"), shared by both twins:
 // each pixel sample's camera ray is traced BACKWARDS by a twin's polarised trace (the same o/e
 // ray tree as a forward trace: ray optics in reciprocal, non-magnetic media is time-reversible, the
 // e-rays too), every beam leaving the scene looks up the environment, and reciprocity turns the

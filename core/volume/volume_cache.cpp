@@ -12,6 +12,7 @@
 
 #include "core/io/atomic_write.h"
 #include "core/io/build_id.h"
+#include "core/io/cache_limit.h"
 #include "core/scene/mesh.h"
 #include "core/volume/media.h"
 
@@ -367,7 +368,7 @@ bool loadVolumeCache(const fs::path& dir, uint64_t key, const Scene& scene, Volu
     v.media = buildMediaTable(scene);
   }
   volume = std::move(v);
-  fs::last_write_time(path, fs::file_time_type::clock::now(), ec);  // recently used: kept longest
+  touchCacheEntry(path);  // recently used: kept longest
   return true;
 }
 
@@ -419,6 +420,7 @@ std::string saveVolumeCache(const fs::path& dir, uint64_t key, const VolumeSet& 
     return e.what();
   }
   trimCache(dir, path, max_cache_bytes);
+  trimCacheDir(dir, path);  // and the whole cache folder's cap (core/io/cache_limit.h)
   return {};
 }
 

@@ -1,4 +1,4 @@
-// On-disk cache of voxelised volumes (issue 14, start-up), beside the light cache and the
+// On-disk cache of voxelised volumes (start-up), beside the light cache and the
 // pipeline cache (core/io/cache_dir.h): a repeated render of a scene reads its VolumeSet back
 // instead of voxelising it again (0.4 s for a 128³ sphere on a quiet 2-core machine, tens of
 // seconds for large crystals on a loaded one).
@@ -20,7 +20,8 @@
 // with one notice and replaced by the next save; an entry of another format version is replaced
 // quietly. Entries over kMaxVolumeEntryBytes are neither written nor read; after a save the
 // oldest volume entries (by modification time; a hit refreshes it) are removed until those left
-// take at most kMaxVolumeCacheBytes.
+// take at most kMaxVolumeCacheBytes, and then the least recently used entries of every cache in
+// the folder until all take at most its cap (core/io/cache_limit.h, 1 GiB by default).
 //
 //   const uint64_t key = eikon::volumeCacheKey(scene);      // 0: no build id, cache nothing
 //   std::string notice;

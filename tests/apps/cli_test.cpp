@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -239,7 +240,7 @@ TEST_F(Cli, EveryShippedSceneRendersCleanUnderStrict) {
   }
 }
 
-// ------------------------------------------------------------------ progress (issue 11)
+// ------------------------------------------------------------------ progress
 
 /// Lines of `err` (progress lines end in '\n' when stderr is not a terminal) that look like
 /// "eikon: STAGE  42.0%  1.2 s, ETA ..." for STAGE starting with `stage`.
@@ -877,9 +878,9 @@ TEST_F(Cli, TraceGpuAgreesWithReference) {
   EXPECT_GT(std::abs(pc[1] - 1.5), 0.1);
 }
 
-// ------------------------------------------------------------------ lights (issue 6)
+// ------------------------------------------------------------------ lights
 
-// Sharp interfaces (issue 13): the light follows the scene's "interfaces" on both twins. A sharp
+// Sharp interfaces: the light follows the scene's "interfaces" on both twins. A sharp
 // scene loses flux to Fresnel reflection, which the summary reports as a share of the emitted
 // flux: at least the normal-incidence loss of the lit disc's two passes, 1 − (1 − R₀)² = 0.0784
 // times the disc's share πR²/(10 mm)² = 0.196 of the light over the box, and at most that share;
@@ -904,7 +905,7 @@ TEST_F(Cli, LightSummaryReportsTheFluxReflectedAtSharpInterfaces) {
     EXPECT_NE(at, std::string::npos) << o.out;
     return at == std::string::npos ? -1.0 : std::strtod(o.out.c_str() + at + 10, nullptr);
   };
-  const double disc = 3.14159265358979 * 2.5 * 2.5 / 100.0;
+  const double disc = std::numbers::pi * 2.5 * 2.5 / 100.0;
   for (const char* device : {"cpu", "gpu"}) {
     const double r = reflected("sharp", device);
     EXPECT_GT(r, 0.0784 * disc * 0.99) << device;

@@ -1,5 +1,5 @@
-// `eikon trace` through the table facet of a stone given as a faceting diagram (shape "faceted",
-// issue 16 item 2): a plate cut on the machine — 8 girdle facets, a table and a flat culet — of
+// `eikon trace` through the table facet of a stone given as a faceting diagram (shape "faceted"):
+// a plate cut on the machine — 8 girdle facets, a table and a flat culet — of
 // n = 2. A ray at 30° from the table's normal refracts to θt with sin θt = sin 30° / 2 (Snell),
 // crosses the 2 mm plate, leaves the parallel culet at 30° again and reaches the volume's floor:
 // its exit point there is displaced by 2·tan θt against the straight line, which fixes θt.
@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -36,7 +37,7 @@ TEST(FacetedCli, TraceThroughTheTableRefractsAsSnellSays) {
               {"name": "T", "side": "table", "distance": 1},
               {"name": "K", "side": "culet", "distance": 1}]}]
 })";
-  const double kDeg = 3.14159265358979323846 / 180.0;
+  const double kDeg = std::numbers::pi / 180.0;
   const double c30 = std::cos(30 * kDeg), s30 = std::sin(30 * kDeg);
   // From the volume's top face y = 5 to the table at (0, 1, −1): 4 mm down, 4 tan 30° along z.
   const double z0 = -1.0 - 4.0 * std::tan(30 * kDeg);

@@ -235,7 +235,7 @@ TEST_F(FitCli, ConradyReportWithoutMaterialAndHuberLoss) {
   EXPECT_EQ(json::parse(h.out)["loss"], "huber:0.0001");
 }
 
-// Issue 11: every model fit offers is a renderer material. The calcite data (both modes within
+// Every model fit offers is a renderer material. The calcite data (both modes within
 // their sigma only with conrady) are fitted with conrady and written; the file loads as a library
 // material and its n_o/n_e load in a scene's "materials" section, where n(λ) is the closed form
 // n0 + A/λ + B/λ^3.5 of the written coefficients. fit prints the Cauchy {A, B, C} that the
@@ -319,7 +319,7 @@ TEST_F(FitCli, ConradyIsWrittenAsASceneMaterialWithItsRendererError) {
   }
 }
 
-// The usage line says what DATA accepts (issue 11: it showed "data(1x)" though two files work).
+// The usage line says what DATA accepts: one or two files, not "data(1x)".
 TEST_F(FitCli, UsageNamesOneOrTwoDataFiles) {
   const Outcome h = run("--help");
   ASSERT_EQ(h.code, 0) << h.err;
@@ -334,7 +334,7 @@ TEST_F(FitCli, UsageNamesOneOrTwoDataFiles) {
   EXPECT_NE(three.err.find("DATA: At Most 2"), std::string::npos) << three.err;
 }
 
-// A fit that Ceres gives up on (issue 11): one index of 1e200 among visible calcite values makes
+// A fit that Ceres gives up on: one index of 1e200 among visible calcite values makes
 // every trust-region step invalid. Ceres logs that through glog ("WARNING: Logging before
 // InitGoogleLogging()", "E... trust_region_minimizer.cc:95] Terminating: ...") even with
 // logging_type SILENT; eikon must print its own line only. The rank-deficient sellmeier2 fit of
@@ -393,7 +393,7 @@ TEST_F(FitCli, WavelengthOutsideTheFitRangeNamesTheRowAndFailuresTheFile) {
                      csv + ": n_o: rank-deficient sellmeier2");
 }
 
-// Issue 11: --samples is bounded before anything is allocated (2000000000 ran 55 s into
+// --samples is bounded before anything is allocated (2000000000 would run for a minute into
 // std::bad_alloc); the bound itself is accepted.
 TEST_F(FitCli, SamplesAreBounded) {
   const std::string yml = std::string(EIKON_SOURCE_DIR) + "/tests/data/fit/N-BK7.yml";
@@ -407,7 +407,7 @@ TEST_F(FitCli, SamplesAreBounded) {
   EXPECT_EQ(json::parse(ok.out)["modes"]["n"]["points"], 100000);
 }
 
-// Issue 11: an output naming the fit's own data file (by any spelling: "./", "..", a symbolic
+// An output naming the fit's own data file (by any spelling: "./", "..", a symbolic
 // link) is refused and the data stay as they were; so are -o and --export-yaml naming one file.
 // -o into folders that do not exist yet creates them.
 TEST_F(FitCli, OutputsNeverReplaceInputsAndFoldersAreCreated) {

@@ -1,4 +1,4 @@
-// Hostile input through the real `eikon` binary (issue 11): what reaches the terminal is one
+// Hostile input through the real `eikon` binary: what reaches the terminal is one
 // "eikon: error: ..." line of printable text whatever bytes the input held, directories given as
 // files say so, and (further down) host memory and the light cache.
 #include <gtest/gtest.h>

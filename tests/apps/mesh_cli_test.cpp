@@ -1,13 +1,15 @@
-// The "mesh" shape through the real binary (issue 16, item 1): a convex mesh is its exact
+// The "mesh" shape through the real binary: a convex mesh is its exact
 // polyhedron, so the self-made cube (tests/data/meshes/box.obj) scaled to 6 × 4 × 5 mm and the
 // `box` shape of that size, placed and turned alike, must leave the same exit points under
 // `eikon trace` with sharp interfaces (to 1e-4 mm, GPU and CPU twin) and render the same image.
 // A non-convex mesh (an L-shaped prism) traces on Snell's line with sharp interfaces and renders
 // with either kind, and bad meshes fail with one line.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -197,6 +199,69 @@ TEST_F(MeshCli, BadVertexLineAndAbsurdScaleFailWithOneLine) {
     EXPECT_EQ(r.err.find("eikon: error: " + s.string() + ": " + want), 0u) << r.err;
     EXPECT_FALSE(fs::exists(dir_ / "o.exr"));
   }
+}
+
+/// box.obj's cube as a binary little-endian PLY whose first face's list count is `first`
+/// (uint32), the rest triangles.
+std::string hostilePly(uint32_t first) {
+  std::string t =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 8\nproperty float x\nproperty float "
+      "y\nproperty float z\nelement face 12\nproperty list uint int vertex_indices\nend_header\n";
+  auto put = [&](auto x) { t.append(reinterpret_cast<const char*>(&x), sizeof x); };
+  for (int i = 0; i < 8; ++i)
+    for (int a : {4, 2, 1}) put(i & a ? 0.5f : -0.5f);
+  const int quads[6][4] = {{4, 6, 7, 5}, {0, 1, 3, 2}, {2, 3, 7, 6},
+                           {0, 4, 5, 1}, {1, 5, 7, 3}, {0, 2, 6, 4}};
+  bool head = true;
+  for (const auto& q : quads)
+    for (int j : {1, 2}) {
+      put(head ? first : uint32_t(3));
+      head = false;
+      for (int c : {q[0], q[j], q[j + 1]}) put(int32_t(c));
+    }
+  return t;
+}
+
+// The files that broke the Assimp reader, through the real binary: a PLY face list of 2³¹
+// corners (minutes and gigabytes), a face of 0 corners (SIGABRT), an OBJ whose mtllib names a
+// FIFO (blocked for ever) and /etc/passwd. Each run is under `timeout` and an address-space
+// limit, so that a regression fails (exit 124, or a memory error) rather than hangs or swells.
+TEST_F(MeshCli, HostileMeshFilesFailAtOnceOrLoadWithoutOpeningAnythingElse) {
+  std::ofstream(dir_ / "huge.ply", std::ios::binary) << hostilePly(uint32_t(1) << 31);
+  std::ofstream(dir_ / "zero.ply", std::ios::binary) << hostilePly(0);
+  ASSERT_EQ(::mkfifo((dir_ / "pipe.mtl").c_str(), 0600), 0);
+  std::ifstream box(kMeshes / "box.obj");
+  std::ofstream(dir_ / "mtl.obj") << "mtllib /etc/passwd\nmtllib pipe.mtl\n" << box.rdbuf();
+  // At most 2 GB of address space (the reader needs a few MB; Assimp reserved 8 GB for the
+  // list) and 60 s.
+  const std::string timed = "ulimit -v 2000000; timeout 60 " + std::string(EIKON_BINARY);
+  const std::string ray = " --origin 0,0,-6 --dir 0,0,1 --reference";
+  const size_t header = hostilePly(3).find("end_header\n") + 11;
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"huge.ply", "huge.ply: byte offset " + std::to_string(header + 96) +
+                       ": the face 0 declares a list 'vertex_indices' of 2147483648 items, more "
+                       "than the "},
+      {"zero.ply", "zero.ply: byte offset " + std::to_string(header + 96) +
+                       ": a face of 0 corners (a point or a line)"}};
+  for (const auto& [file, want] : refused) {
+    const fs::path s = scene(file + ".json", R"({"shape": "mesh", "material": "glass", "file": ")" +
+                                                 file + R"(", "scale": 4})");
+    const auto t0 = std::chrono::steady_clock::now();
+    const Outcome r =
+        eikon::test::runProgram(timed, "trace " + quote(s.string()) + ray, dir_ / "io");
+    const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("[ measured ] %s refused by the binary in %.2f s (exit %d)\n", file.c_str(), sec,
+                r.code);
+    EXPECT_EQ(r.code, 1) << r.err;  // not 124 (the timeout), not -1 (a signal)
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.err.find("eikon: error: " + s.string() + ": /objects/0/file: " + want), 0u)
+        << r.err;
+  }
+  const fs::path s = scene("mtl.json", R"({"shape": "mesh", "material": "glass", "file": "mtl.obj",
+                                           "scale": 4})");
+  const Outcome r = eikon::test::runProgram(timed, "trace " + quote(s.string()) + ray, dir_ / "io");
+  EXPECT_EQ(r.code, 0) << r.err;  // 124: blocked on the FIFO
+  EXPECT_NE(r.out.find("2 interfaces crossed"), std::string::npos) << r.out;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -123,7 +124,7 @@ TEST(RenderLayersCli, AovChannelsReadBackWithOpenImageIO) {
   for (const char* name : {"Z", "Px", "Py", "Pz", "Nx", "Ny", "Nz", "objectId", "steps"})
     ASSERT_EQ(lo.count(name), 1u) << name << " missing in\n" << info.out << stats.out;
   // Pixel (7, 5) of 16 × 12 at fov 30°: u = −(0.5/16·2)·tan 15°·4/3, v = (1/12)·tan 15°.
-  const double t15 = std::tan(15.0 * M_PI / 180.0);
+  const double t15 = std::tan(15.0 * std::numbers::pi / 180.0);
   const double u = 1.0 / 16.0 * t15 * 4.0 / 3.0, v = 1.0 / 12.0 * t15;
   const double dz = 1.0 / std::sqrt(1.0 + u * u + v * v), b = -40.0 * dz;
   const double t = -b - std::sqrt(b * b - (1600.0 - 25.0));

@@ -1,4 +1,4 @@
-// Start-up of `eikon render` (issue 14, item 2 "start-up"): the --timings lines that show where
+// Start-up of `eikon render`: the --timings lines that show where
 // the time before the first dispatch goes. Only what the lines say and their order are tested,
 // never how long a stage took (timings vary ±30% on shared machines).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// `eikon trace --stokes S0,S1,S2,S3` (issue 15; docs/polarisation.md): the Stokes vector of the
+// `eikon trace --stokes S0,S1,S2,S3` (docs/polarisation.md): the Stokes vector of the
 // light leaving along the traced path, "stokes_out" in --json and in the text, from both twins
 // (the GPU's by default, the CPU's with --reference), against closed forms:
 //  - Malus: sheets at 0° and 60° pass ½cos²60° = 0.125 of unpolarised light, linear at 60°
@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -48,7 +49,7 @@ class TraceStokesCli : public ::testing::Test {
 };
 
 std::string sheetJson(double z, double deg) {
-  const double r = deg * 3.14159265358979323846 / 180.0;
+  const double r = deg * std::numbers::pi / 180.0;
   return R"({"shape": "polarizer", "center": [0, 0, )" + std::to_string(z) +
          R"(], "normal": [0, 0, 1], "transmission_axis": [)" + std::to_string(std::cos(r)) + ", " +
          std::to_string(std::sin(r)) + R"(, 0], "size": [20, 20]})";

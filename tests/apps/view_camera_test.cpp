@@ -7,12 +7,11 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 namespace {
 
 using eikon::Camera;
-constexpr double kPi = 3.14159265358979323846;
-
 Camera camera() {
   Camera c;
   c.position = {0, 0, -60};
@@ -24,30 +23,32 @@ Camera camera() {
 
 TEST(ViewCamera, YawTurnsAboutUpKeepingDistance) {
   Camera c = camera();
-  eikon::cli::orbitCamera(c, 0.5 * kPi, 0.0);
+  eikon::cli::orbitCamera(c, 0.5 * std::numbers::pi, 0.0);
   EXPECT_NEAR(glm::length(c.position - c.look_at), 60.0, 1e-12);
   EXPECT_NEAR(c.position.y, 0.0, 1e-12);
   EXPECT_NEAR(std::abs(c.position.x), 60.0, 1e-12);  // a quarter turn: onto the x axis
   EXPECT_NEAR(c.position.z, 0.0, 1e-12);
-  for (int i = 0; i < 3; ++i) eikon::cli::orbitCamera(c, 0.5 * kPi, 0.0);  // a full turn
+  for (int i = 0; i < 3; ++i)
+    eikon::cli::orbitCamera(c, 0.5 * std::numbers::pi, 0.0);  // a full turn
   EXPECT_NEAR(c.position.x, 0.0, 1e-11);
   EXPECT_NEAR(c.position.z, -60.0, 1e-11);
 }
 
 TEST(ViewCamera, PitchRaisesTheCameraAndStopsShortOfThePole) {
   Camera c = camera();
-  eikon::cli::orbitCamera(c, 0.0, kPi / 6);
+  eikon::cli::orbitCamera(c, 0.0, std::numbers::pi / 6);
   EXPECT_NEAR(glm::length(c.position - c.look_at), 60.0, 1e-12);
-  EXPECT_NEAR(c.position.y, 60.0 * std::sin(kPi / 6), 1e-10);
-  eikon::cli::orbitCamera(c, 0.0, kPi);  // past the pole: held 1° short
-  EXPECT_NEAR(c.position.y, 60.0 * std::cos(kPi / 180), 1e-9);
+  EXPECT_NEAR(c.position.y, 60.0 * std::sin(std::numbers::pi / 6), 1e-10);
+  eikon::cli::orbitCamera(c, 0.0, std::numbers::pi);  // past the pole: held 1° short
+  EXPECT_NEAR(c.position.y, 60.0 * std::cos(std::numbers::pi / 180), 1e-9);
   EXPECT_LT(c.position.z, 0.0);  // still on the side it started
 }
 
 TEST(ViewCamera, PanMovesCameraAndLookAtTogether) {
   Camera c = camera();
   eikon::cli::panCamera(c, 0.25, -0.5);
-  const double height = 2.0 * 60.0 * std::tan(15.0 * kPi / 180.0);  // image height at look_at
+  const double height =
+      2.0 * 60.0 * std::tan(15.0 * std::numbers::pi / 180.0);  // image height at look_at
   // Looking along +z with up +y, the image's right is −x.
   EXPECT_NEAR(c.look_at.x, -0.25 * height, 1e-12);
   EXPECT_NEAR(c.look_at.y, -0.5 * height, 1e-12);
@@ -68,7 +69,7 @@ TEST(ViewCamera, PointLightFollowsTheCursorInItsDepthPlane) {
   l.type = eikon::Light::Type::Point;
   l.position = {0, 10, 40};  // 100 mm in front of the camera
   eikon::cli::moveLight(l, c, 0.1, 0.2);
-  const double height = 2.0 * 100.0 * std::tan(15.0 * kPi / 180.0);
+  const double height = 2.0 * 100.0 * std::tan(15.0 * std::numbers::pi / 180.0);
   EXPECT_NEAR(l.position.x, -0.1 * height, 1e-12);  // the image's right is -x
   EXPECT_NEAR(l.position.y, 10 + 0.2 * height, 1e-12);
   EXPECT_NEAR(l.position.z, 40.0, 1e-12);
@@ -78,9 +79,10 @@ TEST(ViewCamera, DirectionalLightTurnsKeepingUnitLength) {
   Camera c = camera();
   eikon::Light l;
   l.direction = {0, -1, 0};
-  eikon::cli::moveLight(l, c, 0.0, kPi / 6 / 3.0);  // dy of 1/18 window heights: 30 degrees
+  eikon::cli::moveLight(l, c, 0.0,
+                        std::numbers::pi / 6 / 3.0);  // dy of 1/18 window heights: 30 degrees
   EXPECT_NEAR(glm::length(l.direction), 1.0, 1e-12);
-  EXPECT_NEAR(std::acos(-l.direction.y), kPi / 6, 1e-12);
+  EXPECT_NEAR(std::acos(-l.direction.y), std::numbers::pi / 6, 1e-12);
   EXPECT_NEAR(l.direction.x, 0.0, 1e-12);  // turned about the camera's right axis (x)
 }
 

@@ -1,4 +1,4 @@
-// `eikon view` (issue 17) as a user runs it: the real binary in a virtual X server (Xvfb, started
+// `eikon view` as a user runs it: the real binary in a virtual X server (Xvfb, started
 // here on a display number it picks itself, -displayfd), a mouse drag sent with xdotool, the
 // screenshot it writes on exit compared with `eikon render` of the camera it prints. The
 // tolerance comes from the renderer's own sample noise, measured from two renders with different
@@ -17,6 +17,7 @@
 #include <fstream>
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -295,7 +296,7 @@ TEST_F(ViewerTest, DragOrbitsAndRefinedViewMatchesRender) {
   EXPECT_GT(before, tolerance) << "the screenshot did not change with the drag";
 }
 
-/// Keys (issue 17 items 1–3): M selects the o-mode, R switches to spectral. With --no-prefetch
+/// Keys: M selects the o-mode, R switches to spectral. With --no-prefetch
 /// the spectral pipeline is compiled only after the key, on the renderer's thread, while the
 /// window keeps presenting the last image under a "compiling..." title and handling events: the
 /// viewer reports the frames it presented meanwhile, which a viewer that froze for the compile
@@ -353,7 +354,7 @@ double patchAt(const Png& img, const glm::dvec3& point) {
   const glm::dvec3 fwd = glm::normalize(look - eye),
                    right = glm::normalize(glm::cross(fwd, {0, 1, 0}));
   const glm::dvec3 up = glm::cross(right, fwd), d = point - eye;
-  const double t = std::tan(0.5 * 40.0 * 3.14159265358979323846 / 180.0), z = glm::dot(d, fwd);
+  const double t = std::tan(0.5 * 40.0 * std::numbers::pi / 180.0), z = glm::dot(d, fwd);
   const double u = glm::dot(d, right) / (z * t * (80.0 / 60.0)), v = glm::dot(d, up) / (z * t);
   const int px = int(std::lround(0.5 * (u + 1.0) * 80.0 - 0.5)),
             py = int(std::lround(0.5 * (1.0 - v) * 60.0 - 0.5));
@@ -390,7 +391,7 @@ LightReport lastLightReport(const std::string& out) {
   return r;
 }
 
-/// Ctrl + drag moves the first light (issue 17 item 3). The moved light is simulated on a thread
+/// Ctrl + drag moves the first light. The moved light is simulated on a thread
 /// of the viewer's own while the view keeps refining with the former light volumes (the viewer
 /// reports the frames it rendered or presented meanwhile: a viewer that simulated in its event
 /// loop would report none), then swapped into the renderer; the view then shows what `eikon
@@ -623,6 +624,51 @@ TEST_F(ViewerTest, HeroSpectralViewGoesFromCoarseStraightToFullQuality) {
     EXPECT_NE(run.out.find(said), std::string::npos) << attenuation << ": " << run.out;
     EXPECT_NE(run.out.find("2 samples after"), std::string::npos) << run.out;
   }
+}
+
+/// S saves into ~/Pictures/eikon (HOME here a temporary folder), never over a file that is there:
+/// with glass_sphere-view-1.png present, two saves write -2 and -3 (both files each), leave the
+/// PNG as it was and print the absolute paths. A --save-dir that cannot be written is refused
+/// before any window.
+TEST_F(ViewerTest, SaveGoesToThePicturesFolderAndNeverOverwrites) {
+  const std::string xvfb = findProgram("Xvfb"), xdotool = findProgram("xdotool");
+  if (xvfb.empty()) GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb)";
+  ASSERT_FALSE(xdotool.empty()) << "xdotool is not installed (Debian package xdotool)";
+  Xvfb server(xvfb);
+  ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
+  const fs::path home = dir_ / "home", pictures = home / "Pictures" / "eikon";
+  fs::create_directories(pictures);
+  std::ofstream(pictures / "glass_sphere-view-1.png") << "not the viewer's";
+  extra_env_ = "HOME=" + quote(home.string());
+  const ViewerRun run = viewWhile(
+      server, xdotool, kGlassSphere, "--width 40 --height 30 --spp 1 --no-prefetch",
+      " search --sync --onlyvisible --name 'refined' windowfocus %1 sleep 0.2 key s sleep 0.6"
+      " key s sleep 0.6 key q");
+  ASSERT_TRUE(WIFEXITED(run.status) && WEXITSTATUS(run.status) == 0) << run.err;
+  EXPECT_EQ(run.err.find("validation"), std::string::npos) << run.err;
+  EXPECT_EQ(eikon::test::slurp(pictures / "glass_sphere-view-1.png"), "not the viewer's");
+  EXPECT_FALSE(fs::exists(pictures / "glass_sphere-view-1.exr"));
+  for (const char* k : {"2", "3"}) {
+    const fs::path exr = pictures / (std::string("glass_sphere-view-") + k + ".exr");
+    const fs::path png = fs::path(exr).replace_extension(".png");
+    EXPECT_GT(fs::file_size(exr), 0u) << exr;
+    EXPECT_EQ(readPng(png).width, 40) << png;
+    EXPECT_NE(run.out.find("eikon view: saved " + exr.string() + " and " + png.string()),
+              std::string::npos)
+        << run.out;
+  }
+  EXPECT_FALSE(fs::exists(pictures / "glass_sphere-view-4.exr"));
+  // Not the current folder.
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find("-view-"), std::string::npos) << e.path();
+  // A folder below a file cannot be made: refused before the window, in one line.
+  std::ofstream(dir_ / "file") << "x";
+  const Outcome bad = eikon::test::runEikon(
+      "view " + quote(kGlassSphere) + " --save-dir " + quote((dir_ / "file" / "sub").string()),
+      dir_ / "render_io", "EIKON_VALIDATION=1 DISPLAY=" + quote(server.display()));
+  EXPECT_NE(bad.code, 0);
+  EXPECT_EQ(bad.err.rfind("eikon: error: ", 0), 0u) << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
 }
 
 }  // namespace

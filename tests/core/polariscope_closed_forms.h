@@ -33,18 +33,16 @@
 #include <functional>
 #include <glm/glm.hpp>
 #include <limits>
+#include <numbers>
 
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
 #include "core/spectrum/illuminants.h"
 
 namespace eikon::test {
-
-constexpr double kMlPi = 3.14159265358979323846;
-
 /// ½ sin²(πΓ/λ), Γ and λ in nm: crossed polarisers with a retarder at 45°.
 inline double crossedRetarder(double gamma_nm, double lambda_nm) {
-  const double s = std::sin(kMlPi * gamma_nm / lambda_nm);
+  const double s = std::sin(std::numbers::pi * gamma_nm / lambda_nm);
   return 0.5 * s * s;
 }
 
@@ -97,7 +95,7 @@ inline double conoscopeOrder(double theta, double t_mm, double n_o, double n_e, 
 /// (0, π/2), where the order rises monotonically from 0 (negative crystals; positive ones fall).
 inline double conoscopeRing(double m, double t_mm, double n_o, double n_e, double lambda_nm) {
   const double sign = n_o > n_e ? 1.0 : -1.0;
-  double lo = 0.0, hi = 0.5 * kMlPi;
+  double lo = 0.0, hi = 0.5 * std::numbers::pi;
   for (int k = 0; k < 200; ++k) {
     const double mid = 0.5 * (lo + hi);
     (sign * conoscopeOrder(mid, t_mm, n_o, n_e, lambda_nm) > m ? hi : lo) = mid;

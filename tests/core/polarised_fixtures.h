@@ -2,12 +2,11 @@
 // tests/core/render): the same plates and spheres, so that both are held to the same closed forms.
 #pragma once
 
+#include <numbers>
 #include <string>
 
 namespace eikon::test {
-
-constexpr double kPolPi = 3.14159265358979323846;
-inline double rad(double deg) { return deg * kPolPi / 180.0; }
+inline double rad(double deg) { return deg * std::numbers::pi / 180.0; }
 
 /// A scene of `objects` (JSON objects, comma-separated) in a 16 mm cube at 64³ under a constant
 /// unit environment, with a glass of n = 1.5 and the given ambient index; `extra`: more top-level

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <string>
 
 #include "core/reference/reference_marcher.h"
@@ -34,7 +35,7 @@ inline void expectNoValidationMessages() {
 
 inline Scene sceneFromJson(const std::string& text) { return parseScene(text, "test-scene.json"); }
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 
 /// Both twins over one voxelised scene.
 struct Twins {

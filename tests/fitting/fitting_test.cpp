@@ -306,7 +306,7 @@ TEST(DispersionFit, ConradyRecoversExactCoefficients) {
     EXPECT_NEAR(r.coeffs[size_t(k)], p[k], 1e-9 * std::max(1.0, std::abs(p[k])));
 }
 
-// Conrady is a renderer material model (issue 11): Dispersion::conrady evaluates the closed form
+// Conrady is a renderer material model: Dispersion::conrady evaluates the closed form
 // n0 + A/λ + B/λ^3.5 exactly, its derivative −A/λ² − 3.5 B/λ^4.5 (per µm, /1000 per nm), and
 // FitResult::dispersion() returns it with the data's range. Its renderer Cauchy approximation is
 // not exact, and reports max/rms |Δn| that the test recomputes from the coefficients.

@@ -4,16 +4,15 @@
 #pragma once
 
 #include <glm/glm.hpp>
+#include <numbers>
 #include <random>
 
 #include "optics/dispersion.h"
 #include "optics/uniaxial.h"
 
 namespace eikon::test {
-
-inline constexpr double kPi = 3.14159265358979323846;
-inline double deg(double d) { return d * kPi / 180.0; }
-inline double toDeg(double r) { return r * 180.0 / kPi; }
+inline double deg(double d) { return d * std::numbers::pi / 180.0; }
+inline double toDeg(double r) { return r * 180.0 / std::numbers::pi; }
 
 /// Calcite at D (589.2938 nm): n_o = 1.658344, n_e = 1.486130 (docs/reference-cases.md), any axis.
 inline Uniaxial calciteD(glm::dvec3 axis = {0, 0, 1}) {

@@ -17,7 +17,6 @@ namespace {
 
 using eikon::test::calciteD;
 using eikon::test::deg;
-using eikon::test::kPi;
 using eikon::test::randomUnit;
 using eikon::test::toDeg;
 

@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <string>
 
 #include "core/spectrum/cie1931.h"
@@ -28,9 +29,7 @@
 
 namespace eikon {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-double deg(double d) { return d * kPi / 180.0; }
+double deg(double d) { return d * std::numbers::pi / 180.0; }
 
 /// A material's dispersion from the shipped library file (materials/NAME.json), key "n", "n_o"
 /// or "n_e": the Sellmeier [B..., C...] of the file.
@@ -69,7 +68,8 @@ TEST(Polarisation, StokesConventionsAreMitsubas) {
   EXPECT_NEAR(r[1], 0.0, 1e-15);
   EXPECT_NEAR(r[2], -1.0, 1e-15);
   // A retarder with its fast axis along x and Γ = 90° turns +45° light into S3 = −1.
-  EXPECT_NEAR(stokesOf(linearRetarder(0.0, kPi / 2) * linearJones(deg(45)))[3], -1.0, 1e-15);
+  EXPECT_NEAR(stokesOf(linearRetarder(0.0, std::numbers::pi / 2) * linearJones(deg(45)))[3], -1.0,
+              1e-15);
   // Mitsuba's stokes_basis of +z is +x; a frame turned by 30° about k re-expresses 0° light as
   // linear at −30°: S2 = −sin 60°.
   const glm::dvec3 k(0, 0, 1), x = stokesBasis(k);
@@ -147,7 +147,7 @@ TEST(Polarisation, BrewsterReflectionOffNbk7IsSPolarised) {
   const Stokes s = muellerOf(reflectionJones(f)) * unpolarised();
   const double dop = degreeOfPolarisation(s);
   std::printf("Brewster N-BK7 (n_d = %.6f, %.4f deg): DoP = %.12f, S1/S0 = %.12f\n", n,
-              iB * 180 / kPi, dop, s[1] / s[0]);
+              iB * 180 / std::numbers::pi, dop, s[1] / s[0]);
   EXPECT_GE(dop, 0.999);
   EXPECT_GE(s[1] / s[0], 0.999);  // along x̂ = ŝ: s-polarised
   EXPECT_NEAR(s[0], 0.5 * std::norm(f.rs), 1e-15);
@@ -178,8 +178,8 @@ TEST(Polarisation, QuarterWaveQuartzPlateMakesCircularLight) {
 // Unpolarised light → polariser along x̂ → plate (axis at 45°) → analyser along ŷ.
 double crossedTransmission(double n_out, const Uniaxial& plate, double d, double nm) {
   const glm::dvec3 k(0, 0, 1), x = stokesBasis(k);
-  const Mueller M = muellerOf(linearPolariser(kPi / 2) * plateJones(n_out, plate, d, k, k, nm, x) *
-                              linearPolariser(0.0));
+  const Mueller M = muellerOf(linearPolariser(std::numbers::pi / 2) *
+                              plateJones(n_out, plate, d, k, k, nm, x) * linearPolariser(0.0));
   return (M * unpolarised())[0];
 }
 
@@ -189,14 +189,15 @@ TEST(Polarisation, CrossedPolarisersWithQuartzPlateAtFiveWavelengths) {
   double worst = 0.0, worst_air = 0.0;
   for (double nm : {450.0, 500.0, 550.0, 600.0, 650.0}) {
     const Uniaxial q = quartz(nm, axis);
-    const double dn = q.n_e - q.n_o, want = 0.5 * std::pow(std::sin(kPi * dn * d / (nm * 1e-6)), 2);
+    const double dn = q.n_e - q.n_o,
+                 want = 0.5 * std::pow(std::sin(std::numbers::pi * dn * d / (nm * 1e-6)), 2);
     // Immersed in a liquid of index n_o: no reflection losses, the ideal retarder.
     const double got = crossedTransmission(q.n_o, q, d, nm);
     worst = std::max(worst, std::abs(got - want));
     EXPECT_NEAR(got, want, 1e-3) << nm;
     // In air: each mode keeps τ = 4n/(1 + n)² of its amplitude², ⅛(τ_o² + τ_e² − 2τ_oτ_e cos Δ).
     const double to = 4 * q.n_o / std::pow(1 + q.n_o, 2), te = 4 * q.n_e / std::pow(1 + q.n_e, 2);
-    const double D = 2 * kPi * dn * d / (nm * 1e-6);
+    const double D = 2 * std::numbers::pi * dn * d / (nm * 1e-6);
     const double air = (to * to + te * te - 2 * to * te * std::cos(D)) / 8.0;
     worst_air = std::max(worst_air, std::abs(crossedTransmission(1.0, q, d, nm) - air));
   }
@@ -251,7 +252,8 @@ TEST(Polarisation, MichelLevyColoursOfQuartzPlates) {
     glm::dvec3 closed(0.0), library(0.0);
     for (double nm = 380.0; nm <= 780.0; nm += 2.0) {
       const Uniaxial q = quartz(nm, axis);
-      const double T = 0.5 * std::pow(std::sin(kPi * (q.n_e - q.n_o) * d / (nm * 1e-6)), 2);
+      const double T =
+          0.5 * std::pow(std::sin(std::numbers::pi * (q.n_e - q.n_o) * d / (nm * 1e-6)), 2);
       const glm::dvec3 w = spectrum::d65(nm) * spectrum::cmf(nm);
       closed += T * w;
       library += crossedTransmission(q.n_o, q, d, nm) * w;

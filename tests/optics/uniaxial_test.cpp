@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include "optics/dispersion.h"
@@ -15,10 +16,8 @@
 #include "optics/interface.h"
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-double deg(double d) { return d * kPi / 180.0; }
-double toDeg(double r) { return r * 180.0 / kPi; }
+double deg(double d) { return d * std::numbers::pi / 180.0; }
+double toDeg(double r) { return r * 180.0 / std::numbers::pi; }
 
 // Ghosh 1999 calcite and quartz, refractiveindex.info formula 2 with C1 as a C = 0 term.
 eikon::Dispersion calciteO() {

@@ -1,4 +1,4 @@
-"""The same scene renders the same from Python and from `eikon render` by default (issue 11).
+"""The same scene renders the same from Python and from `eikon render` by default.
 
 Run by CTest (python.render_defaults) with EIKON_BINARY (the CLI) and EIKON_PYTHON_DIR (the
 built module). Each case writes a small scene, renders it with the CLI's defaults (`eikon render
@@ -96,7 +96,7 @@ class RenderDefaults(unittest.TestCase):
         self.assertLess(float(np.abs(cached - cli).max()), 1e-5)
 
     def test_simulate_light_reports_the_flux_reflected_at_sharp_interfaces(self):
-        # Sharp interfaces (issue 13): the light follows the scene's "interfaces" on both twins
+        # Sharp interfaces: the light follows the scene's "interfaces" on both twins
         # and reports the flux Fresnel reflection takes, at least the normal-incidence loss of the
         # lit disc's two passes, 1 - (1 - R0)^2 = 0.0784, times the disc's share pi R^2 / A of
         # the light (A: the box's area projected along the light), and at most that share; a

@@ -1,4 +1,4 @@
-"""Renderer.render(modes=...) is `eikon render --modes` (issue 17 item 2, docs/viewer.md "Modes").
+"""Renderer.render(modes=...) is `eikon render --modes` (docs/viewer.md "Modes").
 
 Unpolarised light splits at a crystal into the ordinary and the extraordinary mode, each carrying
 half of it: modes="both" is ½·(o + e), "o" and "e" march one mode alone at the whole of the

@@ -4,9 +4,9 @@
   - tests/ mirrors the source tree: every folder under tests/ (but data/, repo/ and python/, the
     Python module's tests) names a source folder at the same path (tests/core/render ↔ core/render),
     and no test source sits loose in tests/core/ (only shared helpers, *.h, live there);
-  - no function in core/, optics/, fitting/ or python/ is longer than MAX_LINES lines (counted by
-    Universal Ctags from its first to its last line, lambdas included), so the marches and the
-    simulators stay split into the named stages docs/twins.md pairs;
+  - no function in core/, optics/, fitting/, python/ or apps/ is longer than MAX_LINES lines
+    (counted by Universal Ctags from its first to its last line, lambdas included), so the marches,
+    the simulators and the commands stay split into named stages (the ones docs/twins.md pairs);
   - every C++ file is formatted with the project's .clang-format (clang-format --dry-run).
 Each violation is printed as FILE:LINE: what.
 usage: layout.py SOURCE_DIR   — prints "layout: N checks, M failed".
@@ -19,7 +19,7 @@ import sys
 import tempfile
 
 MAX_LINES = 120
-LENGTH_CHECKED = ("core/", "optics/", "fitting/", "python/")
+LENGTH_CHECKED = ("core/", "optics/", "fitting/", "python/", "apps/")
 NOT_MIRRORED = ("tests/data", "tests/repo", "tests/python")
 CXX = (".cpp", ".h")
 
@@ -107,6 +107,7 @@ def self_test():
         body = "".join(f"  x += {i};\n" for i in range(MAX_LINES))
         write("core/render/long.cpp", "int longOne(int x) {\n" + body + "  return x;\n}\n")
         write("core/render/short.cpp", "int shortOne(int x) { return x; }\n")
+        write("apps/long_command.cpp", "int longCommand(int x) {\n" + body + "  return x;\n}\n")
         write("tests/core/render/short_test.cpp", "int shortTest() { return 1; }\n")
         write("tests/core/loose_test.cpp", "int looseTest() { return 1; }\n")
         write("tests/core/nowhere/nowhere_test.cpp", "int nowhereTest() { return 1; }\n")
@@ -114,6 +115,7 @@ def self_test():
         subprocess.run(["git", "init", "-q", root], check=True)
         hits = check(root)
         expected = [("core/render/long.cpp:1:", "longOne is 123 lines"),
+                    ("apps/long_command.cpp:1:", "longCommand is 123 lines"),
                     ("tests/core/loose_test.cpp:1:", "a test source loose"),
                     ("tests/core/nowhere/nowhere_test.cpp:1:", "mirrors no source folder"),
                     ("optics/ugly.h:1:", "not formatted")]

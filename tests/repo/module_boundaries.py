@@ -109,7 +109,7 @@ def self_test():
         "core/scene/c.cpp": "  #  include <yaml-cpp/yaml.h>\n",
         "core/scene/CMakeLists.txt": "target_link_libraries(s PUBLIC eikon::fitting)\n",
         "apps/CMakeLists.txt": "target_link_libraries(e PRIVATE yaml-cpp)\n",
-        # The twins crossing (the defect issue 12 removed), and the light module leaning on one.
+        # The twins crossing (one including the other), and the light module leaning on one.
         "core/render/light_simulator.cpp":
             '#include "core/light/seeding.h"\n#include "core/reference/wavefront.h"\n',
         "core/reference/wavefront.h": '#include "core/render/light_simulator.h"\n',

@@ -1,7 +1,7 @@
 // core/io/atomic_write.h: a set of files replaces its targets all together or not at all, and
-// concurrent writers of the same set never leave a mixed set (issue 11: a failed PNG write used
-// to delete the render's previous EXR; two renders to one -o could leave an EXR and a PNG from
-// different renders).
+// concurrent writers of the same set never leave a mixed set: a failed PNG write keeps
+// the render's previous EXR, and two renders to one -o never leave an EXR and a PNG from
+// different renders.
 #include "core/io/atomic_write.h"
 
 #include <fcntl.h>

@@ -86,7 +86,7 @@ TEST(LightCache, KeyFollowsWhatTheSimulationReads) {
   EXPECT_EQ(lightCacheKey(elsewhere, v, o, false), key);
 }
 
-// Sharp interfaces (issue 13): a scene voxelised with "interfaces": "sharp" is lit through its
+// Sharp interfaces: a scene voxelised with "interfaces": "sharp" is lit through its
 // exact boundaries, with "smoothed" through the smoothed field (the index volumes the key hashes
 // may be the same), so a cached smoothed light must not serve the sharp scene, nor a light
 // simulated with LightingOptions::sharp_interfaces = false the default.

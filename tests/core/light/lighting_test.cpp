@@ -1,10 +1,11 @@
-// Simulated light in the view renderer (issue 6, docs/design.md §2 image formation): the band/mode
+// Simulated light in the view renderer (docs/design.md §2 image formation): the band/mode
 // plan, a diffuse floor under a directional light (Lambert's cosine law), single scattering in a
 // slab of haze against its closed form, and the two twins rendering the same lit volume. The light
 // volumes come from the simulator (GPU or CPU reference); both view twins then read the same ones.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "core/reference/reference_lighting.h"
 #include "core/render/light_transport.h"
@@ -13,9 +14,6 @@
 
 namespace eikon::test {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
 double luminance(const glm::dvec3& rgb) { return spectrum::linearSrgbToXyz(rgb).y; }
 
 TEST(Lighting, PlanBandsAddUpToTheLightsLuminance) {
@@ -122,7 +120,7 @@ TEST(Lighting, DiffuseFloorFollowsLambertsCosineLaw) {
   // Everything emitted ends on the floor (opaque) or leaves through the sides: the bookkeeping
   // balances to float round-off.
   EXPECT_LT(sum.conservationError(), 1e-6);
-  const double expected = 0.6 * 2.0 * std::cos(30.0 * kDeg) / kPi;
+  const double expected = 0.6 * 2.0 * std::cos(30.0 * kDeg) / std::numbers::pi;
   auto [ci, gi] = renderBothTwins(scene, v);
   glm::dvec3 c = centreMean(ci, 2), g = centreMean(gi, 2);
   std::printf("floor radiance: CPU (%.6f %.6f %.6f), GPU (%.6f %.6f %.6f), Lambert %.6f\n", c.x,
@@ -163,7 +161,7 @@ TEST(Lighting, DiffuseFloorIsLitTheSameByTheGpuSimulator) {
   LightingSummary sum = simulateLighting(context(), scene, v, {});
   EXPECT_LT(sum.conservationError(), 1e-5);  // float32 tallies (docs/light-simulator.md)
   glm::dvec3 g = centreMean(renderBothTwins(scene, v, false).second, 2);
-  const double expected = 0.6 * 2.0 * std::cos(30.0 * kDeg) / kPi;
+  const double expected = 0.6 * 2.0 * std::cos(30.0 * kDeg) / std::numbers::pi;
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(g[k], expected, 0.02 * expected);
   expectNoValidationMessages();
 }
@@ -191,7 +189,7 @@ TEST(Lighting, InScatterMatchesSingleScatteringInASlab) {
   ASSERT_TRUE(v.scattering);
   simulateLightingReference(scene, v, {});
   const double g = 0.5, sigma = 0.1;
-  const double p = (1 - g * g) / (4 * kPi * std::pow(1 + g * g, 1.5));
+  const double p = (1 - g * g) / (4 * std::numbers::pi * std::pow(1 + g * g, 1.5));
   const double W = v.grid.extent.z;  // the grid's depth (≥ the 12 mm asked, by < 1 voxel)
   const double expected =
       sigma * p * 10.0 * std::exp(-sigma * 5.0) * (1 - std::exp(-sigma * W)) / sigma;

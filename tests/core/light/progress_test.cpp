@@ -1,4 +1,4 @@
-// Progress in pieces (issue 11): the long pieces of work report how far they are often enough for
+// Progress in pieces: the long pieces of work report how far they are often enough for
 // the CLI's progress printer (apps/progress.h) to move at least once a second. The voxeliser
 // reports per z slab, the light simulators per time step (CPU) or dispatch (GPU), the view
 // renderers per band of rows (GPU) or row (CPU). Every sequence of reports stays in [0, 1], never

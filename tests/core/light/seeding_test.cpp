@@ -8,13 +8,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <vector>
 
 namespace eikon::test {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 
 /// n = 1 everywhere in the grid's box: seeding reads only the index and the bounds.
 class Vacuum : public Field {
@@ -67,8 +66,8 @@ TEST(Seeding, SpotLightSeedsItsCone) {
     }
     const int N = std::max(s.point_cells_per_face,
                            int(std::ceil(2.0 * s.beam_min_cells / std::tan(alpha * kDeg))));
-    const double cone = 2 * kPi * (1 - std::cos(alpha * kDeg)),
-                 tol = 2 * kPi * std::sin(alpha * kDeg) * 2 * std::sqrt(2.0) / N;
+    const double cone = 2 * std::numbers::pi * (1 - std::cos(alpha * kDeg)),
+                 tol = 2 * std::numbers::pi * std::sin(alpha * kDeg) * 2 * std::sqrt(2.0) / N;
     const double axisErr =
         std::acos(std::min(1.0, glm::dot(glm::normalize(mean), glm::normalize(l.direction)))) /
         kDeg;

@@ -1,4 +1,4 @@
-// The sharp path's skip distances (core/light/sharp_skip.h; issue 14, docs/performance.md "Light
+// The sharp path's skip distances (core/light/sharp_skip.h; docs/performance.md "Light
 // simulator"): their definition, held to a direct evaluation here (every voxel's Chebyshev
 // distance to the nearest voxel with a 26-neighbour of another region, or of another opacity
 // class), and the sharp runs that use them, held to the same run in single steps: straight steps

@@ -1,4 +1,4 @@
-// The light simulator's CPU twin at sharp interfaces (issue 13; docs/light-simulator.md, "Sharp
+// The light simulator's CPU twin at sharp interfaces (docs/light-simulator.md, "Sharp
 // interfaces"): collimated beams through a plane-parallel slab, a 90° prism used for total
 // internal reflection and a 60° prism at minimum deviation, against closed forms written here
 // (Snell and the Fresnel equations, Born & Wolf §1.5). Positions and directions are measured on a
@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 
 #include "core/reference/wavefront.h"
@@ -24,9 +25,7 @@
 
 namespace eikon::test {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 
 /// The sharp media of a one-object scene: the ambient (n = 1) and the object's glass.
 SharpInterfaces oneGlass(const VolumeSet& vol, double n) {
@@ -354,7 +353,8 @@ TEST(SharpWavefront, GlassSphereConservesFluxAtSharpSurfaces) {
   printWavefrontStats("sharp sphere", st);
   const double ended = st.flux_left + st.flux_caustic + st.flux_energy + st.flux_absorbed +
                        st.flux_reflected + st.flux_live_at_end;
-  const double disc = kPi * 1.0 * 1.0 / (3.2 * 3.2);  // the sphere's shadow / the lit face
+  const double disc =
+      std::numbers::pi * 1.0 * 1.0 / (3.2 * 3.2);  // the sphere's shadow / the lit face
   std::printf(
       "[ measured ] sharp sphere: reflected %.6f of emitted (disc %.4f, normal-incidence "
       "bound %.6f), balance %.2e, interface events %zu; one run each (not asserted): "

@@ -20,6 +20,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -130,7 +131,7 @@ TEST(PolariscopeScenes, ConoscopeRingsAndIsogyresOfCalcite) {
   const ShippedScene s("conoscope_calcite.json");
   const Material& m = s.scene.materials.at("calcite");
   const double nm = 589.2938, no = m.n_o.index(nm), ne = m.n_e.index(nm), t = 1.0;
-  const double deg = kMlPi / 180.0, psi45 = 45.0 * deg;
+  const double deg = std::numbers::pi / 180.0, psi45 = 45.0 * deg;
   for (double th : {3.0, 6.0, 10.0, 14.0})  // isogyres along the polariser (x) and analyser (y)
     for (double psi : {0.0, 90.0, 180.0, 270.0})
       EXPECT_LT(conoscopeTrace(s, th * deg, psi * deg, nm), 1e-8) << th << " " << psi;
@@ -162,7 +163,7 @@ TEST(PolariscopeScenes, GemStoneAxisTurnsWithTheStone) {
     ASSERT_EQ(s.polarizers.size(), 2u);
     ASSERT_EQ(s.objects.size(), 2u);
     const glm::dvec3 a = *s.objects[0].optic_axis;
-    const double r = rot * kMlPi / 180.0;
+    const double r = rot * std::numbers::pi / 180.0;
     EXPECT_NEAR(std::abs(glm::dot(a, glm::dvec3(std::cos(r), 0, -std::sin(r)))), 1.0, 1e-9);
     // the sheets are crossed, polariser along x below, analyser along z above
     EXPECT_NEAR(std::abs(glm::dot(s.polarizers[0].axis, s.polarizers[1].axis)), 0.0, 1e-12);

@@ -22,6 +22,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <random>
 #include <string>
 
@@ -34,8 +35,6 @@
 
 namespace eikon {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 using test::kAside;
 using test::plate;
 using test::rad;
@@ -103,7 +102,7 @@ TEST(PolarisedRender, ReciprocityIdentitiesOfMuellerMatrices) {
     const Mueller M = muellerOf(J), MT = transposed(M);
     EXPECT_LT(maxDiff(muellerOf(Jt), diag(1, 1, 1, -1) * MT * diag(1, 1, 1, -1)), 1e-12);
     EXPECT_LT(maxDiff(muellerOf(D * Jt * D), diag(1, 1, -1, 1) * MT * diag(1, 1, -1, 1)), 1e-12);
-    // and the one the brief of issue 15 suggested for plain transposition does not hold:
+    // and the rule of plain transposition does not hold:
     EXPECT_GT(maxDiff(muellerOf(Jt), diag(1, 1, -1, 1) * MT * diag(1, 1, -1, 1)), 1e-3);
   }
 }
@@ -171,7 +170,7 @@ TEST(PolarisedRender, CrossedSheetsWithQuartzPlateAtFiveWavelengths) {
                   renderCamera(6, 4), 1.5443);
   double worst = 0.0;
   for (double nm : {450.0, 500.0, 550.0, 600.0, 650.0}) {
-    const double D = 2 * kPi * (q.n_e.index(nm) - q.n_o.index(nm)) * t / (nm * 1e-6);
+    const double D = 2 * std::numbers::pi * (q.n_e.index(nm) - q.n_o.index(nm)) * t / (nm * 1e-6);
     const double want = 0.5 * std::pow(std::sin(0.5 * D), 2);
     const RenderImage img = s.render(nm);
     for (size_t p = 0; p < size_t(6 * 4); ++p) {

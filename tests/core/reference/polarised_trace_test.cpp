@@ -21,6 +21,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 
 #include "core/scene/scene.h"
@@ -30,8 +31,6 @@
 
 namespace eikon {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 using test::kAside;
 using test::plate;
 using test::rad;
@@ -127,7 +126,7 @@ TEST(PolarisedTrace, CrossedSheetsWithQuartzPlateAtFiveWavelengths) {
   double worst = 0.0, worst_air = 0.0;
   for (double nm : {450.0, 500.0, 550.0, 600.0, 650.0}) {
     const double no = q.n_o.index(nm), ne = q.n_e.index(nm),
-                 D = 2 * kPi * (ne - no) * t / (nm * 1e-6);
+                 D = 2 * std::numbers::pi * (ne - no) * t / (nm * 1e-6);
     const double ideal = 0.5 * std::pow(std::sin(0.5 * D), 2);
     const double immersed = crossedTrace(1.5443, nm, t);
     const double to = 4 * no / std::pow(1 + no, 2), te = 4 * ne / std::pow(1 + ne, 2);
@@ -197,7 +196,7 @@ TEST(PolarisedTrace, WalkOffBeyondTheCoherenceWidthAddsStokes) {
   const Uniaxial c(m.n_o.index(nm), m.n_e.index(nm), {1, 0, 1});
   const double no = c.n_o, ne45 = c.extraordinaryIndex({0, 0, 1});
   const double to = 4 * no / std::pow(1 + no, 2), te = 4 * ne45 / std::pow(1 + ne45, 2);
-  const double D = 2 * kPi * (ne45 - no) * 4.0 / (nm * 1e-6);
+  const double D = 2 * std::numbers::pi * (ne45 - no) * 4.0 / (nm * 1e-6);
   auto run = [&](double bandwidth, double angle) {
     PolarisedTraceSettings set;
     set.bandwidth_nm = bandwidth;
@@ -245,7 +244,8 @@ TEST(PolarisedTrace, FresnelRhombMakesRightCircularLight) {
   };
   // δ is largest at cos²θ = (1 − 1/n²)/(1 + 1/n²); the 45° root above it, by bisection.
   double lo = std::acos(std::sqrt((1 - n2) / (1 + n2))), hi = rad(89.0);
-  for (int k = 0; k < 100; ++k) (delta(0.5 * (lo + hi)) > kPi / 4 ? lo : hi) = 0.5 * (lo + hi);
+  for (int k = 0; k < 100; ++k)
+    (delta(0.5 * (lo + hi)) > std::numbers::pi / 4 ? lo : hi) = 0.5 * (lo + hi);
   const double th = 0.5 * (lo + hi), c = std::cos(th), sn = std::sin(th);
   // Faces y = ±1; the ray enters normally at E along u1, reflects at y = +1 and y = −1, and
   // leaves normally through the face u1·x = c_exit.
@@ -268,7 +268,7 @@ TEST(PolarisedTrace, FresnelRhombMakesRightCircularLight) {
   const Stokes& o = t.beams[0].stokes;
   const double T = 4 * n / ((1 + n) * (1 + n));
   std::printf("Fresnel rhomb (N-BK7, θ = %.4f deg): S3/S0 = %.7f, S0 = %.9f (closed %.9f)\n",
-              th * 180 / kPi, o[3] / o[0], o[0], T * T);
+              th * 180 / std::numbers::pi, o[3] / o[0], o[0], T * T);
   EXPECT_NEAR(glm::length(t.beams[0].direction - u1), 0.0, 1e-9);
   EXPECT_GE(o[3] / o[0], 0.999);
   EXPECT_NEAR(o[0], T * T, 1e-6);

@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "core/reference/reference_marcher.h"
 #include "core/scene/scene.h"
@@ -20,9 +21,6 @@
 
 namespace eikon {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
 glm::dvec3 analyticSphere(const Scene& s, const glm::dvec3& o, const glm::dvec3& d) {
   const double R = 9.0, n = 1.5;
   const double b = glm::dot(o, d), c = glm::dot(o, o) - R * R, disc = b * b - c;
@@ -58,7 +56,7 @@ TEST(SharpSphereImage, MatchesAnAnalyticRayTrace) {
     const Camera& cam = s.camera;
     const glm::dvec3 fwd = glm::normalize(cam.look_at - cam.position);
     const glm::dvec3 right = glm::normalize(glm::cross(fwd, cam.up)), up = glm::cross(right, fwd);
-    const double th = std::tan(0.5 * cam.fov_deg * kPi / 180.0), aspect = 64.0 / 48.0;
+    const double th = std::tan(0.5 * cam.fov_deg * std::numbers::pi / 180.0), aspect = 64.0 / 48.0;
     int close = 0, total = 0, onSphere = 0;
     for (int y = 0; y < 48; ++y)
       for (int x = 0; x < 64; ++x) {

@@ -1,4 +1,4 @@
-// Light simulator, CPU reference (issue 6): energy bookkeeping, uniform beams, absorption, the
+// Light simulator, CPU reference: energy bookkeeping, uniform beams, absorption, the
 // Luneburg focus, patch budget and termination. The GPU kernel will be tested against this.
 #include "core/reference/wavefront.h"
 
@@ -7,15 +7,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "tests/core/light_fixtures.h"
 #include "tests/core/test_support.h"
 
 namespace eikon::test {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
 Grid cubeGrid(glm::dvec3 origin, int n, double h) {
   Grid g;
   g.dims = {n, n, n};
@@ -103,9 +101,10 @@ TEST(Wavefront, GlassSphereConservesFlux) {
               1e-9 * st.flux_emitted);
   EXPECT_NEAR(st.flux_probe + st.flux_ended_before_probe, st.flux_emitted, 1e-9 * st.flux_emitted);
   const double h = vol.grid.h;
-  EXPECT_GE(st.flux_probe, st.flux_emitted - E * kPi * (1 + 3 * h) * (1 + 3 * h));
+  EXPECT_GE(st.flux_probe, st.flux_emitted - E * std::numbers::pi * (1 + 3 * h) * (1 + 3 * h));
   std::printf("[ measured ] flux ended upstream of x = 1.1 mm: %.6f = E*pi*(%.4f mm)^2\n",
-              st.flux_ended_before_probe, std::sqrt(st.flux_ended_before_probe / (E * kPi)));
+              st.flux_ended_before_probe,
+              std::sqrt(st.flux_ended_before_probe / (E * std::numbers::pi)));
   EXPECT_LE(st.flux_probe, st.flux_emitted * (1 + 1e-9));
 }
 
@@ -257,6 +256,31 @@ TEST(Wavefront, PatchBudgetHoldsAndTheLoopEnds) {
   EXPECT_EQ(st.live_at_end, 0u);
   EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted,
               1e-9 * st.flux_emitted);
+}
+
+// 4'. A patch is split only while its quarters keep the energy threshold (mayBeSplit): with
+// min_energy_fraction = 0.3 a seed's quarters (0.25 of its flux) would be killed after one step
+// each, so no patch splits at all; a patch stretched past the split span ends as a kill by energy
+// where it would have split, and the flux is still all accounted for. With the default threshold
+// the same run splits.
+TEST(Wavefront, NoSplitMakesQuartersBelowTheEnergyThreshold) {
+  const Scene scene = sceneFromJson(kGlassSphereLightScene);
+  const VolumeSet vol = voxelize(scene);
+  VolumeField field(vol);
+  WavefrontSettings s;
+  s.min_energy_fraction = 0.3;
+  WavefrontResult r = WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0));
+  const WavefrontStats& st = r.stats;
+  printWavefrontStats("no doomed quarters", st);
+  EXPECT_EQ(st.splits, 0u);
+  EXPECT_GT(st.kills_energy, 0u);
+  EXPECT_EQ(st.live_at_end, 0u);
+  EXPECT_NEAR(st.flux_left + st.flux_caustic + st.flux_energy, st.flux_emitted,
+              1e-9 * st.flux_emitted);
+  s.min_energy_fraction = 0.2;  // quarters at 0.25 keep the threshold: the first split is made
+  EXPECT_GT(
+      WavefrontSimulator(field, vol.grid, s).run(directionalLight({1, 0, 0}, 1.0)).stats.splits,
+      0u);
 }
 
 // 4a. Threads (WavefrontSettings::threads): each step's patch list is cut into contiguous chunks,
@@ -432,7 +456,7 @@ TEST(Wavefront, PointLightInverseSquare) {
   const WavefrontStats& st = r.stats;
   printWavefrontStats("point light", st);
   EXPECT_EQ(st.seeded, size_t(6 * 64));
-  EXPECT_NEAR(st.flux_emitted, 4 * kPi * I, 1e-12 * 4 * kPi * I);
+  EXPECT_NEAR(st.flux_emitted, 4 * std::numbers::pi * I, 1e-12 * 4 * std::numbers::pi * I);
   EXPECT_NEAR(st.flux_left, st.flux_emitted, 1e-9 * st.flux_emitted);
   EXPECT_EQ(st.kills_caustic + st.kills_energy, 0u);
   EXPECT_GT(st.splits, 0u);
@@ -449,8 +473,9 @@ TEST(Wavefront, PointLightInverseSquare) {
   std::printf(
       "[ measured ] shell sum %.6f vs 4*pi*I*1 = %.6f (rel %.2e); mean over %d voxels at r~1.5: "
       "%.5f vs I/r^2 %.5f\n",
-      shell, 4 * kPi * I, shell / (4 * kPi * I) - 1, ringN, ringSum / ringN, ringExpect / ringN);
-  EXPECT_NEAR(shell, 4 * kPi * I, 0.01 * 4 * kPi * I);
+      shell, 4 * std::numbers::pi * I, shell / (4 * std::numbers::pi * I) - 1, ringN,
+      ringSum / ringN, ringExpect / ringN);
+  EXPECT_NEAR(shell, 4 * std::numbers::pi * I, 0.01 * 4 * std::numbers::pi * I);
   EXPECT_NEAR(ringSum / ringN, ringExpect / ringN, 0.02 * ringExpect / ringN);
 }
 

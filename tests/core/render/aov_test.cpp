@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include "core/volume/render_layers.h"
@@ -100,7 +101,7 @@ double bandOf(bool sharp) { return sharp ? 0.1 : 3.0 * kSigma * kVoxel + 2.0 * k
 glm::dvec3 pixelRay(int x, int y) {
   const glm::dvec3 fwd(0, 0, 1), right = glm::normalize(glm::cross(fwd, glm::dvec3(0, 1, 0)));
   const glm::dvec3 up = glm::cross(right, fwd);
-  const double tanh = std::tan(15.0 * M_PI / 180.0), aspect = double(kW) / kH;
+  const double tanh = std::tan(15.0 * std::numbers::pi / 180.0), aspect = double(kW) / kH;
   const double u = ((x + 0.5) / kW * 2.0 - 1.0) * tanh * aspect;
   const double v = (1.0 - (y + 0.5) / kH * 2.0) * tanh;
   return glm::normalize(fwd + u * right + v * up);

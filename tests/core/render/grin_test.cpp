@@ -3,15 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "tests/core/light_fixtures.h"
 #include "tests/core/test_support.h"
 
 namespace eikon::test {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
 // §7c: n(y) = 1.5 + 0.05 y, launched from the origin at 10° above +x. Closed form (catenary):
 // n₀ + g y = β cosh(g (x − x_c)/β), β = n₀ cos 10°, x_c = −(β/g) asinh(tan 10°).
 // Reference: at x = 4.431635, y = 1.12248370.
@@ -91,7 +89,7 @@ TEST(Grin, LuneburgAnalyticFieldFocusesOnTheFarSide) {
     EXPECT_LT(distanceToLine(focus, t.exit_point, t.exit_direction), 1e-6);
     // OPL from x = −R to the focus: subtract the air paths before x = −R and after the focus.
     double opl = t.optical_path_mm - 0.2 - glm::length(t.exit_point - focus);
-    EXPECT_NEAR(opl, 1.0 + kPi / 2.0, 2e-6);
+    EXPECT_NEAR(opl, 1.0 + std::numbers::pi / 2.0, 2e-6);
     opl_min = std::min(opl_min, opl);
     opl_max = std::max(opl_max, opl);
     // Exit direction (√(1 − h²), −h, 0).

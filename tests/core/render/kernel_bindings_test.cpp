@@ -1,5 +1,5 @@
-// Which resources the specialised view, trace and polarised-trace kernels read (issue 14,
-// start-up). The view renderer binds one-voxel placeholders for the volume's fields, and the
+// Which resources the specialised view, trace and polarised-trace kernels read
+// (start-up). The view renderer binds one-voxel placeholders for the volume's fields, and the
 // session voxelises only the interfaces (voxelizeInterfaces), when the sharp march runs without
 // light volumes (core/render/view_renderer.cpp, fields_unread): that is only right if no such
 // kernel reads a field image then. specialiseSpirv (core/vk/specialise.h) removes the variables

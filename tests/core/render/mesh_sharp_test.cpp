@@ -1,4 +1,4 @@
-// Sharp interfaces of non-convex meshes (issue 16, item 1): each facet refracts at its own
+// Sharp interfaces of non-convex meshes: each facet refracts at its own
 // triangle's plane, crossings found exactly through the mesh's hierarchy (MeshDistance::firstHit;
 // GPU: meshFirstHit in shaders/boundary.glsl). Both twins' traces are held to a ray tracer written
 // here that knows nothing of voxels or hierarchies: it intersects the ray with every face of the

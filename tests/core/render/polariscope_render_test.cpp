@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -77,7 +78,7 @@ double wedgeColours(PolRenderTwins& t, bool gpu, int bins, bool expect) {
     Camera cam = t.scene.camera;
     cam.position = {x, 0.3, -250};
     cam.look_at = {x, 0.3, 0};
-    cam.fov_deg = 2.0 * std::atan(0.02 / 250.0) * 180.0 / kMlPi;  // 0.04 mm across
+    cam.fov_deg = 2.0 * std::atan(0.02 / 250.0) * 180.0 / std::numbers::pi;  // 0.04 mm across
     const glm::dvec3 got = meanRgb(t.render(gpu, cam, s));
     const glm::dvec3 want = transmittedSrgb(
         [&](double nm) { return wedgeTransmission(q.n_o.index(nm), q.n_e.index(nm), th, nm); });
@@ -108,8 +109,8 @@ struct RingFit {
 };
 
 RingFit fitRing(const RenderImage& img, const Camera& cam, double want, double half) {
-  const double tanh = std::tan(0.5 * cam.fov_deg * kMlPi / 180.0),
-               aspect = double(img.width) / img.height, deg = kMlPi / 180.0;
+  const double tanh = std::tan(0.5 * cam.fov_deg * std::numbers::pi / 180.0),
+               aspect = double(img.width) / img.height, deg = std::numbers::pi / 180.0;
   double S[5] = {0, 0, 0, 0, 0}, R[3] = {0, 0, 0};  // Σθ^k, Σ I θ^k (θ relative to want)
   RingFit f;
   for (int y = 0; y < img.height; ++y)
@@ -142,7 +143,8 @@ RingFit fitRing(const RenderImage& img, const Camera& cam, double want, double h
 TEST(PolariscopeRender, ConoscopeRingsAndIsogyresInMonochromaticLight) {
   PolRenderTwins t("conoscope_calcite.json");
   const Material& m = t.scene.materials.at("calcite");
-  const double nm = 589.2938, no = m.n_o.index(nm), ne = m.n_e.index(nm), deg = kMlPi / 180.0;
+  const double nm = 589.2938, no = m.n_o.index(nm), ne = m.n_e.index(nm),
+               deg = std::numbers::pi / 180.0;
   RenderSettings s;
   s.spp = 1;  // the pixel centres
   s.wavelengths = 0;

@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -86,7 +87,7 @@ TEST(PolariscopeScenesGpu, ConoscopeRingsAndIsogyresOfCalcite) {
   ShippedGpu s("conoscope_calcite.json");
   const Material& m = s.scene.materials.at("calcite");
   const double nm = 589.2938, no = m.n_o.index(nm), ne = m.n_e.index(nm), t = 1.0;
-  const double deg = kMlPi / 180.0;
+  const double deg = std::numbers::pi / 180.0;
   auto ray = [&](double theta, double psi_deg) {  // from the light box to the camera
     const double p = psi_deg * deg;
     const glm::dvec3 u(std::sin(theta) * std::cos(p), std::sin(theta) * std::sin(p),

@@ -18,6 +18,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "core/spectrum/color.h"
 #include "core/spectrum/wavelength_sampling.h"
@@ -26,9 +27,6 @@
 
 namespace eikon::test {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
 struct PolRenderTwins {
   Scene scene;
   VolumeSet volume;
@@ -97,7 +95,7 @@ TEST(PolarisedRenderGpu, CrossedSheetsWithQuartzPlateAtFiveWavelengths) {
                     renderCamera(6, 4), 1.5443);
   double worst = 0.0;
   for (double nm : {450.0, 500.0, 550.0, 600.0, 650.0}) {
-    const double D = 2 * kPi * (q.n_e.index(nm) - q.n_o.index(nm)) * t / (nm * 1e-6);
+    const double D = 2 * std::numbers::pi * (q.n_e.index(nm) - q.n_o.index(nm)) * t / (nm * 1e-6);
     const double want = 0.5 * std::pow(std::sin(0.5 * D), 2);
     const RenderImage img = tw.onGpu(nm);
     for (size_t p = 0; p < size_t(6 * 4); ++p) {
@@ -125,7 +123,7 @@ TEST(PolarisedRenderGpu, TwinsAgreeOnAConoscopicFigure) {
       // Per wavelength a Stokes component of unit light is within ½δΔ = π·t·2.4e-7/λ (above; 1.3e-3
       // at 589 nm, +20% for the oblique paths); a spectral channel sums its wavelengths' with
       // their colour weights |M·sampleWeightXyz|.
-      auto perWave = [](double nm) { return 1.2 * kPi * 1.0 * 2.4e-7 / (nm * 1e-6); };
+      auto perWave = [](double nm) { return 1.2 * std::numbers::pi * 1.0 * 2.4e-7 / (nm * 1e-6); };
       double tol = perWave(589.2938);
       if (wavelengths > 0) {
         tol = 1e-6;

@@ -20,15 +20,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "tests/core/polarised_fixtures.h"
 #include "tests/core/test_support.h"
 
 namespace eikon::test {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
 /// One voxelised scene with both twins of the polarised trace; the sheets are passed per call.
 struct PolTwins {
   Scene scene;
@@ -140,7 +138,7 @@ TEST(PolarisedTraceGpu, CrossedSheetsWithQuartzPlateAtFiveWavelengths) {
   double worst = 0.0;
   for (size_t k = 0; k < nms.size(); ++k) {
     const double nm = nms[k], no = q.n_o.index(nm), ne = q.n_e.index(nm);
-    const double D = 2 * kPi * (ne - no) * th / (nm * 1e-6);
+    const double D = 2 * std::numbers::pi * (ne - no) * th / (nm * 1e-6);
     const double ideal = 0.5 * std::pow(std::sin(0.5 * D), 2);
     worst = std::max(worst, std::abs(g[k].totalPower() - ideal));
     EXPECT_NEAR(g[k].totalPower(), ideal, 1e-3) << nm;
@@ -210,7 +208,7 @@ TEST(PolarisedTraceGpu, WalkOffBeyondTheCoherenceWidthAddsStokes) {
   const Uniaxial c(m.n_o.index(nm), m.n_e.index(nm), {1, 0, 1});
   const double no = c.n_o, ne45 = c.extraordinaryIndex({0, 0, 1});
   const double to = 4 * no / std::pow(1 + no, 2), te = 4 * ne45 / std::pow(1 + ne45, 2);
-  const double D = 2 * kPi * (ne45 - no) * 4.0 / (nm * 1e-6);
+  const double D = 2 * std::numbers::pi * (ne45 - no) * 4.0 / (nm * 1e-6);
   const TraceRequest r{{0.3, 0.2, -30}, {0, 0, 1}, nm};
   auto run = [&](double bandwidth, double angle) {
     PolarisedTraceSettings set;
@@ -249,7 +247,8 @@ TEST(PolarisedTraceGpu, FresnelRhombMakesRightCircularLight) {
     return 2.0 * std::atan(ci * std::sqrt(si * si - n2) / (si * si));
   };
   double lo = std::acos(std::sqrt((1 - n2) / (1 + n2))), hi = rad(89.0);
-  for (int k = 0; k < 100; ++k) (delta(0.5 * (lo + hi)) > kPi / 4 ? lo : hi) = 0.5 * (lo + hi);
+  for (int k = 0; k < 100; ++k)
+    (delta(0.5 * (lo + hi)) > std::numbers::pi / 4 ? lo : hi) = 0.5 * (lo + hi);
   const double th = 0.5 * (lo + hi), c = std::cos(th), sn = std::sin(th);
   const glm::dvec3 u1(0, c, sn), u2(0, -c, sn), E(0, -0.9, -3.5);
   const glm::dvec3 P2 = E + (1.9 / c) * u1 + (2.0 / c) * u2;

@@ -47,7 +47,7 @@ double traceDeviation(Twins& t, const Line& l, double height, bool gpu) {
 }
 
 TEST(Prism, MinimumDeviationAtFraunhoferLines) {
-  // Tolerances (issue 4): each line within 0.05°, the F−C spread within 2% of 0.7090°.
+  // Tolerances: each line within 0.05°, the F−C spread within 2% of 0.7090°.
   // Error budget: the Cauchy fit of N-BK7 over 380–780 nm (|Δn| ≲ 1e-4 ⇒ 0.009°), the smoothed
   // faces (a ray bent over ±3σ of a face at 30–50° sees the same profile on entry and exit, so the
   // offsets cancel at minimum deviation), and float32 on the GPU. Averaging 5 rays across the face

@@ -1,4 +1,4 @@
-// Many total internal reflections on both twins (issue 13, the diamond defect): 400 camera rays
+// Many total internal reflections on both twins (the diamond's many reflections): 400 camera rays
 // of scenes/diamond_brilliant.json at 64³ (sharp interfaces) traced by the GPU in ONE dispatch
 // (shaders/trace.comp, 64 rays per workgroup, so that each SIMD group of lavapipe holds
 // neighbours on different paths) and one by one by the CPU twin.

@@ -1,5 +1,5 @@
 // The sharp march of both twins on the same rays (GPU: shaders/sharp.glsl through trace.comp;
-// CPU: RayMarch::marchSharp), on the done-when scenes of issue 13, and the GPU against the same
+// CPU: RayMarch::marchSharp), on the sharp march's reference scenes, and the GPU against the same
 // closed forms as tests/core/reference/sharp_interfaces_test.cpp:
 //  - slab at 0–80°: displacement t·sin(θ − θ_t)/cos θ_t within 1e-4 mm, direction 1e-5 rad;
 //  - calcite plates, optic axis at 0–90° to the normal: o/e separation t·tan ρ within 1e-4 mm;
@@ -184,7 +184,7 @@ TEST(SharpTwins, RadialAxisSpherulite) {
 // Luneburg lens n = √(2 − r²/R²), R = 6: every ray parallel to x focuses on (R, 0, 0). The GPU
 // integrates the region's own profile with RK4 in float (~150 steps of 0.25 h, each rounding
 // ~1e-7 relative): the exit line passes within the CPU test's 1e-4 mm of the focus (measured
-// 2.3e-5), and within 1e-4 mm of the CPU's exit point (measured 6.7e-6).
+// 1.4e-6), and within 1e-4 mm of the CPU's exit point (measured 8.0e-6).
 TEST(SharpTwins, LuneburgFocus) {
   Twins t(sceneJson(R"({"shape": "sphere", "center": [0, 0, 0], "radius": 6, "material": "lens"})",
                     96, R"({"lens": {"n": {"luneburg": {"center": [0, 0, 0], "radius": 6}}}})"));

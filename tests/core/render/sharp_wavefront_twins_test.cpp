@@ -1,4 +1,4 @@
-// The light simulator's GPU twin at sharp interfaces (issue 13; shaders/wavefront.comp with
+// The light simulator's GPU twin at sharp interfaces (shaders/wavefront.comp with
 // kSharpLight, GpuWavefront with WavefrontSettings::sharp_interfaces) against the closed forms of
 // tests/core/light/sharp_wavefront_test.cpp (same scenes, tests/core/light_fixtures.h) and against
 // the CPU twin (WavefrontSimulator with sharpInterfacesFor, double precision).
@@ -27,6 +27,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <variant>
@@ -43,9 +44,7 @@
 
 namespace eikon::test {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kEps32 = 5.960464477539063e-08;  // 2⁻²⁴
 
 /// ulp of a float32 of magnitude ≤ X (mm): 2ε·X rounded up to the binade, as a bound.
@@ -337,13 +336,13 @@ TEST(SharpWavefrontTwins, KinkAtAMeshApexTearsOnBoth) {
   ASSERT_TRUE(vol.boundary.exact);  // the triangles' hits, not the walk
   const WavefrontSettings s = expectNoLightInTheGap(vol, "mesh kink");
   // The analytic prism's run on the CPU twin (its planes' search) against the mesh's: the
-  // mesh's triangles lie in the prism's planes to the rounding of its vertices (Assimp reads
-  // them as float: ≤ 2⁻²⁴·1.7 mm ≈ 1e-7 mm, normals within ~1e-7 rad), so the Fresnel
-  // factors agree to ~1e-7 (flux left bound 1e-7 of emitted) and the light to that and the float
-  // volumes' rounding (each voxel sums ~10 splats: ≤ 10·2⁻²⁴ ≈ 6e-7; L1 bound 1e-6). The beam is
-  // moved off the seed lattice by a fraction of a seed edge: on it, corners at x = ±1 and on the
-  // faces' edges meet ties that rounding settles, and the two searches settle them as mirror images
-  // (5% L1, same flux).
+  // mesh's triangles lie in the prism's planes to the rounding of its vertices (read in double
+  // from 17 digits; bounded here as if float: ≤ 2⁻²⁴·1.7 mm ≈ 1e-7 mm, normals within ~1e-7 rad),
+  // so the Fresnel factors agree to ~1e-7 (flux left bound 1e-7 of emitted) and the light to that
+  // and the float volumes' rounding (each voxel sums ~10 splats: ≤ 10·2⁻²⁴ ≈ 6e-7; L1 bound 1e-6).
+  // The beam is moved off the seed lattice by a fraction of a seed edge: on it, corners at x = ±1
+  // and on the faces' edges meet ties that rounding settles, and the two searches settle them as
+  // mirror images (5% L1, same flux).
   const glm::dvec3 off(0.0123, 2.9, 0.0071);
   const WavefrontSettings ps = sharpSettings(s);
   const VolumeSet pvol = voxelize(sceneFromJson(kSharpApexPrismScene));
@@ -479,7 +478,7 @@ TEST(SharpWavefrontTwins, GlassSphereIrradianceAgrees) {
       std::chrono::duration<double>(t2 - t1).count());
   EXPECT_EQ(g.seeded, c.seeded);
   EXPECT_NEAR(fluxEnded(g), g.flux_emitted, 1e-6 * g.flux_emitted);
-  const double rim = 2.0 * kPi * 1.0 * (0.5 * h) / (3.2 * 3.2);
+  const double rim = 2.0 * std::numbers::pi * 1.0 * (0.5 * h) / (3.2 * 3.2);
   EXPECT_NEAR(g.flux_reflected, c.flux_reflected, rim * c.flux_emitted);
   EXPECT_NEAR(g.flux_caustic, c.flux_caustic, rim * c.flux_emitted);
   EXPECT_NEAR(g.flux_left, c.flux_left, rim * c.flux_emitted);
@@ -502,7 +501,7 @@ TEST(SharpWavefrontTwins, GlassSphereIrradianceAgrees) {
     for (int i = 0; i < m; ++i) sum += lost(a + (i + 0.5) * (b - a) / m);
     return sum * (b - a) / m;
   };
-  const double disc = kPi / (3.2 * 3.2), ideal = disc * integral(0.0, 1.0),
+  const double disc = std::numbers::pi / (3.2 * 3.2), ideal = disc * integral(0.0, 1.0),
                rimBand = disc * integral(1.0 - 0.5 * h, 1.0);
   std::printf(
       "[ measured ] reflected gpu %.6f, cpu %.6f of emitted; closed form %.6f, the rim band's "
@@ -537,7 +536,7 @@ TEST(SharpWavefrontTwins, LightingDriversFollowTheInterfaces) {
   const LightingSummary cpu = simulateLightingReference(scene, b, o);
   o.sharp_interfaces = false;
   const LightingSummary off = simulateLightingReference(scene, c, o);
-  const double disc = kPi / (3.2 * 3.2);
+  const double disc = std::numbers::pi / (3.2 * 3.2);
   std::printf(
       "[ measured ] lighting drivers, sharp sphere: reflected gpu %.6f, cpu %.6f of emitted "
       "(bounds %.4f, %.4f), balance gpu %.1e cpu %.1e; smoothed reflected %.1e\n",
@@ -549,7 +548,7 @@ TEST(SharpWavefrontTwins, LightingDriversFollowTheInterfaces) {
   }
   EXPECT_LT(gpu.conservationError(), 1e-6);
   EXPECT_LT(cpu.conservationError(), 1e-9);
-  const double rim = 2.0 * kPi * 1.0 * (0.5 * a.grid.h) / (3.2 * 3.2);
+  const double rim = 2.0 * std::numbers::pi * 1.0 * (0.5 * a.grid.h) / (3.2 * 3.2);
   EXPECT_NEAR(gpu.flux_reflected, cpu.flux_reflected, rim * cpu.flux_emitted);
   EXPECT_EQ(off.flux_reflected, 0.0);
 }

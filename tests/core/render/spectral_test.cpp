@@ -1,4 +1,4 @@
-// Spectral rendering (issue 4): colourless objects stay grey, the flat spectrum is white and
+// Spectral rendering: colourless objects stay grey, the flat spectrum is white and
 // unbiased, the spectrum through an N-BK7 prism is ordered and has the glass's Abbe number, and
 // the GPU and CPU twins agree in spectral mode.
 //
@@ -230,7 +230,7 @@ TEST(Spectral, PrismSpectrumOrderAndAbbeNumber) {
         vFit);
     // What the renderer carries is the weighted least-squares Cauchy fit of the Sellmeier over
     // 380–780 nm (its V_d is 64.09, −0.12% from the catalogue): the traced V must reproduce the
-    // fit's V within 0.1% (the march itself), and the catalogue 64.17 within 1% (issue 4).
+    // fit's V within 0.1% (the march itself), and the catalogue 64.17 within 1%.
     EXPECT_NEAR(V, vFit, 1e-3 * vFit);
     EXPECT_NEAR(V, catalogue, 0.01 * catalogue);
   }

@@ -1,4 +1,4 @@
-// End-to-end checks of the e-ray march (issue 5): the voxelised, smoothed crystal marched by the
+// End-to-end checks of the e-ray march: the voxelised, smoothed crystal marched by the
 // mode Hamiltonian H_e = ½(pᵀM_e p − 1) (docs/design.md §2; shaders/march.glsl, core/reference)
 // against the closed-form uniaxial library in optics/ (uniaxial.h, interface.h, fresnel.h,
 // pleochroism.h), with the numbers of docs/reference-cases.md §1–3, §8, §9.

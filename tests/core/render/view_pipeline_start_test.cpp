@@ -1,5 +1,5 @@
-// The view pipeline started before the volume exists (core/render/view_pipeline_start.h, issue 14
-// start-up): its key is predicted from the scene, so the prediction must give the flags the
+// The view pipeline started before the volume exists (core/render/view_pipeline_start.h):
+// its key is predicted from the scene, so the prediction must give the flags the
 // voxelised volume gives, for every shipped scene (a miss would compile a second kernel: correct,
 // but the start-up gain lost); and a render that adopts the early pipeline gives the same image,
 // bit for bit, as one that builds its own.

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "core/reference/wavefront.h"
 #include "core/render/light_simulator.h"
@@ -18,9 +19,7 @@
 
 namespace eikon::test {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 
 double seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -102,8 +101,8 @@ void checkPlateRun(const char* name, const WavefrontStats& st, int mode, double 
   // The disc of seed cells: cells of edge e whose centre lies within R. Every such cell lies inside
   // R + e/√2 and every cell inside R − e/√2 is launched, so π(R − e/√2)² ≤ emitted/E ≤ π(R +
   // e/√2)².
-  const double e = 0.5 * 0.15, lo = kPi * std::pow(kBeamR - e / std::sqrt(2.0), 2),
-               hi = kPi * std::pow(kBeamR + e / std::sqrt(2.0), 2);
+  const double e = 0.5 * 0.15, lo = std::numbers::pi * std::pow(kBeamR - e / std::sqrt(2.0), 2),
+               hi = std::numbers::pi * std::pow(kBeamR + e / std::sqrt(2.0), 2);
   EXPECT_GE(st.flux_emitted, lo);
   EXPECT_LE(st.flux_emitted, hi);
   // No absorption and no Fresnel: each mode carries all of its beam's flux through the probe

@@ -1,9 +1,10 @@
 // Convex polyhedra from planes (core/scene/shapes.cpp, finishConvex): the bounding radius from the
 // vertices, and the refusal of empty, unbounded and flat plane sets, for plane counts where the
-// old all-triples vertex search (O(n⁴): 52 s for 1000 planes) was unusable (issue 11, item 4).
+// old all-triples vertex search (O(n⁴): 52 s for 1000 planes) would be unusable.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -12,15 +13,12 @@
 
 namespace eikon {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
 /// A right prism over a regular m-gon of apothem `a` (side normals at angles φ0 + 2πk/m) between
 /// z = ±hz: its vertices lie at distance √((a/cos(π/m))² + hz²) from the origin.
 ConvexShape polygonPrism(int m, double a, double hz, double phi0) {
   ConvexShape c;
   for (int k = 0; k < m; ++k) {
-    const double phi = phi0 + 2.0 * kPi * k / m;
+    const double phi = phi0 + 2.0 * std::numbers::pi * k / m;
     c.planes.push_back({{std::cos(phi), std::sin(phi), 0.0}, a});
   }
   c.planes.push_back({{0, 0, 1}, hz});
@@ -41,7 +39,7 @@ TEST(Convex, ThousandPlanePrismHasItsClosedFormRadius) {
   ConvexShape c = polygonPrism(998, 4.0, 2.5, 0.123);
   ASSERT_EQ(c.planes.size(), 1000u);
   finishConvex(c);
-  const double rc = 4.0 / std::cos(kPi / 998);
+  const double rc = 4.0 / std::cos(std::numbers::pi / 998);
   EXPECT_NEAR(c.bounding_radius, std::sqrt(rc * rc + 2.5 * 2.5), 1e-9);
 }
 
@@ -58,7 +56,7 @@ TEST(Convex, RedundantPlanesDoNotChangeTheCube) {
   const int extra = 994;
   for (int k = 0; k < extra; ++k) {  // Fibonacci directions
     const double z = 1.0 - 2.0 * (k + 0.5) / extra, r = std::sqrt(1.0 - z * z),
-                 phi = k * kPi * (3.0 - std::sqrt(5.0));
+                 phi = k * std::numbers::pi * (3.0 - std::sqrt(5.0));
     c.planes.push_back({{r * std::cos(phi), r * std::sin(phi), z}, 2.0});
   }
   finishConvex(c);
@@ -73,7 +71,7 @@ TEST(Convex, ThousandTangentPlanes) {
   const int n = 1000;
   for (int k = 0; k < n; ++k) {
     const double z = 1.0 - 2.0 * (k + 0.5) / n, r = std::sqrt(1.0 - z * z),
-                 phi = k * kPi * (3.0 - std::sqrt(5.0));
+                 phi = k * std::numbers::pi * (3.0 - std::sqrt(5.0));
     c.planes.push_back({{r * std::cos(phi), r * std::sin(phi), z}, 5.0});
   }
   finishConvex(c);
@@ -114,7 +112,7 @@ TEST(Convex, ThousandPlanesInAScene) {
   std::string planes;
   const int m = 998;
   for (int k = 0; k < m; ++k) {
-    const double phi = 2.0 * kPi * k / m;
+    const double phi = 2.0 * std::numbers::pi * k / m;
     planes +=
         "[" + std::to_string(std::cos(phi)) + ", " + std::to_string(std::sin(phi)) + ", 0, 4], ";
   }

@@ -1,4 +1,4 @@
-// Faceted gems from faceting diagrams (core/scene/faceted.cpp, issue 16 item 2). Every facet of the
+// Faceted gems from faceting diagrams (core/scene/faceted.cpp). Every facet of the
 // three shipped designs has the normal its diagram line says — the angle from the girdle plane
 // acos|n_y| and the azimuth index·360°/gear — to 1e-9, every listed facet has a face of non-zero
 // area, and the polyhedron is closed (its faces' vector areas sum to zero) and convex (every
@@ -17,6 +17,7 @@
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -29,8 +30,7 @@ namespace eikon {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 
 const ConvexShape& convexOf(const Scene& s) {
   return std::get<ConvexShape>(s.objects.at(0).shape.geometry());
@@ -244,14 +244,14 @@ TEST(Faceted, StarFacetThroughAMeetPointOfThreeFacets) {
                        std::sin(35 * kDeg) * std::sin(phi));
     return Plane{n, 4.0 * std::sin(35 * kDeg) + 0.1 * std::cos(35 * kDeg)};
   };
-  const Plane a = crown(0), b = crown(kPi / 4);
+  const Plane a = crown(0), b = crown(std::numbers::pi / 4);
   // With y = 1.6 the two crown planes are lines in (x, z): solve the 2×2 system.
   const double ra = a.d - a.normal.y * 1.6, rb = b.d - b.normal.y * 1.6;
   const double det = a.normal.x * b.normal.z - a.normal.z * b.normal.x;
   const glm::dvec3 p((ra * b.normal.z - rb * a.normal.z) / det, 1.6,
                      (a.normal.x * rb - b.normal.x * ra) / det);
-  const glm::dvec3 ns(std::sin(45 * kDeg) * std::cos(kPi / 8), std::cos(45 * kDeg),
-                      std::sin(45 * kDeg) * std::sin(kPi / 8));
+  const glm::dvec3 ns(std::sin(45 * kDeg) * std::cos(std::numbers::pi / 8), std::cos(45 * kDeg),
+                      std::sin(45 * kDeg) * std::sin(std::numbers::pi / 8));
   ASSERT_EQ(c.planes.size(), 33u);
   EXPECT_NEAR(glm::length(c.planes[25].normal - ns), 0.0, 1e-12);
   EXPECT_NEAR(c.planes[25].d, glm::dot(ns, p), 1e-12);
@@ -425,6 +425,50 @@ TEST(Faceted, GemCadAscFileGivesTheBrilliant) {
       "junk.json", sceneWith(R"({"shape": "faceted", "file": "junk.asc", "material": "g"})"));
   EXPECT_TRUE(test::isOneLineSceneError(test::sceneErrorOf(slurp(junk), junk), junk.string(),
                                         "/objects/0/file", "junk.asc line 2: unknown record 'q'"));
+}
+
+// The shipped GemCad round brilliant (scenes/round_brilliant.asc, through its scene): every one of
+// its 16 + 57 facets has a face, the tiers keep their 8-fold symmetry, and the stone's extremes are
+// the design's closed forms: R = 5 mm, girdle half thickness t = 0.1 mm at the mains, pavilion
+// mains at 40.75° meeting in the culet at y = −(t + R tan 40.75°), the table at
+// y = t + 0.43 R tan 34.5° with its corners on the bezels' tips at 0.57 R.
+TEST(Faceted, ShippedGemCadBrilliantKeepsItsProportions) {
+  const Scene scene =
+      loadScene(fs::path(EIKON_SOURCE_DIR) / "scenes" / "faceted_gemcad_brilliant.json");
+  const ConvexShape& c = convexOf(scene);
+  ASSERT_EQ(c.planes.size(), 73u);
+  const double tol = 1e-9 * c.bounding_radius;
+  const std::vector<glm::dvec3> verts = bruteVertices(c.planes, tol);
+  std::vector<double> areas;
+  for (const Plane& p : c.planes) {
+    areas.push_back(glm::dot(faceVectorArea(p, verts, tol), p.normal));
+    EXPECT_GT(areas.back(), 1e-3) << "facet " << areas.size() - 1 << " has no face";
+  }
+  // Tiers in file order: girdle 16, pavilion mains 8, lower girdle 16, bezels 8, stars 8,
+  // upper girdle 16, table 1. The design turns into itself by 45°, so a tier of 8 has one area
+  // and a tier of 16 one for its even and one for its odd facets (a girdle facet under a main is
+  // thinner than one between two mains).
+  const int tiers[] = {16, 8, 16, 8, 8, 16, 1};
+  size_t k = 0;
+  for (int n : tiers) {
+    const int period = std::max(1, n / 8);
+    for (int i = period; i < n; ++i)
+      EXPECT_NEAR(areas[k + i], areas[k + i % period], 1e-9 * areas[k]) << "facet " << k + i;
+    k += n;
+  }
+  const double R = 5.0, t = 0.1, deg = std::numbers::pi / 180.0;
+  double lowest = 1e300, highest = -1e300;
+  for (const glm::dvec3& v : verts) {
+    lowest = std::min(lowest, v.y);
+    highest = std::max(highest, v.y);
+  }
+  EXPECT_NEAR(lowest, -(t + R * std::tan(40.75 * deg)), 1e-5);  // distances to 1e-6 mm
+  const double table = t + 0.43 * R * std::tan(34.5 * deg);
+  EXPECT_NEAR(highest, table, 1e-6);
+  double corner = 1e300;
+  for (const glm::dvec3& v : verts)
+    corner = std::min(corner, glm::length(v - glm::dvec3(0.57 * R, table, 0.0)));
+  EXPECT_LT(corner, 1e-5);
 }
 
 // `a 20 1e300 5` on line 10 was reported on line 6 ("the facet removes the whole stone"): the

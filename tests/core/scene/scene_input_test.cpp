@@ -1,4 +1,4 @@
-// Hostile scene and material input (issue 11): duplicate JSON keys, material names used as paths,
+// Hostile scene and material input: duplicate JSON keys, material names used as paths,
 // wavelength tables with non-positive wavelengths, directories given as files, and raw bytes in
 // error messages. Every case is a SceneError of one line that names the file and the JSON path.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Limits of what a scene may ask for (issue 11): every quantity derived from the volume and the
+// Limits of what a scene may ask for: every quantity derived from the volume and the
 // objects must be representable (finite extents, a voxel edge whose inverse is finite in float,
 // a grid the GPU's single-precision positions resolve), and objects that the volume would cut
 // away entirely, or that fill it entirely, are never a silent change: an error or a warning

@@ -1,4 +1,4 @@
-// The persistent pipeline cache (core/vk/pipeline_cache.h, issue 14 start-up): a context saves
+// The persistent pipeline cache (core/vk/pipeline_cache.h): a context saves
 // the driver's cache after building pipelines and the next context loads it; a corrupt, truncated,
 // foreign or oversized file is ignored with one note and replaced, never handed to the driver,
 // never a crash. Whether the cache makes the build faster is measured in docs/performance.md, not

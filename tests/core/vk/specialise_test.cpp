@@ -1,4 +1,4 @@
-// Host-side specialisation of SPIR-V (core/vk/specialise.h, issue 14 start-up): the module handed
+// Host-side specialisation of SPIR-V (core/vk/specialise.h): the module handed
 // to the driver has the constants set and frozen and the code they disable removed. Whether that
 // makes the driver faster is measured in docs/performance.md, not here (tests are not timed);
 // that the specialised kernels compute what the driver-specialised ones did is what every GPU

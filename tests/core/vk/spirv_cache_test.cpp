@@ -1,4 +1,4 @@
-// The cache of specialised kernels (core/vk/spirv_cache.h, issue 14 start-up): it gives the
+// The cache of specialised kernels (core/vk/spirv_cache.h): it gives the
 // words specialiseSpirv gives, an entry is what is read back (not a fresh specialisation), and a
 // random, truncated, bit-flipped, foreign or non-SPIR-V file is ignored with one note on stderr,
 // never handed on, and replaced.

@@ -25,6 +25,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <string>
 #include <utility>
@@ -37,7 +38,7 @@
 namespace eikon {
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kFloat = 4.0 / 16777216.0;  // cap · 2⁻²⁴ (voxels)
 
 Scene sceneOf(const std::vector<std::pair<Shape, std::string>>& objects, int resolution) {

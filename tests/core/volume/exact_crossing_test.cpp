@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <utility>
 #include <vector>
@@ -93,10 +94,11 @@ TEST(ShapeClipLine, RotatedBoxEntersAndLeavesThroughItsFaces) {
   ASSERT_TRUE(c.hit);
   // Through the centre, along local (cos 30°, −sin 30°, 0): the local x faces (±0.5) are met at
   // 0.5/cos 30° = 0.577 and the y faces (±0.3) at 0.3/sin 30° = 0.6, so x faces bound it.
-  const double r = 0.5 / std::cos(30.0 * M_PI / 180.0);
+  const double r = 0.5 / std::cos(30.0 * std::numbers::pi / 180.0);
   EXPECT_NEAR(c.t0, 3.0 - r, kTol);
   EXPECT_NEAR(c.t1, 3.0 + r, kTol);
-  const glm::dvec3 xaxis(std::cos(M_PI / 6.0), std::sin(M_PI / 6.0), 0.0);  // local x in world
+  const glm::dvec3 xaxis(std::cos(std::numbers::pi / 6.0), std::sin(std::numbers::pi / 6.0),
+                         0.0);  // local x in world
   EXPECT_NEAR(glm::length(c.n0 + xaxis), 0.0, kTol);
   EXPECT_NEAR(glm::length(c.n1 - xaxis), 0.0, kTol);
 }

@@ -1,4 +1,4 @@
-// Host memory is checked before voxelising (issue 11, item 3): a volume the process cannot hold
+// Host memory is checked before voxelising: a volume the process cannot hold
 // is refused with the numbers ("needs X GiB of host memory, Y available (LIMIT)") instead of
 // ending in std::bad_alloc. Nothing here allocates the volumes it asks for.
 #include "core/volume/host_memory.h"

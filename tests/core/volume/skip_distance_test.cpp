@@ -1,7 +1,7 @@
 // The voxeliser's skip distances (core/volume/skip_distance.h) against their definition,
 // evaluated directly: a voxel is active where a field differs from one of its 26 neighbours, and
-// every voxel's distance is the Chebyshev distance to the nearest active voxel, capped. Issue 14
-// replaced the direct loops by a separable min/max filter and an O(n) distance transform; these
+// every voxel's distance is the Chebyshev distance to the nearest active voxel, capped. The
+// voxeliser computes them with a separable min/max filter and an O(n) distance transform; these
 // tests hold the fast stages to the direct evaluation on random data and on voxelised shapes,
 // and the whole voxeliser to itself across thread counts (bit for bit).
 #include "core/volume/skip_distance.h"

@@ -1,4 +1,4 @@
-// The cache of voxelised volumes (core/volume/volume_cache.h, issue 14 start-up): an entry gives
+// The cache of voxelised volumes (core/volume/volume_cache.h): an entry gives
 // back the voxeliser's volume bit for bit (every array, every flag, the boundary field's shapes
 // and media rebuilt from the scene), the key follows what the voxeliser reads and ignores what it
 // does not, and a random, truncated, bit-flipped, foreign, misnamed or oversized file is ignored

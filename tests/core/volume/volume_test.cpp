@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -19,9 +20,6 @@
 
 namespace eikon {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
 double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
 // ------------------------------------------------------------------ (a) sphere volume
@@ -92,7 +90,7 @@ TEST(Voxelize, SphereVolumeFromCoverage) {
         moment += c * g.center(i, j, k);
       }
   const double h3 = g.h * g.h * g.h;
-  const double volume = sum * h3, exact = 4.0 / 3.0 * kPi * r * r * r;
+  const double volume = sum * h3, exact = 4.0 / 3.0 * std::numbers::pi * r * r * r;
   const double rel = volume / exact - 1.0;
   std::printf("[ measured ] sphere volume %.8f mm^3 vs %.8f (rel %.3e), %d boundary voxels\n",
               volume, exact, rel, partial);

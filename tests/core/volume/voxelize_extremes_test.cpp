@@ -1,4 +1,4 @@
-// The voxeliser with objects at coordinates far outside the volume (issue 11, item 1): the voxel
+// The voxeliser with objects at coordinates far outside the volume: the voxel
 // index range of an object is clamped in floating point before it is converted to int, so a
 // sphere of radius 1e9 mm covers every voxel (before: the overflowing conversion — undefined
 // behaviour, INT_MIN on x86 — clamped the range to one slab, silently dropping the object) and a

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
-"""Writes the self-made test meshes of tests/data/meshes (issue 16, item 1): run it from anywhere,
+"""Writes the self-made test meshes of tests/data/meshes: run it from anywhere,
 it writes next to itself. Every file is generated here, none is downloaded.
 
-  box.obj            the cube [-0.5, 0.5]^3 as 6 quads (Assimp triangulates them), outward
+  box.obj            the cube [-0.5, 0.5]^3 as 6 quads (the reader triangulates them), outward
   box.stl            the same cube as 12 triangles, binary STL (corners stored per triangle)
   box.ply            the same cube as 12 triangles, ASCII PLY
   icosphere2.obj     the unit icosphere of subdivision level 2 (320 triangles, vertices on r = 1)
