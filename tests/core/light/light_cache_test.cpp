@@ -122,9 +122,8 @@ TEST(LightCache, ACorruptedEntryIsRefusedWithANotice) {
   fillLight(stored);
   const uint64_t key = lightCacheKey(scene, stored, LightingOptions{}, false);
   ASSERT_EQ(saveLightCache(dir.path(), key, stored), "");
-  std::filesystem::path entry;
-  for (const auto& e : std::filesystem::directory_iterator(dir.path())) entry = e.path();
-  ASSERT_FALSE(entry.empty());
+  const std::filesystem::path entry = lightCachePath(dir.path(), key);
+  ASSERT_TRUE(std::filesystem::is_regular_file(entry));
   {
     // One byte of the payload (the last float of the flux volume) changed, the size unchanged.
     std::fstream f(entry, std::ios::in | std::ios::out | std::ios::binary);
@@ -148,9 +147,8 @@ TEST(LightCache, AnEntryOfTheWrongSizeIsRefusedUnread) {
   fillLight(stored);
   const uint64_t key = lightCacheKey(scene, stored, LightingOptions{}, false);
   ASSERT_EQ(saveLightCache(dir.path(), key, stored), "");
-  std::filesystem::path entry;
-  for (const auto& e : std::filesystem::directory_iterator(dir.path())) entry = e.path();
-  ASSERT_FALSE(entry.empty());
+  const std::filesystem::path entry = lightCachePath(dir.path(), key);
+  ASSERT_TRUE(std::filesystem::is_regular_file(entry));
   ASSERT_EQ(::truncate(entry.c_str(), off_t(50) << 30), 0);
   VolumeSet loaded = voxelize(scene);
   std::string notice;
