@@ -3,8 +3,8 @@
 #   scripts/fuzz.sh [SECONDS_PER_HARNESS] [HARNESS...]
 # Configures build-fuzz (clang, EIKON_BUILD_FUZZERS=ON: every eikon library built with
 # -fsanitize=address,undefined and fuzzer coverage), builds the harnesses fuzz/*.cpp (or those
-# named: scene_json gemcad_asc fit_csv fit_yaml exr_latlong light_cache volume_cache spirv_cache
-# pipeline_cache) and runs each for SECONDS_PER_HARNESS (default 600) on a copy of its seeds
+# named: scene_json gemcad_asc fit_csv fit_yaml mesh_obj mesh_ply mesh_stl exr_latlong light_cache
+# volume_cache spirv_cache pipeline_cache) and runs each for SECONDS_PER_HARNESS (default 600) on a copy of its seeds
 # (fuzz/corpus/NAME, copied to build-fuzz/corpus/NAME, which keeps what the fuzzer adds). A
 # finding (crash, sanitizer report, timeout of a single input, out-of-memory) is written to
 # build-fuzz/findings/NAME/; the run goes on past findings (-fork), and prints one line per
