@@ -44,6 +44,11 @@ struct RenderArgs {
   bool timings = false;
 };
 
+/// The progressive preview's file for the output `out` (x.exr → x.partial.png): see Preview.
+std::filesystem::path partialPreviewPath(const std::filesystem::path& out) {
+  return std::filesystem::path(out).replace_extension(".partial.png");
+}
+
 /// Refuse an output that is one of the render's own inputs (the same file by device and inode:
 /// also through a symbolic or hard link): `-o scenes/diamond_lights.exr` used to replace the
 /// scene's environment map with the render and exit 0.
@@ -228,26 +233,27 @@ void printSummary(const RenderArgs& a, Session& session, const RenderTwin& twin,
       twin.why.c_str(), img.seconds, rays / img.seconds, img.mean_steps, out.c_str(), png.c_str());
 }
 
-/// Progressive output: the PNG preview rewritten (atomically) as pixel samples finish, at most
-/// once a second, so a long render shows the picture forming; the final pair replaces it. A render
-/// that fails after a preview was written removes it (~Preview): no partial output is left.
+/// Progressive output: a preview of the image so far rewritten (atomically) as pixel samples
+/// finish, at most once a second, so a long render shows the picture forming. It goes to its own
+/// file, "NAME.partial.png" beside the pair (partialPreviewPath), never over NAME.png: the pair
+/// NAME.exr and NAME.png is only ever replaced whole, so a render killed mid-way leaves the
+/// previous pair as it was. The partial preview is removed when the render ends, after the final
+/// pair is written or when it fails (~Preview), and so is one a killed render left there.
 struct Preview {
-  std::filesystem::path png;
+  std::filesystem::path partial;
   double exposure = 0.0;
   std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
-  bool written = false, finished = false;
   ~Preview() {
     std::error_code ec;
-    if (written && !finished) std::filesystem::remove(png, ec);
+    std::filesystem::remove(partial, ec);
   }
   RenderSettings attach(RenderSettings rs) {
     rs.on_pass = [this](const RenderImage& so_far, int, int) {
       const auto now = std::chrono::steady_clock::now();
       if (now - last < std::chrono::seconds(1)) return;
       writeFilesTogether(
-          {{png, pngPreviewContent(so_far.width, so_far.height, so_far.rgb, exposure)}});
+          {{partial, pngPreviewContent(so_far.width, so_far.height, so_far.rgb, exposure)}});
       last = now;
-      written = true;
     };
     return rs;
   }
@@ -261,7 +267,8 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   if (a.timings) timings::enable(true);
   timings::mark("command line");
   std::filesystem::path out(a.output),
-      png = std::filesystem::path(a.output).replace_extension(".png");
+      png = std::filesystem::path(a.output).replace_extension(".png"),
+      partial = partialPreviewPath(out);
   if (out.extension() != ".exr") throw CliError("output must end in .exr: " + a.output);
   (void)progressMode(a.progress, a.quiet);  // a bad --progress fails before any work
   checkExposure(a.exposure);
@@ -277,9 +284,12 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   view.march->integrator = parseIntegrator(a.integrator);
   auto scene = std::make_shared<Scene>(loadScene(a.scene));
   for (const std::string& w : scene->warnings) warn(w, a.strict);
-  refuseOverwritingInputs(*scene, a.scene, {{out, "the output"}, {png, "the PNG preview"}});
+  refuseOverwritingInputs(
+      *scene, a.scene,
+      {{out, "the output"}, {png, "the PNG preview"}, {partial, "the partial PNG preview"}});
   checkWritable(out);
   checkWritable(png);
+  checkWritable(partial);
   const RenderSettings rs = renderSettings(*scene, view);  // the scene's "render" under options
   const double exposure =
       sub.count("--exposure") ? a.exposure : scene->render.exposure.value_or(0.0);
@@ -343,7 +353,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
       progress.note("cost: " + describeRenderCost(cost), true);
     progress.update("rendering", 0.0);  // the trial's stage ("preparing the GPU") has ended
   }
-  Preview preview{png, exposure};
+  Preview preview{partial, exposure};
   RenderImage img = session.render(preview.attach(rs), !cpu);
   progress.finish();
   timings::mark("rendered");
@@ -369,7 +379,6 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
                                 ? exrLayersContent(img.width, img.height, img.rgb, img.bins,
                                                    img.spectral, img.modes, aovNames(img), img.aov)
                                 : exrRgbContent(img.width, img.height, img.rgb)}});
-  preview.finished = true;
   timings::mark("written");
   printSummary(a, session, twin, light, rs, img, out, png);
 }

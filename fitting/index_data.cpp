@@ -276,10 +276,20 @@ namespace {
 // events are walked once (an alias is one event, not the tree it names), and the second key of a
 // map that repeats one is refused with its line: "name:LINE: duplicate key 'type' (first on line
 // L)".
+//
+// The same walk guards against yaml-cpp 0.7's endless loop: a token that cannot start a node where
+// a document's node is expected (a ',' outside [ ] and { }, as in a file holding just ",") is left
+// unread by the parser, which then answers every next HandleNextDocument with an empty document at
+// that same token, forever (upstream fixed it by stopping a parse that makes no progress). A
+// document that starts where the one before it started is that loop: refused with its line.
 class DuplicateKeyCheck final : public YAML::EventHandler {
  public:
-  explicit DuplicateKeyCheck(const std::string& name) : name_(name) {}
-  void OnDocumentStart(const YAML::Mark&) override {}
+  DuplicateKeyCheck(const std::string& name, const std::string& text) : name_(name), text_(text) {}
+  void OnDocumentStart(const YAML::Mark& mark) override {
+    if (started_ && mark.pos == last_start_) refuseStuck(mark);
+    started_ = true;
+    last_start_ = mark.pos;
+  }
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark&, YAML::anchor_t) override { node(nullptr, {}); }
   void OnAlias(const YAML::Mark&, YAML::anchor_t) override { node(nullptr, {}); }
@@ -323,14 +333,27 @@ class DuplicateKeyCheck final : public YAML::EventHandler {
     open_.pop_back();
     node(nullptr, {});
   }
+  /// The parser is stuck at `mark`: say which character stopped it, never quoting more of the file.
+  [[noreturn]] void refuseStuck(const YAML::Mark& mark) const {
+    const std::string at = name_ + ":" + std::to_string(mark.line + 1) + ": malformed YAML: ";
+    const size_t pos = size_t(std::max(mark.pos, 0));
+    if (pos < text_.size() && text_[pos] == ',')
+      throw std::invalid_argument(at + "a ',' outside a flow list [ ] or map { } (column " +
+                                  std::to_string(mark.column + 1) + ")");
+    throw std::invalid_argument(at + "the parser cannot go on at column " +
+                                std::to_string(mark.column + 1));
+  }
   const std::string& name_;
+  const std::string& text_;
   std::vector<Collection> open_;
+  bool started_ = false;
+  int last_start_ = 0;
 };
 
 void checkDuplicateKeys(const std::string& text, const std::string& name) {
   std::istringstream in(text);
   YAML::Parser parser(in);
-  DuplicateKeyCheck check(name);
+  DuplicateKeyCheck check(name, text);
   while (parser.HandleNextDocument(check)) {
   }
 }
@@ -361,8 +384,9 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
   checkOptions(opt);
   YAML::Node root;
   try {
-    root = YAML::Load(withoutByteOrderMark(text));
+    // The event walk first: it refuses the input that yaml-cpp's document loop never leaves.
     checkDuplicateKeys(withoutByteOrderMark(text), name);
+    root = YAML::Load(withoutByteOrderMark(text));
   } catch (const YAML::Exception& e) {
     throw std::invalid_argument(name + ":" + std::to_string(e.mark.line + 1) +
                                 ": malformed YAML: " + e.msg);

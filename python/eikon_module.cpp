@@ -41,6 +41,7 @@ PYBIND11_MODULE(eikon, m) {
   m.doc() =
       "eikon: eikonal rendering of refractive, dispersive and birefringent objects "
       "(wavelengths nm, lengths mm, angles radians). See python/eikon_module.cpp.";
+  registerErrorTranslator();
   bindDispersion(m);
   bindFitting(m);
   bindOptics(m);

@@ -42,6 +42,10 @@ std::string integratorName(Integrator i);
 /// A SettingError of the session (core/session/session.h) as Python's ValueError, the setting
 /// named by its keyword here ("light-splat" → "splat"); the complaint is the CLI's, word for word.
 [[noreturn]] void rethrowSetting(const SettingError& e);
+/// Makes every exception leaving the module raise as pybind11 would raise it, with its message
+/// through printable() (core/scene/messages.h), as the eikon command shows it. Called first by
+/// PYBIND11_MODULE.
+void registerErrorTranslator();
 /// Runs a session check, turning its SettingError into rethrowSetting's ValueError.
 template <class F>
 void checkSetting(F&& check) {

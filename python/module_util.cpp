@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <map>
 #include <mutex>
+#include <new>
 #include <stdexcept>
 
 #include "core/scene/limits.h"
@@ -115,6 +116,53 @@ void rethrowSetting(const SettingError& e) {
   auto it = keyword.find(e.setting());
   throw std::invalid_argument((it == keyword.end() ? e.setting() : it->second) + " " +
                               e.complaint());
+}
+
+// ---------------------------------------------------------------- errors
+// pybind11 turns a C++ exception into a Python one with what() as it is; what() quotes user input
+// (a file name, a material name, a JSON string), which may hold raw control characters (an ESC
+// that recolours a terminal, a newline that forges a second line). The eikon command shows every
+// message through printable() (core/scene/messages.h); this translator, tried before pybind11's
+// own, raises the same Python exception as pybind11 would, with the message through printable().
+// Python's own exceptions (error_already_set: raised in a callback) pass through untouched.
+void registerErrorTranslator() {
+  py::register_local_exception_translator([](std::exception_ptr p) {
+    if (!p) return;
+    auto raise = [](PyObject* type, const std::exception& e) {
+      PyErr_SetString(type, printable(e.what()).c_str());
+    };
+    try {
+      std::rethrow_exception(p);
+    } catch (const py::error_already_set&) {
+      throw;  // pybind11 restores it
+    } catch (const py::value_error& e) {
+      raise(PyExc_ValueError, e);
+    } catch (const py::type_error& e) {
+      raise(PyExc_TypeError, e);
+    } catch (const py::key_error& e) {
+      raise(PyExc_KeyError, e);
+    } catch (const py::index_error& e) {
+      raise(PyExc_IndexError, e);
+    } catch (const py::builtin_exception&) {
+      throw;  // the other pybind11 exceptions, as pybind11 raises them
+    } catch (const std::bad_alloc&) {
+      throw;  // MemoryError
+    } catch (const std::out_of_range& e) {
+      raise(PyExc_IndexError, e);
+    } catch (const std::overflow_error& e) {
+      raise(PyExc_OverflowError, e);
+    } catch (const std::domain_error& e) {
+      raise(PyExc_ValueError, e);
+    } catch (const std::invalid_argument& e) {
+      raise(PyExc_ValueError, e);
+    } catch (const std::length_error& e) {
+      raise(PyExc_ValueError, e);
+    } catch (const std::range_error& e) {
+      raise(PyExc_ValueError, e);
+    } catch (const std::exception& e) {
+      raise(PyExc_RuntimeError, e);
+    }
+  });
 }
 
 // ---------------------------------------------------------------- Vulkan context (lazy, shared)

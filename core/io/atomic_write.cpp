@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -60,30 +61,6 @@ void createParentFolders(const std::filesystem::path& path,
   }
 }
 
-/// An exclusive flock on a lock file, released (and closed) when destroyed.
-class FileLock {
- public:
-  explicit FileLock(const std::filesystem::path& lock_path) {
-    fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-    if (fd_ < 0) throw writeError(lock_path, std::strerror(errno));
-    while (::flock(fd_, LOCK_EX) != 0) {
-      if (errno == EINTR) continue;
-      const int err = errno;
-      ::close(fd_);
-      throw writeError(lock_path, std::string("cannot lock it: ") + std::strerror(err));
-    }
-  }
-  ~FileLock() {
-    ::flock(fd_, LOCK_UN);
-    ::close(fd_);
-  }
-  FileLock(const FileLock&) = delete;
-  FileLock& operator=(const FileLock&) = delete;
-
- private:
-  int fd_ = -1;
-};
-
 }  // namespace
 
 /// The file an output path names: a symbolic link's final target (so the link stays and shows
@@ -131,6 +108,50 @@ std::filesystem::path lockPathFor(const std::filesystem::path& first) {
   return first.parent_path() / ("." + first.stem().string() + ".lock");
 }
 
+// The protocol (atomic_write.h): open without following a link, lock, and keep the lock only if
+// the path still names the file locked. A waiter that wakes on a file its holder has unlinked (or
+// that was replaced meanwhile) starts again on whatever the path names now. Only a process that
+// holds the lock on the file the path names unlinks it, and it does so before it unlocks, as its
+// last act under the lock; so no two processes ever hold a lock on the file the path names.
+OutputSetLock::OutputSetLock(const std::filesystem::path& first) : path_(lockPathFor(first)) {
+  for (int attempt = 0; attempt < 10000; ++attempt) {
+    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd_ < 0 && errno == ELOOP)
+      throw writeError(path_,
+                       "the lock file is a symbolic link; eikon opens its lock file only "
+                       "as a plain file (remove the link)");
+    if (fd_ < 0)
+      throw writeError(path_, std::string("cannot open the lock file: ") + std::strerror(errno));
+    struct stat held {};
+    if (::fstat(fd_, &held) != 0 || !S_ISREG(held.st_mode)) {
+      release(false);
+      throw writeError(path_, "the lock file is not a regular file");
+    }
+    while (::flock(fd_, LOCK_EX) != 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      release(false);
+      throw writeError(path_, std::string("cannot lock it: ") + std::strerror(err));
+    }
+    struct stat named {};
+    if (::lstat(path_.c_str(), &named) == 0 && named.st_dev == held.st_dev &&
+        named.st_ino == held.st_ino)
+      return;        // locked, and it is the lock file the path names: held
+    release(false);  // unlinked or replaced while this process waited: start again
+  }
+  throw writeError(path_, "cannot lock it: the lock file keeps being replaced");
+}
+
+OutputSetLock::~OutputSetLock() { release(true); }
+
+void OutputSetLock::release(bool remove) {
+  if (fd_ < 0) return;
+  if (remove) ::unlink(path_.c_str());  // still holding the lock: see the protocol above
+  ::flock(fd_, LOCK_UN);
+  ::close(fd_);
+  fd_ = -1;
+}
+
 void writeFilesTogether(const std::vector<OutputFile>& outputs) {
   if (outputs.empty()) return;
   std::vector<OutputFile> files = outputs;  // each at the file it names (outputTarget)
@@ -154,8 +175,8 @@ void writeFilesTogether(const std::vector<OutputFile>& outputs) {
       }
     }
     // One file needs no lock: its rename is atomic by itself.
-    std::optional<FileLock> lock;
-    if (files.size() > 1) lock.emplace(lockPathFor(files.front().path));
+    std::optional<OutputSetLock> lock;
+    if (files.size() > 1) lock.emplace(files.front().path);
     // Under the lock: a target that became a folder since would fail its rename after earlier
     // renames had replaced their targets; refuse before replacing anything.
     for (const OutputFile& f : files)

@@ -8,13 +8,17 @@
 //   1. every file to its own temporary; any failure (full disk, a codec error) removes the
 //      temporaries and leaves every target as it was;
 //   2. with an exclusive flock(2) on the lock file ".<stem>.lock" beside the first target
-//   (".x.lock"
-//      for out/x.png and out/x.exr),
-//      each temporary is renamed over its target.
+//      (".x.lock" for out/x.png and out/x.exr; OutputSetLock), each temporary is renamed over its
+//      target, and the lock file is removed again.
 //
 // Two processes writing the same set at once therefore leave one process's complete set, never an
-// EXR from one and a PNG from the other. The lock file is left in place (deleting it would let a
-// third writer lock a different inode than a second one still holds).
+// EXR from one and a PNG from the other. The lock file exists only while a set is being renamed
+// into place. Removing it safely takes a protocol (OutputSetLock): a writer opens it without
+// following a symbolic link (a link planted there is refused, never followed to create a file at
+// its target), locks it, and keeps the lock only if the path still names the file it locked (else
+// it starts again); the holder unlinks it while still holding the lock, as its last act. A writer
+// that waited on the unlinked file then finds it gone and starts again, so no two writers ever
+// hold the lock of the file the path names.
 //
 //   eikon::writeFilesTogether({{"out/x.png", [&](const auto& tmp) { encodePng(tmp); }},
 //                              {"out/x.exr", [&](const auto& tmp) { encodeExr(tmp); }}});
@@ -60,5 +64,22 @@ void writeFilesTogether(const std::vector<OutputFile>& files);
 
 /// The lock file writeFilesTogether holds for a set whose first file is `first`.
 std::filesystem::path lockPathFor(const std::filesystem::path& first);
+
+/// The exclusive lock of the set whose first file is `first` (the protocol above), held from
+/// construction to destruction, which removes the lock file. Throws std::runtime_error "cannot
+/// write 'LOCK': why" for a lock file that is a symbolic link or not a regular file. A reader
+/// that must see a set whole takes it too.
+class OutputSetLock {
+ public:
+  explicit OutputSetLock(const std::filesystem::path& first);
+  ~OutputSetLock();
+  OutputSetLock(const OutputSetLock&) = delete;
+  OutputSetLock& operator=(const OutputSetLock&) = delete;
+
+ private:
+  void release(bool remove);
+  std::filesystem::path path_;
+  int fd_ = -1;
+};
 
 }  // namespace eikon

@@ -52,8 +52,10 @@ void touchCacheEntry(const fs::path& entry) {
 
 uint64_t trimCacheDir(const fs::path& dir, const fs::path& keep, uint64_t max_bytes) {
   if (dir.empty()) return 0;
-  // One trimmer at a time; one that finds the lock taken leaves it to the holder.
-  const int lock = ::open((dir / ".trim.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  // One trimmer at a time; one that finds the lock taken leaves it to the holder. A symbolic link
+  // in the lock's place is not followed (it would create a file at its target): no trim then.
+  const int lock =
+      ::open((dir / ".trim.lock").c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (lock < 0) return 0;
   if (::flock(lock, LOCK_EX | LOCK_NB) != 0) {
     ::close(lock);

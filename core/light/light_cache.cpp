@@ -66,13 +66,13 @@ uint64_t payloadChecksum(const std::vector<glm::vec4>& fluence,
   return h.digest();
 }
 
-std::filesystem::path entryPath(const std::filesystem::path& dir, uint64_t key) {
+}  // namespace
+
+std::filesystem::path lightCachePath(const std::filesystem::path& dir, uint64_t key) {
   char name[40];
   std::snprintf(name, sizeof name, "light-%016llx.bin", static_cast<unsigned long long>(key));
   return dir / name;
 }
-
-}  // namespace
 
 std::filesystem::path defaultLightCacheDir() { return defaultCacheDir(); }
 
@@ -137,7 +137,7 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOpt
 bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& volume,
                     std::string* notice) {
   if (dir.empty()) return false;
-  const std::filesystem::path path = entryPath(dir, key);
+  const std::filesystem::path path = lightCachePath(dir, key);
   auto corrupted = [&](const std::string& why) {
     if (notice) *notice = path.string() + " is corrupted (" + why + "); simulating the light again";
     return false;
@@ -163,6 +163,12 @@ bool loadLightCache(const std::filesystem::path& dir, uint64_t key, VolumeSet& v
   if (stored_key != key || dims != volume.grid.dims)
     return corrupted("header does not match its name");
   const size_t N = volume.grid.count();
+  // The size from the file system before any payload is allocated or read: a file of another size
+  // (a sparse 50 GB one, say) is refused unread.
+  const uintmax_t header_bytes =
+      8 + sizeof format + sizeof stored_key + sizeof dims + sizeof checksum;
+  if (std::filesystem::file_size(path, ec) != header_bytes + 2 * N * sizeof(glm::vec4) || ec)
+    return corrupted("wrong size");
   std::vector<glm::vec4> fluence(N), flux(N);
   in.read(reinterpret_cast<char*>(fluence.data()), std::streamsize(N * sizeof(glm::vec4)));
   in.read(reinterpret_cast<char*>(flux.data()), std::streamsize(N * sizeof(glm::vec4)));
@@ -180,7 +186,7 @@ std::string saveLightCache(const std::filesystem::path& dir, uint64_t key,
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return "cannot create " + dir.string() + ": " + ec.message();
-  const std::filesystem::path final_path = entryPath(dir, key);
+  const std::filesystem::path final_path = lightCachePath(dir, key);
   try {
     // Atomic (core/io): a reader sees the old entry or the whole new one, never a partial file.
     writeFileAtomically(final_path, [&](const std::filesystem::path& tmp) {

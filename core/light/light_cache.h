@@ -29,6 +29,9 @@ std::filesystem::path defaultLightCacheDir();
 uint64_t lightCacheKey(const Scene& scene, const VolumeSet& volume, const LightingOptions& options,
                        bool reference);
 
+/// The file of a key's entry in `dir` ("light-<key in hex>.bin").
+std::filesystem::path lightCachePath(const std::filesystem::path& dir, uint64_t key);
+
 /// Fill volume.light_* from the cache; false if there is no valid entry for the key. An entry
 /// that exists but is corrupted (bad magic, truncated, wrong size, checksum mismatch) also gives
 /// false, and a one-line `notice` for the user; a missing entry or one written by another format

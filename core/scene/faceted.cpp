@@ -435,7 +435,9 @@ FacetTier ascFacet(std::istringstream& in, int gear, const std::string& at) {
 FacetedDesign readGemCadAsc(std::istream& in, const std::string& name) {
   FacetedDesign d;
   std::string line;
-  bool gear_seen = false;
+  // A file is quoted in messages only once it is known to be GemCad's: after a "GemCad" or "g"
+  // record.
+  bool gear_seen = false, recognised = false;
   for (int no = 1; std::getline(in, line); ++no) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const std::string at = name + " line " + std::to_string(no);
@@ -443,6 +445,7 @@ FacetedDesign readGemCadAsc(std::istream& in, const std::string& name) {
     std::istringstream s(line);
     std::string key;
     if (!(s >> key)) continue;
+    if (key == "GemCad") recognised = true;
     if (key == "GemCad" || key == "H" || key == "F" || key == "I" || key == "y") continue;
     if (key == "g") {
       int teeth = 0;
@@ -450,10 +453,14 @@ FacetedDesign readGemCadAsc(std::istream& in, const std::string& name) {
         throw FacetError("/file", at + ": expected 'g TEETH OFFSET' with 3 <= TEETH <= 400");
       if (!d.tiers.empty()) throw FacetError("/file", at + ": the gear must precede the facets");
       d.gear = teeth;
-      gear_seen = true;
+      gear_seen = recognised = true;
     } else if (key == "a") {
       if (!gear_seen) throw FacetError("/file", at + ": a facet before the 'g' (gear) line");
       d.tiers.push_back(ascFacet(s, d.gear, at));
+    } else if (!recognised) {
+      // Not GemCad's export (a wrong file named .asc, say /etc/passwd): its text is not quoted.
+      throw FacetError("/file", at + ": not a GemCad .asc file: expected its first record to be "
+                                     "'GemCad VERSION' or 'g TEETH OFFSET'");
     } else {
       throw FacetError(
           "/file", at + ": unknown record '" + key.substr(0, 40) + "' (GemCad, g, y, I, H, F, a)");

@@ -92,7 +92,9 @@ FacetedStone cutFaceted(const FacetedDesign& design);
 
 /// Read a GemCad .asc file (the text export of GemCad: "g" gear line, "a angle distance index
 /// [n name] index ..." facet lines, negative angles on the pavilion; H/F/I/y/G lines are notes).
-/// Every facet becomes a Distance tier. Throws FacetError("/file", "FILE line N: ...").
+/// Every facet becomes a Distance tier. Throws FacetError("/file", "FILE line N: ..."). The file's
+/// text is quoted in a message only after a "GemCad" or "g" record has shown it to be GemCad's: an
+/// unknown record before either is refused by its line number alone.
 FacetedDesign readGemCadAsc(std::istream& in, const std::string& name);
 
 }  // namespace eikon

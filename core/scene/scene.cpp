@@ -543,6 +543,14 @@ ConvexShape parseFaceted(const Node& o) {
     if (o.has("tiers") || o.has("gear") || o.has("girdle"))
       o.fail("give either file (a GemCad .asc) or gear, girdle and tiers, not both");
     const std::filesystem::path p = namedFile(*f, "a GemCad .asc file");
+    // The name must say GemCad's text export: a file of another kind is not read as one (its
+    // lines would be quoted in the messages, a line of /etc/passwd say).
+    std::string ext = p.extension().string();
+    for (char& c : ext)
+      if (c >= 'A' && c <= 'Z') c = char(c - 'A' + 'a');
+    if (ext != ".asc")
+      f->fail("'" + excerpt(p.filename().string()) +
+              "' does not end in .asc: expected a GemCad .asc file (GemCad's text export)");
     std::string text;
     try {
       text = readTextFile(p, "a GemCad .asc file", 1u << 20);

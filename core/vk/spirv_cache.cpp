@@ -22,7 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr char kMagic[8] = {'E', 'I', 'K', 'S', 'P', 'I', 'R', 'V'};
-constexpr uint64_t kMaxWords = uint64_t(1) << 22;  // 16 MiB: far above any eikon kernel
+constexpr uint64_t kMaxWords = (kMaxSpirvCacheEntryBytes - 32) / 4;
 constexpr uint32_t kSpirvMagic = 0x07230203u;
 
 struct Header {
@@ -47,38 +47,6 @@ uint64_t keyOf(std::span<const uint32_t> spirv, std::span<const uint32_t> values
   return key == 0 ? 1 : key;
 }
 
-/// The words of the entry at `path` for `key`; empty when there is none or it is unusable (then
-/// `why` says why, unless the file is simply missing).
-std::vector<uint32_t> load(const fs::path& path, uint64_t key, std::string& why) {
-  // Opening a pipe for reading waits for a writer: only a regular file is read.
-  std::error_code ec;
-  const fs::file_type type = fs::status(path, ec).type();
-  if (type == fs::file_type::not_found) return {};
-  if (type != fs::file_type::regular) {
-    why = "not a regular file";
-    return {};
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  Header h{};
-  if (bytes.size() >= 8 && std::memcmp(bytes.data(), kMagic, 8) != 0)
-    return why = "not a SPIR-V cache file", std::vector<uint32_t>{};
-  if (bytes.size() < sizeof h) return why = "truncated header", std::vector<uint32_t>{};
-  std::memcpy(&h, bytes.data(), sizeof h);
-  if (h.key != key) return why = "its header does not match its name", std::vector<uint32_t>{};
-  if (h.words < 5 || h.words > kMaxWords) return why = "bad word count", std::vector<uint32_t>{};
-  if (bytes.size() != sizeof h + h.words * 4)
-    return why = bytes.size() < sizeof h + h.words * 4 ? "truncated" : "wrong size",
-           std::vector<uint32_t>{};
-  std::vector<uint32_t> words(h.words);
-  std::memcpy(words.data(), bytes.data() + sizeof h, h.words * 4);
-  if (hashOf(words.data(), h.words * 4) != h.checksum)
-    return why = "checksum mismatch", std::vector<uint32_t>{};
-  if (words[0] != kSpirvMagic) return why = "not SPIR-V", std::vector<uint32_t>{};
-  return words;
-}
-
 /// At most kMaxEntries entries stay: the least recently used (written or read) go first (a rebuilt
 /// eikon keys new ones, and the old ones would pile up).
 constexpr size_t kMaxEntries = 64;
@@ -97,6 +65,50 @@ void trim(const fs::path& dir) {
 
 }  // namespace
 
+std::vector<uint32_t> parseSpirvCacheEntry(std::string_view bytes, uint64_t key, std::string& why) {
+  Header h{};
+  if (bytes.size() >= 8 && std::memcmp(bytes.data(), kMagic, 8) != 0)
+    return why = "not a SPIR-V cache file", std::vector<uint32_t>{};
+  if (bytes.size() < sizeof h) return why = "truncated header", std::vector<uint32_t>{};
+  std::memcpy(&h, bytes.data(), sizeof h);
+  if (h.key != key) return why = "its header does not match its name", std::vector<uint32_t>{};
+  if (h.words < 5 || h.words > kMaxWords) return why = "bad word count", std::vector<uint32_t>{};
+  if (bytes.size() != sizeof h + h.words * 4)
+    return why = bytes.size() < sizeof h + h.words * 4 ? "truncated" : "wrong size",
+           std::vector<uint32_t>{};
+  std::vector<uint32_t> words(h.words);
+  std::memcpy(words.data(), bytes.data() + sizeof h, h.words * 4);
+  if (hashOf(words.data(), h.words * 4) != h.checksum)
+    return why = "checksum mismatch", std::vector<uint32_t>{};
+  if (words[0] != kSpirvMagic) return why = "not SPIR-V", std::vector<uint32_t>{};
+  return words;
+}
+
+// The size is taken before anything is read: an entry larger than any eikon writes (a sparse
+// 50 GB file would take a minute and gigabytes to read whole) is ignored unread, and no more than
+// its size and a byte is read from one that grows meanwhile.
+std::vector<uint32_t> readSpirvCacheEntry(const fs::path& path, uint64_t key, std::string& why) {
+  // Opening a pipe for reading waits for a writer: only a regular file is read.
+  std::error_code ec;
+  const fs::file_type type = fs::status(path, ec).type();
+  if (type == fs::file_type::not_found) return {};
+  if (type != fs::file_type::regular) {
+    why = "not a regular file";
+    return {};
+  }
+  const uintmax_t size = fs::file_size(path, ec);
+  if (ec) return why = "cannot read its size", std::vector<uint32_t>{};
+  if (size > kMaxSpirvCacheEntryBytes)
+    return why = "larger than any entry (" + std::to_string(size) + " bytes)",
+           std::vector<uint32_t>{};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  std::string bytes(size_t(size) + 1, '\0');  // one byte more: a file that grew is "wrong size"
+  in.read(bytes.data(), std::streamsize(bytes.size()));
+  bytes.resize(size_t(in.gcount()));
+  return parseSpirvCacheEntry(bytes, key, why);
+}
+
 fs::path spirvCachePath(std::span<const uint32_t> spirv, std::span<const uint32_t> values,
                         const fs::path& dir) {
   const uint64_t key = dir.empty() ? 0 : keyOf(spirv, values);
@@ -112,7 +124,7 @@ std::vector<uint32_t> specialiseSpirvCached(std::span<const uint32_t> spirv,
   if (path.empty()) return specialiseSpirv(spirv, values);
   const uint64_t key = keyOf(spirv, values);
   std::string why;
-  std::vector<uint32_t> words = load(path, key, why);
+  std::vector<uint32_t> words = readSpirvCacheEntry(path, key, why);
   if (!words.empty()) {
     touchCacheEntry(path);  // recently used: evicted last (its own trim and the folder's cap)
     return words;

@@ -13,9 +13,25 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 namespace eikon::vk {
+
+/// The largest entry: the 32-byte header and 2^22 words (16 MiB, far above any eikon kernel). A
+/// larger file is ignored by its size, unread.
+inline constexpr uint64_t kMaxSpirvCacheEntryBytes = 32 + (uint64_t(1) << 24);
+
+/// The words an entry's bytes hold for `key`, checked (magic, key, word count, size, checksum,
+/// SPIR-V magic); empty with `why` set when any check fails. What the cache reads a file with.
+std::vector<uint32_t> parseSpirvCacheEntry(std::string_view bytes, uint64_t key, std::string& why);
+
+/// The words of the entry file at `path` for `key` (parseSpirvCacheEntry of its bytes); empty when
+/// there is none or it is unusable, then `why` says why unless the file is simply missing. Only a
+/// regular file of at most kMaxSpirvCacheEntryBytes is read; a larger one is refused by its size.
+std::vector<uint32_t> readSpirvCacheEntry(const std::filesystem::path& path, uint64_t key,
+                                          std::string& why);
 
 /// specialiseSpirv(spirv, values), read from or stored in `dir` (empty, or a binary without a
 /// build id: not cached). Throws as specialiseSpirv.

@@ -65,6 +65,34 @@ inline Outcome runProgramWithFileLimit(const std::string& program, const std::st
   return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(io_dir / "stdout"), slurp(io_dir / "stderr")};
 }
 
+/// Start `PROGRAM ARGS` in the background (the shell execs it, so the id returned is the program's,
+/// for kill(2)), its stdout and stderr captured through files in `io_dir`; with `max_file_bytes`
+/// > 0 every file it writes is limited to that size, as runProgramWithFileLimit does. Collect it
+/// with waitProgram.
+inline pid_t startProgram(const std::string& program, const std::string& args,
+                          const std::filesystem::path& io_dir, long max_file_bytes = 0) {
+  const std::string cmd = "exec " + program + " " + args + " >" + (io_dir / "stdout").string() +
+                          " 2>" + (io_dir / "stderr").string() + " </dev/null";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (max_file_bytes > 0) {
+      ::signal(SIGXFSZ, SIG_IGN);
+      const rlimit lim{rlim_t(max_file_bytes), rlim_t(max_file_bytes)};
+      ::setrlimit(RLIMIT_FSIZE, &lim);
+    }
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  return pid;
+}
+
+/// Wait for a program startProgram started; code -1 when a signal killed it.
+inline Outcome waitProgram(pid_t pid, const std::filesystem::path& io_dir) {
+  int st = 0;
+  if (pid < 0 || ::waitpid(pid, &st, 0) != pid) return {-1, "", ""};
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(io_dir / "stdout"), slurp(io_dir / "stderr")};
+}
+
 /// Run `[env] eikon ARGS`, capturing stdout and stderr through files in `io_dir`.
 inline Outcome runEikon(const std::string& args, const std::filesystem::path& io_dir,
                         const std::string& env = "") {

@@ -19,6 +19,7 @@
 
 #include "core/io/exr.h"
 #include "tests/apps/cli_support.h"
+#include "tests/sanitizers.h"
 
 namespace {
 
@@ -444,6 +445,76 @@ TEST_F(Cli, FailedWriteLeavesThePreviousOutputsIntact) {
   ASSERT_EQ(again.code, 0) << again.err;
   EXPECT_NE(slurp(outPath("render.exr")), exr);
   EXPECT_NE(slurp(outPath("render.png")), png);
+}
+
+// The progressive preview went to NAME.png itself: a render killed mid-way (SIGKILL: no clean-up
+// runs) left the previous render's EXR beside a preview of the new one. The preview has its own
+// file, NAME.partial.png, and the pair is replaced only whole: killed after its first preview,
+// the render leaves the previous pair byte for byte.
+TEST_F(Cli, RenderKilledMidWayLeavesThePreviousPairIntact) {
+  const std::string scene = write("scene.json", tinyScene());
+  const std::string common =
+      "render " + quote(scene) + " -q --width 160 --height 120 -o " + quote(outPath());
+  const Outcome first = run(common);
+  ASSERT_EQ(first.code, 0) << first.err;
+  const std::string exr = slurp(outPath("render.exr")), png = slurp(outPath("render.png"));
+  const fs::path partial = outPath("render.partial.png");
+  // Many samples: the render takes a minute, and a preview is written a second into it (the
+  // progressive preview is the GPU twin's: RenderSettings::on_pass).
+  const pid_t pid = eikon::test::startProgram(EIKON_BINARY, common + " --spp 4096", io_);
+  ASSERT_GT(pid, 0);
+  bool previewed = false;
+  for (int i = 0; i < 6000 && !previewed; ++i) {  // up to 120 s
+    ::usleep(20000);
+    previewed = fs::exists(partial) || slurp(outPath("render.png")) != png;
+  }
+  ::kill(pid, SIGKILL);
+  const Outcome killed = eikon::test::waitProgram(pid, io_);
+  EXPECT_EQ(killed.code, -1) << "the render ended before it was killed: " << killed.err;
+  EXPECT_TRUE(previewed) << "no preview within 120 s";
+  EXPECT_TRUE(slurp(outPath("render.exr")) == exr) << "the EXR changed";
+  EXPECT_TRUE(slurp(outPath("render.png")) == png) << "the PNG changed";
+  EXPECT_TRUE(fs::exists(partial));  // the preview, under its own name
+  // The next render replaces the pair and removes the stale preview.
+  const Outcome again = run(common + " --spp 2");
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_TRUE(slurp(outPath("render.png")) != png);
+  EXPECT_FALSE(fs::exists(partial));
+}
+
+// A render that failed after writing a progressive preview removed NAME.png (the preview had
+// replaced it): the previous pair is left byte for byte, and the partial preview removed. Files
+// are limited to 8 KiB, so the previews (~6 KB) are written and the final EXR (~22 KB) is not; 256
+// samples take a few seconds, a preview a second.
+TEST_F(Cli, RenderFailingAfterAPreviewLeavesThePreviousPairIntact) {
+  const std::string scene = write("scene.json", tinyScene());
+  const std::string common =
+      "render " + quote(scene) + " -q --width 160 --height 120 -o " + quote(outPath());
+  const Outcome first = run(common);
+  ASSERT_EQ(first.code, 0) << first.err;
+  const std::string exr = slurp(outPath("render.exr")), png = slurp(outPath("render.png"));
+  const fs::path partial = outPath("render.partial.png");
+  const pid_t pid = eikon::test::startProgram(EIKON_BINARY, common + " --spp 256", io_, 8192);
+  ASSERT_GT(pid, 0);
+  bool previewed = false;
+  auto running = [pid] {  // asked without reaping it (WNOWAIT): waitProgram collects it
+    siginfo_t info{};
+    return ::waitid(P_PID, id_t(pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == 0;
+  };
+  while (running()) {
+    previewed = previewed || fs::exists(partial) || slurp(outPath("render.png")) != png;
+    ::usleep(10000);
+  }
+  const Outcome r = eikon::test::waitProgram(pid, io_);
+  ASSERT_TRUE(previewed) << "the render wrote no preview before it failed; make it longer";
+  EXPECT_NE(r.code, 0);
+  EXPECT_EQ(r.err.rfind("eikon: error: cannot write '" + outPath("render.exr") + "'", 0), 0u)
+      << r.err;
+  EXPECT_TRUE(slurp(outPath("render.exr")) == exr) << "the EXR changed";
+  EXPECT_TRUE(slurp(outPath("render.png")) == png) << "the PNG changed";
+  EXPECT_FALSE(fs::exists(partial));
+  for (auto& e : fs::directory_iterator(out_))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
 }
 
 // A PNG write error (files limited to 2 KiB: libpng's first 4 KiB write fails) is eikon's one
@@ -996,6 +1067,7 @@ TEST_F(Cli, ExposureAndProgressAreCheckedEvenWhenUnused) {
 // it used to end in a bare "std::bad_alloc": under a 1 GiB address-space limit a 16384² image
 // (3 channels, about 12 bytes each measured: 9.7 GB) cannot fit.
 TEST_F(Cli, ImageLargerThanTheHostHoldsIsRefusedWithTheNumbers) {
+  if (eikon::test::kAddressSanitizer) GTEST_SKIP() << eikon::test::kNoAddressSpaceLimitUnderAsan;
   const std::string scene = write("scene.json", tinyScene());
   const Outcome limited = eikon::test::runProgram(
       "ulimit -v 1048576; " + std::string(EIKON_BINARY),

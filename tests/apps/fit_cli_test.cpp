@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -458,7 +459,10 @@ TEST_F(FitCli, HuberScaleOutsideItsRangeIsRefused) {
                                 "600,1.515\n650,1.5135\n700,1.512\n800,1.51\n");
   const Outcome ok = run(csv + " --loss huber:1e-9 --json");
   ASSERT_EQ(ok.code, 0) << ok.err;
-  for (const json& s : json::parse(ok.out)["modes"]["n"]["sigma"]) EXPECT_TRUE(s.is_number());
+  // The parsed document is named: a range-for over a member of the temporary json::parse(...)
+  // would read it after its destruction (the temporary lives only through the range's init).
+  const json fitted = json::parse(ok.out);
+  for (const json& s : fitted["modes"]["n"]["sigma"]) EXPECT_TRUE(s.is_number());
 }
 
 // 300 formula blocks × --samples 100000 (31 KB of YAML) used 3.6 GB before any check: the total is
@@ -472,6 +476,25 @@ TEST_F(FitCli, TotalFormulaSamplesAreBounded) {
                      yml +
                          ": 300 formula blocks x 100000 samples each = 30000000 samples, more "
                          "than the 1000000");
+}
+
+// `eikon fit` of a YAML file holding just "," ran forever (yaml-cpp 0.7's document loop never
+// leaves a ',' outside a flow collection): one line with the file and the line, at once. Run under
+// timeout(1) so that a regression fails (exit 124) instead of hanging the suite.
+TEST_F(FitCli, CommaOutsideAFlowCollectionIsRefusedPromptly) {
+  const struct {
+    const char* text;
+    const char* line;
+  } cases[] = {{",", ":1: "}, {",\n", ":1: "}, {"\n  ,\n", ":2: "}, {"DATA: x\n...\n,", ":3: "}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.text);
+    const std::string yml = write("comma.yml", c.text);
+    const auto start = std::chrono::steady_clock::now();
+    const Outcome r = eikon::test::runProgram("timeout 30 " + std::string(EIKON_BINARY),
+                                              "fit " + yml + " -o " + path("out.json"), dir_);
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+    expectCleanFailure(r, yml + c.line + "malformed YAML: a ',' outside a flow list");
+  }
 }
 
 // Indices above 10 fitted (exit 0) into a material the scene loader refused: the data row is

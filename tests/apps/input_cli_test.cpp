@@ -12,6 +12,7 @@
 
 #include "core/io/exr.h"
 #include "tests/apps/cli_support.h"
+#include "tests/sanitizers.h"
 
 namespace {
 
@@ -135,9 +136,7 @@ TEST_F(InputCli, TraceWarnsAboutAnObjectCoveringTheVolume) {
 // Under `prlimit --as` (1.5 GB of address space) a 256³ volume (≈ 3.9 GB for the voxeliser) is
 // refused with the numbers and the limit, not with std::bad_alloc.
 TEST_F(InputCli, HostMemoryIsCheckedBeforeVoxelising) {
-#if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space at start: no RLIMIT_AS cap";
-#endif
+  if (eikon::test::kAddressSanitizer) GTEST_SKIP() << eikon::test::kNoAddressSpaceLimitUnderAsan;
   const std::string scene =
       write("big.json", R"({"volume": {"bounds_min": [-12, -12, -12], "bounds_max": [12, 12, 12],
       "resolution": 256}, "materials": {"glass": {"n": 1.5}},

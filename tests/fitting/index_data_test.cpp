@@ -4,6 +4,7 @@
 #include "fitting/index_data.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <fstream>
@@ -271,6 +272,35 @@ TEST(RefractiveIndexYaml, BadInputIsOneClearError) {
   expectError(yml("DATA:\n  - type: formula 2\n    wavelength_range: 0.3 2.5\n    coefficients: 0 "
                   "1\n"),
               {"bad.yml:4: DATA[0].coefficients", "odd number of coefficients, got 2"});
+}
+
+// A file holding just "," hung `eikon fit` forever: yaml-cpp 0.7 leaves a ',' outside a flow
+// collection unread and answers every next document with an empty one at that same ','. Refused
+// with the line and the column, promptly (the alarm turns a regression into a failure, not a hang).
+TEST(RefractiveIndexYaml, CommaOutsideAFlowCollectionIsRefusedNotLoopedOn) {
+  struct Case {
+    const char* text;
+    const char* where;
+  };
+  const Case cases[] = {{",", "bad.yml:1: malformed YAML: a ',' outside a flow list"},
+                        {" ,", "bad.yml:1:"},
+                        {"\n\n,", "bad.yml:3: malformed YAML: a ',' outside"},
+                        {", DATA", "bad.yml:1: malformed YAML: a ',' outside"},
+                        {"[a],", "(column 4)"},
+                        {"\"x\",", "(column 4)"},
+                        {"--- ,", "bad.yml:1: malformed YAML: a ',' outside"},
+                        {"- a\n,", "bad.yml:2: malformed YAML: a ',' outside"},
+                        {"DATA: x\n...\n,", "bad.yml:3: malformed YAML: a ',' outside"},
+                        {"\xEF\xBB\xBF,", "bad.yml:1: malformed YAML: a ',' outside"}};
+  ::alarm(20);
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.text);
+    expectError([&] { parseRefractiveIndexYaml(c.text, "bad.yml"); }, {c.where});
+  }
+  ::alarm(0);
+  // A ',' inside a flow list, or inside a plain scalar, is no error of its own.
+  expectError([] { parseRefractiveIndexYaml("[a, b]", "ok.yml"); }, {"ok.yml: expected a"});
+  expectError([] { parseRefractiveIndexYaml("a, b", "ok.yml"); }, {"ok.yml: expected a"});
 }
 
 // The samples of all formula blocks together are bounded (blocks × samples ≤

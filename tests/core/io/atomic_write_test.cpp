@@ -8,8 +8,10 @@
 #include <gtest/gtest.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -59,8 +61,60 @@ TEST_F(AtomicWrite, PairReplacesBothTargetsAndCreatesFolders) {
   EXPECT_EQ(slurp(png), "png 2");
   EXPECT_EQ(slurp(exr), "exr 2");
   EXPECT_EQ(lockPathFor(png), dir_ / "a" / "b" / ".x.lock");
-  EXPECT_TRUE(fs::exists(lockPathFor(png)));
   expectNoTemporaries(dir_);
+}
+
+// Every set written left an empty ".x.lock" behind: the holder removes it as it unlocks.
+TEST_F(AtomicWrite, NoLockFileIsLeftBehind) {
+  const fs::path png = dir_ / "x.png", exr = dir_ / "x.exr";
+  for (int round = 0; round < 2; ++round) {
+    writeFilesTogether({{png, text("png")}, {exr, text("exr")}});
+    EXPECT_FALSE(fs::exists(fs::symlink_status(lockPathFor(png))));
+  }
+  // Nor after a failed write (the lock taken, a rename refused).
+  EXPECT_THROW(
+      writeFilesTogether({{png, text("png 2")},
+                          {exr, [](const fs::path&) { throw std::runtime_error("codec"); }}}),
+      std::runtime_error);
+  EXPECT_FALSE(fs::exists(fs::symlink_status(lockPathFor(png))));
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir_)) names.push_back(e.path().filename());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"x.exr", "x.png"}));
+}
+
+// A symbolic link planted at the lock file's name was followed, creating a file at its target
+// (anywhere the writer may write). The link is refused with one line naming it; nothing is created
+// at its target and both targets stay as they were.
+TEST_F(AtomicWrite, LockFileThatIsASymbolicLinkIsRefused) {
+  const fs::path png = dir_ / "x.png", exr = dir_ / "x.exr", target = dir_ / "elsewhere";
+  writeFilesTogether({{png, text("old png")}, {exr, text("old exr")}});
+  fs::create_symlink(target, lockPathFor(png));
+  try {
+    writeFilesTogether({{png, text("new png")}, {exr, text("new exr")}});
+    ADD_FAILURE() << "a symbolic link as the lock file was followed";
+  } catch (const std::runtime_error& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("cannot write '" + lockPathFor(png).string() +
+                          "': the lock file is a symbolic link",
+                      0),
+              0u)
+        << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+  EXPECT_FALSE(fs::exists(fs::symlink_status(target)));
+  EXPECT_TRUE(fs::is_symlink(lockPathFor(png)));  // not ours to remove
+  EXPECT_EQ(slurp(png), "old png");
+  EXPECT_EQ(slurp(exr), "old exr");
+  expectNoTemporaries(dir_);
+  // A link to an existing file is refused alike, the file untouched.
+  fs::remove(lockPathFor(png));
+  std::ofstream(target) << "precious";
+  fs::create_symlink(target, lockPathFor(png));
+  EXPECT_THROW(writeFilesTogether({{png, text("new png")}, {exr, text("new exr")}}),
+               std::runtime_error);
+  EXPECT_EQ(slurp(target), "precious");
+  EXPECT_EQ(slurp(png), "old png");
 }
 
 // The second file's writer fails after the first file's content is complete (a full disk while
@@ -163,13 +217,9 @@ TEST_F(AtomicWrite, ConcurrentWritersNeverLeaveAMixedPair) {
   std::atomic<int> mixed{0}, checks{0};
   std::thread reader([&] {
     while (!stop) {
-      const int fd = ::open(lockPathFor(png).c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-      ASSERT_GE(fd, 0);
-      ::flock(fd, LOCK_EX);
+      const OutputSetLock lock(png);  // the writers' protocol: they remove the file as they unlock
       if (slurp(png) != slurp(exr)) ++mixed;
       ++checks;
-      ::flock(fd, LOCK_UN);
-      ::close(fd);
     }
   });
   std::vector<std::thread> writers;
@@ -186,7 +236,43 @@ TEST_F(AtomicWrite, ConcurrentWritersNeverLeaveAMixedPair) {
   EXPECT_EQ(mixed.load(), 0) << "of " << checks.load() << " checks";
   EXPECT_GT(checks.load(), 0);
   EXPECT_EQ(slurp(png), slurp(exr));
+  EXPECT_FALSE(fs::exists(fs::symlink_status(lockPathFor(png))));
   expectNoTemporaries(dir_);
+}
+
+// The removal protocol itself: processes (not threads: flock locks belong to open files, and each
+// process opens its own) that each hold the lock in turn while removing it as they unlock never
+// find another process inside. Each increments a counter file under the lock, read-modify-write
+// with a pause between: a lock lost to the removal (two holders at once) loses an increment.
+TEST_F(AtomicWrite, LockRemovalKeepsMutualExclusionAcrossProcesses) {
+  const fs::path first = dir_ / "x.png", counter = dir_ / "count";
+  std::ofstream(counter) << 0;
+  constexpr int kProcesses = 4, kRounds = 150;
+  std::vector<pid_t> pids;
+  for (int p = 0; p < kProcesses; ++p) {
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      for (int r = 0; r < kRounds; ++r) {
+        const OutputSetLock lock(first);
+        int n = 0;
+        std::ifstream(counter) >> n;
+        ::usleep(50);
+        std::ofstream(counter) << n + 1;
+      }
+      ::_exit(0);
+    }
+    pids.push_back(pid);
+  }
+  for (const pid_t pid : pids) {
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  }
+  int n = 0;
+  std::ifstream(counter) >> n;
+  EXPECT_EQ(n, kProcesses * kRounds);
+  EXPECT_FALSE(fs::exists(fs::symlink_status(lockPathFor(first))));
 }
 
 }  // namespace

@@ -6,7 +6,9 @@
 #include "core/light/light_cache.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -120,9 +122,8 @@ TEST(LightCache, ACorruptedEntryIsRefusedWithANotice) {
   fillLight(stored);
   const uint64_t key = lightCacheKey(scene, stored, LightingOptions{}, false);
   ASSERT_EQ(saveLightCache(dir.path(), key, stored), "");
-  std::filesystem::path entry;
-  for (const auto& e : std::filesystem::directory_iterator(dir.path())) entry = e.path();
-  ASSERT_FALSE(entry.empty());
+  const std::filesystem::path entry = lightCachePath(dir.path(), key);
+  ASSERT_TRUE(std::filesystem::is_regular_file(entry));
   {
     // One byte of the payload (the last float of the flux volume) changed, the size unchanged.
     std::fstream f(entry, std::ios::in | std::ios::out | std::ios::binary);
@@ -136,6 +137,26 @@ TEST(LightCache, ACorruptedEntryIsRefusedWithANotice) {
   EXPECT_EQ(notice.find('\n'), std::string::npos) << "one line: " << notice;
   EXPECT_TRUE(loaded.light_fluence.empty());  // nothing half-read
   EXPECT_TRUE(loaded.light_flux.empty());
+}
+
+// An entry of the wrong size is refused by its size alone: a sparse 50 GB file is not read.
+TEST(LightCache, AnEntryOfTheWrongSizeIsRefusedUnread) {
+  TempDir dir;
+  const Scene scene = litScene();
+  VolumeSet stored = voxelize(scene);
+  fillLight(stored);
+  const uint64_t key = lightCacheKey(scene, stored, LightingOptions{}, false);
+  ASSERT_EQ(saveLightCache(dir.path(), key, stored), "");
+  const std::filesystem::path entry = lightCachePath(dir.path(), key);
+  ASSERT_TRUE(std::filesystem::is_regular_file(entry));
+  ASSERT_EQ(::truncate(entry.c_str(), off_t(50) << 30), 0);
+  VolumeSet loaded = voxelize(scene);
+  std::string notice;
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(loadLightCache(dir.path(), key, loaded, &notice));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1));
+  EXPECT_NE(notice.find("wrong size"), std::string::npos) << notice;
+  EXPECT_TRUE(loaded.light_fluence.empty());
 }
 
 }  // namespace

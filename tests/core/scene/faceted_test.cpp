@@ -498,6 +498,53 @@ TEST(Faceted, AscDistancesAreBoundedAndBlamedOnTheirLine) {
       errorFor("a 20 1e6 5\n"), scene, "/objects/0/file: d.asc line 10", "the facet cuts nothing"));
 }
 
+// A faceted object's "file" was read whatever its name, and the error quoted its first line (a
+// line of /etc/passwd, say). The name must end in .asc (any case), refused at the JSON path; and a
+// file so named whose first record is not GemCad's is refused by line number, its text unquoted.
+TEST(Faceted, AscFileMustBeNamedAscAndIsQuotedOnlyOnceRecognised) {
+  test::TempDir dir;
+  const std::string passwd =
+      "root:x:0:0:root:/root:/bin/bash\ndaemon:x:1:1:daemon:/usr/sbin:/usr/sbin/nologin\n";
+  dir.write("passwd", passwd);
+  const fs::path named = dir.write(
+      "named.json", sceneWith(R"({"shape": "faceted", "file": "passwd", "material": "g"})"));
+  std::string m = test::sceneErrorOf(slurp(named), named);
+  EXPECT_TRUE(test::isOneLineSceneError(m, named.string(), "/objects/0/file",
+                                        "'passwd' does not end in .asc: expected a GemCad .asc"))
+      << m;
+  EXPECT_EQ(m.find("root"), std::string::npos) << m;
+  dir.write("b.TXT", brilliantAsc());  // GemCad's text, but not named so
+  const fs::path txt =
+      dir.write("txt.json", sceneWith(R"({"shape": "faceted", "file": "b.TXT", "material": "g"})"));
+  EXPECT_TRUE(test::isOneLineSceneError(test::sceneErrorOf(slurp(txt), txt), txt.string(),
+                                        "/objects/0/file", "'b.TXT' does not end in .asc"));
+
+  dir.write("passwd.asc", passwd);
+  const fs::path asc = dir.write(
+      "asc.json", sceneWith(R"({"shape": "faceted", "file": "passwd.asc", "material": "g"})"));
+  m = test::sceneErrorOf(slurp(asc), asc);
+  EXPECT_TRUE(test::isOneLineSceneError(m, asc.string(), "/objects/0/file",
+                                        "passwd.asc line 1: not a GemCad .asc file: expected its "
+                                        "first record to be 'GemCad VERSION' or 'g TEETH OFFSET'"))
+      << m;
+  for (const char* secret : {"root", "bin/bash", "daemon"})
+    EXPECT_EQ(m.find(secret), std::string::npos) << m;
+  // Note records may precede the header; an unknown one is still not quoted.
+  dir.write("notes.asc", "H a title\nsecret words\n");
+  const fs::path notes = dir.write(
+      "notes.json", sceneWith(R"({"shape": "faceted", "file": "notes.asc", "material": "g"})"));
+  m = test::sceneErrorOf(slurp(notes), notes);
+  EXPECT_TRUE(test::isOneLineSceneError(m, notes.string(), "/objects/0/file",
+                                        "notes.asc line 2: not a GemCad .asc file"))
+      << m;
+  EXPECT_EQ(m.find("secret"), std::string::npos) << m;
+  // The extension in capitals is GemCad's too, and read.
+  dir.write("B.ASC", brilliantAsc());
+  const fs::path upper = dir.write(
+      "upper.json", sceneWith(R"({"shape": "faceted", "file": "B.ASC", "material": "g"})"));
+  EXPECT_NO_THROW(loadScene(upper));
+}
+
 // A NUL in a .asc file cut the message at it ("unknown record '"): the file is refused as text
 // holding a NUL, by offset and line.
 TEST(Faceted, AscFileWithANulIsRefused) {

@@ -4,9 +4,13 @@
 // never handed on, and replaced.
 #include "core/vk/spirv_cache.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -124,6 +128,39 @@ TEST_F(SpirvCache, DamagedFilesAreIgnoredWithOneNoteAndReplaced) {
   EXPECT_EQ(specialiseSpirvCached(viewSpirv(), sharp_, dir_.path()), fresh);
   EXPECT_NE(::testing::internal::GetCapturedStderr().find("ignored: not SPIR-V"),
             std::string::npos);
+}
+
+// An entry was read whole before any check: a sparse 50 GB file took 68 s and 4 GB. Its size
+// is taken first, and an entry larger than any eikon writes is ignored unread, at once.
+TEST_F(SpirvCache, AnOversizedEntryIsIgnoredByItsSizeUnread) {
+  const std::vector<uint32_t> fresh = specialiseSpirv(viewSpirv(), sharp_);
+  const fs::path file = spirvCachePath(viewSpirv(), sharp_, dir_.path());
+  specialiseSpirvCached(viewSpirv(), sharp_, dir_.path());
+  const std::string good = slurp(file);
+  const off_t huge = off_t(50) << 30;
+  {
+    put(file, good.substr(0, 32));  // a valid header, then 50 GB of holes
+    const int fd = ::open(file.c_str(), O_WRONLY | O_CLOEXEC);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::ftruncate(fd, huge), 0) << "this file system holds no 50 GB sparse file";
+    ::close(fd);
+  }
+  ASSERT_EQ(fs::file_size(file), uintmax_t(huge));
+  std::string why;
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_TRUE(readSpirvCacheEntry(file, 1, why).empty());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("50 GB sparse SPIR-V cache entry refused in %.6f s\n", seconds);
+  EXPECT_LT(seconds, 0.5);
+  EXPECT_EQ(why, "larger than any entry (53687091200 bytes)");
+  // The cache ignores it with its note, specialises afresh and replaces it.
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(specialiseSpirvCached(viewSpirv(), sharp_, dir_.path()), fresh);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("ignored: larger than any entry (53687091200 bytes)"), std::string::npos)
+      << err;
+  EXPECT_EQ(slurp(file), good);
 }
 
 }  // namespace

@@ -8,7 +8,9 @@
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -240,6 +242,22 @@ TEST_F(VolumeCache, DamagedFilesAreIgnoredWithOneNoticeAndReplaced) {
   std::string notice;
   EXPECT_FALSE(loadVolumeCache(dir_.path(), key, s, v, &notice));
   EXPECT_NE(notice.find("does not match its name"), std::string::npos) << notice;
+}
+
+// An entry whose size disagrees with its header is refused by the sizes alone: a sparse 50 GB
+// file behind a valid header is not read.
+TEST_F(VolumeCache, ASparseHugeEntryIsIgnoredUnread) {
+  const Scene s = scene(kCrystal);
+  const uint64_t key = volumeCacheKey(s);
+  const fs::path file = volumeCachePath(dir_.path(), key);
+  ASSERT_EQ(saveVolumeCache(dir_.path(), key, voxelize(s)), "");
+  ASSERT_EQ(::truncate(file.c_str(), off_t(50) << 30), 0);
+  VolumeSet v;
+  std::string notice;
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(loadVolumeCache(dir_.path(), key, s, v, &notice));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1));
+  EXPECT_NE(notice.find("ignored: wrong size"), std::string::npos) << notice;
 }
 
 // A pipe in an entry's place is not opened (a read would wait for a writer: renders hung), and
