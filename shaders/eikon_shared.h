@@ -101,6 +101,16 @@ using uvec4 = glm::uvec4;
 // from its uniform block (EIKON_B_EXACT_ROWS) everywhere, the convex planes' loops included
 #define EIKON_F_SMALL_SHAPES 524288
 
+// ViewParams.pass.w bits: how one pass of the view kernel samples and what it writes (shaders/
+// view.comp; set by ViewRenderer::render).
+#define EIKON_PASS_HERO 1          // hero wavelength sampling: all bins from one march
+#define EIKON_PASS_LAYERS 2        // write the per-channel layers after the band's pixels
+#define EIKON_PASS_LAYER_MODES 4   // the layers keep the two modes apart
+#define EIKON_PASS_MODES_SHIFT 3   // (pass.w >> 3) & EIKON_PASS_MODES_MASK: both (0), o (1), e (2)
+#define EIKON_PASS_MODES_MASK 3
+#define EIKON_PASS_AOV 32          // the AOV layer: keys the pipeline only (the kernel reads kAov)
+#define EIKON_PASS_SHARED 64       // sharing across stratified passes (view.comp main)
+
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0
 #define EIKON_INT_MIDPOINT 1

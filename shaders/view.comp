@@ -1,10 +1,11 @@
 #version 450
 // View renderer: one thread per pixel and one pass per dispatch: pixel sample P.pass.x (jittered
 // when spp > 1) at wavelengths [P.pass.y, P.pass.y + P.pass.z) of its N stratified ones (spectral
-// mode, CIE 1931 → linear sRGB), or at all N by hero wavelength sampling (P.pass.w & 1) or at the
-// fixed wavelength (RGB mode, RGB attenuation). Uniaxial scenes march the o- and e-modes, each
-// carrying half of the unpolarised radiance, or one of them at the whole of it ((P.pass.w >> 3) & 3
-// = 1: o only, 2: e only; RenderSettings::modes, core/volume/march_types.h). Output: this
+// mode, CIE 1931 → linear sRGB), or at all N by hero wavelength sampling (EIKON_PASS_HERO) or at
+// the fixed wavelength (RGB mode, RGB attenuation). Uniaxial scenes march the o- and e-modes, each
+// carrying half of the unpolarised radiance, or one of them at the whole of it (the pass's modes,
+// EIKON_PASS_MODES_SHIFT: 1 o only, 2 e only; RenderSettings::modes, core/volume/march_types.h).
+// The bits of P.pass.w are named in eikon_shared.h (EIKON_PASS_*). Output: this
 // pass's share of the pixel's linear sRGB radiance (the host sums the passes and divides by spp),
 // w = its steps, or −(steps + 1) when a march of the pass ran out of the driver's loop budget.
 //
@@ -24,8 +25,8 @@ layout(local_size_x = EIKON_WG_X, local_size_y = EIKON_WG_Y) in;
 #include "march.glsl"
 
 layout(std430, binding = EIKON_B_OUTPUT) writeonly buffer OutBuf { vec4 pixels[]; };
-// Sharing across passes (P.pass.w & 64; main below): per pixel of the image, 1 where the pixel
-// sample's first pass added every wavelength.
+// Sharing across passes (EIKON_PASS_SHARED; main below): per pixel of the image, 1 where the
+// pixel sample's first pass added every wavelength.
 layout(std430, binding = EIKON_B_SHARED_PATHS) buffer SharedPathsBuf { uint sharedPaths[]; };
 
 uint pcg_hash(uint v) {
@@ -42,12 +43,12 @@ vec3 cmf(float lambda_nm) {
   return mix(tables[EIKON_CMF_OFFSET + i].xyz, tables[EIKON_CMF_OFFSET + i + 1].xyz, f);
 }
 
-// Layers (P.pass.w & 2; core/volume/render_layers.h): after the band's pixels, per pixel
-// `layerStride` vec4s hold, per mode kept apart (2 where P.pass.w & 4, else 1), one value per
-// channel (the N wavelength bins in spectral mode, r, g, b in RGB mode). A pass writes the bins it
+// Layers (EIKON_PASS_LAYERS; core/volume/render_layers.h): after the band's pixels, per pixel
+// `layerStride` vec4s hold, per mode kept apart (2 with EIKON_PASS_LAYER_MODES, else 1), one value
+// per channel (the N wavelength bins in spectral mode, r, g, b in RGB mode). A pass writes the bins it
 // marches; the host reads those.
 int layerChannels() { return hasFlag(EIKON_F_SPECTRAL) ? P.limits.z : 3; }
-int layerModes() { return (P.pass.w & 4) != 0 ? 2 : 1; }
+int layerModes() { return (P.pass.w & EIKON_PASS_LAYER_MODES) != 0 ? 2 : 1; }
 int layerStride() { return (layerChannels() * layerModes() + 3) / 4; }
 void layerWrite(int bandPixel, int mode, int channel, float v) {
   int i = min(mode, layerModes() - 1) * layerChannels() + channel;
@@ -60,7 +61,7 @@ void layerWrite(int bandPixel, int mode, int channel, float v) {
 // Every pass writes both; the host takes the geometry from the pixel's first pass (sample 0, its
 // first wavelength, the o-mode) and adds up the steps.
 void aovWrite(int bandPixel, vec4 pointObject, vec3 normal, float steps) {
-  int layers = (P.pass.w & 2) != 0 ? layerStride() : 0;
+  int layers = (P.pass.w & EIKON_PASS_LAYERS) != 0 ? layerStride() : 0;
   int base = P.image.x * P.image.w * (1 + layers) + 2 * bandPixel;
   pixels[base] = pointObject;
   pixels[base + 1] = vec4(normal, steps);
@@ -137,7 +138,7 @@ void main() {
     // The modes marched, [m0, m1): both, each carrying half of the unpolarised light, or the one
     // selected at the whole of it (march_types.h modeRange). Isotropic scenes: the one mode.
     const int modes = hasFlag(EIKON_F_UNIAXIAL) ? 2 : 1;
-    const int selected = (P.pass.w >> 3) & 3;
+    const int selected = (P.pass.w >> EIKON_PASS_MODES_SHIFT) & EIKON_PASS_MODES_MASK;
     const int m0 = modes == 2 && selected == 2 ? 1 : 0;
     const int m1 = modes == 2 && selected == 1 ? 1 : modes;
     const float modeWeight = m1 - m0 == 2 ? 0.5 : 1.0;
@@ -146,13 +147,14 @@ void main() {
     // Wavelength sharing (march.glsl) within one pass: where nothing but the index can depend on λ
     // the host makes a pass all N wavelengths; elsewhere the sharing across passes below.
     const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
-    // Sharing across passes (P.pass.w & 64, stratified renders whose passes march one wavelength
-    // each: crystals, attenuating, emitting or opaque scenes; view_renderer.cpp). The pixel
+    // Sharing across passes (EIKON_PASS_SHARED, stratified renders whose passes march one
+    // wavelength each: crystals, attenuating, emitting or opaque scenes; view_renderer.cpp). The pixel
     // sample's first pass (k0 = 0, told to cover all N) marches λ_0 with the record on; where
     // nothing on the path turned out to depend on λ it adds the other wavelengths from the record
     // and notes it in sharedPaths, and the sample's later passes skip the pixel; elsewhere it
     // stops after λ_0, as a pass of one wavelength does, and the later passes march as before.
-    const bool crossShare = spectral && (P.pass.w & 1) == 0 && (P.pass.w & 64) != 0;
+    const bool crossShare =
+        spectral && (P.pass.w & EIKON_PASS_HERO) == 0 && (P.pass.w & EIKON_PASS_SHARED) != 0;
     if (crossShare && k0 > 0 && sharedPaths[pixelIndex] != 0u) {
       pixels[int(gid.y) * W + px] = vec4(0.0);
       if (kAov) aovWrite(int(gid.y) * W + px, vec4(0.0, 0.0, 0.0, -1.0), vec3(0.0), 0.0);
@@ -160,7 +162,7 @@ void main() {
     }
     bool share = spectral && (!hasFlag(lambdaDependent) || crossShare);
     bool reuse = false;
-    // Hero wavelength sampling (P.pass.w & 1; docs/spectra.md, Wilkie et al. 2014): λ_j = 380 +
+    // Hero wavelength sampling (EIKON_PASS_HERO; docs/spectra.md, Wilkie et al. 2014): λ_j = 380 +
     // ((k_h + j) mod N + u)·400/N, one shared jitter u, the hero's stratum k_h cycling over the
     // samples (core/spectrum/wavelength_sampling.h heroWavelengths). One march at the hero (both
     // modes) in the loop below; its lookups before the path's first dispersive event are recorded
@@ -168,8 +170,8 @@ void main() {
     // after it only the hero can have made the path, so the hero's own radiance counts N times.
     // With λ-dependent weights on the path (attenuation, emission, opaque surfaces) the hero
     // carries everything from the start.
-    const bool hero = spectral && (P.pass.w & 1) != 0;
-    const bool layers = (P.pass.w & 2) != 0;
+    const bool hero = spectral && (P.pass.w & EIKON_PASS_HERO) != 0;
+    const bool layers = (P.pass.w & EIKON_PASS_LAYERS) != 0;
     const int bandPixel = int(gid.y) * W + px;
     int heroCount0 = 0;                // hero: records made by the o-mode's march
     float heroMode[2] = float[2](0.0, 0.0);  // hero: each mode's own radiance (after divergence)

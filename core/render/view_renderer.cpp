@@ -33,12 +33,21 @@
 namespace eikon {
 namespace {
 
-// ViewParams.pass.w bit 5: the aov layer. The kernel reads kAov (a specialisation constant), so the
-// bit only keys the pipeline; bits 0–4 and 6 are the kernel's (hero, layers, modes, and the
-// sharing across passes: view.comp).
-constexpr int kAovPassBit = 32;
-constexpr int kSharedPassBit = 64;  // view.comp's sharing across passes (render())
+// ViewParams.pass.w's bits are named in shaders/eikon_shared.h (EIKON_PASS_*). The AOV bit only
+// keys the pipeline: the kernel reads kAov, a specialisation constant.
+constexpr int kAovPassBit = EIKON_PASS_AOV;
+constexpr int kSharedPassBit = EIKON_PASS_SHARED;  // view.comp's sharing across passes (render())
 void validate(const MarchSettings& m) { checkMarchSettings(m); }
+
+/// The view kernel's ViewParams.pass.w for a pass of render(): hero sampling, the layers and
+/// whether they keep the modes apart, the modes marched, the AOV layer, the sharing across passes.
+int passBits(const RenderSettings& s, bool hero, const LayerSums& layers, bool crossShare) {
+  int bits = (hero ? EIKON_PASS_HERO : 0) | (int(s.modes) << EIKON_PASS_MODES_SHIFT) |
+             (s.aov_layer ? kAovPassBit : 0) | (crossShare ? kSharedPassBit : 0);
+  if (layers.active())
+    bits |= EIKON_PASS_LAYERS | (layers.modes() == 2 ? EIKON_PASS_LAYER_MODES : 0);
+  return bits;
+}
 
 }  // namespace
 
@@ -574,7 +583,7 @@ struct ViewRenderer::Impl {
     timings::mark("volume uploaded");
   }
 
-  // The AOV layer is view.comp's pass.w bit 8 (render()), its kAov constant.
+  // The AOV layer is view.comp's pass.w bit EIKON_PASS_AOV (render()), its kAov constant.
   Key keyOf(Kernel kernel, const gpu::ViewParams& p) const {
     const int aov = kernel == kView && (p.pass.w & kAovPassBit) != 0 ? 1 : 0;
     return std::make_tuple(int(kernel), p.grid_dims.w, int(p.march.w), sharp ? 1 : 0, aov, exact);
@@ -800,7 +809,6 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   // Layers (core/volume/render_layers.h): per pixel, after the band's RGB, `stride` vec4s of
   // channel values per mode (view.comp layerWrite); the pass's bins are added on the host.
   LayerSums layers(s, size_t(img.width) * size_t(img.height), I.uniaxial);
-  const int layerBits = layers.active() ? (2 | (layers.modes() == 2 ? 4 : 0)) : 0;
   const size_t stride = layers.active() ? size_t((layers.channels() * layers.modes() + 3) / 4) : 0;
   // The AOV layer: two vec4s per pixel after those (view.comp aovWrite).
   const size_t perPixel = 1 + stride + (s.aov_layer ? 2 : 0);
@@ -815,9 +823,9 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   vk::ComputePipeline& view = I.pipeline(Impl::kView, p);
   view.bindBuffer(EIKON_B_OUTPUT, out);
   const size_t pixels = size_t(img.width) * size_t(img.height);
-  // Sharing across passes (view.comp, P.pass.w & 64): where the passes march one wavelength each
-  // (a crystal, dispersive medium, attenuation, emission or opaque object in the scene), a pixel
-  // sample's first pass also adds the other wavelengths of every pixel whose path met nothing
+  // Sharing across passes (view.comp, EIKON_PASS_SHARED): where the passes march one wavelength
+  // each (a crystal, dispersive medium, attenuation, emission or opaque object in the scene), a
+  // pixel sample's first pass also adds the other wavelengths of every pixel whose path met nothing
   // that depends on λ (from its record), notes it in one word per pixel, and the sample's later
   // passes skip that pixel. The spectral and modes layers keep the plain passes (their bins are
   // written pass by pass); an image whose words exceed one storage buffer too.
@@ -834,8 +842,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   for (int pass = 0; pass < passes; ++pass) {
     const int k = pass % passesPerSample;
     p.pass = glm::ivec4(pass / passesPerSample, k * perPass, crossShare && k == 0 ? N : perPass,
-                        (hero ? 1 : 0) | layerBits | (int(s.modes) << 3) |
-                            (s.aov_layer ? kAovPassBit : 0) | (crossShare ? kSharedPassBit : 0));
+                        passBits(s, hero, layers, crossShare));
     for (int y0 = 0, n = 0; y0 < img.height; y0 += n) {
       n = std::min(rows, img.height - y0);
       const auto band_start = std::chrono::steady_clock::now();
