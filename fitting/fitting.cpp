@@ -11,6 +11,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "optics/units.h"
+
 namespace eikon {
 namespace {
 
@@ -267,7 +269,7 @@ std::vector<std::string> parameterNames(DispersionModel m) {
 }
 
 double modelIndex(DispersionModel m, const double* p, double lambda_nm, double* g) {
-  const double l = lambda_nm * 1e-3, l2 = l * l;
+  const double l = micrometresFromNanometres(lambda_nm), l2 = l * l;
   switch (m) {
     case DispersionModel::Cauchy2:
     case DispersionModel::Cauchy3: {

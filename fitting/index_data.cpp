@@ -13,6 +13,7 @@
 
 #include "core/io/text_file.h"
 #include "fitting/refractiveindex_formula.h"
+#include "optics/units.h"
 
 namespace eikon {
 namespace {
@@ -484,7 +485,7 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
       const int m = opt.formula_samples;
       for (int j = 0; j < m; ++j) {
         const double lnm = lo + (hi - lo) * j / double(m - 1);
-        p.add(lnm, f->index(lnm * 1e-3), std::nullopt,
+        p.add(lnm, f->index(micrometresFromNanometres(lnm)), std::nullopt,
               path + " (" + type + " at " + fmt(lnm) + " nm)");
       }
     } else {

@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "optics/units.h"
+
 namespace eikon {
 namespace {
 
@@ -95,7 +97,7 @@ bool Dispersion::isDispersionless() const {
 }
 
 double Dispersion::index(double lambda_nm) const {
-  const double l = lambda_nm * 1e-3, l2 = l * l;
+  const double l = micrometresFromNanometres(lambda_nm), l2 = l * l;
   switch (kind_) {
     case Kind::Constant:
       return a_[0];
@@ -119,7 +121,7 @@ double Dispersion::index(double lambda_nm) const {
 }
 
 double Dispersion::derivative(double lambda_nm) const {
-  const double l = lambda_nm * 1e-3, l2 = l * l;
+  const double l = micrometresFromNanometres(lambda_nm), l2 = l * l;
   switch (kind_) {
     case Kind::Constant:
       return 0.0;
@@ -161,7 +163,7 @@ CauchyApproximation Dispersion::cauchyApproximation(double lo_nm, double hi_nm) 
   };
   for (int i = 0; i < samples; ++i) {
     double lnm = lo_nm + (hi_nm - lo_nm) * i / double(samples - 1);
-    double l2 = (lnm * 1e-3) * (lnm * 1e-3);
+    double l2 = micrometresFromNanometres(lnm) * micrometresFromNanometres(lnm);
     double basis[3] = {1.0, 1.0 / l2, 1.0 / (l2 * l2)};
     double n = index(lnm), w2 = weight(lnm) * weight(lnm);
     for (int r = 0; r < 3; ++r) {
@@ -173,7 +175,7 @@ CauchyApproximation Dispersion::cauchyApproximation(double lo_nm, double hi_nm) 
   double sum2 = 0.0;
   for (int i = 0; i < samples; ++i) {
     double lnm = lo_nm + (hi_nm - lo_nm) * i / double(samples - 1);
-    double l2 = (lnm * 1e-3) * (lnm * 1e-3);
+    double l2 = micrometresFromNanometres(lnm) * micrometresFromNanometres(lnm);
     double e = index(lnm) - (out.coeffs[0] + out.coeffs[1] / l2 + out.coeffs[2] / (l2 * l2));
     out.max_error = std::max(out.max_error, std::abs(e));
     sum2 += e * e;

@@ -7,6 +7,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "optics/units.h"
+
 namespace eikon {
 namespace {
 
@@ -199,7 +201,7 @@ glm::dvec3 onModeShell(const Field& field, int mode, double il2, double il4, con
 std::vector<Patch> seedWavefront(const Field& field, const Grid& grid,
                                  const WavefrontSettings& settings, const Light& light) {
   const WavefrontSettings s = checkedWavefrontSettings(settings, grid);
-  const double l_um = s.wavelength_nm * 1e-3;
+  const double l_um = micrometresFromNanometres(s.wavelength_nm);
   const double il2 = 1.0 / (l_um * l_um);
   const Seeder seeder{field, grid, s, il2, il2 * il2, field.boundsMin(), field.boundsMax()};
   std::vector<Patch> out;

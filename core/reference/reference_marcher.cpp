@@ -22,6 +22,7 @@
 #include "core/volume/render_layers.h"
 #include "optics/fresnel.h"
 #include "optics/interface.h"
+#include "optics/units.h"
 
 namespace eikon {
 namespace {
@@ -160,7 +161,7 @@ class RayMarch {
         bmax_(f.boundsMax()),
         bf_(f.boundary()),
         media_(f.media()) {
-    const double l_um = lambda_nm * 1e-3;
+    const double l_um = micrometresFromNanometres(lambda_nm);
     il2_ = 1.0 / (l_um * l_um);
     il4_ = il2_ * il2_;
   }

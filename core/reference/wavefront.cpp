@@ -17,6 +17,7 @@
 #include "core/reference/field.h"
 #include "optics/fresnel.h"
 #include "optics/interface.h"
+#include "optics/units.h"
 
 namespace eikon {
 namespace {
@@ -1169,7 +1170,7 @@ SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm
 WavefrontSimulator::WavefrontSimulator(const Field& field, const Grid& splat_grid,
                                        const WavefrontSettings& settings)
     : field_(field), grid_(splat_grid), s_(checkedWavefrontSettings(settings, splat_grid)) {
-  const double l_um = s_.wavelength_nm * 1e-3;
+  const double l_um = micrometresFromNanometres(s_.wavelength_nm);
   il2_ = 1.0 / (l_um * l_um);
   il4_ = il2_ * il2_;
 }

@@ -20,6 +20,7 @@
 #include "core/render/view_pipeline_start.h"
 #include "core/vk/resources.h"
 #include "core/volume/media.h"
+#include "optics/units.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/scan.spv.h"
 #include "shaders/wavefront.spv.h"
@@ -220,7 +221,7 @@ struct GpuWavefront::Impl {
       throw std::invalid_argument("wavefront: mode must be 0 (o) or 1 (e)");
     // The e-mode of an isotropic volume is the o-mode (no axis anywhere).
     eMode = s.mode == 1 && vol.uniaxial;
-    const double l = s.wavelength_nm * 1e-3;
+    const double l = micrometresFromNanometres(s.wavelength_nm);
     il2 = 1.0 / (l * l);
     il4 = il2 * il2;
     sharp = s.sharp_interfaces && sharpLightApplies(vol);
@@ -521,7 +522,7 @@ struct GpuWavefront::Impl {
     P.grid_dims = glm::ivec4(g.dims[0], g.dims[1], g.dims[2], featureFlags());
     P.step = glm::vec4(float(s.dt), float(s.split_span_voxels * g.h), float(s.min_energy_fraction),
                        float(1.0 / h3));
-    const double l = s.wavelength_nm * 1e-3;
+    const double l = micrometresFromNanometres(s.wavelength_nm);
     P.wavelength = glm::vec4(float(l), float(il2), float(il4), float(scale));
     P.control = glm::ivec4(s.probe_axis >= 0 && s.probe_axis < 3 ? s.probe_axis : -1,
                            steps_per_dispatch, s.max_steps, eMode ? 1 : 0);

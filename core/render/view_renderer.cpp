@@ -25,6 +25,7 @@
 #include "core/vk/timings.h"
 #include "core/volume/polarised_render.h"
 #include "core/volume/render_layers.h"
+#include "optics/units.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/polarised_trace.spv.h"
 #include "shaders/trace.spv.h"
@@ -783,7 +784,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   p.cam_forward.w = float(double(img.width) / img.height);
   p.limits.y = s.spp;
   p.limits.z = std::max(1, s.wavelengths);
-  double l = s.wavelength_nm * 1e-3;
+  double l = micrometresFromNanometres(s.wavelength_nm);
   p.wavelength = glm::vec4(float(l), float(1.0 / (l * l)), float(1.0 / (l * l * l * l)), 0.0f);
   I.boundary.setRenderWavelength(s.wavelength_nm);  // the RGB march's indices (sharp.glsl)
 
@@ -941,7 +942,8 @@ std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(
     std::vector<gpu::TraceRay> in(count);
     for (size_t i = 0; i < count; ++i) {
       const TraceRequest& q = rays[first + i];
-      in[i].origin = glm::vec4(glm::vec3(q.origin), float(q.wavelength_nm * 1e-3));
+      in[i].origin =
+          glm::vec4(glm::vec3(q.origin), float(micrometresFromNanometres(q.wavelength_nm)));
       in[i].direction = glm::vec4(glm::vec3(q.direction / glm::length(q.direction)), 0.0f);
     }
     gpu::ViewParams p = I.baseParams(m, 0);
@@ -990,7 +992,8 @@ std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<Polar
   }
   auto* in = static_cast<gpu::PolarisedRay*>(I.polarisedRays.mapped());
   for (size_t i = 0; i < n; ++i) {
-    in[i].origin = glm::vec4(glm::vec3(rays[i].origin), float(rays[i].wavelength_nm * 1e-3));
+    in[i].origin = glm::vec4(glm::vec3(rays[i].origin),
+                             float(micrometresFromNanometres(rays[i].wavelength_nm)));
     in[i].direction = glm::vec4(glm::vec3(glm::normalize(rays[i].direction)), 0.0f);
     in[i].stokes = glm::vec4(inputs[i]);
   }

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/scene/scene.h"
+#include "optics/units.h"
 
 namespace eikon {
 namespace {
@@ -82,7 +83,7 @@ MediaTable buildMediaTable(const Scene& scene) {
 }
 
 double mediumIndex(const MediumDispersion& d, double lambda_nm) {
-  const double l = lambda_nm * 1e-3, l2 = l * l;
+  const double l = micrometresFromNanometres(lambda_nm), l2 = l * l;
   switch (d.kind) {
     case MediumDispersion::Kind::Constant:
       return d.coeff[0];
