@@ -74,6 +74,13 @@ write("mesh_obj", "forms.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvn 0
 write("mesh_obj", "mtllib.obj", "mtllib /etc/passwd\nmtllib pipe.mtl\n" + obj(*TET))
 write("mesh_obj", "bad_index.obj", obj(TET[0], [(0, 1, 9)]))
 write("mesh_obj", "line.obj", obj(TET[0], [(0, 1, 2)]) + "l 1 2\nf 1 2\n")
+# An L-shaped prism whose caps are single concave hexagons (ear clipping), and a pentagram face.
+L = [(3, 1), (1, 1), (1, 2), (0, 2), (0, 0), (3, 0)]
+write("mesh_obj", "concave_l.obj", obj([(x, y, z) for z in (0, 1) for (x, y) in L],
+                                        [tuple(range(5, -1, -1)), tuple(range(6, 12))] +
+                                        [(k, (k + 1) % 6, 6 + (k + 1) % 6, 6 + k) for k in range(6)]))
+write("mesh_obj", "pentagram.obj", "v 1 0 0\nv -0.809 0.588 0\nv 0.309 -0.951 0\n"
+      "v 0.309 0.951 0\nv -0.809 -0.588 0\nf 1 2 3 4 5\n")
 write("mesh_ply", "box_ascii.ply", ply_ascii(V, T))
 write("mesh_ply", "box_le.ply", ply_binary(V, T))
 write("mesh_ply", "tetra_be_double.ply", ply_binary(*TET, big=True, coord="double"))

@@ -20,6 +20,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from repo_checks import report_planted, run_check  # noqa: E402
+
 HISTORY = re.compile(r"\b(issues?|sessions?)\s*#?\s*[0-9]+", re.IGNORECASE)
 CHANGELOG = "CHANGELOG.md"
 PI = re.compile(r"3\.14159|\bM_PI\b|\bacos\s*\(\s*-\s*1(\.0*)?\s*\)")
@@ -146,30 +149,11 @@ def self_test():
                     ("shaders/shared.h:4:", "a second GLSL definition of π (the first: "
                                             "shaders/march.glsl:1)")]
 
-        def matches(h, e):
-            return h.startswith(e[0]) and e[1] in h
-        missing = [e[0] + " " + e[1] for e in expected if not any(matches(h, e) for h in hits)]
-        extra = [h for h in hits if not any(matches(h, e) for e in expected)]
-        for m in missing:
-            print(f"conventions self-test: not reported: {m}")
-        for x in extra:
-            print(f"conventions self-test: reported wrongly: {x}")
-        print(f"conventions self-test: {len(expected)} defects planted, {len(missing)} missed, "
-              f"{len(extra)} false")
-        return 1 if missing or extra else 0
+        return report_planted("conventions", expected, hits)
 
 
 def main():
-    if len(sys.argv) == 2 and sys.argv[1] == "--self-test":
-        return self_test()
-    if len(sys.argv) != 2:
-        print(__doc__)
-        return 2
-    hits = check(os.path.abspath(sys.argv[1]))
-    for h in hits:
-        print(h)
-    print(f"conventions: {len(hits)} failed")
-    return 1 if hits else 0
+    return run_check("conventions", check, self_test, __doc__)
 
 
 if __name__ == "__main__":

@@ -18,6 +18,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from repo_checks import report_planted, run_check  # noqa: E402
+
 MAX_LINES = 120
 LENGTH_CHECKED = ("core/", "optics/", "fitting/", "python/", "apps/")
 NOT_MIRRORED = ("tests/data", "tests/repo", "tests/python")
@@ -120,30 +123,11 @@ def self_test():
                     ("tests/core/nowhere/nowhere_test.cpp:1:", "mirrors no source folder"),
                     ("optics/ugly.h:1:", "not formatted")]
 
-        def matches(h, e):
-            return h.startswith(e[0]) and e[1] in h
-        missing = [e[0] + " " + e[1] for e in expected if not any(matches(h, e) for h in hits)]
-        extra = [h for h in hits if not any(matches(h, e) for e in expected)]
-        for m in missing:
-            print(f"layout self-test: not reported: {m}")
-        for x in extra:
-            print(f"layout self-test: reported wrongly: {x}")
-        print(f"layout self-test: {len(expected)} defects planted, {len(missing)} missed, "
-              f"{len(extra)} false")
-        return 1 if missing or extra else 0
+        return report_planted("layout", expected, hits)
 
 
 def main():
-    if len(sys.argv) == 2 and sys.argv[1] == "--self-test":
-        return self_test()
-    if len(sys.argv) != 2:
-        print(__doc__)
-        return 2
-    hits = check(os.path.abspath(sys.argv[1]))
-    for h in hits:
-        print(h)
-    print(f"layout: {len(hits)} failed")
-    return 1 if hits else 0
+    return run_check("layout", check, self_test, __doc__)
 
 
 if __name__ == "__main__":
