@@ -4,10 +4,11 @@
 #   scripts/sanitize.sh [CTEST_ARGS...]        e.g. scripts/sanitize.sh -R 'Cli\.|AtomicWrite'
 # Configures build-asan (RelWithDebInfo, -fsanitize=address,undefined -fno-omit-frame-pointer,
 # the system's C++ compiler), builds everything and runs ctest there in two passes, then prints
-# the counts of both:
+# the counts of each (run, passed, failed, skipped). CTEST_ARGS (-R, -E, -j, ...) go to both
+# passes; the passes are told apart by the label "python", so do not give -L or -LE.
 #   1. every test but the Python module's, with leak detection on: any ASan, UBSan or LSan report
 #      fails its test (UBSAN_OPTIONS=halt_on_error=1);
-#   2. the Python module's tests (python.*): /usr/bin/python3 is not instrumented, so the ASan
+#   2. the Python module's tests (label python): /usr/bin/python3 is not instrumented, so the ASan
 #      runtime is preloaded (LD_PRELOAD; it must be the first library loaded) for ctest and the
 #      interpreters it starts, and leak detection is off there (the interpreter keeps its objects
 #      at exit by design, which LSan would report as leaks of the test).
@@ -34,33 +35,52 @@ export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 export LSAN_OPTIONS="suppressions=$root/scripts/lsan_suppressions.txt:print_suppressions=0"
 asan_common=abort_on_error=0:strict_string_checks=1:check_initialization_order=1:detect_stack_use_after_return=1
 mkdir -p "$build/sanitize"
+rm -f "$build"/sanitize/ctest*.log
+
+# The two passes are told apart by the label "python" (python/CMakeLists.txt), not by a -R or -E:
+# ctest keeps only the last -R and the last -E it is given, so those stay the caller's.
 status=0
-ASAN_OPTIONS="detect_leaks=1:$asan_common" \
-  ctest --test-dir "$build" -E '^python\.' -j"$jobs" --output-on-failure "$@" \
-  | tee "$build/sanitize/ctest.log" || status=1
+selects() { ctest --test-dir "$build" -N "$@" | grep 'Total Tests: [1-9]' >/dev/null; }
+cxx_ran=0
+if selects "$@" -LE '^python$'; then
+  cxx_ran=1
+  ASAN_OPTIONS="detect_leaks=1:$asan_common" \
+    ctest --test-dir "$build" -j"$jobs" --output-on-failure "$@" -LE '^python$' \
+    | tee "$build/sanitize/ctest.log" || status=1
+fi
 
 # The runtime the build linked: the compiler's libasan.
 cxx="$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")"
 libasan="$("$cxx" -print-file-name=libasan.so)"
 python_ran=0
-if [ -f "$libasan" ] && ctest --test-dir "$build" -N -R '^python\.' | grep -q 'Total Tests: [1-9]'; then
+if selects "$@" -L '^python$' && [ -f "$libasan" ]; then
   python_ran=1
   LD_PRELOAD="$libasan" ASAN_OPTIONS="detect_leaks=0:$asan_common" \
-    ctest --test-dir "$build" -R '^python\.' -j"$jobs" --output-on-failure "$@" \
+    ctest --test-dir "$build" -j"$jobs" --output-on-failure "$@" -L '^python$' \
     | tee "$build/sanitize/ctest-python.log" || status=1
-elif [ ! -f "$libasan" ]; then
+elif selects "$@" -L '^python$'; then
   echo "eikon: sanitize: no libasan.so for $cxx: the Python module's tests are left out" >&2
+  status=1
 fi
 
-# "N% tests passed, F tests failed out of T" of each pass, summed.
-summary() { grep -Eo '[0-9]+ tests failed out of [0-9]+' "$1" | tail -1; }
-failed=0 total=0
-for log in "$build/sanitize/ctest.log" $([ "$python_ran" = 1 ] && echo "$build/sanitize/ctest-python.log"); do
-  read -r f _ _ _ _ t <<<"$(summary "$log" || echo "0 tests failed out of 0")"
-  failed=$((failed + f)) total=$((total + t))
-done
-skipped="$(cat "$build"/sanitize/ctest*.log | grep -c '\*\*\*Skipped\|Not Run' || true)"
-echo "eikon: sanitize: $((total - failed)) passed, $failed failed, of $total tests" \
-  "($skipped skipped or not run; logs in $build/sanitize/)"
-[ "$failed" -eq 0 ] || status=1
+# One line per pass: ctest's "F tests failed out of T" (a test that could not start, "***Not Run",
+# is a failure) and its skipped tests (a GTEST_SKIP, "***Skipped", counted by its result line).
+total_failed=0
+report() {
+  local log="$1" pass="$2" f t s
+  if ! read -r f _ _ _ _ t < <(grep -Eo '[0-9]+ tests failed out of [0-9]+' "$log" | tail -1) ||
+    [ -z "$t" ]; then
+    echo "eikon: sanitize: $pass: ctest printed no counts (see $log)"
+    total_failed=$((total_failed + 1))
+    return
+  fi
+  s="$(grep -Ec 'Test +#[0-9]+: .*\*\*\*Skipped' "$log" || true)"
+  echo "eikon: sanitize: $pass: $t run, $((t - f - s)) passed, $f failed, $s skipped"
+  total_failed=$((total_failed + f))
+}
+[ "$cxx_ran" = 0 ] || report "$build/sanitize/ctest.log" "C++ and repository tests"
+[ "$python_ran" = 0 ] || report "$build/sanitize/ctest-python.log" "Python module tests (python.*)"
+[ "$cxx_ran$python_ran" != 00 ] || { echo "eikon: sanitize: no test selected" >&2; status=1; }
+echo "eikon: sanitize: logs in $build/sanitize/"
+[ "$total_failed" -eq 0 ] || status=1
 exit "$status"
