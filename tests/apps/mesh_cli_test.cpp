@@ -223,9 +223,9 @@ std::string hostilePly(uint32_t first) {
   return t;
 }
 
-// The files that broke the Assimp reader, through the real binary: a PLY face list of 2³¹
-// corners (minutes and gigabytes), a face of 0 corners (SIGABRT), an OBJ whose mtllib names a
-// FIFO (blocked for ever) and /etc/passwd. Each run is under `timeout` and an address-space
+// Hostile mesh files through the real binary: a PLY face list of 2³¹ corners (minutes and
+// gigabytes for a reader that trusts it), a face of 0 corners, an OBJ whose mtllib names a FIFO
+// (an open blocks for ever) and /etc/passwd. Each run is under `timeout` and an address-space
 // limit, so that a regression fails (exit 124, or a memory error) rather than hangs or swells.
 TEST_F(MeshCli, HostileMeshFilesFailAtOnceOrLoadWithoutOpeningAnythingElse) {
   if (eikon::test::kAddressSanitizer) GTEST_SKIP() << eikon::test::kNoAddressSpaceLimitUnderAsan;
@@ -234,8 +234,7 @@ TEST_F(MeshCli, HostileMeshFilesFailAtOnceOrLoadWithoutOpeningAnythingElse) {
   ASSERT_EQ(::mkfifo((dir_ / "pipe.mtl").c_str(), 0600), 0);
   std::ifstream box(kMeshes / "box.obj");
   std::ofstream(dir_ / "mtl.obj") << "mtllib /etc/passwd\nmtllib pipe.mtl\n" << box.rdbuf();
-  // At most 2 GB of address space (the reader needs a few MB; Assimp reserved 8 GB for the
-  // list) and 60 s.
+  // At most 2 GB of address space (the reader needs a few MB; the list declares 8 GB) and 60 s.
   const std::string timed = "ulimit -v 2000000; timeout 60 " + std::string(EIKON_BINARY);
   const std::string ray = " --origin 0,0,-6 --dir 0,0,1 --reference";
   const size_t header = hostilePly(3).find("end_header\n") + 11;

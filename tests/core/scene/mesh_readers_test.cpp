@@ -1,11 +1,11 @@
-// eikon's mesh readers (core/scene/mesh_readers.h) on known shapes in every format, and on the
-// hostile files that the Assimp reader they replace failed on: a PLY face list declaring 2³¹
-// corners (Assimp ran on for minutes and grew past 7 GB), a binary PLY cut inside a face or
-// declaring more than it holds, faces of 0, 1 and 2 corners (Assimp aborted the process on 0), an
-// OBJ whose mtllib names /etc/passwd and a FIFO (Assimp opened both and hung on the FIFO). Then
-// the precision: coordinates that need double, read by the reader and hit by the CPU twin's
-// ray–triangle search, agree with a double-precision ray–triangle intersection computed here (the
-// float reader was 1e-6 mm off).
+// eikon's mesh readers (core/scene/mesh_readers.h) on known shapes in every format, and on hostile
+// files: a PLY face list declaring 2³¹ corners (a reader that trusts the count reserves gigabytes),
+// a binary PLY cut inside a face or declaring more than it holds (a reader that trusts it reads
+// out of bounds), faces of 0, 1 and 2 corners, an OBJ whose mtllib names /etc/passwd and a FIFO (a
+// reader that follows mtllib opens any path and blocks on the FIFO). Then the precision:
+// coordinates that need double, read by the reader and hit by the CPU twin's ray–triangle search,
+// agree with a double-precision ray–triangle intersection computed here (a float32 reader is
+// 1e-6 mm off).
 #include "core/scene/mesh_readers.h"
 
 #include <fcntl.h>
@@ -253,8 +253,8 @@ double secondsFor(const std::function<void()>& f) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Assimp reserved what a face's list count declared: a 418-byte PLY whose first face declares
-// 2³¹ corners ran for minutes and grew past 7 GB. The count is checked against the bytes left
+// A 418-byte PLY whose first face declares 2³¹ corners: a reader that reserves what the count
+// declares runs for minutes and grows past 7 GB. The count is checked against the bytes left
 // before anything is read or allocated.
 TEST(MeshReaders, PlyFaceListOfTwoToTheThirtyOneIsRefusedAtOnce) {
   test::TempDir dir;
@@ -282,8 +282,7 @@ TEST(MeshReaders, PlyFaceListOfTwoToTheThirtyOneIsRefusedAtOnce) {
 }
 
 // A binary PLY cut inside its last face, or declaring more vertices or faces than it holds, is
-// refused without reading past its end (Assimp's binary PLY reader read out of bounds); the
-// offset is named.
+// refused without reading past its end; the offset is named.
 TEST(MeshReaders, TruncatedOrOverdeclaredBinaryPlyIsRefused) {
   const std::string whole = boxPly("binary_little_endian", "uchar", 3);
   EXPECT_EQ(parsePly(whole, "box.ply").triangles.size(), 12u);
@@ -319,8 +318,8 @@ TEST(MeshReaders, TruncatedOrOverdeclaredBinaryPlyIsRefused) {
       "o.ply: byte offset " + std::to_string(b.size()) + ": the file ends inside the face 12");
 }
 
-// A face of 0 corners aborted the process inside Assimp (SIGABRT: its triangulation asserted);
-// 1 and 2 corners are points and lines. Each is one line naming the face's line or offset.
+// A face of 0 corners has nothing to triangulate; 1 and 2 corners are points and lines. Each is
+// refused in one line naming the face's line or offset, and the process goes on.
 TEST(MeshReaders, FacesOfFewerThanThreeCornersAreRefused) {
   for (uint64_t n : {0, 1, 2}) {
     for (const std::string format : {"ascii", "binary_little_endian"}) {
@@ -359,8 +358,8 @@ TEST(MeshReaders, FacesOfFewerThanThreeCornersAreRefused) {
   }
 }
 
-// Assimp's OBJ reader opened what `mtllib` names: /etc/passwd, and a FIFO, on which it blocked
-// forever. Both are ignored now: the geometry loads at once and neither file is opened (watched
+// An OBJ's `mtllib` names /etc/passwd and a FIFO (on which an open would block forever). Both
+// are ignored: the geometry loads at once and neither file is opened (watched
 // with inotify: a regular file and a FIFO in a temporary folder). A regression fails on the
 // timeout rather than hanging (the FIFO is then opened for writing, which releases the reader).
 TEST(MeshReaders, ObjMtllibOpensNothing) {
