@@ -61,12 +61,21 @@ uint64_t trimCacheDir(const fs::path& dir, const fs::path& keep, uint64_t max_by
     ::close(lock);
     return 0;
   }
+  const uint64_t removed = removeLeastRecentlyUsed(dir, keep, max_bytes);
+  ::flock(lock, LOCK_UN);
+  ::close(lock);
+  return removed;
+}
+
+uint64_t removeLeastRecentlyUsed(const fs::path& dir, const fs::path& keep, uint64_t max_bytes,
+                                 const std::string& prefix) {
   std::error_code ec;
   std::vector<std::pair<fs::file_time_type, std::pair<fs::path, uint64_t>>> entries;
   uint64_t total = 0;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     std::error_code e;
-    if (!isCacheEntryName(it->path().filename().string()) || !it->is_regular_file(e)) continue;
+    const std::string name = it->path().filename().string();
+    if (!isCacheEntryName(name) || name.rfind(prefix, 0) != 0 || !it->is_regular_file(e)) continue;
     const uint64_t size = it->file_size(e);
     const fs::file_time_type time = it->last_write_time(e);
     if (e) continue;  // removed meanwhile
@@ -85,8 +94,6 @@ uint64_t trimCacheDir(const fs::path& dir, const fs::path& keep, uint64_t max_by
       continue;             // cannot be removed (permissions): it stays counted
     total -= entry.second;  // gone: removed here or by another process
   }
-  ::flock(lock, LOCK_UN);
-  ::close(lock);
   return removed;
 }
 

@@ -233,28 +233,6 @@ std::vector<bool> expectedArrays(const Scalars& s) {
           uniaxial, true, uniaxial, scattering, sharp,    sharp};
 }
 
-/// Removes the oldest volume entries but `keep` until all take at most `max_bytes`.
-void trimCache(const fs::path& dir, const fs::path& keep, uint64_t max_bytes) {
-  std::error_code ec;
-  std::vector<std::pair<fs::file_time_type, fs::path>> entries;
-  uint64_t total = 0;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    const std::string name = e.path().filename().string();
-    if (name.rfind("volume-", 0) != 0 || e.path().extension() != ".bin") continue;
-    const uint64_t size = e.file_size(ec);
-    if (ec) continue;
-    total += size;
-    entries.emplace_back(e.last_write_time(ec), e.path());
-  }
-  std::sort(entries.begin(), entries.end());
-  for (const auto& [time, path] : entries) {
-    if (total <= max_bytes) break;
-    if (path == keep) continue;
-    const uint64_t size = fs::file_size(path, ec);
-    if (!ec && fs::remove(path, ec)) total -= size;
-  }
-}
-
 }  // namespace
 
 uint64_t volumeCacheKey(const Scene& scene) {
@@ -419,7 +397,7 @@ std::string saveVolumeCache(const fs::path& dir, uint64_t key, const VolumeSet& 
   } catch (const std::exception& e) {
     return e.what();
   }
-  trimCache(dir, path, max_cache_bytes);
+  removeLeastRecentlyUsed(dir, path, max_cache_bytes, "volume-");  // its own cap
   trimCacheDir(dir, path);  // and the whole cache folder's cap (core/io/cache_limit.h)
   return {};
 }
