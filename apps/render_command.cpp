@@ -13,6 +13,7 @@
 
 #include "apps/commands.h"
 #include "apps/progress.h"
+#include "core/contract/polarised_render.h"
 #include "core/io/cache_dir.h"
 #include "core/io/exr.h"
 #include "core/light/light_cache.h"
@@ -23,7 +24,6 @@
 #include "core/session/session.h"
 #include "core/vk/context.h"
 #include "core/vk/timings.h"
-#include "core/volume/polarised_render.h"
 
 namespace eikon::cli {
 

@@ -32,6 +32,7 @@
 #include "apps/commands.h"
 #include "apps/view_camera.h"
 #include "apps/view_save.h"
+#include "core/contract/polarised_render.h"
 #include "core/io/exr.h"
 #include "core/light/light_cache.h"
 #include "core/render/render_defaults.h"
@@ -40,7 +41,6 @@
 #include "core/vk/context.h"
 #include "core/vk/swapchain.h"
 #include "core/vk/timings.h"
-#include "core/volume/polarised_render.h"
 
 namespace eikon::cli {
 
@@ -380,7 +380,7 @@ class Viewer {
   }
 
   /// Whether spectral renders of this scene sample by hero wavelengths (the renderer decides by
-  /// the same test: core/volume/march_types.h).
+  /// the same test: core/contract/march_types.h).
   bool heroSampling() const {
     const VolumeSet& v = session_.prepareGpuRender();  // made before the first render
     return useHeroSampling(base_.sampling, v.attenuating || v.emissive || v.opaque);

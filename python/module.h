@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "core/contract/march_types.h"
 #include "core/scene/messages.h"  // formatNumber, for messages
 #include "core/session/session.h"
-#include "core/volume/march_types.h"
 #include "optics/uniaxial.h"
 
 namespace eikon::python {

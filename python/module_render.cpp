@@ -9,11 +9,11 @@
 #include <mutex>
 #include <optional>
 
+#include "core/contract/polarised_render.h"
 #include "core/io/exr.h"
 #include "core/light/light_cache.h"
 #include "core/render/render_defaults.h"
 #include "core/vk/context.h"
-#include "core/volume/polarised_render.h"
 #include "python/module.h"
 #include "python/progress.h"
 

@@ -281,7 +281,7 @@ struct MarchResult {
   float drift;
   int interfaces;
   int tir;
-  // kAov: the first interface met (core/volume/march_types.h FirstInterface): its point, unit
+  // kAov: the first interface met (core/contract/march_types.h FirstInterface): its point, unit
   // normal facing the ray's origin, and scene object (−1 unknown: smoothed interfaces).
   bool hit;
   vec3 hitPoint;

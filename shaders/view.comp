@@ -4,7 +4,7 @@
 // mode, CIE 1931 → linear sRGB), or at all N by hero wavelength sampling (EIKON_PASS_HERO) or at
 // the fixed wavelength (RGB mode, RGB attenuation). Uniaxial scenes march the o- and e-modes, each
 // carrying half of the unpolarised radiance, or one of them at the whole of it (the pass's modes,
-// EIKON_PASS_MODES_SHIFT: 1 o only, 2 e only; RenderSettings::modes, core/volume/march_types.h).
+// EIKON_PASS_MODES_SHIFT: 1 o only, 2 e only; RenderSettings::modes, core/contract/march_types.h).
 // The bits of P.pass.w are named in eikon_shared.h (EIKON_PASS_*). Output: this
 // pass's share of the pixel's linear sRGB radiance (the host sums the passes and divides by spp),
 // w = its steps, or −(steps + 1) when a march of the pass ran out of the driver's loop budget.
@@ -43,7 +43,7 @@ vec3 cmf(float lambda_nm) {
   return mix(tables[EIKON_CMF_OFFSET + i].xyz, tables[EIKON_CMF_OFFSET + i + 1].xyz, f);
 }
 
-// Layers (EIKON_PASS_LAYERS; core/volume/render_layers.h): after the band's pixels, per pixel
+// Layers (EIKON_PASS_LAYERS; core/contract/render_layers.h): after the band's pixels, per pixel
 // `layerStride` vec4s hold, per mode kept apart (2 with EIKON_PASS_LAYER_MODES, else 1), one value
 // per channel (the N wavelength bins in spectral mode, r, g, b in RGB mode). A pass writes the bins it
 // marches; the host reads those.
@@ -55,7 +55,7 @@ void layerWrite(int bandPixel, int mode, int channel, float v) {
   pixels[P.image.x * P.image.w + bandPixel * layerStride() + i / 4][i % 4] = v;
 }
 
-// The AOV layer (kAov; core/volume/render_layers.h): after the band's pixels and layers, two vec4s
+// The AOV layer (kAov; core/contract/render_layers.h): after the band's pixels and layers, two vec4s
 // per pixel: (first interface point, its object or −1), (its unit normal facing the eye, zero
 // where the pass's first march met no interface; the march steps of all the pass's marches).
 // Every pass writes both; the host takes the geometry from the pixel's first pass (sample 0, its

@@ -6,8 +6,8 @@
 #include <mutex>
 #include <thread>
 
+#include "core/contract/polarised_render.h"
 #include "core/reference/polarised_trace.h"
-#include "core/volume/polarised_render.h"
 
 namespace eikon {
 

@@ -1,5 +1,5 @@
 // The CPU twin of polarised renders (docs/polarisation.md "Polarised renders"): the
-// shared driver core/volume/polarised_render.h over this twin's polarised trace (tracePolarised,
+// shared driver core/contract/polarised_render.h over this twin's polarised trace (tracePolarised,
 // core/reference/polarised_trace.h, in double precision), the pixel samples' rays spread over
 // threads. The GPU twin is ViewRenderer::renderPolarised.
 //
@@ -9,10 +9,10 @@
 //   // img.rgb: S0 after the camera's analyser; img.stokes: S0..S3 × RGB per pixel
 #pragma once
 
+#include "core/contract/march_types.h"
+#include "core/contract/polarised.h"
 #include "core/scene/scene.h"
 #include "core/volume/field.h"
-#include "core/volume/march_types.h"
-#include "core/volume/polarised.h"
 
 namespace eikon {
 

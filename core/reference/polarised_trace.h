@@ -25,8 +25,8 @@
 //   eikon::PolarisedTrace t = eikon::tracePolarised(field, scene.polarizers, ray, {1, 0, 0, 0});
 //   // t.beams[k].stokes: what leaves along direction t.beams[k].direction
 //
-// The settings and beams are the neutral ones of core/volume/polarised.h, shared with the GPU twin
-// (ViewRenderer::tracePolarised, shaders/polarised_trace.comp).
+// The settings and beams are the neutral ones of core/contract/polarised.h, shared with the GPU
+// twin (ViewRenderer::tracePolarised, shaders/polarised_trace.comp).
 //
 // Only homogeneous regions are supported (a gradient-index or radial-axis region on the path is
 // a std::runtime_error naming it); an opaque region absorbs the branch.
@@ -34,10 +34,10 @@
 
 #include <vector>
 
+#include "core/contract/march_types.h"
+#include "core/contract/polarised.h"
 #include "core/scene/scene.h"
 #include "core/volume/field.h"
-#include "core/volume/march_types.h"
-#include "core/volume/polarised.h"
 #include "optics/polarization.h"
 
 namespace eikon {

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/contract/render_layers.h"
 #include "core/reference/field.h"
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
@@ -19,7 +20,6 @@
 #include "core/spectrum/wavelength_sampling.h"
 #include "core/volume/boundary.h"
 #include "core/volume/media.h"
-#include "core/volume/render_layers.h"
 #include "optics/fresnel.h"
 #include "optics/interface.h"
 #include "optics/units.h"

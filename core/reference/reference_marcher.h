@@ -16,9 +16,9 @@
 #include <functional>
 #include <memory>
 
+#include "core/contract/march_types.h"
 #include "core/scene/scene.h"
 #include "core/volume/field.h"
-#include "core/volume/march_types.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {
@@ -46,7 +46,7 @@ class AnalyticField : public Field {
 };
 
 struct HeroRecord;  // hero wavelength sampling's record of one pixel sample (the .cpp)
-class LayerSums;    // core/volume/render_layers.h
+class LayerSums;    // core/contract/render_layers.h
 
 class ReferenceMarcher {
  public:

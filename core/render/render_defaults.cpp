@@ -2,8 +2,8 @@
 
 #include <stdexcept>
 
+#include "core/contract/polarised_render.h"
 #include "core/vk/context.h"
-#include "core/volume/polarised_render.h"
 
 namespace eikon {
 

@@ -12,9 +12,9 @@
 #include <functional>
 #include <string>
 
+#include "core/contract/march_types.h"
 #include "core/light/lighting_driver.h"
 #include "core/scene/scene.h"
-#include "core/volume/march_types.h"
 
 namespace eikon {
 namespace vk {

@@ -18,9 +18,9 @@
 
 #include <memory>
 
+#include "core/contract/march_types.h"
 #include "core/scene/scene.h"
 #include "core/vk/context.h"
-#include "core/volume/march_types.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {

@@ -17,14 +17,14 @@
 #include <tuple>
 #include <variant>
 
+#include "core/contract/polarised_render.h"
+#include "core/contract/render_layers.h"
 #include "core/render/boundary_device.h"
 #include "core/render/view_pipeline_start.h"
 #include "core/spectrum/cie1931.h"
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
 #include "core/vk/timings.h"
-#include "core/volume/polarised_render.h"
-#include "core/volume/render_layers.h"
 #include "optics/units.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/polarised_trace.spv.h"
@@ -807,7 +807,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   // Bands of rows within a pass so that progress is reported and no dispatch runs for long: the
   // band buffer holds up to ~2e5 rays' worth of rows; the first band is one workgroup row, each
   // next one is sized from the last one's time to take ~0.25 s.
-  // Layers (core/volume/render_layers.h): per pixel, after the band's RGB, `stride` vec4s of
+  // Layers (core/contract/render_layers.h): per pixel, after the band's RGB, `stride` vec4s of
   // channel values per mode (view.comp layerWrite); the pass's bins are added on the host.
   LayerSums layers(s, size_t(img.width) * size_t(img.height), I.uniaxial);
   const size_t stride = layers.active() ? size_t((layers.channels() * layers.modes() + 3) / 4) : 0;
@@ -1027,8 +1027,8 @@ std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<Polar
   return out;
 }
 
-// The shared driver (core/volume/polarised_render.h) over this twin's polarised trace: every pixel
-// sample's camera ray (at each wavelength) is one workgroup of polarised_trace.comp in its
+// The shared driver (core/contract/polarised_render.h) over this twin's polarised trace: every
+// pixel sample's camera ray (at each wavelength) is one workgroup of polarised_trace.comp in its
 // Mueller-row variant (P.pass.z); the environment is looked up on the host per beam, with the
 // same Environment::lookup as the CPU twin, so the twins differ only in their traces.
 RenderImage ViewRenderer::renderPolarised(const RenderSettings& s,

@@ -16,11 +16,11 @@
 #include <memory>
 #include <vector>
 
+#include "core/contract/march_types.h"
+#include "core/contract/polarised.h"
 #include "core/scene/scene.h"
 #include "core/vk/context.h"
 #include "core/vk/resources.h"
-#include "core/volume/march_types.h"
-#include "core/volume/polarised.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {
@@ -78,7 +78,7 @@ class ViewRenderer {
                                              const std::vector<TraceRequest>& rays,
                                              const std::vector<Stokes>& inputs,
                                              const PolarisedTraceSettings& settings = {});
-  /// A polarised render of the scene's camera (core/volume/polarised_render.h, the GPU twin of
+  /// A polarised render of the scene's camera (core/contract/polarised_render.h, the GPU twin of
   /// core/reference/polarised_render.h): rgb = S0 after the camera's analyser, stokes layers if
   /// asked. Throws as renderPolarisedWith and tracePolarised (at most 8 polariser sheets).
   RenderImage renderPolarised(const RenderSettings& settings,

@@ -18,8 +18,8 @@
 
 #include <string>
 
+#include "core/contract/march_types.h"
 #include "core/scene/scene.h"
-#include "core/volume/march_types.h"
 
 namespace eikon {
 

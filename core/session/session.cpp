@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/contract/polarised_render.h"
+#include "core/contract/render_layers.h"
 #include "core/light/light_cache.h"
 #include "core/light/lighting.h"
 #include "core/reference/polarised_render.h"
@@ -18,8 +20,6 @@
 #include "core/scene/limits.h"
 #include "core/vk/context.h"
 #include "core/volume/host_memory.h"
-#include "core/volume/polarised_render.h"
-#include "core/volume/render_layers.h"
 #include "core/volume/volume_cache.h"
 
 namespace eikon {

@@ -30,10 +30,10 @@
 #include <string>
 #include <vector>
 
+#include "core/contract/march_types.h"
+#include "core/contract/polarised.h"
 #include "core/light/lighting_driver.h"
 #include "core/scene/scene.h"
-#include "core/volume/march_types.h"
-#include "core/volume/polarised.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {

@@ -26,10 +26,10 @@
 #include <random>
 #include <string>
 
+#include "core/contract/polarised_render.h"
 #include "core/reference/polarised_trace.h"
 #include "core/scene/scene.h"
 #include "core/volume/field.h"
-#include "core/volume/polarised_render.h"
 #include "core/volume/volume_set.h"
 #include "tests/core/polarised_fixtures.h"
 

@@ -1,4 +1,4 @@
-// The AOV layer (RenderSettings::aov_layer; core/volume/render_layers.h) on both twins, against
+// The AOV layer (RenderSettings::aov_layer; core/contract/render_layers.h) on both twins, against
 // closed forms: a glass sphere (object 0) and an axis-aligned glass box (object 1) seen by a
 // pinhole camera. Each pixel's first camera ray is the pixel centre's at spp = 1 (the camera
 // model: d = normalize(forward + u·right + v·up)), so its first interface is the nearest
@@ -31,7 +31,7 @@
 #include <numbers>
 #include <string>
 
-#include "core/volume/render_layers.h"
+#include "core/contract/render_layers.h"
 #include "tests/core/test_support.h"
 
 namespace eikon::test {

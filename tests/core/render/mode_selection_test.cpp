@@ -1,5 +1,5 @@
-// RenderSettings::modes (core/volume/march_types.h; `eikon render --modes`, the viewer's M key) on
-// both twins.
+// RenderSettings::modes (core/contract/march_types.h; `eikon render --modes`, the viewer's M key)
+// on both twins.
 //
 // Closed form: unpolarised light splits at a crystal into the o- and the e-mode, each carrying
 // half, so the image of both modes is ½·(O + E), where O and E are the images of one mode marched

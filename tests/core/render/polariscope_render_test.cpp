@@ -1,5 +1,5 @@
-// Polarised RENDERS of the shipped polariscope scenes (core/volume/polarised_render.h), both twins,
-// against the closed forms of tests/core/polariscope_closed_forms.h:
+// Polarised RENDERS of the shipped polariscope scenes (core/contract/polarised_render.h), both
+// twins, against the closed forms of tests/core/polariscope_closed_forms.h:
 //  - scenes/polariscope_quartz_wedge.json: the rendered sRGB colour of the wedge where its net
 //    retardation is Γ = 100…1800 nm (at 550 nm) is the Michel-Lévy colour of the light box's flat
 //    spectrum × ½(τ_oτ_e)² sin²(πΔn(λ)t/λ) (1 nm, the renderer's colour matrix), ΔE76 ≤ 2. The
@@ -26,8 +26,8 @@
 #include <string>
 #include <vector>
 
+#include "core/contract/polarised_render.h"
 #include "core/reference/polarised_render.h"
-#include "core/volume/polarised_render.h"
 #include "tests/core/polariscope_closed_forms.h"
 #include "tests/core/test_support.h"
 

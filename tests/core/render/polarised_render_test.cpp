@@ -1,5 +1,5 @@
 // Polarised renders of the GPU twin (ViewRenderer::renderPolarised: shaders/polarised_trace.comp
-// in its Mueller-row variant under the shared driver core/volume/polarised_render.h) against the
+// in its Mueller-row variant under the shared driver core/contract/polarised_render.h) against the
 // closed forms of the CPU twin's tests (tests/core/reference/polarised_render_test.cpp) and
 // against the CPU twin, pixel by pixel, on small images.
 //

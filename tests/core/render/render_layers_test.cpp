@@ -1,5 +1,5 @@
 // The extra layers of a render (RenderSettings::spectral_layer, ::mode_layers;
-// core/volume/render_layers.h) on both twins.
+// core/contract/render_layers.h) on both twins.
 //
 // Closed forms: the spectral channels are bin means of the spectral radiance, so integrating them
 // with the CIE 1931 functions bin by bin (∫_bin cmf, core/spectrum/cie1931.h) and the E-white sRGB

@@ -23,8 +23,8 @@
 #include <glm/glm.hpp>
 #include <vector>
 
+#include "core/contract/march_types.h"
 #include "core/scene/shapes.h"
-#include "core/volume/march_types.h"
 
 namespace eikon {
 

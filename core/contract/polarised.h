@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/volume/march_types.h"
+#include "core/contract/march_types.h"
 #include "optics/polarization.h"
 
 namespace eikon {
@@ -23,7 +23,7 @@ struct PolarisedTraceSettings {
   int max_events = 256;            ///< interface events per branch (the GPU twin: at most 48)
   std::vector<int> reflect_at;     ///< interface events (0-based per branch) that take the
                                    ///< reflected beam instead of the transmitted one (GPU: < 24)
-  /// Renders (core/volume/polarised_render.h): each beam's `stokes` is the first ROW of its
+  /// Renders (core/contract/polarised_render.h): each beam's `stokes` is the first ROW of its
   /// Mueller matrix (M00, M01, M02, M03: S0 out per input basis state) instead of M·input.
   bool mueller_row = false;
 };

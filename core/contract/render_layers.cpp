@@ -1,5 +1,5 @@
 // Render layers shared by both twins: see render_layers.h.
-#include "core/volume/render_layers.h"
+#include "core/contract/render_layers.h"
 
 #include <cmath>
 #include <glm/glm.hpp>

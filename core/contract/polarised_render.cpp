@@ -1,4 +1,4 @@
-#include "core/volume/polarised_render.h"
+#include "core/contract/polarised_render.h"
 
 #include <algorithm>
 #include <array>

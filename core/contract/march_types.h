@@ -91,7 +91,7 @@ struct RenderSettings {
   bool mode_layers = false;     ///< o- and e-mode radiance as separate RGB layers
   /// A polarised render (docs/polarisation.md "Polarised renders"): asked for here (`eikon render
   /// --polarised`), or implied by the scene's polariser sheets or camera analyser, or by
-  /// stokes_layers (isPolarisedRender in core/volume/polarised_render.h).
+  /// stokes_layers (isPolarisedRender in core/contract/polarised_render.h).
   bool polarised = false;
   bool stokes_layers = false;  ///< S0..S3 as RGB layers (RenderImage::stokes; --layers stokes)
   /// RenderImage::aov: the first interface of each pixel's first camera ray (depth, point,
@@ -129,8 +129,8 @@ struct RenderImage {
   std::vector<float> modes;
   /// RenderSettings::stokes_layers (polarised renders): 12 floats per pixel, the Stokes vector's
   /// linear sRGB (S0.R, S0.G, S0.B, S1.R, …, S3.B) after the camera's analyser, in the frame
-  /// stokesBasis(−v) of each pixel's camera ray v (kStokesFrame of core/volume/polarised_render.h;
-  /// S0 = rgb); empty otherwise.
+  /// stokesBasis(−v) of each pixel's camera ray v (kStokesFrame of
+  /// core/contract/polarised_render.h; S0 = rgb); empty otherwise.
   std::vector<float> stokes;
   /// RenderSettings::aov_layer: kAovChannels floats per pixel (rows from the top), in the order
   /// of kAovChannelNames: Z (distance from the eye to the first interface along the pixel's first

@@ -6,7 +6,7 @@
 //
 //   J_f = D·J_bᵀ·D in mirrored frames (x̂, −ŷ) at both ends, so in Stokes M_f = Q·M_bᵀ·Q with
 //   Q = diag(1, 1, −1, 1) (with S3 = 2 Im(E_x E_y*): M(Jᵀ) = diag(1,1,1,−1)·M(J)ᵀ·diag(1,1,1,−1)
-//   and M(D) = diag(1, 1, −1, −1); tests/core/volume/polarised_render_test.cpp checks both).
+//   and M(D) = diag(1, 1, −1, −1); tests/core/reference/polarised_render_test.cpp checks both).
 //
 // For unpolarised environment radiance L the camera receives L × the first column of M_f, i.e.
 // Q × the first ROW of M_b: the twins' traces report that row per beam
@@ -31,9 +31,9 @@
 #include <string>
 #include <vector>
 
+#include "core/contract/march_types.h"
+#include "core/contract/polarised.h"
 #include "core/scene/scene.h"
-#include "core/volume/march_types.h"
-#include "core/volume/polarised.h"
 
 namespace eikon {
 

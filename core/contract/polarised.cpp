@@ -1,4 +1,4 @@
-#include "core/volume/polarised.h"
+#include "core/contract/polarised.h"
 
 #include <cmath>
 #include <cstdio>
