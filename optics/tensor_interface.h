@@ -56,9 +56,12 @@
 // Worked example (air → aragonite, γ̂ normal to the surface, i = 30° in the αγ plane):
 //   eikon::TensorMedium air = eikon::TensorMedium::isotropic(1.0);
 //   eikon::TensorMedium ara(1.530, 1.680, 1.685, {1, 0, 0}, {0, 0, 1});
-//   auto r = eikon::solveTensorInterface(air, eikon::WaveMode::Fast, {0.5, 0, 0.866}, {0, 0, 1},
+//   auto r = eikon::solveTensorInterface(air, eikon::WaveMode::Fast, {0.5, 0, 0.866025}, {0, 0, 1},
 //                                        ara);
-//   // r.transmitted[0..1]: two refracted waves, n between 1.530.. and 1.685; Σ power = 1.
+//   // r.transmitted[0]: the TM wave, n = 1.544273 at 18.8915° from the normal, ray at 15.7563°;
+//   // r.transmitted[1]: the TE wave, n = n_β = 1.680 at 17.3147°, no walk-off. How the power is
+//   // shared depends on the incident polarisation (air's two modes are an arbitrary orthogonal
+//   // pair: average them for unpolarised light); Σ power = 1.
 //
 // Common mistakes: choosing the transmitted root by the sign of Re q instead of the ray; taking
 // |amplitude|² as power (the normal flux per |E|² differs between waves); expecting a biaxial
