@@ -128,6 +128,41 @@ struct Root {
   double score = 0;  // > 0: leaves towards +m̂
 };
 
+// Two waves with the same real p (a double root): rotate their E pair within its span so that
+// the normal-flux form B(E₁, E₂) = (p·m̂)(E₁·E₂) − ½[(E₁·m̂)(E₂·p) + (E₂·m̂)(E₁·p)] is diagonal.
+// Distinct modes are flux-orthogonal by themselves; a degenerate pair must be made so, or the
+// powers of the two waves would not add up.
+void makeFluxOrthogonal(glm::dvec3 p, glm::dvec3 m, glm::dvec3& e1, glm::dvec3& e2) {
+  auto B = [&](glm::dvec3 a, glm::dvec3 b) {
+    return glm::dot(p, m) * glm::dot(a, b) -
+           0.5 * (glm::dot(a, m) * glm::dot(b, p) + glm::dot(b, m) * glm::dot(a, p));
+  };
+  const double phi = 0.5 * std::atan2(2.0 * B(e1, e2), B(e1, e1) - B(e2, e2));
+  const glm::dvec3 a = std::cos(phi) * e1 + std::sin(phi) * e2;
+  const glm::dvec3 b = -std::sin(phi) * e1 + std::cos(phi) * e2;
+  e1 = a;
+  e2 = b;
+}
+
+// A real double root (a wave normal along an optic axis) often comes out of the quartic as a
+// complex pair ±1e-8 i, since rounding of the coefficients moves it that far. Such a pair is made
+// real when both modes there carry energy across the interface (|t̂·m̂| > 1e-6): a genuine
+// evanescent pair (a per-mode critical angle) has a grazing ray instead.
+void snapOpticAxisPairs(const TensorMedium& med, glm::dvec3 p_t, glm::dvec3 m,
+                        std::array<cd, 4>& roots) {
+  for (size_t i = 0; i < 4; ++i)
+    for (size_t j = i + 1; j < 4; ++j) {
+      const double scale = std::abs(roots[i]) + 1.0;
+      if (roots[i].imag() == 0.0 || std::abs(roots[i] - roots[j]) > 1e-6 * scale) continue;
+      if (std::abs(roots[i].imag()) > 1e-6 * scale || std::abs(roots[j].imag()) > 1e-6 * scale)
+        continue;
+      const double x0 = 0.5 * (roots[i].real() + roots[j].real());
+      const WaveModes md = med.modes(p_t + x0 * m);
+      if (std::min(std::abs(glm::dot(md.fast.t, m)), std::abs(glm::dot(md.slow.t, m))) > 1e-6)
+        roots[i] = roots[j] = x0;
+    }
+}
+
 // The quartic's roots on the requested side with their fields (see the header essay). Real roots
 // take E and the ray from TensorMedium::modes (the mode whose index matches |p|; a same-side
 // double root gets the fast and slow D pair), complex roots the null vector of W.
@@ -148,6 +183,7 @@ std::array<maxwell::Wave, 2> quarticWaves(const TensorMedium& med, glm::dvec3 p_
     z = cd(static_cast<double>(zl.real()), static_cast<double>(zl.imag()));
     if (std::abs(z.imag()) <= 1e-14 * scale) z = z.real();
   }
+  snapOpticAxisPairs(med, p_t, m, roots);
   std::array<Root, 4> r;
   for (size_t k = 0; k < 4; ++k) {
     const double scale = std::abs(roots[k]) + 1.0;
@@ -185,6 +221,12 @@ std::array<maxwell::Wave, 2> quarticWaves(const TensorMedium& med, glm::dvec3 p_
       E = k == 0 ? es : maxwell::cross(p, es);
     }
     out[k] = maxwell::makeWave(p, E);
+  }
+  if (double_root && side[0].real && side[1].real) {
+    glm::dvec3 e1 = maxwell::real(out[0].E), e2 = maxwell::real(out[1].E);
+    makeFluxOrthogonal(maxwell::real(out[0].p), m, e1, e2);
+    out[0] = maxwell::makeWave(out[0].p, maxwell::cv(e1));
+    out[1] = maxwell::makeWave(out[1].p, maxwell::cv(e2));
   }
   return out;
 }

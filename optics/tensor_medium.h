@@ -4,10 +4,11 @@
 // trichroic absorption. Refraction and reflection between two such media is tensor_interface.h.
 //
 // Essay. A non-magnetic, lossless crystal has a real symmetric relative permittivity ε. In its
-// principal frame (unit axes α̂, β̂, γ̂, right-handed, β̂ = γ̂ × α̂) ε = diag(n_α², n_β², n_γ²) with
-// n_α ≤ n_β ≤ n_γ (Born & Wolf "Principles of Optics" 7th ed. §15.2; Yariv & Yeh "Optical Waves
-// in Crystals" §4.2). Write a_i = 1/n_i² (a_α ≥ a_β ≥ a_γ). A plane wave with unit wave normal ŝ
-// and index n (p = n ŝ in units of k₀) obeys Fresnel's equation of wave normals
+// principal frame (unit axes α̂, β̂, γ̂, right-handed, β̂ = γ̂ × α̂)
+// ε = diag(n_α², n_β², n_γ²) with n_α ≤ n_β ≤ n_γ (Born & Wolf "Principles of Optics" 7th ed.
+// §15.2; Yariv & Yeh "Optical Waves in Crystals" §4.2). Write a_i = 1/n_i² (a_α ≥ a_β ≥ a_γ). A
+// plane wave with unit wave normal ŝ and index n (p = n ŝ in units of k₀) obeys Fresnel's equation
+// of wave normals
 //     Σ_i s_i² / (1/n² − a_i) = 0                 (B&W §15.2.3; Y&Y §4.2),
 // a quadratic in u = 1/n² with two roots: the FAST mode (larger u, smaller n) and the SLOW mode.
 // Solving it as a quadratic loses the splitting near the optic axes (B² − 4C cancels). This
