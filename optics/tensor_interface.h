@@ -113,7 +113,7 @@ struct TensorInterfaceSolution {
 std::array<double, 5> bookerQuartic(const TensorMedium& medium, glm::dvec3 p_t, glm::dvec3 m);
 
 /// All four complex roots of c₄q⁴ + c₃q³ + c₂q² + c₁q + c₀ (c₄ ≠ 0), by Aberth–Ehrlich iteration
-/// and Newton polishing; conjugate pairs of a real polynomial are made exactly conjugate.
+/// and Newton polishing; a root whose imaginary part is below 1e-14 (relative) is returned real.
 std::array<maxwell::cd, 4> quarticRoots(const std::array<double, 5>& c);
 
 /// The two waves of `medium` with tangential wave vector p_t that leave the interface on the side

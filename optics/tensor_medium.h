@@ -74,7 +74,7 @@
 // n_β = 1.680, n_γ = 1.685, biaxial negative, 2V_x = 18°):
 //   eikon::TensorMedium ara(1.530, 1.680, 1.685, {0, 0, 1}, {0, 1, 0});   // α̂ = c, γ̂ = b
 //   ara.opticAxisAngle();        // V_z = 80.37° (from γ̂)
-//   ara.twoV();                  // 19.26° (acute; published 18°, indices rounded to 1e-3)
+//   ara.twoV();                  // 19.27° (acute; published 18°, indices rounded to 1e-3)
 //   ara.opticSign();             // OpticSign::Negative
 //   auto m = ara.modes(ara.opticAxes()[0]);   // m.fast.n == m.slow.n == 1.680, on_optic_axis
 //
