@@ -12,7 +12,6 @@
 
 #include "core/scene/messages.h"  // formatNumber, for messages
 #include "core/session/session.h"
-#include "core/volume/march_types.h"
 #include "optics/uniaxial.h"
 
 namespace eikon::python {
