@@ -5,7 +5,8 @@
 #include "apps/commands.h"
 #include "core/scene/material_library.h"
 #include "core/scene/scene.h"
-#include "core/vk/context.h"
+#include "core/session/front_end.h"
+#include "core/session/session.h"
 
 namespace eikon::cli {
 
@@ -13,8 +14,7 @@ void addInfoCommand(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "info", "Show the Vulkan device, its limits, the build and the material library");
   sub->callback([] {
-    auto ctx = vk::Context::create();
-    const auto& l = ctx->limits();
+    const DeviceInfo d = deviceInfo(*newContext());
     std::printf("eikon 0.1.0 (C++20, %s build)\n",
 #ifdef NDEBUG
                 "release"
@@ -26,14 +26,13 @@ void addInfoCommand(CLI::App& app) {
     auto row = [](const char* label, const std::string& value) {
       std::printf("%-20s%s\n", (std::string(label) + ":").c_str(), value.c_str());
     };
-    row("device",
-        ctx->deviceName() + " (" + ctx->deviceTypeName() + "), Vulkan " + ctx->apiVersionString());
-    row("max 3D image side", std::to_string(l.max_image_dimension_3d) + " voxels");
-    row("max storage buffer", std::to_string(l.max_storage_buffer_range >> 20) + " MiB");
-    row("device heap", std::to_string(l.heap_size >> 20) + " MiB");
-    row("shader float64", l.shader_float64 ? "yes" : "no");
+    row("device", d.name + " (" + d.type + "), Vulkan " + d.api_version);
+    row("max 3D image side", std::to_string(d.max_image_dimension_3d) + " voxels");
+    row("max storage buffer", std::to_string(d.max_storage_buffer_range >> 20) + " MiB");
+    row("device heap", std::to_string(d.heap_size >> 20) + " MiB");
+    row("shader float64", d.shader_float64 ? "yes" : "no");
     row("validation layers",
-        std::string(ctx->validationEnabled() ? "on" : "off") + " (EIKON_VALIDATION=1 enables)");
+        std::string(d.validation ? "on" : "off") + " (EIKON_VALIDATION=1 enables)");
     // The library a scene's "material" names (docs/scene-format.md "materials").
     std::string names, folders;
     for (const std::string& n : libraryMaterialNames()) names += (names.empty() ? "" : ", ") + n;

@@ -13,17 +13,12 @@
 
 #include "apps/commands.h"
 #include "apps/progress.h"
-#include "core/contract/polarised_render.h"
 #include "core/io/cache_dir.h"
 #include "core/io/exr.h"
-#include "core/light/light_cache.h"
-#include "core/render/render_defaults.h"
-#include "core/render/view_renderer.h"
 #include "core/scene/scene_warnings.h"
+#include "core/session/front_end.h"
 #include "core/session/render_cost.h"
 #include "core/session/session.h"
-#include "core/vk/context.h"
-#include "core/vk/timings.h"
 
 namespace eikon::cli {
 
@@ -188,7 +183,7 @@ LightRequest lightRequest(const RenderArgs& a) {
 }
 
 std::filesystem::path lightCacheDir(const RenderArgs& a) {
-  return a.light_cache.empty() ? defaultLightCacheDir() : std::filesystem::path(a.light_cache);
+  return a.light_cache.empty() ? defaultLightCacheFolder() : std::filesystem::path(a.light_cache);
 }
 
 /// The EXR channel names of img.aov (empty without the AOV layer).
@@ -215,8 +210,7 @@ void printSummary(const RenderArgs& a, Session& session, const RenderTwin& twin,
     std::printf(
         "eikon: simulated %zu light runs on %s in %.2f s: %zu patches (%.3g patches/s), flux "
         "balance %.1e, reflected %.3g of emitted\n",
-        light.summary.runs,
-        light.on_cpu ? "the CPU reference" : session.context().deviceName().c_str(),
+        light.summary.runs, light.on_cpu ? "the CPU reference" : session.deviceName(true).c_str(),
         light.summary.seconds, light.summary.patches,
         double(light.summary.patches) / std::max(light.summary.seconds, 1e-9),
         light.summary.conservationError(),
@@ -229,7 +223,7 @@ void printSummary(const RenderArgs& a, Session& session, const RenderTwin& twin,
       a.scene.c_str(), img.width, img.height,
       rs.wavelengths > 0 ? (std::to_string(rs.wavelengths) + " wavelengths").c_str() : "RGB",
       isPolarisedRender(*session.scene(), rs) ? ", polarised" : "", rs.spp,
-      twin.cpu ? "CPU reference" : session.context().deviceName().c_str(), twin.cpu ? "CPU" : "GPU",
+      twin.cpu ? "CPU reference" : session.deviceName(true).c_str(), twin.cpu ? "CPU" : "GPU",
       twin.why.c_str(), img.seconds, rays / img.seconds, img.mean_steps, out.c_str(), png.c_str());
 }
 
@@ -294,7 +288,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   const double exposure =
       sub.count("--exposure") ? a.exposure : scene->render.exposure.value_or(0.0);
   // (auto renders every polarised render on the GPU twin: cpuTwinFasterBecause)
-  if (device != "cpu" && isPolarisedRender(*scene, rs)) checkGpuPolariserSheets(*scene);
+  if (device != "cpu" && isPolarisedRender(*scene, rs)) checkPolariserSheetsOnGpu(*scene);
   checkRenderFitsHost(*scene, rs);  // before voxelising: the image's memory, with the numbers
   for (const std::string& w : materialRangeWarnings(*scene, rs)) warn(w, a.strict);
   timings::mark("scene parsed");
@@ -305,7 +299,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   Session session(scene);
   session.setThreads(a.threads);
   const RenderTwin twin =
-      renderTwin(device, *scene, rs, [&] { return session.context().deviceTypeName(); });
+      renderTwin(device, *scene, rs, [&] { return deviceInfo(session.context()).type; });
   const bool cpu = twin.cpu;
   // The GPU render's start-up (docs/performance.md "Start-up"); the CPU twin takes far longer to
   // render than to voxelise, and voxelises every time.

@@ -19,9 +19,8 @@
 
 #include "apps/commands.h"
 #include "apps/progress.h"
-#include "core/render/view_renderer.h"
+#include "core/session/front_end.h"
 #include "core/session/session.h"
-#include "core/vk/timings.h"
 
 namespace eikon::cli {
 namespace {
@@ -194,7 +193,7 @@ void runTrace(const TraceArgs& a) {
     throw CliError(std::string("--stokes: ") + kNeedsSharp);  // before any voxelising or warning
   // An explicit --stokes on the GPU: a scene with more polariser sheets than its polarised trace
   // takes is refused before voxelising (without --stokes the trace runs and says why not).
-  if (a.stokes_given && !a.reference) checkGpuPolariserSheets(*scene);
+  if (a.stokes_given && !a.reference) checkPolariserSheetsOnGpu(*scene);
   // Voxelising a 128³ scene takes seconds; the trace itself is instant.
   Progress progress(progress_mode);
   MarchSettings ms;

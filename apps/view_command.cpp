@@ -1,6 +1,6 @@
 // eikon view SCENE.json [--width W --height H]: an interactive window on the scene, rendered by the
 // GPU twin exactly as `eikon render` renders it (ViewRenderer through the session), shown through
-// a Vulkan swapchain (core/vk/swapchain.h) in a GLFW window (X11). docs/viewer.md.
+// a Vulkan swapchain (ViewPresenter, core/session/viewer.h) in a GLFW window (X11). docs/viewer.md.
 //
 // Progressive refinement: after any change the view restarts with a coarse frame (a quarter of
 // the resolution, one sample, few wavelengths), then the full resolution at few wavelengths
@@ -32,15 +32,10 @@
 #include "apps/commands.h"
 #include "apps/view_camera.h"
 #include "apps/view_save.h"
-#include "core/contract/polarised_render.h"
 #include "core/io/exr.h"
-#include "core/light/light_cache.h"
-#include "core/render/render_defaults.h"
-#include "core/render/view_renderer.h"
+#include "core/session/front_end.h"
 #include "core/session/session.h"
-#include "core/vk/context.h"
-#include "core/vk/swapchain.h"
-#include "core/vk/timings.h"
+#include "core/session/viewer.h"
 
 namespace eikon::cli {
 
@@ -101,9 +96,9 @@ void addViewOptions(CLI::App* sub, ViewArgs& a) {
 struct MovedLight {
   Light light;                           ///< the light simulated
   std::vector<glm::vec4> fluence, flux;  ///< its light volumes (VolumeSet's)
-  /// The first light: the lit renderer made from them (Session::makeRendererFor), which replaces
-  /// the viewer's unlit one.
-  std::unique_ptr<ViewRenderer> renderer;
+  /// The first light: the lit renderer made from them (LitRenderer::make), which replaces the
+  /// viewer's unlit one.
+  LitRenderer renderer;
   bool cached = false;                ///< they came from the light cache
   double seconds = 0;                 ///< the simulation's (or the cache lookup's) time, all told
   double voxelise_seconds = 0;        ///< the first light: the whole volume made meanwhile
@@ -205,7 +200,7 @@ class LightMover {
         result_.warnings = o.warnings;
         if (view) {
           stage_ = Stage::Preparing;
-          result_.renderer = session_->makeRendererFor(*view->ctx, *view->scene, &view->expected);
+          result_.renderer = LitRenderer::make(*session_, *view->ctx, *view->scene, view->expected);
         }
         VolumeSet& v = session_->prepare(false);  // made by simulateLight; refilled by the next
         result_.fluence = std::move(v.light_fluence);
@@ -257,7 +252,7 @@ const char* integratorName(Integrator i) {
 /// The interactive window: input, refinement, frames.
 class Viewer {
  public:
-  Viewer(const ViewArgs& a, Session& session, GLFWwindow* window, vk::Swapchain& chain,
+  Viewer(const ViewArgs& a, Session& session, GLFWwindow* window, ViewPresenter& chain,
          RenderSettings base, LightMover* mover)
       : args_(a),
         session_(session),
@@ -654,8 +649,7 @@ class Viewer {
     session_.scene()->lights.front() = moved_.light;
     timings::mark(first_light_ ? "first light swapped in" : "moved light swapped in");
     if (moved_.renderer)
-      session_.adoptRenderer(std::move(moved_.renderer), std::move(moved_.fluence),
-                             std::move(moved_.flux));
+      moved_.renderer.adoptInto(session_, std::move(moved_.fluence), std::move(moved_.flux));
     else
       session_.setLightVolumes(std::move(moved_.fluence), std::move(moved_.flux));
     // The first light: how long the mover's voxelising took, and the frames shown unlit before
@@ -803,7 +797,7 @@ class Viewer {
   const ViewArgs& args_;
   Session& session_;
   GLFWwindow* window_;
-  vk::Swapchain& chain_;
+  ViewPresenter& chain_;
   RenderSettings base_;
   LightMover* mover_;
   Light wanted_light_;
@@ -910,7 +904,7 @@ void runView(const ViewArgs& given, const CLI::App& sub) {
     std::fprintf(stderr, "eikon: warning: %s\n", w.c_str());
   if (!sub.count("--exposure") && scene->render.exposure) a.exposure = *scene->render.exposure;
   RenderSettings base = renderSettings(*scene, view);
-  if (isPolarisedRender(*scene, base)) checkGpuPolariserSheets(*scene);  // before any window
+  if (isPolarisedRender(*scene, base)) checkPolariserSheetsOnGpu(*scene);  // before any window
   base.march.integrator = integrator;
   const int width = view.width.value_or(scene->camera.width),
             height = view.height.value_or(scene->camera.height);
@@ -918,28 +912,30 @@ void runView(const ViewArgs& given, const CLI::App& sub) {
   Glfw glfw;
   uint32_t n_ext = 0;
   const char** ext = glfwGetRequiredInstanceExtensions(&n_ext);
-  vk::ContextOptions options;
-  for (uint32_t i = 0; i < n_ext; ++i) options.surface_extensions.push_back(ext[i]);
-  options.swapchain = true;
+  std::vector<std::string> surface_extensions(ext, ext + n_ext);
   Window window(width, height, "eikon view: " + scene->file.filename().string() + " (preparing)");
-  Session session(scene,
-                  [&] { return std::shared_ptr<vk::Context>(vk::Context::create(options)); });
+  Session session(scene, presentingContext(surface_extensions));
   session.setProgress(
       {[&](const char*, double) { glfwPollEvents(); }, [&](const char*) { glfwPollEvents(); }});
-  vk::Context& ctx = session.context();
-  VkSurfaceKHR surface = VK_NULL_HANDLE;
-  if (glfwCreateWindowSurface(ctx.instance(), window.handle, nullptr, &surface) != VK_SUCCESS)
-    throw CliError("cannot create a Vulkan surface for the window (" + glfwLastError() + ")");
+  session.context();  // the device, then the window's surface and swapchain on it
   int fw = 0, fh = 0;
   glfwGetFramebufferSize(window.handle, &fw, &fh);
-  vk::Swapchain chain(ctx, surface, uint32_t(fw), uint32_t(fh));
+  ViewPresenter chain(
+      session,
+      [&](VkInstance instance) {
+        VkSurfaceKHR surface = VK_NULL_HANDLE;
+        if (glfwCreateWindowSurface(instance, window.handle, nullptr, &surface) != VK_SUCCESS)
+          throw CliError("cannot create a Vulkan surface for the window (" + glfwLastError() + ")");
+        return surface;
+      },
+      uint32_t(fw), uint32_t(fh));
   std::unique_ptr<LightMover> mover;
   // As eikon render: the light volumes show only where a material has an albedo.
   if (!scene->lights.empty() && !a.no_light && !scene->anyScattering())
     std::fputs(kLightsNotSimulatedNote, stderr);
   if (!scene->lights.empty() && !a.no_light && scene->anyScattering())
     mover = std::make_unique<LightMover>(*scene, session.lightOnCpuTwin(LightRequest{}, false),
-                                         defaultLightCacheDir());
+                                         defaultLightCacheFolder());
   // Input is handled from here on: events that arrive while the scene is voxelised (polled by
   // the progress callbacks) already move the camera of the first frame.
   Viewer viewer(a, session, window.handle, chain, base, mover.get());

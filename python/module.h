@@ -10,7 +10,6 @@
 #include <string>
 #include <vector>
 
-#include "core/contract/march_types.h"
 #include "core/scene/messages.h"  // formatNumber, for messages
 #include "core/session/session.h"
 #include "optics/uniaxial.h"

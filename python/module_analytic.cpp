@@ -11,16 +11,15 @@
 #include <cmath>
 #include <optional>
 
-#include "core/reference/reference_marcher.h"
 #include "core/scene/limits.h"
+#include "core/session/analytic_trace.h"
 #include "python/module.h"
 
 namespace eikon::python {
 namespace {
 // An analytic field for the CPU reference: a named closed-form profile or a Python callable.
 struct AnalyticSpec {
-  std::shared_ptr<AnalyticField> field;
-  Environment env;
+  std::shared_ptr<AnalyticTrace> field;
 };
 
 struct Box {
@@ -66,9 +65,9 @@ void checkCorners(const Box& b, const std::string& what, F&& index) {
   }
 }
 
-std::shared_ptr<AnalyticSpec> makeSpec(AnalyticField::IndexFn fn, const Box& b) {
+std::shared_ptr<AnalyticSpec> makeSpec(AnalyticTrace::IndexFn fn, const Box& b) {
   auto s = std::make_shared<AnalyticSpec>();
-  s->field = std::make_shared<AnalyticField>(std::move(fn), b.lo, b.hi, b.cell);
+  s->field = std::make_shared<AnalyticTrace>(std::move(fn), b.lo, b.hi, b.cell);
   return s;
 }
 
@@ -152,7 +151,6 @@ std::shared_ptr<AnalyticSpec> makeFromFunction(py::function f, const py::handle&
 
 py::dict traceAnalytic(const AnalyticSpec& a, const py::handle& origin, const py::handle& direction,
                        std::optional<MarchSettings> march, double wavelength_nm) {
-  ReferenceMarcher r(*a.field, a.env);
   const TraceRequest q{toVec3(origin), toVec3(direction), wavelength_nm};
   const MarchSettings ms = march.value_or(MarchSettings{});
   checkSetting([&] {  // as Renderer.trace's
@@ -162,7 +160,7 @@ py::dict traceAnalytic(const AnalyticSpec& a, const py::handle& origin, const py
   TraceOutcome t;
   {
     py::gil_scoped_release release;
-    t = r.trace(q, ms);
+    t = a.field->trace(q, ms);
   }
   return outcomeDict(t, "o");
 }

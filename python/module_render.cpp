@@ -9,11 +9,8 @@
 #include <mutex>
 #include <optional>
 
-#include "core/contract/polarised_render.h"
 #include "core/io/exr.h"
-#include "core/light/light_cache.h"
-#include "core/render/render_defaults.h"
-#include "core/vk/context.h"
+#include "core/session/front_end.h"
 #include "python/module.h"
 #include "python/progress.h"
 
@@ -86,7 +83,7 @@ std::shared_ptr<Prepared> cachedPrepared(const std::shared_ptr<Scene>& s) {
 std::string lightCacheDir(const py::object& light_cache) {
   if (light_cache.is_none()) return {};
   if (py::isinstance<py::bool_>(light_cache))
-    return light_cache.cast<bool>() ? defaultLightCacheDir().string() : std::string();
+    return light_cache.cast<bool>() ? defaultLightCacheFolder().string() : std::string();
   const py::object os = py::module_::import("os");
   if (!py::isinstance<py::str>(light_cache) && !py::isinstance(light_cache, os.attr("PathLike")))
     throw py::type_error(
@@ -216,7 +213,7 @@ py::object render(Prepared& p, int width, int height, std::optional<int> spp,
     return withProgress(s, printer, [&] {
       s.setThreads(threads);
       const bool gpu =
-          !renderTwin(device, *p.scene, settings, [&] { return s.context().deviceTypeName(); }).cpu;
+          !renderTwin(device, *p.scene, settings, [&] { return deviceInfo(s.context()).type; }).cpu;
       if (light && !p.scene->lights.empty() && !s.prepare(gpu).lit()) {
         LightRequest l;
         l.threads = threads;

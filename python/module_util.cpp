@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "core/scene/limits.h"
-#include "core/vk/context.h"
+#include "core/session/front_end.h"
 #include "python/module.h"
 
 namespace eikon::python {
@@ -174,8 +174,7 @@ std::shared_ptr<vk::Context> g_ctx;
 std::shared_ptr<vk::Context> context() {
   std::lock_guard<std::mutex> lock(g_ctx_mutex);
   if (!g_ctx) {
-    vk::ContextOptions opt;  // validation follows EIKON_VALIDATION=1
-    g_ctx = std::shared_ptr<vk::Context>(vk::Context::create(opt).release());
+    g_ctx = newContext();  // validation follows EIKON_VALIDATION=1
   }
   return g_ctx;
 }
@@ -295,18 +294,18 @@ void bindVulkan(py::module_& m) {
       "validation_messages",
       []() {
         std::lock_guard<std::mutex> lock(g_ctx_mutex);
-        return g_ctx ? g_ctx->validationMessages() : std::vector<std::string>{};
+        return g_ctx ? validationMessages(*g_ctx) : std::vector<std::string>{};
       },
       "messages of the Khronos validation layer so far (EIKON_VALIDATION=1); [] without a context");
   m.def(
       "device_info",
       []() {
-        auto c = context();
+        const DeviceInfo c = deviceInfo(*context());
         py::dict d;
-        d["name"] = c->deviceName();
-        d["type"] = c->deviceTypeName();
-        d["api_version"] = c->apiVersionString();
-        d["validation"] = c->validationEnabled();
+        d["name"] = c.name;
+        d["type"] = c.type;
+        d["api_version"] = c.api_version;
+        d["validation"] = c.validation;
         return d;
       },
       "create the Vulkan context if needed and describe its device");
