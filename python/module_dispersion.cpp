@@ -154,6 +154,12 @@ void bindMaterials(py::module_& m) {
       .def_readonly("name", &Material::name)
       .def_readonly("source", &Material::source)
       .def_readonly("uniaxial", &Material::uniaxial)
+      .def_readonly("biaxial", &Material::biaxial, "n_alpha/n_beta/n_gamma (listed, not rendered)")
+      .def_readonly("n_alpha", &Material::n_alpha)
+      .def_readonly("n_beta", &Material::n_beta)
+      .def_readonly("n_gamma", &Material::n_gamma)
+      .def_property_readonly("alpha_axis", [](const Material& x) { return fromVec3(x.alpha_axis); })
+      .def_property_readonly("gamma_axis", [](const Material& x) { return fromVec3(x.gamma_axis); })
       .def_property_readonly(
           "n", [](const Material& x) { return x.n_o; }, "index (isotropic) = n_o")
       .def_readonly("n_o", &Material::n_o)
@@ -175,7 +181,10 @@ void bindMaterials(py::module_& m) {
           },
           py::arg("lambda_nm"), py::arg("axis") = py::none(), "the crystal at one wavelength")
       .def("__repr__", [](const Material& x) {
-        return "<eikon.Material " + x.name + (x.uniaxial ? " (uniaxial)>" : ">");
+        return "<eikon.Material " + x.name +
+               (x.uniaxial  ? " (uniaxial)>"
+                : x.biaxial ? " (biaxial)>"
+                            : ">");
       });
 
   m.def(

@@ -1,6 +1,7 @@
 #include "core/scene/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -81,6 +82,9 @@ class Node {
     if (!j_.is_object()) fail("expected an object");
   }
   void allowKeys(std::initializer_list<const char*> keys) const {
+    allowKeys(std::vector<std::string>(keys.begin(), keys.end()));
+  }
+  void allowKeys(const std::vector<std::string>& keys) const {
     requireObject();
     std::set<std::string> allowed(keys.begin(), keys.end());
     for (auto it = j_.begin(); it != j_.end(); ++it)
@@ -321,7 +325,10 @@ Dispersion parseDispersion(const Node& n, GrinProfile* grin) {
   return d;
 }
 
-Attenuation parseAttenuation(const Node& n) {
+/// An attenuation: a number, [r, g, b] band values or a spectrum {"wavelength_nm", "per_mm"}.
+/// `visible`: a spectrum must cover 380–780 nm (material files and biaxial keys: the renderer
+/// samples the whole visible range, and a constant continuation beyond the data is a guess).
+Attenuation parseAttenuation(const Node& n, bool visible = false) {
   Attenuation a;
   if (n.isObject()) {
     n.allowKeys({"wavelength_nm", "per_mm"});
@@ -341,29 +348,99 @@ Attenuation parseAttenuation(const Node& n) {
       if (i && !(a.wavelengths_nm[i] > a.wavelengths_nm[i - 1]))
         n.fail("wavelength_nm must be strictly increasing");
     }
+    if (visible && (a.wavelengths_nm.front() > 380.0 || a.wavelengths_nm.back() < 780.0))
+      n.at("wavelength_nm")
+          .fail("a spectrum must cover 380-780 nm, got " + fmt(a.wavelengths_nm.front()) + "-" +
+                fmt(a.wavelengths_nm.back()) + " nm");
     return a;
   }
   a.rgb = n.color();
   return a;
 }
 
+constexpr std::array<const char*, 8> kBiaxialKeys = {"n_alpha",
+                                                     "n_beta",
+                                                     "n_gamma",
+                                                     "alpha_axis",
+                                                     "gamma_axis",
+                                                     "attenuation_alpha_per_mm",
+                                                     "attenuation_beta_per_mm",
+                                                     "attenuation_gamma_per_mm"};
+
+/// A biaxial material: n_alpha ≤ n_beta ≤ n_gamma at 380, 587.6 and 780 nm, alpha_axis and
+/// gamma_axis (normalised, then orthogonal within 1e-6), attenuation per principal axis. The
+/// isotropic and uniaxial keys are refused: one material is one kind of medium.
+void parseBiaxial(const Node& m, Material& mat) {
+  for (const char* k : {"n", "n_o", "n_e", "optic_axis", "attenuation_per_mm",
+                        "attenuation_o_per_mm", "attenuation_e_per_mm"})
+    if (m.has(k))
+      m.at(k).fail(
+          std::string("is an isotropic/uniaxial key; a biaxial material (n_alpha, "
+                      "n_beta, n_gamma) takes alpha_axis, gamma_axis and "
+                      "attenuation_alpha/beta/gamma_per_mm instead"));
+  for (const char* k : {"n_alpha", "n_beta", "n_gamma", "alpha_axis", "gamma_axis"})
+    if (!m.has(k)) m.fail(std::string("biaxial material is missing \"") + k + "\"");
+  mat.biaxial = true;
+  mat.n_alpha = parseDispersion(m.at("n_alpha"), nullptr);
+  mat.n_beta = parseDispersion(m.at("n_beta"), nullptr);
+  mat.n_gamma = parseDispersion(m.at("n_gamma"), nullptr);
+  for (double l : {380.0, 587.6, 780.0}) {
+    const double a = mat.n_alpha.index(l), b = mat.n_beta.index(l), g = mat.n_gamma.index(l);
+    if (!(a <= b))
+      m.at("n_beta").fail("must be >= n_alpha (n_alpha <= n_beta <= n_gamma): at " + fmt(l) +
+                          " nm n_alpha = " + fmt(a) + ", n_beta = " + fmt(b));
+    if (!(b <= g))
+      m.at("n_gamma").fail("must be >= n_beta (n_alpha <= n_beta <= n_gamma): at " + fmt(l) +
+                           " nm n_beta = " + fmt(b) + ", n_gamma = " + fmt(g));
+  }
+  mat.alpha_axis = m.at("alpha_axis").unitVector();
+  mat.gamma_axis = m.at("gamma_axis").unitVector();
+  const double c = glm::dot(mat.alpha_axis, mat.gamma_axis);
+  if (std::abs(c) > 1e-6)
+    m.at("gamma_axis")
+        .fail(
+            "must be orthogonal to alpha_axis (|cos| <= 1e-6 after normalising both), got cos "
+            "= " +
+            fmt(c));
+  if (auto a = m.get("attenuation_alpha_per_mm"))
+    mat.attenuation_alpha = parseAttenuation(*a, true);
+  if (auto a = m.get("attenuation_beta_per_mm")) mat.attenuation_beta = parseAttenuation(*a, true);
+  if (auto a = m.get("attenuation_gamma_per_mm"))
+    mat.attenuation_gamma = parseAttenuation(*a, true);
+}
+
 Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
-  if (is_file)
-    m.allowKeys({"name", "source", "notes", "fit", "n", "n_o", "n_e", "optic_axis",
-                 "attenuation_per_mm", "attenuation_o_per_mm", "attenuation_e_per_mm", "emission",
-                 "opacity", "albedo", "phase_g"});
-  else
-    m.allowKeys({"n", "n_o", "n_e", "optic_axis", "attenuation_per_mm", "attenuation_o_per_mm",
-                 "attenuation_e_per_mm", "emission", "opacity", "albedo", "phase_g", "source",
-                 "notes"});
+  std::vector<std::string> keys = {"n",
+                                   "n_o",
+                                   "n_e",
+                                   "optic_axis",
+                                   "attenuation_per_mm",
+                                   "attenuation_o_per_mm",
+                                   "attenuation_e_per_mm",
+                                   "emission",
+                                   "opacity",
+                                   "albedo",
+                                   "phase_g",
+                                   "source",
+                                   "notes"};
+  keys.insert(keys.end(), kBiaxialKeys.begin(), kBiaxialKeys.end());
+  if (is_file) keys.insert(keys.end(), {"name", "fit", "published_2v"});
+  m.allowKeys(keys);
   Material mat;
   mat.name = name;
   if (auto s = m.get("source")) mat.source = s->string();
   bool iso = m.has("n"), crystal = m.has("n_o") || m.has("n_e");
+  const bool biaxial = std::any_of(kBiaxialKeys.begin(), kBiaxialKeys.end(),
+                                   [&](const char* k) { return m.has(k); });
   if (iso && crystal)
     m.fail("give either \"n\" (isotropic) or \"n_o\" and \"n_e\" (uniaxial), not both");
-  if (!iso && !crystal) m.fail("missing \"n\" (isotropic) or \"n_o\"/\"n_e\" (uniaxial)");
-  if (iso) {
+  if (!iso && !crystal && !biaxial)
+    m.fail(
+        "missing \"n\" (isotropic), \"n_o\"/\"n_e\" (uniaxial) or \"n_alpha\"/\"n_beta\"/"
+        "\"n_gamma\" (biaxial)");
+  if (biaxial) {
+    parseBiaxial(m, mat);
+  } else if (iso) {
     mat.n_o = parseDispersion(m.at("n"), &mat.grin);
     mat.n_e = mat.n_o;
     if (m.has("optic_axis")) m.fail("optic_axis given for an isotropic material (use n_o and n_e)");
@@ -372,7 +449,7 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
           "attenuation_o_per_mm/attenuation_e_per_mm are for uniaxial materials; use "
           "attenuation_per_mm");
     if (auto a = m.get("attenuation_per_mm"))
-      mat.attenuation_o = mat.attenuation_e = parseAttenuation(*a);
+      mat.attenuation_o = mat.attenuation_e = parseAttenuation(*a, is_file);
   } else {
     if (!m.has("n_o")) m.fail("uniaxial material is missing n_o");
     if (!m.has("n_e")) m.fail("uniaxial material is missing n_e (extraordinary index)");
@@ -382,8 +459,8 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
     if (auto a = m.get("optic_axis")) mat.optic_axis = a->unitVector();
     if (m.has("attenuation_per_mm"))
       m.fail("uniaxial materials take attenuation_o_per_mm and attenuation_e_per_mm");
-    if (auto a = m.get("attenuation_o_per_mm")) mat.attenuation_o = parseAttenuation(*a);
-    if (auto a = m.get("attenuation_e_per_mm")) mat.attenuation_e = parseAttenuation(*a);
+    if (auto a = m.get("attenuation_o_per_mm")) mat.attenuation_o = parseAttenuation(*a, is_file);
+    if (auto a = m.get("attenuation_e_per_mm")) mat.attenuation_e = parseAttenuation(*a, is_file);
   }
   if (auto e = m.get("emission")) mat.emission = e->color();
   if (auto o = m.get("opacity")) mat.opacity = o->number(0.0, 1.0);
@@ -393,7 +470,8 @@ Material parseMaterial(const Node& m, const std::string& name, bool is_file) {
       a->fail("albedo must be in [0, 1] per band");
     // Translucent scattering is albedo·σ_t: without attenuation there is nothing to scatter.
     if (mat.opacity < 0.5 && glm::length(mat.albedo) > 0 && mat.attenuation_o.isZero() &&
-        mat.attenuation_e.isZero())
+        mat.attenuation_e.isZero() && mat.attenuation_alpha.isZero() &&
+        mat.attenuation_beta.isZero() && mat.attenuation_gamma.isZero())
       a->fail(
           "a translucent material scatters albedo x attenuation; give attenuation_per_mm > 0 (or "
           "opacity 1 for a "
@@ -1349,6 +1427,11 @@ static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::
     SceneObject obj = parseObject(o);
     if (!scene.materials.count(obj.material)) loadLibraryMaterial(o, obj, scene);
     const Material& mat = scene.materials[obj.material];
+    if (mat.biaxial)
+      o.at("material")
+          .fail("'" + excerpt(obj.material) +
+                "' is a biaxial material: biaxial materials are not rendered yet (the "
+                "library and `eikon info` list them)");
     if (obj.radial_axis && !mat.uniaxial)
       o.at("optic_axis_field").fail("optic_axis_field given for an isotropic material");
     if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis && !obj.radial_axis)

@@ -46,6 +46,9 @@ struct Attenuation {
   glm::dvec3 rgb{0.0};
   std::vector<double> wavelengths_nm, values;  ///< spectral form (sorted), overrides rgb if set
   double at(double lambda_nm) const;
+  /// The band values the renderer stores, σ at 612, 549 and 465 nm (r, g, b): the RGB triple
+  /// itself, or the spectrum interpolated linearly at those wavelengths (core/volume/media.cpp).
+  glm::dvec3 bands() const { return {at(612.0), at(549.0), at(465.0)}; }
   bool isZero() const;
 };
 
@@ -58,6 +61,16 @@ struct Material {
   GrinProfile grin;  ///< isotropic gradient-index profile (replaces n_o if set)
   std::optional<glm::dvec3> optic_axis;  ///< unit vector, world space
   Attenuation attenuation_o, attenuation_e;
+  /// A biaxial crystal (docs/scene-format.md "Biaxial materials"): the principal indices
+  /// n_α ≤ n_β ≤ n_γ of light polarised along alpha_axis, betaAxis() and gamma_axis (unit,
+  /// orthogonal, world space) and the attenuation of each. The library and listings carry it;
+  /// loadScene refuses an object made of one (the renderer does not march biaxial media), and
+  /// n_o, n_e and the o/e attenuation keep their defaults.
+  bool biaxial = false;
+  Dispersion n_alpha, n_beta, n_gamma;
+  glm::dvec3 alpha_axis{1, 0, 0}, gamma_axis{0, 0, 1};
+  Attenuation attenuation_alpha, attenuation_beta, attenuation_gamma;
+  glm::dvec3 betaAxis() const { return glm::cross(gamma_axis, alpha_axis); }  ///< γ × α
   glm::dvec3 emission{0.0};  ///< radiance per mm (translucent) or surface radiance (opaque)
   double opacity = 0.0;      ///< 1 = opaque: rays stop at the surface
   /// Translucent: single-scattering albedo σ_s/σ_t per RGB band (σ_t = the attenuation), so the

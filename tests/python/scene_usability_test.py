@@ -1,5 +1,6 @@
-"""A scene's "render" is the default of Python's render as of `eikon render`, and the material
-library forgives case, spaces and underscores and answers a misspelt name with the closest ones.
+"""A scene's "render" is the default of Python's render as of `eikon render`, the material
+library forgives case, spaces and underscores and answers a misspelt name with the closest ones,
+and its biaxial materials load but cannot make an object.
 
 Run by CTest (python.scene_usability) with EIKON_BINARY (the CLI) and EIKON_PYTHON_DIR (the
 built module). The CLI and Python run the same GPU march, so their images agree to float rounding
@@ -79,6 +80,24 @@ class SceneUsability(unittest.TestCase):
         message = str(caught.exception)
         self.assertIn("did you mean 'N-BK7'?", message)
         self.assertIn("ruby", message)
+
+    def test_biaxial_materials_load_but_no_object_is_made_of_one(self):
+        # docs/scene-format.md "Biaxial materials": listed with their principal indices and axes;
+        # the renderer does not march them yet, so a scene placing one in an object is refused.
+        topaz = eikon.load_material("topaz")
+        self.assertTrue(topaz.biaxial)
+        self.assertFalse(topaz.uniaxial)
+        self.assertIn("(biaxial)", repr(topaz))
+        a, b, g = (topaz.n_alpha.index(587.6), topaz.n_beta.index(587.6),
+                   topaz.n_gamma.index(587.6))
+        self.assertLess(a, b)
+        self.assertLess(b, g)
+        self.assertAlmostEqual(float(np.dot(topaz.alpha_axis, topaz.gamma_axis)), 0.0, delta=1e-12)
+        bad = copy.deepcopy(SCENE)
+        bad["objects"][0]["material"] = "topaz"
+        with self.assertRaisesRegex(Exception, r"/objects/0/material: 'topaz' is a biaxial "
+                                               r"material: biaxial materials are not rendered yet"):
+            eikon.Scene.parse(bad, "bad.json")
 
 
 if __name__ == "__main__":
