@@ -64,4 +64,35 @@ std::vector<double> parseNumberList(const std::string& value, const std::string&
   return out;
 }
 
+void addSettingOptions(CLI::App* sub, unsigned front, SettingValues& values) {
+  for (const Setting& s : settings()) {
+    if (!(s.fronts & front)) continue;
+    SettingValue& v = values[s.name];
+    const std::string option = std::string("--") + s.name, help = settingHelp(s, front);
+    const std::string value = settingDefault(s, front).value;
+    switch (s.kind) {
+      case SettingKind::Integer:
+        v.integer = value.empty() ? 0 : std::stoi(value);
+        sub->add_option(option, v.integer, help);
+        break;
+      case SettingKind::Number:
+        v.number = value.empty() ? 0.0 : std::stod(value);
+        sub->add_option(option, v.number, help);
+        break;
+      case SettingKind::Choice:
+      case SettingKind::Text:
+        v.text = value;
+        sub->add_option(option, v.text, help);
+        break;
+      case SettingKind::Flag:
+        sub->add_flag(option, v.flag, help);
+        break;
+    }
+  }
+}
+
+void markGivenSettings(const CLI::App& sub, SettingValues& values) {
+  for (auto& [name, v] : values) v.given = sub.count("--" + name) > 0;
+}
+
 }  // namespace eikon::cli

@@ -5,11 +5,15 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <functional>
+#include <map>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "core/scene/messages.h"
+#include "core/session/settings.h"
 
 namespace eikon::cli {
 
@@ -40,6 +44,30 @@ inline void checkExposure(double stops) {
 /// CliError "OPTION must be COUNT finite numbers NAMES, got 'VALUE'".
 std::vector<double> parseNumberList(const std::string& value, const std::string& option,
                                     size_t count, const std::string& names);
+
+/// A command's settings by name (core/session/settings.h), as addSettingOptions reads them.
+using SettingValues = std::map<std::string, SettingValue, std::less<>>;
+/// One option --NAME per setting of `front` (a SettingFront bit), made from the settings table:
+/// its kind, help and default; it reads into values[NAME]. The callback calls markGivenSettings.
+void addSettingOptions(CLI::App* sub, unsigned front, SettingValues& values);
+/// values[NAME].given for each setting option the user gave.
+void markGivenSettings(const CLI::App& sub, SettingValues& values);
+/// The option --NAME of the setting `name` read into the command's own `variable` (an int, a
+/// double or a std::string), with the table's help and default for `front` (an unset default
+/// leaves the variable as it is).
+template <class T>
+CLI::Option* addSettingOption(CLI::App* sub, const char* name, unsigned front, T& variable) {
+  const Setting& s = setting(name);
+  if (const std::string value = settingDefault(s, front).value; !value.empty()) {
+    if constexpr (std::is_same_v<T, int>)
+      variable = std::stoi(value);
+    else if constexpr (std::is_same_v<T, double>)
+      variable = std::stod(value);
+    else
+      variable = value;
+  }
+  return sub->add_option(std::string("--") + name, variable, settingHelp(s, front));
+}
 
 void addRenderCommand(CLI::App& app);
 void addTraceCommand(CLI::App& app);

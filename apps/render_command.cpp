@@ -25,18 +25,14 @@ namespace eikon::cli {
 namespace {
 struct RenderArgs {
   std::string scene, output;
-  int width = 0, height = 0, spp = 1, wavelengths = -1, threads = 0;
-  double step = kDefaultRenderStepVoxels, exposure = 0.0;
-  std::string integrator = "rk4", progress = "auto", spectral_sampling = "auto", layers,
-              modes = "both", device = "auto";
-  bool reference = false, no_skip = false, no_fresnel = false, quiet = false, strict = false;
-  bool polarised = false;
-  // Light simulator (scenes with "lights").
-  int light_bands = 0, max_patches = 1 << 20;
-  double light_step = 0.0, light_split = 1.0;
-  std::string light_splat = "accumulate", light_cache, caustics = "pass", light_device = "auto";
+  double exposure = 0.0;
+  std::string progress = "auto", light_cache;
+  bool reference = false, quiet = false, strict = false;
   bool no_light = false, no_light_cache = false, no_volume_cache = false;
   bool timings = false;
+  /// The render, march, light and twin settings: options made from the settings table
+  /// (core/session/settings.h), as Python's keywords are.
+  SettingValues settings;
 };
 
 /// The progressive preview's file for the output `out` (x.exr → x.partial.png): see Preview.
@@ -67,71 +63,17 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
   sub->add_option("scene", a.scene, "Scene JSON file")->required();
   sub->add_option("-o,--output", a.output, "Output EXR path (the PNG preview is written beside it)")
       ->required();
-  sub->add_option("--width", a.width, "Image width in [1, 16384] (default: the scene camera's)");
-  sub->add_option("--height", a.height, "Image height in [1, 16384] (default: the scene camera's)");
-  sub->add_option(
-      "--spp", a.spp,
-      "Jittered samples per pixel in [1, 4096] (default: the scene's \"render\" spp, else 1)");
-  sub->add_option("--wavelengths", a.wavelengths,
-                  "Spectral samples per pixel sample in [1, 256], or 0 for RGB mode (default: the "
-                  "scene's \"render\" wavelengths, else 16 for dispersive scenes, else 0)");
-  sub->add_option("--spectral-sampling", a.spectral_sampling,
-                  "Spectral renders: hero (one march per pixel sample, the other wavelengths "
-                  "share its path until it disperses), stratified (one march per wavelength) or "
-                  "auto (hero unless the scene attenuates, emits or has opaque objects; default)");
-  sub->add_option("--layers", a.layers,
-                  "Extra EXR layers, comma-separated: spectral (one S0.<nm> channel per "
-                  "wavelength bin; needs --wavelengths > 0), modes (o.R..B, e.R..B: the o- and "
-                  "e-mode radiance), aov (Z, Px Py Pz, Nx Ny Nz, objectId: the first interface "
-                  "of each pixel's first ray; steps: march steps per pixel) and stokes (S0.R..S3.B "
-                  "of a polarised render; implies --polarised); R, G, B are always written");
-  sub->add_flag("--polarised", a.polarised,
-                "Polarised render (Stokes transport, docs/polarisation.md) even without polariser "
-                "sheets or a camera analyzer, which make a render polarised by themselves");
-  sub->add_option("--modes", a.modes,
-                  "Crystal scenes: both (unpolarised light, each mode carrying half; default), o "
-                  "or e (that mode alone, at the whole of the light: o + e = 2 x both)");
-  sub->add_option("--step", a.step,
-                  "Integration step in voxels (default 0.5; see docs/view-renderer.md)");
-  sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4)");
+  addSettingOptions(sub, SettingFront::RenderCli, a.settings);
   sub->add_option(
       "--exposure", a.exposure,
       "PNG preview exposure in stops (default: the scene's \"render\" exposure, else 0)");
-  sub->add_option("--threads", a.threads,
-                  "CPU threads for --reference, voxelising and the CPU light simulator, [1, 1024] "
-                  "(default, or 0: all; the simulator at most 8)");
-  sub->add_option("--device", a.device,
-                  "auto (default: the faster twin; the GPU on a GPU, on a CPU Vulkan device such "
-                  "as lavapipe the CPU reference for mesh scenes of at least 131072 rays at 1 spp; "
-                  "docs/view-renderer.md), gpu or cpu (the double-precision CPU reference)");
   sub->add_flag("--reference", a.reference, "Same as --device cpu");
-  sub->add_flag("--no-skip", a.no_skip, "Do not cross homogeneous regions in one step");
-  sub->add_flag("--no-fresnel", a.no_fresnel, "Disable Fresnel reflection and transmission losses");
   sub->add_flag("--strict", a.strict,
                 "Treat warnings (e.g. wavelengths outside a material's range) as errors");
   sub->add_flag("-q,--quiet", a.quiet, "No progress lines (same as --progress never)");
   sub->add_option(
       "--progress", a.progress,
       "auto (default: progress with ETA on stderr when it is a terminal), always or never");
-  sub->add_option(
-      "--light-bands", a.light_bands,
-      "Light simulator wavelength bands, [1, 64] (default, or 0: 12 dispersive, 3 attenuating, "
-      "else 1)");
-  sub->add_option(
-      "--light-splat", a.light_splat,
-      "accumulate (fluence rate, default) or highest (the highest patch irradiance per voxel)");
-  sub->add_option("--light-device", a.light_device,
-                  "auto (default: the CPU reference when the Vulkan device is a CPU, e.g. "
-                  "lavapipe, where the two are about even: the CPU faster for one run, the GPU "
-                  "for a 12-band dispersive scene; else the GPU), gpu or cpu");
-  sub->add_option("--caustics", a.caustics,
-                  "pass (light continues through a focus, default) or kill (Tevs: patches end at a "
-                  "fold caustic)");
-  sub->add_option("--light-step", a.light_step,
-                  "Light simulator time step in voxels, (0, 2] (default, or 0: 0.5)");
-  sub->add_option("--light-split", a.light_split,
-                  "Split wavefront patches longer than this many voxels (default 1)");
-  sub->add_option("--max-patches", a.max_patches, "Most live wavefront patches (default 1048576)");
   sub->add_option("--light-cache", a.light_cache,
                   "Directory of cached light volumes (default $EIKON_CACHE_DIR, "
                   "$XDG_CACHE_HOME/eikon or ~/.cache/eikon)");
@@ -149,37 +91,14 @@ void addRenderOptions(CLI::App* sub, RenderArgs& a) {
                 "start-up stage (also EIKON_TIMINGS=1)");
 }
 
-/// The view settings as given: an option not given keeps the session's default (the scene
-/// camera's size, its default wavelength count), so only given ones are range-checked.
-ViewRequest viewRequest(const RenderArgs& a, const CLI::App& sub) {
-  ViewRequest v;
-  if (sub.count("--width")) v.width = a.width;
-  if (sub.count("--height")) v.height = a.height;
-  if (sub.count("--spp")) v.spp = a.spp;
-  if (sub.count("--wavelengths")) v.wavelengths = a.wavelengths;
-  MarchSettings ms;  // the integrator is parsed after the range checks, as before
-  ms.step_voxels = a.step;
-  ms.skip_empty = !a.no_skip;
-  ms.fresnel = !a.no_fresnel;
-  v.march = ms;
-  v.sampling = parseSpectralSampling(a.spectral_sampling);
-  parseLayers(a.layers, v);
-  v.polarised = a.polarised;
-  v.modes = parseModes(a.modes);
-  return v;
-}
-
-LightRequest lightRequest(const RenderArgs& a) {
-  LightRequest l;
-  l.bands = a.light_bands;
-  l.splat = a.light_splat;
-  l.step_voxels = a.light_step;
-  l.split_voxels = a.light_split;
-  l.max_patches = a.max_patches;
-  l.caustics = a.caustics;
-  l.device = a.light_device;
-  l.threads = a.threads;
-  return l;
+/// The settings as given: an option not given keeps the session's default (the scene camera's
+/// size, its default wavelength count), so only given ones and those with a default are checked,
+/// by the table's ranges (core/session/settings.h) as Python's.
+SettingRequests settingRequests(const RenderArgs& a) {
+  SettingRequests r;
+  fillSettings(a.settings, SettingFront::RenderCli, r);
+  r.view.march = r.march;  // the CLI always gives the march (the table's defaults)
+  return r;
 }
 
 std::filesystem::path lightCacheDir(const RenderArgs& a) {
@@ -267,15 +186,15 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   (void)progressMode(a.progress, a.quiet);  // a bad --progress fails before any work
   checkExposure(a.exposure);
   // The range checks are the session's, as Python's (core/session/session.h).
-  ViewRequest view = viewRequest(a, sub);
+  const SettingRequests requests = settingRequests(a);
+  const ViewRequest& view = requests.view;
   checkViewRequest(view);
-  const LightRequest light_request = lightRequest(a);
+  const LightRequest& light_request = requests.light;
   checkLightRequest(light_request);
-  checkRenderDevice(a.device);
-  if (a.reference && a.device != "cpu" && sub.count("--device"))
-    throw CliError("--reference is --device cpu; it does not go with --device " + a.device);
-  const std::string device = a.reference ? "cpu" : a.device;
-  view.march->integrator = parseIntegrator(a.integrator);
+  checkRenderDevice(requests.device);
+  if (a.reference && requests.device != "cpu" && sub.count("--device"))
+    throw CliError("--reference is --device cpu; it does not go with --device " + requests.device);
+  const std::string device = a.reference ? "cpu" : requests.device;
   auto scene = std::make_shared<Scene>(loadScene(a.scene));
   for (const std::string& w : scene->warnings) warn(w, a.strict);
   refuseOverwritingInputs(
@@ -297,7 +216,7 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
   RenderCost cost = renderWork(*scene, rs);
   if (cost.host_bytes >= kLongRenderBytes) progress.note("cost: " + describeRenderCost(cost), true);
   Session session(scene);
-  session.setThreads(a.threads);
+  session.setThreads(requests.threads);
   const RenderTwin twin =
       renderTwin(device, *scene, rs, [&] { return deviceInfo(session.context()).type; });
   const bool cpu = twin.cpu;
@@ -383,7 +302,10 @@ void addRenderCommand(CLI::App& app) {
   auto* sub =
       app.add_subcommand("render", "Render a scene to an EXR (linear sRGB) and a PNG preview");
   addRenderOptions(sub, *args);
-  sub->callback([args, sub] { runRender(*args, *sub); });
+  sub->callback([args, sub] {
+    markGivenSettings(*sub, args->settings);
+    runRender(*args, *sub);
+  });
 }
 
 }  // namespace eikon::cli

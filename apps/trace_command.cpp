@@ -46,7 +46,7 @@ Stokes parseStokes(const std::string& s) {
 struct TraceArgs {
   std::string scene, origin, dir, stokes;
   bool stokes_given = false;  ///< --stokes was given, with any value (an empty one is refused)
-  double wavelength = 587.5618, step = 0.25;
+  double wavelength = 0, step = 0;  ///< the settings table's defaults (addSettingOption)
   bool json = false, reference = false, quiet = false, strict = false;
   std::string integrator = "rk4", progress = "auto";
 };
@@ -155,8 +155,8 @@ void addTraceCommand(CLI::App& app) {
   sub->add_option("scene", a->scene, "Scene JSON file")->required();
   sub->add_option("--origin", a->origin, "Ray origin x,y,z (mm)")->required();
   sub->add_option("--dir", a->dir, "Ray direction x,y,z (any non-zero length)")->required();
-  sub->add_option("--wavelength", a->wavelength, "Wavelength in nm (default 587.5618, the d line)");
-  sub->add_option("--step", a->step, "Integration step in voxels (default 0.25)");
+  addSettingOption(sub, "wavelength", SettingFront::TraceCli, a->wavelength);  // the table's
+  addSettingOption(sub, "step", SettingFront::TraceCli, a->step);
   CLI::Option* stokes = sub->add_option(
       "--stokes", a->stokes,
       "Input Stokes vector S0,S1,S2,S3 of the polarised trace, in Mitsuba 3's "

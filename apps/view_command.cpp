@@ -45,31 +45,26 @@ using Clock = std::chrono::steady_clock;
 
 struct ViewArgs {
   std::string scene, screenshot, save_dir;
-  int width = 0, height = 0, spp = 16, wavelengths = -1, coarse = 4, exit_after_frames = 0;
+  int width = 0, height = 0, spp = 0, wavelengths = -1, coarse = 4, exit_after_frames = 0;
   bool wait_for_input = false;
   double exposure = 0.0;
-  std::string integrator = "rk4", modes = "both";
+  std::string integrator, modes;  ///< spp, integrator, modes: the table's defaults
   bool no_light = false, no_prefetch = false;
 };
 
 void addViewOptions(CLI::App* sub, ViewArgs& a) {
   sub->add_option("scene", a.scene, "Scene JSON file")->required();
-  sub->add_option("--width", a.width, "Window width in [1, 16384] (default: the scene camera's)");
-  sub->add_option("--height", a.height,
-                  "Window height in [1, 16384] (default: the scene camera's)");
-  sub->add_option("--spp", a.spp,
-                  "Samples per pixel the view is refined to while nothing changes, in [1, 4096] "
-                  "(default 16)");
-  sub->add_option("--wavelengths", a.wavelengths,
-                  "Spectral samples of the refined view in [1, 256], or 0 for RGB (default: 16 "
-                  "for dispersive scenes, else 0; the R key toggles)");
+  // The settings of the table (core/session/settings.h), with its help and defaults.
+  for (auto [name, variable] : {std::pair{"width", &a.width},
+                                {"height", &a.height},
+                                {"spp", &a.spp},
+                                {"wavelengths", &a.wavelengths}})
+    addSettingOption(sub, name, SettingFront::ViewCli, *variable);
   sub->add_option("--coarse", a.coarse,
                   "The first frame after a change has 1/N of the resolution per side, N in [1, "
                   "16] (default 4); N doubles while a coarse frame takes over 0.1 s");
-  sub->add_option("--integrator", a.integrator, "euler, midpoint or rk4 (default rk4; I cycles)");
-  sub->add_option("--modes", a.modes,
-                  "Crystal scenes: both (default), o or e: that mode alone, as eikon render "
-                  "--modes (M cycles)");
+  addSettingOption(sub, "integrator", SettingFront::ViewCli, a.integrator);
+  addSettingOption(sub, "modes", SettingFront::ViewCli, a.modes);
   sub->add_flag("--no-prefetch", a.no_prefetch,
                 "Do not compile the pipelines of the R and I keys ahead in the background (a key "
                 "then shows 'compiling' while its pipeline compiles)");

@@ -39,19 +39,21 @@ py::array_t<double> fromVector(const std::vector<double>& v);
 Mode parseMode(const std::string& s);
 std::string integratorName(Integrator i);
 /// A SettingError of the session (core/session/session.h) as Python's ValueError, the setting
-/// named by its keyword here ("light-splat" → "splat"); the complaint is the CLI's, word for word.
-[[noreturn]] void rethrowSetting(const SettingError& e);
+/// named by its keyword here ("light-splat" → "splat", the settings table's); the complaint is the
+/// CLI's, word for word. Within `scope` ("march": MarchSettings itself) its prefix is dropped
+/// ("march.integrator" → "integrator").
+[[noreturn]] void rethrowSetting(const SettingError& e, std::string_view scope = {});
 /// Makes every exception leaving the module raise as pybind11 would raise it, with its message
 /// through printable() (core/scene/messages.h), as the eikon command shows it. Called first by
 /// PYBIND11_MODULE.
 void registerErrorTranslator();
 /// Runs a session check, turning its SettingError into rethrowSetting's ValueError.
 template <class F>
-void checkSetting(F&& check) {
+void checkSetting(F&& check, std::string_view scope = {}) {
   try {
     check();
   } catch (const SettingError& e) {
-    rethrowSetting(e);
+    rethrowSetting(e, scope);
   }
 }
 

@@ -231,7 +231,8 @@ py::object render(Prepared& p, int width, int height, std::optional<int> spp,
 
 py::dict simulateLight(Prepared& p, int bands, const std::string& splat, double step_voxels,
                        double smoothing_voxels, const std::string& caustics,
-                       const std::string& device, const py::object& progress) {
+                       const std::string& device, const py::object& progress, double split_voxels,
+                       int max_patches) {
   const bool gpu = isGpu(device);
   LightRequest l;
   l.bands = bands;
@@ -240,6 +241,8 @@ py::dict simulateLight(Prepared& p, int bands, const std::string& splat, double 
   l.smoothing_voxels = smoothing_voxels;
   l.caustics = caustics;
   l.device = device;
+  l.split_voxels = split_voxels;
+  l.max_patches = max_patches;
   checkSetting([&] { checkLightRequest(l); });
   PyProgress printer(pyProgressMode(progress));
   const LightingSummary sum = p.run([&](Session& s) {
@@ -395,6 +398,82 @@ py::array_t<float> readExr(const std::string& path) {
   return a;
 }
 
+// ---------------------------------------------------------------- keywords from the settings table
+
+/// A keyword's default on a Python front end: None for an unset number, else the table's value.
+py::object settingDefaultObject(const Setting& s, unsigned front) {
+  const std::string value = settingDefault(s, front).value;
+  switch (s.kind) {
+    case SettingKind::Flag:
+      return py::bool_(value == "true");
+    case SettingKind::Choice:
+    case SettingKind::Text:
+      return py::str(value);
+    case SettingKind::Integer:
+      return value.empty() ? py::object(py::none()) : py::object(py::int_(std::stoi(value)));
+    case SettingKind::Number:
+      return value.empty() ? py::object(py::none()) : py::object(py::float_(std::stod(value)));
+  }
+  return py::none();
+}
+
+/// The keyword of the setting `name` (core/session/settings.h) with its default on `front`.
+py::arg_v settingArg(const char* name, unsigned front) {
+  const Setting& s = setting(name);
+  // py::arg keeps the pointer: the table's strings live as long as the module.
+  const char* keyword = *s.keyword ? s.keyword : s.name;
+  if (settingKeyword(s) != keyword || !(s.fronts & front))
+    throw std::logic_error(std::string("setting '") + name + "' has no Python keyword here");
+  return py::arg_v(keyword, settingDefaultObject(s, front));
+}
+
+/// "keyword=default (--option): help" of each named setting on `front`, one a line, for a
+/// docstring.
+std::string settingsDoc(std::initializer_list<const char*> names, unsigned front) {
+  std::string doc;
+  for (const char* name : names) {
+    const Setting& s = setting(name);
+    doc += "\n  " + settingKeyword(s) + "=" +
+           py::repr(settingDefaultObject(s, front)).cast<std::string>() +
+           ((s.fronts & SettingFront::Cli) ? std::string(" (--") + s.name + ")" : "") + ": " +
+           settingHelp(s, front);
+  }
+  return doc;
+}
+
+/// The table itself (eikon.settings()): what the tests compare the keywords and the CLI with.
+py::list settingsList() {
+  const std::pair<unsigned, const char*> fronts[] = {
+      {SettingFront::RenderCli, "render"},
+      {SettingFront::TraceCli, "trace"},
+      {SettingFront::ViewCli, "view"},
+      {SettingFront::PyRender, "Renderer.render"},
+      {SettingFront::PyLight, "Renderer.simulate_light"},
+      {SettingFront::PyTrace, "Renderer.trace"}};
+  const char* kinds[] = {"integer", "number", "choice", "flag", "text"};
+  py::list out;
+  for (const Setting& s : settings()) {
+    py::dict d, help, defaults;
+    py::list choices;
+    for (const SettingChoice& c : s.choices) choices.append(c.name);
+    for (const auto& [bit, where] : fronts) {
+      if (!(s.fronts & bit)) continue;
+      help[where] = settingHelp(s, bit);
+      defaults[where] = settingDefault(s, bit).value;
+    }
+    d["name"] = s.name;
+    d["kind"] = kinds[int(s.kind)];
+    d["keyword"] = settingKeyword(s);
+    d["help"] = help;
+    d["defaults"] = defaults;
+    d["range"] = settingRange(s);
+    d["choices"] = choices;
+    d["field"] = s.field;
+    out.append(d);
+  }
+  return out;
+}
+
 void bindModuleCalls(py::module_& m) {
   m.def(
       "render",
@@ -437,10 +516,67 @@ void bindModuleCalls(py::module_& m) {
       "voxelize_count", [] { return g_voxelizations.load(); },
       "how many times this module has voxelised a scene (each Renderer once, module-level calls "
       "once per scene)");
+  m.def("settings", &settingsList,
+        "the settings table (core/session/settings.h) that `eikon render`'s options and these "
+        "keywords are made from: [{'name', 'kind', 'keyword', 'help': {front: text}, 'defaults': "
+        "{front: value}, 'range', 'choices', 'field'}]");
   m.def("read_exr", &readExr, py::arg("path"),
         "(H, W, 3) float32 linear RGB of an EXR (e.g. what `eikon render` wrote)");
 }
 }  // namespace
+
+constexpr unsigned kR = SettingFront::PyRender, kL = SettingFront::PyLight,
+                   kT = SettingFront::PyTrace;
+
+const std::string& renderDoc() {
+  static const std::string doc =
+      "(H, W, 3) float32 linear sRGB, rendered as `eikon render` renders, with its defaults and "
+      "its checks. The keywords of the settings table (eikon.settings()), each with its option of "
+      "`eikon render`:" +
+      settingsDoc({"width", "height", "spp", "wavelengths", "wavelength", "device", "threads",
+                   "spectral-sampling", "layers", "polarised", "modes"},
+                  kR) +
+      "\nThe others:"
+      "\n  march=None: MarchSettings (its step_voxels, integrator, skip_empty and fresnel are "
+      "--step, --integrator, --no-skip and --no-fresnel); None is 0.5-voxel RK4 steps"
+      "\n  light=True: a lit scene's lights are simulated before its first render (unless "
+      "simulate_light() did), on the twin the CLI picks; light=False leaves an unsimulated scene "
+      "unlit (--no-light)"
+      "\n  light_cache=True: the CLI's light cache folder; a path: that folder; False: none"
+      "\n  progress=None|True|False: a tqdm bar per stage on stderr (plain lines without tqdm), "
+      "None shows stages that run over a second unless $EIKON_PROGRESS=never (or always)"
+      "\nWith layers the result is a dict: rgb, spectral (H, W, N bins) with wavelengths_nm (the "
+      "bin centres), o and e (H, W, 3 each), and for aov depth (H, W; mm, inf where none), point "
+      "and normal (H, W, 3), object_id (H, W; int32, -1 where none) and steps (H, W); "
+      "layers='stokes' adds stokes (H, W, 4, 3: S0..S3 x RGB) and stokes_frame "
+      "(docs/polarisation.md). A polarised render without layers='stokes' (polarised=True, "
+      "polariser sheets or a camera analyzer) returns the plain (H, W, 3) S0.";
+  return doc;
+}
+
+const std::string& lightDoc() {
+  static const std::string doc =
+      "simulate the scene's lights (docs/lighting.md) into the volume that later renders read; "
+      "returns the summed run statistics. The keywords of the settings table (eikon.settings()), "
+      "each with its option of `eikon render`:" +
+      settingsDoc({"light-bands", "light-splat", "light-step", "light-smoothing", "caustics",
+                   "light-device", "light-split", "max-patches"},
+                  kL) +
+      "\n  progress= as render's";
+  return doc;
+}
+
+/// A trace's docstring, with its keywords of the settings table (kept for the module's life).
+const char* traceDoc(const char* what) {
+  static std::vector<std::unique_ptr<std::string>> docs;
+  docs.push_back(std::make_unique<std::string>(
+      what +
+      std::string(". The keywords of the settings table (eikon.settings()), each with its "
+                  "option of `eikon trace`:") +
+      settingsDoc({"wavelength"}, kT) +
+      "\n  march=None: MarchSettings() (its step_voxels is --step; 0.25 voxels by default)"));
+  return docs.back()->c_str();
+}
 
 void bindRenderer(py::module_& m) {
   py::class_<Prepared, std::shared_ptr<Prepared>>(
@@ -451,58 +587,33 @@ void bindRenderer(py::module_& m) {
            py::arg("scene"))
       .def_property_readonly("scene", [](const Prepared& p) { return p.scene; })
       .def("grid", &grid, "voxel grid facts (voxelises on first call)")
-      .def("render", &render, py::arg("width") = 0, py::arg("height") = 0,
-           py::arg("spp") = py::none(), py::arg("wavelengths") = py::none(),
-           py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(),
-           py::arg("device") = "auto", py::arg("threads") = 0, py::arg("light") = true,
-           py::arg("light_cache") = true, py::arg("sampling") = "auto", py::arg("layers") = "",
-           py::arg("polarised") = false, py::arg("modes") = "both",
-           py::arg("progress") = py::none(),
-           "(H, W, 3) float32 linear sRGB, with the defaults of `eikon render`: device='auto' "
-           "(--device: the faster twin, the GPU on a GPU; 'gpu' or 'cpu' forces one); spp=None and "
-           "wavelengths=None are the scene's \"render\" spp and wavelengths where it gives them, "
-           "else 1 and 16 for a "
-           "dispersive scene, else 0 (RGB; > 0 = spectral with that many samples); march=None is "
-           "0.5-voxel RK4 "
-           "steps; light=True simulates a lit scene's lights before its first render (unless "
-           "simulate_light() "
-           "did), on the twin the CLI picks, through the CLI's light cache (light_cache=True: the "
-           "default "
-           "folder, a path: that folder, False: none); light=False leaves an unsimulated scene "
-           "unlit (--no-light); sampling='auto'|'hero'|'stratified' (--spectral-sampling); "
-           "layers='spectral,modes,aov' (--layers) returns a dict: rgb, spectral (H, W, N bins) "
-           "with wavelengths_nm (the bin centres), o and e (H, W, 3 each), and for aov depth "
-           "(H, W; mm, inf where none), point and normal (H, W, 3), object_id (H, W; int32, -1 "
-           "where none) and steps (H, W); layers='stokes' (a polarised render; also "
-           "polarised=True, polariser sheets or a camera analyzer, which return the plain "
-           "(H, W, 3) S0 without it) adds stokes (H, W, 4, 3: S0..S3 x RGB) and stokes_frame "
-           "(docs/polarisation.md); modes='both'|'o'|'e' (--modes): a crystal's two modes, each "
-           "carrying half of the light, or one mode alone at the whole of it, so o + e = 2·both; "
-           "progress=None|True|False: a tqdm bar per stage on stderr (plain lines without tqdm), "
-           "None shows stages that run over a second unless $EIKON_PROGRESS=never (or always)")
-      .def(
-          "simulate_light", &simulateLight, py::arg("bands") = 0, py::arg("splat") = "accumulate",
-          py::arg("step_voxels") = 0.5, py::arg("smoothing_voxels") = 1.0,
-          py::arg("caustics") = "pass", py::arg("device") = "gpu", py::arg("progress") = py::none(),
-          "simulate the scene's lights (docs/lighting.md) into the volume that later renders read; "
-          "returns the summed run statistics; progress= as render's")
+      .def("render", &render, settingArg("width", kR), settingArg("height", kR),
+           settingArg("spp", kR), settingArg("wavelengths", kR), settingArg("wavelength", kR),
+           py::arg("march") = py::none(), settingArg("device", kR), settingArg("threads", kR),
+           py::arg("light") = true, py::arg("light_cache") = true,
+           settingArg("spectral-sampling", kR), settingArg("layers", kR),
+           settingArg("polarised", kR), settingArg("modes", kR), py::arg("progress") = py::none(),
+           renderDoc().c_str())
+      .def("simulate_light", &simulateLight, settingArg("light-bands", kL),
+           settingArg("light-splat", kL), settingArg("light-step", kL),
+           settingArg("light-smoothing", kL), settingArg("caustics", kL),
+           settingArg("light-device", kL), py::arg("progress") = py::none(),
+           settingArg("light-split", kL), settingArg("max-patches", kL), lightDoc().c_str())
       .def("light_volumes", &lightVolumes,
            "{'fluence': (Z, Y, X, 4) φ_r, φ_g, φ_b, φ_Y (W/mm²), 'flux': (Z, Y, X, 4) net flux "
            "vector} "
            "on the voxel grid (index [k, j, i] is the voxel centred at origin + (i + ½, j + ½, k + "
            "½)·h)")
       .def("trace_rays", &traceRays, py::arg("origins"), py::arg("directions"),
-           py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(),
-           py::arg("device") = "gpu",
-           "many rays: {'wavelength_nm': (N,), 'device', 'modes': {'o': {key: (N,3)|(N,)}, 'e': "
-           "...}}")
+           settingArg("wavelength", kT), py::arg("march") = py::none(), py::arg("device") = "gpu",
+           traceDoc("many rays: {'wavelength_nm': (N,), 'device', 'modes': {'o': {key: "
+                    "(N,3)|(N,)}, 'e': ...}}"))
       .def("trace", &traceOne, py::arg("origin"), py::arg("direction"),
-           py::arg("wavelength_nm") = 587.5618, py::arg("march") = py::none(),
-           py::arg("device") = "gpu",
-           "one ray, the CLI JSON shape: {'wavelength_nm', 'device', 'modes': [{'mode': 'o', ...}, "
-           "...]}")
+           settingArg("wavelength", kT), py::arg("march") = py::none(), py::arg("device") = "gpu",
+           traceDoc("one ray, the CLI JSON shape: {'wavelength_nm', 'device', 'modes': [{'mode': "
+                    "'o', ...}, ...]}"))
       .def("trace_polarised", &tracePolarisedOne, py::arg("origin"), py::arg("direction"),
-           py::arg("wavelength_nm") = 587.5618, py::arg("stokes") = std::vector<double>{1, 0, 0, 0},
+           settingArg("wavelength", kT), py::arg("stokes") = std::vector<double>{1, 0, 0, 0},
            py::arg("device") = "gpu", py::arg("bandwidth_nm") = 10.0,
            py::arg("source_angle_rad") = 1e-3, py::arg("reflect_at") = std::vector<int>{},
            "the polarised trace of one ray (`eikon trace --stokes`; docs/polarisation.md) for the "

@@ -20,7 +20,7 @@ void bindScene(py::module_& m) {
                        bool fresnel, double interface_threshold, int max_steps) {
              MarchSettings s;
              s.step_voxels = step_voxels;
-             checkSetting([&] { s.integrator = parseIntegrator(integrator); });
+             checkSetting([&] { s.integrator = parseIntegrator(integrator); }, "march");
              s.skip_empty = skip_empty;
              s.fresnel = fresnel;
              s.interface_threshold = interface_threshold;
@@ -34,7 +34,7 @@ void bindScene(py::module_& m) {
       .def_property(
           "integrator", [](const MarchSettings& s) { return integratorName(s.integrator); },
           [](MarchSettings& s, const std::string& v) {
-            checkSetting([&] { s.integrator = parseIntegrator(v); });
+            checkSetting([&] { s.integrator = parseIntegrator(v); }, "march");
           })
       .def_readwrite("skip_empty", &MarchSettings::skip_empty)
       .def_readwrite("fresnel", &MarchSettings::fresnel)

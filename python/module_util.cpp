@@ -105,17 +105,17 @@ Mode parseMode(const std::string& s) {
 std::string integratorName(Integrator i) {
   return i == Integrator::Euler ? "euler" : i == Integrator::Midpoint ? "midpoint" : "rk4";
 }
-// Python's keyword for each setting the session checks (its SettingError::setting()).
-void rethrowSetting(const SettingError& e) {
-  static const std::map<std::string, std::string> keyword = {
-      {"step", "march.step_voxels"},     {"light-bands", "bands"},
-      {"light-splat", "splat"},          {"light-step", "step_voxels"},
-      {"light-device", "device"},        {"light-split", "split_voxels"},
-      {"max-patches", "max_patches"},    {"wavelength", "wavelength_nm"},
-      {"spectral-sampling", "sampling"}, {"dir", "direction"}};
-  auto it = keyword.find(e.setting());
-  throw std::invalid_argument((it == keyword.end() ? e.setting() : it->second) + " " +
-                              e.complaint());
+// Python's keyword for each setting the session checks (its SettingError::setting()): the
+// settings table's (core/session/settings.h); within `scope` ("march": MarchSettings's own
+// attributes) without the scope's prefix.
+void rethrowSetting(const SettingError& e, std::string_view scope) {
+  std::string keyword = e.setting() == "dir" ? "direction" : e.setting();
+  for (const Setting& s : settings())
+    if (e.setting() == s.name) keyword = settingKeyword(s);
+  if (!scope.empty() && keyword.size() > scope.size() &&
+      keyword.compare(0, scope.size(), scope) == 0 && keyword[scope.size()] == '.')
+    keyword.erase(0, scope.size() + 1);
+  throw std::invalid_argument(keyword + " " + e.complaint());
 }
 
 // ---------------------------------------------------------------- errors

@@ -27,14 +27,6 @@ namespace eikon {
 // ---------------------------------------------------------------- settings and their ranges
 
 namespace {
-void checkRange(const char* name, int v, int lo, int hi) {
-  if (v < lo || v > hi)
-    throw SettingError(name, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                                 "], got " + std::to_string(v));
-}
-}  // namespace
-
-namespace {
 /// Floats per pixel of a render's image and layers (RenderImage).
 int renderChannels(const Scene& scene, const RenderSettings& rs) {
   int channels = 3;
@@ -50,21 +42,24 @@ Integrator parseIntegrator(const std::string& s) {
   if (s == "euler") return Integrator::Euler;
   if (s == "midpoint") return Integrator::Midpoint;
   if (s == "rk4") return Integrator::RK4;
-  throw SettingError("integrator", "must be euler, midpoint or rk4");
+  checkSettingChoice(setting("integrator"), s);
+  throw std::logic_error("parseIntegrator: a choice of the table it does not know");
 }
 
 SpectralSampling parseSpectralSampling(const std::string& s) {
   if (s == "auto") return SpectralSampling::Auto;
   if (s == "hero") return SpectralSampling::Hero;
   if (s == "stratified") return SpectralSampling::Stratified;
-  throw SettingError("spectral-sampling", "must be auto, hero or stratified, got '" + s + "'");
+  checkSettingChoice(setting("spectral-sampling"), s);
+  throw std::logic_error("parseSpectralSampling: a choice of the table it does not know");
 }
 
 Modes parseModes(const std::string& s) {
   if (s == "both") return Modes::Both;
   if (s == "o") return Modes::O;
   if (s == "e") return Modes::E;
-  throw SettingError("modes", "must be o, e or both, got '" + s + "'");
+  checkSettingChoice(setting("modes"), s);
+  throw std::logic_error("parseModes: a choice of the table it does not know");
 }
 
 void parseLayers(const std::string& list, ViewRequest& view) {
@@ -82,9 +77,9 @@ void parseLayers(const std::string& list, ViewRequest& view) {
     else if (name == "stokes")
       view.stokes_layers = true;
     else
-      throw SettingError(
-          "layers", "must be a comma-separated list of spectral, modes, aov and stokes, got '" +
-                        name + "' in '" + list + "'");
+      throw SettingError("layers", "must be a comma-separated list of " +
+                                       settingChoiceList(setting("layers"), " and ") + ", got '" +
+                                       name + "' in '" + list + "'");
     start = end + 1;
   }
 }
@@ -127,22 +122,18 @@ void checkTraceFitsHost(size_t rays, double caller_bytes) {
                            "); trace fewer rays at a time");
 }
 
-void checkMarchStep(double step_voxels) {
-  if (!(step_voxels > 0 && step_voxels <= 4))
-    throw SettingError("step", "must be in (0, 4] voxels");
-}
+void checkMarchStep(double step_voxels) { checkSettingValue(setting("step"), step_voxels); }
 
 // A size not given is the scene camera's; a given one must be a real size (0 used to mean "the
 // scene's" silently, and a negative wavelength count the default).
 void checkViewRequest(const ViewRequest& v) {
-  if (v.width) checkRange("width", *v.width, 1, 16384);
-  if (v.height) checkRange("height", *v.height, 1, 16384);
-  if (v.spp) checkRange("spp", *v.spp, 1, 4096);
-  if (v.wavelengths) checkRange("wavelengths", *v.wavelengths, 0, 256);
+  if (v.width) checkSettingValue(setting("width"), *v.width);
+  if (v.height) checkSettingValue(setting("height"), *v.height);
+  if (v.spp) checkSettingValue(setting("spp"), *v.spp);
+  if (v.wavelengths) checkSettingValue(setting("wavelengths"), *v.wavelengths);
   if (v.march) checkMarchStep(v.march->step_voxels);
   if (v.march) checkMarchSettings(*v.march);  // the rest, as both twins check them
-  if (!(v.wavelength_nm >= 100 && v.wavelength_nm <= 10000))
-    throw SettingError("wavelength", "must be in [100, 10000] nm");
+  checkSettingValue(setting("wavelength"), v.wavelength_nm);
 }
 
 RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
@@ -198,34 +189,34 @@ std::vector<std::string> materialRangeWarnings(const Scene& scene, const RenderS
   return out;
 }
 
-void checkThreads(int threads) {
-  if (threads < 0 || threads > 1024)
-    throw SettingError("threads", "must be in [1, 1024], or 0 for all cores");
-}
+void checkThreads(int threads) { checkSettingValue(setting("threads"), threads); }
 
 void checkLightRequest(const LightRequest& l) {
-  if (l.bands < 0 || l.bands > 64)
-    throw SettingError("light-bands", "must be in [1, 64], or 0 for the scene's default");
-  if (l.splat != "accumulate" && l.splat != "highest")
-    throw SettingError("light-splat", "must be accumulate or highest, got '" + l.splat + "'");
-  if (l.device != "auto" && l.device != "gpu" && l.device != "cpu")
-    throw SettingError("light-device", "must be auto, gpu or cpu, got '" + l.device + "'");
-  if (l.caustics != "pass" && l.caustics != "kill")
-    throw SettingError("caustics", "must be pass or kill, got '" + l.caustics + "'");
-  if (!(l.step_voxels >= 0 && l.step_voxels <= 2))
-    throw SettingError("light-step", "must be in (0, 2] voxels, or 0 for the default (0.5)");
+  checkSettingValue(setting("light-bands"), l.bands);
+  checkSettingChoice(setting("light-splat"), l.splat);
+  checkSettingChoice(setting("light-device"), l.device);
+  checkSettingChoice(setting("caustics"), l.caustics);
+  checkSettingValue(setting("light-step"), l.step_voxels);
   checkThreads(l.threads);
-  if (!(l.smoothing_voxels >= 0 && l.smoothing_voxels <= 8))
-    throw SettingError("smoothing_voxels", "must be in [0, 8] voxels");
-  if (!(l.split_voxels >= 0.25 && l.split_voxels <= 8))
-    throw SettingError("light-split", "must be in [0.25, 8] voxels");
-  if (l.max_patches < 1024 || l.max_patches > (1 << 24))
-    throw SettingError("max-patches", "must be in [1024, 16777216]");
+  checkSettingValue(setting("light-smoothing"), l.smoothing_voxels);
+  checkSettingValue(setting("light-split"), l.split_voxels);
+  checkSettingValue(setting("max-patches"), l.max_patches);
 }
 
-void checkRenderDevice(const std::string& device) {
-  if (device != "auto" && device != "gpu" && device != "cpu")
-    throw SettingError("device", "must be auto, gpu or cpu, got '" + device + "'");
+void checkRenderDevice(const std::string& device) { checkSettingChoice(setting("device"), device); }
+
+void fillSettings(const std::map<std::string, SettingValue, std::less<>>& values, unsigned front,
+                  SettingRequests& requests) {
+  for (const Setting& s : settings()) {
+    const auto it = values.find(s.name);
+    if (!(s.fronts & front) || it == values.end()) continue;
+    const SettingValue& v = it->second;
+    if (!v.given && !*settingDefault(s, front).value && s.kind != SettingKind::Flag) continue;
+    if (s.kind == SettingKind::Integer) checkSettingValue(s, v.integer);
+    if (s.kind == SettingKind::Number) checkSettingValue(s, v.number);
+    if (s.kind == SettingKind::Choice) checkSettingChoice(s, v.text);
+    s.fill(v, requests);  // a Text setting is checked by its parser here
+  }
 }
 
 LightingOptions lightingOptions(const LightRequest& l, double voxel_mm) {
@@ -257,8 +248,7 @@ void checkTraceRequest(const TraceRequest& ray) {
   if (glm::length(ray.direction) < 1e-12) throw SettingError("dir", "must be a non-zero vector");
   if (!std::isfinite(glm::length(ray.direction)))
     throw SettingError("dir", "must have a finite length (scale it down)");
-  if (!(ray.wavelength_nm >= 100 && ray.wavelength_nm <= 10000))
-    throw SettingError("wavelength", "must be in [100, 10000] nm");
+  checkSettingValue(setting("wavelength"), ray.wavelength_nm);
 }
 
 // ---------------------------------------------------------------- the session

@@ -24,6 +24,7 @@
 #include <array>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -34,6 +35,7 @@
 #include "core/contract/polarised.h"
 #include "core/light/lighting_driver.h"
 #include "core/scene/scene.h"
+#include "core/session/settings.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {
@@ -43,20 +45,6 @@ class Context;
 class ViewRenderer;
 class ReferenceMarcher;
 class VolumeField;
-
-/// A setting out of its range, or an unknown name: what() is "<setting> <complaint>".
-class SettingError : public std::invalid_argument {
- public:
-  SettingError(const std::string& setting, const std::string& complaint)
-      : std::invalid_argument(setting + " " + complaint),
-        setting_(setting),
-        complaint_(complaint) {}
-  const std::string& setting() const { return setting_; }
-  const std::string& complaint() const { return complaint_; }
-
- private:
-  std::string setting_, complaint_;
-};
 
 /// What a render is asked for; an unset value takes the default of core/render/render_defaults.h.
 struct ViewRequest {
@@ -115,6 +103,21 @@ struct LightRequest {
   int threads = 0;                   ///< CPU twin threads (0: all, at most 8)
 };
 void checkLightRequest(const LightRequest& light);
+/// What the settings of the table (core/session/settings.h) fill: a render, its march, the light
+/// simulator, the twin and the CPU threads, each at its default until a setting fills it.
+struct SettingRequests {
+  ViewRequest view;
+  MarchSettings march;  ///< render: ViewRequest::march (the CLI sets it); trace: the trace's
+  LightRequest light;
+  std::string device = "auto";      ///< checkRenderDevice, renderTwin
+  int threads = 0;                  ///< Session::setThreads
+  double wavelength_nm = 587.5618;  ///< a trace's (TraceRequest::wavelength_nm)
+};
+/// The settings of `front` (one SettingFront bit) from `values` (by name), in table order: each
+/// given one, and each with a default, checked against its range or choices (SettingError) and
+/// filled into `requests`. A setting missing from `values` is left as it is.
+void fillSettings(const std::map<std::string, SettingValue, std::less<>>& values, unsigned front,
+                  SettingRequests& requests);
 /// The twin a render is asked for: "auto" (renderTwin), "gpu" or "cpu"; else
 /// SettingError("device", ...).
 void checkRenderDevice(const std::string& device);
