@@ -184,7 +184,9 @@ vec3 meshPermute(vec3 v, int kx, int ky, int kz) { return vec3(v[kx], v[ky], v[k
 // normal n has sign(n·d) = facing (±1): MeshDistance::firstHit. One node per loop pass (a leaf's
 // ≤ 4 triangles unrolled in it), nearer child first, at most EIKON_MESH_MAX_PASSES passes (a search
 // cut there finds nothing, as on the CPU); the test at the end of a pass (no pass for a failing
-// test). gMeshPasses counts the passes (boundary_probe reports them).
+// test). gMeshPasses counts the passes (boundary_probe reports them): a global, not state passed
+// along, because it is instrumentation only: no result depends on it, and in every other kernel
+// nothing reads it and the compiler drops it.
 int gMeshPasses = 0;
 bool meshFirstHit(int s, vec3 o, vec3 d, float t0, float t1, float facing, out float tHit,
                   out vec3 nHit, out int faceHit) {
@@ -786,6 +788,9 @@ const int kExactUnrollShapes = 4;
 #ifdef EIKON_EXACT_ROW
 void exactLoadShapes() {}
 #else
+// A copy of the shape table's first rows, loaded once per invocation (exactLoadShapes) and read
+// only afterwards: globals, like the parameter block P, since they are the same for every ray and
+// every function of the kernel reads them; no result depends on when the copy was made.
 vec4 gShapeRows[kExactMaxRows];
 bool gShapeRowsLoaded = false;
 #define EIKON_EXACT_ROW(i) gShapeRows[i]

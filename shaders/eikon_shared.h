@@ -109,7 +109,7 @@ using uvec4 = glm::uvec4;
 #define EIKON_PASS_MODES_SHIFT 3   // (pass.w >> 3) & EIKON_PASS_MODES_MASK: both (0), o (1), e (2)
 #define EIKON_PASS_MODES_MASK 3
 #define EIKON_PASS_AOV 32          // the AOV layer: keys the pipeline only (the kernel reads kAov)
-#define EIKON_PASS_SHARED 64       // sharing across stratified passes (view.comp main)
+#define EIKON_PASS_SHARED 64       // sharing across stratified passes (view.comp stratifiedAdd)
 
 // Integrators (ViewParams.march.w).
 #define EIKON_INT_EULER 0

@@ -16,18 +16,12 @@
 //   EIKON_FIELD_INV_H      1/h;
 //   EIKON_FIELD_LAMBDA_UM  the wavelength (µm), EIKON_FIELD_IL2 / EIKON_FIELD_IL4 its 1/λ², 1/λ⁴;
 //   EIKON_FIELD_HAS_AXIS   an expression, false where the kernel binds no optic axis;
-//   EIKON_FIELD_ON_DISPERSION(b, c)  optional: called with the B, C samples (march.glsl notes
-//                          whether any ray saw dispersion, for wavelength sharing);
 //   EIKON_FIELD_FLAGS      optional: the EIKON_F_* flags hasFlag tests (default P.grid_dims.w).
 //                          march.glsl makes them a specialization constant: lavapipe runs both
 //                          sides of every branch (masked SIMD), so only code that a constant
 //                          removes costs nothing (docs/performance.md).
 #ifndef EIKON_FIELD_GLSL
 #define EIKON_FIELD_GLSL
-
-#ifndef EIKON_FIELD_ON_DISPERSION
-#define EIKON_FIELD_ON_DISPERSION(b, c)
-#endif
 
 #ifndef EIKON_FIELD_FLAGS
 #define EIKON_FIELD_FLAGS P.grid_dims.w
@@ -74,28 +68,35 @@ ivec3 voxelAt(vec3 x) {
 }
 
 // (n, ∂n/∂x, ∂n/∂y, ∂n/∂z) of mode 0 (o) or 1 (e) at x and the kernel's wavelength:
-// A + B/λ² + C/λ⁴ (docs/design.md §2, Dispersion).
+// A + B/λ² + C/λ⁴ (docs/design.md §2, Dispersion). Sets `dispersive` where the sampled B or C is
+// non-zero (march.glsl's wavelength sharing: the path met dispersion).
 // Where the kernel binds no optic axis the e-mode images are the o-mode's, so mode 1 reads
 // those (one branch fewer for a kernel specialised without crystals).
-vec4 sampleIndex(vec3 x, int mode) {
+vec4 sampleIndex(vec3 x, int mode, inout bool dispersive) {
   Stencil s = stencilAt(x);
   vec4 a;
   if (mode == 0 || !(EIKON_FIELD_HAS_AXIS)) {
     a = TRI(idxOA, s);
     if (hasFlag(EIKON_F_DISPERSIVE)) {
       vec4 b = TRI(idxOB, s), c = TRI(idxOC, s);
-      EIKON_FIELD_ON_DISPERSION(b, c);
+      if (any(notEqual(b, vec4(0.0))) || any(notEqual(c, vec4(0.0)))) dispersive = true;
       a += b * EIKON_FIELD_IL2 + c * EIKON_FIELD_IL4;
     }
   } else {
     a = TRI(idxEA, s);
     if (hasFlag(EIKON_F_DISPERSIVE)) {
       vec4 b = TRI(idxEB, s), c = TRI(idxEC, s);
-      EIKON_FIELD_ON_DISPERSION(b, c);
+      if (any(notEqual(b, vec4(0.0))) || any(notEqual(c, vec4(0.0)))) dispersive = true;
       a += b * EIKON_FIELD_IL2 + c * EIKON_FIELD_IL4;
     }
   }
   return a;
+}
+
+// The same where nothing notes dispersion (wavefront.comp).
+vec4 sampleIndex(vec3 x, int mode) {
+  bool unused = false;
+  return sampleIndex(x, mode, unused);
 }
 
 // (σ_r, σ_g, σ_b band values per mm, opacity) of the o-mode at x: a function of its own, so that

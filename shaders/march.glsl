@@ -52,7 +52,10 @@ layout(std140, binding = EIKON_B_SMALL_MEDIA) uniform SmallMediaBuf {
 #define EIKON_SHAPE_ROW(i) (hasFlag(EIKON_F_SMALL_SHAPES) ? exactRows[i] : shapeTable[i])
 #define EIKON_MEDIUM_ROW(i) (hasFlag(EIKON_F_SMALL_MEDIA) ? smallMedia[i] : mediaTable[i])
 
-// Per-wavelength state set before a march.
+// The wavelength of the march (setWavelength, before each march). Globals, unlike the per-ray
+// PathRecord below: constant for the length of a march and read by nearly every function of it
+// (each field sample through field.glsl's EIKON_FIELD_LAMBDA_UM / IL2 / IL4, each colour through
+// colourOf), like the parameter block P.
 float gLambdaUm = 0.5876;
 float gIl2 = 1.0 / (0.5876 * 0.5876);
 float gIl4 = gIl2 * gIl2;
@@ -65,26 +68,57 @@ void setWavelength(float lambda_um, bool scalar) {
   gScalar = scalar;
 }
 
-// Wavelength sharing (view.comp, spectral mode): while marching the first wavelength of a pixel
-// sample, note whether any sample saw dispersion (B or C ≠ 0, a dispersive medium) or a weight
-// that depends on λ (attenuation, emission along the path, in-scatter, a lit surface: each sets
-// gDispersiveHit where it adds something), and record every environment lookup and opaque
-// surface's emission as (linear sRGB radiance, weight). If none did, the path and every weight
-// are the same at all wavelengths: the others are Σ weight·S(λ, rgb), without marching.
+// The record of one pixel sample's path that wavelength sharing and hero sampling evaluate at
+// other wavelengths (view.comp), created by the caller of march() and passed to every stage that
+// reads or writes it (`inout PathRecord rec`; the field helpers get `inout bool dispersive`).
+//
+// Wavelength sharing (view.comp, stratified spectral passes): while marching the first wavelength
+// of a pixel sample with `record` set, note whether any sample saw dispersion (B or C ≠ 0, a
+// dispersive medium) or a weight that depends on λ (attenuation, emission along the path,
+// in-scatter, a lit surface: each sets `dispersive` where it adds something), and record every
+// environment lookup and opaque surface's emission as (linear sRGB radiance, weight). If none did,
+// the path and every weight are the same at all wavelengths: the others are Σ weight·S(λ, rgb),
+// without marching.
 //
 // Hero wavelength sampling (view.comp, docs/spectra.md) uses the same record differently: while
-// gHero is set and the hero's path has met nothing dispersive (gDispersiveHit false), every
-// environment lookup is recorded as (linear sRGB radiance, weight × gRecordWeight) and left out of
-// the march's radiance — view.comp evaluates it at all N wavelengths, which share the path up to
+// `hero` is set and the hero's path has met nothing dispersive (`dispersive` false), every
+// environment lookup is recorded as (linear sRGB radiance, weight × `weight`) and left out of the
+// march's radiance — view.comp evaluates it at all N wavelengths, which share the path up to
 // there. From the path's first dispersive event on (or a 7th lookup, which the record cannot hold:
 // the cut depends on the path alone, not on λ) lookups are the hero's alone.
-bool gDispersiveHit = false;
-bool gRecord = false;
-bool gRecordOverflow = false;
-bool gHero = false;
-float gRecordWeight = 1.0;
-int gNumRecorded = 0;
-vec4 gRecorded[6];
+const int kRecordMax = 6;
+struct PathRecord {
+  bool record;      // wavelength sharing: record the lookups
+  bool hero;        // hero sampling: record the lookups before the first dispersive event
+  float weight;     // hero: the mode's share of the light, times each recorded weight
+  bool overflow;    // wavelength sharing: a lookup found the record full
+  bool dispersive;  // the path met something that depends on λ
+  int count;        // entries used
+  // (linear sRGB radiance, weight). Indexed only by constants (recordPush, and loops of constant
+  // count that are unrolled): llvmpipe keeps such an array in registers, where one indexed at run
+  // time would live in memory and be copied whole at every inout call.
+  vec4 entries[kRecordMax];
+};
+
+// Appends (rgb, weight) to the record, which has room (count < kRecordMax).
+void recordPush(inout PathRecord rec, vec3 rgb, float weight) {
+  for (int i = 0; i < kRecordMax; ++i)  // a constant count: unrolled (constant indices)
+    if (i == rec.count) rec.entries[i] = vec4(rgb, weight);
+  rec.count++;
+}
+
+// A record that records nothing (RGB and trace marches; the start of each strategy's).
+PathRecord noRecord() {
+  PathRecord rec;
+  rec.record = false;
+  rec.hero = false;
+  rec.weight = 1.0;
+  rec.overflow = false;
+  rec.dispersive = false;
+  rec.count = 0;
+  for (int i = 0; i < kRecordMax; ++i) rec.entries[i] = vec4(0.0);
+  return rec;
+}
 
 // Specialization constants (core/render/view_renderer.cpp: one pipeline per feature set). llvmpipe
 // (lavapipe) executes both sides of every branch with a lane mask and every loop body at least
@@ -113,8 +147,6 @@ layout(constant_id = 4) const int kExact = 0;
 #define EIKON_FIELD_IL2 gIl2
 #define EIKON_FIELD_IL4 gIl4
 #define EIKON_FIELD_HAS_AXIS hasFlag(EIKON_F_UNIAXIAL)
-#define EIKON_FIELD_ON_DISPERSION(b, c) \
-  if (any(notEqual(b, vec4(0.0))) || any(notEqual(c, vec4(0.0)))) gDispersiveHit = true
 #define EIKON_BOUNDARY_HAS_CONVEX hasFlag(EIKON_F_CONVEX)
 #define EIKON_BOUNDARY_HAS_MESH hasFlag(EIKON_F_MESH)
 #define EIKON_BOUNDARY_CONVEX_APART hasFlag(EIKON_F_CONVEX_APART)
@@ -157,28 +189,30 @@ vec3 environmentRgb(vec3 d);
 // Radiance rgb (linear sRGB, the same at every λ of the path) times a throughput weight, recorded
 // for wavelength sharing: the environment's (environmentWeighted) and an opaque surface's own
 // emission (surfaceWeighted).
-vec3 recordedWeighted(vec3 weight, vec3 rgb) {
-  if (hasFlag(EIKON_F_SPECTRAL) && gHero && !gDispersiveHit) {
-    if (gNumRecorded < 6) {
-      gRecorded[gNumRecorded++] = vec4(rgb, weight.x * gRecordWeight);
+vec3 recordedWeighted(inout PathRecord rec, vec3 weight, vec3 rgb) {
+  if (hasFlag(EIKON_F_SPECTRAL) && rec.hero && !rec.dispersive) {
+    if (rec.count < kRecordMax) {
+      recordPush(rec, rgb, weight.x * rec.weight);
       return vec3(0.0);
     }
-    gDispersiveHit = true;  // the record is full: from here on the hero's alone
+    rec.dispersive = true;  // the record is full: from here on the hero's alone
   }
-  if (hasFlag(EIKON_F_SPECTRAL) && gRecord) {  // only view.comp's spectral mode records
-    if (gNumRecorded < 6) gRecorded[gNumRecorded++] = vec4(rgb, weight.x);
-    else gRecordOverflow = true;
+  if (hasFlag(EIKON_F_SPECTRAL) && rec.record) {  // only view.comp's spectral mode records
+    if (rec.count < kRecordMax) recordPush(rec, rgb, weight.x);
+    else rec.overflow = true;
   }
   return weight * colourOf(rgb);
 }
 
-vec3 environmentWeighted(vec3 weight, vec3 d) { return recordedWeighted(weight, environmentRgb(d)); }
+vec3 environmentWeighted(inout PathRecord rec, vec3 weight, vec3 d) {
+  return recordedWeighted(rec, weight, environmentRgb(d));
+}
 
 // An opaque surface's emission rgb seen with weight, plus the light it reflects (diffuse, which
 // depends on λ through the light volumes: a path that sees any is not shared).
-vec3 surfaceWeighted(vec3 weight, vec3 rgb, vec3 diffuse) {
-  if (hasFlag(EIKON_F_LIT) && any(notEqual(diffuse, vec3(0.0)))) gDispersiveHit = true;
-  return recordedWeighted(weight, rgb) + weight * diffuse;
+vec3 surfaceWeighted(inout PathRecord rec, vec3 weight, vec3 rgb, vec3 diffuse) {
+  if (hasFlag(EIKON_F_LIT) && any(notEqual(diffuse, vec3(0.0)))) rec.dispersive = true;
+  return recordedWeighted(rec, weight, rgb) + weight * diffuse;
 }
 
 vec3 environmentRgb(vec3 d) {
@@ -295,8 +329,9 @@ vec3 axisAt(vec3 x) { return axisField(x).xyz; }
 //  o-mode (docs/design.md §2, isotropic form): dx/ds = w/n, dw/ds = ∇n on the shell |w| = n.
 //  e-mode (Hamiltonian H = ½(pᵀM_e p − 1), w = p): eModeRates (field.glsl) divided by |M p| to
 //    step in arc length. Where there is no axis the e-mode is the o-mode.
-void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
-  vec4 o = sampleIndex(x, 0);
+// `dispersive`: set where a sample saw dispersion (sampleIndex), as in every helper below.
+void deriv(vec3 x, vec3 w, int mode, inout bool dispersive, out vec3 dx, out vec3 dw) {
+  vec4 o = sampleIndex(x, 0, dispersive);
   vec4 af = mode == 1 ? axisField(x) : vec4(0.0);
   if (!hasAxis(af.xyz)) {
     // Isotropic Hamiltonian M = I/n² in ray arc length: dx/ds = w/|w|, dw/ds = |w|∇n/n. On the
@@ -308,29 +343,29 @@ void deriv(vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
     return;
   }
   vec3 Mp, dp;
-  eModeRates(w, af, o, sampleIndex(x, 1), Mp, dp);
+  eModeRates(w, af, o, sampleIndex(x, 1, dispersive), Mp, dp);
   float L = length(Mp);
   dx = Mp / L;
   dw = dp / L;
 }
 
 // Ray direction of mode `mode` for wave vector w at x.
-vec3 rayDirection(vec3 x, vec3 w, int mode) {
+vec3 rayDirection(vec3 x, vec3 w, int mode, inout bool dispersive) {
   if (mode == 0) return normalize(w);
   vec3 a = axisAt(x);
   if (!hasAxis(a)) return normalize(w);
-  return normalize(applyM(w, a, sampleIndex(x, 0).x, sampleIndex(x, 1).x));
+  return normalize(applyM(w, a, sampleIndex(x, 0, dispersive).x, sampleIndex(x, 1, dispersive).x));
 }
 
 // Attenuation per unit ray length of `mode` at x for wave vector w (band values or the value at λ);
 // the e-mode's is pleochroic (attenuationE, field.glsl).
-vec3 attenuationAt(vec3 x, vec3 w, int mode) {
+vec3 attenuationAt(vec3 x, vec3 w, int mode, inout bool dispersive) {
   vec3 so = sigmaOf(sampleMedium(x, 0).xyz);
   if (mode == 0) return so;
   vec3 a = axisAt(x);
   if (!hasAxis(a)) return so;
   vec3 se = sigmaOf(sampleMedium(x, 1).xyz);
-  return attenuationE(so, se, w, a, sampleIndex(x, 0).x, sampleIndex(x, 1).x);
+  return attenuationE(so, se, w, a, sampleIndex(x, 0, dispersive).x, sampleIndex(x, 1, dispersive).x);
 }
 
 // ---- The march, stage by stage (the same stages, under the same names, as ReferenceMarcher's in
@@ -370,13 +405,13 @@ const int kStepStop = 2;   // the march ends (opaque surface, or out of the volu
 
 // Homogeneous region (skip distance D ≥ 2 voxels): one straight, exact step of (D − 1.5)·h along
 // the ray direction, with the emission and attenuation integrated in closed form.
-int straightStep(inout MarchState S, inout MarchResult R, int mode) {
+int straightStep(inout MarchState S, inout MarchResult R, inout PathRecord rec, int mode) {
   vec4 em = vec4(0.0);
   if (!S.inLayer && !hasFlag(EIKON_F_NO_SKIP)) em = imageLoad(emissionImg, voxelAt(S.x));
   if (em.w < 2.0) return kStepNone;
   const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
   const float h = P.grid_origin.w;
-  vec3 dir = rayDirection(S.x, S.w, mode);
+  vec3 dir = rayDirection(S.x, S.w, mode, rec.dispersive);
   float tb0, tb1;
   boxHit(S.x, dir, bmin, bmax, tb0, tb1);
   float tExit = max(tb1, 0.0);
@@ -387,16 +422,16 @@ int straightStep(inout MarchState S, inout MarchResult R, int mode) {
   bool leaving = len >= tExit;
   len = min(len, tExit);
   if (hasFlag(EIKON_F_OPACITY) && sampleMedium(S.x, mode).w >= 0.5) {
-    S.L += surfaceWeighted(S.T, em.xyz / sampleMedium(S.x, mode).w, diffuseSurface(S.x, mode));
+    S.L += surfaceWeighted(rec, S.T, em.xyz / sampleMedium(S.x, mode).w, diffuseSurface(S.x, mode));
     S.stopped = true;
     return kStepStop;
   }
   if (hasFlag(EIKON_F_EMISSION) || hasFlag(EIKON_F_ATTENUATION)) {
-    vec3 sig = hasFlag(EIKON_F_ATTENUATION) ? attenuationAt(S.x, S.w, mode) : vec3(0.0);
+    vec3 sig = hasFlag(EIKON_F_ATTENUATION) ? attenuationAt(S.x, S.w, mode, rec.dispersive) : vec3(0.0);
     vec3 e = colourOf(em.xyz);
     // In-scatter with the light at the middle of this straight step, constant over it.
     if (scattering) e += inScatter(S.x + 0.5 * len * dir, dir, sig);
-    if (any(notEqual(sig, vec3(0.0))) || any(notEqual(e, vec3(0.0)))) gDispersiveHit = true;
+    if (any(notEqual(sig, vec3(0.0))) || any(notEqual(e, vec3(0.0)))) rec.dispersive = true;
     vec3 att = exp(-sig * len);
     // ∫₀^len T e^{−σs} e ds = T e (1 − e^{−σ len})/σ  (→ T e len as σ → 0)
     S.L += S.T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
@@ -409,7 +444,7 @@ int straightStep(inout MarchState S, inout MarchResult R, int mode) {
 
 // One integration step of the ray equation (Euler, midpoint or RK4), then the fields at its end,
 // the optical path and (o-mode) the drift of the invariant |w| = n.
-StepEnd integrateStep(inout MarchState S, inout MarchResult R, int mode) {
+StepEnd integrateStep(inout MarchState S, inout MarchResult R, inout bool dispersive, int mode) {
   const float ds = P.march.x * P.grid_origin.w;
   const int integrator = kIntegrator == -1 ? int(P.march.w) : kIntegrator;
   StepEnd E;
@@ -417,26 +452,26 @@ StepEnd integrateStep(inout MarchState S, inout MarchResult R, int mode) {
   E.w0 = S.w;
   float n0 = S.nn.x;
   vec3 k1x, k1w, k2x, k2w, k3x, k3w, k4x, k4w;
-  deriv(S.x, S.w, mode, k1x, k1w);
+  deriv(S.x, S.w, mode, dispersive, k1x, k1w);
   if (integrator == EIKON_INT_EULER) {
     S.x += ds * k1x;
     S.w += ds * k1w;
   } else if (integrator == EIKON_INT_MIDPOINT) {
-    deriv(S.x + 0.5 * ds * k1x, S.w + 0.5 * ds * k1w, mode, k2x, k2w);
+    deriv(S.x + 0.5 * ds * k1x, S.w + 0.5 * ds * k1w, mode, dispersive, k2x, k2w);
     S.x += ds * k2x;
     S.w += ds * k2w;
   } else {
-    deriv(S.x + 0.5 * ds * k1x, S.w + 0.5 * ds * k1w, mode, k2x, k2w);
-    deriv(S.x + 0.5 * ds * k2x, S.w + 0.5 * ds * k2w, mode, k3x, k3w);
-    deriv(S.x + ds * k3x, S.w + ds * k3w, mode, k4x, k4w);
+    deriv(S.x + 0.5 * ds * k1x, S.w + 0.5 * ds * k1w, mode, dispersive, k2x, k2w);
+    deriv(S.x + 0.5 * ds * k2x, S.w + 0.5 * ds * k2w, mode, dispersive, k3x, k3w);
+    deriv(S.x + ds * k3x, S.w + ds * k3w, mode, dispersive, k4x, k4w);
     S.x += ds / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
     S.w += ds / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
   }
-  S.nn = sampleIndex(S.x, 0);
+  S.nn = sampleIndex(S.x, 0, dispersive);
   E.gradN = S.nn.yzw;
   E.aHere = mode == 1 ? axisAt(S.x) : vec3(0.0);
   E.eHere = mode == 1 && hasAxis(E.aHere);
-  E.ne = E.eHere ? sampleIndex(S.x, 1) : S.nn;
+  E.ne = E.eHere ? sampleIndex(S.x, 1, dispersive) : S.nn;
   if (mode == 0) {
     R.drift = max(R.drift, abs(length(S.w) - S.nn.x));
     R.opl += 0.5 * (n0 + S.nn.x) * ds;
@@ -449,23 +484,23 @@ StepEnd integrateStep(inout MarchState S, inout MarchResult R, int mode) {
 
 // Emission, attenuation and in-scatter at the step's midpoint (only sampled where the scene has
 // any); true if the step ended on an opaque surface.
-bool mediumAlongStep(inout MarchState S, StepEnd E, int mode) {
+bool mediumAlongStep(inout MarchState S, inout PathRecord rec, StepEnd E, int mode) {
   const float ds = P.march.x * P.grid_origin.w;
   vec3 xm = 0.5 * (E.x0 + S.x);
   if (hasFlag(EIKON_F_EMISSION)) {
     vec3 e = sampleEmission(xm);
-    if (any(notEqual(e, vec3(0.0)))) gDispersiveHit = true;  // λ-dependent (wavelength sharing)
+    if (any(notEqual(e, vec3(0.0)))) rec.dispersive = true;  // λ-dependent (wavelength sharing)
     S.L += S.T * colourOf(e) * ds;
   }
   if (hasFlag(EIKON_F_ATTENUATION)) {
-    vec3 sig = attenuationAt(xm, 0.5 * (E.w0 + S.w), mode);
-    if (any(notEqual(sig, vec3(0.0)))) gDispersiveHit = true;
+    vec3 sig = attenuationAt(xm, 0.5 * (E.w0 + S.w), mode, rec.dispersive);
+    if (any(notEqual(sig, vec3(0.0)))) rec.dispersive = true;
     if (hasFlag(EIKON_F_LIT) && hasFlag(EIKON_F_SCATTER)) S.L += S.T * inScatter(xm, normalize(S.x - E.x0), sig) * ds;
     S.T *= exp(-sig * ds);
   }
   if (hasFlag(EIKON_F_OPACITY) && sampleMedium(S.x, mode).w >= 0.5) {
     // Surface emission: the emission field over the coverage (opacity ≥ 0.5 here), as the albedo.
-    S.L += surfaceWeighted(S.T, sampleEmission(S.x) / sampleMedium(S.x, mode).w, diffuseSurface(S.x, mode));
+    S.L += surfaceWeighted(rec, S.T, sampleEmission(S.x) / sampleMedium(S.x, mode).w, diffuseSurface(S.x, mode));
     S.stopped = true;
     return true;
   }
@@ -500,21 +535,21 @@ void projectOnShell(inout MarchState S, StepEnd E, vec3 N) {
 // Fresnel at a crossed layer of normal N (transmitted fraction 1 − R, with the full unpolarised
 // equations, and an external reflection that samples the environment), or a total internal
 // reflection, which the ODE produced by itself (no Fresnel loss).
-void fresnelAtLayer(inout MarchState S, inout MarchResult R, vec3 N, int mode) {
+void fresnelAtLayer(inout MarchState S, inout MarchResult R, inout PathRecord rec, vec3 N, int mode) {
   vec3 dIn = normalize(S.wBefore), dOut = normalize(S.w);
   float ci = dot(dIn, N), co = dot(dOut, N);
   float n1 = length(S.wBefore), n2 = length(S.w);
   if (ci * co > 0.0) {
     // Which side is the crystal? The end of the layer with the larger birefringence (the
     // axis field itself is dilated into the air around crystals).
-    float bOut = abs(sampleIndex(S.x, 1).x - sampleIndex(S.x, 0).x);
-    float bIn = abs(sampleIndex(S.xOpen, 1).x - sampleIndex(S.xOpen, 0).x);
+    float bOut = abs(sampleIndex(S.x, 1, rec.dispersive).x - sampleIndex(S.x, 0, rec.dispersive).x);
+    float bIn = abs(sampleIndex(S.xOpen, 1, rec.dispersive).x - sampleIndex(S.xOpen, 0, rec.dispersive).x);
     bool outCrystal = bOut >= bIn;
     vec3 a = axisAt(outCrystal ? S.x : S.xOpen);
     float wsw = sWeight(outCrystal ? dOut : dIn, a, N, dIn, mode);
     vec2 rsp = fresnelRsRp(abs(ci), n1, n2);
     float Rf = hasFlag(EIKON_F_UNIAXIAL) ? wsw * rsp.x + (1.0 - wsw) * rsp.y : 0.5 * (rsp.x + rsp.y);
-    if (n2 > n1) S.L += environmentWeighted(S.T * Rf, reflect(dIn, N));
+    if (n2 > n1) S.L += environmentWeighted(rec, S.T * Rf, reflect(dIn, N));
     S.T *= 1.0 - Rf;
     R.interfaces++;
   } else {
@@ -550,7 +585,7 @@ void layerAccumulate(inout MarchState S, StepEnd E) {
 
 // Interface bookkeeping: a layer opens where |∇n|·h rises above 1e-6 and closes where it falls
 // back; a closed layer whose peak exceeded march.y was an interface (projectOnShell, fresnelAtLayer).
-void layerStep(inout MarchState S, inout MarchResult R, StepEnd E, int mode) {
+void layerStep(inout MarchState S, inout MarchResult R, inout PathRecord rec, StepEnd E, int mode) {
   const float h = P.grid_origin.w, ds = P.march.x * h;
   // The thresholds squared, as layerGradient2 (a negative march.y stays below every peak).
   const float thrLow2 = kLayerOpen2, thrIface2 = P.march.y * abs(P.march.y);
@@ -576,7 +611,7 @@ void layerStep(inout MarchState S, inout MarchResult R, StepEnd E, int mode) {
     R.hitObject = -1;
   }
   if (dot(N, N) > 0.0 && abs(dot(S.x - S.xOpen, N)) <= 12.0 * h) projectOnShell(S, E, N);
-  if (S.peak2 > thrIface2 && !hasFlag(EIKON_F_NO_FRESNEL) && dot(N, N) > 0.0) fresnelAtLayer(S, R, N, mode);
+  if (S.peak2 > thrIface2 && !hasFlag(EIKON_F_NO_FRESNEL) && dot(N, N) > 0.0) fresnelAtLayer(S, R, rec, N, mode);
 }
 
 // Whether x is outside the volume box (clipToVolume's test).
@@ -603,7 +638,7 @@ bool clipToVolume(inout MarchState S, inout MarchResult R, StepEnd E) {
 
 // Both marches start here: R initialised, and the ray either misses the volume (R is the
 // environment seen along d; false) or enters it at o + t0·d, t0 ≥ 0 (true).
-bool enterVolume(vec3 o, vec3 d, out MarchResult R, out float t0) {
+bool enterVolume(vec3 o, vec3 d, inout PathRecord rec, out MarchResult R, out float t0) {
   R.radiance = vec3(0.0);
   R.throughput = vec3(1.0);
   R.opl = 0.0;
@@ -623,7 +658,7 @@ bool enterVolume(vec3 o, vec3 d, out MarchResult R, out float t0) {
   const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
   float t1;
   if (!boxHit(o, d, bmin, bmax, t0, t1)) {
-    R.radiance = environmentWeighted(vec3(1.0), d);
+    R.radiance = environmentWeighted(rec, vec3(1.0), d);
     return false;
   }
   t0 = max(t0, 0.0);
@@ -633,17 +668,17 @@ bool enterVolume(vec3 o, vec3 d, out MarchResult R, out float t0) {
 #include "sharp.glsl"
 
 // kSharpMarch (with EIKON_F_SHARP): the pipeline holds one of the two marches, which halves what
-// lavapipe compiles.
-MarchResult march(vec3 o, vec3 d, int mode) {
+// lavapipe compiles. rec: the caller's record of the path (PathRecord), carried on.
+MarchResult march(vec3 o, vec3 d, int mode, inout PathRecord rec) {
   if (!hasFlag(EIKON_F_UNIAXIAL)) mode = 0;  // always so; as a constant it folds the e-mode away
-  if (kSharpMarch) return marchSharp(o, d, mode);
+  if (kSharpMarch) return marchSharp(o, d, mode, rec);
   MarchResult R;
   float t0;
-  if (!enterVolume(o, d, R, t0)) return R;
+  if (!enterVolume(o, d, rec, R, t0)) return R;
   MarchState S;
   S.x = o + d * t0;
   R.opl = P.march.z * t0;  // the ambient index
-  S.nn = sampleIndex(S.x, 0);
+  S.nn = sampleIndex(S.x, 0, rec.dispersive);
   S.w = S.nn.x * d;  // the volume's faces are isotropic (air): p = n d
   S.T = vec3(1.0);
   S.L = vec3(0.0);
@@ -665,11 +700,11 @@ MarchResult march(vec3 o, vec3 d, int mode) {
     StepEnd E;
     bool event = false;
     for (; steps < maxSteps; ++steps) {
-      const int straight = straightStep(S, R, mode);
+      const int straight = straightStep(S, R, rec, mode);
       if (straight == kStepStop) break;
       if (straight == kStepTaken) continue;
-      E = integrateStep(S, R, mode);
-      if (mediumAlongStep(S, E, mode)) break;
+      E = integrateStep(S, R, rec.dispersive, mode);
+      if (mediumAlongStep(S, rec, E, mode)) break;
       if (layerEvent(S, E) || outsideVolume(S.x)) {
         event = true;
         break;
@@ -677,7 +712,7 @@ MarchResult march(vec3 o, vec3 d, int mode) {
       layerAccumulate(S, E);
     }
     if (!event) break;
-    layerStep(S, R, E, mode);
+    layerStep(S, R, rec, E, mode);
     if (clipToVolume(S, R, E)) break;
     ++steps;
   }
@@ -687,10 +722,10 @@ MarchResult march(vec3 o, vec3 d, int mode) {
   R.cut = loopLimitReached() || (!S.stopped && steps >= maxSteps);
   R.steps = steps;
   R.exit_point = S.x;
-  R.exit_dir = rayDirection(S.x, S.w, mode);
+  R.exit_dir = rayDirection(S.x, S.w, mode, rec.dispersive);
   R.wave_normal = normalize(S.w);
   R.left = !S.stopped && !R.cut;
-  if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
+  if (R.left) S.L += environmentWeighted(rec, S.T, R.exit_dir);
   R.radiance = S.L;
   R.throughput = S.T;
   return R;

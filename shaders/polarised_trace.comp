@@ -83,6 +83,11 @@ struct Branch {
   int events;
 };
 
+// The ray tree of the invocation's one ray (the CPU's Tracer): the branches waiting, the leaves,
+// whether it was cut short, the region refused (+1) and the input wave vector. Globals, not a
+// struct passed inout: the stack and the leaves are arrays of Branch indexed at run time, which
+// llvmpipe keeps in memory and would copy whole at every call that took them inout (the
+// polarised render ran ~1.6× slower so, on lavapipe).
 Branch gStack[EIKON_POL_MAX_STACK];
 int gTop = 0;
 Branch gLeaves[EIKON_POL_MAX_LEAVES];

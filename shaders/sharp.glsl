@@ -34,13 +34,14 @@ bool mediumUniaxial(int r) { return (mediumFlags(r) & EIKON_MEDIUM_UNIAXIAL) != 
 bool mediumOpaque(int r) { return (mediumFlags(r) & EIKON_MEDIUM_OPAQUE) != 0; }
 
 // n of a region's dispersion record (mode 0: n_o, 1: n_e) at the march's wavelength: the
-// material's own formula (mediumIndex). Notes dispersion for wavelength sharing (view.comp).
+// material's own formula (mediumIndex). Sets `dispersive` where the formula depends on λ
+// (march.glsl PathRecord: wavelength sharing and hero sampling, view.comp).
 //
 // The view kernel's RGB renders march at the one render wavelength: there the includer defines
 // EIKON_INDEX_AT_RENDER_WAVELENGTH true and the index is the host's (v15, BoundaryDevice::
 // setRenderWavelength), which folds the formulas away (lavapipe runs all of their code, loops
 // included, at every crossing otherwise).
-float mediumIndex(int r, int mode) {
+float mediumIndex(int r, int mode, inout bool dispersive) {
 #ifdef EIKON_INDEX_AT_RENDER_WAVELENGTH
   if (EIKON_INDEX_AT_RENDER_WAVELENGTH) {
     vec4 atRender = mediumRow(r, 15);
@@ -55,11 +56,10 @@ float mediumIndex(int r, int mode) {
   float sc[6] = float[6](c1.z, c1.w, c2.x, c2.y, c2.z, c2.w);
   if (kind == 0) return coeff[0];
   // Dispersive unless a Cauchy formula without λ terms (its B, C, ... all zero).
-  bool dispersive = kind != 1;
+  if (kind != 1) dispersive = true;
   for (int k = 1; k < 6; ++k)  // a constant count: unrolled (the loop budget)
     if (k < terms && coeff[k] != 0.0) dispersive = true;
-  if (dispersive) gDispersiveHit = true;
-  float l = gLambdaUm, l2 = l * l;
+  float l = EIKON_FIELD_LAMBDA_UM, l2 = l * l;
   if (kind == 1) {
     float n = 0.0, p = 1.0;
     for (int k = 0; k < terms; ++k, p /= l2) n += coeff[k] * p;
@@ -73,12 +73,19 @@ float mediumIndex(int r, int mode) {
   return coeff[0] + coeff[1] / l + coeff[2] / (l2 * l * sqrt(l));
 }
 
+// The same where nothing notes dispersion (wavefront.comp).
+float mediumIndex(int r, int mode) {
+  bool unused = false;
+  return mediumIndex(r, mode, unused);
+}
+
 // n_o / n_e of region r at x and its gradient (mediumIndexAt): a GRIN profile replaces the index.
-float regionIndex(int r, int mode, vec3 x, out vec3 grad) {
+// `dispersive` as mediumIndex's.
+float regionIndex(int r, int mode, vec3 x, out vec3 grad, inout bool dispersive) {
   grad = vec3(0.0);
-  if (!hasFlag(EIKON_F_VARYING)) return mediumIndex(r, mode);  // no GRIN region in the scene
+  if (!hasFlag(EIKON_F_VARYING)) return mediumIndex(r, mode, dispersive);  // no GRIN region in the scene
   int grin = int(mediumRow(r, 11).w);
-  if (grin == 0) return mediumIndex(r, mode);
+  if (grin == 0) return mediumIndex(r, mode, dispersive);
   vec4 g = mediumRow(r, 12), c = mediumRow(r, 13);  // (n0, ∇n), (origin, radius)
   vec3 d = x - c.xyz;
   float R2 = c.w * c.w, r2 = dot(d, d) / R2;
@@ -101,9 +108,15 @@ float regionIndex(int r, int mode, vec3 x, out vec3 grad) {
   return sqrt(max(2.0 - r2, 1.0));
 }
 
-float regionIndex(int r, int mode, vec3 x) {
+float regionIndex(int r, int mode, vec3 x, inout bool dispersive) {
   vec3 g;
-  return regionIndex(r, mode, x, g);
+  return regionIndex(r, mode, x, g, dispersive);
+}
+
+// The same where nothing notes dispersion (polarised_trace.comp).
+float regionIndex(int r, int mode, vec3 x) {
+  bool unused = false;
+  return regionIndex(r, mode, x, unused);
 }
 
 // The optic axis field of a region at x: (unit axis, 1/r of a radial field or 0); zero where
@@ -161,21 +174,22 @@ vec3 orientNormal(vec3 N, vec3 flow) { return dot(N, flow) < 0.0 ? -N : N; }
 #ifndef EIKON_SHARP_NO_MARCH
 
 // Box entry: the region there, and the wave vector of the mode in its medium along d.
-void sharpEnter(inout MarchState S, vec3 x, vec3 d, int mode) {
+void sharpEnter(inout MarchState S, inout bool dispersive, vec3 x, vec3 d, int mode) {
   S.x = x;
   S.region = regionAt(x);  // on the shapes on the exact path, else the field's
-  float n = regionIndex(S.region, 0, x);
+  float n = regionIndex(S.region, 0, x, dispersive);
   vec4 af = regionAxisField(S.region, x);
   if (mode == 1 && hasAxis(af.xyz))
-    n = inversesqrt(dot(d, applyM(d, af.xyz, n, regionIndex(S.region, 1, x))));
+    n = inversesqrt(dot(d, applyM(d, af.xyz, n, regionIndex(S.region, 1, x, dispersive))));
   S.w = n * d;
 }
 
 // The ray (energy) direction in the ray's region: w/|w|, or M_e w for the e-mode in a crystal.
-vec3 sharpDirection(MarchState S, int mode) {
+vec3 sharpDirection(MarchState S, int mode, inout bool dispersive) {
   vec4 af = regionAxisField(S.region, S.x);
   if (mode == 0 || !hasAxis(af.xyz)) return normalize(S.w);
-  return normalize(applyM(S.w, af.xyz, regionIndex(S.region, 0, S.x), regionIndex(S.region, 1, S.x)));
+  return normalize(applyM(S.w, af.xyz, regionIndex(S.region, 0, S.x, dispersive),
+                          regionIndex(S.region, 1, S.x, dispersive)));
 }
 
 #endif  // EIKON_SHARP_NO_MARCH
@@ -213,20 +227,20 @@ BoundaryCrossing nextCrossing(vec3 a, vec3 b, int region) {
 #ifndef EIKON_SHARP_NO_MARCH
 // Emission, attenuation (exact: e^{−σ len}) and in-scatter along a straight piece in the ray's
 // region.
-void absorbAlong(inout MarchState S, vec3 dir, float len, int mode) {
+void absorbAlong(inout MarchState S, inout bool dispersive, vec3 dir, float len, int mode) {
   // Nothing to add where no medium attenuates, emits or scatters light (S.L += 0, S.T *= 1).
   if (!hasFlag(EIKON_F_ATTENUATION) && !hasFlag(EIKON_F_EMISSION) && !hasFlag(EIKON_F_LIT)) return;
   int r = S.region;
   vec3 sig = sigmaOf(mediumRow(r, 8).xyz);
   vec4 af = regionAxisField(r, S.x);
   if (mode == 1 && hasAxis(af.xyz))
-    sig = attenuationE(sig, sigmaOf(mediumRow(r, 9).xyz), S.w, af.xyz, regionIndex(r, 0, S.x),
-                       regionIndex(r, 1, S.x));
+    sig = attenuationE(sig, sigmaOf(mediumRow(r, 9).xyz), S.w, af.xyz, regionIndex(r, 0, S.x, dispersive),
+                       regionIndex(r, 1, S.x, dispersive));
   vec3 e = colourOf(mediumRow(r, 10).xyz);
   vec3 alb = mediumRow(r, 11).xyz;
   if (hasFlag(EIKON_F_LIT) && alb.x + alb.y + alb.z > 0.0) e += inScatter(S.x + 0.5 * len * dir, dir, sig);
   // What depends on λ ends wavelength sharing (march.glsl): any attenuation or light added.
-  if (any(notEqual(sig, vec3(0.0))) || any(notEqual(e, vec3(0.0)))) gDispersiveHit = true;
+  if (any(notEqual(sig, vec3(0.0))) || any(notEqual(e, vec3(0.0)))) dispersive = true;
   vec3 att = exp(-sig * len);
   S.L += S.T * mix(e * len, e * (1.0 - att) / max(sig, vec3(1e-30)), greaterThan(sig, vec3(1e-6)));
   S.T *= att;
@@ -237,9 +251,9 @@ const int kSharpCross = 1;  // at a boundary crossing
 const int kSharpLeave = 2;  // out of the volume
 
 // The ray equation in a varying region from its own analytic medium (deriv's twin).
-void sharpDeriv(int region, vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) {
+void sharpDeriv(int region, vec3 x, vec3 w, int mode, inout bool dispersive, out vec3 dx, out vec3 dw) {
   vec3 g;
-  float n = regionIndex(region, 0, x, g);
+  float n = regionIndex(region, 0, x, g, dispersive);
   vec4 af = mode == 1 ? regionAxisField(region, x) : vec4(0.0);
   if (!hasAxis(af.xyz)) {
     float lw = length(w);
@@ -248,7 +262,7 @@ void sharpDeriv(int region, vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) 
     return;
   }
   vec3 ge;
-  float ne = regionIndex(region, 1, x, ge);
+  float ne = regionIndex(region, 1, x, ge, dispersive);
   vec3 Mp, dp;
   eModeRates(w, af, vec4(n, g), vec4(ne, ge), Mp, dp);
   float L = length(Mp);
@@ -261,14 +275,14 @@ void sharpDeriv(int region, vec3 x, vec3 w, int mode, out vec3 dx, out vec3 dw) 
 // with dL/ds = w·dx/ds (n for the o-mode, p·t for the e-mode): one more component of the same
 // ODE, so L keeps the integrator's fourth order. `tangent` is the last stage's dx/ds (sharpLand's
 // rate).
-void sharpRk4(int region, float ds, int mode, inout vec3 x, inout vec3 w, inout float opl,
-              out vec3 tangent) {
+void sharpRk4(int region, float ds, int mode, inout bool dispersive, inout vec3 x, inout vec3 w,
+              inout float opl, out vec3 tangent) {
   vec3 kx = vec3(0.0), kw = vec3(0.0), sx = vec3(0.0), sw = vec3(0.0);
   float sl = 0.0;
   for (int st = 0; st < 4; ++st) {
     float c = st == 0 ? 0.0 : (st == 3 ? 1.0 : 0.5);
     vec3 dx, dw, ws = w + c * ds * kw;
-    sharpDeriv(region, x + c * ds * kx, ws, mode, dx, dw);
+    sharpDeriv(region, x + c * ds * kx, ws, mode, dispersive, dx, dw);
     float b = (st == 0 || st == 3) ? 1.0 : 2.0;
     sx += b * dx;
     sw += b * dw;
@@ -302,14 +316,14 @@ vec3 volumeSide(vec3 o, vec3 d, vec3 bmin, vec3 bmax) {
 // Called once, from sharpAdvance (one inlined copy of its sharpRk4).
 const int kLandPasses = 3;
 const float kLandMinRate = 1e-3;
-void sharpLand(int region, int mode, vec3 x0, vec3 w0, float s, float ds, vec3 q, vec3 N,
-               out vec3 x1, out vec3 w1, out float opl) {
+void sharpLand(int region, int mode, inout bool dispersive, vec3 x0, vec3 w0, float s, float ds,
+               vec3 q, vec3 N, out vec3 x1, out vec3 w1, out float opl) {
   for (int pass = 0;; ++pass) {
     vec3 tangent;
     x1 = x0;
     w1 = w0;
     opl = 0.0;
-    sharpRk4(region, s, mode, x1, w1, opl, tangent);
+    sharpRk4(region, s, mode, dispersive, x1, w1, opl, tangent);
     float rate = dot(tangent, N);
     if (pass == kLandPasses || !(rate > kLandMinRate)) break;
     s = clamp(s - dot(x1 - q, N) / rate, 0.0, ds);
@@ -325,7 +339,8 @@ void sharpLand(int region, int mode, vec3 x0, vec3 w0, float s, float ds, vec3 q
 //     a face first, the step is shortened to the one that ends on that plane (sharpLand), so that
 //     x, w and the optical path belong to where it ends, and the crossing is that point of the
 //     path.
-int sharpAdvance(inout MarchState S, inout MarchResult R, out BoundaryCrossing c, int mode) {
+int sharpAdvance(inout MarchState S, inout MarchResult R, inout bool dispersive, out BoundaryCrossing c,
+                 int mode) {
   const vec3 bmin = P.grid_origin.xyz, bmax = P.grid_origin.xyz + P.grid_extent.xyz;
   const float h = P.grid_origin.w;
   bool straight = !hasFlag(EIKON_F_VARYING) || mediumHomogeneous(S.region);
@@ -333,7 +348,7 @@ int sharpAdvance(inout MarchState S, inout MarchResult R, out BoundaryCrossing c
   float len = 0.0, ds = P.march.x * h, keep = 1.0, opl = 0.0;
   bool leaving = true;
   if (straight) {  // sharpSegment
-    dir = sharpDirection(S, mode);
+    dir = sharpDirection(S, mode, dispersive);
     float tb0, tb1;
     boxHit(S.x, dir, bmin, bmax, tb0, tb1);
     len = max(tb1, 0.0);
@@ -345,7 +360,7 @@ int sharpAdvance(inout MarchState S, inout MarchResult R, out BoundaryCrossing c
     x1 = S.x + dir * len;
   } else {  // sharpStep
     vec3 tangent;
-    sharpRk4(S.region, ds, mode, x1, w1, opl, tangent);
+    sharpRk4(S.region, ds, mode, dispersive, x1, w1, opl, tangent);
     vec3 chord = x1 - x0;
     float a0, a1;
     dir = normalize(chord);
@@ -363,17 +378,17 @@ int sharpAdvance(inout MarchState S, inout MarchResult R, out BoundaryCrossing c
     if (keep < 1.0) {
       vec3 onPlane = c.found ? c.point : x1;  // x1: the chord's exit from the volume
       vec3 N = c.found ? c.normal : volumeSide(x0, dir, bmin, bmax);
-      sharpLand(S.region, mode, x0, w0, keep * ds, ds, onPlane, N, x1, w1, opl);
+      sharpLand(S.region, mode, dispersive, x0, w0, keep * ds, ds, onPlane, N, x1, w1, opl);
       if (c.found) c.point = x1;
     }
     R.opl += opl;
-    if (mode == 0) R.drift = max(R.drift, abs(length(w1) - regionIndex(S.region, 0, x1)));
+    if (mode == 0) R.drift = max(R.drift, abs(length(w1) - regionIndex(S.region, 0, x1, dispersive)));
     S.x = 0.5 * (x0 + x1);
     S.w = 0.5 * (w0 + w1);
     dir = normalize(x1 - x0 + 1e-30);
     len = length(x1 - x0);
   }
-  absorbAlong(S, dir, len, mode);
+  absorbAlong(S, dispersive, dir, len, mode);
   S.x = x1;
   S.w = w1;
   return c.found ? kSharpCross : leaving ? kSharpLeave : kSharpGo;
@@ -383,7 +398,8 @@ int sharpAdvance(inout MarchState S, inout MarchResult R, out BoundaryCrossing c
 // mirror; otherwise the ray carries (1 − R) on and an external reflection adds R × environment.
 // (refractIsotropic, refractIntoUniaxial, refractOutOfUniaxial and reflectInsideUniaxial are one
 // solveInterfaceMode each: the incident wave's tangential part on the outgoing mode's shell.)
-void crossInterface(inout MarchState S, inout MarchResult R, BoundaryCrossing c, int mode) {
+void crossInterface(inout MarchState S, inout MarchResult R, inout PathRecord rec, BoundaryCrossing c,
+                    int mode) {
   int A = S.region, B = c.to;
   vec3 x = S.x, N = c.normal, s = normalize(S.w);
   vec4 afA = regionAxisField(A, x), afB = regionAxisField(B, x);
@@ -394,8 +410,8 @@ void crossInterface(inout MarchState S, inout MarchResult R, BoundaryCrossing c,
     S.region = B;  // equal media: nothing changes (an opaque one stops the ray next)
     return;
   }
-  float noA = regionIndex(A, 0, x), neA = regionIndex(A, 1, x);
-  float noB = regionIndex(B, 0, x), neB = regionIndex(B, 1, x);
+  float noA = regionIndex(A, 0, x, rec.dispersive), neA = regionIndex(A, 1, x, rec.dispersive);
+  float noB = regionIndex(B, 0, x, rec.dispersive), neB = regionIndex(B, 1, x, rec.dispersive);
   float n1 = length(S.w);
   // Leaving a crystal the normal is oriented along the incident ray (energy) direction and the
   // incident wave's index is the mode's n(θ); otherwise along s with |w|.
@@ -427,7 +443,7 @@ void crossInterface(inout MarchState S, inout MarchResult R, BoundaryCrossing c,
       float wsw = sWeight(uB ? o.s : s, uB ? afB.xyz : afA.xyz, N, s, mode);
       Rf = wsw * rsp.x + (1.0 - wsw) * rsp.y;
     }
-    if (o.n > n1) S.L += environmentWeighted(S.T * Rf, reflect(s, N));
+    if (o.n > n1) S.L += environmentWeighted(rec, S.T * Rf, reflect(s, N));
     S.T *= 1.0 - Rf;
   }
   R.interfaces++;
@@ -445,10 +461,10 @@ bool loopLimitReached() {
   return passes < 2;
 }
 
-MarchResult marchSharp(vec3 o, vec3 d, int mode) {
+MarchResult marchSharp(vec3 o, vec3 d, int mode, inout PathRecord rec) {
   MarchResult R;
   float t0;
-  if (!enterVolume(o, d, R, t0)) return R;
+  if (!enterVolume(o, d, rec, R, t0)) return R;
   MarchState S;
   S.nn = vec4(0.0);  // unused by the sharp march, but defined
   S.inLayer = false;
@@ -460,27 +476,27 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   S.T = vec3(1.0);
   S.L = vec3(0.0);
   S.stopped = false;
-  sharpEnter(S, o + d * t0, d, mode);
+  sharpEnter(S, rec.dispersive, o + d * t0, d, mode);
   R.opl = P.march.z * t0;
   const int maxSteps = P.limits.x;
   int steps = 0;
   bool cut = false;
   for (; steps < maxSteps; ++steps) {
     if (hasFlag(EIKON_F_OPACITY) && mediumOpaque(S.region)) {  // surface emission over the coverage, as the smoothed path
-      S.L += surfaceWeighted(S.T, mediumRow(S.region, 10).xyz / mediumRow(S.region, 8).w,
+      S.L += surfaceWeighted(rec, S.T, mediumRow(S.region, 10).xyz / mediumRow(S.region, 8).w,
                              diffuseSurface(S.x, mode));
       S.stopped = true;
       break;
     }
     BoundaryCrossing c;
-    int ev = sharpAdvance(S, R, c, mode);
+    int ev = sharpAdvance(S, R, rec.dispersive, c, mode);
     if (kAov && ev == kSharpCross && !R.hit) {  // the AOV layer: the exact crossing
       R.hit = true;
       R.hitPoint = c.point;
       R.hitNormal = dot(c.normal, S.w) > 0.0 ? -c.normal : c.normal;
       R.hitObject = max(c.from, c.to) - 1;
     }
-    if (ev == kSharpCross) crossInterface(S, R, c, mode);
+    if (ev == kSharpCross) crossInterface(S, R, rec, c, mode);
     if (loopLimitReached()) {
       cut = true;
       break;
@@ -489,14 +505,14 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode) {
   }
   R.steps = steps;
   R.exit_point = S.x;
-  R.exit_dir = sharpDirection(S, mode);
+  R.exit_dir = sharpDirection(S, mode, rec.dispersive);
   R.wave_normal = normalize(S.w);
   // The check in the loop sees a budget spent in the loops of a pass; one spent by the march
   // loop's own last pass stops it silently after that pass, which only a check after it sees.
   cut = cut || loopLimitReached();
   R.cut = cut || (!S.stopped && steps >= maxSteps);  // the loop limit, or out of steps
   R.left = !S.stopped && !cut && steps < maxSteps;
-  if (R.left) S.L += environmentWeighted(S.T, R.exit_dir);
+  if (R.left) S.L += environmentWeighted(rec, S.T, R.exit_dir);
   R.radiance = S.L;
   R.throughput = S.T;
   return R;

@@ -31,7 +31,8 @@ void main() {
   // One call site of march() (lavapipe compiles every inlined copy): the modes are a loop.
   int modes = hasFlag(EIKON_F_UNIAXIAL) ? 2 : 1;
   for (int mode = 0; mode < modes; ++mode) {
-    TraceResult o = pack(march(ray.origin.xyz, d, mode));
+    PathRecord rec = noRecord();  // nothing is evaluated at other wavelengths
+    TraceResult o = pack(march(ray.origin.xyz, d, mode, rec));
     results[2 * i + mode] = o;
     if (modes == 1) results[2 * i + 1] = o;
   }

@@ -145,8 +145,6 @@ layout(std140, binding = EIKON_B_SMALL_MEDIA) uniform SmallMediaBuf {
 };
 #define EIKON_SHAPE_ROW(i) (hasFlag(EIKON_F_SMALL_SHAPES) ? exactRows[i] : shapeTable[i])
 #define EIKON_MEDIUM_ROW(i) (hasFlag(EIKON_F_SMALL_MEDIA) ? smallMedia[i] : mediaTable[i])
-float gLambdaUm = 0.5876;      // sharp.glsl's mediumIndex: set to P.wavelength.x in main()
-bool gDispersiveHit = false;  // written by mediumIndex, unused here
 #define EIKON_BOUNDARY_HAS_CONVEX hasFlag(EIKON_F_CONVEX)
 #define EIKON_BOUNDARY_HAS_MESH hasFlag(EIKON_F_MESH)
 #define EIKON_BOUNDARY_CONVEX_APART hasFlag(EIKON_F_CONVEX_APART)
@@ -961,7 +959,6 @@ void scatter(uint id) {
 void main() {
   const uint id = gl_GlobalInvocationID.x, mode = pc.control.y;
   P = params;
-  gLambdaUm = P.wavelength.x;
   if (mode == EIKON_WM_PROPAGATE)
     propagate(id);
   else if (mode == EIKON_WM_SCATTER)

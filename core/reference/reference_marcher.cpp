@@ -58,9 +58,9 @@ void validate(const MarchSettings& m) { checkMarchSettings(m); }
 
 }  // namespace
 
-/// Hero wavelength sampling (view.comp, march.glsl gHero): the environment lookups of a hero march
-/// made before its path met anything dispersive, as (linear sRGB radiance, weight), valid at every
-/// wavelength of the pixel sample; after that (or once full) lookups are the hero's alone.
+/// Hero wavelength sampling (view.comp, march.glsl PathRecord): the environment lookups of a hero
+/// march made before its path met anything dispersive, as (linear sRGB radiance, weight), valid at
+/// every wavelength of the pixel sample; after that (or once full) lookups are the hero's alone.
 struct HeroRecord {
   static constexpr int kMax = 6;
   bool diverged = false;
@@ -915,8 +915,9 @@ struct ReferenceMarcher::SampleTally {
 glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
                                            uint32_t sample, const RenderSettings& s,
                                            SampleTally& tally, LayerSums* layers) const {
-  // view.comp's hero branch: one march (per mode) at λ_0, its lookups before the path's first
-  // dispersive event recorded for all N wavelengths, the rest the hero's alone, counted N times.
+  // view.comp renderSpectralSample, hero: one march (per mode) at λ_0, its lookups before the
+  // path's first dispersive event recorded for all N wavelengths, the rest the hero's alone,
+  // counted N times.
   const auto n = uint32_t(s.wavelengths);
   const std::vector<double> lambdas = spectrum::heroWavelengths(pixel, sample, n);
   const int modes = field_.uniaxial() ? 2 : 1;
@@ -955,26 +956,31 @@ glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3
   return xyz;
 }
 
-glm::dvec3 ReferenceMarcher::sampleRgb(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel,
-                                       uint32_t sidx, const RenderSettings& s, bool hero,
-                                       SampleTally& tally, LayerSums& layers) const {
-  const glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
-  LayerSums* lp = layers.active() ? &layers : nullptr;
-  if (s.wavelengths > 0 && hero) return M * heroSampleXyz(eye, d, pixel, sidx, s, tally, lp);
+glm::dvec3 ReferenceMarcher::rgbSample(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel,
+                                       const RenderSettings& s, SampleTally& tally,
+                                       LayerSums* layers) const {
   // Unpolarised light: each mode carries half, or the one selected the whole (modeRange).
   const ModeRange mr = modeRange(s.modes, field_.uniaxial());
-  if (s.wavelengths == 0) {  // RGB mode: one march per mode at the index wavelength
-    glm::dvec3 rad(0.0);
-    for (int mode = mr.first; mode < mr.end; ++mode) {
-      const Result r = march(eye, d, s.wavelength_nm, false, s.march, mode);
-      const glm::dvec3 part = mr.weight * r.radiance;
-      rad += part;
-      tally.add(r, 1.0);
-      if (lp)
-        for (int c = 0; c < 3; ++c) lp->at(pixel, mode)[c] += part[c];
-    }
-    return rad;
+  glm::dvec3 rad(0.0);
+  for (int mode = mr.first; mode < mr.end; ++mode) {
+    const Result r = march(eye, d, s.wavelength_nm, false, s.march, mode);
+    const glm::dvec3 part = mr.weight * r.radiance;
+    rad += part;
+    tally.add(r, 1.0);
+    if (layers)
+      for (int c = 0; c < 3; ++c) layers->at(pixel, mode)[c] += part[c];
   }
+  return rad;
+}
+
+glm::dvec3 ReferenceMarcher::stratifiedSampleXyz(const glm::dvec3& eye, const glm::dvec3& d,
+                                                 uint32_t pixel, uint32_t sidx,
+                                                 const RenderSettings& s, SampleTally& tally,
+                                                 LayerSums* layers) const {
+  // Unpolarised light: each mode carries half, or the one selected the whole (modeRange). Every
+  // wavelength is marched: view.comp's wavelength sharing only skips marches whose results the
+  // record already gives.
+  const ModeRange mr = modeRange(s.modes, field_.uniaxial());
   const auto n = uint32_t(s.wavelengths);
   const std::vector<double> lambdas = spectrum::stratifiedWavelengths(pixel, sidx, n);
   glm::dvec3 xyz(0.0);
@@ -985,11 +991,22 @@ glm::dvec3 ReferenceMarcher::sampleRgb(const glm::dvec3& eye, const glm::dvec3& 
       const double part = mr.weight * r.radiance.x;
       rad += part;
       tally.add(r, s.wavelengths);
-      if (lp) lp->at(pixel, mode)[k] += part;
+      if (layers) layers->at(pixel, mode)[k] += part;
     }
     xyz += rad * spectrum::sampleWeightXyz(lambdas[k], n);
   }
-  return M * xyz;
+  return xyz;
+}
+
+glm::dvec3 ReferenceMarcher::sampleRgb(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel,
+                                       uint32_t sidx, const RenderSettings& s, bool hero,
+                                       SampleTally& tally, LayerSums& layers) const {
+  // The strategy, as view.comp's main chooses it from the pass bits.
+  LayerSums* lp = layers.active() ? &layers : nullptr;
+  if (s.wavelengths == 0) return rgbSample(eye, d, pixel, s, tally, lp);
+  const glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
+  if (hero) return M * heroSampleXyz(eye, d, pixel, sidx, s, tally, lp);
+  return M * stratifiedSampleXyz(eye, d, pixel, sidx, s, tally, lp);
 }
 
 RenderImage ReferenceMarcher::render(const Camera& cam, const RenderSettings& s,

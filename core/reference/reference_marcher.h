@@ -67,6 +67,15 @@ class ReferenceMarcher {
   glm::dvec3 heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
                            uint32_t sample, const RenderSettings& s, SampleTally& tally,
                            LayerSums* layers) const;
+  /// Linear sRGB of one pixel sample in RGB mode: one march per mode at the index wavelength
+  /// (view.comp renderRgbSample).
+  glm::dvec3 rgbSample(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel,
+                       const RenderSettings& s, SampleTally& tally, LayerSums* layers) const;
+  /// CIE XYZ (as heroSampleXyz's) of one pixel sample at its N stratified wavelengths, one march
+  /// per wavelength and mode (view.comp renderSpectralSample, stratified).
+  glm::dvec3 stratifiedSampleXyz(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel,
+                                 uint32_t sidx, const RenderSettings& s, SampleTally& tally,
+                                 LayerSums* layers) const;
   /// Linear sRGB of one pixel sample along d from eye (hero, stratified or RGB) of the modes
   /// settings.modes selects (modeRange), its marches added to `tally` and their radiance to
   /// `layers`.

@@ -771,6 +771,94 @@ void addAov(RenderImage& img, const std::vector<glm::vec4>& band, int rows, int 
         FirstInterface{true, glm::dvec3(glm::vec3(a)), glm::dvec3(glm::vec3(b)), int(a.w)});
   }
 }
+
+/// How render() splits a pixel sample into passes, by the wavelength strategy view.comp's main
+/// chooses from the pass bits: RGB (one pass at the fixed wavelength), stratified spectral (one
+/// wavelength per pass, or all N where wavelength sharing makes one march serve every
+/// wavelength, with sharing across passes where it does not) or hero spectral (one pass, all N).
+/// Passes are one pixel sample at one wavelength (both modes) per dispatch because lavapipe's
+/// loop budget is per invocation, all loops together (view.comp's header,
+/// docs/view-renderer.md).
+enum class Strategy { Rgb, Stratified, Hero };
+struct PassPlan {
+  Strategy strategy = Strategy::Rgb;
+  int N = 1;                ///< wavelengths per pixel sample (1 in RGB mode)
+  int perPass = 1;          ///< wavelengths a pass marches (or shares)
+  int passesPerSample = 1;  ///< passes per pixel sample
+  int passes = 1;           ///< passes in all (spp of them per sample)
+  bool crossShare = false;  ///< sharing across stratified passes (EIKON_PASS_SHARED)
+};
+
+/// The plan for the scene's flags (EIKON_F_*): strategy and sharing as view.comp applies them.
+/// Sharing across passes (view.comp, EIKON_PASS_SHARED): where the passes march one wavelength
+/// each (a crystal, dispersive medium, attenuation, emission or opaque object in the scene), a
+/// pixel sample's first pass also adds the other wavelengths of every pixel whose path met nothing
+/// that depends on λ (from its record), notes it in one word per pixel, and the sample's later
+/// passes skip that pixel. The spectral and modes layers keep the plain passes (their bins are
+/// written pass by pass); an image whose words exceed one storage buffer too.
+PassPlan planPasses(const RenderSettings& s, int flags, const LayerSums& layers, size_t pixels,
+                    const vk::DeviceLimits& limits) {
+  PassPlan plan;
+  if (s.wavelengths > 0) {
+    const bool weightsDependOnLambda =
+        (flags & (EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY)) != 0;
+    plan.strategy =
+        useHeroSampling(s.sampling, weightsDependOnLambda) ? Strategy::Hero : Strategy::Stratified;
+    plan.N = s.wavelengths;
+  }
+  const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY |
+                              EIKON_F_UNIAXIAL | EIKON_F_DISPERSIVE;
+  // Hero: one pass per pixel sample, all N wavelengths; stratified: all N in one pass where no
+  // march depends on λ (the others are table lookups), else one each.
+  const bool share = plan.strategy == Strategy::Hero ||
+                     (plan.strategy == Strategy::Stratified && (flags & lambdaDependent) == 0);
+  plan.perPass = share ? plan.N : 1;
+  plan.passesPerSample = (plan.N + plan.perPass - 1) / plan.perPass;
+  plan.passes = s.spp * plan.passesPerSample;
+  plan.crossShare = plan.strategy == Strategy::Stratified && s.wavelengths > 1 && !share &&
+                    !layers.active() &&
+                    pixels * sizeof(uint32_t) <= limits.max_storage_buffer_range;
+  return plan;
+}
+
+/// ViewParams.pass of pass `pass`: (pixel sample, first wavelength, wavelengths, pass bits). A
+/// pixel sample's first pass with sharing across passes is told to cover all N.
+glm::ivec4 passOf(const PassPlan& plan, int pass, const RenderSettings& s,
+                  const LayerSums& layers) {
+  const int k = pass % plan.passesPerSample;
+  return glm::ivec4(pass / plan.passesPerSample, k * plan.perPass,
+                    plan.crossShare && k == 0 ? plan.N : plan.perPass,
+                    passBits(s, plan.strategy == Strategy::Hero, layers, plan.crossShare));
+}
+
+/// The layer channels [c0, c1) a pass writes: r, g, b (RGB), all N bins (hero), the pass's
+/// wavelength bins (stratified).
+std::pair<int, int> layerChannelsOf(const PassPlan& plan, const glm::ivec4& pass) {
+  switch (plan.strategy) {
+    case Strategy::Rgb:
+      return {0, 3};
+    case Strategy::Hero:
+      return {0, plan.N};
+    case Strategy::Stratified:
+      break;
+  }
+  return {pass.y, std::min(pass.y + pass.z, plan.N)};
+}
+
+/// Adds one band's pixels (view.comp: this pass's share of linear sRGB, w = its steps, or
+/// −(steps + 1) where a march was cut) to the sums.
+void addPixels(std::vector<double>& acc, RenderImage& img, double& steps,
+               const std::vector<glm::vec4>& band, int rows, int y0) {
+  for (size_t i = 0; i < size_t(img.width) * size_t(rows); ++i) {
+    const glm::vec4& v = band[i];
+    const size_t o = (size_t(y0) * size_t(img.width) + i) * 3;
+    acc[o] += v.x;
+    acc[o + 1] += v.y;
+    acc[o + 2] += v.z;
+    if (v.w < 0.0f) ++img.cut_samples;
+    steps += v.w < 0.0f ? -double(v.w) - 1.0 : double(v.w);
+  }
+}
 }  // namespace
 
 RenderImage ViewRenderer::render(const RenderSettings& s) {
@@ -788,33 +876,22 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   p.wavelength = glm::vec4(float(l), float(1.0 / (l * l)), float(1.0 / (l * l * l * l)), 0.0f);
   I.boundary.setRenderWavelength(s.wavelength_nm);  // the RGB march's indices (sharp.glsl)
 
-  // Passes: one pixel sample at one wavelength (both modes) per dispatch, or at all N where no
-  // march depends on λ (view.comp's wavelength sharing: one march serves every wavelength, the
-  // others are table lookups) — lavapipe's loop budget is per invocation, all loops together
-  // (view.comp's header, docs/view-renderer.md). Passes are outermost so that every finished pass
-  // is a whole (noisier) image: RenderSettings::on_pass shows the picture forming.
-  // Hero wavelength sampling (docs/spectra.md): one pass per pixel sample, all N wavelengths.
-  const int N = std::max(1, s.wavelengths);
-  const bool weightsDependOnLambda =
-      (p.grid_dims.w & (EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY)) != 0;
-  const bool hero = s.wavelengths > 0 && useHeroSampling(s.sampling, weightsDependOnLambda);
-  const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY |
-                              EIKON_F_UNIAXIAL | EIKON_F_DISPERSIVE;
-  const bool share = s.wavelengths > 0 && (hero || (p.grid_dims.w & lambdaDependent) == 0);
-  const int perPass = share ? N : 1;
-  const int passesPerSample = (N + perPass - 1) / perPass;
-  const int passes = s.spp * passesPerSample;
+  // Passes (planPasses) are outermost so that every finished pass is a whole (noisier) image:
+  // RenderSettings::on_pass shows the picture forming.
   // Bands of rows within a pass so that progress is reported and no dispatch runs for long: the
   // band buffer holds up to ~2e5 rays' worth of rows; the first band is one workgroup row, each
   // next one is sized from the last one's time to take ~0.25 s.
   // Layers (core/contract/render_layers.h): per pixel, after the band's RGB, `stride` vec4s of
   // channel values per mode (view.comp layerWrite); the pass's bins are added on the host.
   LayerSums layers(s, size_t(img.width) * size_t(img.height), I.uniaxial);
+  const size_t pixels = size_t(img.width) * size_t(img.height);
+  const PassPlan plan = planPasses(s, p.grid_dims.w, layers, pixels, I.ctx.limits());
+  const int passes = plan.passes, passesPerSample = plan.passesPerSample;
   const size_t stride = layers.active() ? size_t((layers.channels() * layers.modes() + 3) / 4) : 0;
   // The AOV layer: two vec4s per pixel after those (view.comp aovWrite).
   const size_t perPixel = 1 + stride + (s.aov_layer ? 2 : 0);
   if (s.aov_layer) initAov(img);
-  const double rowWork = double(img.width) * perPass;
+  const double rowWork = double(img.width) * plan.perPass;
   int max_rows = std::clamp(int(std::ceil(2.0e5 / std::max(rowWork, 1.0))), EIKON_WG_Y, img.height);
   max_rows = (max_rows + EIKON_WG_Y - 1) / EIKON_WG_Y * EIKON_WG_Y;
   int rows = EIKON_WG_Y;
@@ -823,16 +900,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   p.pass.w = s.aov_layer ? kAovPassBit : 0;  // the pipeline's key (keyOf)
   vk::ComputePipeline& view = I.pipeline(Impl::kView, p);
   view.bindBuffer(EIKON_B_OUTPUT, out);
-  const size_t pixels = size_t(img.width) * size_t(img.height);
-  // Sharing across passes (view.comp, EIKON_PASS_SHARED): where the passes march one wavelength
-  // each (a crystal, dispersive medium, attenuation, emission or opaque object in the scene), a
-  // pixel sample's first pass also adds the other wavelengths of every pixel whose path met nothing
-  // that depends on λ (from its record), notes it in one word per pixel, and the sample's later
-  // passes skip that pixel. The spectral and modes layers keep the plain passes (their bins are
-  // written pass by pass); an image whose words exceed one storage buffer too.
-  const bool crossShare = s.wavelengths > 1 && !share && !layers.active() &&
-                          pixels * sizeof(uint32_t) <= I.ctx.limits().max_storage_buffer_range;
-  vk::Buffer sharedPaths(I.ctx, (crossShare ? pixels : 1) * sizeof(uint32_t),
+  vk::Buffer sharedPaths(I.ctx, (plan.crossShare ? pixels : 1) * sizeof(uint32_t),
                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "shared paths");
   view.bindBuffer(EIKON_B_SHARED_PATHS, sharedPaths);
   std::vector<double> acc(pixels * 3, 0.0);
@@ -841,9 +909,7 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   double steps = 0.0;
   auto t0 = std::chrono::steady_clock::now();
   for (int pass = 0; pass < passes; ++pass) {
-    const int k = pass % passesPerSample;
-    p.pass = glm::ivec4(pass / passesPerSample, k * perPass, crossShare && k == 0 ? N : perPass,
-                        passBits(s, hero, layers, crossShare));
+    p.pass = passOf(plan, pass, s, layers);
     for (int y0 = 0, n = 0; y0 < img.height; y0 += n) {
       n = std::min(rows, img.height - y0);
       const auto band_start = std::chrono::steady_clock::now();
@@ -857,19 +923,10 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
       out.read(band.data(), size_t(img.width) * size_t(n) * perPixel * sizeof(glm::vec4));
       if (s.aov_layer) addAov(img, band, n, y0, stride, pass == 0, I.scene.camera.position);
       if (layers.active()) {
-        const int c0 = s.wavelengths == 0 || hero ? 0 : p.pass.y;
-        const int c1 = s.wavelengths == 0 ? 3 : hero ? N : std::min(p.pass.y + p.pass.z, N);
+        const auto [c0, c1] = layerChannelsOf(plan, p.pass);
         addLayers(layers, band, img.width, n, y0, c0, c1, stride);
       }
-      for (size_t i = 0; i < size_t(img.width) * size_t(n); ++i) {
-        const glm::vec4& v = band[i];
-        const size_t o = (size_t(y0) * size_t(img.width) + i) * 3;
-        acc[o] += v.x;
-        acc[o + 1] += v.y;
-        acc[o + 2] += v.z;
-        if (v.w < 0.0f) ++img.cut_samples;
-        steps += v.w < 0.0f ? -double(v.w) - 1.0 : double(v.w);
-      }
+      addPixels(acc, img, steps, band, n, y0);
       if (s.progress) s.progress((pass + double(y0 + n) / img.height) / passes);
       const double band_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - band_start).count();
