@@ -19,9 +19,9 @@
 #include <random>
 #include <string>
 
+#include "anisotropic/dispersion.h"
 #include "fitting/fitting.h"
 #include "fitting/index_data.h"
-#include "optics/dispersion.h"
 
 int main(int argc, char** argv) {
   double min_seconds = 1.0;

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "optics/units.h"
+#include "anisotropic/units.h"
 
 namespace eikon {
 namespace {

@@ -46,8 +46,8 @@
 #include <string>
 #include <vector>
 
+#include "anisotropic/dispersion.h"
 #include "fitting/index_data.h"
-#include "optics/dispersion.h"
 
 namespace eikon {
 

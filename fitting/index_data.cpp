@@ -11,9 +11,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "anisotropic/units.h"
 #include "core/io/text_file.h"
 #include "fitting/refractiveindex_formula.h"
-#include "optics/units.h"
 
 namespace eikon {
 namespace {

@@ -38,7 +38,7 @@
 #include <string>
 #include <vector>
 
-#include "optics/index_limits.h"
+#include "anisotropic/index_limits.h"
 
 namespace eikon {
 
@@ -87,7 +87,7 @@ inline constexpr double kMinFitWavelengthNm = 100.0;
 inline constexpr double kMaxFitWavelengthNm = 100000.0;
 
 /// The indices a fit takes: [1, 10], those a scene's materials may have (kMinIndex, kMaxIndex of
-/// optics/index_limits.h); data above 10 made a material that `eikon fit` wrote and the scene
+/// anisotropic/index_limits.h); data above 10 made a material that `eikon fit` wrote and the scene
 /// loader refused. A row outside is refused with its file and line (after the window has dropped
 /// what it leaves out).
 inline constexpr double kMinFitIndex = kMinIndex;

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "anisotropic/uniaxial.h"
 #include "core/scene/messages.h"  // formatNumber, for messages
 #include "core/session/session.h"
-#include "optics/uniaxial.h"
 
 namespace eikon::python {
 namespace py = pybind11;

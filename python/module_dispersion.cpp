@@ -8,11 +8,11 @@
 #include <filesystem>
 #include <optional>
 
+#include "anisotropic/dispersion.h"
 #include "core/scene/limits.h"
 #include "core/scene/material_library.h"
 #include "core/scene/scene.h"
 #include "fitting/index_data.h"
-#include "optics/dispersion.h"
 #include "python/module.h"
 
 namespace eikon::python {

@@ -6,10 +6,10 @@
 
 #include <cmath>
 
-#include "optics/bm_mapping.h"
-#include "optics/fresnel.h"
-#include "optics/interface.h"
-#include "optics/pleochroism.h"
+#include "anisotropic/bm_mapping.h"
+#include "anisotropic/fresnel.h"
+#include "anisotropic/interface.h"
+#include "anisotropic/pleochroism.h"
 #include "python/module.h"
 
 namespace eikon::python {

@@ -1,6 +1,6 @@
-// The Fresnel factors of the GPU twins (optics/fresnel.h on the CPU): the s and p reflectances of
+// The Fresnel factors of the GPU twins (anisotropic/fresnel.h on the CPU): the s and p reflectances of
 // an isotropic interface and the D-projection weight of a crystal mode between them (the
-// APPROXIMATE split of optics/fresnel.h, uniaxialEntryApprox / uniaxialExitApprox). Included by
+// APPROXIMATE split of anisotropic/fresnel.h, uniaxialEntryApprox / uniaxialExitApprox). Included by
 // march.glsl (the view march) and wavefront.comp (the light simulator's sharp interfaces).
 #ifndef EIKON_FRESNEL_GLSL
 #define EIKON_FRESNEL_GLSL

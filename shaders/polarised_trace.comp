@@ -57,7 +57,7 @@ CV cvAdd(CV a, CV b) { return CV(a.re + b.re, a.im + b.im); }
 CV cvMul(vec2 c, CV v) { return CV(c.x * v.re - c.y * v.im, c.x * v.im + c.y * v.re); }
 float cvNorm2(CV v) { return dot(v.re, v.re) + dot(v.im, v.im); }
 
-// Mitsuba 3's stokes_basis (optics/polarization.cpp stokesBasis): the Stokes reference direction
+// Mitsuba 3's stokes_basis (anisotropic/polarization.cpp stokesBasis): the Stokes reference direction
 // of a unit forward direction.
 vec3 stokesBasis(vec3 n) {
   float sgn = n.z >= 0.0 ? 1.0 : -1.0, a = -1.0 / (sgn + n.z), b = n.x * n.y * a;
@@ -159,7 +159,7 @@ void segment(inout Branch b, float len) {
 }
 
 // Born & Wolf's complex amplitudes n1 → n2 at cos i = ci; beyond the critical angle
-// cos t = +i√((n1/n2)² sin²i − 1) (optics/polarization.cpp fresnelAmplitudes). xy: (r_s, r_p)
+// cos t = +i√((n1/n2)² sin²i − 1) (anisotropic/polarization.cpp fresnelAmplitudes). xy: (r_s, r_p)
 // as two complex numbers, zw: the power-normalised (t̃_s, t̃_p).
 void fresnelAmplitudes(float ci, float n1, float n2, out vec2 rs, out vec2 rp, out vec2 ts,
                        out vec2 tp) {

@@ -8,7 +8,7 @@
 // one (GRIN, radial optic axis) is integrated with RK4 on the region's own analytic medium, the
 // optical path with it; each segment or step chord is tested with nextCrossing, a step that meets
 // a face ends on it on its own path (sharpLand), and at a crossing the exact interface laws
-// (optics/interface.h, optics/fresnel.h) are applied.
+// (anisotropic/interface.h, anisotropic/fresnel.h) are applied.
 //
 // The light simulator (wavefront.comp) defines EIKON_SHARP_NO_MARCH before including this file: it
 // takes the medium table, the interface laws and nextCrossing, not the march's stages.
@@ -132,7 +132,7 @@ vec4 regionAxisField(int r, vec3 x) {
   return vec4(d / len, 1.0 / len);
 }
 
-// ---- The interface laws (optics/interface.cpp) ----
+// ---- The interface laws (anisotropic/interface.cpp) ----
 
 struct ModeWave {
   bool exists;

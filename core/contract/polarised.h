@@ -5,14 +5,14 @@
 // (eikon trace --stokes, Python) drive and compare them the same way.
 //
 // Frames: an input Stokes vector is given in Mitsuba 3's stokesBasis of the ray direction, each
-// beam's in the stokesBasis of its own direction (optics/polarization.h).
+// beam's in the stokesBasis of its own direction (anisotropic/polarization.h).
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "anisotropic/polarization.h"
 #include "core/contract/march_types.h"
-#include "optics/polarization.h"
 
 namespace eikon {
 

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "optics/units.h"
+#include "anisotropic/units.h"
 
 namespace eikon {
 namespace {

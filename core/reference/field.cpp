@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "optics/pleochroism.h"
+#include "anisotropic/pleochroism.h"
 
 namespace eikon {
 

@@ -8,8 +8,8 @@
 //
 // They read a medium through a Field (core/volume/field.h): a VolumeField samples the voxelised
 // VolumeSet with the shader's stencil (stencilAt / TRI), an AnalyticField (reference_marcher.h) is
-// an exact n(x). The formulas that optics/ already has are taken from there (Fresnel:
-// optics/fresnel.h; pleochroism: optics/pleochroism.h).
+// an exact n(x). The formulas that anisotropic/ already has are taken from there (Fresnel:
+// anisotropic/fresnel.h; pleochroism: anisotropic/pleochroism.h).
 #pragma once
 
 #include <glm/glm.hpp>
@@ -37,7 +37,7 @@ glm::dvec4 axisField(const Field& f, const glm::dvec3& x);
 void eModeRates(const glm::dvec3& p, const glm::dvec4& af, const glm::dvec4& o, const glm::dvec4& e,
                 glm::dvec3& Mp, glm::dvec3& dp);
 /// e-mode attenuation per unit ray length for wave vector w: the pleochroic σ(θ) per unit
-/// wave-normal length (optics/pleochroism.h, first order) times cos ρ = ŝ·t̂, t̂ ∥ M_e w.
+/// wave-normal length (anisotropic/pleochroism.h, first order) times cos ρ = ŝ·t̂, t̂ ∥ M_e w.
 glm::dvec3 attenuationE(const glm::dvec3& so, const glm::dvec3& se, const glm::dvec3& w,
                         const glm::dvec3& a, double no, double ne);
 

@@ -3,9 +3,9 @@
 // input basis state, as a 3D complex field — and the Stokes vector of the light leaving along the
 // path for a given input Stokes vector.
 //
-// What happens along the path (optics/polarization.h does the optics):
+// What happens along the path (anisotropic/polarization.h does the optics):
 //   * at every interface the exact Maxwell amplitudes (isotropic: Born & Wolf's r/t with the TIR
-//     phase; crystal faces: the 4×4 solve of optics/maxwell_boundary.h, so no D-projection
+//     phase; crystal faces: the 4×4 solve of anisotropic/maxwell_boundary.h, so no D-projection
 //     approximation): the path follows the transmitted beam(s), or the reflected one(s) on total
 //     internal reflection or where `reflect_at` asks; a wave entering a crystal splits into an o
 //     and an e branch, which are traced separately (a ray tree, at most max_branches leaves);
@@ -19,7 +19,7 @@
 //     by less than the coherence length λ²/bandwidth_nm; otherwise their Stokes vectors add.
 //
 // Frames: the input Stokes vector is given in Mitsuba 3's stokesBasis of the ray direction, each
-// output beam's Stokes vector in the stokesBasis of its own direction (optics/polarization.h).
+// output beam's Stokes vector in the stokesBasis of its own direction (anisotropic/polarization.h).
 //
 //   eikon::TraceRequest ray{{0, 0, -30}, {0, 0, 1}, 589.29};
 //   eikon::PolarisedTrace t = eikon::tracePolarised(field, scene.polarizers, ray, {1, 0, 0, 0});
@@ -34,11 +34,11 @@
 
 #include <vector>
 
+#include "anisotropic/polarization.h"
 #include "core/contract/march_types.h"
 #include "core/contract/polarised.h"
 #include "core/scene/scene.h"
 #include "core/volume/field.h"
-#include "optics/polarization.h"
 
 namespace eikon {
 

@@ -12,6 +12,9 @@
 #include <stdexcept>
 #include <thread>
 
+#include "anisotropic/fresnel.h"
+#include "anisotropic/interface.h"
+#include "anisotropic/units.h"
 #include "core/contract/render_layers.h"
 #include "core/reference/field.h"
 #include "core/spectrum/cie1931.h"
@@ -20,9 +23,6 @@
 #include "core/spectrum/wavelength_sampling.h"
 #include "core/volume/boundary.h"
 #include "core/volume/media.h"
-#include "optics/fresnel.h"
-#include "optics/interface.h"
-#include "optics/units.h"
 
 namespace eikon {
 namespace {
@@ -458,7 +458,7 @@ void RayMarch::projectOnShell(MarchState& S, const StepEnd& E, const glm::dvec3&
 }
 
 // Fresnel at a crossed layer, or a total internal reflection (march.glsl fresnelAtLayer); the
-// reflectances are optics/fresnel.h's.
+// reflectances are anisotropic/fresnel.h's.
 void RayMarch::fresnelAtLayer(MarchState& S, MarchResult& R, const glm::dvec3& N) const {
   const glm::dvec3 dIn = glm::normalize(S.wBefore), dOut = glm::normalize(S.w);
   const double ci = glm::dot(dIn, N), co = glm::dot(dOut, N);
@@ -580,7 +580,7 @@ MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
 // homogeneous regions are crossed in one straight segment, varying ones (GRIN, radial axis) are
 // integrated with RK4 on the region's own analytic medium, the optical path with it; every segment
 // or step chord is tested with nextCrossing, a step that meets a face ends on it on its own path
-// (sharpLand), and at a crossing the exact interface laws of optics/ are applied.
+// (sharpLand), and at a crossing the exact interface laws of anisotropic/ are applied.
 
 // Box entry: the region there, and the wave vector of the mode in its medium along d.
 void RayMarch::sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& d) const {
@@ -767,9 +767,9 @@ SharpEvent RayMarch::sharpStep(MarchState& S, MarchResult& R, BoundaryCrossing& 
   return c.found ? SharpEvent::Cross : out ? SharpEvent::Leave : SharpEvent::Go;
 }
 
-// The exact laws at a crossing (optics/interface.h, optics/fresnel.h): Snell, or the o/e waves
-// into / out of a crystal; TIR is a lossless mirror; otherwise the ray carries (1 − R) on and an
-// external reflection adds R × environment(mirror direction), as the smoothed path does.
+// The exact laws at a crossing (anisotropic/interface.h, anisotropic/fresnel.h): Snell, or the o/e
+// waves into / out of a crystal; TIR is a lossless mirror; otherwise the ray carries (1 − R) on and
+// an external reflection adds R × environment(mirror direction), as the smoothed path does.
 void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCrossing& c) const {
   const MediumRecord &A = rec(S.region), &B = rec(c.to);
   const glm::dvec3 x = S.x, N = c.normal, s = glm::normalize(S.w);

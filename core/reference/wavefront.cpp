@@ -12,12 +12,12 @@
 #include <stdexcept>
 #include <thread>
 
+#include "anisotropic/fresnel.h"
+#include "anisotropic/interface.h"
+#include "anisotropic/units.h"
 #include "core/light/seeding.h"
 #include "core/light/sharp_skip.h"
 #include "core/reference/field.h"
-#include "optics/fresnel.h"
-#include "optics/interface.h"
-#include "optics/units.h"
 
 namespace eikon {
 namespace {
@@ -344,12 +344,12 @@ double PatchStepper::mediumSigma(int region, const glm::dvec3& w) const {
 }
 
 // Corner k at the crossing c (p.x[k] its point, p.w[k] the incident wave vector): the exact laws
-// of optics/ between the media of c.from and c.to (docs/light-simulator.md, "Sharp interfaces").
-// Isotropic ↔ isotropic: Snell and the unpolarised Fresnel T = 1 − R; into a crystal: the run's
-// mode (o by Snell with n_o, e by the closed form of the e-wave normal) with the exact Maxwell
-// share of the unpolarised power, doubled because a mode's run carries half the light; out of a
-// crystal: the exact exit transmission of the mode; crystal → crystal: the phase-matched wave of
-// the same mode, no loss. Where the outgoing wave does not exist, total internal reflection: the
+// of anisotropic/ between the media of c.from and c.to (docs/light-simulator.md, "Sharp
+// interfaces"). Isotropic ↔ isotropic: Snell and the unpolarised Fresnel T = 1 − R; into a crystal:
+// the run's mode (o by Snell with n_o, e by the closed form of the e-wave normal) with the exact
+// Maxwell share of the unpolarised power, doubled because a mode's run carries half the light; out
+// of a crystal: the exact exit transmission of the mode; crystal → crystal: the phase-matched wave
+// of the same mode, no loss. Where the outgoing wave does not exist, total internal reflection: the
 // mirror (same mode), no loss, the corner's mirror bit flips and it stays in its region. Equal
 // media, or an opaque one entered: only the region changes. Multiplies `transmission` by T; true if
 // the corner was turned.

@@ -27,9 +27,9 @@
 // Sharp interfaces (docs/light-simulator.md, "Sharp interfaces"): given the scene's
 // boundary field and one medium per region (SharpInterfaces), every corner crosses its region's
 // homogeneous medium along a straight line in constant time, is stopped at the first boundary
-// (locateCrossing), refracted or totally reflected there with the exact laws of optics/ (Snell,
-// Beyerle–McDermid for the e-wave) and goes on for the rest of the step; the patch's flux is
-// multiplied by the corners' Fresnel transmissions, (1 − R)^¼ per corner crossing (exact for a
+// (locateCrossing), refracted or totally reflected there with the exact laws of anisotropic/
+// (Snell, Beyerle–McDermid for the e-wave) and goes on for the rest of the step; the patch's flux
+// is multiplied by the corners' Fresnel transmissions, (1 − R)^¼ per corner crossing (exact for a
 // plane wave on a plane face, where all four see the same R).
 //
 // Units: positions in mm; a light's `irradiance` is E (directional, per mm²) or I (point, per

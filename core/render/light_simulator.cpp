@@ -13,6 +13,7 @@
 #include <variant>
 #include <vector>
 
+#include "anisotropic/units.h"
 #include "core/light/lighting.h"
 #include "core/light/seeding.h"
 #include "core/light/sharp_skip.h"
@@ -20,7 +21,6 @@
 #include "core/render/view_pipeline_start.h"
 #include "core/vk/resources.h"
 #include "core/volume/media.h"
-#include "optics/units.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/scan.spv.h"
 #include "shaders/wavefront.spv.h"

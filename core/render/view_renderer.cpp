@@ -17,6 +17,7 @@
 #include <tuple>
 #include <variant>
 
+#include "anisotropic/units.h"
 #include "core/contract/polarised_render.h"
 #include "core/contract/render_layers.h"
 #include "core/render/boundary_device.h"
@@ -25,7 +26,6 @@
 #include "core/spectrum/color.h"
 #include "core/spectrum/rgb_to_spectrum.h"
 #include "core/vk/timings.h"
-#include "optics/units.h"
 #include "shaders/eikon_shared.h"
 #include "shaders/polarised_trace.spv.h"
 #include "shaders/trace.spv.h"

@@ -4,7 +4,7 @@
 
 #include <cstddef>
 
-#include "optics/index_limits.h"  // kMinIndex, kMaxIndex
+#include "anisotropic/index_limits.h"  // kMinIndex, kMaxIndex
 
 namespace eikon {
 

@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
+#include "anisotropic/dispersion.h"
 #include "core/scene/messages.h"
 #include "core/scene/shapes.h"
-#include "optics/dispersion.h"
 
 namespace eikon {
 

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
+#include "anisotropic/units.h"
 #include "core/scene/scene.h"
-#include "optics/units.h"
 
 namespace eikon {
 namespace {

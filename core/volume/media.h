@@ -41,7 +41,7 @@ namespace eikon {
 
 struct Scene;
 
-/// A dispersion formula as coefficients (optics/dispersion.h's forms, λ in µm inside):
+/// A dispersion formula as coefficients (anisotropic/dispersion.h's forms, λ in µm inside):
 ///   Constant : n = coeff[0]
 ///   Cauchy   : n = Σ_k coeff[k] / λ^{2k}                        (terms = number of coefficients)
 ///   Sellmeier: n² = 1 + Σ_k coeff[k] λ² / (λ² − sellmeier_c[k])  (SCHOTT form)

@@ -12,9 +12,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "anisotropic/dispersion.h"
 #include "core/scene/scene.h"
 #include "fitting/index_data.h"
-#include "optics/dispersion.h"
 #include "tests/apps/cli_support.h"
 
 namespace {

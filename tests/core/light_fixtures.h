@@ -29,7 +29,7 @@ inline Light beam(glm::dvec3 axis_point, glm::dvec3 dir, double radius, double E
 }
 
 /// Unpolarised Fresnel reflectance n1 → n2 at incidence i (Born & Wolf eq. 1.5.21), written out
-/// here rather than taken from optics/ (the code under test calls that).
+/// here rather than taken from anisotropic/ (the code under test calls that).
 inline double fresnelR(double n1, double n2, double i) {
   const double si = std::sin(i), st = n1 * si / n2;
   if (st >= 1.0) return 1.0;

@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "anisotropic/dispersion.h"
 #include "fitting/refractiveindex_formula.h"
-#include "optics/dispersion.h"
 
 namespace eikon {
 namespace {

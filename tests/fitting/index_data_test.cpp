@@ -10,8 +10,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "anisotropic/dispersion.h"
 #include "fitting/refractiveindex_formula.h"
-#include "optics/dispersion.h"
 
 namespace eikon {
 namespace {

@@ -130,7 +130,7 @@ def self_test():
                                 "#include <numbers>\ndouble c() { return std::numbers::pi; }\n")
         write("core/pi.cpp", "constexpr double kPi = 3.14159265358979323846;\n")
         write("tests/d_test.cpp", "double d() { return M_PI / 2; }\n")
-        write("optics/e.h", "inline double e() { return std::acos(-1.0); }\n")
+        write("anisotropic/e.h", "inline double e() { return std::acos(-1.0); }\n")
         write("shaders/shared.h", "#ifdef __cplusplus\nnamespace x {}\n#else\n"
                                   "const float kPi = 3.14159265358979323846;\n#endif\n")
         write("shaders/march.glsl", "const float kPi = 3.14159265;\n")
@@ -145,7 +145,7 @@ def self_test():
                     ("CMakeLists.txt:1:", f"'{i.title()} 7' is history"),
                     ("core/pi.cpp:1:", "π defined in C++"),
                     ("tests/d_test.cpp:1:", "π defined in C++"),
-                    ("optics/e.h:1:", "π defined in C++"),
+                    ("anisotropic/e.h:1:", "π defined in C++"),
                     ("shaders/shared.h:4:", "a second GLSL definition of π (the first: "
                                             "shaders/march.glsl:1)")]
 

@@ -4,7 +4,7 @@
   - tests/ mirrors the source tree: every folder under tests/ (but data/, repo/ and python/, the
     Python module's tests) names a source folder at the same path (tests/core/render ↔ core/render),
     and no test source sits loose in tests/core/ (only shared helpers, *.h, live there);
-  - no function in core/, optics/, fitting/, python/ or apps/ is longer than MAX_LINES lines
+  - no function in core/, anisotropic/, fitting/, python/ or apps/ is longer than MAX_LINES lines
     (counted by Universal Ctags from its first to its last line, lambdas included), so the marches,
     the simulators and the commands stay split into named stages (the ones docs/twins.md pairs);
   - every C++ file is formatted with the project's .clang-format (clang-format --dry-run).
@@ -22,7 +22,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from repo_checks import report_planted, run_check  # noqa: E402
 
 MAX_LINES = 120
-LENGTH_CHECKED = ("core/", "optics/", "fitting/", "python/", "apps/")
+LENGTH_CHECKED = ("core/", "anisotropic/", "fitting/", "python/", "apps/")
 NOT_MIRRORED = ("tests/data", "tests/repo", "tests/python")
 CXX = (".cpp", ".h")
 
@@ -114,14 +114,14 @@ def self_test():
         write("tests/core/render/short_test.cpp", "int shortTest() { return 1; }\n")
         write("tests/core/loose_test.cpp", "int looseTest() { return 1; }\n")
         write("tests/core/nowhere/nowhere_test.cpp", "int nowhereTest() { return 1; }\n")
-        write("optics/ugly.h", "int  ugly( int x ){return x;}\n")
+        write("anisotropic/ugly.h", "int  ugly( int x ){return x;}\n")
         subprocess.run(["git", "init", "-q", root], check=True)
         hits = check(root)
         expected = [("core/render/long.cpp:1:", "longOne is 123 lines"),
                     ("apps/long_command.cpp:1:", "longCommand is 123 lines"),
                     ("tests/core/loose_test.cpp:1:", "a test source loose"),
                     ("tests/core/nowhere/nowhere_test.cpp:1:", "mirrors no source folder"),
-                    ("optics/ugly.h:1:", "not formatted")]
+                    ("anisotropic/ugly.h:1:", "not formatted")]
 
         return report_planted("layout", expected, hits)
 

@@ -10,10 +10,10 @@ links; from that:
   - the front ends apps/ and python/ go through one door: they may include core/session/ (which
     forwards what they need of the layers under it), fitting/ (`eikon fit`, Python's fits) and the
     data layers a front end hands the session or shows: core/scene/ and core/io/ (and, for
-    python/, optics/: the module exposes pure optics formulas); not core/render, core/vk,
+    python/, anisotropic/: the module exposes pure optics formulas); not core/render, core/vk,
     core/light, core/volume, core/reference or core/spectrum;
   - its CMakeLists.txt links (eikon::NAME or eikon_NAME) only the targets its row names;
-  - and, for the libraries the fitting tool keeps to itself: no file under optics/ or core/
+  - and, for the libraries the fitting tool keeps to itself: no file under anisotropic/ or core/
     includes a Ceres, glog, Eigen or yaml-cpp header, and no CMakeLists.txt outside fitting/ links
     Ceres::ceres or yaml-cpp.
 Each violation is printed as FILE:LINE: what.
@@ -31,18 +31,18 @@ SOURCE_EXT = (".h", ".hpp", ".cpp", ".cc", ".inl")
 FOREIGN_HEADERS = ("ceres/", "glog/", "Eigen/", "yaml-cpp/")
 CERES_OR_YAML = re.compile(r"\bCeres::\w+|\byaml-cpp\b")
 # Folders that must stay free of the fitting tool's libraries.
-SCENE_SIDE = ("optics/", "core/")
+SCENE_SIDE = ("anisotropic/", "core/")
 
 # docs/architecture.md's table: module folder -> (its CMake target eikon::NAME, or None for a front
 # end, and the project targets it links, PUBLIC or PRIVATE).
 MODULES = {
-    "optics/": ("optics", ()),
-    "fitting/": ("fitting", ("optics", "io")),
+    "anisotropic/": ("anisotropic", ()),
+    "fitting/": ("fitting", ("anisotropic", "io")),
     "core/spectrum/": ("spectrum", ()),
     "core/io/": ("io", ()),
     "core/vk/": ("vk", ("io",)),
     "shaders/": ("shaders", ()),
-    "core/scene/": ("scene", ("optics", "io", "spectrum")),
+    "core/scene/": ("scene", ("anisotropic", "io", "spectrum")),
     "core/volume/": ("volume", ("scene", "io")),
     "core/contract/": ("contract", ("scene", "spectrum")),
     "core/light/": ("light", ("volume", "spectrum", "io")),
@@ -55,7 +55,7 @@ MODULES = {
 # The front ends' door: the folders they may include, instead of all the session reaches.
 DOOR = {
     "apps/": ("core/session/", "fitting/", "core/scene/", "core/io/"),
-    "python/": ("core/session/", "fitting/", "core/scene/", "core/io/", "optics/"),
+    "python/": ("core/session/", "fitting/", "core/scene/", "core/io/", "anisotropic/"),
 }
 # Project folders that are no module: nothing under a module may include them.
 NON_MODULES = ("bench/", "fuzz/", "tests/")
@@ -214,8 +214,8 @@ def planted_trees():
 def self_test():
     """Made-up trees with known defects, and clean ones: the checks must tell them apart."""
     bad = {
-        "optics/a.h": '#include "fitting/fitting.h"\n',
-        "optics/b.cpp": "#include <ceres/ceres.h>\n",
+        "anisotropic/a.h": '#include "fitting/fitting.h"\n',
+        "anisotropic/b.cpp": "#include <ceres/ceres.h>\n",
         "core/scene/c.cpp": "  #  include <yaml-cpp/yaml.h>\n",
         "core/scene/CMakeLists.txt": "target_link_libraries(s PUBLIC eikon::fitting)\n",
         "apps/CMakeLists.txt": "target_link_libraries(e PRIVATE yaml-cpp)\n",
@@ -229,11 +229,11 @@ def self_test():
         "core/light/seeding.cpp": '#include "core/reference/reference_marcher.h"\n',
         # The front ends past their door, the fitting tool on a scene header, a layer upwards.
         "apps/render.cpp": '#include "core/session/session.h"\n#include "core/vk/timings.h"\n',
-        "python/analytic.cpp": '#include "optics/fresnel.h"\n'
+        "python/analytic.cpp": '#include "anisotropic/fresnel.h"\n'
                                '#include "core/reference/reference_marcher.h"\n',
         "python/CMakeLists.txt": "target_link_libraries(p PRIVATE eikon::session\n"
                                  "  eikon::render)\n",
-        "fitting/index_data.h": '#include "optics/index_limits.h"\n#include "core/scene/limits.h"\n',
+        "fitting/index_data.h": '#include "anisotropic/index_limits.h"\n#include "core/scene/limits.h"\n',
         "core/volume/voxelizer.cpp": '#include "core/scene/scene.h"\n#include "apps/commands.h"\n',
         "core/session/session.cpp": '#include "core/render/view_renderer.h"\n'
                                     '#include "tests/core/session/x.h"\n',
@@ -245,10 +245,10 @@ def self_test():
               "python/CMakeLists.txt:2:", "fitting/index_data.h:2:", "core/volume/voxelizer.cpp:2:",
               "core/session/session.cpp:2:"]
     good = {
-        "optics/a.h": '#include "optics/uniaxial.h"\n#include <glm/glm.hpp>\n',
-        "core/scene/c.cpp": '#include "optics/dispersion.h"\n// fitting/ is not included here\n',
+        "anisotropic/a.h": '#include "anisotropic/uniaxial.h"\n#include <glm/glm.hpp>\n',
+        "core/scene/c.cpp": '#include "anisotropic/dispersion.h"\n// fitting/ is not included here\n',
         "fitting/CMakeLists.txt":
-            "target_link_libraries(eikon_fitting PUBLIC eikon::optics PRIVATE eikon::io "
+            "target_link_libraries(eikon_fitting PUBLIC eikon::anisotropic PRIVATE eikon::io "
             "Ceres::ceres yaml-cpp)\n",
         "CMakeLists.txt": "find_package(Ceres 2.1 REQUIRED)\nfind_package(yaml-cpp 0.7 REQUIRED)\n",
         "apps/fit.cpp": '#include "fitting/fitting.h"\n#include "core/io/atomic_write.h"\n',
@@ -263,7 +263,7 @@ def self_test():
         "apps/render.cpp":
             '#include "core/session/front_end.h"\n#include "core/scene/scene.h"\n'
             '#include "apps/commands.h"\n#include <GLFW/glfw3.h>\n',
-        "python/module.cpp": '#include "optics/fresnel.h"\n#include "python/module.h"\n',
+        "python/module.cpp": '#include "anisotropic/fresnel.h"\n#include "python/module.h"\n',
         "core/session/session.cpp": '#include "core/render/view_renderer.h"\n'
                                     '#include "core/vk/context.h"\n',
         "bench/march_bench.cpp": '#include "core/render/view_renderer.h"\n',

@@ -1,6 +1,6 @@
 // The sharp march of the CPU twin (ReferenceMarcher with "interfaces": "sharp", the default)
 // against closed forms at planar faces, where the boundary field and the analytic refinement
-// locate the crossing exactly (core/volume/boundary.h) and optics/ applies the exact laws:
+// locate the crossing exactly (core/volume/boundary.h) and anisotropic/ applies the exact laws:
 //  - a plane-parallel slab at 0–80°: lateral displacement t·sin(θ − θ_t)/cos θ_t within 1e-4 mm,
 //    the exit direction the incident one within 1e-5 rad (64³ and 128³);
 //  - calcite and quartz plates at normal incidence, optic axis at α = 0–90° to the normal: the

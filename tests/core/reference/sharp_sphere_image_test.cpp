@@ -13,11 +13,11 @@
 #include <cstdio>
 #include <numbers>
 
+#include "anisotropic/fresnel.h"
 #include "core/reference/reference_marcher.h"
 #include "core/scene/scene.h"
 #include "core/volume/field.h"
 #include "core/volume/volume_set.h"
-#include "optics/fresnel.h"
 
 namespace eikon {
 namespace {

@@ -32,13 +32,13 @@
 #include <string>
 #include <variant>
 
+#include "anisotropic/fresnel.h"
 #include "core/light/lighting.h"
 #include "core/reference/reference_lighting.h"
 #include "core/reference/wavefront.h"
 #include "core/render/light_simulator.h"
 #include "core/render/light_transport.h"
 #include "core/volume/media.h"
-#include "optics/fresnel.h"
 #include "tests/core/light_fixtures.h"
 #include "tests/core/test_support.h"
 

@@ -1,6 +1,6 @@
 // End-to-end checks of the e-ray march: the voxelised, smoothed crystal marched by the
 // mode Hamiltonian H_e = ½(pᵀM_e p − 1) (docs/design.md §2; shaders/march.glsl, core/reference)
-// against the closed-form uniaxial library in optics/ (uniaxial.h, interface.h, fresnel.h,
+// against the closed-form uniaxial library in anisotropic/ (uniaxial.h, interface.h, fresnel.h,
 // pleochroism.h), with the numbers of docs/reference-cases.md §1–3, §8, §9.
 //
 // How the expected values are built. Every test takes the crystal's indices from the volume
@@ -20,10 +20,10 @@
 #include <random>
 #include <string>
 
-#include "optics/fresnel.h"
-#include "optics/interface.h"
-#include "optics/pleochroism.h"
-#include "optics/uniaxial.h"
+#include "anisotropic/fresnel.h"
+#include "anisotropic/interface.h"
+#include "anisotropic/pleochroism.h"
+#include "anisotropic/uniaxial.h"
 #include "tests/core/test_support.h"
 
 namespace eikon::test {
