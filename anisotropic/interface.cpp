@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "anisotropic/bm_mapping.h"
+
 namespace eikon {
 namespace {
 
@@ -39,13 +41,35 @@ ModeWave solveInterfaceMode(glm::dvec3 p_t, glm::dvec3 m, const glm::dmat3& M, b
   return w;
 }
 
+ModeWave solveUniaxialMode(glm::dvec3 p_t, glm::dvec3 m, const Uniaxial& crystal, Mode mode,
+                           bool transmitted) {
+  if (mode == Mode::Ordinary)
+    return solveInterfaceMode(p_t, m, crystal.hamiltonianMatrix(Mode::Ordinary), transmitted);
+  const BMMapping bm(crystal);
+  const glm::dvec3 mm = bm.mapNormal(m);  // m' = γm/|γm|, oriented as m
+  const glm::dvec3 pm = bm.mapWaveVector(p_t);
+  const glm::dvec3 ptm = pm - glm::dot(pm, mm) * mm;  // conserved in mapped space
+  const double q2 = 1.0 - glm::dot(ptm, ptm);         // the mapped e-shell: |p'| = 1
+  ModeWave w;
+  if (q2 < 0.0) return w;  // evanescent for this mode
+  // In mapped space the ray runs along p', so energy along m ⇔ p'·m' > 0: the + root transmits.
+  const glm::dvec3 pmapped = ptm + (transmitted ? 1.0 : -1.0) * std::sqrt(q2) * mm;
+  w.q = glm::dot(bm.unmapWaveVector(pmapped), m);
+  const glm::dvec3 p = p_t + w.q * m;
+  w.n = glm::length(p);
+  w.s = p / w.n;
+  w.t = bm.unmapRayDirection(pmapped);  // ∝ γp' = γ²p = M_e p
+  w.exists = true;
+  return w;
+}
+
 ModePair refractIntoUniaxial(glm::dvec3 s_in, glm::dvec3 normal, double n1,
                              const Uniaxial& crystal) {
   const glm::dvec3 u = glm::normalize(s_in);
   const glm::dvec3 m = orient(normal, u);
   const glm::dvec3 pt = tangential(n1 * u, m);
-  return {solveInterfaceMode(pt, m, crystal.hamiltonianMatrix(Mode::Ordinary), true),
-          solveInterfaceMode(pt, m, crystal.hamiltonianMatrix(Mode::Extraordinary), true)};
+  return {solveUniaxialMode(pt, m, crystal, Mode::Ordinary, true),
+          solveUniaxialMode(pt, m, crystal, Mode::Extraordinary, true)};
 }
 
 ModeWave refractOutOfUniaxial(const Uniaxial& crystal, Mode mode, glm::dvec3 s_in,
@@ -67,8 +91,8 @@ ModePair reflectInsideUniaxialBoth(const Uniaxial& crystal, Mode mode, glm::dvec
   const glm::dvec3 u = glm::normalize(s_in);
   const glm::dvec3 m = orient(normal, crystal.rayDirection(mode, u));
   const glm::dvec3 pt = tangential(crystal.index(mode, u) * u, m);
-  return {solveInterfaceMode(pt, m, crystal.hamiltonianMatrix(Mode::Ordinary), false),
-          solveInterfaceMode(pt, m, crystal.hamiltonianMatrix(Mode::Extraordinary), false)};
+  return {solveUniaxialMode(pt, m, crystal, Mode::Ordinary, false),
+          solveUniaxialMode(pt, m, crystal, Mode::Extraordinary, false)};
 }
 
 ModeWave refractIsotropic(glm::dvec3 s_in, glm::dvec3 normal, double n1, double n2) {

@@ -69,6 +69,17 @@ struct ModePair {
 /// energy goes; `transmitted` picks the root with (Mp)·m ≥ 0 (true) or ≤ 0 (reflected, false).
 ModeWave solveInterfaceMode(glm::dvec3 p_t, glm::dvec3 m, const glm::dmat3& M, bool transmitted);
 
+/// The outgoing wave of `mode` in a uniaxial `crystal` with tangential wave vector `p_t` (⊥ m),
+/// `m` and `transmitted` as for solveInterfaceMode. The o-wave's shell is the sphere |p| = n_o;
+/// the e-wave's is found by the Beyerle–McDermid mapping (bm_mapping.h): p' = γp puts the e-shell
+/// on the unit sphere and the normal on m' = γm/|γm|, so the root is an isotropic one,
+/// q' = ±√(1 − |p'_t|²) along m', mapped back with γ⁻¹; the tangential part stays p_t exactly
+/// (the mapping gives only the normal component q). Every e-refraction and e-reflection of the
+/// CPU twin goes through it, as the shaders' solveInterfaceMode does (sharp.glsl); the direct
+/// quadratic, solveInterfaceMode with crystal.hamiltonianMatrix(mode), is its test oracle.
+ModeWave solveUniaxialMode(glm::dvec3 p_t, glm::dvec3 m, const Uniaxial& crystal, Mode mode,
+                           bool transmitted);
+
 /// Isotropic (index n1) → uniaxial crystal: the refracted o- and e-waves.
 ModePair refractIntoUniaxial(glm::dvec3 s_in, glm::dvec3 normal, double n1,
                              const Uniaxial& crystal);

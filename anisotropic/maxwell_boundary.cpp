@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "anisotropic/bm_mapping.h"
+
 namespace eikon::maxwell {
 namespace {
 
@@ -44,12 +46,28 @@ std::array<Wave, 2> isotropicWaves(glm::dvec3 p_t, glm::dvec3 m, double n, bool 
   return {makeWave(p, es), makeWave(p, cross(p, es))};
 }
 
+namespace {
+
+// The e-wave's normal component: a propagating root by the Beyerle–McDermid mapping (the pipeline's
+// e-solve, interface.h solveUniaxialMode: in mapped space the e-shell is the unit sphere), an
+// evanescent one from the complex root of the quadratic (the mapping's root is real only).
+cd extraordinaryQ(glm::dvec3 p_t, glm::dvec3 m, const Uniaxial& c, bool transmitted) {
+  const BMMapping bm(c);
+  const glm::dvec3 mm = bm.mapNormal(m), pm = bm.mapWaveVector(p_t);
+  const glm::dvec3 ptm = pm - glm::dot(pm, mm) * mm;
+  const double q2 = 1.0 - glm::dot(ptm, ptm);
+  if (!(q2 >= 0.0)) return outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Extraordinary), transmitted);
+  const glm::dvec3 pmapped = ptm + (transmitted ? 1.0 : -1.0) * std::sqrt(q2) * mm;
+  return {glm::dot(bm.unmapWaveVector(pmapped), m), 0.0};
+}
+
+}  // namespace
+
 std::array<Wave, 2> crystalWaves(glm::dvec3 p_t, glm::dvec3 m, const Uniaxial& c,
                                  bool transmitted) {
   const CV po =
       cv(p_t) + outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Ordinary), transmitted) * cv(m);
-  const CV pe =
-      cv(p_t) + outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Extraordinary), transmitted) * cv(m);
+  const CV pe = cv(p_t) + extraordinaryQ(p_t, m, c, transmitted) * cv(m);
   const CV a = cv(c.axis);
   const glm::dmat3 eps_inv = glm::inverse(c.epsilon());
   CV Eo = cross(po, a);

@@ -146,24 +146,51 @@ vec3 applyMedium(vec3 p, bool eMat, vec3 a, float no, float ne) {
   return eMat ? applyM(p, a, no, ne) : p / (no * no);
 }
 
-// The outgoing wave with tangential wave vector pt (⊥ m) on the shell pᵀMp = 1: the root of the
-// quadratic in the normal component along (transmitted) or against (reflected) m.
+// The Beyerle–McDermid mapping (anisotropic/bm_mapping.h): γ = aaᵀ/n_o + (I − aaᵀ)/n_e = M_e^{1/2}
+// puts the e-mode's index surface pᵀM_e p = 1 on the unit sphere |γp| = 1. Wave vectors and normals
+// map with γ, back with γ⁻¹ = n_o aaᵀ + n_e (I − aaᵀ).
+vec3 bmGamma(vec3 v, vec3 a, float no, float ne) {
+  float av = dot(a, v);
+  return a * (av / no) + (v - a * av) / ne;
+}
+vec3 bmGammaInverse(vec3 v, vec3 a, float no, float ne) {
+  float av = dot(a, v);
+  return a * (av * no) + (v - a * av) * ne;
+}
+
+// The outgoing wave with tangential wave vector pt (⊥ m) on its mode's shell (anisotropic/
+// interface.cpp solveUniaxialMode): the o-wave (and an isotropic medium) on the sphere |p| = n_o,
+// the root of the quadratic pᵀp/n_o² = 1 along (transmitted) or against (reflected) m; the e-wave (eMat, axis a)
+// by the mapping: in mapped space its shell is the unit sphere and the normal m' = γm/|γm|, so
+// q' = ±√(1 − |p'_t|²) and the normal component q = (γ⁻¹p')·m; the tangential part stays pt.
 ModeWave solveInterfaceMode(vec3 pt, vec3 m, bool eMat, vec3 a, float no, float ne, bool transmitted) {
   ModeWave w;
   w.exists = false;
   w.s = vec3(0.0);
   w.n = 0.0;
   w.t = vec3(0.0);
-  vec3 Mm = applyMedium(m, eMat, a, no, ne);
-  float A = dot(m, Mm), B = 2.0 * dot(pt, Mm), C = dot(pt, applyMedium(pt, eMat, a, no, ne)) - 1.0;
-  float disc = B * B - 4.0 * A * C;
-  if (disc < 0.0) return w;  // evanescent for this mode
-  float root = sqrt(disc);
-  float q = (-B + (transmitted ? root : -root)) / (2.0 * A);
+  float q;
+  vec3 pmapped;
+  if (eMat) {
+    vec3 mm = normalize(bmGamma(m, a, no, ne));
+    vec3 pm = bmGamma(pt, a, no, ne);
+    vec3 ptm = pm - dot(pm, mm) * mm;
+    float q2 = 1.0 - dot(ptm, ptm);
+    if (q2 < 0.0) return w;  // evanescent for this mode
+    pmapped = ptm + (transmitted ? 1.0 : -1.0) * sqrt(q2) * mm;
+    q = dot(bmGammaInverse(pmapped, a, no, ne), m);
+  } else {  // the quadratic of pᵀp/n_o² = 1 in q
+    vec3 Mm = applyMedium(m, false, a, no, ne);
+    float A = dot(m, Mm), B = 2.0 * dot(pt, Mm), C = dot(pt, applyMedium(pt, false, a, no, ne)) - 1.0;
+    float disc = B * B - 4.0 * A * C;
+    if (disc < 0.0) return w;  // evanescent for this mode
+    float root = sqrt(disc);
+    q = (-B + (transmitted ? root : -root)) / (2.0 * A);
+  }
   vec3 p = pt + q * m;
   w.n = length(p);
   w.s = p / w.n;
-  w.t = normalize(applyMedium(p, eMat, a, no, ne));
+  w.t = eMat ? normalize(bmGamma(pmapped, a, no, ne)) : w.s;  // ∝ γp' = M_e p
   w.exists = true;
   return w;
 }

@@ -394,9 +394,8 @@ bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k,
     const Uniaxial A(a.n, a.n_e, a.axis), B(b.n, b.n_e, b.axis);
     const glm::dvec3 m = glm::dot(mediumVelocity(c.from, w), N) >= 0 ? N : -N;
     const glm::dvec3 pt = w - glm::dot(w, m) * m;
-    out = solveInterfaceMode(pt, m, B.hamiltonianMatrix(mode), true);
-    if (!out.exists)
-      out = solveInterfaceMode(pt, m, A.hamiltonianMatrix(mode), false), mirror = true;
+    out = solveUniaxialMode(pt, m, B, mode, true);
+    if (!out.exists) out = solveUniaxialMode(pt, m, A, mode, false), mirror = true;
   }
   if (!out.exists && !mirror) {
     // Total internal reflection into an isotropic medium, or a crystal mode that cannot enter.

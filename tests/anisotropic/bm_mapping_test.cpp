@@ -93,11 +93,13 @@ TEST(BMMapping, Section3CaseInMappedSpace) {
 }
 
 TEST(BMMapping, MappedRefractionEqualsDirectQuadraticRandom) {
-  // Mapped-space Snell (tangential p' conserved w.r.t. n' = γn̂/|γn̂|, |p'| = 1) against the
-  // direct quadratic solve of interface.h, for random crystals, axes, normals and incidences.
+  // The pipeline's e-refraction and e-reflection (refractIntoUniaxial, reflectInsideUniaxial:
+  // solveUniaxialMode, the mapping) and BMMapping's own refractE / reflectE, against the oracle:
+  // the direct quadratic of pᵀM_e p = 1 (solveInterfaceMode with M_e), for random crystals, axes,
+  // normals and incidences. Both are exact; they differ by rounding (|p| ≤ 3: ~1e-15).
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> n1d(1.0, 2.5);
-  double worst_refract = 0, worst_reflect = 0;
+  double worst_refract = 0, worst_reflect = 0, worst_ray = 0;
   int compared = 0, tir = 0;
   for (int k = 0; k < 5000; ++k) {
     const auto c = randomCrystal(rng);
@@ -106,26 +108,39 @@ TEST(BMMapping, MappedRefractionEqualsDirectQuadraticRandom) {
     glm::dvec3 s_in = randomUnit(rng);
     if (glm::dot(s_in, normal) < 0) s_in = -s_in;  // travelling into the crystal along +normal
     const double n1 = n1d(rng);
-    const auto direct = eikon::refractIntoUniaxial(s_in, normal, n1, c);
+    const glm::dvec3 pt = n1 * s_in - glm::dot(n1 * s_in, normal) * normal;
+    const glm::dmat3 Me = c.hamiltonianMatrix(eikon::Mode::Extraordinary);
+    const auto oracle = eikon::solveInterfaceMode(pt, normal, Me, true);
+    const auto mapped = eikon::refractIntoUniaxial(s_in, normal, n1, c).e;
     const glm::dvec3 pe = bm.refractE(n1 * s_in, normal);
-    ASSERT_EQ(direct.e.exists, glm::length(pe) > 0) << k;
-    if (!direct.e.exists) {
+    ASSERT_EQ(oracle.exists, mapped.exists) << k;
+    ASSERT_EQ(oracle.exists, glm::length(pe) > 0) << k;
+    if (!oracle.exists) {
       ++tir;
       continue;
     }
     ++compared;
-    worst_refract = std::max(worst_refract, glm::length(pe - direct.e.p()));
-    // e→e reflection inside: mapped mirror law vs the other root of the quadratic.
-    const auto refl =
-        eikon::reflectInsideUniaxial(c, eikon::Mode::Extraordinary, direct.e.s, normal);
-    const glm::dvec3 pr = bm.reflectE(direct.e.p(), normal);
-    worst_reflect = std::max(worst_reflect, glm::length(pr - refl.p()));
+    worst_refract = std::max(
+        {worst_refract, glm::length(pe - oracle.p()), glm::length(mapped.p() - oracle.p())});
+    worst_ray = std::max(worst_ray, glm::length(mapped.t - oracle.t));
+    EXPECT_NEAR(mapped.q, oracle.q, 1e-12) << k;
+    // e→e reflection inside: the mapped mirror law against the quadratic's other root.
+    const glm::dvec3 m = glm::dot(oracle.t, normal) < 0 ? -normal : normal;
+    const glm::dvec3 ptr = oracle.p() - glm::dot(oracle.p(), m) * m;
+    const auto reflOracle = eikon::solveInterfaceMode(ptr, m, Me, false);
+    const auto refl = eikon::reflectInsideUniaxial(c, eikon::Mode::Extraordinary, oracle.s, normal);
+    const glm::dvec3 pr = bm.reflectE(oracle.p(), normal);
+    ASSERT_TRUE(reflOracle.exists && refl.exists) << k;
+    worst_reflect = std::max(
+        {worst_reflect, glm::length(pr - reflOracle.p()), glm::length(refl.p() - reflOracle.p())});
+    worst_ray = std::max(worst_ray, glm::length(refl.t - reflOracle.t));
   }
   std::cout << "[ BM ] compared " << compared << " (" << tir << " e-TIR), max |Δp| refraction "
-            << worst_refract << ", reflection " << worst_reflect << "\n";
+            << worst_refract << ", reflection " << worst_reflect << ", ray " << worst_ray << "\n";
   EXPECT_GT(compared, 1000);
   EXPECT_LT(worst_refract, 1e-12);
   EXPECT_LT(worst_reflect, 1e-12);
+  EXPECT_LT(worst_ray, 1e-12);
 }
 
 TEST(BMMapping, NormalsMappedWithInverseGammaAreWrong) {
