@@ -45,20 +45,21 @@ ModeWave solveUniaxialMode(glm::dvec3 p_t, glm::dvec3 m, const Uniaxial& crystal
                            bool transmitted) {
   if (mode == Mode::Ordinary)
     return solveInterfaceMode(p_t, m, crystal.hamiltonianMatrix(Mode::Ordinary), transmitted);
+  // The phase-matched line p = p_t + q m maps to p' = γp_t + q γm, the e-shell to the unit
+  // sphere |p'| = 1: q is a root of |γp_t + q γm|² = 1, whose discriminant is |γm|²(1 − |p'_t|²)
+  // with p'_t the part of γp_t ⊥ γm (the mapped-space Snell law of bm_mapping.h).
   const BMMapping bm(crystal);
-  const glm::dvec3 mm = bm.mapNormal(m);  // m' = γm/|γm|, oriented as m
-  const glm::dvec3 pm = bm.mapWaveVector(p_t);
-  const glm::dvec3 ptm = pm - glm::dot(pm, mm) * mm;  // conserved in mapped space
-  const double q2 = 1.0 - glm::dot(ptm, ptm);         // the mapped e-shell: |p'| = 1
+  const glm::dvec3 gp = bm.mapWaveVector(p_t), gm = bm.mapWaveVector(m);
+  const double A = glm::dot(gm, gm), Bh = glm::dot(gp, gm), C = glm::dot(gp, gp) - 1.0;
+  const double disc = Bh * Bh - A * C;
   ModeWave w;
-  if (q2 < 0.0) return w;  // evanescent for this mode
-  // In mapped space the ray runs along p', so energy along m ⇔ p'·m' > 0: the + root transmits.
-  const glm::dvec3 pmapped = ptm + (transmitted ? 1.0 : -1.0) * std::sqrt(q2) * mm;
-  w.q = glm::dot(bm.unmapWaveVector(pmapped), m);
+  if (disc < 0.0) return w;  // evanescent for this mode
+  // In mapped space the ray runs along p', so energy along m ⇔ p'·γm > 0: the + root transmits.
+  w.q = (-Bh + (transmitted ? 1.0 : -1.0) * std::sqrt(disc)) / A;
   const glm::dvec3 p = p_t + w.q * m;
   w.n = glm::length(p);
   w.s = p / w.n;
-  w.t = bm.unmapRayDirection(pmapped);  // ∝ γp' = γ²p = M_e p
+  w.t = bm.unmapRayDirection(gp + w.q * gm);  // ∝ γp' = γ²p = M_e p
   w.exists = true;
   return w;
 }

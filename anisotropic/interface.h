@@ -72,11 +72,11 @@ ModeWave solveInterfaceMode(glm::dvec3 p_t, glm::dvec3 m, const glm::dmat3& M, b
 /// The outgoing wave of `mode` in a uniaxial `crystal` with tangential wave vector `p_t` (⊥ m),
 /// `m` and `transmitted` as for solveInterfaceMode. The o-wave's shell is the sphere |p| = n_o;
 /// the e-wave's is found by the Beyerle–McDermid mapping (bm_mapping.h): p' = γp puts the e-shell
-/// on the unit sphere and the normal on m' = γm/|γm|, so the root is an isotropic one,
-/// q' = ±√(1 − |p'_t|²) along m', mapped back with γ⁻¹; the tangential part stays p_t exactly
-/// (the mapping gives only the normal component q). Every e-refraction and e-reflection of the
-/// CPU twin goes through it, as the shaders' solveInterfaceMode does (sharp.glsl); the direct
-/// quadratic, solveInterfaceMode with crystal.hamiltonianMatrix(mode), is its test oracle.
+/// on the unit sphere, and the phase-matched line p = p_t + q m on p' = γp_t + q γm, so q is the
+/// root of |γp_t + q γm|² = 1 (the mapped Snell law); the tangential part stays p_t exactly. Every
+/// e-refraction and e-reflection of the CPU twin goes through it, as the shaders'
+/// solveInterfaceMode does (sharp.glsl); the direct quadratic, solveInterfaceMode with
+/// crystal.hamiltonianMatrix(mode), is its test oracle.
 ModeWave solveUniaxialMode(glm::dvec3 p_t, glm::dvec3 m, const Uniaxial& crystal, Mode mode,
                            bool transmitted);
 

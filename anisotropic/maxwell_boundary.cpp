@@ -53,12 +53,12 @@ namespace {
 // evanescent one from the complex root of the quadratic (the mapping's root is real only).
 cd extraordinaryQ(glm::dvec3 p_t, glm::dvec3 m, const Uniaxial& c, bool transmitted) {
   const BMMapping bm(c);
-  const glm::dvec3 mm = bm.mapNormal(m), pm = bm.mapWaveVector(p_t);
-  const glm::dvec3 ptm = pm - glm::dot(pm, mm) * mm;
-  const double q2 = 1.0 - glm::dot(ptm, ptm);
-  if (!(q2 >= 0.0)) return outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Extraordinary), transmitted);
-  const glm::dvec3 pmapped = ptm + (transmitted ? 1.0 : -1.0) * std::sqrt(q2) * mm;
-  return {glm::dot(bm.unmapWaveVector(pmapped), m), 0.0};
+  const glm::dvec3 gp = bm.mapWaveVector(p_t), gm = bm.mapWaveVector(m);
+  const double A = glm::dot(gm, gm), Bh = glm::dot(gp, gm), C = glm::dot(gp, gp) - 1.0;
+  const double disc = Bh * Bh - A * C;
+  if (!(disc >= 0.0))
+    return outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Extraordinary), transmitted);
+  return {(-Bh + (transmitted ? 1.0 : -1.0) * std::sqrt(disc)) / A, 0.0};
 }
 
 }  // namespace

@@ -160,9 +160,10 @@ vec3 bmGammaInverse(vec3 v, vec3 a, float no, float ne) {
 
 // The outgoing wave with tangential wave vector pt (⊥ m) on its mode's shell (anisotropic/
 // interface.cpp solveUniaxialMode): the o-wave (and an isotropic medium) on the sphere |p| = n_o,
-// the root of the quadratic pᵀp/n_o² = 1 along (transmitted) or against (reflected) m; the e-wave (eMat, axis a)
-// by the mapping: in mapped space its shell is the unit sphere and the normal m' = γm/|γm|, so
-// q' = ±√(1 − |p'_t|²) and the normal component q = (γ⁻¹p')·m; the tangential part stays pt.
+// the root of the quadratic pᵀp/n_o² = 1 along (transmitted) or against (reflected) m; the e-wave
+// (eMat, axis a) by the mapping: the phase-matched line p = pt + q m maps to p' = γpt + q γm, and
+// the e-shell to the unit sphere |p'| = 1, so q is a root of |γpt + q γm|² = 1 (no normalising: a
+// square root fewer in float) and the tangential part stays pt.
 ModeWave solveInterfaceMode(vec3 pt, vec3 m, bool eMat, vec3 a, float no, float ne, bool transmitted) {
   ModeWave w;
   w.exists = false;
@@ -172,13 +173,12 @@ ModeWave solveInterfaceMode(vec3 pt, vec3 m, bool eMat, vec3 a, float no, float 
   float q;
   vec3 pmapped;
   if (eMat) {
-    vec3 mm = normalize(bmGamma(m, a, no, ne));
-    vec3 pm = bmGamma(pt, a, no, ne);
-    vec3 ptm = pm - dot(pm, mm) * mm;
-    float q2 = 1.0 - dot(ptm, ptm);
-    if (q2 < 0.0) return w;  // evanescent for this mode
-    pmapped = ptm + (transmitted ? 1.0 : -1.0) * sqrt(q2) * mm;
-    q = dot(bmGammaInverse(pmapped, a, no, ne), m);
+    vec3 gp = bmGamma(pt, a, no, ne), gm = bmGamma(m, a, no, ne);
+    float A = dot(gm, gm), Bh = dot(gp, gm), C = dot(gp, gp) - 1.0;
+    float disc = Bh * Bh - A * C;  // A (1 − |p'_t|²), p'_t the part of γpt ⊥ γm
+    if (disc < 0.0) return w;      // evanescent for this mode
+    q = (-Bh + (transmitted ? sqrt(disc) : -sqrt(disc))) / A;
+    pmapped = gp + q * gm;
   } else {  // the quadratic of pᵀp/n_o² = 1 in q
     vec3 Mm = applyMedium(m, false, a, no, ne);
     float A = dot(m, Mm), B = 2.0 * dot(pt, Mm), C = dot(pt, applyMedium(pt, false, a, no, ne)) - 1.0;
