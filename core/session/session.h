@@ -2,8 +2,10 @@
 // (apps/) and the Python module (python/): prepare a scene (its Vulkan device and its voxelised
 // volume, each made once and on first need), simulate its light (GPU or CPU twin, through the
 // light cache), render it and trace rays in both modes, on the GPU twin or the CPU twin. The
-// range checks of the user's settings live here too, so that the CLI and Python refuse the same
-// settings with the same words (docs/design.md §3).
+// range checks of the user's settings live here too, read from the one settings table
+// (core/session/settings.h: each setting's name, default, range and help, from which the CLI's
+// options and Python's keywords are made), so that the CLI and Python refuse the same settings
+// with the same words (docs/design.md §3).
 //
 //   auto scene = std::make_shared<eikon::Scene>(eikon::loadScene("scenes/glass_sphere.json"));
 //   eikon::ViewRequest view;  view.width = 320;
