@@ -484,8 +484,9 @@ TEST_F(Cli, RenderKilledMidWayLeavesThePreviousPairIntact) {
 
 // A render that failed after writing a progressive preview removed NAME.png (the preview had
 // replaced it): the previous pair is left byte for byte, and the partial preview removed. Files
-// are limited to 8 KiB, so the previews (~6 KB) are written and the final EXR (~22 KB) is not; 256
-// samples take a few seconds, a preview a second.
+// are limited to 8 KiB, so the previews (~6 KB) are written and the final EXR (~22 KB) is not; 1024
+// samples take a few seconds (256 took 1.3 s on a quiet machine: too short for a preview, which
+// comes at most once a second), a preview a second.
 TEST_F(Cli, RenderFailingAfterAPreviewLeavesThePreviousPairIntact) {
   const std::string scene = write("scene.json", tinyScene());
   const std::string common =
@@ -494,7 +495,7 @@ TEST_F(Cli, RenderFailingAfterAPreviewLeavesThePreviousPairIntact) {
   ASSERT_EQ(first.code, 0) << first.err;
   const std::string exr = slurp(outPath("render.exr")), png = slurp(outPath("render.png"));
   const fs::path partial = outPath("render.partial.png");
-  const pid_t pid = eikon::test::startProgram(EIKON_BINARY, common + " --spp 256", io_, 8192);
+  const pid_t pid = eikon::test::startProgram(EIKON_BINARY, common + " --spp 1024", io_, 8192);
   ASSERT_GT(pid, 0);
   bool previewed = false;
   auto running = [pid] {  // asked without reaping it (WNOWAIT): waitProgram collects it
