@@ -44,6 +44,16 @@ double distance(eikon::maxwell::CV a, eikon::maxwell::CV b) { return eikon::maxw
 
 eikon::maxwell::CV field(const eikon::OutgoingWave& w) { return w.amplitude * w.wave.E; }
 
+/// A crystal of principal indices n[0..2] (α, β, γ) with its principal axis a along x̂, c along ẑ
+/// and the third along ŷ (β̂ follows from α̂ and γ̂ as the medium defines it).
+TensorMedium principalCut(const double (&n)[3], int a, int c) {
+  glm::dvec3 ax[3];
+  ax[a] = {1, 0, 0};
+  ax[3 - a - c] = {0, 1, 0};
+  ax[c] = {0, 0, 1};
+  return TensorMedium(n[0], n[1], n[2], ax[0], ax[2]);
+}
+
 }  // namespace
 
 TEST(TensorInterface, BookerQuarticRoots) {
@@ -166,12 +176,7 @@ TEST(TensorInterface, BiaxialPrincipalCutsMatchClosedForms) {
     for (int c = 0; c < 3; ++c) {
       if (a == c) continue;
       const int b = 3 - a - c;
-      glm::dvec3 ax[3];  // world directions of α̂, β̂, γ̂: axis a → X, b → Y, c → Z
-      ax[a] = X;
-      ax[b] = Y;
-      ax[c] = Z;
-      if (glm::dot(glm::cross(ax[2], ax[0]), ax[1]) < 0) ax[1] = -ax[1];  // keep right-handed
-      const TensorMedium crystal(n[0], n[1], n[2], ax[0], ax[2]);
+      const TensorMedium crystal = principalCut(n, a, c);
       for (double i = 0; i < 89; i += 4.3) {
         const double si = std::sin(deg(i)), ci = std::cos(deg(i));
         const auto in = eikon::maxwell::isotropicWaves({si, 0, 0}, Z, 1.0, true);
@@ -275,11 +280,7 @@ TEST(TensorInterface, BiaxialPrincipalCutsFromInside) {
     for (int c = 0; c < 3; ++c) {
       if (a == c) continue;
       const int b = 3 - a - c;
-      glm::dvec3 ax[3];
-      ax[a] = X;
-      ax[b] = Y;
-      ax[c] = Z;
-      const TensorMedium crystal(n[0], n[1], n[2], ax[0], ax[2]);
+      const TensorMedium crystal = principalCut(n, a, c);
       for (double xi = 0.05; xi < 1.5; xi += 0.07) {
         const cd q2 = std::sqrt(cd(1.0 - xi * xi));
         // TE: wave normal (ξ, 0, q₁)/n_b.
