@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "anisotropic/bm_mapping.h"
+#include "anisotropic/interface.h"
 
 namespace eikon::maxwell {
 namespace {
@@ -52,13 +52,9 @@ namespace {
 // e-solve, interface.h solveUniaxialMode: in mapped space the e-shell is the unit sphere), an
 // evanescent one from the complex root of the quadratic (the mapping's root is real only).
 cd extraordinaryQ(glm::dvec3 p_t, glm::dvec3 m, const Uniaxial& c, bool transmitted) {
-  const BMMapping bm(c);
-  const glm::dvec3 gp = bm.mapWaveVector(p_t), gm = bm.mapWaveVector(m);
-  const double A = glm::dot(gm, gm), Bh = glm::dot(gp, gm), C = glm::dot(gp, gp) - 1.0;
-  const double disc = Bh * Bh - A * C;
-  if (!(disc >= 0.0))
-    return outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Extraordinary), transmitted);
-  return {(-Bh + (transmitted ? 1.0 : -1.0) * std::sqrt(disc)) / A, 0.0};
+  const ModeWave w = solveUniaxialMode(p_t, m, c, Mode::Extraordinary, transmitted);
+  if (w.exists) return {w.q, 0.0};
+  return outgoingQ(p_t, m, c.hamiltonianMatrix(Mode::Extraordinary), transmitted);
 }
 
 }  // namespace
