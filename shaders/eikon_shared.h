@@ -177,6 +177,7 @@ struct ViewParams {
   ivec4 image;       // x: width; y: height; z: first row of this dispatch; w: rows in this dispatch
   vec4 wavelength;   // x: λ (µm) of the non-spectral mode; y: 1/λ²; z: 1/λ⁴
   ivec4 pass;        // x: the pixel sample of this dispatch; y: its first wavelength; z: wavelengths
+  ivec4 transport;   // x: 1 full transport (MarchSettings::transport); y: max reflections; z, w: unused
 };
 
 // One ray for the trace kernel: origin and unit direction in world space, λ in µm.
@@ -354,7 +355,7 @@ struct WavePatch {
 #define EIKON_CORNER_FACES 0x7E000000
 
 #ifdef __cplusplus
-static_assert(sizeof(ViewParams) == 16 * 16, "ViewParams must be vec4-packed");
+static_assert(sizeof(ViewParams) == 17 * 16, "ViewParams must be vec4-packed");
 static_assert(sizeof(TraceRay) == 32 && sizeof(TraceResult) == 64, "trace records must be vec4-packed");
 static_assert(sizeof(PolarisedRay) == 48 && sizeof(PolarisedBeamOut) == 80 &&
                   sizeof(PolarisedResult) == 16 + 80 * EIKON_POL_MAX_BEAMS,

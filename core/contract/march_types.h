@@ -3,32 +3,72 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <glm/glm.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "core/spectrum/wavelength_sampling.h"
+
 namespace eikon {
 
 enum class Integrator { Euler = 0, Midpoint = 1, RK4 = 2 };
 
+/// What a view sample follows at an interface it crosses (docs/view-renderer.md "Light transport").
+///   Full: the light tree, one branch per sample. Where the Fresnel equations split the light into
+///     a reflected share R and a transmitted 1 − R, the path takes the reflection with probability
+///     R and the refraction otherwise (Russian roulette with the Fresnel weights as the
+///     probabilities, so the path's weight is unchanged and the estimate unbiased). Internal
+///     reflections are followed, and external ones marched on into the scene. After
+///     MarchSettings::max_reflections such choices the path goes on as Single.
+///   Single: the transmitted path alone, its weight times 1 − R at each crossing, with an external
+///     reflection's R × the environment in the mirror direction added (no tracing into the
+///     scene) and internal partial reflections dropped. `eikon trace` follows this path.
+/// Total internal reflection is followed in both.
+enum class Transport { Single = 0, Full = 1 };
+
+/// The seed of one march's random choices (Transport::Full): one per pixel, pixel sample and
+/// mode, the same at every wavelength of the sample (a non-dispersive path is then the same path
+/// at all of them, which wavelength sharing and hero sampling rely on). Bit-exact with
+/// shaders/march.glsl transportSeed.
+inline std::uint32_t transportSeed(std::uint32_t pixel, std::uint32_t sample, int mode) {
+  return spectrum::pcgHash(pixel * 0x9E3779B1u ^
+                           spectrum::pcgHash(sample * 2u + std::uint32_t(mode) + 0x5BD1E995u));
+}
+
+/// The k-th uniform number in [0, 1) of a seed: 24 bits, exact in float (march.glsl
+/// transportUniform).
+inline double transportUniform(std::uint32_t seed, std::uint32_t k) {
+  return double(spectrum::pcgHash(seed + k * 0x632BE5ABu) >> 8u) * (1.0 / 16777216.0);
+}
+
 struct MarchSettings {
   double step_voxels = 0.25;  ///< ds in voxels (the constant spatial step)
   Integrator integrator = Integrator::RK4;
-  bool skip_empty = true;             ///< straight steps across homogeneous regions
-  bool fresnel = true;                ///< Fresnel losses/reflections at interfaces
-  double interface_threshold = 0.02;  ///< |∇n|·h peak that makes a layer an interface
-  int max_steps = 20000;              ///< per ray; a ray that runs out is reported as stopped
+  bool skip_empty = true;                 ///< straight steps across homogeneous regions
+  bool fresnel = true;                    ///< Fresnel losses/reflections at interfaces
+  double interface_threshold = 0.02;      ///< |∇n|·h peak that makes a layer an interface
+  int max_steps = 20000;                  ///< per ray; a ray that runs out is reported as stopped
+  Transport transport = Transport::Full;  ///< what a view sample follows at interfaces
+  /// Transport::Full: the Fresnel choices a path makes before it goes on as Transport::Single
+  /// (docs/view-renderer.md "Light transport" measures what the limit loses).
+  int max_reflections = 32;
 };
 
 /// The settings both twins refuse alike (std::invalid_argument), before any work: the step in
-/// (0, 4] voxels, max_steps ≥ 1, the interface threshold finite and > 0 (the GPU twin alone used
-/// to check it, so a NaN threshold rendered on the CPU twin and was refused on the GPU).
+/// (0, 4] voxels, max_steps ≥ 1, max_reflections in [0, 1024], the interface threshold finite and >
+/// 0 (the GPU twin alone used to check it, so a NaN threshold rendered on the CPU twin and was
+/// refused on the GPU).
 inline void checkMarchSettings(const MarchSettings& m) {
   if (!(m.step_voxels > 0 && m.step_voxels <= 4))
     throw std::invalid_argument("march step must be in (0, 4] voxels");
   if (m.max_steps < 1) throw std::invalid_argument("max_steps must be >= 1");
+  if (m.max_reflections < 0 || m.max_reflections > 1024)
+    throw std::invalid_argument("max_reflections must be in [0, 1024]");
+  if (m.transport != Transport::Single && m.transport != Transport::Full)
+    throw std::invalid_argument("transport must be single or full");
   if (!(m.interface_threshold > 0 && std::isfinite(m.interface_threshold)))
     throw std::invalid_argument("interface threshold must be a finite number > 0");
 }
