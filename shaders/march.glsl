@@ -20,6 +20,23 @@ layout(std430, binding = EIKON_B_PARAMS) readonly buffer ParamsBuf { ViewParams 
 ViewParams P;
 
 void loadParams() { P = params; }
+
+// The PCG integer hash (core/spectrum/wavelength_sampling.h pcgHash, bit-exact).
+uint pcg_hash(uint v) {
+  uint state = v * 747796405u + 2891336453u;
+  uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+
+// Full transport's random choices (core/contract/march_types.h transportSeed, transportUniform;
+// bit-exact): the seed of a pixel sample's march in one mode, the same at every wavelength, and
+// its k-th uniform number in [0, 1), 24 bits (exact in float).
+uint transportSeed(uint pixel, uint sampleIndex, int mode) {
+  return pcg_hash(pixel * 0x9E3779B1u ^ pcg_hash(sampleIndex * 2u + uint(mode) + 0x5BD1E995u));
+}
+float transportUniform(uint seed, uint k) {
+  return float(pcg_hash(seed + k * 0x632BE5ABu) >> 8u) * (1.0 / 16777216.0);
+}
 layout(binding = EIKON_B_INDEX_O_A, rgba32f) readonly uniform image3D idxOA;
 layout(binding = EIKON_B_INDEX_O_B, rgba32f) readonly uniform image3D idxOB;
 layout(binding = EIKON_B_INDEX_O_C, rgba32f) readonly uniform image3D idxOC;
@@ -94,6 +111,8 @@ struct PathRecord {
   bool overflow;    // wavelength sharing: a lookup found the record full
   bool dispersive;  // the path met something that depends on λ
   int count;        // entries used
+  uint pixel;       // full transport: the pixel and pixel sample the march's choices are drawn for
+  uint sampleIndex; //   (transportSeed)
   // (linear sRGB radiance, weight). Indexed only by constants (recordPush, and loops of constant
   // count that are unrolled): llvmpipe keeps such an array in registers, where one indexed at run
   // time would live in memory and be copied whole at every inout call.
@@ -116,7 +135,17 @@ PathRecord noRecord() {
   rec.overflow = false;
   rec.dispersive = false;
   rec.count = 0;
+  rec.pixel = 0u;
+  rec.sampleIndex = 0u;
   for (int i = 0; i < kRecordMax; ++i) rec.entries[i] = vec4(0.0);
+  return rec;
+}
+
+// A record for pixel sample `sampleIndex` of `pixel` (view.comp), which seeds its full transport.
+PathRecord sampleRecord(uint pixel, int sampleIndex) {
+  PathRecord rec = noRecord();
+  rec.pixel = pixel;
+  rec.sampleIndex = uint(sampleIndex);
   return rec;
 }
 
@@ -388,7 +417,52 @@ struct MarchState {
   vec3 gAcc;
   vec3 xOpen;
   vec3 xPeak;  // kAov: where the layer's |∇n|·h peaked so far
+  // Full transport (P.transport; core/contract/march_types.h Transport): the seed of the march's
+  // choices, the uniforms drawn so far, and the reflections followed.
+  uint seed;
+  uint draws;
+  int reflections;
 };
+
+// The march's state before its first step: at x with wave vector w, nothing gathered, the
+// choices seeded for the record's pixel sample and `mode`.
+MarchState startState(vec3 x, vec3 w, int mode, PathRecord rec) {
+  MarchState S;
+  S.x = x;
+  S.w = w;
+  S.nn = vec4(0.0);
+  S.T = vec3(1.0);
+  S.L = vec3(0.0);
+  S.stopped = false;
+  S.region = 0;
+  S.inLayer = false;
+  S.peak2 = 0.0;
+  S.wBefore = w;
+  S.gAcc = vec3(0.0);
+  S.xOpen = x;
+  S.xPeak = x;
+  S.seed = transportSeed(rec.pixel, rec.sampleIndex, mode);
+  S.draws = 0u;
+  S.reflections = 0;
+  return S;
+}
+
+// Full transport (P.transport.x), while the path has followed fewer than P.transport.y
+// reflections: true (the path reflects, counted) with probability Rf, else false (it refracts),
+// in both cases at its whole weight (Russian roulette with the Fresnel weights; the CPU twin's
+// RayMarch::followReflection).
+bool followReflection(inout MarchState S, float Rf) {
+  if (P.transport.x == 0 || S.reflections >= P.transport.y) return false;
+  float u = transportUniform(S.seed, S.draws);
+  S.draws++;
+  if (!(u < Rf)) return false;
+  S.reflections++;
+  return true;
+}
+
+// Whether a crossing weighs the path by 1 − R and looks its external reflection up in the
+// environment (the single transmitted path): transport single, or past the reflection limit.
+bool singlePathWeights(MarchState S) { return P.transport.x == 0 || S.reflections >= P.transport.y; }
 
 // What an integration step leaves for the stages after it.
 struct StepEnd {
@@ -549,9 +623,23 @@ void fresnelAtLayer(inout MarchState S, inout MarchResult R, inout PathRecord re
     float wsw = sWeight(outCrystal ? dOut : dIn, a, N, dIn, mode);
     vec2 rsp = fresnelRsRp(abs(ci), n1, n2);
     float Rf = hasFlag(EIKON_F_UNIAXIAL) ? wsw * rsp.x + (1.0 - wsw) * rsp.y : 0.5 * (rsp.x + rsp.y);
+    R.interfaces++;
+    if (followReflection(S, Rf)) {
+      // Back to where the layer opened, on the incident side, with the mirrored wave vector; a
+      // crystal's e-wave put back on its shell there (the layer's own normal N).
+      S.x = S.xOpen;
+      S.nn = sampleIndex(S.x, 0, rec.dispersive);
+      S.w = reflect(S.wBefore, N);
+      StepEnd E;
+      E.aHere = mode == 1 ? axisAt(S.x) : vec3(0.0);
+      E.eHere = mode == 1 && hasAxis(E.aHere);
+      E.ne = E.eHere ? sampleIndex(S.x, 1, rec.dispersive) : S.nn;
+      projectOnShell(S, E, N);
+      return;
+    }
+    if (!singlePathWeights(S)) return;
     if (n2 > n1) S.L += environmentWeighted(rec, S.T * Rf, reflect(dIn, N));
     S.T *= 1.0 - Rf;
-    R.interfaces++;
   } else {
     R.tir++;
   }
@@ -675,21 +763,10 @@ MarchResult march(vec3 o, vec3 d, int mode, inout PathRecord rec) {
   MarchResult R;
   float t0;
   if (!enterVolume(o, d, rec, R, t0)) return R;
-  MarchState S;
-  S.x = o + d * t0;
   R.opl = P.march.z * t0;  // the ambient index
-  S.nn = sampleIndex(S.x, 0, rec.dispersive);
-  S.w = S.nn.x * d;  // the volume's faces are isotropic (air): p = n d
-  S.T = vec3(1.0);
-  S.L = vec3(0.0);
-  S.stopped = false;
-  S.region = 0;
-  S.inLayer = false;
-  S.peak2 = 0.0;
-  S.wBefore = S.w;
-  S.gAcc = vec3(0.0);
-  S.xOpen = S.x;
-  S.xPeak = S.x;
+  vec4 nn = sampleIndex(o + d * t0, 0, rec.dispersive);
+  MarchState S = startState(o + d * t0, nn.x * d, mode, rec);  // the volume's faces are isotropic (air): p = n d
+  S.nn = nn;
   const int maxSteps = P.limits.x;
   int steps = 0;
   // Per step: straightStep, integrateStep, mediumAlongStep, layerStep, clipToVolume. lavapipe runs

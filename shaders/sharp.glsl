@@ -422,7 +422,9 @@ int sharpAdvance(inout MarchState S, inout MarchResult R, inout bool dispersive,
 }
 
 // The exact laws at a crossing: Snell, or the o/e waves into / out of a crystal; TIR is a lossless
-// mirror; otherwise the ray carries (1 − R) on and an external reflection adds R × environment.
+// mirror; otherwise the path reflects with probability R or refracts (full transport,
+// followReflection), or carries (1 − R) on while an external reflection adds R × environment
+// (single path).
 // (refractIsotropic, refractIntoUniaxial, refractOutOfUniaxial and reflectInsideUniaxial are one
 // solveInterfaceMode each: the incident wave's tangential part on the outgoing mode's shell.)
 void crossInterface(inout MarchState S, inout MarchResult R, inout PathRecord rec, BoundaryCrossing c,
@@ -450,7 +452,24 @@ void crossInterface(inout MarchState S, inout MarchResult R, inout PathRecord re
   vec3 pt = nIn * s - dot(nIn * s, m) * m;
   bool eOut = uB && mode == 1;  // into a crystal: the mode's shell there
   ModeWave o = solveInterfaceMode(pt, m, eOut, afB.xyz, noB, neB, true);
-  if (!o.exists) {  // total internal reflection: a mirror, no loss; the ray stays in A
+  // The mirror wave in A (total internal reflection, or a partial reflection followed): in a
+  // crystal the reflected wave of the same mode (reflectInsideUniaxial), else w mirrored.
+  bool reflects = !o.exists;
+  R.interfaces += reflects ? 0 : 1;
+  if (o.exists && !hasFlag(EIKON_F_NO_FRESNEL)) {
+    vec2 rsp = fresnelRsRp(min(1.0, abs(dot(s, N))), n1, o.n);
+    float Rf = 0.5 * (rsp.x + rsp.y);
+    if (uA || uB) {
+      float wsw = sWeight(uB ? o.s : s, uB ? afB.xyz : afA.xyz, N, s, mode);
+      Rf = wsw * rsp.x + (1.0 - wsw) * rsp.y;
+    }
+    reflects = followReflection(S, Rf);  // the partial reflection, internal or external
+    if (!reflects && singlePathWeights(S)) {
+      if (o.n > n1) S.L += environmentWeighted(rec, S.T * Rf, reflect(s, N));
+      S.T *= 1.0 - Rf;
+    }
+  }
+  if (reflects) {  // the ray stays in A
     if (uA) {
       m = orientNormal(N, flowA);
       float nr = eIn ? inversesqrt(dot(s, applyM(s, afA.xyz, noA, neA))) : noA;
@@ -460,20 +479,9 @@ void crossInterface(inout MarchState S, inout MarchResult R, inout PathRecord re
     } else {
       S.w = reflect(S.w, N);
     }
-    R.tir++;
+    R.tir += o.exists ? 0 : 1;
     return;
   }
-  if (!hasFlag(EIKON_F_NO_FRESNEL)) {
-    vec2 rsp = fresnelRsRp(min(1.0, abs(dot(s, N))), n1, o.n);
-    float Rf = 0.5 * (rsp.x + rsp.y);
-    if (uA || uB) {
-      float wsw = sWeight(uB ? o.s : s, uB ? afB.xyz : afA.xyz, N, s, mode);
-      Rf = wsw * rsp.x + (1.0 - wsw) * rsp.y;
-    }
-    if (o.n > n1) S.L += environmentWeighted(rec, S.T * Rf, reflect(s, N));
-    S.T *= 1.0 - Rf;
-  }
-  R.interfaces++;
   S.w = o.n * o.s;
   S.region = B;
 }
@@ -492,17 +500,7 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode, inout PathRecord rec) {
   MarchResult R;
   float t0;
   if (!enterVolume(o, d, rec, R, t0)) return R;
-  MarchState S;
-  S.nn = vec4(0.0);  // unused by the sharp march, but defined
-  S.inLayer = false;
-  S.peak2 = 0.0;
-  S.wBefore = vec3(0.0);
-  S.gAcc = vec3(0.0);
-  S.xOpen = vec3(0.0);
-  S.xPeak = vec3(0.0);
-  S.T = vec3(1.0);
-  S.L = vec3(0.0);
-  S.stopped = false;
+  MarchState S = startState(vec3(0.0), vec3(0.0), mode, rec);  // nn, the layer: unused here
   sharpEnter(S, rec.dispersive, o + d * t0, d, mode);
   R.opl = P.march.z * t0;
   const int maxSteps = P.limits.x;

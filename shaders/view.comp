@@ -31,12 +31,6 @@ layout(std430, binding = EIKON_B_OUTPUT) writeonly buffer OutBuf { vec4 pixels[]
 // pixel sample's first pass added every wavelength.
 layout(std430, binding = EIKON_B_SHARED_PATHS) buffer SharedPathsBuf { uint sharedPaths[]; };
 
-uint pcg_hash(uint v) {
-  uint state = v * 747796405u + 2891336453u;
-  uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-  return (word >> 22u) ^ word;
-}
-
 vec3 cmf(float lambda_nm) {
   float t = lambda_nm - 360.0;
   if (t < 0.0 || t > 470.0) return vec3(0.0);
@@ -204,9 +198,9 @@ void layersOfModes(int bandPixel, int k, vec3 rad, vec3 radMode[2]) {
 // ---- The strategies (the pass bits EIKON_PASS_*; main chooses) ----
 
 // RGB mode: one march per mode at the fixed wavelength P.wavelength.x, RGB attenuation.
-void renderRgbSample(vec3 d, int bandPixel, inout SampleSum acc) {
+void renderRgbSample(vec3 d, uint pixelIndex, int s, int bandPixel, inout SampleSum acc) {
   setWavelength(P.wavelength.x, false);
-  PathRecord rec = noRecord();
+  PathRecord rec = sampleRecord(pixelIndex, s);
   vec3 radMode[2];
   int unused;
   vec3 rad = marchModes(d, passModes(), 1.0, false, rec, acc, radMode, unused);
@@ -220,6 +214,8 @@ struct SpectralSpan {
   float width;
   uint seed;  // stratified: u(k) from pcg_hash(seed + k)
   float uh;   // hero: the one jitter shared by all N
+  uint pixel;  // the pixel sample (its records' sampleRecord)
+  int sampleIndex;
 };
 
 SpectralSpan spectralSpan(int s, uint pixelIndex) {
@@ -230,6 +226,8 @@ SpectralSpan spectralSpan(int s, uint pixelIndex) {
   w.width = 400.0 / float(w.N);
   w.seed = pcg_hash(pixelIndex + pcg_hash(uint(s)));
   w.uh = 0.0;
+  w.pixel = pixelIndex;
+  w.sampleIndex = s;
   return w;
 }
 
@@ -266,7 +264,7 @@ float recordedRadiance(PathRecord rec, int i0, int i1) {
 // The record for marching bin k: on for the pass's first wavelength where it may be shared.
 PathRecord stratifiedRecord(int k, SpectralSpan w, bool crossShare) {
   const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
-  PathRecord rec = noRecord();
+  PathRecord rec = sampleRecord(w.pixel, w.sampleIndex);
   rec.record = (!hasFlag(lambdaDependent) || crossShare) && k == w.k0;
   return rec;
 }
@@ -306,7 +304,7 @@ void heroBegin(int s, uint pixelIndex, float modeWeight, inout SpectralSpan w, o
   w.k0 = int((offset + uint(s)) % uint(w.N));
   w.k1 = w.k0 + 1;
   w.uh = float(pcg_hash(w.seed) >> 8u) * (1.0 / 16777216.0);
-  rec = noRecord();
+  rec = sampleRecord(w.pixel, w.sampleIndex);
   rec.hero = true;
   rec.weight = modeWeight;
 }
@@ -373,7 +371,7 @@ void main() {
   vec3 d = cameraRay(px, py, s, pixelIndex);
   SampleSum acc = emptySum();
   if (!hasFlag(EIKON_F_SPECTRAL)) {
-    renderRgbSample(d, bandPixel, acc);
+    renderRgbSample(d, pixelIndex, s, bandPixel, acc);
   } else {
     renderSpectralSample(d, s, hero, crossShare, pixelIndex, bandPixel, acc);
     mat3 M = mat3(tables[EIKON_MATRIX_OFFSET].xyz, tables[EIKON_MATRIX_OFFSET + 1].xyz,

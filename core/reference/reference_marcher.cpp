@@ -79,6 +79,7 @@ struct MarchResult {
   bool left = true;
   bool ran_out = false;  ///< ended by max_steps alone (march.glsl's cut, RenderImage::cut_samples)
   int steps = 0, interfaces = 0, tir = 0;
+  int reflections = 0;    ///< Fresnel reflections followed (Transport::Full)
   long long fetches = 0;  ///< volume-field reads (CountedField)
   FirstInterface first;   ///< the first interface met (the AOV layer)
 };
@@ -94,7 +95,8 @@ struct MarchState {
   bool inLayer = false;
   double peak = 0.0;
   glm::dvec3 wBefore{0.0}, gAcc{0.0}, xOpen{0.0};
-  glm::dvec3 xPeak{0.0};  ///< where the layer's |∇n|·h peaked so far (the AOV layer)
+  glm::dvec3 xPeak{0.0};    ///< where the layer's |∇n|·h peaked so far (the AOV layer)
+  std::uint32_t draws = 0;  ///< Transport::Full: the uniforms drawn so far (transportUniform's k)
 };
 
 /// What an integration step leaves for the stages after it (march.glsl's StepEnd).
@@ -146,8 +148,9 @@ class CountedField {
 class RayMarch {
  public:
   RayMarch(const Field& f, const Environment& env, double lambda_nm, bool scalar,
-           const MarchSettings& m, int mode, HeroRecord* hero = nullptr)
+           const MarchSettings& m, int mode, HeroRecord* hero = nullptr, std::uint32_t seed = 0)
       : hero_(hero),
+        seed_(seed),
         f_(f),
         env_(env),
         lambda_nm_(lambda_nm),
@@ -245,8 +248,11 @@ class RayMarch {
                  double& opl) const;
   SharpEvent sharpStep(MarchState& S, MarchResult& R, BoundaryCrossing& c) const;
   void crossInterface(MarchState& S, MarchResult& R, const BoundaryCrossing& c) const;
+  void reflectInRegion(MarchState& S, const glm::dvec3& N) const;
+  bool followReflection(MarchState& S, MarchResult& R, double Rf) const;
 
   HeroRecord* hero_;
+  std::uint32_t seed_;  ///< Transport::Full: transportSeed of the pixel sample and mode
   CountedField f_;
   const Environment& env_;
   double lambda_nm_, il2_ = 0.0, il4_ = 0.0;
@@ -477,9 +483,33 @@ void RayMarch::fresnelAtLayer(MarchState& S, MarchResult& R, const glm::dvec3& N
   if (!(n1 > 0.0 && n2 > 0.0) || !std::isfinite(n1 + n2)) return;  // fresnelReflectance's domain
   const FresnelReflectance rsp = fresnelReflectance(std::abs(ci), n1, n2);
   const double Rf = f_.uniaxial() ? wsw * rsp.Rs + (1.0 - wsw) * rsp.Rp : 0.5 * (rsp.Rs + rsp.Rp);
+  R.interfaces++;
+  if (followReflection(S, R, Rf)) {
+    // Back to where the layer opened, on the incident side, with the mirrored wave vector; a
+    // crystal's e-wave put back on its shell there (the layer's own normal N).
+    S.x = S.xOpen;
+    S.nn = sampleIndex(S.x, 0);
+    S.w = glm::reflect(S.wBefore, N);
+    StepEnd E;
+    E.aHere = axisAt(S.x);
+    E.eHere = mode_ == 1 && field::hasAxis(E.aHere);
+    E.ne = E.eHere ? sampleIndex(S.x, 1) : S.nn;
+    projectOnShell(S, E, N);
+    return;
+  }
+  if (m_.transport == Transport::Full && R.reflections < m_.max_reflections) return;
   if (n2 > n1) S.L += environmentWeighted(S.T * Rf, glm::reflect(dIn, N));
   S.T *= 1.0 - Rf;
-  R.interfaces++;
+}
+
+// Transport::Full, while the path has followed fewer than max_reflections: true (the path
+// reflects, counted) with probability Rf, else false (it refracts) — in both cases at its whole
+// weight, the Fresnel weights being the probabilities (Russian roulette, unbiased).
+bool RayMarch::followReflection(MarchState& S, MarchResult& R, double Rf) const {
+  if (m_.transport != Transport::Full || R.reflections >= m_.max_reflections) return false;
+  if (!(transportUniform(seed_, S.draws++) < Rf)) return false;
+  R.reflections++;
+  return true;
 }
 
 // Interface bookkeeping (march.glsl layerStep).
@@ -793,16 +823,11 @@ void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCross
     out = refractOutOfUniaxial(cr, mode, s, N, regionIndex(c.to, 0, x));
   }
   if (!out.exists) {  // total internal reflection: a mirror, no loss; the ray stays in A
-    if (A.uniaxial) {
-      const Uniaxial cr(regionIndex(S.region, 0, x), regionIndex(S.region, 1, x), glm::dvec3(afA));
-      const ModeWave r = reflectInsideUniaxial(cr, mode, s, N);
-      S.w = r.exists ? r.p() : glm::reflect(S.w, N);
-    } else {
-      S.w = glm::reflect(S.w, N);
-    }
+    reflectInRegion(S, N);
     R.tir++;
     return;
   }
+  R.interfaces++;
   if (m_.fresnel) {
     const FresnelReflectance rsp = fresnelReflectance(std::abs(glm::dot(s, N)), n1, out.n);
     double Rf = 0.5 * (rsp.Rs + rsp.Rp);
@@ -812,12 +837,35 @@ void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCross
           sWeight(intoCrystal ? out.s : s, glm::dvec3(intoCrystal ? afB : afA), N, s, mode_);
       Rf = wsw * rsp.Rs + (1.0 - wsw) * rsp.Rp;
     }
-    if (out.n > n1) S.L += environmentWeighted(S.T * Rf, glm::reflect(s, N));
-    S.T *= 1.0 - Rf;
+    if (followReflection(S, R, Rf)) {  // the partial reflection, internal or external
+      reflectInRegion(S, N);
+      return;
+    }
+    if (m_.transport == Transport::Single || R.reflections >= m_.max_reflections) {
+      if (out.n > n1) S.L += environmentWeighted(S.T * Rf, glm::reflect(s, N));
+      S.T *= 1.0 - Rf;
+    }
   }
-  R.interfaces++;
   S.w = out.p();
   S.region = c.to;
+}
+
+// The mirror wave in the ray's own region (total internal reflection, or a partial reflection
+// followed): in a crystal the reflected wave of the same mode (reflectInsideUniaxial), else w
+// mirrored in the face.
+void RayMarch::reflectInRegion(MarchState& S, const glm::dvec3& N) const {
+  const MediumRecord& A = rec(S.region);
+  if (A.uniaxial) {
+    const glm::dvec3 s = glm::normalize(S.w);
+    const glm::dvec4 afA = mediumAxisField(A, S.x);
+    const Uniaxial cr(regionIndex(S.region, 0, S.x), regionIndex(S.region, 1, S.x),
+                      glm::dvec3(afA));
+    const ModeWave r =
+        reflectInsideUniaxial(cr, mode_ == 1 ? Mode::Extraordinary : Mode::Ordinary, s, N);
+    S.w = r.exists ? r.p() : glm::reflect(S.w, N);
+  } else {
+    S.w = glm::reflect(S.w, N);
+  }
 }
 
 MarchResult RayMarch::marchSharp(const glm::dvec3& o, const glm::dvec3& d) const {
@@ -861,10 +909,10 @@ struct ReferenceMarcher::Result : MarchResult {};
 
 ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm::dvec3& d,
                                                  double lambda_nm, bool scalar,
-                                                 const MarchSettings& m, int mode,
-                                                 HeroRecord* hero) const {
+                                                 const MarchSettings& m, int mode, HeroRecord* hero,
+                                                 uint32_t seed) const {
   Result r;
-  const RayMarch rm(field_, env_, lambda_nm, scalar, m, mode, hero);
+  const RayMarch rm(field_, env_, lambda_nm, scalar, m, mode, hero, seed);
   static_cast<MarchResult&>(r) = rm.march(o, d);
   r.fetches = rm.fetches();
   return r;
@@ -878,7 +926,10 @@ TraceOutcome ReferenceMarcher::trace(const TraceRequest& ray, const MarchSetting
     throw std::invalid_argument("trace direction must be a non-zero finite vector");
   if (!(ray.wavelength_nm > 0)) throw std::invalid_argument("trace wavelength must be > 0 nm");
   if (mode != 0 && mode != 1) throw std::invalid_argument("mode must be 0 (o) or 1 (e)");
-  Result r = march(ray.origin, ray.direction / len, ray.wavelength_nm, true, m,
+  // The transmitted path (Transport::Single): its transmittance is the product of the crossings'.
+  MarchSettings single = m;
+  single.transport = Transport::Single;
+  Result r = march(ray.origin, ray.direction / len, ray.wavelength_nm, true, single,
                    field_.uniaxial() ? mode : 0);
   TraceOutcome t;
   t.exit_point = r.exit_point;
@@ -928,7 +979,8 @@ glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3
   int count0 = 0;                   // records made by the o-mode's march
   for (int mode = mr.first; mode < mr.end; ++mode) {
     rec.diverged = field_.weightsDependOnLambda();
-    Result r = march(o, d, lambdas[0], true, s.march, mode, &rec);
+    Result r =
+        march(o, d, lambdas[0], true, s.march, mode, &rec, transportSeed(pixel, sample, mode));
     heroMode[mode] = rec.weight * r.radiance.x;
     if (mode == 0) count0 = rec.count;
     tally.add(r, 1.0);
@@ -957,13 +1009,14 @@ glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3
 }
 
 glm::dvec3 ReferenceMarcher::rgbSample(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel,
-                                       const RenderSettings& s, SampleTally& tally,
+                                       uint32_t sidx, const RenderSettings& s, SampleTally& tally,
                                        LayerSums* layers) const {
   // Unpolarised light: each mode carries half, or the one selected the whole (modeRange).
   const ModeRange mr = modeRange(s.modes, field_.uniaxial());
   glm::dvec3 rad(0.0);
   for (int mode = mr.first; mode < mr.end; ++mode) {
-    const Result r = march(eye, d, s.wavelength_nm, false, s.march, mode);
+    const Result r = march(eye, d, s.wavelength_nm, false, s.march, mode, nullptr,
+                           transportSeed(pixel, sidx, mode));
     const glm::dvec3 part = mr.weight * r.radiance;
     rad += part;
     tally.add(r, 1.0);
@@ -987,7 +1040,8 @@ glm::dvec3 ReferenceMarcher::stratifiedSampleXyz(const glm::dvec3& eye, const gl
   for (size_t k = 0; k < lambdas.size(); ++k) {
     double rad = 0.0;
     for (int mode = mr.first; mode < mr.end; ++mode) {
-      const Result r = march(eye, d, lambdas[k], true, s.march, mode);
+      const Result r =
+          march(eye, d, lambdas[k], true, s.march, mode, nullptr, transportSeed(pixel, sidx, mode));
       const double part = mr.weight * r.radiance.x;
       rad += part;
       tally.add(r, s.wavelengths);
@@ -1003,7 +1057,7 @@ glm::dvec3 ReferenceMarcher::sampleRgb(const glm::dvec3& eye, const glm::dvec3& 
                                        SampleTally& tally, LayerSums& layers) const {
   // The strategy, as view.comp's main chooses it from the pass bits.
   LayerSums* lp = layers.active() ? &layers : nullptr;
-  if (s.wavelengths == 0) return rgbSample(eye, d, pixel, s, tally, lp);
+  if (s.wavelengths == 0) return rgbSample(eye, d, pixel, sidx, s, tally, lp);
   const glm::dmat3 M = spectrum::spectralToLinearSrgbMatrix();
   if (hero) return M * heroSampleXyz(eye, d, pixel, sidx, s, tally, lp);
   return M * stratifiedSampleXyz(eye, d, pixel, sidx, s, tally, lp);

@@ -61,7 +61,8 @@ class ReferenceMarcher {
   struct Result;
   struct SampleTally;  // the marches of one pixel sample (the .cpp)
   Result march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar,
-               const MarchSettings& m, int mode, HeroRecord* hero = nullptr) const;
+               const MarchSettings& m, int mode, HeroRecord* hero = nullptr,
+               uint32_t seed = 0) const;
   /// CIE XYZ (unnormalised, as Σ L·sampleWeightXyz) of one pixel sample by hero wavelength
   /// sampling (docs/spectra.md); adds its marches to `tally`, and its bins to `layers`.
   glm::dvec3 heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
@@ -69,7 +70,7 @@ class ReferenceMarcher {
                            LayerSums* layers) const;
   /// Linear sRGB of one pixel sample in RGB mode: one march per mode at the index wavelength
   /// (view.comp renderRgbSample).
-  glm::dvec3 rgbSample(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel,
+  glm::dvec3 rgbSample(const glm::dvec3& eye, const glm::dvec3& d, uint32_t pixel, uint32_t sidx,
                        const RenderSettings& s, SampleTally& tally, LayerSums* layers) const;
   /// CIE XYZ (as heroSampleXyz's) of one pixel sample at its N stratified wavelengths, one march
   /// per wavelength and mode (view.comp renderSpectralSample, stratified).

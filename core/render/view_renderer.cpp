@@ -872,6 +872,9 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   p.cam_forward.w = float(double(img.width) / img.height);
   p.limits.y = s.spp;
   p.limits.z = std::max(1, s.wavelengths);
+  // The view march's transport (the trace kernel's parameters keep 0: the transmitted path).
+  p.transport =
+      glm::ivec4(s.march.transport == Transport::Full ? 1 : 0, s.march.max_reflections, 0, 0);
   double l = micrometresFromNanometres(s.wavelength_nm);
   p.wavelength = glm::vec4(float(l), float(1.0 / (l * l)), float(1.0 / (l * l * l * l)), 0.0f);
   I.boundary.setRenderWavelength(s.wavelength_nm);  // the RGB march's indices (sharp.glsl)

@@ -119,6 +119,23 @@ const std::vector<Setting> kSettings = {
      .help = "Disable Fresnel reflection and transmission losses", .field = "MarchSettings::fresnel",
      .fill = [](const SettingValue& v, SettingRequests& r) { r.march.fresnel = !v.flag; },
      .keyword = "march.fresnel"},
+    {.name = "transport", .kind = K::Choice, .fronts = F::RenderCli | F::ViewCli | F::PyRender,
+     .help = "What a view sample follows at an interface (docs/view-renderer.md \"Light "
+             "transport\")",
+     .field = "MarchSettings::transport",
+     .fill = [](const SettingValue& v, SettingRequests& r) {
+       r.march.transport = v.text == "single" ? Transport::Single : Transport::Full;
+     },
+     .value = "full", .says_value = true,
+     .choices = {{"full", "reflection or refraction by their Fresnel weights, every path to its end"},
+                 {"single", "the transmitted path, external reflections from the environment"}},
+     .keyword = "march.transport"},
+    {.name = "max-reflections", .kind = K::Integer,
+     .fronts = F::RenderCli | F::ViewCli | F::PyRender,
+     .help = "Fresnel reflections a path follows before it goes on as the transmitted path",
+     .field = "MarchSettings::max_reflections",
+     .fill = [](const SettingValue& v, SettingRequests& r) { r.march.max_reflections = v.integer; },
+     .value = "32", .min = 0, .max = 1024, .keyword = "march.max_reflections"},
     {.name = "threads", .kind = K::Integer, .fronts = F::RenderCli | F::PyRender,
      .help = "CPU threads of the CPU twin, voxelising and the CPU light simulator,",
      .field = "Session::setThreads, LightRequest::threads",
