@@ -6,6 +6,7 @@
 //
 //   build/bench/view_bench [scene.json] [--width W --height H] [--no-cpu] [--interfaces]
 //                          [--march sharp|smoothed] [--only SUBSTRING] [--no-accuracy] [--repeat N]
+//                          [--transport]
 //
 // --march: voxelise with that kind of interface whatever the scene says (the variants' integrator
 // and step only matter where the march integrates: every layer when smoothed, varying regions when
@@ -19,6 +20,10 @@
 // for the CPU twin also the volume-field reads per ray (every trilinear sample of the index,
 // medium and other volumes, and every boundary-field cell locateCrossing evaluates; the GPU's are
 // not counted, to keep counters out of the shader's inner loops).
+//
+// --transport: only full transport against the single transmitted path (docs/view-renderer.md
+// "Light transport"), at equal samples: time and steps per ray, their ratio, and the image mean
+// lost to the reflection limit (32 against 1024).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -72,6 +77,54 @@ int compareInterfaces(vk::Context& ctx, const Scene& scene, int width, int heigh
   return 0;
 }
 
+// Mean of the image's three channels over all pixels.
+double imageMean(const RenderImage& img) {
+  double sum = 0.0;
+  for (float v : img.rgb) sum += v;
+  return sum / double(std::max<size_t>(img.rgb.size(), 1));
+}
+
+// Full transport against the single transmitted path at equal samples (the scene's "render" spp,
+// at least 4), GPU (and the CPU twin unless --no-cpu): seconds and steps per ray of each and their
+// ratio; and what the reflection limit loses: the image mean at max_reflections 32 (default)
+// against 1024 (GPU), as a relative difference.
+int compareTransport(vk::Context& ctx, const Scene& scene, int width, int height, bool cpu) {
+  const VolumeSet vol = voxelize(scene);
+  ViewRenderer gpu(ctx, scene, vol);
+  VolumeField field(vol);
+  ReferenceMarcher ref(field, scene.environment);
+  RenderSettings rs;
+  rs.width = width;
+  rs.height = height;
+  rs.spp = std::max(4, scene.render.spp.value_or(4));
+  rs.march.step_voxels = 0.5;  // the renders' default (`eikon render --step`)
+  double t[2][2] = {{0, 0}, {0, 0}};
+  const Transport kinds[2] = {Transport::Single, Transport::Full};
+  gpu.render(rs);  // warm-up
+  for (int k = 0; k < 2; ++k) {
+    rs.march.transport = kinds[k];
+    const RenderImage g = gpu.render(rs);
+    t[k][0] = g.seconds;
+    std::printf("%-6s GPU: %8.3f s, %8.1f steps/ray, mean %.5f, cut samples %lld\n",
+                k ? "full" : "single", g.seconds, g.mean_steps, imageMean(g), g.cut_samples);
+    if (!cpu) continue;
+    const RenderImage c = ref.render(scene.camera, rs);
+    t[k][1] = c.seconds;
+    std::printf("%-6s CPU: %8.3f s, %8.1f steps/ray, mean %.5f\n", k ? "full" : "single", c.seconds,
+                c.mean_steps, imageMean(c));
+  }
+  std::printf("ratio full / single at %d spp: GPU time %.2f", rs.spp, t[1][0] / t[0][0]);
+  if (cpu) std::printf(", CPU time %.2f", t[1][1] / t[0][1]);
+  std::printf("\n");
+  rs.march.transport = Transport::Full;
+  const double at32 = imageMean(gpu.render(rs));
+  rs.march.max_reflections = 1024;
+  const double at1024 = imageMean(gpu.render(rs));
+  std::printf("reflection limit: image mean %.6f at 32, %.6f at 1024: %.2e relative\n", at32,
+              at1024, (at1024 - at32) / std::max(std::abs(at1024), 1e-30));
+  return 0;
+}
+
 int main(int argc, char** argv) {
   std::string scene_path = std::string(EIKON_SOURCE_DIR) + "/scenes/glass_sphere.json";
   int width = 800, height = 600;
@@ -85,6 +138,8 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-cpu", cpu, "Skip the CPU reference");
   bool interfaces = false;
   app.add_flag("--interfaces", interfaces, "Only compare sharp and smoothed interfaces");
+  bool transport = false;
+  app.add_flag("--transport", transport, "Only compare full transport with the single path");
   std::string march_kind, only;
   app.add_option("--march", march_kind, "Voxelise with sharp or smoothed interfaces")
       ->check(CLI::IsMember({"sharp", "smoothed"}));
@@ -100,6 +155,7 @@ int main(int argc, char** argv) {
   if (march_kind == "smoothed") scene.interfaces = Scene::Interfaces::Smoothed;
   auto ctx = vk::Context::create();
   if (interfaces) return compareInterfaces(*ctx, scene, width, height, cpu);
+  if (transport) return compareTransport(*ctx, scene, width, height, cpu);
   auto t0 = std::chrono::steady_clock::now();
   VolumeSet vol = voxelize(scene);
   double vox_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -104,13 +104,14 @@ std::map<std::string, double> statsByChannel(const std::string& verbose, const s
 // (radius 5 at the origin, eye at z = −40, sharp interfaces): the four central pixels' rays are
 // the nearest to the axis, all at the same angle, so the least Z is theirs, t = −b − √(b² − 1575)
 // along d (b = o·d); the sky around has Z = inf (iinfo counts them), objectId −1 there and 0 on
-// the sphere; Nz ≤ 0 (normals face the camera); steps ≤ 2 per pixel (enter, leave).
+// the sphere; Nz ≤ 0 (normals face the camera); steps ≤ 2 per pixel (enter, leave: the single
+// transmitted path, `--transport single`; full transport adds a step per internal reflection).
 TEST(RenderLayersCli, AovChannelsReadBackWithOpenImageIO) {
   Dir d;
   const fs::path out = d.path / "out.exr";
   const Outcome r =
       eikon::test::runEikon("render " + quote((d.path / "scene.json").string()) + " -o " +
-                                quote(out.string()) + " --wavelengths 0 --layers aov -q",
+                                quote(out.string()) + " --wavelengths 0 --layers aov --transport single -q",
                             d.path);
   ASSERT_EQ(r.code, 0) << r.err;
   const Outcome info = eikon::test::runProgram("iinfo", "-v " + quote(out.string()), d.path);

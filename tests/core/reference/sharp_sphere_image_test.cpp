@@ -3,7 +3,8 @@
 // with the exact sphere, Snell and the unpolarised Fresnel R at entry and exit (no total internal
 // reflection is possible inside a sphere: the exit angle equals the refraction angle), the
 // external reflection R₁ × environment(mirror) added and internal reflections dropped, as the
-// march does (docs/view-renderer.md "Sharp interfaces: the march"):
+// march's single transmitted path (Transport::Single) does (docs/view-renderer.md "Light
+// transport"):
 //   L = R₁·E(r) + (1 − R₁)(1 − R₂)·E(d_out),   R₂ = R₁ (the same angle pair).
 // ≥ 99% of pixel values must agree within 1e-3 relative; only pixels whose rays land within
 // ~1e-9 rad of a checker edge may differ.
@@ -52,7 +53,9 @@ TEST(SharpSphereImage, MatchesAnAnalyticRayTrace) {
                    "sphere.json");
     const VolumeSet v = voxelize(s);
     const VolumeField f(v);
-    const RenderImage img = ReferenceMarcher(f, s.environment).render(s.camera, RenderSettings{});
+    RenderSettings rs;
+    rs.march.transport = Transport::Single;  // the single transmitted path the trace writes
+    const RenderImage img = ReferenceMarcher(f, s.environment).render(s.camera, rs);
     const Camera& cam = s.camera;
     const glm::dvec3 fwd = glm::normalize(cam.look_at - cam.position);
     const glm::dvec3 right = glm::normalize(glm::cross(fwd, cam.up)), up = glm::cross(right, fwd);

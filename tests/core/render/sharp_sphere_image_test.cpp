@@ -2,7 +2,8 @@
 // camera ray meets the exact sphere, Snell refracts it in and out, the transmitted part carries
 // (1 − R)² of the environment behind it and the external reflection R of the environment in the
 // mirror direction (unpolarised Fresnel; a sphere has no TIR for rays from outside, and internal
-// partial reflections are dropped, as the march drops them). The environment is the checkerboard
+// partial reflections are dropped, as the march's single transmitted path, Transport::Single,
+// drops them). The environment is the checkerboard
 // of Environment::lookup. Pixels whose rays pass within float rounding of a checker edge may flip
 // colour; the issue asks that ≥ 99% of the pixels agree within 1e-3 relative.
 #include <gtest/gtest.h>
@@ -58,6 +59,7 @@ void checkSphere(int resolution) {
   const VolumeSet volume = voxelize(scene);
   ViewRenderer gpu(context(), scene, volume);
   RenderSettings rs;
+  rs.march.transport = Transport::Single;  // the single transmitted path the trace above writes
   const RenderImage img = gpu.render(rs);
   const Camera& cam = scene.camera;
   const glm::dvec3 fwd = glm::normalize(cam.look_at - cam.position);
