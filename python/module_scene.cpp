@@ -8,6 +8,13 @@
 
 namespace eikon::python {
 namespace {
+// "full" or "single" (MarchSettings::transport); anything else is a ValueError.
+Transport parseTransportName(const std::string& name) {
+  if (name == "full") return Transport::Full;
+  if (name == "single") return Transport::Single;
+  throw py::value_error("transport must be full or single, not '" + name + "'");
+}
+
 std::vector<std::string> modesTraced(const Scene&) {
   // Both twins march the e-mode of uniaxial crystals; an isotropic scene's e-mode is its o-mode.
   return {"o", "e"};
@@ -17,7 +24,8 @@ std::vector<std::string> modesTraced(const Scene&) {
 void bindScene(py::module_& m) {
   py::class_<MarchSettings>(m, "MarchSettings")
       .def(py::init([](double step_voxels, const std::string& integrator, bool skip_empty,
-                       bool fresnel, double interface_threshold, int max_steps) {
+                       bool fresnel, double interface_threshold, int max_steps,
+                       const std::string& transport, int max_reflections) {
              MarchSettings s;
              s.step_voxels = step_voxels;
              checkSetting([&] { s.integrator = parseIntegrator(integrator); }, "march");
@@ -25,11 +33,14 @@ void bindScene(py::module_& m) {
              s.fresnel = fresnel;
              s.interface_threshold = interface_threshold;
              s.max_steps = max_steps;
+             s.transport = parseTransportName(transport);
+             s.max_reflections = max_reflections;
              return s;
            }),
            py::arg("step_voxels") = 0.25, py::arg("integrator") = "rk4",
            py::arg("skip_empty") = true, py::arg("fresnel") = true,
-           py::arg("interface_threshold") = 0.02, py::arg("max_steps") = 20000)
+           py::arg("interface_threshold") = 0.02, py::arg("max_steps") = 20000,
+           py::arg("transport") = "full", py::arg("max_reflections") = 32)
       .def_readwrite("step_voxels", &MarchSettings::step_voxels)
       .def_property(
           "integrator", [](const MarchSettings& s) { return integratorName(s.integrator); },
@@ -40,6 +51,11 @@ void bindScene(py::module_& m) {
       .def_readwrite("fresnel", &MarchSettings::fresnel)
       .def_readwrite("interface_threshold", &MarchSettings::interface_threshold)
       .def_readwrite("max_steps", &MarchSettings::max_steps)
+      .def_property(
+          "transport",
+          [](const MarchSettings& s) { return s.transport == Transport::Full ? "full" : "single"; },
+          [](MarchSettings& s, const std::string& v) { s.transport = parseTransportName(v); })
+      .def_readwrite("max_reflections", &MarchSettings::max_reflections)
       .def("__repr__", [](const MarchSettings& s) {
         return "<eikon.MarchSettings step_voxels=" + std::to_string(s.step_voxels) + " " +
                integratorName(s.integrator) + ">";

@@ -119,7 +119,7 @@ const std::vector<Setting> kSettings = {
      .help = "Disable Fresnel reflection and transmission losses", .field = "MarchSettings::fresnel",
      .fill = [](const SettingValue& v, SettingRequests& r) { r.march.fresnel = !v.flag; },
      .keyword = "march.fresnel"},
-    {.name = "transport", .kind = K::Choice, .fronts = F::RenderCli | F::ViewCli | F::PyRender,
+    {.name = "transport", .kind = K::Choice, .fronts = F::RenderCli | F::PyRender,
      .help = "What a view sample follows at an interface (docs/view-renderer.md \"Light "
              "transport\")",
      .field = "MarchSettings::transport",
@@ -130,8 +130,7 @@ const std::vector<Setting> kSettings = {
      .choices = {{"full", "reflection or refraction by their Fresnel weights, every path to its end"},
                  {"single", "the transmitted path, external reflections from the environment"}},
      .keyword = "march.transport"},
-    {.name = "max-reflections", .kind = K::Integer,
-     .fronts = F::RenderCli | F::ViewCli | F::PyRender,
+    {.name = "max-reflections", .kind = K::Integer, .fronts = F::RenderCli | F::PyRender,
      .help = "Fresnel reflections a path follows before it goes on as the transmitted path",
      .field = "MarchSettings::max_reflections",
      .fill = [](const SettingValue& v, SettingRequests& r) { r.march.max_reflections = v.integer; },

@@ -524,12 +524,14 @@ TEST_F(Cli, RenderFailingAfterAPreviewLeavesThePreviousPairIntact) {
 
 // A PNG write error (files limited to 2 KiB: libpng's first 4 KiB write fails) is eikon's one
 // line, naming the file and libpng's reason; libpng's own "libpng error: Write Error" line used to
-// come first.
+// come first. --transport single keeps the sphere visible in the constant sky (full transport
+// makes it vanish there, and the PNG would compress below the limit).
 TEST_F(Cli, PngWriteErrorIsOneEikonLine) {
   const std::string scene = write("scene.json", tinyScene());
   const Outcome r = eikon::test::runProgramWithFileLimit(
       EIKON_BINARY,
-      "render " + quote(scene) + " -q --reference --width 160 --height 120 -o " + quote(outPath()),
+      "render " + quote(scene) + " -q --reference --transport single --width 160 --height 120 -o " +
+          quote(outPath()),
       io_, 2048);
   expectCleanFailure(
       r, "cannot write '" + outPath("render.png") + "': libpng: Write Error (File too large)");
