@@ -113,6 +113,7 @@ struct PathRecord {
   int count;        // entries used
   uint pixel;       // full transport: the pixel and pixel sample the march's choices are drawn for
   uint sampleIndex; //   (transportSeed)
+  int firstChoice;  // full transport: kChoiceDrawn, or the branch of the split first choice to march
   // (linear sRGB radiance, weight). Indexed only by constants (recordPush, and loops of constant
   // count that are unrolled): llvmpipe keeps such an array in registers, where one indexed at run
   // time would live in memory and be copied whole at every inout call.
@@ -137,6 +138,7 @@ PathRecord noRecord() {
   rec.count = 0;
   rec.pixel = 0u;
   rec.sampleIndex = 0u;
+  rec.firstChoice = 0;
   for (int i = 0; i < kRecordMax; ++i) rec.entries[i] = vec4(0.0);
   return rec;
 }
@@ -332,6 +334,7 @@ bool boxHit(vec3 o, vec3 d, vec3 bmin, vec3 bmax, out float t0, out float t1) {
 }
 
 struct MarchResult {
+  bool split;  // full transport: the first Fresnel choice was met and split (PathRecord.firstChoice)
   vec3 radiance;
   vec3 exit_point;
   vec3 exit_dir;     // ray (energy) direction
@@ -422,6 +425,8 @@ struct MarchState {
   uint seed;
   uint draws;
   int reflections;
+  int firstChoice;  // PathRecord.firstChoice
+  bool split;       // the first choice was met and split
 };
 
 // The march's state before its first step: at x with wave vector w, nothing gathered, the
@@ -444,20 +449,34 @@ MarchState startState(vec3 x, vec3 w, int mode, PathRecord rec) {
   S.seed = transportSeed(rec.pixel, rec.sampleIndex, mode);
   S.draws = 0u;
   S.reflections = 0;
+  S.firstChoice = rec.firstChoice;
+  S.split = false;
   return S;
 }
+
+// How a march makes its path's first Fresnel choice (core/contract/march_types.h FirstChoice): a
+// view sample splits it, marching the transmitted branch at weight 1 − R and, where that path met
+// a choice, the reflected one at weight R (view.comp marchModes).
+const int kChoiceDrawn = 0;
+const int kChoiceTransmit = 1;
+const int kChoiceReflect = 2;
 
 // Full transport (P.transport.x), while the path has followed fewer than P.transport.y
 // reflections: true (the path reflects, counted) with probability Rf, else false (it refracts),
 // in both cases at its whole weight (Russian roulette with the Fresnel weights; the CPU twin's
-// RayMarch::followReflection).
+// RayMarch::followReflection). The first choice, where split, is the march's branch at its weight.
 bool followReflection(inout MarchState S, float Rf) {
   if (P.transport.x == 0 || S.reflections >= P.transport.y) return false;
-  float u = transportUniform(S.seed, S.draws);
+  bool first = S.draws == 0u;
+  bool reflects = transportUniform(S.seed, S.draws) < Rf;
   S.draws++;
-  if (!(u < Rf)) return false;
-  S.reflections++;
-  return true;
+  if (first && S.firstChoice != kChoiceDrawn) {
+    S.split = true;
+    reflects = S.firstChoice == kChoiceReflect;
+    S.T *= reflects ? Rf : 1.0 - Rf;
+  }
+  if (reflects) S.reflections++;
+  return reflects;
 }
 
 // Whether a crossing weighs the path by 1 − R and looks its external reflection up in the
@@ -727,6 +746,7 @@ bool clipToVolume(inout MarchState S, inout MarchResult R, StepEnd E) {
 // Both marches start here: R initialised, and the ray either misses the volume (R is the
 // environment seen along d; false) or enters it at o + t0·d, t0 ≥ 0 (true).
 bool enterVolume(vec3 o, vec3 d, inout PathRecord rec, out MarchResult R, out float t0) {
+  R.split = false;
   R.radiance = vec3(0.0);
   R.throughput = vec3(1.0);
   R.opl = 0.0;
@@ -805,6 +825,7 @@ MarchResult march(vec3 o, vec3 d, int mode, inout PathRecord rec) {
   if (R.left) S.L += environmentWeighted(rec, S.T, R.exit_dir);
   R.radiance = S.L;
   R.throughput = S.T;
+  R.split = S.split;
   return R;
 }
 

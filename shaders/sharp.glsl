@@ -540,6 +540,7 @@ MarchResult marchSharp(vec3 o, vec3 d, int mode, inout PathRecord rec) {
   if (R.left) S.L += environmentWeighted(rec, S.T, R.exit_dir);
   R.radiance = S.L;
   R.throughput = S.T;
+  R.split = S.split;
   return R;
 }
 #endif  // EIKON_SHARP_NO_MARCH

@@ -164,13 +164,20 @@ vec3 marchModes(vec3 d, ModeSpan m, float stepDivisor, bool hero, inout PathReco
   vec3 rad = vec3(0.0);
   radMode = vec3[2](vec3(0.0), vec3(0.0));
   heroCount0 = 0;
-  for (int mode = m.m0; mode < m.m1; ++mode) {
+  // Per mode, full transport splits the path's first Fresnel choice (march.glsl kChoice*): the
+  // transmitted branch, then, where it met a choice, the reflected one; one march call site.
+  const bool full = P.transport.x != 0;
+  int mode = m.m0, branch = full ? kChoiceTransmit : kChoiceDrawn;
+  while (mode < m.m1) {
     if (hero) rec.dispersive = hasFlag(weightDependent);
+    rec.firstChoice = branch;
     MarchResult r = march(P.cam_pos.xyz, d, mode, rec);
     vec3 part = m.modeWeight * r.radiance;
     rad += part;
-    radMode[mode] = part;
-    if (hero && mode == 0) heroCount0 = rec.count;
+    radMode[mode] += part;
+    bool nextMode = branch != kChoiceTransmit || !r.split;
+    branch = nextMode ? (full ? kChoiceTransmit : kChoiceDrawn) : kChoiceReflect;
+    if (hero && mode == 0 && nextMode) heroCount0 = rec.count;
     acc.steps += float(r.steps) / stepDivisor;
     acc.cut = acc.cut || r.cut;
     if (kAov) {
@@ -181,6 +188,7 @@ vec3 marchModes(vec3 d, ModeSpan m, float stepDivisor, bool hero, inout PathReco
       }
       acc.aovFirst = false;
     }
+    if (nextMode) ++mode;
   }
   return rad;
 }

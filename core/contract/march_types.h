@@ -38,6 +38,15 @@ inline std::uint32_t transportSeed(std::uint32_t pixel, std::uint32_t sample, in
                            spectrum::pcgHash(sample * 2u + std::uint32_t(mode) + 0x5BD1E995u));
 }
 
+/// How a march makes the first Fresnel choice of its path (Transport::Full). A view sample splits
+/// it instead of drawing it: it marches the Transmit branch, weighted by 1 − R at that choice,
+/// and, where that path met a choice at all, the Reflect branch, weighted by R; their radiances
+/// add up. The choice a camera ray meets first is the surface it sees, whose reflection is the
+/// most visible; drawn, it would be speckle (a pixel's share of reflecting samples), split it is
+/// exact at the cost of one more march, which for an external reflection mostly leaves the scene
+/// at once. Later choices are drawn.
+enum class FirstChoice { Drawn = 0, Transmit = 1, Reflect = 2 };
+
 /// The k-th uniform number in [0, 1) of a seed: 24 bits, exact in float (march.glsl
 /// transportUniform).
 inline double transportUniform(std::uint32_t seed, std::uint32_t k) {

@@ -80,6 +80,7 @@ struct MarchResult {
   bool ran_out = false;  ///< ended by max_steps alone (march.glsl's cut, RenderImage::cut_samples)
   int steps = 0, interfaces = 0, tir = 0;
   int reflections = 0;    ///< Fresnel reflections followed (Transport::Full)
+  bool split = false;     ///< the first Fresnel choice was met and split (FirstChoice)
   long long fetches = 0;  ///< volume-field reads (CountedField)
   FirstInterface first;   ///< the first interface met (the AOV layer)
 };
@@ -148,9 +149,11 @@ class CountedField {
 class RayMarch {
  public:
   RayMarch(const Field& f, const Environment& env, double lambda_nm, bool scalar,
-           const MarchSettings& m, int mode, HeroRecord* hero = nullptr, std::uint32_t seed = 0)
+           const MarchSettings& m, int mode, HeroRecord* hero = nullptr, std::uint32_t seed = 0,
+           FirstChoice first = FirstChoice::Drawn)
       : hero_(hero),
         seed_(seed),
+        first_(first),
         f_(f),
         env_(env),
         lambda_nm_(lambda_nm),
@@ -253,6 +256,7 @@ class RayMarch {
 
   HeroRecord* hero_;
   std::uint32_t seed_;  ///< Transport::Full: transportSeed of the pixel sample and mode
+  FirstChoice first_;   ///< Transport::Full: how the path's first Fresnel choice is made
   CountedField f_;
   const Environment& env_;
   double lambda_nm_, il2_ = 0.0, il4_ = 0.0;
@@ -504,12 +508,19 @@ void RayMarch::fresnelAtLayer(MarchState& S, MarchResult& R, const glm::dvec3& N
 
 // Transport::Full, while the path has followed fewer than max_reflections: true (the path
 // reflects, counted) with probability Rf, else false (it refracts) — in both cases at its whole
-// weight, the Fresnel weights being the probabilities (Russian roulette, unbiased).
+// weight, the Fresnel weights being the probabilities (Russian roulette, unbiased). The path's
+// first choice, where split (FirstChoice), is this march's branch at its weight instead.
 bool RayMarch::followReflection(MarchState& S, MarchResult& R, double Rf) const {
   if (m_.transport != Transport::Full || R.reflections >= m_.max_reflections) return false;
-  if (!(transportUniform(seed_, S.draws++) < Rf)) return false;
-  R.reflections++;
-  return true;
+  const bool first = S.draws == 0;
+  bool reflects = transportUniform(seed_, S.draws++) < Rf;
+  if (first && first_ != FirstChoice::Drawn) {
+    R.split = true;
+    reflects = first_ == FirstChoice::Reflect;
+    S.T *= reflects ? Rf : 1.0 - Rf;
+  }
+  if (reflects) R.reflections++;
+  return reflects;
 }
 
 // Interface bookkeeping (march.glsl layerStep).
@@ -910,9 +921,9 @@ struct ReferenceMarcher::Result : MarchResult {};
 ReferenceMarcher::Result ReferenceMarcher::march(const glm::dvec3& o, const glm::dvec3& d,
                                                  double lambda_nm, bool scalar,
                                                  const MarchSettings& m, int mode, HeroRecord* hero,
-                                                 uint32_t seed) const {
+                                                 uint32_t seed, FirstChoice first) const {
   Result r;
-  const RayMarch rm(field_, env_, lambda_nm, scalar, m, mode, hero, seed);
+  const RayMarch rm(field_, env_, lambda_nm, scalar, m, mode, hero, seed, first);
   static_cast<MarchResult&>(r) = rm.march(o, d);
   r.fetches = rm.fetches();
   return r;
@@ -963,6 +974,25 @@ struct ReferenceMarcher::SampleTally {
   }
 };
 
+ReferenceMarcher::Result ReferenceMarcher::marchSample(const glm::dvec3& o, const glm::dvec3& d,
+                                                       double lambda_nm, bool scalar,
+                                                       const MarchSettings& m, int mode,
+                                                       HeroRecord* hero, uint32_t seed,
+                                                       SampleTally& tally, double share) const {
+  const bool full = m.transport == Transport::Full;
+  if (hero) hero->diverged = field_.weightsDependOnLambda();
+  Result r = march(o, d, lambda_nm, scalar, m, mode, hero, seed,
+                   full ? FirstChoice::Transmit : FirstChoice::Drawn);
+  tally.add(r, share);
+  if (!r.split) return r;
+  if (hero) hero->diverged = field_.weightsDependOnLambda();
+  const Result reflected =
+      march(o, d, lambda_nm, scalar, m, mode, hero, seed, FirstChoice::Reflect);
+  tally.add(reflected, share);
+  r.radiance += reflected.radiance;
+  return r;
+}
+
 glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
                                            uint32_t sample, const RenderSettings& s,
                                            SampleTally& tally, LayerSums* layers) const {
@@ -978,12 +1008,10 @@ glm::dvec3 ReferenceMarcher::heroSampleXyz(const glm::dvec3& o, const glm::dvec3
   double heroMode[2] = {0.0, 0.0};  // each mode's own radiance after its path dispersed
   int count0 = 0;                   // records made by the o-mode's march
   for (int mode = mr.first; mode < mr.end; ++mode) {
-    rec.diverged = field_.weightsDependOnLambda();
-    Result r =
-        march(o, d, lambdas[0], true, s.march, mode, &rec, transportSeed(pixel, sample, mode));
+    const Result r = marchSample(o, d, lambdas[0], true, s.march, mode, &rec,
+                                 transportSeed(pixel, sample, mode), tally, 1.0);
     heroMode[mode] = rec.weight * r.radiance.x;
     if (mode == 0) count0 = rec.count;
-    tally.add(r, 1.0);
   }
   glm::dvec3 xyz =
       double(n) * (heroMode[0] + heroMode[1]) * spectrum::sampleWeightXyz(lambdas[0], n);
@@ -1015,11 +1043,10 @@ glm::dvec3 ReferenceMarcher::rgbSample(const glm::dvec3& eye, const glm::dvec3& 
   const ModeRange mr = modeRange(s.modes, field_.uniaxial());
   glm::dvec3 rad(0.0);
   for (int mode = mr.first; mode < mr.end; ++mode) {
-    const Result r = march(eye, d, s.wavelength_nm, false, s.march, mode, nullptr,
-                           transportSeed(pixel, sidx, mode));
+    const Result r = marchSample(eye, d, s.wavelength_nm, false, s.march, mode, nullptr,
+                                 transportSeed(pixel, sidx, mode), tally, 1.0);
     const glm::dvec3 part = mr.weight * r.radiance;
     rad += part;
-    tally.add(r, 1.0);
     if (layers)
       for (int c = 0; c < 3; ++c) layers->at(pixel, mode)[c] += part[c];
   }
@@ -1040,11 +1067,10 @@ glm::dvec3 ReferenceMarcher::stratifiedSampleXyz(const glm::dvec3& eye, const gl
   for (size_t k = 0; k < lambdas.size(); ++k) {
     double rad = 0.0;
     for (int mode = mr.first; mode < mr.end; ++mode) {
-      const Result r =
-          march(eye, d, lambdas[k], true, s.march, mode, nullptr, transportSeed(pixel, sidx, mode));
+      const Result r = marchSample(eye, d, lambdas[k], true, s.march, mode, nullptr,
+                                   transportSeed(pixel, sidx, mode), tally, s.wavelengths);
       const double part = mr.weight * r.radiance.x;
       rad += part;
-      tally.add(r, s.wavelengths);
       if (layers) layers->at(pixel, mode)[k] += part;
     }
     xyz += rad * spectrum::sampleWeightXyz(lambdas[k], n);

@@ -61,8 +61,14 @@ class ReferenceMarcher {
   struct Result;
   struct SampleTally;  // the marches of one pixel sample (the .cpp)
   Result march(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar,
-               const MarchSettings& m, int mode, HeroRecord* hero = nullptr,
-               uint32_t seed = 0) const;
+               const MarchSettings& m, int mode, HeroRecord* hero = nullptr, uint32_t seed = 0,
+               FirstChoice first = FirstChoice::Drawn) const;
+  /// One mode's march of a view sample (the view kernel's marchModes): with Transport::Full its
+  /// first Fresnel choice split (FirstChoice), the two branches' radiance summed, both marches
+  /// added to `tally` (steps shared by `share` wavelengths). A hero record restarts per branch.
+  Result marchSample(const glm::dvec3& o, const glm::dvec3& d, double lambda_nm, bool scalar,
+                     const MarchSettings& m, int mode, HeroRecord* hero, uint32_t seed,
+                     SampleTally& tally, double share) const;
   /// CIE XYZ (unnormalised, as Σ L·sampleWeightXyz) of one pixel sample by hero wavelength
   /// sampling (docs/spectra.md); adds its marches to `tally`, and its bins to `layers`.
   glm::dvec3 heroSampleXyz(const glm::dvec3& o, const glm::dvec3& d, uint32_t pixel,
