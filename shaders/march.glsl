@@ -32,7 +32,7 @@ uint pcg_hash(uint v) {
 // bit-exact): the seed of a pixel sample's march in one mode, the same at every wavelength, and
 // its k-th uniform number in [0, 1), 24 bits (exact in float).
 uint transportSeed(uint pixel, uint sampleIndex, int mode) {
-  return pcg_hash(pixel * 0x9E3779B1u ^ pcg_hash(sampleIndex * 2u + uint(mode) + 0x5BD1E995u));
+  return pcg_hash(pixel * 0x9E3779B1u ^ pcg_hash(sampleIndex * 4u + uint(mode) + 0x5BD1E995u));
 }
 float transportUniform(uint seed, uint k) {
   return float(pcg_hash(seed + k * 0x632BE5ABu) >> 8u) * (1.0 / 16777216.0);

@@ -32,10 +32,11 @@ enum class Transport { Single = 0, Full = 1 };
 /// The seed of one march's random choices (Transport::Full): one per pixel, pixel sample and
 /// mode, the same at every wavelength of the sample (a non-dispersive path is then the same path
 /// at all of them, which wavelength sharing and hero sampling rely on). Bit-exact with
-/// shaders/march.glsl transportSeed.
+/// shaders/march.glsl transportSeed. Modes 0 and 1 are the o- and e-mode's marches, 2 the
+/// polarised trace's branches; a sample's four slots keep every stream apart.
 inline std::uint32_t transportSeed(std::uint32_t pixel, std::uint32_t sample, int mode) {
   return spectrum::pcgHash(pixel * 0x9E3779B1u ^
-                           spectrum::pcgHash(sample * 2u + std::uint32_t(mode) + 0x5BD1E995u));
+                           spectrum::pcgHash(sample * 4u + std::uint32_t(mode) + 0x5BD1E995u));
 }
 
 /// How a march makes the first Fresnel choice of its path (Transport::Full). A view sample splits
