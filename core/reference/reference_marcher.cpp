@@ -1151,7 +1151,8 @@ void TreeBuilder::reflected(const Pending& p) {
   size_t j = 0, splits = 0;
   for (; j < steps.size(); ++j)
     if (!steps[j].tir && ++splits == p.script.size()) break;
-  if (j == steps.size()) throw std::logic_error("light tree: a scripted split was not met again");
+  if (j == steps.size() || !steps[j].reflected)
+    throw std::logic_error("light tree: a scripted reflection was not met again");
   const TreeStep& t = steps[j];
   LightTreeNode n;
   n.parent = p.parent;

@@ -101,13 +101,13 @@ const std::vector<Setting> kSettings = {
      .value = "0.5", .min = 0, .max = 4, .min_open = true, .unit = "voxels",
      .keyword = "march.step_voxels", .defaults = {{F::TraceCli, "0.25", ""}}},
     {.name = "tree-min-weight", .kind = K::Number, .fronts = F::TraceCli,
-     .help = "The light tree's (--tree) weight below which a branch is cut",
+     .help = "Light tree (--tree): the weight below which a branch is cut,",
      .field = "LightTreeSettings::min_weight",
      .fill = [](const SettingValue& v, SettingRequests& r) { r.tree.min_weight = v.number; },
      .value = "1e-06", .min = 1e-15, .max = 1, .keyword = "min_weight"},
     {.name = "tree-max-depth", .kind = K::Integer, .fronts = F::TraceCli,
-     .help = "The light tree's (--tree) reflections, refractions and total reflections a branch "
-             "takes before it is cut",
+     .help = "Light tree (--tree): the reflections, refractions and total reflections a branch "
+             "takes before it is cut,",
      .field = "LightTreeSettings::max_depth",
      .fill = [](const SettingValue& v, SettingRequests& r) { r.tree.max_depth = v.integer; },
      .value = "64", .min = 1, .max = 1024, .keyword = "max_depth"},

@@ -5,6 +5,8 @@
 //    to the slab's total reflectance R + (1 − R)²R/(1 − R²) = 2R/(1 + R), those beyond it to
 //    1 − that, within the weight the threshold cut (bounded below 1e-11, so within 1e-9), and
 //    exit + absorbed + cut = 1 within 1e-12;
+//  - the slab absorbing (σ = 0.1/mm) before an opaque wall: the exits, the stops on the wall and
+//    the absorbed weight are the closed forms with one pass's e^{−σt} in each round trip;
 //  - a glass sphere (n = 1.5168): the branch with one internal reflection (refract, reflect,
 //    refract) leaves at the deviation D(b) = 180° + 2i − 4r, whose minimum over the impact
 //    parameter, at cos² i = (n² − 1)/3, is 158.64° (the primary bow 21.36° from the antisolar
@@ -93,6 +95,30 @@ TEST(LightTree, SlabTotalReflectanceAtNormalIncidence) {
   EXPECT_NEAR(balance(t), 1.0, 1e-12);
   EXPECT_NEAR(leaves, 1.0, 1e-12);  // the leaves carry the totals
   EXPECT_NEAR(t.absorbed, 0.0, 1e-15);
+}
+
+TEST(LightTree, AbsorbingSlabAndOpaqueWallBalanceInClosedForm) {
+  // An absorbing slab (σ = 0.1/mm, t = 4 mm: one pass keeps a = e^{−σt}) before an opaque wall:
+  // R_total = R + (1 − R)²Ra²/(1 − R²a²) leaves in front, T_total = (1 − R)²a/(1 − R²a²) stops on
+  // the wall, and the slab absorbs the rest.
+  const Cpu c(
+      R"({"shape": "box", "center": [0, 0, 0], "size": [14, 14, 4], "material": "glass"},
+         {"shape": "box", "center": [0, 0, 6], "size": [14, 14, 2], "material": "wall"})",
+      R"({"glass": {"n": 1.5, "attenuation_per_mm": 0.1}, "wall": {"n": 1, "opacity": 1}})");
+  const LightTree t = c.tree({0.3, 0.2, -20.0}, {0, 0, 1}, 0, 1e-13);
+  const double R = 0.04, a = std::exp(-0.4), D = 1.0 - R * R * a * a;
+  const double Rtot = R + (1 - R) * (1 - R) * R * a * a / D, Ttot = (1 - R) * (1 - R) * a / D;
+  std::printf(
+      "absorbing slab: exit %.15f (closed %.15f), stopped %.15f (closed %.15f), absorbed "
+      "%.15f, cut %.2e\n",
+      t.exit, Rtot, t.stopped, Ttot, t.absorbed, t.cut);
+  int stops = 0;
+  for (const LightTreeNode& n : t.nodes) stops += n.event == TreeEvent::Stop;
+  EXPECT_GT(stops, 2);
+  EXPECT_NEAR(t.exit, Rtot, t.cut + 1e-12);
+  EXPECT_NEAR(t.stopped, Ttot, t.cut + 1e-12);
+  EXPECT_NEAR(t.absorbed, 1.0 - Rtot - Ttot, t.cut + 1e-12);
+  EXPECT_NEAR(balance(t), 1.0, 1e-12);
 }
 
 TEST(LightTree, SmoothedSlabSplitsAtItsLayers) {
