@@ -18,7 +18,9 @@ namespace eikon {
 struct LightTreeSettings {
   double min_weight = 1e-6;  ///< a branch whose weight falls below this is cut
   int max_depth = 64;        ///< events (reflect, refract, tir) a branch takes before it is cut
-  int max_nodes = 100000;    ///< the tree's size limit: further branches are cut
+  /// The tree's size limit: once it has this many nodes every further event is cut, and the
+  /// branches under way end with a leaf each (a small multiple of it bounds the tree).
+  int max_nodes = 100000;
 };
 
 /// The ranges both the CLI and Python refuse (std::invalid_argument, one line): min_weight in

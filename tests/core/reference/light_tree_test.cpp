@@ -262,6 +262,14 @@ TEST(LightTree, LimitsCutBranchesAndAreChecked) {
   EXPECT_NEAR(t.exit, R + (1 - R) * (1 - R), 1e-12);
   EXPECT_NEAR(t.cut, (1 - R) * R, 1e-12);
   EXPECT_NEAR(balance(t), 1.0, 1e-12);
+  s = {};
+  s.max_nodes = 4;  // enter, the front face's reflect and refract, then the tree is full
+  const LightTree full = c.ref.lightTree({{0.3, 0.2, -20.0}, {0, 0, 1}, 587.5618}, {}, 0, s);
+  int byNodes = 0;
+  for (const LightTreeNode& n : full.nodes) byNodes += n.cut == TreeCut::Nodes;
+  EXPECT_GT(byNodes, 0);
+  EXPECT_LE(full.nodes.size(), 6u * 4u);  // the leaves of the branches under way on top
+  EXPECT_NEAR(balance(full), 1.0, 1e-12);
   for (double w : {0.0, 2.0, std::nan("")}) {
     s = {};
     s.min_weight = w;
