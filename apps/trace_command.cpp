@@ -10,6 +10,10 @@
 // S0,S1,S2,S3 (default 1,0,0,0, unpolarised; in Mitsuba 3's stokesBasis of --dir), and the Stokes
 // vector of the light leaving along the traced path is printed: "stokes_out" (the strongest
 // beam, in the stokesBasis of its direction) and "polarised_beams" (every exit direction).
+//
+// --tree prints the light tree of the ray as JSON instead (core/contract/light_tree.h, on the
+// CPU twin): every Fresnel split followed both ways, per mode (docs/design.md §3 "The light
+// tree"), within --tree-min-weight and --tree-max-depth.
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +24,7 @@
 #include "apps/commands.h"
 #include "apps/progress.h"
 #include "core/session/front_end.h"
+#include "core/session/light_tree_json.h"
 #include "core/session/session.h"
 
 namespace eikon::cli {
@@ -47,7 +52,10 @@ struct TraceArgs {
   std::string scene, origin, dir, stokes;
   bool stokes_given = false;  ///< --stokes was given, with any value (an empty one is refused)
   double wavelength = 0, step = 0;  ///< the settings table's defaults (addSettingOption)
-  bool json = false, reference = false, quiet = false, strict = false;
+  bool json = false, reference = false, quiet = false, strict = false, tree = false;
+  double tree_min_weight = 0;  ///< the settings table's defaults (addSettingOption)
+  int tree_max_depth = 0;
+  bool tree_limits_given = false;  ///< --tree-min-weight or --tree-max-depth was given
   std::string integrator = "rk4", progress = "auto";
 };
 
@@ -162,6 +170,13 @@ void addTraceCommand(CLI::App& app) {
       "Input Stokes vector S0,S1,S2,S3 of the polarised trace, in Mitsuba 3's "
       "stokesBasis of --dir (default 1,0,0,0: unpolarised); needs sharp interfaces");
   sub->add_flag("--json", a->json, "Print JSON");
+  sub->add_flag("--tree", a->tree,
+                "Print the ray's light tree as JSON: every Fresnel split followed both ways, per "
+                "mode, on the CPU twin (docs/design.md §3)");
+  CLI::Option* min_weight =
+      addSettingOption(sub, "tree-min-weight", SettingFront::TraceCli, a->tree_min_weight);
+  CLI::Option* max_depth =
+      addSettingOption(sub, "tree-max-depth", SettingFront::TraceCli, a->tree_max_depth);
   sub->add_flag("--reference", a->reference,
                 "Use the double-precision CPU reference instead of the GPU");
   sub->add_flag("-q,--quiet", a->quiet, "No progress lines (same as --progress never)");
@@ -169,8 +184,9 @@ void addTraceCommand(CLI::App& app) {
   sub->add_option("--progress", a->progress,
                   "auto (default: voxelising progress with ETA on stderr when it is a terminal), "
                   "always or never");
-  sub->callback([a, stokes] {
+  sub->callback([a, stokes, min_weight, max_depth] {
     a->stokes_given = stokes->count() > 0;
+    a->tree_limits_given = min_weight->count() + max_depth->count() > 0;
     runTrace(*a);
   });
 }
@@ -184,6 +200,16 @@ void runTrace(const TraceArgs& a) {
   checkTraceRequest(req);
   checkMarchStep(a.step);
   const Stokes stokes_in = a.stokes_given ? parseStokes(a.stokes) : Stokes(1, 0, 0, 0);
+  if (a.tree_limits_given && !a.tree)
+    throw CliError("--tree-min-weight and --tree-max-depth need --tree");
+  if (a.tree && a.stokes_given) throw CliError("--tree and --stokes: one at a time");
+  LightTreeSettings tree;
+  if (a.tree) {
+    checkSettingValue(setting("tree-min-weight"), a.tree_min_weight);
+    checkSettingValue(setting("tree-max-depth"), a.tree_max_depth);
+    tree.min_weight = a.tree_min_weight;
+    tree.max_depth = a.tree_max_depth;
+  }
   req.direction = glm::normalize(req.direction);
   const ProgressMode progress_mode = progressMode(a.progress, a.quiet);
   auto scene = std::make_shared<Scene>(loadScene(a.scene));
@@ -205,6 +231,16 @@ void runTrace(const TraceArgs& a) {
   Session session(scene);
   session.setProgress({[&](const char* what, double f) { progress.update(what, f); },
                        [&](const char* what) { progress.working(what); }});
+  if (a.tree) {  // the CPU twin's alone
+    session.prepare(false);
+    timings::mark("voxelised");
+    const std::vector<LightTree> trees = session.lightTrees(req, ms, tree);
+    progress.finish();
+    timings::mark("traced");
+    const nlohmann::json j = lightTreesJson(req, tree, trees, session.deviceName(false));
+    std::printf("%s\n", j.dump(2).c_str());
+    return;
+  }
   session.prepare(!a.reference);
   timings::mark("voxelised");
   const std::array<TraceOutcome, 2> modes = session.trace({req}, ms, !a.reference).front();

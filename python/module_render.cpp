@@ -11,6 +11,7 @@
 
 #include "core/io/exr.h"
 #include "core/session/front_end.h"
+#include "core/session/light_tree_json.h"
 #include "python/module.h"
 #include "python/progress.h"
 
@@ -342,6 +343,29 @@ py::dict traceOne(Prepared& p, const py::handle& origin, const py::handle& direc
   return d;
 }
 
+// The light trees of one ray (Session::lightTrees, `eikon trace --tree`) on the CPU twin: the
+// CLI's JSON as Python objects (json.loads of the same text).
+py::object lightTreeOne(Prepared& p, const py::handle& origin, const py::handle& direction,
+                        double wavelength_nm, std::optional<MarchSettings> march, double min_weight,
+                        int max_depth) {
+  const TraceRequest q{toVec3(origin), toVec3(direction), wavelength_nm};
+  const MarchSettings ms = march.value_or(MarchSettings{});
+  LightTreeSettings tree;
+  tree.min_weight = min_weight;
+  tree.max_depth = max_depth;
+  checkSetting([&] {
+    checkTraceRequest(q);
+    checkMarchStep(ms.step_voxels);
+    checkMarchSettings(ms);
+    checkSettingValue(setting("tree-min-weight"), min_weight);
+    checkSettingValue(setting("tree-max-depth"), max_depth);
+  });
+  const std::string text = p.run([&](Session& s) {
+    return lightTreesJson(q, tree, s.lightTrees(q, ms, tree), s.deviceName(false)).dump();
+  });
+  return py::module_::import("json").attr("loads")(text);
+}
+
 py::array_t<double> stokesArray(const Stokes& s) {
   py::array_t<double> a(4);
   for (int k = 0; k < 4; ++k) a.mutable_at(k) = s[k];
@@ -496,6 +520,15 @@ void bindModuleCalls(py::module_& m) {
       py::arg("scene"),
       "trace(scene, origin, direction, wavelength_nm=, march=, device=) — see Renderer.trace");
   m.def(
+      "light_tree",
+      [](std::shared_ptr<Scene> s, py::args a, py::kwargs kw) {
+        auto p = py::cast(cachedPrepared(s));
+        return p.attr("light_tree")(*a, **kw);
+      },
+      py::arg("scene"),
+      "light_tree(scene, origin, direction, wavelength_nm=, march=, min_weight=, max_depth=) — "
+      "see Renderer.light_tree");
+  m.def(
       "trace_polarised",
       [](std::shared_ptr<Scene> s, py::args a, py::kwargs kw) {
         auto p = py::cast(cachedPrepared(s));
@@ -612,6 +645,15 @@ void bindRenderer(py::module_& m) {
            settingArg("wavelength", kT), py::arg("march") = py::none(), py::arg("device") = "gpu",
            traceDoc("one ray, the CLI JSON shape: {'wavelength_nm', 'device', 'modes': [{'mode': "
                     "'o', ...}, ...]}"))
+      .def("light_tree", &lightTreeOne, py::arg("origin"), py::arg("direction"),
+           settingArg("wavelength", kT), py::arg("march") = py::none(),
+           py::arg("min_weight") = LightTreeSettings{}.min_weight,
+           py::arg("max_depth") = LightTreeSettings{}.max_depth,
+           "the light tree of one ray on the CPU twin (`eikon trace --tree`; docs/design.md §3): "
+           "every Fresnel split followed both ways, {'ray', 'limits', 'trees': [{'mode', 'nodes': "
+           "[{'id', 'parent', 'event', 'point', 'direction', 'weight', ...}], 'exits', 'totals': "
+           "{'exit', 'stopped', 'absorbed', 'cut'}, 'marches'}], 'device'}; min_weight in "
+           "[1e-15, 1] and max_depth in [1, 1024] as --tree-min-weight and --tree-max-depth")
       .def("trace_polarised", &tracePolarisedOne, py::arg("origin"), py::arg("direction"),
            settingArg("wavelength", kT), py::arg("stokes") = std::vector<double>{1, 0, 0, 0},
            py::arg("device") = "gpu", py::arg("bandwidth_nm") = 10.0,

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <mutex>
 #include <numbers>
 #include <stdexcept>
@@ -109,6 +110,25 @@ struct StepEnd {
   glm::dvec3 gradN{0.0};        ///< the gradient the layer normal accumulates
 };
 
+/// One event of a path the light tree marches (ReferenceMarcher::lightTree): a split, where it
+/// reflected or refracted as its script said, or a total internal reflection.
+struct TreeStep {
+  bool tir = false, reflected = false;
+  double Rf = 1.0;                    ///< the split's Fresnel reflectance (tir: 1)
+  glm::dvec3 point{0.0}, dirIn{0.0};  ///< where, and the ray direction arriving
+  glm::dvec3 dir{0.0}, wave{0.0};     ///< the ray direction and wave normal leaving
+  double T = 1.0, opl = 0.0;          ///< attenuation and optical path so far
+  int region = 0;                     ///< the region leaving (the sharp march)
+};
+
+/// The light tree's choices for one march: the splits' reflect (true) / refract (false) in order,
+/// refraction past its end, and the events the march met.
+struct ChoiceScript {
+  const std::vector<bool>* choices = nullptr;
+  size_t splits = 0;
+  std::vector<TreeStep> steps;
+};
+
 enum class Straight { None, Taken, Stop };
 /// How a stage of the sharp march ended: still inside its region, at a boundary crossing, or
 /// out of the volume.
@@ -174,6 +194,9 @@ class RayMarch {
   MarchResult march(const glm::dvec3& o, const glm::dvec3& d) const;
   /// The volume-field reads of this march so far (CountedField).
   long long fetches() const { return f_.fetches; }
+  /// The light tree's march: followReflection takes the script's choices, and the events are
+  /// recorded in it (ReferenceMarcher::lightTree).
+  void setScript(ChoiceScript* script) { script_ = script; }
   /// Both marches start here: false (R = the environment along d) if the ray misses the volume,
   /// else true with the entry at o + t0·d, t0 ≥ 0.
   bool enterVolume(const glm::dvec3& o, const glm::dvec3& d, MarchResult& R, double& t0) const;
@@ -253,6 +276,11 @@ class RayMarch {
   void crossInterface(MarchState& S, MarchResult& R, const BoundaryCrossing& c) const;
   void reflectInRegion(MarchState& S, const glm::dvec3& N) const;
   bool followReflection(MarchState& S, MarchResult& R, double Rf) const;
+  void noteEvent(const MarchState& S, const MarchResult& R, bool tir, bool reflected,
+                 double Rf) const;
+  void noteAfter(const MarchState& S) const;
+
+  ChoiceScript* script_ = nullptr;
 
   HeroRecord* hero_;
   std::uint32_t seed_;  ///< Transport::Full: transportSeed of the pixel sample and mode
@@ -475,6 +503,7 @@ void RayMarch::fresnelAtLayer(MarchState& S, MarchResult& R, const glm::dvec3& N
   const double n1 = glm::length(S.wBefore), n2 = glm::length(S.w);
   if (!(ci * co > 0.0)) {
     R.tir++;
+    noteEvent(S, R, true, true, 1.0);
     return;
   }
   // The crystal side is the layer end with the larger birefringence (the axis field is dilated
@@ -512,6 +541,13 @@ void RayMarch::fresnelAtLayer(MarchState& S, MarchResult& R, const glm::dvec3& N
 // first choice, where split (FirstChoice), is this march's branch at its weight instead.
 bool RayMarch::followReflection(MarchState& S, MarchResult& R, double Rf) const {
   if (m_.transport != Transport::Full || R.reflections >= m_.max_reflections) return false;
+  if (script_) {  // the light tree: the branch's scripted choice, the weights its own
+    const size_t k = script_->splits++;
+    const bool reflect = k < script_->choices->size() && (*script_->choices)[k];
+    noteEvent(S, R, false, reflect, Rf);
+    if (reflect) R.reflections++;
+    return reflect;
+  }
   const bool first = S.draws == 0;
   bool reflects = transportUniform(seed_, S.draws++) < Rf;
   if (first && first_ != FirstChoice::Drawn) {
@@ -521,6 +557,31 @@ bool RayMarch::followReflection(MarchState& S, MarchResult& R, double Rf) const 
   }
   if (reflects) R.reflections++;
   return reflects;
+}
+
+// The light tree's record of an event where it happens (the ray arriving), its leaving direction
+// filled in by noteAfter once the crossing has been applied.
+void RayMarch::noteEvent(const MarchState& S, const MarchResult& R, bool tir, bool reflected,
+                         double Rf) const {
+  if (!script_) return;
+  TreeStep t;
+  t.tir = tir;
+  t.reflected = reflected;
+  t.Rf = Rf;
+  t.point = S.x;
+  t.dirIn = bf_ && media_ ? sharpDirection(S) : rayDirection(S.x, S.w);
+  t.T = S.T.x;
+  t.opl = R.opl;
+  t.dir = glm::dvec3(0.0);
+  script_->steps.push_back(t);
+}
+
+void RayMarch::noteAfter(const MarchState& S) const {
+  if (!script_ || script_->steps.empty() || script_->steps.back().dir != glm::dvec3(0.0)) return;
+  TreeStep& t = script_->steps.back();
+  t.dir = bf_ && media_ ? sharpDirection(S) : rayDirection(S.x, S.w);
+  t.wave = glm::normalize(S.w);
+  t.region = S.region;
 }
 
 // Interface bookkeeping (march.glsl layerStep).
@@ -602,6 +663,7 @@ MarchResult RayMarch::march(const glm::dvec3& o, const glm::dvec3& d) const {
     const StepEnd E = integrateStep(S, R);
     if (mediumAlongStep(S, E)) break;
     layerStep(S, R, E);
+    noteAfter(S);
     if (clipToVolume(S, R, E)) break;
   }
   R.steps = steps;
@@ -834,6 +896,7 @@ void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCross
     out = refractOutOfUniaxial(cr, mode, s, N, regionIndex(c.to, 0, x));
   }
   if (!out.exists) {  // total internal reflection: a mirror, no loss; the ray stays in A
+    noteEvent(S, R, true, true, 1.0);
     reflectInRegion(S, N);
     R.tir++;
     return;
@@ -901,6 +964,7 @@ MarchResult RayMarch::marchSharp(const glm::dvec3& o, const glm::dvec3& d) const
                  std::max(c.from, c.to) - 1};
     if (ev == SharpEvent::Leave) break;
     if (ev == SharpEvent::Cross) crossInterface(S, R, c);
+    noteAfter(S);
   }
   R.steps = steps;
   R.exit_point = S.x;
@@ -954,6 +1018,203 @@ TraceOutcome ReferenceMarcher::trace(const TraceRequest& ray, const MarchSetting
   t.interfaces = r.interfaces;
   t.total_internal_reflections = r.tir;
   return t;
+}
+
+namespace {
+
+/// Builds a light tree (ReferenceMarcher::lightTree). Each branch is one march of the ray with
+/// the choices of its splits scripted (ChoiceScript): the reflections of the branches it descends
+/// from, then refraction at every later split. Each later split spawns the reflected branch, whose
+/// script is the same choices with that split reflected; it is marched in turn.
+class TreeBuilder {
+ public:
+  using MarchFn = std::function<MarchResult(const std::vector<bool>&, std::vector<TreeStep>&)>;
+  TreeBuilder(MarchFn march, const LightTreeSettings& s, LightTree& out)
+      : march_(std::move(march)), s_(s), out_(out) {}
+  void build(const glm::dvec3& entry, const glm::dvec3& d, double opl_entry);
+
+ private:
+  /// A branch being followed: its last node, the product of its Fresnel factors, its attenuation
+  /// there, its depth, and the choices of its splits so far.
+  struct Branch {
+    int node = 0;
+    double F = 1.0, T = 1.0;
+    int depth = 0;
+    std::vector<bool> script;
+  };
+  /// A reflected branch waiting for its march: the split's parent node, and its Fresnel product
+  /// and depth after the reflection; its script ends with the reflection.
+  struct Pending {
+    std::vector<bool> script;
+    int parent = 0;
+    double F = 1.0;
+    int depth = 0;
+  };
+  int add(LightTreeNode n) {
+    n.id = int(out_.nodes.size());
+    out_.nodes.push_back(n);
+    return n.id;
+  }
+  int object(int region) const { return out_.sharp ? region - 1 : -1; }
+  bool cut(double w, int depth, const TreeStep& t, int parent);
+  void follow(Branch b, const std::vector<TreeStep>& steps, size_t from, const MarchResult& end);
+  void reflected(const Pending& p);
+
+  MarchFn march_;
+  const LightTreeSettings& s_;
+  LightTree& out_;
+  std::vector<Pending> pending_;
+};
+
+void TreeBuilder::build(const glm::dvec3& entry, const glm::dvec3& d, double opl_entry) {
+  LightTreeNode root;
+  root.event = TreeEvent::Enter;
+  root.point = entry;
+  root.direction = root.wave_normal = d;
+  root.weight = 1.0;
+  root.optical_path_mm = opl_entry;
+  add(root);
+  std::vector<TreeStep> steps;
+  const MarchResult end = march_({}, steps);
+  follow(Branch{}, steps, 0, end);
+  while (!pending_.empty()) {
+    const Pending p = std::move(pending_.back());
+    pending_.pop_back();
+    reflected(p);
+  }
+}
+
+// A branch of weight w would take an event of depth `depth` at t: true (a cut leaf added) where
+// the weight is below the threshold, the depth past the limit, or the tree full.
+bool TreeBuilder::cut(double w, int depth, const TreeStep& t, int parent) {
+  const TreeCut why = w < s_.min_weight                        ? TreeCut::Weight
+                      : depth > s_.max_depth                   ? TreeCut::Depth
+                      : int(out_.nodes.size()) >= s_.max_nodes ? TreeCut::Nodes
+                                                               : TreeCut::None;
+  if (why == TreeCut::None) return false;
+  LightTreeNode n;
+  n.parent = parent;
+  n.event = TreeEvent::Cut;
+  n.point = t.point;
+  n.direction = n.wave_normal = t.dirIn;
+  n.weight = w;
+  n.fresnel_r = t.Rf;
+  n.optical_path_mm = t.opl;
+  n.object = out_.nodes[size_t(parent)].object;
+  n.depth = depth - 1;
+  n.cut = why;
+  add(n);
+  out_.cut += w;
+  return true;
+}
+
+// The branch b from its march's event `from` on: each split's reflection is left for its own
+// march (or cut), the refraction followed; the march's end is the branch's leaf.
+void TreeBuilder::follow(Branch b, const std::vector<TreeStep>& steps, size_t from,
+                         const MarchResult& end) {
+  for (size_t k = from; k < steps.size(); ++k) {
+    const TreeStep& t = steps[k];
+    out_.absorbed += b.F * (b.T - t.T);
+    b.T = t.T;
+    if (!t.tir) {
+      std::vector<bool> script = b.script;
+      script.push_back(true);
+      if (!cut(b.F * t.T * t.Rf, b.depth + 1, t, b.node))
+        pending_.push_back({std::move(script), b.node, b.F * t.Rf, b.depth + 1});
+      b.script.push_back(false);
+      b.F *= 1.0 - t.Rf;
+    }
+    if (cut(b.F * t.T, b.depth + 1, t, b.node)) return;
+    LightTreeNode n;
+    n.parent = b.node;
+    n.event = t.tir ? TreeEvent::Tir : TreeEvent::Refract;
+    n.point = t.point;
+    n.direction = t.dir;
+    n.wave_normal = t.wave;
+    n.weight = b.F * t.T;
+    n.fresnel_r = t.Rf;
+    n.optical_path_mm = t.opl;
+    n.object = object(t.region);
+    n.depth = ++b.depth;
+    b.node = add(n);
+  }
+  out_.absorbed += b.F * (b.T - end.throughput.x);
+  LightTreeNode n;
+  n.parent = b.node;
+  n.event = end.left ? TreeEvent::Exit : end.ran_out ? TreeEvent::Cut : TreeEvent::Stop;
+  n.cut = end.ran_out ? TreeCut::Steps : TreeCut::None;
+  n.point = end.exit_point;
+  n.direction = end.exit_dir;
+  n.wave_normal = end.wave_normal;
+  n.weight = b.F * end.throughput.x;
+  n.optical_path_mm = end.opl;
+  n.object = end.left ? -1 : out_.nodes[size_t(b.node)].object;
+  n.depth = b.depth;
+  add(n);
+  (end.left ? out_.exit : end.ran_out ? out_.cut : out_.stopped) += n.weight;
+}
+
+// A reflected branch: its march repeats its ancestors' events (already in the tree) up to its
+// last scripted split, where it reflects; from there it is followed as any branch.
+void TreeBuilder::reflected(const Pending& p) {
+  std::vector<TreeStep> steps;
+  const MarchResult end = march_(p.script, steps);
+  size_t j = 0, splits = 0;
+  for (; j < steps.size(); ++j)
+    if (!steps[j].tir && ++splits == p.script.size()) break;
+  if (j == steps.size() || !steps[j].reflected)
+    throw std::logic_error("light tree: a scripted reflection was not met again");
+  const TreeStep& t = steps[j];
+  LightTreeNode n;
+  n.parent = p.parent;
+  n.event = TreeEvent::Reflect;
+  n.point = t.point;
+  n.direction = t.dir;
+  n.wave_normal = t.wave;
+  n.weight = p.F * t.T;
+  n.fresnel_r = t.Rf;
+  n.optical_path_mm = t.opl;
+  n.object = object(t.region);
+  n.depth = p.depth;
+  follow(Branch{add(n), p.F, t.T, p.depth, p.script}, steps, j + 1, end);
+}
+
+}  // namespace
+
+LightTree ReferenceMarcher::lightTree(const TraceRequest& ray, const MarchSettings& m, int mode,
+                                      const LightTreeSettings& tree) const {
+  validate(m);
+  checkLightTreeSettings(tree);
+  const double len = glm::length(ray.direction);
+  if (!(len > 0) || !std::isfinite(len))
+    throw std::invalid_argument("trace direction must be a non-zero finite vector");
+  if (!(ray.wavelength_nm > 0)) throw std::invalid_argument("trace wavelength must be > 0 nm");
+  if (mode != 0 && mode != 1) throw std::invalid_argument("mode must be 0 (o) or 1 (e)");
+  const glm::dvec3 d = ray.direction / len;
+  LightTree out;
+  out.uniaxial = field_.uniaxial();
+  out.mode = out.uniaxial ? mode : 0;
+  out.sharp = field_.boundary() && field_.media();
+  // Every split followed both ways: Full transport, its roulette replaced by the script, with no
+  // limit on the reflections a branch follows (the tree's own limits cut it).
+  MarchSettings full = m;
+  full.transport = Transport::Full;
+  full.max_reflections = std::numeric_limits<int>::max();
+  auto march = [&](const std::vector<bool>& script, std::vector<TreeStep>& steps) {
+    RayMarch rm(field_, env_, ray.wavelength_nm, true, full, out.mode);
+    ChoiceScript cs;
+    cs.choices = &script;
+    rm.setScript(&cs);
+    const MarchResult r = rm.march(ray.origin, d);
+    steps = std::move(cs.steps);
+    ++out.marches;
+    return r;
+  };
+  double t0 = 0.0, t1 = 0.0;
+  const bool hits = boxHit(ray.origin, d, field_.boundsMin(), field_.boundsMax(), t0, t1);
+  t0 = hits ? std::max(t0, 0.0) : 0.0;
+  TreeBuilder(march, tree, out).build(ray.origin + t0 * d, d, field_.ambientIndex() * t0);
+  return out;
 }
 
 /// What the marches of one pixel sample add up to: steps and field reads as the mean per march

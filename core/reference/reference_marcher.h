@@ -16,6 +16,7 @@
 #include <functional>
 #include <memory>
 
+#include "core/contract/light_tree.h"
 #include "core/contract/march_types.h"
 #include "core/scene/scene.h"
 #include "core/volume/field.h"
@@ -54,6 +55,11 @@ class ReferenceMarcher {
 
   /// Trace one ray at its wavelength in mode 0 (o, or the isotropic ray) or 1 (e).
   TraceOutcome trace(const TraceRequest& ray, const MarchSettings& settings, int mode = 0) const;
+  /// The light tree of one ray at its wavelength in mode 0 (o, or the isotropic ray) or 1 (e)
+  /// (core/contract/light_tree.h): every Fresnel split followed both ways, by re-marching the
+  /// ray with the reflect/refract choices of each branch forced (O(depth) marches per leaf).
+  LightTree lightTree(const TraceRequest& ray, const MarchSettings& settings, int mode,
+                      const LightTreeSettings& tree) const;
   /// Render the camera view, multi-threaded (threads = 0: hardware concurrency).
   RenderImage render(const Camera& camera, const RenderSettings& settings, int threads = 0) const;
 

@@ -526,6 +526,19 @@ std::vector<std::array<TraceOutcome, 2>> Session::trace(const std::vector<TraceR
   return out;
 }
 
+std::vector<LightTree> Session::lightTrees(const TraceRequest& ray, const MarchSettings& march,
+                                           const LightTreeSettings& tree) {
+  checkTraceRequest(ray);
+  checkMarchSettings(march);
+  checkLightTreeSettings(tree);
+  checkIndicesAt(*scene_, ray.wavelength_nm);
+  ReferenceMarcher& r = cpuMarcher();
+  std::vector<LightTree> trees;
+  for (int mode = 0; mode < (scene_->anyUniaxial() ? 2 : 1); ++mode)
+    trees.push_back(r.lightTree(ray, march, mode, tree));
+  return trees;
+}
+
 PolarisedTrace Session::tracePolarised(const TraceRequest& ray, const Stokes& input,
                                        const PolarisedTraceSettings& settings, bool gpu) {
   checkPolarisedTrace(ray, input, settings);

@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "core/contract/light_tree.h"
 #include "core/contract/march_types.h"
 #include "core/contract/polarised.h"
 #include "core/light/lighting_driver.h"
@@ -114,6 +115,7 @@ struct SettingRequests {
   std::string device = "auto";      ///< checkRenderDevice, renderTwin
   int threads = 0;                  ///< Session::setThreads
   double wavelength_nm = 587.5618;  ///< a trace's (TraceRequest::wavelength_nm)
+  LightTreeSettings tree;           ///< `eikon trace --tree`'s limits
 };
 /// The settings of `front` (one SettingFront bit) from `values` (by name), in table order: each
 /// given one, and each with a default, checked against its range or choices (SettingError) and
@@ -258,6 +260,11 @@ class Session {
   /// the o-mode by definition).
   std::vector<std::array<TraceOutcome, 2>> trace(const std::vector<TraceRequest>& rays,
                                                  const MarchSettings& march, bool gpu);
+  /// The light trees of one ray on the CPU twin (ReferenceMarcher::lightTree,
+  /// core/contract/light_tree.h; `eikon trace --tree`): {o, e} in a scene with crystals, each of
+  /// weight 1, else the one isotropic tree. Throws std::invalid_argument for a bad input.
+  std::vector<LightTree> lightTrees(const TraceRequest& ray, const MarchSettings& march,
+                                    const LightTreeSettings& tree);
   /// The polarised trace of one ray for the input Stokes vector `input` through the scene's sharp
   /// interfaces and polariser sheets (docs/polarisation.md): the GPU twin
   /// (ViewRenderer::tracePolarised) or the CPU twin (tracePolarised). Throws
