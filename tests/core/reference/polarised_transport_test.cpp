@@ -11,7 +11,7 @@
 //    uniform and unpolarised (equilibrium radiation), so every pixel's S0 is 1 and S1..S3 are 0:
 //    a glass sphere and the calcite plate of scenes/calcite_plate.json, at 64 samples, S0 mean ≥
 //    0.995, at most 1% of the pixels below 0.95, the mean of S1..S3 within 3σ of 0 (σ from the
-//    pixels' spread). Transport::Single (the transmitted path alone) fails all of these;
+//    pixels' spread). Transport::Single (the transmitted path alone) fails the S0 checks (0.91);
 //  - Transport::Full with max_reflections = 0 is Transport::Single, bit for bit.
 #include <gtest/gtest.h>
 
