@@ -229,7 +229,7 @@ struct BoundaryAnswer {
 // stokesBasis(direction)).
 struct PolarisedRay {
   vec4 origin;     // xyz (mm), w: λ (µm)
-  vec4 direction;  // xyz unit
+  vec4 direction;  // xyz unit; w: the seed of Transport::Full's choices, as its bits (gSeed)
   vec4 stokes;     // S0..S3
 };
 

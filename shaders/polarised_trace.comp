@@ -81,6 +81,7 @@ struct Branch {
   int modes;
   int nmodes;
   int events;
+  int choices;  // reflect-or-transmit choices made (P.pass.w > 0): the uniform's index k
 };
 
 // The ray tree of the invocation's one ray (the CPU's Tracer): the branches waiting, the leaves,
@@ -95,6 +96,18 @@ int gLeafCount = 0;
 bool gTruncated = false;
 int gUnsupported = 0;
 vec3 gPin;  // the input wave vector n_ambient·d
+uint gSeed;  // the ray's seed (its direction.w's bits): Transport::Full's choices
+
+// march_types.h's transportUniform (pcgHash as wavelength_sampling.cpp): the k-th uniform in
+// [0, 1) of a seed, 24 bits, exact in float, so both twins draw the same numbers.
+uint branchHash(uint v) {
+  uint state = v * 747796405u + 2891336453u;
+  uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+float branchUniform(uint seed, int k) {
+  return float(branchHash(seed + uint(k) * 0x632BE5ABu) >> 8u) * (1.0 / 16777216.0);
+}
 
 void push(Branch b) {
   if (gTop >= EIKON_POL_MAX_STACK) {
@@ -205,8 +218,43 @@ Branch outgoing(Branch b, ModeWave w, int mode, bool crystal, vec3 a, vec3 sHat,
   return nb;
 }
 
-// The interface: the branch goes on as the transmitted beam(s) (the o and e modes into a
-// crystal), or the reflected one(s) on total internal reflection or where asked (reflect_at).
+// What one crossing's outgoing waves share: the incident (ŝ, p̂) frame and field components, cos i,
+// the incident and the far side's ordinary index, and each side's crystal axis (zero: isotropic).
+struct Incidence {
+  vec3 sHat;
+  vec2 es0, ep0, es1, ep1;
+  float ci, nIn, noB;
+  vec3 aA, aB;
+  bool uA, uB;
+};
+
+// The outgoing wave w (mode k) of a crossing, reflected or transmitted, its fields scaled.
+Branch wave(Branch b, ModeWave w, int k, bool reflect, Incidence I, float scale) {
+  vec2 rs, rp, ts, tp;
+  fresnelAmplitudes(I.ci, I.nIn, reflect ? I.noB : w.n, rs, rp, ts, tp);
+  Branch nb = outgoing(b, w, k, reflect ? I.uA : I.uB, reflect ? I.aA : I.aB, I.sHat,
+                       scale * (reflect ? rs : ts), scale * (reflect ? rp : tp), I.es0, I.ep0,
+                       I.es1, I.ep1);
+  return nb;
+}
+
+// The power of the waves w (both input basis states together).
+float wavesPower(Branch b, ModeWave w[2], bool reflect, Incidence I) {
+  float sum = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    if (!w[k].exists) continue;
+    Branch nb = wave(b, w[k], k, reflect, I, 1.0);
+    sum += cvNorm2(nb.G0) + cvNorm2(nb.G1);
+  }
+  return sum;
+}
+
+// The interface (the CPU's Tracer::cross): the branch goes on as the transmitted beam(s) (the o
+// and e modes into a crystal), or the reflected one(s) (both modes in a crystal) on total internal
+// reflection, where asked (reflect_at), or, with Transport::Full (P.pass.w: the choices a branch
+// may make), where its random choice takes them: the reflection with probability p = the
+// reflected share of the branch's power (both basis states), the chosen fields scaled by 1/√p or
+// 1/√(1 − p).
 void cross(Branch b, BoundaryCrossing c) {
   int A = b.region, B = c.to;
   if (mediumOpaque(B)) return;  // absorbed: nothing of this branch leaves
@@ -217,11 +265,16 @@ void cross(Branch b, BoundaryCrossing c) {
     push(b);
     return;
   }
-  bool uA = hasAxis(afA.xyz), uB = hasAxis(afB.xyz);
+  Incidence I;
+  I.uA = hasAxis(afA.xyz);
+  I.uB = hasAxis(afB.xyz);
+  I.aA = afA.xyz;
+  I.aB = afB.xyz;
   float noA = regionIndex(A, 0, x), neA = regionIndex(A, 1, x);
-  float noB = regionIndex(B, 0, x), neB = regionIndex(B, 1, x);
-  float nIn = length(b.p);
-  vec3 s = b.p / nIn;
+  I.noB = regionIndex(B, 0, x);
+  float neB = regionIndex(B, 1, x);
+  I.nIn = length(b.p);
+  vec3 s = b.p / I.nIn;
   vec3 m = orientNormal(c.normal, b.ray);
   // Along the face (the CPU's kGrazeCos): not a crossing; the Fresnel factor √(n₂cos t/(n₁cos i))
   // divides by cos i = 0 there (NaN). The branch goes on in its own medium, one event spent.
@@ -231,36 +284,45 @@ void cross(Branch b, BoundaryCrossing c) {
     return;
   }
   vec3 pt = b.p - dot(b.p, m) * m;
-  ModeWave w[2];
-  for (int k = 0; k < 2; ++k) w[k] = solveInterfaceMode(pt, m, k == 1, afB.xyz, noB, neB, true);
-  if (!uB) w[1].exists = false;
+  ModeWave wt[2], wr[2];
+  for (int k = 0; k < 2; ++k) wt[k] = solveInterfaceMode(pt, m, k == 1, I.aB, I.noB, neB, true);
+  if (!I.uB) wt[1].exists = false;
   int mask = int(sheets[0].w);
   bool asked = b.events < 24 && ((mask >> b.events) & 1) != 0;
-  bool reflect = asked || !(w[0].exists || w[1].exists);
-  if (reflect) {
-    for (int k = 0; k < 2; ++k) w[k] = solveInterfaceMode(pt, m, k == 1, afA.xyz, noA, neA, false);
-    if (!uA) w[1].exists = false;
+  bool reflect = asked || !(wt[0].exists || wt[1].exists);
+  bool choose = !reflect && b.choices < P.pass.w;
+  if (reflect || choose) {
+    for (int k = 0; k < 2; ++k) wr[k] = solveInterfaceMode(pt, m, k == 1, I.aA, noA, neA, false);
+    if (!I.uA) wr[1].exists = false;
   }
-  vec3 sHat = cross(s, m);
-  if (length(sHat) < 1e-6) sHat = stokesBasis(s);  // normal incidence: any ŝ ⊥ s
-  sHat = normalize(sHat);
-  vec3 pIn = cross(s, sHat);
-  vec2 es0 = cvDot(b.G0, sHat), ep0 = cvDot(b.G0, pIn), es1 = cvDot(b.G1, sHat),
-       ep1 = cvDot(b.G1, pIn);
-  float ci = min(1.0, abs(dot(s, m)));
-  bool crystal = reflect ? uA : uB;
-  vec3 a = reflect ? afA.xyz : afB.xyz;
+  I.sHat = cross(s, m);
+  if (length(I.sHat) < 1e-6) I.sHat = stokesBasis(s);  // normal incidence: any ŝ ⊥ s
+  I.sHat = normalize(I.sHat);
+  vec3 pIn = cross(s, I.sHat);
+  I.es0 = cvDot(b.G0, I.sHat);
+  I.ep0 = cvDot(b.G0, pIn);
+  I.es1 = cvDot(b.G1, I.sHat);
+  I.ep1 = cvDot(b.G1, pIn);
+  I.ci = min(1.0, abs(dot(s, m)));
+  float scale = 1.0;
+  if (choose) {
+    float pr = wavesPower(b, wr, true, I), pw = pr + wavesPower(b, wt, false, I);
+    if (pw > 0.0) {
+      float p = pr / pw;
+      reflect = branchUniform(gSeed, b.choices) < p;
+      scale = inversesqrt(reflect ? p : 1.0 - p);
+      b.choices++;
+    }
+  }
   for (int k = 0; k < 2; ++k) {
-    if (!w[k].exists) continue;
-    vec2 rs, rp, ts, tp;
-    fresnelAmplitudes(ci, nIn, reflect ? noB : w[k].n, rs, rp, ts, tp);
-    Branch nb = outgoing(b, w[k], k, crystal, a, sHat, reflect ? rs : ts, reflect ? rp : tp, es0,
-                         ep0, es1, ep1);
+    ModeWave w = reflect ? wr[k] : wt[k];
+    if (!w.exists) continue;
+    Branch nb = wave(b, w, k, reflect, I, scale);
     if (cvNorm2(nb.G0) + cvNorm2(nb.G1) < 1e-12) continue;
     nb.region = reflect ? A : B;
     nb.x = x;
     nb.events = b.events + 1;
-    if (crystal && nb.nmodes < 15) {
+    if ((reflect ? I.uA : I.uB) && nb.nmodes < 15) {
       nb.modes |= k << nb.nmodes;
       nb.nmodes++;
     }
@@ -399,6 +461,8 @@ void main() {
   b.modes = 0;
   b.nmodes = 0;
   b.events = 0;
+  b.choices = 0;
+  gSeed = floatBitsToUint(ray.direction.w);
   PolarisedResult res;
   res.head = ivec4(0);
   float t0, t1;

@@ -39,6 +39,11 @@ void checkPolarisedTrace(const TraceRequest& ray, const Stokes& in,
   }
   if (s.max_branches < 1 || s.max_events < 1)
     throw std::invalid_argument("polarised trace settings must be positive");
+  if (s.max_reflections < 0 || s.max_reflections > 1024)
+    throw std::invalid_argument("polarised trace max_reflections must be in [0, 1024], got " +
+                                std::to_string(s.max_reflections));
+  if (s.transport != Transport::Single && s.transport != Transport::Full)
+    throw std::invalid_argument("polarised trace transport must be single or full");
 }
 
 }  // namespace eikon

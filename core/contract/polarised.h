@@ -26,6 +26,14 @@ struct PolarisedTraceSettings {
   /// Renders (core/contract/polarised_render.h): each beam's `stokes` is the first ROW of its
   /// Mueller matrix (M00, M01, M02, M03: S0 out per input basis state) instead of M·input.
   bool mueller_row = false;
+  /// What each branch follows at a crossing that transmits (docs/polarisation.md "Interfaces"):
+  /// Single, the transmitted beam(s); Full, the reflected or the transmitted beam(s), chosen at
+  /// random with the branch's unpolarised reflected power fraction p (transportUniform of the
+  /// trace's seed; fields scaled by 1/√p or 1/√(1 − p), so every Mueller quantity stays unbiased),
+  /// at most max_reflections choices per branch, transmitted only after them. A single trace
+  /// (eikon trace --polarised) is Single and deterministic; renders take MarchSettings::transport.
+  Transport transport = Transport::Single;
+  int max_reflections = 32;  ///< Full: choices per branch, in [0, 1024] (MarchSettings's)
 };
 
 /// One beam leaving the scene.
@@ -53,7 +61,8 @@ struct PolarisedTrace {
 
 /// Throws std::invalid_argument (one line) on a bad ray (zero or non-finite direction,
 /// wavelength ≤ 0), input Stokes vector (S0 ≤ 0, non-finite, √(S1² + S2² + S3²) > S0) or settings
-/// (bandwidth_nm finite > 0, source_angle_rad in (0, π], each named).
+/// (bandwidth_nm finite > 0, source_angle_rad in (0, π], max_reflections in [0, 1024], each
+/// named).
 void checkPolarisedTrace(const TraceRequest& ray, const Stokes& input,
                          const PolarisedTraceSettings& settings);
 

@@ -19,6 +19,8 @@ namespace {
 /// Rays per call of the batch: bounds the GPU twin's result buffer (~340 bytes a ray) and sets
 /// how often progress is reported.
 constexpr size_t kBatchRays = 1 << 15;
+/// The polarised trace's own stream of transportSeed (the view march's modes use 0 and 1).
+constexpr int kPolarisedStream = 2;
 
 /// The scene camera's rays, as ReferenceMarcher::render and view.comp make them.
 struct CameraRays {
@@ -141,6 +143,8 @@ RenderImage renderPolarisedWith(const Scene& scene, const RenderSettings& s,
   checkPolarisedScene(scene, s);
   PolarisedTraceSettings ts = trace;
   ts.mueller_row = true;
+  ts.transport = s.march.transport;
+  ts.max_reflections = s.march.max_reflections;
   const CameraRays cam(scene.camera, img.width, img.height, s.spp);
   const bool spectral = s.wavelengths > 0;
   const int N = std::max(1, s.wavelengths);
@@ -154,6 +158,7 @@ RenderImage renderPolarisedWith(const Scene& scene, const RenderSettings& s,
   for (int y0 = 0; y0 < img.height; y0 += rowsPerBatch) {
     const int y1 = std::min(img.height, y0 + rowsPerBatch);
     std::vector<TraceRequest> rays;
+    std::vector<std::uint32_t> seeds;
     std::vector<RaySlot> slots;
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < img.width; ++x) {
@@ -167,11 +172,12 @@ RenderImage renderPolarisedWith(const Scene& scene, const RenderSettings& s,
                   : spectrum::stratifiedWavelengths(uint32_t(pixel), uint32_t(k), uint32_t(N));
           for (double l : lambdas) {
             rays.push_back({scene.camera.position, v, l});
+            seeds.push_back(transportSeed(uint32_t(pixel), uint32_t(k), kPolarisedStream));
             slots.push_back({pixel, pixel * size_t(s.spp) + size_t(k), v, l});
           }
         }
       }
-    const std::vector<PolarisedTrace> traces = batch(rays, ts);
+    const std::vector<PolarisedTrace> traces = batch(rays, seeds, ts);
     if (traces.size() != rays.size())
       throw std::logic_error("polarised render: the batch returned a trace count mismatch");
     for (size_t i = 0; i < rays.size(); ++i) {

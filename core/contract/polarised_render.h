@@ -20,13 +20,19 @@
 // exit parallel but displaced (a calcite plate's walk-off) add coherently.
 //
 //   RenderImage img = renderPolarisedWith(scene, settings, batch, threads);
-//   // batch(rays, trace_settings) -> the twin's traces (mueller_row set), one per ray
+//   // batch(rays, seeds, trace_settings) -> the twin's traces (mueller_row set), one per ray
+//
+// The trace follows the render's MarchSettings::transport and max_reflections: with
+// Transport::Full each branch takes the reflection or the transmission at random (p its reflected
+// power fraction; docs/polarisation.md "Interfaces"), drawn from seeds[i] =
+// transportSeed(pixel, sample, 2) (the same at every wavelength of a sample), so that S0 equals
+// the unpolarised full-transport render within noise.
 //
 // Left out (documented): lights, emission and in-scatter (the polariscope and conoscope scenes are
-// environment-lit), a polarised environment (refused), partial reflections other than total
-// internal reflection (the trace follows the transmitted beams).
+// environment-lit), a polarised environment (refused).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -56,9 +62,11 @@ std::string polarisedBecause(const Scene& scene, const RenderSettings& s);
 /// voxelising; renderPolarisedWith calls it too.
 void checkPolarisedScene(const Scene& scene, const RenderSettings& s);
 
-/// A twin's polarised trace of many rays (one trace per ray, settings.mueller_row set).
+/// A twin's polarised trace of many rays (one trace per ray, settings.mueller_row set), seeds[i]
+/// drawing ray i's Transport::Full choices.
 using PolarisedBatch = std::function<std::vector<PolarisedTrace>(
-    const std::vector<TraceRequest>& rays, const PolarisedTraceSettings& settings)>;
+    const std::vector<TraceRequest>& rays, const std::vector<std::uint32_t>& seeds,
+    const PolarisedTraceSettings& settings)>;
 
 /// The camera pixel's Stokes vector (frame stokesBasis(−v)) for unit unpolarised environment
 /// radiance from one backward beam: Q × the beam's Mueller row (beam.stokes with mueller_row), in

@@ -15,7 +15,8 @@ RenderImage renderPolarised(const Field& field, const Scene& scene, const Render
                             int threads, const PolarisedTraceSettings& trace) {
   const int workers =
       threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
-  auto batch = [&](const std::vector<TraceRequest>& rays, const PolarisedTraceSettings& ts) {
+  auto batch = [&](const std::vector<TraceRequest>& rays, const std::vector<std::uint32_t>& seeds,
+                   const PolarisedTraceSettings& ts) {
     std::vector<PolarisedTrace> out(rays.size());
     std::atomic<size_t> next{0};
     std::exception_ptr error;
@@ -23,7 +24,7 @@ RenderImage renderPolarised(const Field& field, const Scene& scene, const Render
     auto work = [&] {
       for (size_t i = next++; i < rays.size(); i = next++) {
         try {
-          out[i] = tracePolarised(field, scene.polarizers, rays[i], {1, 0, 0, 0}, ts);
+          out[i] = tracePolarised(field, scene.polarizers, rays[i], {1, 0, 0, 0}, ts, seeds[i]);
         } catch (...) {
           std::lock_guard<std::mutex> lock(error_mutex);
           if (!error) error = std::current_exception();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -53,6 +54,7 @@ struct Branch {
   double opl = 0.0;  ///< ∫p·dx from the origin (mm)
   std::string modes;
   int events = 0;
+  int choices = 0;  ///< reflect-or-transmit choices made (Transport::Full): the uniform's index k
 };
 
 double power(const Branch& b) {
@@ -63,10 +65,11 @@ double power(const Branch& b) {
 class Tracer {
  public:
   Tracer(const Field& f, const std::vector<PolarizerSheet>& sheets, double lambda_nm,
-         const PolarisedTraceSettings& s)
+         const PolarisedTraceSettings& s, std::uint32_t seed)
       : sheets_(sheets),
         lambda_(lambda_nm),
         s_(s),
+        seed_(seed),
         bf_(f.boundary()),
         media_(f.media()),
         bmin_(f.boundsMin()),
@@ -86,6 +89,7 @@ class Tracer {
   const std::vector<PolarizerSheet>& sheets_;
   double lambda_;
   const PolarisedTraceSettings& s_;
+  std::uint32_t seed_;
   const BoundaryField* bf_;
   const MediaTable* media_;
   glm::dvec3 bmin_, bmax_;
@@ -157,7 +161,13 @@ void Tracer::segment(Branch& b, double len) const {
 }
 
 // The exact interface map; the branch goes on as the transmitted beam(s) (the o and e modes
-// into a crystal), or the reflected one(s) on total internal reflection or where asked.
+// into a crystal), or the reflected one(s) (both modes in a crystal: mode conversion) on total
+// internal reflection, where asked, or, with Transport::Full, where its random choice takes them:
+// the reflection with probability p = the reflected share of the branch's power, summed over both
+// input basis states (its unpolarised reflected power fraction), the chosen fields scaled by 1/√p
+// or 1/√(1 − p) so that every |G|² and every product of fields is unbiased. The uniform is the
+// branch's choices-th of the trace's seed: o and e branches of one path draw the same numbers and
+// so make the same choice wherever their p are alike, which keeps their coherent sums together.
 void Tracer::cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branch>& stack) const {
   const MediumRecord &A = rec(b.region), &B = rec(c.to);
   if (B.opaque()) return;  // absorbed: nothing of this branch leaves
@@ -175,15 +185,32 @@ void Tracer::cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branc
     return;
   }
   const InterfaceMap map = interfaceMap(from, b.mode, glm::normalize(b.p), c.normal, to);
+  const std::array<CV, 4> out0 = map.apply(b.G[0]), out1 = map.apply(b.G[1]);
+  auto slotPower = [&](size_t slot) {
+    if (!map.beams[slot].exists) return 0.0;
+    const double a = maxwell::norm(out0[slot]), e = maxwell::norm(out1[slot]);
+    return a * a + e * e;
+  };
   const bool asked =
       std::find(s_.reflect_at.begin(), s_.reflect_at.end(), b.events) != s_.reflect_at.end();
-  const bool reflect = asked || !(map.beams[2].exists || map.beams[3].exists);
+  bool reflect = asked || !(map.beams[2].exists || map.beams[3].exists);
+  double scale = 1.0;
+  int choices = b.choices;
+  if (!reflect && s_.transport == Transport::Full && b.choices < s_.max_reflections) {
+    const double pr = slotPower(0) + slotPower(1), pt = slotPower(2) + slotPower(3);
+    if (pr + pt > 0.0) {
+      const double p = pr / (pr + pt);
+      reflect = transportUniform(seed_, std::uint32_t(b.choices)) < p;
+      scale = 1.0 / std::sqrt(reflect ? p : 1.0 - p);
+      ++choices;
+    }
+  }
   const OpticalMedium& side = reflect ? from : to;
   for (size_t slot = reflect ? 0 : 2; slot < (reflect ? 2u : 4u); ++slot) {
     const OutgoingBeam& beam = map.beams[slot];
     if (!beam.exists) continue;
     Branch nb = b;
-    nb.G = {map.apply(b.G[0])[slot], map.apply(b.G[1])[slot]};
+    nb.G = {Complex(scale) * out0[slot], Complex(scale) * out1[slot]};
     if (power(nb) < 1e-14) continue;
     nb.p = beam.p;
     nb.ray = beam.ray;
@@ -191,6 +218,7 @@ void Tracer::cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branc
     nb.region = reflect ? b.region : c.to;
     nb.x = c.point;
     nb.events = b.events + 1;
+    nb.choices = choices;
     if (side.crystal) nb.modes += beam.mode == Mode::Ordinary ? 'o' : 'e';
     stack.push_back(nb);
   }
@@ -277,14 +305,14 @@ PolarisedBeam recombine(const std::vector<const Branch*>& group, const Stokes& i
 
 PolarisedTrace tracePolarised(const Field& field, const std::vector<PolarizerSheet>& sheets,
                               const TraceRequest& ray, const Stokes& input,
-                              const PolarisedTraceSettings& settings) {
+                              const PolarisedTraceSettings& settings, std::uint32_t seed) {
   checkPolarisedTrace(ray, input, settings);
   if (!field.boundary() || !field.media())
     throw std::runtime_error(
         "polarised trace: the field has no sharp boundaries (it needs "
         "\"interfaces\": \"sharp\")");
   const glm::dvec3 d = glm::normalize(ray.direction);
-  const Tracer tracer(field, sheets, ray.wavelength_nm, settings);
+  const Tracer tracer(field, sheets, ray.wavelength_nm, settings, seed);
   PolarisedTrace out;
   out.frame_x_in = stokesBasis(d);
   Branch b;

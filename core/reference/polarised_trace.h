@@ -7,8 +7,11 @@
 //   * at every interface the exact Maxwell amplitudes (isotropic: Born & Wolf's r/t with the TIR
 //     phase; crystal faces: the 4×4 solve of anisotropic/maxwell_boundary.h, so no D-projection
 //     approximation): the path follows the transmitted beam(s), or the reflected one(s) on total
-//     internal reflection or where `reflect_at` asks; a wave entering a crystal splits into an o
-//     and an e branch, which are traced separately (a ray tree, at most max_branches leaves);
+//     internal reflection, where `reflect_at` asks, or (Transport::Full) where a random choice
+//     with the branch's reflected power fraction p takes them (fields scaled by 1/√p or
+//     1/√(1 − p); `seed` gives the uniforms, as march_types.h transportUniform); a wave entering
+//     a crystal splits into an o and an e branch, and one reflected inside a crystal into two,
+//     which are traced separately (a ray tree, at most max_branches leaves);
 //   * in a crystal each branch gains k₀∫p·dx (p the wave vector: walk-off is accounted for) and
 //     loses exp(−½σL) of its amplitude (pleochroic σ(θ)cos ρ per ray length, field::attenuationE);
 //   * a straight piece that crosses a polariser sheet's rectangle (scene "polarizer", outside or
@@ -32,6 +35,7 @@
 // a std::runtime_error naming it); an opaque region absorbs the branch.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "anisotropic/polarization.h"
@@ -45,9 +49,10 @@ namespace eikon {
 /// Trace `ray` (forwards) through the field's sharp boundaries and the given sheets. Throws
 /// std::invalid_argument on a bad ray, input Stokes vector (S0 ≤ 0, DoP > 1) or settings, and
 /// std::runtime_error when the field has no sharp boundary field or the path meets a region the
-/// polarised trace does not support.
+/// polarised trace does not support. `seed` draws the choices of Transport::Full (renders:
+/// transportSeed(pixel, sample, 2)); a Transport::Single trace does not use it.
 PolarisedTrace tracePolarised(const Field& field, const std::vector<PolarizerSheet>& sheets,
                               const TraceRequest& ray, const Stokes& input,
-                              const PolarisedTraceSettings& settings = {});
+                              const PolarisedTraceSettings& settings = {}, std::uint32_t seed = 0);
 
 }  // namespace eikon

@@ -1,6 +1,7 @@
 #include "core/render/view_renderer.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -1030,10 +1031,13 @@ std::vector<std::array<TraceOutcome, 2>> ViewRenderer::traceModes(
 std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<PolarizerSheet>& sheets,
                                                          const std::vector<TraceRequest>& rays,
                                                          const std::vector<Stokes>& inputs,
-                                                         const PolarisedTraceSettings& settings) {
+                                                         const PolarisedTraceSettings& settings,
+                                                         const std::vector<std::uint32_t>& seeds) {
   Impl& I = *impl_;
   if (inputs.size() != rays.size())
     throw std::invalid_argument("polarised trace: one input Stokes vector per ray");
+  if (!seeds.empty() && seeds.size() != rays.size())
+    throw std::invalid_argument("polarised trace: one seed per ray");
   for (size_t i = 0; i < rays.size(); ++i) checkPolarisedTrace(rays[i], inputs[i], settings);
   if (!I.sharp)
     throw std::runtime_error(
@@ -1054,7 +1058,9 @@ std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<Polar
   for (size_t i = 0; i < n; ++i) {
     in[i].origin = glm::vec4(glm::vec3(rays[i].origin),
                              float(micrometresFromNanometres(rays[i].wavelength_nm)));
-    in[i].direction = glm::vec4(glm::vec3(glm::normalize(rays[i].direction)), 0.0f);
+    // w: the seed's bits (floatBitsToUint in the kernel; copied, never computed with).
+    in[i].direction = glm::vec4(glm::vec3(glm::normalize(rays[i].direction)),
+                                std::bit_cast<float>(seeds.empty() ? 0u : seeds[i]));
     in[i].stokes = glm::vec4(inputs[i]);
   }
   gpu::ViewParams p = I.baseParams(MarchSettings{}, 0);
@@ -1065,7 +1071,8 @@ std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<Polar
   p.image = glm::ivec4(int(n), 1, 0, 1);
   p.pass = glm::ivec4(std::min(settings.max_events, EIKON_POL_MAX_EVENTS),
                       std::min(settings.max_branches, EIKON_POL_MAX_LEAVES),
-                      settings.mueller_row ? 1 : 0, 0);
+                      settings.mueller_row ? 1 : 0,
+                      settings.transport == Transport::Full ? settings.max_reflections : 0);
   I.params.write(&p, sizeof p);
   vk::Buffer sb(I.ctx, sheetData.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                 "polariser sheets");
@@ -1096,9 +1103,10 @@ RenderImage ViewRenderer::renderPolarised(const RenderSettings& s,
   const Scene& scene = impl_->scene;
   return renderPolarisedWith(
       scene, s,
-      [&](const std::vector<TraceRequest>& rays, const PolarisedTraceSettings& ts) {
+      [&](const std::vector<TraceRequest>& rays, const std::vector<std::uint32_t>& seeds,
+          const PolarisedTraceSettings& ts) {
         return tracePolarised(scene.polarizers, rays,
-                              std::vector<Stokes>(rays.size(), Stokes(1, 0, 0, 0)), ts);
+                              std::vector<Stokes>(rays.size(), Stokes(1, 0, 0, 0)), ts, seeds);
       },
       trace);
 }

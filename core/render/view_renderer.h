@@ -73,11 +73,13 @@ class ViewRenderer {
   /// twin of core/reference/polarised_trace.h's tracePolarised; shaders/polarised_trace.comp):
   /// inputs[i] is ray i's input Stokes vector. Throws std::invalid_argument as the CPU twin does
   /// (and for more than 8 sheets or a ray/input count mismatch), std::runtime_error for a scene
-  /// without sharp interfaces or a path through a region the trace does not support.
+  /// without sharp interfaces or a path through a region the trace does not support. seeds[i]
+  /// draws ray i's Transport::Full choices (empty: seed 0 for every ray).
   std::vector<PolarisedTrace> tracePolarised(const std::vector<PolarizerSheet>& sheets,
                                              const std::vector<TraceRequest>& rays,
                                              const std::vector<Stokes>& inputs,
-                                             const PolarisedTraceSettings& settings = {});
+                                             const PolarisedTraceSettings& settings = {},
+                                             const std::vector<std::uint32_t>& seeds = {});
   /// A polarised render of the scene's camera (core/contract/polarised_render.h, the GPU twin of
   /// core/reference/polarised_render.h): rgb = S0 after the camera's analyser, stokes layers if
   /// asked. Throws as renderPolarisedWith and tracePolarised (at most 8 polariser sheets).

@@ -54,6 +54,7 @@ struct Scenery {
     s.stokes_layers = true;
     s.wavelength_nm = nm;
     s.wavelengths = wavelengths;
+    s.march.transport = Transport::Single;  // the closed forms are the transmitted path's
     return renderPolarised(field, scene, s, 2);
   }
 };

@@ -50,9 +50,11 @@ struct PolRenderTwins {
     sc.camera = cam;
     if (!on_gpu) return renderPolarised(field, sc, s);
     return renderPolarisedWith(
-        sc, s, [&](const std::vector<TraceRequest>& rays, const PolarisedTraceSettings& ts) {
+        sc, s,
+        [&](const std::vector<TraceRequest>& rays, const std::vector<std::uint32_t>& seeds,
+            const PolarisedTraceSettings& ts) {
           return gpu.tracePolarised(sc.polarizers, rays,
-                                    std::vector<Stokes>(rays.size(), {1, 0, 0, 0}), ts);
+                                    std::vector<Stokes>(rays.size(), {1, 0, 0, 0}), ts, seeds);
         });
   }
 };
@@ -71,6 +73,7 @@ double wedgeColours(PolRenderTwins& t, bool gpu, int bins, bool expect) {
   RenderSettings s;
   s.width = s.height = 8;
   s.spp = 1;
+  s.march.transport = Transport::Single;  // the closed forms are the transmitted path's
   s.wavelengths = bins;
   double worst = 0.0;
   for (double G = 100.0; G <= 1800.0; G += 100.0) {
@@ -147,6 +150,7 @@ TEST(PolariscopeRender, ConoscopeRingsAndIsogyresInMonochromaticLight) {
                deg = std::numbers::pi / 180.0;
   RenderSettings s;
   s.spp = 1;  // the pixel centres
+  s.march.transport = Transport::Single;
   s.wavelengths = 0;
   s.wavelength_nm = nm;  // monochromatic: RGB mode at one wavelength
   for (bool gpu : {false, true}) {
