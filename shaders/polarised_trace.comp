@@ -98,17 +98,6 @@ int gUnsupported = 0;
 vec3 gPin;  // the input wave vector n_ambient·d
 uint gSeed;  // the ray's seed (its direction.w's bits): Transport::Full's choices
 
-// march_types.h's transportUniform (pcgHash as wavelength_sampling.cpp): the k-th uniform in
-// [0, 1) of a seed, 24 bits, exact in float, so both twins draw the same numbers.
-uint branchHash(uint v) {
-  uint state = v * 747796405u + 2891336453u;
-  uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-  return (word >> 22u) ^ word;
-}
-float branchUniform(uint seed, int k) {
-  return float(branchHash(seed + uint(k) * 0x632BE5ABu) >> 8u) * (1.0 / 16777216.0);
-}
-
 void push(Branch b) {
   if (gTop >= EIKON_POL_MAX_STACK) {
     gTruncated = true;
@@ -309,7 +298,7 @@ void cross(Branch b, BoundaryCrossing c) {
     float pr = wavesPower(b, wr, true, I), pw = pr + wavesPower(b, wt, false, I);
     if (pw > 0.0) {
       float p = pr / pw;
-      reflect = branchUniform(gSeed, b.choices) < p;
+      reflect = transportUniform(gSeed, uint(b.choices)) < p;  // march.glsl
       scale = inversesqrt(reflect ? p : 1.0 - p);
       b.choices++;
     }
