@@ -24,11 +24,13 @@
 // is the simulator's own, kill). --no-straight-to-boundary: sharp straight steps on the skip
 // distances only (WavefrontSettings::straight_to_boundary), to measure what running up to the
 // boundary gains (docs/performance.md "Light simulator"). Each run prints its tears (torn patches
-// made pencils).
+// made pencils). --reflections G1,G2,…: run the full resolution once per listed reflected-
+// generation limit (WavefrontSettings::max_reflection_generations; default 0), each printing the
+// reflected copies made and the flux dropped past the limit, and the time against the first.
 //
 //   light_bench [--resolution N] [--no-skip-resolution M] [--steps-per-dispatch K] [--no-cpu]
 //               [--no-gpu] [--threads T1,T2,…] [--sharp] [--interfaces smoothed,sharp] [--no-low]
-//               [--caustics kill|pass] [--no-straight-to-boundary]
+//               [--caustics kill|pass] [--no-straight-to-boundary] [--reflections G1,G2,…]
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -72,6 +74,9 @@ void print(const char* name, const Run& r) {
       "reflected %.9g + live %.9g  (balance %+.2e relative)\n",
       s.flux_emitted, s.flux_left, s.flux_caustic, s.flux_energy, s.flux_absorbed, s.flux_reflected,
       s.flux_live_at_end, (ended - s.flux_emitted) / s.flux_emitted);
+  if (s.reflections > 0)
+    std::printf("       reflected copies %zu, reflected flux dropped %.3e of emitted\n",
+                s.reflections, s.flux_reflected / s.flux_emitted);
   if (s.straight_steps > 0)
     std::printf("       straight steps %zu covering %zu time steps (%.1f each)\n", s.straight_steps,
                 s.straight_time_steps, double(s.straight_time_steps) / double(s.straight_steps));
@@ -89,6 +94,7 @@ int gStepsPerDispatch = 16;
 bool gSharp = false;              ///< --sharp
 bool gPassCaustics = false;       ///< --caustics pass
 bool gToBoundary = true;          ///< !--no-straight-to-boundary
+int gReflections = 0;             ///< the run's --reflections entry
 std::vector<int> gThreads = {0};  ///< CPU reference thread counts (0: hardware concurrency)
 
 Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu) {
@@ -99,19 +105,22 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
   s.sharp_interfaces = gSharp;
   s.pass_caustics = gPassCaustics;
   s.straight_to_boundary = gToBoundary;
+  s.max_reflection_generations = gReflections;
   // The CPU twin's set-up (its skip distances and media; the field), timed as the GPU's is.
   const auto tc = std::chrono::steady_clock::now();
   const SharpInterfaces sharp =
       gSharp ? sharpInterfacesFor(vol, s.wavelength_nm) : SharpInterfaces{};
   const VolumeField field(vol);
   const double cpuSetup = seconds(tc);
-  std::printf("\nvolume %dx%dx%d (h = %.4g mm), straight steps %s, interfaces %s\n",
-              vol.grid.dims[0], vol.grid.dims[1], vol.grid.dims[2], vol.grid.h,
-              skip ? "on (skip_empty = true)" : "off (skip_empty = false)",
-              !sharp.active()             ? "smoothed"
-              : vol.boundary.convex_apart ? "sharp (crossings on the planes: faces known)"
-              : vol.boundary.exact        ? "sharp (crossings on the shapes)"
-                                          : "sharp (crossings by the walk)");
+  std::printf(
+      "\nvolume %dx%dx%d (h = %.4g mm), reflected generations %d, straight steps %s, "
+      "interfaces %s\n",
+      vol.grid.dims[0], vol.grid.dims[1], vol.grid.dims[2], vol.grid.h, gReflections,
+      skip ? "on (skip_empty = true)" : "off (skip_empty = false)",
+      !sharp.active()             ? "smoothed"
+      : vol.boundary.convex_apart ? "sharp (crossings on the planes: faces known)"
+      : vol.boundary.exact        ? "sharp (crossings on the shapes)"
+                                  : "sharp (crossings by the walk)");
   Pair p;
   if (ctx) {
     // Set-up (uploads, the pipelines' compilation) apart: a render pays it once per scene.
@@ -194,8 +203,15 @@ int main(int argc, char** argv) {
                  "CPU thread counts to compare, comma separated (0: all cores)")
       ->delimiter(',')
       ->check(CLI::Range(0, 1024));
+  std::vector<int> reflections = {0};
+  app.add_option("--reflections", reflections,
+                 "Reflected-generation limits to compare, comma separated (sharp interfaces; "
+                 "WavefrontSettings::max_reflection_generations, default 0)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 64));
   CLI11_PARSE(app, argc, argv);
   if (gThreads.empty()) gThreads = {0};
+  if (reflections.empty()) reflections = {0};
   gPassCaustics = caustics == "pass";
   const Scene scene = loadScene(scene_path);
   if (scene.lights.empty()) {
@@ -211,20 +227,27 @@ int main(int argc, char** argv) {
 
   if (interfaces.empty()) interfaces = {gSharp ? "sharp" : "smoothed"};
   std::vector<std::string> rows;
-  for (const std::string& kind : interfaces) {
-    gSharp = kind == "sharp";
-    const Pair full = simulate(ctx.get(), scene, resolution, true, cpu);
-    char row[256];
-    const double c = full.cpu.empty() ? 0.0 : full.cpu.back().s,
-                 g = full.haveGpu ? full.gpu.s : 0.0;
-    std::snprintf(row, sizeof row,
-                  "| %s | %d | %s | %.2f (+%.2f set-up) | %.2f (+%.2f set-up) | %.2f |",
-                  scene_path.c_str(), resolution, kind.c_str(), c, full.cpuSetup, g, full.gpuSetup,
-                  c > 0 && g > 0 ? c / g : 0.0);
-    rows.push_back(row);
-  }
+  for (const std::string& kind : interfaces)
+    for (int g : reflections) {
+      gSharp = kind == "sharp";
+      gReflections = g;
+      const Pair full = simulate(ctx.get(), scene, resolution, true, cpu);
+      char row[320];
+      const double c = full.cpu.empty() ? 0.0 : full.cpu.back().s,
+                   gs = full.haveGpu ? full.gpu.s : 0.0;
+      const WavefrontStats& st = full.cpu.empty() ? full.gpu.st : full.cpu.back().st;
+      std::snprintf(
+          row, sizeof row,
+          "| %s | %d | %s | %d | %.3e | %.2f (+%.2f set-up) | %.2f (+%.2f set-up) | %.2f |",
+          scene_path.c_str(), resolution, kind.c_str(), g,
+          st.flux_emitted > 0 ? st.flux_reflected / st.flux_emitted : 0.0, c, full.cpuSetup, gs,
+          full.gpuSetup, c > 0 && gs > 0 ? c / gs : 0.0);
+      rows.push_back(row);
+    }
+  gReflections = reflections.front();
   std::printf(
-      "\n| scene | resolution | interfaces | CPU s (last thread count) | GPU s | CPU/GPU |\n");
+      "\n| scene | resolution | interfaces | reflected generations | reflected flux dropped (of "
+      "emitted) | CPU s (last thread count) | GPU s | CPU/GPU |\n");
   for (const std::string& r : rows) std::printf("%s\n", r.c_str());
   if (!lowRuns) return 0;
   std::printf(

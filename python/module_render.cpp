@@ -259,7 +259,7 @@ py::dict simulateLight(Prepared& p, int bands, const std::string& splat, double 
   d["flux_caustic"] = sum.flux_caustic;
   d["flux_energy"] = sum.flux_energy;
   d["flux_absorbed"] = sum.flux_absorbed;
-  d["flux_reflected"] = sum.flux_reflected;  // sharp interfaces: Fresnel reflection
+  d["flux_reflected"] = sum.flux_reflected;  // sharp interfaces: Fresnel reflection not followed
   d["conservation_error"] = sum.conservationError();
   d["device"] = device;
   return d;

@@ -287,6 +287,7 @@ struct PolarisedResult {
 #define EIKON_PATCH_ENERGY 4    // killed: flux below min_energy_fraction of its seed's
 #define EIKON_PATCH_OPAQUE 5    // killed: centre in an opaque voxel (flux counted as absorbed)
 #define EIKON_PATCH_TORN 6      // alive, torn by a boundary (sharp): becomes four pencils, as a split
+#define EIKON_PATCH_REFLECT 7   // alive, its step undone (sharp): becomes itself and its reflected copy
 // Splat buffer: per voxel 4 signed 64-bit fixed-point sums as (lo, hi) uint pairs, in the order
 // weight, and the biased weight·(1 + dir.x), ·(1 + dir.y), ·(1 + dir.z) (every term ≥ 0; the host
 // subtracts the weight) (EIKON_SPLAT_ACC_WORDS words per voxel), then one uint per voxel
@@ -302,7 +303,8 @@ struct WaveParams {
   ivec4 control;     // x: probe axis (−1: none); y: steps per dispatch; z: max_steps; w: mode (0 o, 1 e)
   vec4 probe;        // x: probe plane position (mm); yzw: unused
   ivec4 options;     // x: 1 = straight steps across homogeneous regions (skip_empty); y: 1 = pass_caustics;
-                     // z: 1 = straight steps up to the next boundary (straight_to_boundary); w: unused
+                     // z: 1 = straight steps up to the next boundary (straight_to_boundary);
+                     // w: reflected generations followed (max_reflection_generations)
 };
 
 // Push constants of wavefront.comp. control: x: patches in the source list; y: pass (EIKON_WM_*);
@@ -327,7 +329,9 @@ struct WaveTally {
   uvec4 count_b;  // x: live at max_steps; y: patches asking for a split; z: survivors (count ≥ 1); w: max steps
   vec4 probe_pos;  // probe plane crossings in the last dispatch: xyz: Σ ±flux·crossing point; w: Σ ±flux
   vec4 probe_dir;  // xyz: Σ ±flux·unit direction of the centre's motion at the crossing;
-                   // w: sharp interfaces: Σ flux lost to Fresnel reflection in the last dispatch
+                   // w: sharp interfaces: Σ flux lost to Fresnel reflection in the last dispatch,
+                   // less the flux reflected copies took up
+  uvec4 count_c;   // x: reflected copies asked for (EIKON_PATCH_REFLECT); yzw: unused
 };
 
 // One patch: four corners in bilinear order (0,0), (1,0), (1,1), (0,1).
@@ -339,12 +343,17 @@ struct WavePatch {
   vec4 w[4];    // xyz: corner wave vector w = p (o-mode |w| = n; e-mode wᵀM_e w = 1)
   vec4 flux;    // x: flux (W); y: area0 (mm²); z: seed flux (W); w: flux absorbed in this dispatch
   ivec4 state;  // x: EIKON_PATCH_*; y: launch orientation (±1, 0); z: entered (0/1); w: steps done
-  ivec4 region; // sharp interfaces: corner k's region (bits 0–15; −1: not located yet), its
-                // mirror bit EIKON_CORNER_MIRRORED (odd number of total internal reflections) and
-                // its boundary events modulo 256 (bits 17–24: region changes and mirrors; a patch
-                // whose corners disagree is torn, Patch::events) and its face digest (bits 25–30)
+  vec4 refl;    // reflected wavefronts (sharp): x: shadow flux still to be reflected into the patch
+                // (Patch::shadow); y: generation; z: armed (1: the copy for this crossing is made)
+  ivec4 region; // sharp interfaces: corner k's region (bits 0–14; −1: not located yet), its
+                // pending bit EIKON_CORNER_PENDING (a reflected copy's corner that turns back at
+                // its next crossing), its mirror bit EIKON_CORNER_MIRRORED (odd number of total
+                // internal reflections) and its boundary events modulo 256 (bits 17–24: region
+                // changes and mirrors; a patch whose corners disagree is torn, Patch::events) and
+                // its face digest (bits 25–30)
 };
-#define EIKON_CORNER_REGION 0xFFFF
+#define EIKON_CORNER_REGION 0x7FFF
+#define EIKON_CORNER_PENDING 0x8000
 #define EIKON_CORNER_MIRRORED 0x10000
 #define EIKON_CORNER_EVENT_SHIFT 17
 #define EIKON_CORNER_EVENT 0x20000
@@ -362,9 +371,9 @@ static_assert(sizeof(PolarisedRay) == 48 && sizeof(PolarisedBeamOut) == 80 &&
               "polarised trace records must be vec4-packed");
 static_assert(sizeof(BoundaryQuery) == 48 && sizeof(BoundaryAnswer) == 80,
               "boundary probe records must be vec4-packed");
-static_assert(sizeof(WavePush) == 16 && sizeof(ScanPush) == 16 && sizeof(WaveTally) == 7 * 16,
+static_assert(sizeof(WavePush) == 16 && sizeof(ScanPush) == 16 && sizeof(WaveTally) == 8 * 16,
               "wavefront push/tally records must be vec4-packed");
-static_assert(sizeof(WaveParams) == 8 * 16 && sizeof(WavePatch) == 11 * 16, "wavefront records must be vec4-packed");
+static_assert(sizeof(WaveParams) == 8 * 16 && sizeof(WavePatch) == 12 * 16, "wavefront records must be vec4-packed");
 }  // namespace eikon::gpu
 #else
 // π for every kernel (C++ takes std::numbers::pi).

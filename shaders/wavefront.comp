@@ -76,8 +76,10 @@ layout(constant_id = 3) const int kExact = 0;
 #define EIKON_WO_PROBE 4
 #define EIKON_WO_HIGHEST 8
 #define EIKON_WO_TO_BOUNDARY 16
+#define EIKON_WO_REFLECT 32
 bool hasOption(int o) {
   if (kWaveOptions != -1) return (kWaveOptions & o) != 0;
+  if (o == EIKON_WO_REFLECT) return P.options.w > 0;
   if (o == EIKON_WO_SKIP) return P.options.x != 0;
   if (o == EIKON_WO_PASS_CAUSTICS) return P.options.y != 0;
   if (o == EIKON_WO_TO_BOUNDARY) return P.options.z != 0;
@@ -385,10 +387,14 @@ void splatSegment(vec3 c0, vec3 u, float L, float E0, float sigma, vec3 dir, flo
 
 // The corners lie in different regions, or only some have been mirrored: the patch is being torn
 // by a boundary; it is not split and not tested for a caustic until all four are on one side.
+// Reflected copies: so are a copy's corners while only some of them have turned back.
 bool straddles(ivec4 region) {
-  const ivec4 r = region & EIKON_CORNER_REGION, mir = region & EIKON_CORNER_MIRRORED;
+  const ivec4 r = region & EIKON_CORNER_REGION;
+  const ivec4 mir = region & (EIKON_CORNER_MIRRORED | EIKON_CORNER_PENDING);
   return r.y != r.x || r.z != r.x || r.w != r.x || mir.y != mir.x || mir.z != mir.x || mir.w != mir.x;
 }
+
+bool anyPending(ivec4 region) { return any(notEqual(region & EIKON_CORNER_PENDING, ivec4(0))); }
 
 bool anyMirrored(ivec4 region) { return any(notEqual(region & EIKON_CORNER_MIRRORED, ivec4(0))); }
 
@@ -540,6 +546,8 @@ struct PatchStep {
   // the four corners of a fourth root (Fresnel transmission; attenuation exp(−σ·length)).
   float fresnel;
   float attenuation;
+  // Reflected copies: the product over the pending corners that reflected in this step of T^¼.
+  float gain;
 };
 
 // ---- Sharp interfaces: the stages of PatchStepper (core/reference/wavefront.cpp) ----
@@ -553,8 +561,11 @@ struct PatchStep {
 // crystal → crystal: the phase-matched wave of the same mode, no loss. Where the outgoing wave does
 // not exist: total internal reflection, the mirror wave of the same mode, no loss; the corner's
 // mirror bit flips and it stays in A. Equal media, or an opaque one entered: only the region
-// changes. Multiplies `transmission` by T; true if the corner was turned.
-bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, inout float transmission) {
+// changes. Multiplies `transmission` by T; true if the corner was turned. A pending corner of a
+// reflected copy (EIKON_CORNER_PENDING) takes the mirror wave where its twin's corner goes through,
+// stays in A and multiplies `gain` by that T instead (PatchStepper::crossInterface).
+bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, inout float transmission,
+                    inout float gain) {
   const int B = c.to;
   const vec3 N = c.normal;
   const bool uA = mediumUniaxial(A), uB = mediumUniaxial(B), e = eMode();
@@ -562,6 +573,8 @@ bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, i
   const float neA = uA ? mediumIndex(A, 1) : 0.0, neB = uB ? mediumIndex(B, 1) : 0.0;
   const vec3 aA = mediumRow(A, 7).xyz, aB = mediumRow(B, 7).xyz;
   const bool same = noA == noB && neA == neB && (!uA || aA == aB);
+  const bool reflects = (corner & EIKON_CORNER_PENDING) != 0;
+  corner &= ~EIKON_CORNER_PENDING;
   corner = addEvent(corner);  // every region change or mirror is an event (torn)
   if (c.face >= 0) {
     const int h = (corner & EIKON_CORNER_FACES) >> EIKON_CORNER_FACE_SHIFT;
@@ -592,10 +605,14 @@ bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, i
     const vec3 mc = dot(mediumVelocity(A, w), N) >= 0.0 ? N : -N;
     const vec3 ptc = w - dot(w, mc) * mc;
     o = solveInterfaceMode(ptc, mc, e, aB, noB, neB, true);
-    if (!o.exists) {
+    if (!o.exists || reflects) {
       o = solveInterfaceMode(ptc, mc, e, aA, noA, neA, false);
       mirror = true;
     }
+  }
+  if (reflects && o.exists && !mirror) {  // a reflected copy's corner: the mirror, gain T
+    gain *= T;
+    o.exists = false;
   }
   if (!o.exists && !mirror) {  // total internal reflection (or a crystal mode that cannot enter)
     o = solveInterfaceMode(pt, m, uA && e, aA, noA, uA ? neA : noA, false);
@@ -619,7 +636,7 @@ bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, i
 // up to the first boundary, turned there (crossInterface) and on for the rest of dt (at most 16
 // crossings). Its share of the patch's factors: T^¼ of each transmission, exp(−σ·length/4).
 void sharpCorner(inout vec3 x, inout vec3 w, inout int corner, inout PatchStep st) {
-  float T = P.step.x, absorb = 0.0, trans = 1.0;
+  float T = P.step.x, absorb = 0.0, trans = 1.0, gain = 1.0;
   for (int guard = 0; T > 0.0; ++guard) {
     const int r = regionOf(corner);
     const vec3 d = T * mediumVelocity(r, w);
@@ -635,9 +652,10 @@ void sharpCorner(inout vec3 x, inout vec3 w, inout int corner, inout PatchStep s
     absorb += mediumSigma(r, w) * c.t * len;
     x = c.point;
     T *= 1.0 - c.t;
-    crossInterface(c, r, w, corner, trans);
+    crossInterface(c, r, w, corner, trans, gain);
   }
   st.fresnel *= pow(trans, 0.25);
+  if (hasOption(EIKON_WO_REFLECT)) st.gain *= pow(gain, 0.25);
   st.attenuation *= exp(-0.25 * absorb);
 }
 
@@ -706,11 +724,13 @@ PatchStep moveStep(inout vec3 x[4], inout vec3 w[4], inout WavePatch p) {
   st.wm0 = meanOf(w);
   vec3 vel[4];
   float sigma1;
-  st.kStraight = straightSteps(x, w, p.flux, p.state, p.region, vel, sigma1);
+  // (the flux ahead: a reflected copy's own and what its pending corners will reflect in)
+  st.kStraight = straightSteps(x, w, vec4(p.flux.x + p.refl.x, p.flux.yzw), p.state, p.region, vel, sigma1);
   st.dA = vec3(0.0), st.dB = vec3(0.0), st.dC = vec3(0.0), st.dD = vec3(0.0);
   st.vc = vec3(0.0);
   st.fresnel = 1.0;
   st.attenuation = 1.0;
+  st.gain = 1.0;
   // The sharp corners and RK4 under the constant kSharpLight, so that each run's pipeline holds
   // only one of them (llvmpipe would run both under masks).
   if (st.kStraight > 0) {
@@ -746,6 +766,14 @@ vec4 attenuateStep(inout WavePatch p, inout PatchStep st, vec3 w[4], inout float
   if (kSharpLight) {
     reflected += p.flux.x * (1.0 - st.fresnel);
     p.flux.x *= st.fresnel;
+    if (hasOption(EIKON_WO_REFLECT)) {
+      // A reflected copy: what its pending corners reflected, taken from the flux the crossing
+      // dropped; once all four have reflected the rest of the shadow is the transmitted twin's.
+      const float gained = p.refl.x * (1.0 - st.gain);
+      p.flux.x += gained;
+      reflected -= gained;
+      p.refl.x = anyPending(p.region) ? p.refl.x - gained : 0.0;
+    }
     st.sigma = st.ds > 0.0 ? -log(st.attenuation) / st.ds : 0.0;
     att = st.attenuation;
     st.fluxMid = p.flux.x * sqrt(att);
@@ -757,6 +785,7 @@ vec4 attenuateStep(inout WavePatch p, inout PatchStep st, vec3 w[4], inout float
   st.E0 = p.flux.x;
   p.flux.w += p.flux.x * (1.0 - att);
   p.flux.x *= att;
+  p.refl.x *= att;
   return med;
 }
 
@@ -822,7 +851,8 @@ bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) 
   }
   // Energy: below the threshold, or due a split whose quarters would be (mayBeSplit).
   const bool stretched = maxEdgeOf(x) > P.step.y && !straddling;
-  if (p.flux.x < P.step.z * p.flux.z || (stretched && !mayBeSplit(p.flux.x, p.flux.z))) {
+  const float ahead = p.flux.x + p.refl.x;  // a reflected copy's flux and its shadow
+  if (ahead < P.step.z * p.flux.z || (stretched && !mayBeSplit(ahead, p.flux.z))) {
     p.state.x = EIKON_PATCH_ENERGY;
     return true;
   }
@@ -866,7 +896,20 @@ void propagate(uint id) {
   // step on llvmpipe, masked, to find that no lane goes on.
   int it = 0;
   if (P.control.y > 0 && p.state.w < P.control.z) do {
+      // Reflected wavefronts: a step of a whole patch that takes a Fresnel loss at a crossing is
+      // undone, and the list rebuild writes the patch (armed) and its reflected copy, which both
+      // take it from the state before (PatchStepper::advance).
+      const bool mayReflect = hasOption(EIKON_WO_REFLECT) && float(P.options.w) > p.refl.y &&
+                              p.refl.z == 0.0 && !anyPending(p.region) && !straddles(p.region);
+      const vec3 x0[4] = x, w0[4] = w;
+      const ivec4 region0 = p.region, state0 = p.state;
       PatchStep st = moveStep(x, w, p);
+      p.refl.z = 0.0;
+      if (mayReflect && st.kStraight == 0 && st.fresnel < 1.0) {
+        x = x0, w = w0, p.region = region0, p.state = state0;
+        p.state.x = EIKON_PATCH_REFLECT;
+        break;
+      }
       const vec4 med = attenuateStep(p, st, w, reflected);
       splatStep(st, x, w);
       probeStep(st, probePos, probeDir);
@@ -896,6 +939,21 @@ void scatter(uint id) {
     p.x[k].w = 0.0;
     p.w[k].w = 0.0;
   }
+  if (kSharpLight && p.state.x == EIKON_PATCH_REFLECT) {
+    // The patch, armed, and (unless the budget refused it) its reflected copy: one generation
+    // deeper, every corner pending, no flux of its own and the patch's as its shadow.
+    p.state.x = EIKON_PATCH_ALIVE;
+    p.refl.z = 1.0;
+    storeOther(o, p);
+    if (next - o == 2u) {
+      WavePatch c = p;
+      c.refl = vec4(p.flux.x, p.refl.y + 1.0, 0.0, 0.0);
+      c.flux.x = 0.0;
+      for (int k = 0; k < 4; ++k) c.region[k] |= EIKON_CORNER_PENDING;
+      storeOther(o + 1u, c);
+    }
+    return;
+  }
   if (next - o == 1u) {  // kept (a refused split goes on unsplit, as in the reference)
     p.state.x = EIKON_PATCH_ALIVE;
     storeOther(o, p);
@@ -913,6 +971,7 @@ void scatter(uint id) {
       }
       c.flux.x = 0.25 * p.flux.x;
       c.flux.y = 0.25 * p.flux.y;
+      c.refl.x = 0.25 * p.refl.x;
       c.state.x = EIKON_PATCH_ALIVE;
       storeOther(o + uint(k), c);
     }
@@ -950,7 +1009,8 @@ void scatter(uint id) {
       }
       c.flux.x = 0.25 * p.flux.x;
       c.flux.y = 0.25 * p.flux.y;
-      c.state.x = maxEdgeOf(cx) > maxEdge && mayBeSplit(c.flux.x, c.flux.z) ? EIKON_PATCH_SPLIT
+      c.refl.x = 0.25 * p.refl.x;
+      c.state.x = maxEdgeOf(cx) > maxEdge && mayBeSplit(c.flux.x + c.refl.x, c.flux.z) ? EIKON_PATCH_SPLIT
                                                                             : EIKON_PATCH_ALIVE;
       storeOther(o + uint(cb * 2 + ca), c);
     }

@@ -1,7 +1,8 @@
 #version 450
 // Count passes of the light simulator's list rebuild (see wavefront.comp and
 // docs/light-simulator.md): per patch of the source list, its number of outputs (0 dead or out of
-// steps, 1 kept, 4 split one level or torn into pencils) into scan[i], and in the COUNT and BUDGET
+// steps, 1 kept, 2 itself and its reflected copy, 4 split one level or torn into pencils) into
+// scan[i], and in the COUNT and BUDGET
 // passes the workgroup's kill statistics and probe-plane sums reduced in shared memory (a tree of
 // EIKON_WAVE_WG lanes, float sums) into tally[workgroup], which the host adds in double. A separate
 // shader from wavefront.comp so that the propagation shader carries no barrier (llvmpipe
@@ -25,11 +26,11 @@ WavePatch loadPatch(uint i) {
 
 shared vec4 sFluxA[EIKON_WAVE_WG], sFluxB[EIKON_WAVE_WG], sCentroid[EIKON_WAVE_WG];
 shared vec4 sProbePos[EIKON_WAVE_WG], sProbeDir[EIKON_WAVE_WG];
-shared uvec4 sCountA[EIKON_WAVE_WG], sCountB[EIKON_WAVE_WG];
+shared uvec4 sCountA[EIKON_WAVE_WG], sCountB[EIKON_WAVE_WG], sCountC[EIKON_WAVE_WG];
 
 void countPass(uint id, uint lid, uint mode) {
   vec4 fa = vec4(0.0), fb = vec4(0.0), cen = vec4(0.0), ppos = vec4(0.0), pdir = vec4(0.0);
-  uvec4 ca = uvec4(0u), cb = uvec4(0u);
+  uvec4 ca = uvec4(0u), cb = uvec4(0u), cc = uvec4(0u);
   if (id < pc.control.x) {
     WavePatch p = loadPatch(id);
     const float e = p.flux.x;
@@ -52,6 +53,11 @@ void countPass(uint id, uint lid, uint mode) {
         keep = 1u;
         wantSplit = true;
         cen.w = 1.0;
+        break;
+      case EIKON_PATCH_REFLECT:  // itself and its reflected copy: ranked as a split request
+        keep = 1u;
+        wantSplit = true;
+        cc.x = 1u;
         break;
       case EIKON_PATCH_LEFT:
         fa.x = e;
@@ -76,12 +82,13 @@ void countPass(uint id, uint lid, uint mode) {
     cb.y = wantSplit ? 1u : 0u;
     cb.z = keep;
     cb.w = uint(max(p.state.w, 0));
-    uint c = wantSplit ? 4u : keep;
+    const uint grown = cc.x != 0u ? 2u : 4u;
+    uint c = wantSplit ? grown : keep;
     if (mode == EIKON_WM_COUNT_SPLITS) c = wantSplit ? 1u : 0u;
     if (mode == EIKON_WM_COUNT_BUDGET && wantSplit) {
       const bool granted = scan[id] < pc.control.z;
-      c = granted ? 4u : 1u;
-      if (!granted) cen.w = 0.0;  // a refused tear goes on whole: no pencils, not a tear
+      c = granted ? grown : 1u;
+      if (!granted) cen.w = 0.0, cc.x = 0u;  // a refused tear or copy: the patch goes on whole
     }
     scan[id] = c;
   }
@@ -95,6 +102,7 @@ void countPass(uint id, uint lid, uint mode) {
   sProbeDir[lid] = pdir;
   sCountA[lid] = ca;
   sCountB[lid] = cb;
+  sCountC[lid] = cc;
   for (uint s = EIKON_WAVE_WG / 2; s > 0u; s >>= 1) {
     memoryBarrierShared();
     barrier();
@@ -105,6 +113,7 @@ void countPass(uint id, uint lid, uint mode) {
       sProbePos[lid] += sProbePos[lid + s];
       sProbeDir[lid] += sProbeDir[lid + s];
       sCountA[lid] += sCountA[lid + s];
+      sCountC[lid] += sCountC[lid + s];
       const uvec4 o = sCountB[lid + s];
       sCountB[lid] = uvec4(sCountB[lid].xyz + o.xyz, max(sCountB[lid].w, o.w));
     }
@@ -120,6 +129,7 @@ void countPass(uint id, uint lid, uint mode) {
     t.count_b = sCountB[0];
     t.probe_pos = sProbePos[0];
     t.probe_dir = sProbeDir[0];
+    t.count_c = sCountC[0];
     tally[gl_WorkGroupID.x] = t;
   }
 }

@@ -127,6 +127,7 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOpt
   const bool sharp = o.sharp_interfaces && sharpLightApplies(v);
   h.value(sharp);
   if (sharp) {
+    h.value(o.max_reflection_generations);
     h.vec(v.boundary.region);
     h.vec(v.boundary.distance);
     h.vec(packMediaTable(v.media));

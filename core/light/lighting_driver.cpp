@@ -46,6 +46,7 @@ LightingSummary simulateLightingWith(const Scene& scene, VolumeSet& volume,
     s.wavelength_nm = r.wavelength_nm;
     s.mode = r.mode;
     s.sharp_interfaces = options.sharp_interfaces;
+    s.max_reflection_generations = options.max_reflection_generations;
     if (options.progress)
       s.progress = [&, i](double f) {
         options.progress((double(i) + std::min(f, 1.0)) / double(runs.size()), label);

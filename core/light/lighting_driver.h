@@ -33,6 +33,10 @@ struct LightingOptions {
   /// sharpInterfacesFor on the CPU); false: the smoothed field throughout. Sets
   /// wave.sharp_interfaces for every run.
   bool sharp_interfaces = true;
+  /// Sharp interfaces: reflected generations followed (sets wave.max_reflection_generations for
+  /// every run; docs/light-simulator.md, "Reflected wavefronts"). Past this depth the reflected
+  /// power is dropped (flux_reflected); 0: the transmitted light alone.
+  int max_reflection_generations = 4;
   /// progress(fraction done, what) now and then; may be empty.
   std::function<void(double, const std::string&)> progress;
 };
@@ -44,7 +48,7 @@ struct LightingSummary {
   size_t patches = 0;    ///< patches processed: seeded + 4 per split
   double flux_emitted = 0, flux_left = 0, flux_caustic = 0, flux_energy = 0, flux_absorbed = 0,
          flux_live_at_end = 0;
-  double flux_reflected = 0;  ///< sharp interfaces: lost to Fresnel reflection
+  double flux_reflected = 0;  ///< sharp interfaces: Fresnel reflection not followed (dropped)
   /// |emitted − (left + caustic + energy + absorbed + reflected + live)| / emitted: the balance.
   std::vector<std::string>
       notes;  ///< what the driver changed, for the user (e.g. a lowered patch budget)

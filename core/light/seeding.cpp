@@ -179,6 +179,8 @@ WavefrontSettings checkedWavefrontSettings(const WavefrontSettings& settings, co
     throw std::invalid_argument("wavefront: mode must be 0 (o) or 1 (e)");
   if (s.beam_min_cells < 1) throw std::invalid_argument("wavefront: beam_min_cells must be >= 1");
   if (s.threads < 0) throw std::invalid_argument("wavefront: threads must be >= 0");
+  if (s.max_reflection_generations < 0 || s.max_reflection_generations > 64)
+    throw std::invalid_argument("wavefront: max_reflection_generations must be 0 to 64");
   return s;
 }
 

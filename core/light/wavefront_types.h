@@ -92,6 +92,12 @@ struct WavefrontSettings {
   /// boundary, searched along its straight line (true), not only (D − 1.5) voxels on the skip
   /// distances (false: for comparison). Exact either way; it changes how many steps a run takes.
   bool straight_to_boundary = true;
+  /// Sharp interfaces: reflected generations followed (docs/light-simulator.md, "Reflected
+  /// wavefronts"). Where a patch's corners transmit at a crossing, the reflected part R of the flux
+  /// becomes a reflected copy of the patch, one generation deeper, up to this depth; past it the
+  /// reflected power is dropped into stats.flux_reflected. 0: no reflected wavefronts (the
+  /// transmitted path alone). LightingOptions::max_reflection_generations sets it for renders.
+  int max_reflection_generations = 0;
   /// Called after every time step (CPU) or dispatch of steps (GPU) with an estimate of the run's
   /// fraction done (wavefrontRunFraction), from the thread that called run(); may be empty.
   /// Not part of the physics (not in the light cache key).
@@ -137,6 +143,19 @@ struct Patch {
   /// bits; unchanged by crossings whose face the search does not give).
   /// Corners of equal event counts but different digests crossed different facets: torn too.
   std::array<int, 4> faces{};
+  /// Sharp interfaces, reflected wavefronts (WavefrontSettings::max_reflection_generations): the
+  /// reflection depth (0: the light's own wavefront; a reflected copy is one deeper); the corners
+  /// that turn back at their next crossing instead of going through (bit k: corner k of a reflected
+  /// copy that has not reached the interface yet); `shadow`, the flux still to be reflected into
+  /// the patch as those corners reflect (the flux its transmitted twin carries, attenuated as this
+  /// patch is: each pending corner's crossing moves shadow·(1 − T^¼) into `energy`); `armed`: the
+  /// copy for the crossing the patch is about to take has been made (its next step makes none).
+  int generation = 0;
+  unsigned pending = 0;
+  double shadow = 0.0;
+  bool armed = false;
+  /// Set by a step that spawns a reflected copy, for the emission after it (not carried on).
+  bool spawn = false;
 };
 
 /// The face digest of a corner (Patch::faces) after it crossed plane `face` (≥ 0) of region
@@ -157,14 +176,20 @@ struct WavefrontStats {
   /// different outcomes) replaced by four pencils, one along each corner's ray (counted in
   /// `splits` too: each adds three patches)
   size_t tears = 0;
+  /// Sharp interfaces: reflected copies made (max_reflection_generations; a copy the patch budget
+  /// refuses counts in splits_refused)
+  size_t reflections = 0;
   size_t kills_left = 0, kills_caustic = 0, kills_energy = 0, kills_opaque = 0;
-  size_t live_at_end = 0;     ///< patches still alive when max_steps ran out (0 if the loop ended)
-  double flux_emitted = 0;    ///< Σ seed flux (only seeds whose centre ray meets the volume)
-  double flux_left = 0;       ///< carried out of the volume
-  double flux_caustic = 0;    ///< carried by patches killed at an orientation flip
-  double flux_energy = 0;     ///< carried by patches killed below the energy threshold
-  double flux_absorbed = 0;   ///< removed by exp(−σΔs) along the way, plus opaque kills
-  double flux_reflected = 0;  ///< sharp interfaces: lost to Fresnel reflection (1 − T) at them
+  size_t live_at_end = 0;    ///< patches still alive when max_steps ran out (0 if the loop ended)
+  double flux_emitted = 0;   ///< Σ seed flux (only seeds whose centre ray meets the volume)
+  double flux_left = 0;      ///< carried out of the volume
+  double flux_caustic = 0;   ///< carried by patches killed at an orientation flip
+  double flux_energy = 0;    ///< carried by patches killed below the energy threshold
+  double flux_absorbed = 0;  ///< removed by exp(−σΔs) along the way, plus opaque kills
+  /// Sharp interfaces: Fresnel reflection (1 − T) at them not followed as a reflected wavefront
+  /// (beyond max_reflection_generations, or a copy refused by the patch budget): the flux lost at
+  /// the crossings less the flux the reflected copies took up
+  double flux_reflected = 0;
   double flux_live_at_end = 0;
   double flux_probe = 0;  ///< net flux crossing the probe plane in the +axis direction
   /// Flux of patches that ended (any reason, or still live at max_steps) on the upstream side of

@@ -55,7 +55,7 @@ struct alignas(64) Chunk {
   /// serial redo), else relative to the chunk's start (−1 per kill, +3 per split).
   long long live = 0;
   long long maxAfterSplit = LLONG_MIN;  ///< highest `live` right after a split in this step
-  size_t kills = 0, splits = 0, refused = 0, tears = 0;  ///< this step's
+  size_t kills = 0, splits = 0, refused = 0, tears = 0, reflections = 0;  ///< this step's
 };
 
 /// Worker threads for one WavefrontSimulator::run, created once: go(f) calls f(c) for chunk c on
@@ -156,6 +156,9 @@ struct PatchStep {
   // the four corners of a fourth root (Fresnel transmission; attenuation exp(−σ·length)).
   double fresnel = 1.0;
   double attenuation = 1.0;
+  /// Reflected copies: the product over the pending corners that reflected in this step of T^¼
+  /// (the transmission their twins' corners took): shadow·(1 − gain) is reflected into the patch.
+  double gain = 1.0;
 };
 
 /// The per-patch physics of one WavefrontSimulator::run: the functions and stages of
@@ -224,7 +227,14 @@ class PatchStepper {
   glm::dvec3 mediumVelocity(int region, const glm::dvec3& w) const;
   double mediumSigma(int region, const glm::dvec3& w) const;
   void sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& st) const;
-  bool crossInterface(const BoundaryCrossing& c, Patch& p, int k, double& transmission) const;
+  bool crossInterface(const BoundaryCrossing& c, Patch& p, int k, double& transmission,
+                      double& gain) const;
+  bool spawnsReflection(const Patch& p) const {
+    return sharp_ && p.generation < s_.max_reflection_generations && !p.armed && p.pending == 0u &&
+           !straddles(p);
+  }
+  /// The flux a patch holds or will hold: its own and what its pending corners will reflect in.
+  static double fluxAhead(const Patch& p) { return p.energy + p.shadow; }
   bool straddles(const Patch& p) const;
   bool torn(const Patch& p) const;
   /// Whether p may be split: only while its quarters keep at least the energy threshold
@@ -239,7 +249,7 @@ class PatchStepper {
     return e;
   }
   bool mayBeSplit(const Patch& p) const {
-    return 0.25 * p.energy >= s_.min_energy_fraction * p.seed_energy;
+    return 0.25 * fluxAhead(p) >= s_.min_energy_fraction * p.seed_energy;
   }
   double straightClear(const glm::dvec3& x, const glm::dvec3& v, int r) const;
 
@@ -352,12 +362,17 @@ double PatchStepper::mediumSigma(int region, const glm::dvec3& w) const {
 // of the same mode, no loss. Where the outgoing wave does not exist, total internal reflection: the
 // mirror (same mode), no loss, the corner's mirror bit flips and it stays in its region. Equal
 // media, or an opaque one entered: only the region changes. Multiplies `transmission` by T; true if
-// the corner was turned.
-bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k,
-                                  double& transmission) const {
+// the corner was turned. A pending corner of a reflected copy (Patch::pending) takes the reflected
+// wave where its twin's corner goes through (the mirror: reflectIsotropic, reflectInsideUniaxial
+// of the same mode, as total internal reflection), stays in its region and multiplies `gain` by
+// the T its twin's corner took instead.
+bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k, double& transmission,
+                                  double& gain) const {
   const WavefrontMedium &a = mediumOf(c.from), &b = mediumOf(c.to);
   glm::dvec3 N = glm::length(c.normal) > 0 ? c.normal : c.field_normal;
   const bool same = a.n == b.n && a.n_e == b.n_e && (a.n_e == 0.0 || a.axis == b.axis);
+  const bool reflects = (p.pending >> k) & 1u;
+  p.pending &= ~(1u << k);
   ++p.events[size_t(k)];  // every region change or mirror is an event (torn)
   if (c.face >= 0)
     p.faces[size_t(k)] = faceDigest(p.faces[size_t(k)], std::max(c.from, c.to), c.face);
@@ -395,7 +410,11 @@ bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k,
     const glm::dvec3 m = glm::dot(mediumVelocity(c.from, w), N) >= 0 ? N : -N;
     const glm::dvec3 pt = w - glm::dot(w, m) * m;
     out = solveUniaxialMode(pt, m, B, mode, true);
-    if (!out.exists) out = solveUniaxialMode(pt, m, A, mode, false), mirror = true;
+    if (!out.exists || reflects) out = solveUniaxialMode(pt, m, A, mode, false), mirror = true;
+  }
+  if (reflects && out.exists && !mirror) {  // a reflected copy's corner: the mirror, gain T
+    gain *= T;
+    out = ModeWave{};
   }
   if (!out.exists && !mirror) {
     // Total internal reflection into an isotropic medium, or a crystal mode that cannot enter.
@@ -424,7 +443,7 @@ bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k,
 void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& st) const {
   const BoundaryField& bf = *sharp_->boundary;
   glm::dvec3& x = p.x[size_t(k)];
-  double absorb = 0.0, trans = 1.0;
+  double absorb = 0.0, trans = 1.0, gain = 1.0;
   for (int guard = 0; T > 0.0; ++guard) {
     const int r = p.region[size_t(k)];
     const glm::dvec3 d = T * mediumVelocity(r, p.w[size_t(k)]);
@@ -473,9 +492,10 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
     x = c.point;
     T *= 1.0 - c.t;
     c.from = r;  // the corner's own region, whatever the field says at its start
-    if (crossInterface(c, p, k, trans)) ++ch.st.interface_events;
+    if (crossInterface(c, p, k, trans, gain)) ++ch.st.interface_events;
   }
   if (trans != 1.0) st.fresnel *= std::pow(trans, 0.25);  // pow(1, ¼) = 1 exactly
+  if (gain != 1.0) st.gain *= std::pow(gain, 0.25);
   if (absorb != 0.0) st.attenuation *= std::exp(-0.25 * absorb);
 }
 
@@ -485,7 +505,8 @@ void PatchStepper::sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& 
 bool PatchStepper::straddles(const Patch& p) const {
   const bool oneRegion =
       p.region[1] == p.region[0] && p.region[2] == p.region[0] && p.region[3] == p.region[0];
-  return !oneRegion || (p.mirrored != 0u && p.mirrored != 15u);
+  return !oneRegion || (p.mirrored != 0u && p.mirrored != 15u) ||
+         (p.pending != 0u && p.pending != 15u);
 }
 
 // Sharp interfaces: the corners met different boundaries, or one boundary with different outcomes
@@ -698,7 +719,8 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1)
   // the same each step; sigma1 = −log of it per unit of the centre's path.
   const double ds1 = glm::length(vc) * dt_, thr = s_.min_energy_fraction * p.seed_energy;
   sigma1 = 0.0;
-  if (p.energy < thr) {
+  const double flux = fluxAhead(p);
+  if (flux < thr) {
     kmax = std::min(kmax, 1.0);
   } else if (ds1 > 0) {
     const glm::dvec3 m = c0 + 0.5 * dt_ * vc;
@@ -706,7 +728,7 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1)
                          : eMode_ ? sigmaE(m, wm)
                                   : bandAt(glm::dvec3(f_.medium(m)));
     if (sigma > 0 && thr > 0)
-      kmax = std::min(kmax, std::floor(std::log(p.energy / thr) / (sigma * ds1)) + 1.0);
+      kmax = std::min(kmax, std::floor(std::log(flux / thr) / (sigma * ds1)) + 1.0);
   }
   if (sharp_ && ds1 > 0) sigma1 = 0.25 * absorb1 / ds1;
   if (kmax < 1.0) return 0;
@@ -761,6 +783,31 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
     ch.maxAfterSplit = std::max(ch.maxAfterSplit, ch.live);
     return true;
   };
+  if (p0.spawn) {
+    // A reflected copy (advance): the patch, armed, and its copy, both from the state before the
+    // step; one patch more unless that takes ch.live over budget (then the patch goes on alone and
+    // its reflected power is dropped at the crossing).
+    Patch orig = p0;
+    orig.spawn = false;
+    orig.armed = true;
+    if (ch.live + 1 > budget) {
+      ++ch.refused;
+      ch.next->push_back(orig);
+      return;
+    }
+    ++ch.live;
+    ++ch.reflections;
+    ch.maxAfterSplit = std::max(ch.maxAfterSplit, ch.live);
+    Patch copy = orig;
+    copy.armed = false;
+    copy.generation = orig.generation + 1;
+    copy.pending = 15u;
+    copy.shadow = orig.energy;
+    copy.energy = 0.0;
+    ch.next->push_back(orig);
+    ch.next->push_back(copy);
+    return;
+  }
   if (sharp_ && torn(p0)) {
     if (!grant(p0)) return;
     ++ch.tears;
@@ -774,6 +821,8 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
       c.events.fill(p0.events[k]);
       c.faces.fill(p0.faces[k]);
       c.mirrored = ((p0.mirrored >> k) & 1u) ? 15u : 0u;
+      c.pending = ((p0.pending >> k) & 1u) ? 15u : 0u;
+      c.shadow = 0.25 * p0.shadow;
       c.energy = 0.25 * p0.energy;
       c.area0 = 0.25 * p0.area0;
       ch.next->push_back(c);
@@ -824,6 +873,7 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
           c.w[size_t(k)] = W[pb[k]][pa[k]];
         }
         c.energy = 0.25 * p.energy;  // equal parameter area: a quarter of the parent's ray tubes
+        c.shadow = 0.25 * p.shadow;
         c.area0 = 0.25 * p.area0;
         work.push_back(c);
       }
@@ -877,6 +927,13 @@ glm::dvec4 PatchStepper::attenuateStep(Chunk& ch, Patch& p, PatchStep& st) const
     // The corners' Fresnel losses, then their attenuation; σ: the mean over the centre's path.
     ch.st.flux_reflected += p.energy * (1.0 - st.fresnel);
     p.energy *= st.fresnel;
+    // A reflected copy: what its pending corners reflected in this step, taken from the flux the
+    // crossing dropped; once all four have reflected the rest of the shadow is the transmitted
+    // twin's and not this patch's.
+    const double gained = p.shadow * (1.0 - st.gain);
+    p.energy += gained;
+    ch.st.flux_reflected -= gained;
+    p.shadow = p.pending != 0u ? p.shadow - gained : 0.0;
     st.sigma = st.ds > 0 ? -std::log(st.attenuation) / st.ds : 0.0;
   } else {
     st.sigma = eMode_ ? sigmaE(m, 0.5 * (st.wm0 + meanW(p))) : bandAt(glm::dvec3(med));
@@ -886,6 +943,7 @@ glm::dvec4 PatchStepper::attenuateStep(Chunk& ch, Patch& p, PatchStep& st) const
   st.fluxMid = p.energy * (sharp_ ? std::sqrt(att) : std::exp(-0.5 * st.sigma * st.ds));
   ch.st.flux_absorbed += p.energy * (1.0 - att);
   p.energy *= att;
+  p.shadow *= att;
   p.transmittance *= att;
   return med;
 }
@@ -972,7 +1030,7 @@ bool PatchStepper::endOfStep(Chunk& ch, Patch& p, const PatchStep& st,
     return true;
   }
   // Energy: below the threshold, or due a split whose quarters would be (mayBeSplit).
-  if (p.energy < s_.min_energy_fraction * p.seed_energy ||
+  if (fluxAhead(p) < s_.min_energy_fraction * p.seed_energy ||
       (!(sharp_ && straddles(p)) && maxEdgeOf(p) > maxEdge_ && !mayBeSplit(p))) {
     ++ch.st.kills_energy;
     ch.st.flux_energy += p.energy;
@@ -987,7 +1045,25 @@ void PatchStepper::advance(Chunk& ch, Patch p, long long budget, bool keep) cons
     ch.done.push_back(p);
     return;
   }
+  // Reflected wavefronts: a step of a whole patch that takes a Fresnel loss at a crossing is
+  // undone; the patch and its reflected copy (emit) then both take it from the state before (the
+  // copy's corners meet the interface where the patch's do, with the same T, and turn back there).
+  const bool mayReflect = spawnsReflection(p);
+  Patch before;
+  size_t events0 = 0;
+  if (mayReflect) before = p, events0 = ch.st.interface_events;
   PatchStep st = moveStep(ch, p);
+  p.armed = false;
+  if (mayReflect && st.kStraight == 0 && st.fresnel < 1.0) {
+    ch.st.interface_events = events0;
+    before.spawn = true;
+    if (keep) {
+      ch.surv.push_back(before);
+      ch.survKills.push_back(ch.kills);
+    }
+    emit(ch, before, budget);
+    return;
+  }
   const glm::dvec4 med = attenuateStep(ch, p, st);
   splatStep(ch, st, p);
   probeStep(ch, st, p);
@@ -1024,19 +1100,20 @@ std::vector<Chunk> makeChunks(int nChunks, size_t voxels, std::vector<double>& a
 long long settleStep(std::vector<Chunk>& chunks, const PatchStepper& stepper, long long L0,
                      long long maxPatches, int ping, WavefrontStats& st) {
   if (chunks.size() == 1) {
-    if (chunks[0].splits > 0) st.max_live = std::max(st.max_live, size_t(chunks[0].maxAfterSplit));
+    if (chunks[0].splits + chunks[0].reflections > 0)
+      st.max_live = std::max(st.max_live, size_t(chunks[0].maxAfterSplit));
     return chunks[0].live;
   }
   bool fits = true;
   long long Lc = L0;
   size_t peak = 0;
   for (const Chunk& ch : chunks) {
-    if (ch.splits > 0) {
+    if (ch.splits + ch.reflections > 0) {
       const long long top = Lc + ch.maxAfterSplit;
       fits = fits && top <= maxPatches;
       peak = std::max(peak, size_t(top));
     }
-    Lc += 3 * (long long)ch.splits - (long long)ch.kills;
+    Lc += 3 * (long long)ch.splits + (long long)ch.reflections - (long long)ch.kills;
   }
   if (fits) {
     st.max_live = std::max(st.max_live, peak);
@@ -1046,7 +1123,7 @@ long long settleStep(std::vector<Chunk>& chunks, const PatchStepper& stepper, lo
   long long live = L0;
   for (Chunk& ch : chunks) {
     ch.out[ping].clear();
-    ch.splits = ch.refused = ch.tears = 0;
+    ch.splits = ch.refused = ch.tears = ch.reflections = 0;
     ch.maxAfterSplit = LLONG_MIN;
     size_t seen = 0;
     for (size_t i = 0; i < ch.surv.size(); ++i) {
@@ -1057,7 +1134,8 @@ long long settleStep(std::vector<Chunk>& chunks, const PatchStepper& stepper, lo
       live = ch.live;
     }
     live -= (long long)(ch.kills - seen);
-    if (ch.splits > 0) st.max_live = std::max(st.max_live, size_t(ch.maxAfterSplit));
+    if (ch.splits + ch.reflections > 0)
+      st.max_live = std::max(st.max_live, size_t(ch.maxAfterSplit));
   }
   return live;
 }
@@ -1074,6 +1152,7 @@ void reduceChunks(std::vector<Chunk>& chunks, WavefrontStats& st, std::vector<do
     st.splits += a.splits;
     st.splits_refused += a.splits_refused;
     st.tears += a.tears;
+    st.reflections += a.reflections;
     st.kills_left += a.kills_left;
     st.kills_caustic += a.kills_caustic;
     st.kills_energy += a.kills_energy;
@@ -1246,7 +1325,7 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
       ch.done.clear();
       ch.surv.clear();
       ch.survKills.clear();
-      ch.kills = ch.splits = ch.refused = ch.tears = 0;
+      ch.kills = ch.splits = ch.refused = ch.tears = ch.reflections = 0;
       ch.live = nChunks == 1 ? L0 : 0;
       ch.maxAfterSplit = LLONG_MIN;
       const long long budget = nChunks == 1 ? maxPatches : LLONG_MAX;
@@ -1269,6 +1348,7 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
       ch.st.splits += ch.splits;
       ch.st.splits_refused += ch.refused;
       ch.st.tears += ch.tears;
+      ch.st.reflections += ch.reflections;
       done.insert(done.end(), ch.done.begin(), ch.done.end());
     }
     st.max_live = std::max(st.max_live, size_t(live));

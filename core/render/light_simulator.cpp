@@ -176,6 +176,7 @@ struct GpuWavefront::Impl {
   size_t list_cap = 0;                  // patches the scan and tally buffers hold
   std::vector<gpu::WaveTally> tallies;  // the last pass's, read back
   size_t asked_tears = 0;               // tears asked for in the pass addTallies read last
+  size_t asked_reflections = 0;         // reflected copies asked for in that pass
   double il2 = 0, il4 = 0, n_min = 1.0;
 
   Impl(vk::Context& c, const VolumeSet& v, WavefrontSettings settings, int k,
@@ -225,6 +226,9 @@ struct GpuWavefront::Impl {
     il2 = 1.0 / (l * l);
     il4 = il2 * il2;
     sharp = s.sharp_interfaces && sharpLightApplies(vol);
+    // A corner's word holds its region in 15 bits (EIKON_CORNER_REGION).
+    if (sharp && vol.boundary.shapes.size() > size_t(EIKON_CORNER_REGION))
+      throw std::invalid_argument("wavefront: more than 32767 objects for the GPU light simulator");
     n_min = smallestIndex();
     if (!(n_min > 0)) throw std::invalid_argument("wavefront: the index volume has n <= 0");
   }
@@ -397,12 +401,13 @@ struct GpuWavefront::Impl {
   }
   /// wavefront.comp's kWaveOptions: bit 0 straight steps, bit 1 pass caustics, bit 2 probe plane,
   /// bit 3 the highest-energy maximum (readSplat reads it only for Splat::HighestEnergy), bit 4
-  /// straight steps up to the next boundary (straight_to_boundary).
+  /// straight steps up to the next boundary (straight_to_boundary), reflected wavefronts (sharp,
+  /// max_reflection_generations > 0).
   int options() const {
     return (s.skip_empty ? 1 : 0) | (s.pass_caustics ? 2 : 0) |
            (s.probe_axis >= 0 && s.probe_axis < 3 ? 4 : 0) |
            (s.splat == WavefrontSettings::Splat::HighestEnergy ? 8 : 0) |
-           (s.straight_to_boundary ? 16 : 0);
+           (s.straight_to_boundary ? 16 : 0) | (sharp && s.max_reflection_generations > 0 ? 32 : 0);
   }
 
   // Patch list `which` (0: EIKON_WB_PATCHES, 1: _B) holds at least n patches. Only called between
@@ -529,7 +534,7 @@ struct GpuWavefront::Impl {
     control = P.control;
     P.probe = glm::vec4(float(s.probe_position), 0.0f, 0.0f, 0.0f);
     P.options = glm::ivec4(s.skip_empty ? 1 : 0, s.pass_caustics ? 1 : 0,
-                           s.straight_to_boundary ? 1 : 0, 0);
+                           s.straight_to_boundary ? 1 : 0, s.max_reflection_generations);
     params.write(&P, sizeof P);
     // Zeroed in place (the buffer is mapped): no 50 MB staging vector at 128³.
     std::memset(splat.mapped(), 0, splatWords() * sizeof(uint32_t));
@@ -542,7 +547,7 @@ struct GpuWavefront::Impl {
     tallies.resize(groups(n));
     tally.read(tallies.data(), tallies.size() * sizeof(gpu::WaveTally));
     survivors = 0, want_split = 0;
-    size_t pass_tears = 0;
+    size_t pass_tears = 0, pass_reflections = 0;
     for (const gpu::WaveTally& t : tallies) {
       st.flux_left += t.flux_a.x, st.flux_caustic += t.flux_a.y, st.flux_energy += t.flux_a.z;
       st.flux_absorbed += double(t.flux_a.w) + double(t.flux_b.x);
@@ -559,9 +564,14 @@ struct GpuWavefront::Impl {
       st.flux_probe += t.probe_pos.w;
       st.probe_direction += glm::dvec3(glm::vec3(t.probe_dir));
       st.flux_reflected += t.probe_dir.w;
+      pass_reflections += t.count_c.x;
     }
     st.tears += pass_tears;
     asked_tears = pass_tears;
+    // A reflected copy is asked for as a split is (ranked with them under the budget) but adds
+    // one patch and is no split.
+    st.reflections += pass_reflections;
+    asked_reflections = pass_reflections;
   }
 
   /// The next list's length when the pass over list `src` (n patches) asks for more than the
@@ -578,13 +588,18 @@ struct GpuWavefront::Impl {
       pass(c, EIKON_WM_COUNT_BUDGET, n, src, uint32_t(granted));
       scanner->record(c, n, totalSlot());
     });
-    st.splits += granted;
     st.splits_refused += want_split - granted;
-    // The BUDGET pass tallied again, counting only the tears granted (a refused one goes on whole).
+    // The BUDGET pass tallied again, counting only the tears and reflected copies granted (a
+    // refused one goes on whole).
     tally.read(tallies.data(), tallies.size() * sizeof(gpu::WaveTally));
-    size_t granted_tears = 0;
-    for (const gpu::WaveTally& t : tallies) granted_tears += size_t(t.caustic_sum.w);
+    size_t granted_tears = 0, granted_reflections = 0;
+    for (const gpu::WaveTally& t : tallies) {
+      granted_tears += size_t(t.caustic_sum.w);
+      granted_reflections += t.count_c.x;
+    }
     st.tears = st.tears - asked_tears + granted_tears;
+    st.reflections = st.reflections - asked_reflections + granted_reflections;
+    st.splits += granted - granted_reflections;
     return readTotal();
   }
 
@@ -634,7 +649,7 @@ struct GpuWavefront::Impl {
       if (total > budget) {
         total = grantSplits(n, src, survivors, wantSplit, st);
       } else {
-        st.splits += wantSplit;
+        st.splits += wantSplit - asked_reflections;
       }
       st.max_live = std::max<size_t>(st.max_live, total);
       if (s.progress)
