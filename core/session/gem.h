@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/scene/scene.h"
+#include "core/session/settings.h"
 
 namespace eikon {
 
