@@ -66,6 +66,10 @@ RenderImage renderUnder(Session& session, Scene& scene, const GemRequest& r, Gem
   req.height = r.height;
   req.spp = r.spp;
   req.wavelengths = wavelengths;
+  // Stratified passes: every wavelength marches its own path (the same Fresnel choices), so a
+  // pixel's colour is the dispersion's; hero sampling would leave only the hero wavelength after
+  // the first dispersive refraction (docs/spectra.md), colouring every pixel with its noise.
+  req.sampling = SpectralSampling::Stratified;
   req.aov_layer = aov;
   return session.render(renderSettings(scene, req), false);
 }

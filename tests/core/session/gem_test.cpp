@@ -47,18 +47,18 @@ GemRequest smallRequest() {
 }
 
 // Fire is light split into colours by dispersion. At a fixed index the paths through the stone
-// are the same at the index wavelength; a larger Cauchy B spreads them further across the spot
-// sources' edges, so more of the returned light is coloured. Without dispersion every wavelength
-// takes the same path (the same Fresnel choices: one seed per pixel sample), so no pixel is
-// coloured at all: the fire is exactly 0.
+// are the same at the index wavelength; the angle between a ray's red and blue ends grows in
+// proportion to the Cauchy B (13 times from 0.002 to 0.026), so more pixels see a spot source in
+// only part of the spectrum. Without dispersion every wavelength takes the same path through the
+// stone (the same Fresnel choices: one seed per pixel sample); what colour remains is sampling's
+// at the sources' edges (the wavelengths' passes), which dispersion only adds to.
 TEST(Gem, FireRisesWithDispersionAtAFixedIndex) {
   const GemRequest r = smallRequest();
   const double none = analyseGem(brilliant(cauchyAtDiamondIndex(0.0)), r).fire;
   const double low = analyseGem(brilliant(cauchyAtDiamondIndex(0.002)), r).fire;
   const double high = analyseGem(brilliant(cauchyAtDiamondIndex(0.026)), r).fire;
-  EXPECT_EQ(none, 0.0);
-  EXPECT_GT(low, 0.0);
-  EXPECT_GT(high, 1.2 * low) << "B = 0.026 against B = 0.002";
+  EXPECT_GT(low, none);
+  EXPECT_GT(high, 2.0 * low) << "B = 0.026 against B = 0.002";
 }
 
 // Light entering the table at normal incidence meets the pavilion mains (40.75°) at 49.25° and
