@@ -74,5 +74,6 @@ void addTraceCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addFitCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
+void addGemCommand(CLI::App& app);
 
 }  // namespace eikon::cli

@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   eikon::cli::addInfoCommand(app);
   eikon::cli::addFitCommand(app);
   eikon::cli::addViewCommand(app);
+  eikon::cli::addGemCommand(app);
   refuseEmptyNumbers(app);
   // "eikon bogus": CLI11 says only "A subcommand is required".
   if (argc > 1 && argv[1][0] != '-' &&

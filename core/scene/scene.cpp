@@ -15,6 +15,7 @@
 #include "core/io/exr.h"
 #include "core/io/text_file.h"
 #include "core/scene/faceted.h"
+#include "core/scene/gem_lighting.h"
 #include "core/scene/limits.h"
 #include "core/scene/material_library.h"
 #include "core/scene/mesh.h"
@@ -1248,6 +1249,21 @@ static void parseEnvironment(const Node& e, Environment& env) {
   if (auto p = e.get("polarization")) env.polarization = parsePolarization(*p);
 }
 
+// "environment": {"preset": NAME, ...}: the gem studio's lighting (core/scene/gem_lighting.h)
+// about the scene camera's viewing direction, made into a latlong image here.
+static void parseGemEnvironment(const Node& e, const Camera& camera, Environment& env) {
+  e.allowKeys({"preset", "head_shadow_deg", "spot_radius_deg", "spot_radiance", "width"});
+  GemLighting g;
+  if (!parseGemPreset(e.at("preset").string(), g.preset))
+    e.at("preset").fail("unknown preset '" + excerpt(e.at("preset").string()) + "' (" +
+                        gemPresetNames() + ")");
+  if (auto v = e.get("head_shadow_deg")) g.head_shadow_deg = v->number(0.0, 89.0);
+  if (auto v = e.get("spot_radius_deg")) g.spot_radius_deg = v->number(0.1, 20.0);
+  if (auto v = e.get("spot_radiance")) g.spot_radiance = v->number(0.0, kMaxColor, true);
+  if (auto v = e.get("width")) g.width = int(v->integer(64, 8192));
+  makeGemEnvironment(g, camera, env);
+}
+
 static void parseVolume(const Node& v, VolumeSpec& vol) {
   v.allowKeys({"bounds_min", "bounds_max", "resolution", "smoothing_voxels", "smoothing_method"});
   if (auto b = v.get("bounds_min")) vol.bounds_min = b->position();
@@ -1554,7 +1570,12 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   root.allowKeys({"camera", "environment", "volume", "materials", "objects", "lights",
                   "ambient_index", "description", "interfaces", "render"});
   if (auto c = root.get("camera")) parseCamera(*c, scene.camera);
-  if (auto e = root.get("environment")) parseEnvironment(*e, scene.environment);
+  if (auto e = root.get("environment")) {
+    if (e->has("preset"))
+      parseGemEnvironment(*e, scene.camera, scene.environment);
+    else
+      parseEnvironment(*e, scene.environment);
+  }
   if (auto v = root.get("volume")) parseVolume(*v, scene.volume);
   if (auto a = root.get("ambient_index")) scene.ambient_index = a->number(kMinIndex, kMaxIndex);
   if (auto f = root.get("interfaces")) scene.interfaces = parseInterfaces(*f);
