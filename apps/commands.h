@@ -74,5 +74,10 @@ void addTraceCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addFitCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
+/// `eikon sweep` (apps/sweep_command.cpp) is listed among the commands, but main() hands its
+/// arguments to runSweepCommand before parsing: it runs `python3 -m eikon.sweeps` (and returns
+/// only by throwing CliError).
+void addSweepCommand(CLI::App& app);
+int runSweepCommand(int argc, char** argv);
 
 }  // namespace eikon::cli

@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   eikon::cli::addInfoCommand(app);
   eikon::cli::addFitCommand(app);
   eikon::cli::addViewCommand(app);
+  eikon::cli::addSweepCommand(app);
   refuseEmptyNumbers(app);
   // "eikon bogus": CLI11 says only "A subcommand is required".
   if (argc > 1 && argv[1][0] != '-' &&
@@ -56,6 +57,15 @@ int main(int argc, char** argv) {
                    .c_str(),
                stderr);
     return 2;
+  }
+  // `eikon sweep`'s options are Python's (python/eikon/sweeps/run.py), its --help too.
+  if (argc > 1 && std::string(argv[1]) == "sweep") {
+    try {
+      return eikon::cli::runSweepCommand(argc, argv);
+    } catch (const eikon::cli::CliError& e) {
+      std::fputs(eikon::errorLine(e.what()).c_str(), stderr);
+      return e.exit_code;
+    }
   }
   // A bad cache cap is refused before any work, not met when the first entry is saved.
   if (std::string error; !eikon::cacheMaxBytesSetting(&error)) {
