@@ -63,7 +63,7 @@ def write(out, item, result, exposure=0.0):
     if result.get("persist", True):
         os.makedirs(os.path.join(out, "items"), exist_ok=True)
         _atomic(os.path.join(out, "items", item.key + ".json"),
-                lambda f: json.dump(record, f, sort_keys=True))
+                lambda f: json.dump(record, f))
     return record
 
 

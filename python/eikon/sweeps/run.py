@@ -19,11 +19,12 @@ def _cores():
         return os.cpu_count() or 1
 
 
-def _local_cluster(workers):
-    """N worker processes of one thread each, the cores shared among them (lavapipe's threads,
-    LP_NUM_THREADS, and the renders' threads=). The workers ignore Ctrl-C: the driver stops them."""
+def local_cluster(workers, threads=None):
+    """N worker processes of one Dask thread each, the cores shared among them: `threads` (default
+    cores // N) is lavapipe's LP_NUM_THREADS and the renders' threads= (unless the task gives it).
+    The workers ignore Ctrl-C: the driver stops them."""
     from distributed import LocalCluster
-    threads = max(1, _cores() // workers)
+    threads = threads or max(1, _cores() // workers)
     env = {"LP_NUM_THREADS": str(threads), "EIKON_SWEEP_THREADS": str(threads)}
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
@@ -37,10 +38,12 @@ def _client(workers, scheduler):
     from distributed import Client
     if scheduler:
         try:
+            if os.path.isfile(scheduler):  # dask-scheduler --scheduler-file FILE
+                return Client(scheduler_file=scheduler, timeout=10, set_as_default=False), None
             return Client(scheduler, timeout=10, set_as_default=False), None
         except (OSError, TimeoutError) as e:
             raise spec.SweepError(f"cannot reach the Dask scheduler at '{scheduler}': {e}") from None
-    cluster = _local_cluster(workers or _cores())
+    cluster = local_cluster(workers or _cores())
     return Client(cluster, set_as_default=False), cluster
 
 
@@ -62,7 +65,8 @@ def _check(sweep):
         raise spec.SweepError(str(e).strip().splitlines()[0]) from None
 
 
-def sweep(sweep, out, workers=None, scheduler=None, progress=None, retry_failed=False):
+def sweep(sweep, out, workers=None, scheduler=None, progress=None, retry_failed=False,
+          client=None):
     """Run a sweep (a SWEEP.json path, or its content as a dict) into the folder `out`; returns
     results.csv as a pandas DataFrame. workers: the LocalCluster's worker processes (default: one
     per core); scheduler: an existing Dask scheduler's address instead. Items finished in `out`
@@ -76,17 +80,20 @@ def sweep(sweep, out, workers=None, scheduler=None, progress=None, retry_failed=
     os.makedirs(out, exist_ok=True)
     done = {k: r for k, r in records.load(out).items() if not (retry_failed and r.get("error"))}
     todo = [i for i in items if i.key not in done]
-    if todo:
-        _run(s, todo, out, done, workers, scheduler, progress, len(items))
-    frame = records.table(items, done)
-    records.write_table(out, frame)
+    try:
+        if todo:
+            _run(s, todo, out, done, (workers, scheduler, client), progress, len(items))
+    finally:  # Ctrl-C too: the table of what is done
+        frame = records.table(items, done)
+        records.write_table(out, frame)
     return frame
 
 
-def _run(s, todo, out, done, workers, scheduler, progress, total):
+def _run(s, todo, out, done, where, progress, total):
     from distributed import as_completed
     exposure = s.task.options.get("exposure", 0.0)
-    client, cluster = _client(workers, scheduler)
+    workers, scheduler, given = where
+    client, cluster = (given, None) if given is not None else _client(workers, scheduler)
     bar = Progress(total, total - len(todo), progress)
     futures = {}
     try:
@@ -116,7 +123,8 @@ def _run(s, todo, out, done, workers, scheduler, progress, total):
             if not f.done():
                 f.cancel()
         bar.close()
-        client.close()
+        if given is None:
+            client.close()
         if cluster is not None:
             cluster.close()
 
@@ -140,7 +148,8 @@ def main(argv=None):
     p.add_argument("--workers", type=int, metavar="N",
                    help="worker processes of a LocalCluster (default: one per core)")
     p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="an existing Dask scheduler (tcp://host:8786) instead of a LocalCluster")
+                   help="an existing Dask scheduler (tcp://host:8786, or the file of "
+                   "dask-scheduler --scheduler-file) instead of a LocalCluster")
     p.add_argument("--retry-failed", action="store_true", help="run refused items again")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     a = p.parse_args(argv)
@@ -155,8 +164,8 @@ def main(argv=None):
         return 2
     except KeyboardInterrupt:
         n = len(records.load(a.output)) if os.path.isdir(a.output) else 0
-        print(f"eikon: sweep interrupted; {n} finished items kept in {a.output} (run it again to "
-              "finish)", file=sys.stderr)
+        print(f"eikon: sweep interrupted; {n} finished item{'' if n == 1 else 's'} kept in "
+              f"{a.output} (run it again to finish)", file=sys.stderr)
         return 130
     failed = int(frame["error"].notna().sum())
     print(f"eikon: sweep: {len(frame)} items, {failed} failed, in {time.monotonic() - start:.1f} s:"

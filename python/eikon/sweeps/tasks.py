@@ -7,6 +7,7 @@ A new task is a Task subclass in TASKS: its options checked in __init__ (TaskErr
 option), prepare(scene) and run(session, scene).
 """
 import numbers
+import os
 
 import numpy as np
 
@@ -90,6 +91,8 @@ class RenderTask(Task):
     def run(self, session, scene):
         import eikon
         kw = {k: v for k, v in self.options.items() if k != "exposure"}
+        if "threads" not in kw and os.environ.get("EIKON_SWEEP_THREADS", "").isdigit():
+            kw["threads"] = int(os.environ["EIKON_SWEEP_THREADS"])  # the worker's share of cores
         if "march" in kw:
             kw["march"] = eikon.MarchSettings(**kw["march"])
         rgb = np.asarray(session.render(progress=False, **kw), dtype=np.float32)
