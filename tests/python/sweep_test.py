@@ -174,6 +174,11 @@ class LocalSweep(unittest.TestCase):
         path = sweep_file(self.dir, {}, task={"kind": "render", "sp": 1})
         r = run_cli([path, "-o", os.path.join(self.dir, "out")])
         self.assertIn(f"{path}: /task/sp: unknown option of the render task", r.stderr)
+        if not hasattr(eikon, "gem"):  # the gem task needs the module's eikon.gem
+            path = sweep_file(self.dir, {}, task={"kind": "gem"})
+            r = run_cli([path, "-o", os.path.join(self.dir, "out")])
+            self.assertEqual((r.returncode, r.stderr.count("\n")), (2, 1), r.stderr)
+            self.assertIn(f'{path}: /task/kind: task "gem" needs eikon.gem', r.stderr)
         with open(path, "w") as f:
             f.write('{"scene": 1,')
         r = run_cli([path, "-o", os.path.join(self.dir, "out")])

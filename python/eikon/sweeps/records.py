@@ -7,8 +7,6 @@ import json
 import os
 import tempfile
 
-import pandas as pd
-
 
 def _atomic(path, write):
     folder = os.path.dirname(path) or "."
@@ -47,18 +45,53 @@ def load(out):
     return done
 
 
-def write(out, item, result, exposure=0.0):
-    """Write one finished item: its images, then its record. Returns the record."""
+MARKER = ".eikon-sweep"
+
+
+def marker(out):
+    """A token in DIR/.eikon-sweep: a worker that reads the same token there sees this output
+    folder (the same machine, or a shared file system) and writes its images itself."""
+    path = os.path.join(out, MARKER)
+    try:
+        with open(path, encoding="utf-8") as f:
+            token = f.read().strip()
+        if token:
+            return token
+    except OSError:
+        pass
+    token = os.urandom(16).hex()
+    _atomic(path, lambda f: f.write(token + "\n"))
+    return token
+
+
+def sees(out, token):
+    try:
+        with open(os.path.join(out, MARKER), encoding="utf-8") as f:
+            return f.read().strip() == token
+    except OSError:
+        return False
+
+
+def write_images(out, stem, images, exposure=0.0):
+    """Each image as an EXR and its PNG preview, one set, atomically; {column: file name}."""
     import eikon
     files = {}
-    for name, rgb in result.get("images", {}).items():
-        stem = item.stem if name == "image" else f"{item.stem}-{name}"
+    for name, rgb in images.items():
+        base = stem if name == "image" else f"{stem}-{name}"
         prefix = "" if name == "image" else name + "_"
-        eikon.write_image(os.path.join(out, stem + ".exr"), rgb,
-                          png=os.path.join(out, stem + ".png"), exposure=exposure)
-        files[prefix + "exr"], files[prefix + "png"] = stem + ".exr", stem + ".png"
+        eikon.write_image(os.path.join(out, base + ".exr"), rgb,
+                          png=os.path.join(out, base + ".png"), exposure=exposure)
+        files[prefix + "exr"], files[prefix + "png"] = base + ".exr", base + ".png"
+    return files
+
+
+def write(out, item, result, exposure=0.0):
+    """Write one finished item: its images (unless its worker wrote them: result["files"]), then
+    its record. Returns the record."""
+    files = result.get("files") or write_images(out, item.stem, result.get("images", {}), exposure)
     record = {"key": item.key, "values": item.values, "figures": result.get("figures", {}),
-              "files": files, "seconds": result.get("seconds"), "worker": result.get("worker"),
+              "files": files, "seconds": result.get("seconds"),
+              "task_seconds": result.get("task_seconds"), "worker": result.get("worker"),
               "warm": result.get("warm"), "error": result.get("error")}
     if result.get("persist", True):
         os.makedirs(os.path.join(out, "items"), exist_ok=True)
@@ -73,7 +106,9 @@ def _cell(value):
 
 def table(items, records):
     """The DataFrame of results.csv: one row per item that has a record, in the items' order:
-    index, a column per varied pointer, the figures, the files, seconds, worker, warm, error."""
+    index, a column per varied pointer, the figures, the files, seconds (the item on its worker),
+    task_seconds (the task's own run in it), worker, warm, error."""
+    import pandas as pd
     rows, figure_names, file_names = [], [], []
     for item in items:
         r = records.get(item.key)
@@ -87,13 +122,13 @@ def table(items, records):
                 file_names.append(name)
         rows.append((item, r))
     columns = (["index"] + list(items[0].values if items else []) + figure_names + file_names +
-               ["seconds", "worker", "warm", "error"])
+               ["seconds", "task_seconds", "worker", "warm", "error"])
     data = []
     for item, r in rows:
         row = {"index": item.index, **{p: _cell(v) for p, v in item.values.items()}}
         row.update({n: r["figures"].get(n) for n in figure_names})
         row.update({n: r["files"].get(n) for n in file_names})
-        row.update(seconds=r["seconds"], worker=r["worker"], warm=r["warm"], error=r["error"])
+        row.update(seconds=r["seconds"], task_seconds=r.get("task_seconds"), worker=r["worker"], warm=r["warm"], error=r["error"])
         data.append(row)
     return pd.DataFrame(data, columns=columns)
 

@@ -101,10 +101,11 @@ def _run(s, todo, out, done, where, progress, total):
         if link:
             bar.note(f"eikon: Dask dashboard at {link}")
         from .worker import run_item
-        by_key = {}
+        by_key, token, folder = {}, records.marker(out), os.path.abspath(out)
         for item in todo:
             payload = {"index": item.index, "key": item.key, "scene": item.scene,
-                       "origin": item.origin}
+                       "origin": item.origin, "out": folder, "token": token, "stem": item.stem,
+                       "exposure": exposure}
             f = client.submit(run_item, s.task.spec(), payload, pure=False,
                               key=f"eikon-item-{item.index}-{item.key[:16]}")
             futures[f] = item

@@ -103,9 +103,14 @@ class RenderTask(Task):
         return figures, {"image": rgb}
 
 
+# results.csv's own columns: a task's figure of the same name is left out.
+RESERVED = ("index", "seconds", "task_seconds", "worker", "warm", "error")
+
+
 class GemTask(Task):
     """eikon.gem(scene, **options) (`eikon gem`'s figures: brightness, fire, scintillation, ...):
-    its numbers are the figures, its (H, W, 3) arrays the images."""
+    its top-level numbers are the figures, its (H, W, 3) arrays (and those of a dict in it, e.g.
+    images={"dome": ...}) the images."""
 
     kind = "gem"
 
@@ -121,10 +126,13 @@ class GemTask(Task):
         out = eikon.gem(scene, **self.options)
         figures, images = {}, {}
         for name, value in (out.items() if isinstance(out, dict) else vars(out).items()):
+            if name in RESERVED:
+                continue
             if isinstance(value, numbers.Real) and not isinstance(value, bool):
                 figures[name] = float(value)
-            elif isinstance(value, np.ndarray) and value.ndim == 3 and value.shape[2] == 3:
-                images[name] = value.astype(np.float32)
+            for sub, array in (value.items() if isinstance(value, dict) else [("", value)]):
+                if isinstance(array, np.ndarray) and array.ndim == 3 and array.shape[2] == 3:
+                    images[f"{name}_{sub}" if sub else name] = array.astype(np.float32)
         return figures, images
 
 

@@ -12,7 +12,7 @@ import json
 import os
 import time
 
-from . import tasks
+from . import records, tasks
 
 _sessions = collections.OrderedDict()  # session key -> (eikon.Scene, session)
 
@@ -62,9 +62,11 @@ def _session(task, scene_dict, origin):
 
 
 def run_item(task_spec, item):
-    """Run one item ({"index", "key", "scene", "origin"}) of the task `task_spec`; returns its
-    record: figures, images, seconds, worker, warm (a kept session served it) and error (the
-    refusal's text, the others None)."""
+    """Run one item ({"index", "key", "scene", "origin"}, and "out", "token", "stem", "exposure"
+    where the driver's folder may be visible) of the task `task_spec`; returns its record:
+    figures, task_seconds (the task's own run: the render), images (or files: the worker saw the driver's folder, records.sees, and wrote them
+    there, sparing the driver and the network), seconds, worker, warm (a kept session served it)
+    and error (the refusal's text, the others None)."""
     start = time.perf_counter()
     _trace("start", item["key"])
     record = {"index": item["index"], "key": item["key"], "worker": _worker_name(),
@@ -72,7 +74,13 @@ def run_item(task_spec, item):
     try:
         task = tasks.make(task_spec["kind"], {k: v for k, v in task_spec.items() if k != "kind"})
         scene, session, record["warm"] = _session(task, item["scene"], item["origin"])
+        run_start = time.perf_counter()
         record["figures"], record["images"] = task.run(session, scene)
+        record["task_seconds"] = time.perf_counter() - run_start
+        out = item.get("out")
+        if out and records.sees(out, item.get("token")):  # the driver's folder: write here
+            record["files"] = records.write_images(out, item["stem"], record.pop("images"),
+                                                   item.get("exposure", 0.0))
     except Exception as e:  # a refused item is a row with its error; the others go on
         record["error"] = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
     record["seconds"] = time.perf_counter() - start
