@@ -77,15 +77,18 @@ def sweep(sweep, out, workers=None, scheduler=None, progress=None, retry_failed=
     s = spec.Sweep(sweep) if not isinstance(sweep, dict) else spec.Sweep(spec=sweep)
     items = s.items()
     _check(s)
-    os.makedirs(out, exist_ok=True)
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise spec.SweepError(f"{out}: the output folder is a file")
     done = {k: r for k, r in records.load(out).items() if not (retry_failed and r.get("error"))}
     todo = [i for i in items if i.key not in done]
     try:
         if todo:
             _run(s, todo, out, done, (workers, scheduler, client), progress, len(items))
-    finally:  # Ctrl-C too: the table of what is done
+    finally:  # Ctrl-C too: the table of what is done (no folder where no cluster was reached)
         frame = records.table(items, done)
-        records.write_table(out, frame)
+        if os.path.isdir(out) or not todo:
+            os.makedirs(out, exist_ok=True)
+            records.write_table(out, frame)
     return frame
 
 
@@ -97,6 +100,7 @@ def _run(s, todo, out, done, where, progress, total):
     bar = Progress(total, total - len(todo), progress)
     futures = {}
     try:
+        os.makedirs(out, exist_ok=True)
         link = _dashboard(client)
         if link:
             bar.note(f"eikon: Dask dashboard at {link}")
@@ -139,9 +143,15 @@ def _result(future):
         return {"error": f"{type(e).__name__}: {e}", "persist": False}
 
 
-def main(argv=None):
+def _parser():
     import argparse
-    p = argparse.ArgumentParser(
+
+    class Parser(argparse.ArgumentParser):
+        def error(self, message):  # one line, as every eikon command says it
+            print(f"eikon: error: {message} (run with --help)", file=sys.stderr)
+            sys.exit(2)
+
+    p = Parser(
         prog="eikon sweep", description="Many renders of one kind on Dask: the items of SWEEP.json "
         "(its \"vary\" pointers' cartesian product) into DIR/results.csv and their images.")
     p.add_argument("sweep", metavar="SWEEP.json")
@@ -153,6 +163,11 @@ def main(argv=None):
                    "dask-scheduler --scheduler-file) instead of a LocalCluster")
     p.add_argument("--retry-failed", action="store_true", help="run refused items again")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return p
+
+
+def main(argv=None):
+    p = _parser()
     a = p.parse_args(argv)
     if a.workers is not None and a.scheduler:
         p.error("--workers starts a LocalCluster; --scheduler uses an existing one: give one")
