@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """The sweep's scaling and per-item overhead (docs/performance.md "Sweeps").
 
-  PYTHONPATH=build/python /usr/bin/python3 bench/sweep_bench.py [--items 16] [--width 400]
-      [--height 300] [--spp 8] [--resolution 64] [--rounds 3]
+  PYTHONPATH=build/python /usr/bin/python3 bench/sweep_bench.py [--items 24] [--width 400]
+      [--height 300] [--spp 16] [--resolution 64] [--rounds 3]
 
 A camera-only turntable of glass_sphere (--items positions). The item's own render is timed in
 this process on a warm Renderer with one lavapipe thread (the median of --items renders), and
@@ -118,7 +118,7 @@ def timed_sweep(a, workers, threads):
 
 def main():
     p = argparse.ArgumentParser()
-    for name, default in (("items", 16), ("width", 400), ("height", 300), ("spp", 8),
+    for name, default in (("items", 24), ("width", 400), ("height", 300), ("spp", 16),
                           ("resolution", 64), ("rounds", 3)):
         p.add_argument("--" + name, type=int, default=default)
     a = p.parse_args()
@@ -137,7 +137,8 @@ def main():
     rows = [(w, t, *best[(w, t)]) for w, t in configs]
     for workers, threads, wall, _, cpu in rows:
         print(f"{workers} worker(s) x {threads} thread(s): {a.items} items in {wall:.2f} s = "
-              f"{a.items / wall:.2f} items/s (fastest of {a.rounds}); {cpu:.3f} CPU s per item")
+              f"{a.items / wall:.2f} items/s (fastest of {a.rounds}); {cpu:.3f} CPU s per item; "
+              f"{cpu * a.items / wall:.2f} cores received")
     base = a.items / rows[0][2]
     print(f"scaling 2 workers / 1 worker (1 thread each): {a.items / rows[1][2] / base:.2f}x; "
           f"2 x 1 thread / 1 x {rows[2][1]} threads: {rows[2][2] / rows[1][2]:.2f}x")
