@@ -75,5 +75,10 @@ void addInfoCommand(CLI::App& app);
 void addFitCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
 void addGemCommand(CLI::App& app);
+/// `eikon sweep` (apps/sweep_command.cpp) is listed among the commands, but main() hands its
+/// arguments to runSweepCommand before parsing: it runs `python3 -m eikon.sweeps` (and returns
+/// only by throwing CliError).
+void addSweepCommand(CLI::App& app);
+int runSweepCommand(int argc, char** argv);
 
 }  // namespace eikon::cli

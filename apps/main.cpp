@@ -11,7 +11,7 @@
 
 namespace {
 
-/// The commands, "render, trace, info, fit, view", in the order they were added.
+/// The commands, "render, trace, info, fit, view, sweep", in the order they were added.
 std::string commandList(const CLI::App& app) {
   std::string list;
   for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
   eikon::cli::addFitCommand(app);
   eikon::cli::addViewCommand(app);
   eikon::cli::addGemCommand(app);
+  eikon::cli::addSweepCommand(app);
   refuseEmptyNumbers(app);
   // "eikon bogus": CLI11 says only "A subcommand is required".
   if (argc > 1 && argv[1][0] != '-' &&
@@ -57,6 +58,15 @@ int main(int argc, char** argv) {
                    .c_str(),
                stderr);
     return 2;
+  }
+  // `eikon sweep`'s options are Python's (python/eikon/sweeps/run.py), its --help too.
+  if (argc > 1 && std::string(argv[1]) == "sweep") {
+    try {
+      return eikon::cli::runSweepCommand(argc, argv);
+    } catch (const eikon::cli::CliError& e) {
+      std::fputs(eikon::errorLine(e.what()).c_str(), stderr);
+      return e.exit_code;
+    }
   }
   // A bad cache cap is refused before any work, not met when the first entry is saved.
   if (std::string error; !eikon::cacheMaxBytesSetting(&error)) {

@@ -50,4 +50,16 @@ PYBIND11_MODULE(eikon, m) {
   bindAnalytic(m);
   bindVulkan(m);
   m.attr("__version__") = "0.1.0";
+  // The module's Python half (python/eikon/: eikon.sweeps, `python3 -m eikon.sweeps`) is its
+  // submodules: a module with __path__ is a package to the import system.
+  py::list path;
+  path.append(EIKON_PYTHON_PACKAGE_DIR);
+  m.attr("__path__") = path;
+  m.def(
+      "sweep",
+      [](py::args a, py::kwargs kw) {
+        return py::module_::import("eikon.sweeps").attr("sweep")(*a, **kw);
+      },
+      "sweep(sweep, out, workers=None, scheduler=None, progress=None) -> pandas.DataFrame: many "
+      "renders of one kind on Dask (eikon.sweeps.sweep; docs/sweep.md)");
 }

@@ -422,6 +422,21 @@ py::array_t<float> readExr(const std::string& path) {
   return a;
 }
 
+/// eikon.write_image: an (H, W, 3) linear RGB image as `eikon render` writes it, the EXR (and the
+/// PNG preview) as one set, atomically (core/io/atomic_write.h): both files or neither.
+void writeImage(const std::string& exr,
+                py::array_t<float, py::array::c_style | py::array::forcecast> rgb,
+                const std::string& png, double exposure) {
+  if (rgb.ndim() != 3 || rgb.shape(2) != 3 || rgb.shape(0) < 1 || rgb.shape(1) < 1)
+    throw py::value_error("write_image: rgb must be an (H, W, 3) array");
+  const int h = int(rgb.shape(0)), w = int(rgb.shape(1));
+  std::vector<float> pixels(rgb.data(), rgb.data() + rgb.size());
+  std::vector<OutputFile> files{{exr, exrRgbContent(w, h, pixels)}};
+  if (!png.empty()) files.push_back({png, pngPreviewContent(w, h, pixels, exposure)});
+  py::gil_scoped_release release;
+  writeFilesTogether(files);
+}
+
 // ---------------------------------------------------------------- keywords from the settings table
 
 /// A keyword's default on a Python front end: None for an unset number, else the table's value.
@@ -555,6 +570,10 @@ void bindModuleCalls(py::module_& m) {
         "{front: value}, 'range', 'choices', 'field'}]");
   m.def("read_exr", &readExr, py::arg("path"),
         "(H, W, 3) float32 linear RGB of an EXR (e.g. what `eikon render` wrote)");
+  m.def("write_image", &writeImage, py::arg("exr"), py::arg("rgb"), py::arg("png") = "",
+        py::arg("exposure") = 0.0,
+        "write an (H, W, 3) linear RGB image as `eikon render` does: the EXR and, with png=, its "
+        "8-bit preview (exposure in stops), as one set, atomically (both files or neither)");
 }
 }  // namespace
 

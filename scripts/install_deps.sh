@@ -9,6 +9,7 @@ PKGS=(
   nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
   googletest libgtest-dev libbenchmark-dev universal-ctags clang-format
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-scipy python3-matplotlib python3-tqdm
+  python3-distributed python3-pandas
   jupyter-nbconvert python3-nbformat python3-ipykernel
   libglfw3-dev xvfb xdotool
   openimageio-tools
