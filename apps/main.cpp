@@ -11,7 +11,7 @@
 
 namespace {
 
-/// The commands, "render, trace, info, fit, view, sweep", in the order they were added.
+/// The commands, "render, trace, info, fit, view, gem, sweep", in the order they were added.
 std::string commandList(const CLI::App& app) {
   std::string list;
   for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))

@@ -614,12 +614,12 @@ TEST_F(Cli, UnknownCommandIsNamedWithTheCommands) {
   for (const char* args : {"bogus", "bogus render", "Render x.json"}) {
     const Outcome r = run(args);
     const std::string word = std::string(args).substr(0, std::string(args).find(' '));
-    expectCleanFailure(r,
-                       "'" + word +
-                           "' is not an eikon command (render, trace, info, fit, view, sweep; run "
-                           "with --help)");
+    expectCleanFailure(
+        r, "'" + word +
+               "' is not an eikon command (render, trace, info, fit, view, gem, sweep; run "
+               "with --help)");
   }
-  expectCleanFailure(run(""), "a command is required: render, trace, info, fit, view, sweep");
+  expectCleanFailure(run(""), "a command is required: render, trace, info, fit, view, gem, sweep");
 }
 
 // An empty number (--width "") was converted to 0: "--width must be in [1, 16384], got 0", and
