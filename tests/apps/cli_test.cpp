@@ -688,8 +688,8 @@ TEST_F(Cli, TraceWavelengthWhereAnIndexLeavesItsRangeIsRefused) {
 // it is bounded as a scene's positions are, ±1e12 mm.
 TEST_F(Cli, TraceOriginBeyondTheCoordinateLimit) {
   const std::string scene = write("scene.json", tinyScene());
-  for (const char* json : {"", " --json"}) {
-    const Outcome r = run("trace " + quote(scene) + " -q --origin 0,2,-1e300 --dir 0,0,1" + json);
+  for (const char* asJson : {"", " --json"}) {
+    const Outcome r = run("trace " + quote(scene) + " -q --origin 0,2,-1e300 --dir 0,0,1" + asJson);
     expectCleanFailure(r, "--origin must be within ±1e12 mm");
     EXPECT_EQ(r.out, "");
   }

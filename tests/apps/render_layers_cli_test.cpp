@@ -109,10 +109,10 @@ std::map<std::string, double> statsByChannel(const std::string& verbose, const s
 TEST(RenderLayersCli, AovChannelsReadBackWithOpenImageIO) {
   Dir d;
   const fs::path out = d.path / "out.exr";
-  const Outcome r =
-      eikon::test::runEikon("render " + quote((d.path / "scene.json").string()) + " -o " +
-                                quote(out.string()) + " --wavelengths 0 --layers aov --transport single -q",
-                            d.path);
+  const Outcome r = eikon::test::runEikon("render " + quote((d.path / "scene.json").string()) +
+                                              " -o " + quote(out.string()) +
+                                              " --wavelengths 0 --layers aov --transport single -q",
+                                          d.path);
   ASSERT_EQ(r.code, 0) << r.err;
   const Outcome info = eikon::test::runProgram("iinfo", "-v " + quote(out.string()), d.path);
   ASSERT_EQ(info.code, 0) << info.err;

@@ -56,7 +56,9 @@ RenderImage renderOnePixel(bool sharp, bool lone_box = false, bool walk = false)
   if (walk) volume.boundary.exact = false;
   const VolumeField field(volume);
   const ReferenceMarcher ref(field, scene.environment);
-  return ref.render(scene.camera, RenderSettings{}, 1);
+  RenderSettings rs;
+  rs.march.transport = Transport::Single;  // one march per sample: the counts are one path's
+  return ref.render(scene.camera, rs, 1);
 }
 
 TEST(FieldFetches, SharpSlabReadsTheCellsItWalks) {

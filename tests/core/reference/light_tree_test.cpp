@@ -208,7 +208,8 @@ TEST(LightTree, RightAnglePrismHypotenuseReflectsTotally) {
   EXPECT_NEAR(tir->weight, 1.0 - R0, 1e-12);
   EXPECT_EQ(tir->object, 0);  // inside the prism, the scene's object 0
   for (const LightTreeNode& m : t.nodes) {
-    if (m.event == TreeEvent::Exit) EXPECT_EQ(m.object, -1);
+    if (m.event != TreeEvent::Exit) continue;
+    EXPECT_EQ(m.object, -1);
   }
   EXPECT_NEAR(tir->direction.x, std::sqrt(0.5), 1e-9);
   EXPECT_NEAR(tir->direction.y, std::sqrt(0.5), 1e-9);

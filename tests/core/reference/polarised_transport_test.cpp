@@ -126,7 +126,7 @@ TEST(PolarisedTransport, CalcitePlateInAWhiteFurnaceIsWhiteAndUnpolarised) {
   scene.camera.height = 12;
   const Scenery s(scene);
   const RenderImage full = s.render(Transport::Full, 64);
-  std::printf("calcite plate: %d of %d samples cut\n", full.cut_samples, 16 * 12 * 64);
+  std::printf("calcite plate: %lld of %d samples cut\n", full.cut_samples, 16 * 12 * 64);
   expectWhiteFurnace(furnace(full), "calcite plate, full transport");
   const Furnace single = furnace(s.render(Transport::Single, 64));
   std::printf("calcite plate, transmitted paths alone: S0 mean %.6f\n", single.s0_mean);

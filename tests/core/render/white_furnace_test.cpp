@@ -120,7 +120,11 @@ RenderSettings furnaceSettings(int wavelengths) {
   RenderSettings rs;
   rs.spp = 64;
   rs.wavelengths = wavelengths;
-  rs.march.step_voxels = 0.5;  // the renders' default (`eikon render --step`)
+  // Energy does not depend on the step (every path still ends in the environment at its whole
+  // weight); one voxel keeps the GRIN sphere's longest paths (trapped for dozens of total
+  // reflections) within lavapipe's loop budget, which cuts them short otherwise and so reads as
+  // lost light (docs/view-renderer.md "Passes, bands and progress").
+  rs.march.step_voxels = 1.0;
   return rs;
 }
 
