@@ -36,6 +36,9 @@ pictures=(
   "faceted_emerald_cut|800x600|"
   "faceted_oval|800x600|"
   "faceted_pear|800x600|"
+  # A coloured stone: attenuation makes the spectral passes stratified (every wavelength marched per
+  # sample), so 16 samples of 8 wavelengths converge its colour.
+  "faceted_oval_ruby|800x600|"
   # The oval's fire on a table: the light through its sharp facets in 12 bands (~50 s), then the
   # view; 32 samples take the grain off the table and the spots in the shadow.
   "faceted_oval_fire|800x600|"
