@@ -47,6 +47,7 @@ PYBIND11_MODULE(eikon, m) {
   bindOptics(m);
   bindScene(m);
   bindRenderer(m);
+  bindGem(m);
   bindAnalytic(m);
   bindVulkan(m);
   m.attr("__version__") = "0.1.0";

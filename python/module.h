@@ -78,6 +78,7 @@ void bindFitting(py::module_& m);     // module_fitting.cpp: index data, fits
 void bindOptics(py::module_& m);      // module_optics.cpp: Uniaxial, BMMapping, interfaces
 void bindScene(py::module_& m);       // module_scene.cpp: MarchSettings, Camera, VolumeSpec, Scene
 void bindRenderer(py::module_& m);    // module_render.cpp: Renderer, render(), trace()
+void bindGem(py::module_& m);         // module_gem.cpp: gem() (`eikon gem`)
 void bindAnalytic(py::module_& m);    // module_analytic.cpp: AnalyticField
 void bindVulkan(py::module_& m);      // module_util.cpp: validation_messages, device_info
 

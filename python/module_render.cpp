@@ -233,7 +233,7 @@ py::object render(Prepared& p, int width, int height, std::optional<int> spp,
 py::dict simulateLight(Prepared& p, int bands, const std::string& splat, double step_voxels,
                        double smoothing_voxels, const std::string& caustics,
                        const std::string& device, const py::object& progress, double split_voxels,
-                       int max_patches) {
+                       int max_patches, int reflections) {
   const bool gpu = isGpu(device);
   LightRequest l;
   l.bands = bands;
@@ -244,6 +244,7 @@ py::dict simulateLight(Prepared& p, int bands, const std::string& splat, double 
   l.device = device;
   l.split_voxels = split_voxels;
   l.max_patches = max_patches;
+  l.reflections = reflections;
   checkSetting([&] { checkLightRequest(l); });
   PyProgress printer(pyProgressMode(progress));
   const LightingSummary sum = p.run([&](Session& s) {
@@ -612,7 +613,7 @@ const std::string& lightDoc() {
       "returns the summed run statistics. The keywords of the settings table (eikon.settings()), "
       "each with its option of `eikon render`:" +
       settingsDoc({"light-bands", "light-splat", "light-step", "light-smoothing", "caustics",
-                   "light-device", "light-split", "max-patches"},
+                   "light-device", "light-split", "max-patches", "light-reflections"},
                   kL) +
       "\n  progress= as render's";
   return doc;
@@ -650,7 +651,8 @@ void bindRenderer(py::module_& m) {
            settingArg("light-splat", kL), settingArg("light-step", kL),
            settingArg("light-smoothing", kL), settingArg("caustics", kL),
            settingArg("light-device", kL), py::arg("progress") = py::none(),
-           settingArg("light-split", kL), settingArg("max-patches", kL), lightDoc().c_str())
+           settingArg("light-split", kL), settingArg("max-patches", kL),
+           settingArg("light-reflections", kL), lightDoc().c_str())
       .def("light_volumes", &lightVolumes,
            "{'fluence': (Z, Y, X, 4) φ_r, φ_g, φ_b, φ_Y (W/mm²), 'flux': (Z, Y, X, 4) net flux "
            "vector} "

@@ -201,6 +201,7 @@ void checkLightRequest(const LightRequest& l) {
   checkSettingValue(setting("light-smoothing"), l.smoothing_voxels);
   checkSettingValue(setting("light-split"), l.split_voxels);
   checkSettingValue(setting("max-patches"), l.max_patches);
+  checkSettingValue(setting("light-reflections"), l.reflections);
 }
 
 void checkRenderDevice(const std::string& device) { checkSettingChoice(setting("device"), device); }
@@ -227,6 +228,7 @@ LightingOptions lightingOptions(const LightRequest& l, double voxel_mm) {
   lo.wave.dt = l.step_voxels * voxel_mm;
   lo.wave.split_span_voxels = l.split_voxels;
   lo.wave.max_patches = l.max_patches;
+  lo.max_reflection_generations = l.reflections;
   lo.wave.pass_caustics = l.caustics == "pass";
   lo.wave.threads = l.threads;
   lo.smoothing_voxels = l.smoothing_voxels;

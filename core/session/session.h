@@ -100,6 +100,7 @@ struct LightRequest {
   double step_voxels = 0.0;          ///< time step in voxels, [0, 2]; 0: 0.5
   double split_voxels = 1.0;         ///< split patches longer than this, [0.25, 8]
   int max_patches = 1 << 20;         ///< live patches, [1024, 2^24]
+  int reflections = 4;               ///< reflected generations at sharp interfaces, [0, 64]
   std::string caustics = "pass";     ///< pass (through a fold caustic) or kill (Tevs)
   double smoothing_voxels = 1.0;     ///< σ of the final smoothing of the light volumes, [0, 8]
   std::string device = "auto";       ///< auto (lightOnCpu), gpu or cpu

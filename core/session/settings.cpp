@@ -214,6 +214,11 @@ const std::vector<Setting> kSettings = {
      .help = "Most live wavefront patches", .field = "LightRequest::max_patches",
      .fill = [](const SettingValue& v, SettingRequests& r) { r.light.max_patches = v.integer; },
      .value = "1048576", .min = 1024, .max = 16777216, .keyword = "max_patches"},
+    {.name = "light-reflections", .kind = K::Integer, .fronts = F::RenderCli | F::PyLight,
+     .help = "Generations of reflected wavefronts followed at sharp interfaces",
+     .field = "LightRequest::reflections",
+     .fill = [](const SettingValue& v, SettingRequests& r) { r.light.reflections = v.integer; },
+     .value = "4", .min = 0, .max = 64, .keyword = "reflections"},
 };
 // clang-format on
 

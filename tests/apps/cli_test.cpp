@@ -924,6 +924,39 @@ TEST_F(Cli, LightSummaryReportsTheFluxReflectedAtSharpInterfaces) {
   EXPECT_EQ(reflected("smoothed", "cpu"), 0.0);
 }
 
+// --light-reflections N follows N generations of reflected wavefronts at sharp interfaces: with
+// none, every Fresnel reflection of the sphere's two crossings is dropped into flux_reflected;
+// with the default 4 the first ones go on as patches, so less is dropped (docs/light-simulator.md
+// "Reflected wavefronts"). The sphere reflects at least R(0) = 4% of what reaches it at the top.
+TEST_F(Cli, LightReflectionsZeroDropsMoreReflectedFlux) {
+  const std::string scene = R"({
+  "camera": {"position": [0, 20, -20], "look_at": [0, -2, 0], "up": [0, 1, 0], "fov_deg": 30, "width": 16, "height": 12},
+  "environment": {"type": "constant", "radiance": 0.1},
+  "volume": {"bounds_min": [-5, -5, -5], "bounds_max": [5, 5, 5], "resolution": 24},
+  "interfaces": "sharp",
+  "materials": {"glass": {"n": 1.5}, "floor": {"n": 1, "opacity": 1, "albedo": 0.8}},
+  "objects": [{"shape": "box", "center": [0, -3.5, 0], "size": [8, 1, 8], "material": "floor"},
+              {"shape": "sphere", "center": [0, 0.5, 0], "radius": 2.5, "material": "glass"}],
+  "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 2}]
+})";
+  auto reflected = [&](const std::string& options) {
+    const Outcome o =
+        render(scene, "-q --caustics kill --no-light-cache --light-device cpu " + options);
+    EXPECT_EQ(o.code, 0) << o.err;
+    const size_t at = o.out.find("reflected ");
+    EXPECT_NE(at, std::string::npos) << o.out;
+    return at == std::string::npos ? -1.0 : std::strtod(o.out.c_str() + at + 10, nullptr);
+  };
+  const double disc = std::numbers::pi * 2.5 * 2.5 / 100.0;  // the sphere's share of the flux
+  const double none = reflected("--light-reflections 0"), four = reflected("");
+  EXPECT_GT(none, 0.04 * disc);
+  EXPECT_GT(none, four);
+  EXPECT_EQ(reflected("--light-reflections 4"), four);
+  const Outcome bad = render(scene, "-q --light-reflections 65");
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.err.find("--light-reflections must be in [0, 64]"), std::string::npos) << bad.err;
+}
+
 // A lit floor under the tiny glass sphere: the light is simulated once and then read back from
 // the cache (keyed by the medium, the lights and the simulator settings, never the camera), and
 // the cached render is the same picture. The sphere sits a little off the light's seed lattice,

@@ -102,6 +102,9 @@ class SettingsTable(unittest.TestCase):
         with self.assertRaises(ValueError) as cm:
             r.simulate_light(split_voxels=9)
         self.assertEqual(str(cm.exception), "split_voxels must be in [0.25, 8] voxels")
+        with self.assertRaises(ValueError) as cm:
+            r.simulate_light(reflections=65)
+        self.assertEqual(str(cm.exception), "reflections must be in [0, 64]")
         self.assertEqual(eikon.voxelize_count(), 0)
 
 

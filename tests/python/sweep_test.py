@@ -6,9 +6,10 @@ item rendered alone in this process (1e-9 relative: an item's result depends on 
 its EXR holds that image; a refused item (an unknown material) is one row with its error while
 the others complete; a re-run does no work (no item starts, nothing is rewritten); a worker killed
 with SIGKILL in the middle of an item still leaves every row, each once, the item run again on
-another worker; a separately started dask-scheduler with a dask-worker on localhost runs the sweep
-through --scheduler; a bad sweep file is one line naming the file and the JSON path, with no
-output.
+another worker; a gem sweep's rows (two pavilion angles) equal eikon.gem run alone on each item
+(1e-9 relative), its pictures written beside the table; a separately started dask-scheduler with a
+dask-worker on localhost runs the sweep through --scheduler; a bad sweep file is one line naming
+the file and the JSON path, with no output.
 """
 import json
 import os
@@ -39,6 +40,17 @@ SCENE = {
 }
 TASK = {"kind": "render", "width": 32, "height": 24, "spp": 2}
 TURNTABLE = [[0, 0, -40], [20, 0, -34.64], [34.64, 0, -20]]
+# A small round brilliant for the gem task (its camera and environment are the analysis' own).
+GEM_SCENE = {
+    "camera": {"position": [0, 52, -30], "look_at": [0, -0.8, 0], "up": [0, 1, 0], "fov_deg": 12,
+               "width": 16, "height": 16},
+    "volume": {"bounds_min": [-5.6, -4.9, -5.6], "bounds_max": [5.6, 2.1, 5.6], "resolution": 32},
+    "materials": {"diamond": {"n": {"sellmeier": [0.3306, 4.3356, 0.030625, 0.011236],
+                                    "range_nm": [225, 10000]}}},
+    "objects": [{"shape": "brilliant", "diameter": 10, "table": 0.57, "crown_deg": 34.5,
+                 "pavilion_deg": 40.75, "girdle": 0.02, "facets": 16, "material": "diamond"}],
+}
+GEM_OPTIONS = {"tilts": [0], "width": 32, "height": 32, "spp": 1}
 
 
 def sweep_file(folder, vary, scene=SCENE, task=TASK):
@@ -104,6 +116,27 @@ class LocalSweep(unittest.TestCase):
         self.assertEqual(stamps, {n: os.stat(os.path.join(out, "items", n)).st_mtime_ns
                                   for n in os.listdir(os.path.join(out, "items"))})
         pd.testing.assert_frame_equal(again, frame)
+
+    def test_gem_rows_equal_eikon_gem_alone(self):
+        out = os.path.join(self.dir, "out")
+        task = {"kind": "gem", **GEM_OPTIONS, "keep_images": True}
+        path = sweep_file(self.dir, {"/objects/0/pavilion_deg": [39.5, 42]}, GEM_SCENE, task)
+        frame = eikon.sweep(path, out, workers=2, progress=False)
+        self.assertEqual(len(frame), 2)
+        self.assertTrue(frame["error"].isna().all(), list(frame["error"]))
+        for _, row in frame.iterrows():
+            scene = json.loads(json.dumps(GEM_SCENE))
+            scene["objects"][0]["pavilion_deg"] = float(row["/objects/0/pavilion_deg"])
+            want = eikon.gem(eikon.Scene.parse(scene), keep_images=True, **GEM_OPTIONS)
+            for name in ("brightness", "fire", "scintillation", "windowing", "extinction",
+                         "contrast_change"):
+                self.assertLessEqual(abs(row[name] - want[name]), 1e-9 * abs(want[name]), name)
+            for name in ("dome_0", "spot_0", "aset", "idealscope", "lightbox"):
+                np.testing.assert_array_equal(
+                    eikon.read_exr(os.path.join(out, row[name + "_exr"])), want["images"][name])
+                self.assertTrue(os.path.isfile(os.path.join(out, row[name + "_png"])))
+        # The two pavilions are two stones: the figures differ.
+        self.assertNotEqual(frame["brightness"].iloc[0], frame["brightness"].iloc[1])
 
     @unittest.skipUnless(EIKON, "needs EIKON_BINARY")
     def test_a_worker_killed_mid_item_loses_nothing(self):
@@ -174,11 +207,10 @@ class LocalSweep(unittest.TestCase):
         path = sweep_file(self.dir, {}, task={"kind": "render", "sp": 1})
         r = run_cli([path, "-o", os.path.join(self.dir, "out")])
         self.assertIn(f"{path}: /task/sp: unknown option of the render task", r.stderr)
-        if not hasattr(eikon, "gem"):  # the gem task needs the module's eikon.gem
-            path = sweep_file(self.dir, {}, task={"kind": "gem"})
-            r = run_cli([path, "-o", os.path.join(self.dir, "out")])
-            self.assertEqual((r.returncode, r.stderr.count("\n")), (2, 1), r.stderr)
-            self.assertIn(f'{path}: /task/kind: task "gem" needs eikon.gem', r.stderr)
+        path = sweep_file(self.dir, {}, task={"kind": "gem", "spp": "4"})
+        r = run_cli([path, "-o", os.path.join(self.dir, "out")])
+        self.assertEqual((r.returncode, r.stderr.count("\n")), (2, 1), r.stderr)
+        self.assertIn(f"{path}: /task/spp: expected int, got '4'", r.stderr)
         with open(path, "w") as f:
             f.write('{"scene": 1,')
         r = run_cli([path, "-o", os.path.join(self.dir, "out")])

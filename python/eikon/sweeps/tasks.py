@@ -1,5 +1,5 @@
-"""The tasks a sweep runs on each item, by name: "render" (Renderer.render) and "gem" (eikon.gem,
-where the module has it). A task checks its options when the sweep is read, prepares a session
+"""The tasks a sweep runs on each item, by name: "render" (Renderer.render) and "gem"
+(eikon.gem). A task checks its options when the sweep is read, prepares a session
 for a scene (the part a worker keeps warm) and runs one item on it, returning its figures (the
 results.csv columns) and its images ({name: (H, W, 3) float32 linear sRGB}, written beside it).
 
@@ -108,31 +108,38 @@ RESERVED = ("index", "seconds", "task_seconds", "worker", "warm", "error")
 
 
 class GemTask(Task):
-    """eikon.gem(scene, **options) (`eikon gem`'s figures: brightness, fire, scintillation, ...):
-    its top-level numbers are the figures, its (H, W, 3) arrays (and those of a dict in it, e.g.
-    images={"dome": ...}) the images."""
+    """eikon.gem(scene, **options) (`eikon gem`'s figures; its keywords: tilts, width, height,
+    spp, wavelengths, object, threads, keep_images). Figures: its top-level numbers (brightness,
+    fire, scintillation, windowing, extinction, contrast_change, object); with keep_images its
+    pictures are the images (dome_K and spot_K per tilt, aset, idealscope, lightbox)."""
 
     kind = "gem"
+    OPTIONS = {"tilts": (list, str), "width": int, "height": int, "spp": int, "wavelengths": int,
+               "object": int, "threads": int, "keep_images": bool, "exposure": numbers.Real}
 
     def __init__(self, options):
-        import eikon
-        if not callable(getattr(eikon, "gem", None)):
-            raise TaskError('task "gem" needs eikon.gem (the figures of `eikon gem`), which this '
-                            "eikon module does not have")
         super().__init__(options)
+        for name, value in self.options.items():
+            if name not in self.OPTIONS:
+                known = ", ".join(sorted(self.OPTIONS))
+                raise TaskError(f"unknown option of the gem task (known: {known})", name)
+            want = self.OPTIONS[name]
+            types = want if isinstance(want, tuple) else (want,)
+            if not isinstance(value, types) or isinstance(value, bool) != (want is bool):
+                what = " or ".join(t.__name__ for t in types)
+                raise TaskError(f"expected {what}, got {value!r}", name)
 
     def run(self, session, scene):
         import eikon
-        out = eikon.gem(scene, **self.options)
-        figures, images = {}, {}
-        for name, value in (out.items() if isinstance(out, dict) else vars(out).items()):
-            if name in RESERVED:
-                continue
-            if isinstance(value, numbers.Real) and not isinstance(value, bool):
-                figures[name] = float(value)
-            for sub, array in (value.items() if isinstance(value, dict) else [("", value)]):
-                if isinstance(array, np.ndarray) and array.ndim == 3 and array.shape[2] == 3:
-                    images[f"{name}_{sub}" if sub else name] = array.astype(np.float32)
+        kw = {k: v for k, v in self.options.items() if k != "exposure"}
+        if "threads" not in kw and os.environ.get("EIKON_SWEEP_THREADS", "").isdigit():
+            kw["threads"] = int(os.environ["EIKON_SWEEP_THREADS"])  # the worker's share of cores
+        out = eikon.gem(scene, **kw)
+        figures = {name: float(value) for name, value in out.items()
+                   if name not in RESERVED and isinstance(value, numbers.Real)
+                   and not isinstance(value, bool)}
+        images = {name: np.asarray(rgb, dtype=np.float32)
+                  for name, rgb in out.get("images", {}).items()}
         return figures, images
 
 

@@ -12,6 +12,7 @@
 #include <set>
 #include <string>
 
+#include "core/render/render_defaults.h"
 #include "core/session/session.h"
 
 namespace eikon {
@@ -167,6 +168,8 @@ TEST(Settings, DefaultsFillTheRequestsAsTheSessionsDefaults) {
   EXPECT_EQ(r.light.step_voxels, light.step_voxels);
   EXPECT_EQ(r.light.split_voxels, light.split_voxels);
   EXPECT_EQ(r.light.max_patches, light.max_patches);
+  EXPECT_EQ(r.light.reflections, light.reflections);
+  EXPECT_EQ(light.reflections, defaultLightingOptions().max_reflection_generations);
   EXPECT_EQ(r.light.caustics, light.caustics);
   EXPECT_EQ(r.light.smoothing_voxels, light.smoothing_voxels);
   EXPECT_EQ(r.light.device, light.device);
