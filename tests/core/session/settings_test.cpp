@@ -60,20 +60,26 @@ TEST(Settings, EveryRowIsComplete) {
     // Neutral words: the CLI option without its dashes, lower case and hyphens.
     EXPECT_EQ(std::string(s.name).find_first_not_of("abcdefghijklmnopqrstuvwxyz-"),
               std::string::npos);
-    if (ranged(s)) EXPECT_LT(s.min, s.max);
-    if (s.kind == SettingKind::Choice || s.kind == SettingKind::Text)
+    if (ranged(s)) {
+      EXPECT_LT(s.min, s.max);
+    }
+    if (s.kind == SettingKind::Choice || s.kind == SettingKind::Text) {
       EXPECT_GE(s.choices.size(), 2u);
+    }
     for (const SettingChoice& c : s.choices) EXPECT_GT(std::string(c.means).size(), 3u) << c.name;
     // An unset default says what it means.
     for (unsigned front : kFronts)
-      if ((s.fronts & front) && s.kind != SettingKind::Flag && !*settingDefault(s, front).value)
+      if ((s.fronts & front) && s.kind != SettingKind::Flag && !*settingDefault(s, front).value) {
         EXPECT_GT(std::string(settingDefault(s, front).means).size(), 3u);
+      }
   }
   // One keyword per setting on each Python front end.
   for (unsigned front : {SettingFront::PyRender, SettingFront::PyLight, SettingFront::PyTrace}) {
     std::set<std::string> keywords;
     for (const Setting& s : settings())
-      if (s.fronts & front) EXPECT_TRUE(keywords.insert(settingKeyword(s)).second) << s.name;
+      if (s.fronts & front) {
+        EXPECT_TRUE(keywords.insert(settingKeyword(s)).second) << s.name;
+      }
   }
 }
 
@@ -89,7 +95,9 @@ TEST(Settings, EveryDefaultIsInsideItsRange) {
         const double v = std::stod(d.value);
         // A value standing for "unset" (Python's width=0) must not be one the range takes.
         EXPECT_EQ(settingInRange(s, v), !d.unset);
-        if (!d.unset) EXPECT_EQ(refusedByFill(s, v, front), "");
+        if (!d.unset) {
+          EXPECT_EQ(refusedByFill(s, v, front), "");
+        }
       } else if (s.kind == SettingKind::Choice) {
         EXPECT_NO_THROW(checkSettingChoice(s, d.value));
       }
@@ -114,9 +122,13 @@ TEST(Settings, EveryBoundRefusesItsNeighbourNamingTheSetting) {
       const unsigned cli = s.fronts & SettingFront::RenderCli  ? SettingFront::RenderCli
                            : s.fronts & SettingFront::TraceCli ? SettingFront::TraceCli
                                                                : SettingFront::ViewCli;
-      if (s.fronts & SettingFront::Cli) EXPECT_EQ(refusedByFill(s, bad, cli), s.name);
+      if (s.fronts & SettingFront::Cli) {
+        EXPECT_EQ(refusedByFill(s, bad, cli), s.name);
+      }
     }
-    if (!integer) EXPECT_EQ(refusedName([&] { checkSettingValue(s, std::nan("")); }), s.name);
+    if (!integer) {
+      EXPECT_EQ(refusedName([&] { checkSettingValue(s, std::nan("")); }), s.name);
+    }
     // The bounds themselves are taken (an open one is not, unless it is the special value).
     const bool min_taken = !s.min_open || (s.special && *s.special == s.min);
     EXPECT_EQ(refusedName([&] { checkSettingValue(s, s.min); }), min_taken ? "" : s.name);
