@@ -23,29 +23,6 @@ struct GemArgs {
   bool json = false;
 };
 
-nlohmann::json reportJson(const GemReport& r, const std::string& scene) {
-  nlohmann::json j;
-  j["brightness"] = r.brightness;
-  j["fire"] = r.fire;
-  j["scintillation"] = r.scintillation;
-  j["windowing"] = r.windowing;
-  j["extinction"] = r.extinction;
-  j["contrast_change"] = r.contrast_change;
-  j["object"] = r.object;
-  j["scene"] = scene;
-  j["seconds"] = r.seconds;
-  j["per_tilt"] = nlohmann::json::array();
-  for (const GemTilt& t : r.per_tilt)
-    j["per_tilt"].push_back({{"tilt_deg", t.tilt_deg},
-                             {"brightness", t.brightness},
-                             {"fire", t.fire},
-                             {"windowing", t.windowing},
-                             {"extinction", t.extinction},
-                             {"flashes", t.flashes},
-                             {"outline_px", t.outline_px}});
-  return j;
-}
-
 /// The tilts' face-up images side by side, five to a row (black where a row is short).
 std::vector<float> contactSheet(const std::vector<std::vector<float>>& tiles, int w, int h,
                                 int& sheet_w, int& sheet_h) {
@@ -106,7 +83,7 @@ void runGem(const GemArgs& a) {
     throw CliError(a.scene + ": " + e.what());
   }
   const GemReport r = analyseGem(scene, req);
-  const nlohmann::json j = reportJson(r, a.scene);
+  const nlohmann::json j = gemReportJson(r, a.scene);
   if (!a.output.empty()) writeReport(dir, r, j);
   if (a.json) {
     std::printf("%s\n", j.dump(2).c_str());

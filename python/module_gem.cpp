@@ -38,28 +38,10 @@ std::vector<double> gemTilts(const py::handle& tilts) {
 /// `eikon gem --json`'s figures: the overall numbers, per_tilt, and with keep_images the pictures
 /// ("dome_K" and "spot_K" for per_tilt[K], "aset", "idealscope", "lightbox" face-up).
 py::dict gemDict(const GemReport& r, bool keep_images) {
-  py::dict d;
-  d["brightness"] = r.brightness;
-  d["fire"] = r.fire;
-  d["scintillation"] = r.scintillation;
-  d["windowing"] = r.windowing;
-  d["extinction"] = r.extinction;
-  d["contrast_change"] = r.contrast_change;
-  d["object"] = r.object;
-  d["seconds"] = r.seconds;
-  py::list per_tilt;
-  for (const GemTilt& t : r.per_tilt) {
-    py::dict p;
-    p["tilt_deg"] = t.tilt_deg;
-    p["brightness"] = t.brightness;
-    p["fire"] = t.fire;
-    p["windowing"] = t.windowing;
-    p["extinction"] = t.extinction;
-    p["flashes"] = t.flashes;
-    p["outline_px"] = t.outline_px;
-    per_tilt.append(p);
-  }
-  d["per_tilt"] = per_tilt;
+  // The CLI's JSON (gemReportJson) as Python objects, without the scene file it names.
+  nlohmann::json j = gemReportJson(r, "");
+  j.erase("scene");
+  py::dict d = py::module_::import("json").attr("loads")(j.dump());
   if (keep_images) {
     const GemImages& im = r.images;
     py::dict images;

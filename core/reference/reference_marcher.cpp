@@ -1056,6 +1056,22 @@ class TreeBuilder {
     return n.id;
   }
   int object(int region) const { return out_.sharp ? region - 1 : -1; }
+  /// The node of a branch's event at step t: where t happened, with this event, weight and depth.
+  LightTreeNode stepNode(int parent, TreeEvent event, const TreeStep& t, double weight,
+                         int depth) const {
+    LightTreeNode n;
+    n.parent = parent;
+    n.event = event;
+    n.point = t.point;
+    n.direction = t.dir;
+    n.wave_normal = t.wave;
+    n.weight = weight;
+    n.fresnel_r = t.Rf;
+    n.optical_path_mm = t.opl;
+    n.object = object(t.region);
+    n.depth = depth;
+    return n;
+  }
   bool cut(double w, int depth, const TreeStep& t, int parent);
   void follow(Branch b, const std::vector<TreeStep>& steps, size_t from, const MarchResult& end);
   void reflected(const Pending& p);
@@ -1125,18 +1141,9 @@ void TreeBuilder::follow(Branch b, const std::vector<TreeStep>& steps, size_t fr
       b.F *= 1.0 - t.Rf;
     }
     if (cut(b.F * t.T, b.depth + 1, t, b.node)) return;
-    LightTreeNode n;
-    n.parent = b.node;
-    n.event = t.tir ? TreeEvent::Tir : TreeEvent::Refract;
-    n.point = t.point;
-    n.direction = t.dir;
-    n.wave_normal = t.wave;
-    n.weight = b.F * t.T;
-    n.fresnel_r = t.Rf;
-    n.optical_path_mm = t.opl;
-    n.object = object(t.region);
-    n.depth = ++b.depth;
-    b.node = add(n);
+    ++b.depth;
+    b.node =
+        add(stepNode(b.node, t.tir ? TreeEvent::Tir : TreeEvent::Refract, t, b.F * t.T, b.depth));
   }
   out_.absorbed += b.F * (b.T - end.throughput.x);
   LightTreeNode n;
@@ -1165,17 +1172,7 @@ void TreeBuilder::reflected(const Pending& p) {
   if (j == steps.size() || !steps[j].reflected)
     throw std::logic_error("light tree: a scripted reflection was not met again");
   const TreeStep& t = steps[j];
-  LightTreeNode n;
-  n.parent = p.parent;
-  n.event = TreeEvent::Reflect;
-  n.point = t.point;
-  n.direction = t.dir;
-  n.wave_normal = t.wave;
-  n.weight = p.F * t.T;
-  n.fresnel_r = t.Rf;
-  n.optical_path_mm = t.opl;
-  n.object = object(t.region);
-  n.depth = p.depth;
+  const LightTreeNode n = stepNode(p.parent, TreeEvent::Reflect, t, p.F * t.T, p.depth);
   follow(Branch{add(n), p.F, t.T, p.depth, p.script}, steps, j + 1, end);
 }
 

@@ -299,4 +299,27 @@ GemReport analyseGem(const std::shared_ptr<Scene>& scene, const GemRequest& r,
   return report;
 }
 
+nlohmann::json gemReportJson(const GemReport& r, const std::string& scene) {
+  nlohmann::json j;
+  j["brightness"] = r.brightness;
+  j["fire"] = r.fire;
+  j["scintillation"] = r.scintillation;
+  j["windowing"] = r.windowing;
+  j["extinction"] = r.extinction;
+  j["contrast_change"] = r.contrast_change;
+  j["object"] = r.object;
+  j["scene"] = scene;
+  j["seconds"] = r.seconds;
+  j["per_tilt"] = nlohmann::json::array();
+  for (const GemTilt& t : r.per_tilt)
+    j["per_tilt"].push_back({{"tilt_deg", t.tilt_deg},
+                             {"brightness", t.brightness},
+                             {"fire", t.fire},
+                             {"windowing", t.windowing},
+                             {"extinction", t.extinction},
+                             {"flashes", t.flashes},
+                             {"outline_px", t.outline_px}});
+  return j;
+}
+
 }  // namespace eikon

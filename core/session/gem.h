@@ -15,6 +15,7 @@
 
 #include <functional>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -74,5 +75,9 @@ struct GemReport {
 /// empty) gets the fraction done.
 GemReport analyseGem(const std::shared_ptr<Scene>& scene, const GemRequest& request,
                      const std::function<void(double)>& progress = {});
+
+/// A report as `eikon gem --json` prints it and Python's `eikon.gem` returns it: the overall
+/// figures, "object", "scene" (the scene file named), "seconds" and "per_tilt".
+nlohmann::json gemReportJson(const GemReport& report, const std::string& scene);
 
 }  // namespace eikon
