@@ -48,7 +48,7 @@ using uvec4 = glm::uvec4;
 // The medium table of the sharp march (core/volume/media.h packMediaTable): EIKON_MEDIUM_VEC4S
 // vec4s per region; flag bits of row 7's w as kMedium* there.
 #define EIKON_B_MEDIA 22
-#define EIKON_MEDIUM_VEC4S 16
+#define EIKON_MEDIUM_VEC4S 22
 // The same two tables as uniform blocks for the view kernels (march.glsl), padded to fixed sizes
 // within Vulkan's guaranteed 16 KiB: the shape table's first EIKON_EXACT_MAX_ROWS rows (all of it on
 // the exact path) and the medium table when it has at most EIKON_SMALL_MEDIA_REGIONS regions
@@ -61,12 +61,13 @@ using uvec4 = glm::uvec4;
 // path independent of λ and added every wavelength from its lookups (the later passes skip it).
 #define EIKON_B_SHARED_PATHS 26
 #define EIKON_EXACT_MAX_ROWS 256
-#define EIKON_SMALL_MEDIA_REGIONS 64
+#define EIKON_SMALL_MEDIA_REGIONS 46  // 46 · 22 vec4s · 16 bytes ≤ 16 KiB
 #define EIKON_MEDIUM_HOMOGENEOUS 1
 #define EIKON_MEDIUM_UNIAXIAL 2
 #define EIKON_MEDIUM_RADIAL_AXIS 4
 #define EIKON_MEDIUM_GRIN 8
 #define EIKON_MEDIUM_OPAQUE 16
+#define EIKON_MEDIUM_BIAXIAL 32
 
 // ViewParams.flags bits.
 #define EIKON_F_DISPERSIVE 1

@@ -179,12 +179,12 @@ int crossingPathFlags(const BoundaryField& field) {
 
 BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& field,
                                const MediaTable& media, const std::string& file, bool voxels_read) {
-  static_assert(kMediumVec4s == EIKON_MEDIUM_VEC4S &&
-                    kMediumHomogeneous == EIKON_MEDIUM_HOMOGENEOUS &&
-                    kMediumUniaxial == EIKON_MEDIUM_UNIAXIAL &&
-                    kMediumRadialAxis == EIKON_MEDIUM_RADIAL_AXIS &&
-                    kMediumGrin == EIKON_MEDIUM_GRIN && kMediumOpaque == EIKON_MEDIUM_OPAQUE,
-                "the medium table's layout is declared twice (media.h, eikon_shared.h)");
+  static_assert(
+      kMediumVec4s == EIKON_MEDIUM_VEC4S && kMediumHomogeneous == EIKON_MEDIUM_HOMOGENEOUS &&
+          kMediumUniaxial == EIKON_MEDIUM_UNIAXIAL &&
+          kMediumRadialAxis == EIKON_MEDIUM_RADIAL_AXIS && kMediumGrin == EIKON_MEDIUM_GRIN &&
+          kMediumOpaque == EIKON_MEDIUM_OPAQUE && kMediumBiaxial == EIKON_MEDIUM_BIAXIAL,
+      "the medium table's layout is declared twice (media.h, eikon_shared.h)");
   checkBoundaryFits(ctx, field, media, file);
   // Else placeholders (regions on the shapes: none is read).
   present_ = voxels_read && field.hasVoxels();
@@ -212,7 +212,9 @@ BoundaryDevice::BoundaryDevice(const vk::Context& ctx, const BoundaryField& fiel
   if (packed_.empty()) packed_.assign(size_t(kMediumVec4s) * 4, 0.0f);
   media_ = vk::Buffer(ctx, packed_.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       "medium table");
-  // The uniform blocks: fixed sizes (4 KiB and 16 KiB, within every device's 16 KiB range).
+  // The uniform blocks: fixed sizes (4 KiB and 15.8 KiB, within every device's 16 KiB range).
+  static_assert(EIKON_SMALL_MEDIA_REGIONS * kMediumVec4s * 16 <= 16384,
+                "the small medium table must fit Vulkan's guaranteed uniform range");
   static_assert(kExactMaxRows == EIKON_EXACT_MAX_ROWS,
                 "the exact path's row cap is declared twice");
   std::vector<glm::vec4> rows(size_t(EIKON_EXACT_MAX_ROWS), glm::vec4(0.0f));
@@ -240,6 +242,7 @@ void BoundaryDevice::setRenderWavelength(double lambda_nm) {
     float* v15 = packed_.data() + (r * kMediumVec4s + 15) * 4;
     v15[0] = float(mediumIndex(table_.regions[r].n_o, lambda_nm));
     v15[1] = float(mediumIndex(table_.regions[r].n_e, lambda_nm));
+    v15[2] = float(mediumIndex(table_.regions[r].n_beta, lambda_nm));
   }
   writeMedia();
 }

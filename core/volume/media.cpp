@@ -22,10 +22,34 @@ MediumDispersion dispersionRecord(const Dispersion& d) {
 
 glm::dvec3 bands(const Attenuation& a) { return glm::dvec3(a.at(612.0), a.at(549.0), a.at(465.0)); }
 
+// A biaxial crystal: the principal indices and axes of the material (homogeneous; the scene
+// refuses GRIN profiles and axis fields on one).
+MediumRecord biaxialRecord(const SceneObject& obj, const Material& mat) {
+  (void)obj;
+  MediumRecord m;
+  m.biaxial = true;
+  m.n_o = dispersionRecord(mat.n_alpha);
+  m.n_beta = dispersionRecord(mat.n_beta);
+  m.n_e = dispersionRecord(mat.n_gamma);
+  m.axis = glm::normalize(mat.gamma_axis);
+  m.alpha_axis = glm::normalize(mat.alpha_axis);
+  m.sigma_o = bands(mat.attenuation_alpha);
+  m.sigma_beta = bands(mat.attenuation_beta);
+  m.sigma_e = bands(mat.attenuation_gamma);
+  m.opacity = mat.opacity;
+  m.emission = mat.emission;
+  m.albedo = mat.albedo;
+  m.phase_g = mat.phase_g;
+  m.homogeneous = true;
+  return m;
+}
+
 MediumRecord objectRecord(const SceneObject& obj, const Material& mat) {
   MediumRecord m;
+  if (mat.biaxial) return biaxialRecord(obj, mat);
   m.n_o = dispersionRecord(mat.n_o);
   m.n_e = mat.uniaxial ? dispersionRecord(mat.n_e) : m.n_o;
+  m.n_beta = m.n_o;
   m.uniaxial = mat.uniaxial;
   m.radial_axis = mat.uniaxial && obj.radial_axis;
   if (m.radial_axis)
@@ -34,6 +58,7 @@ MediumRecord objectRecord(const SceneObject& obj, const Material& mat) {
     m.axis = glm::normalize(obj.optic_axis ? *obj.optic_axis : *mat.optic_axis);
   m.sigma_o = bands(mat.attenuation_o);
   m.sigma_e = mat.uniaxial ? bands(mat.attenuation_e) : m.sigma_o;
+  m.sigma_beta = m.sigma_o;
   m.opacity = mat.opacity;
   m.emission = mat.emission;
   m.albedo = mat.albedo;
@@ -64,6 +89,17 @@ void packDispersion(const MediumDispersion& d, float* v) {
   }
 }
 
+// Rows 16–21 (the β index, α̂, σ_β).
+void packBiaxial(const MediumRecord& m, float* v) {
+  v[16 * 4 + 0] = float(int(m.n_beta.kind));
+  v[16 * 4 + 1] = float(m.n_beta.terms);
+  packDispersion(m.n_beta, v + 17 * 4);
+  for (int c = 0; c < 3; ++c) {
+    v[20 * 4 + c] = float(m.alpha_axis[c]);
+    v[21 * 4 + c] = float(m.sigma_beta[c]);
+  }
+}
+
 }  // namespace
 
 MediaTable buildMediaTable(const Scene& scene) {
@@ -71,6 +107,7 @@ MediaTable buildMediaTable(const Scene& scene) {
   MediumRecord ambient;
   ambient.n_o.coeff[0] = scene.ambient_index;
   ambient.n_e = ambient.n_o;
+  ambient.n_beta = ambient.n_o;
   t.regions.push_back(ambient);
   // Medium ids as the boundary field numbers them (1 + index in scene.materials' order).
   for (const SceneObject& obj : scene.objects) {
@@ -143,6 +180,7 @@ std::vector<float> packMediaTable(const MediaTable& table) {
   for (size_t r = 0; r < table.regions.size(); ++r) {
     const MediumRecord& m = table.regions[r];
     float* v = out.data() + r * size_t(kMediumVec4s) * 4;
+    packBiaxial(m, v);
     v[0] = float(int(m.n_o.kind));
     v[1] = float(m.n_o.terms);
     v[2] = float(int(m.n_e.kind));
@@ -151,7 +189,8 @@ std::vector<float> packMediaTable(const MediaTable& table) {
     packDispersion(m.n_e, v + 16);
     const int flags = (m.homogeneous ? kMediumHomogeneous : 0) |
                       (m.uniaxial ? kMediumUniaxial : 0) | (m.radial_axis ? kMediumRadialAxis : 0) |
-                      (m.grin_type != 0 ? kMediumGrin : 0) | (m.opaque() ? kMediumOpaque : 0);
+                      (m.grin_type != 0 ? kMediumGrin : 0) | (m.opaque() ? kMediumOpaque : 0) |
+                      (m.biaxial ? kMediumBiaxial : 0);
     const glm::dvec4 rows[] = {
         {m.axis, double(flags)},         {m.sigma_o, m.opacity},
         {m.sigma_e, m.phase_g},          {m.emission, double(m.medium)},

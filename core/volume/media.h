@@ -17,7 +17,7 @@
 //   v1 .. v3    : n_o coefficients: coeff[0..5], sellmeier_c[0..5] (12 floats, unused = 0)
 //   v4 .. v6    : n_e coefficients, the same layout (a copy of n_o for isotropic media)
 //   v7          : (axis.xyz, flags)   flags: bit 0 homogeneous, 1 uniaxial, 2 radial axis,
-//                                     3 GRIN, 4 opaque (opacity ≥ 0.5)
+//                                     3 GRIN, 4 opaque (opacity ≥ 0.5), 5 biaxial
 //   v8          : (σ_o at 612, 549, 465 nm, opacity)
 //   v9          : (σ_e at 612, 549, 465 nm, phase g)
 //   v10         : (emission rgb, medium id)      medium id: BoundaryField::medium[r]
@@ -25,8 +25,12 @@
 //   v12         : (GRIN n0, GRIN gradient xyz)
 //   v13         : (GRIN origin / centre xyz, GRIN radius)
 //   v14         : (radial-axis centre xyz, 0)
-//   v15         : (n_o, n_e at the view render's wavelength, 0, 0): written for each render by
-//                 BoundaryDevice::setRenderWavelength; 0 in packMediaTable's output
+//   v15         : (n_o, n_e, n_beta at the view render's wavelength, 0): written for each render
+//                 by BoundaryDevice::setRenderWavelength; 0 in packMediaTable's output
+//   v16         : (kind_beta, terms_beta, 0, 0)
+//   v17 .. v19  : n_beta coefficients (a copy of n_o for isotropic and uniaxial media)
+//   v20         : (alpha_axis.xyz, 0)   (zero unless biaxial)
+//   v21         : (σ_beta at 612, 549, 465 nm, 0)
 //
 //   eikon::MediaTable media = eikon::buildMediaTable(scene);
 //   double n = eikon::mediumIndex(media.regions[r].n_o, 587.5618);
@@ -53,15 +57,27 @@ struct MediumDispersion {
   std::array<double, 6> sellmeier_c{};
 };
 
-/// The medium of one region.
+/// The medium of one region: a dielectric tensor ε = n_o² α̂α̂ᵀ + n_beta² β̂β̂ᵀ + n_e² γ̂γ̂ᵀ given
+/// by its principal indices, each with its own dispersion, and its principal axes. Isotropic and
+/// uniaxial media are the special cases the laws solve in closed form:
+///   isotropic: n_beta = n_e = n_o, no axes;
+///   uniaxial : n_beta = n_o (the ordinary index on every direction ⊥ the optic axis), n_e along
+///              `axis` (γ̂ = the optic axis; α̂ any direction ⊥ it, stored as zero);
+///   biaxial  : n_o = n_α ≤ n_beta = n_β ≤ n_e = n_γ at 587.6 nm, `axis` = γ̂, `alpha_axis` = α̂,
+///              β̂ = γ̂ × α̂; its two wave modes are named fast (mode 0) and slow (mode 1).
+/// σ per principal axis likewise: sigma_o (α̂, or ⊥ the optic axis), sigma_beta, sigma_e (γ̂).
 struct MediumRecord {
-  MediumDispersion n_o, n_e;  ///< n_e = n_o for isotropic media
+  MediumDispersion n_o, n_e;  ///< principal indices along α̂ and γ̂ (n_e = n_o: isotropic)
+  MediumDispersion n_beta;    ///< principal index along β̂ (= n_o unless biaxial)
   bool homogeneous = true;    ///< nothing varies in space inside the region
   bool uniaxial = false;
+  bool biaxial = false;
   bool radial_axis = false;     ///< a(x) = (x − axis_centre)/|x − axis_centre|
-  glm::dvec3 axis{0.0};         ///< unit optic axis (uniaxial, not radial); zero otherwise
+  glm::dvec3 axis{0.0};         ///< unit optic axis (uniaxial, not radial) or γ̂; zero otherwise
+  glm::dvec3 alpha_axis{0.0};   ///< unit α̂ (biaxial); zero otherwise
   glm::dvec3 axis_centre{0.0};  ///< centre of a radial axis field
   glm::dvec3 sigma_o{0.0}, sigma_e{0.0};  ///< attenuation per mm at the bands 612, 549, 465 nm
+  glm::dvec3 sigma_beta{0.0};             ///< the same for light with D along β̂
   double opacity = 0.0;
   glm::dvec3 emission{0.0};
   glm::dvec3 albedo{0.0};
@@ -81,10 +97,10 @@ struct MediaTable {
 };
 
 /// vec4s per region in packMediaTable's layout.
-inline constexpr int kMediumVec4s = 16;
+inline constexpr int kMediumVec4s = 22;
 /// Flag bits of v7.w.
 inline constexpr int kMediumHomogeneous = 1, kMediumUniaxial = 2, kMediumRadialAxis = 4,
-                     kMediumGrin = 8, kMediumOpaque = 16;
+                     kMediumGrin = 8, kMediumOpaque = 16, kMediumBiaxial = 32;
 
 /// One record per region of the scene's boundary field (region 0: the ambient index, clear).
 MediaTable buildMediaTable(const Scene& scene);
