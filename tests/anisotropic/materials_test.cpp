@@ -117,7 +117,19 @@ TEST(Materials, LibraryMatchesReference) {
     const auto axis = m.at("optic_axis").get<std::vector<double>>();
     ASSERT_EQ(axis.size(), 3u);
     EXPECT_GT(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2], 0.0);
+    // [r, g, b] band values or a spectrum over 380–780 nm (ruby; its values are checked against
+    // the data in tests/core/scene/measured_spectra_test.cpp).
     for (const char* k : {"attenuation_o_per_mm", "attenuation_e_per_mm"}) {
+      if (m.at(k).is_object()) {
+        const auto nm = m.at(k).at("wavelength_nm").get<std::vector<double>>();
+        const auto a = m.at(k).at("per_mm").get<std::vector<double>>();
+        ASSERT_EQ(a.size(), nm.size()) << k;
+        ASSERT_FALSE(nm.empty()) << k;
+        EXPECT_LE(nm.front(), 380.0) << k;
+        EXPECT_GE(nm.back(), 780.0) << k;
+        for (double x : a) EXPECT_GE(x, 0.0) << k;
+        continue;
+      }
       const auto a = m.at(k).get<std::vector<double>>();
       ASSERT_EQ(a.size(), 3u) << k;
       for (double x : a) EXPECT_GE(x, 0.0) << k;
