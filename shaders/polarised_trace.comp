@@ -146,10 +146,10 @@ void segment(inout Branch b, float len) {
   applySheets(b, b.x, b.ray, len);
   b.opl += dot(b.p - gPin, b.ray) * len;
   int r = b.region;
-  float sigma = bandAt(mediumRow(r, 8).xyz);
+  float sigma = regionSigmaAt(r, 0);
   vec4 af = regionAxisField(r, b.x);
   if (mediumUniaxial(r) && b.mode == 1 && hasAxis(af.xyz))
-    sigma = attenuationE(vec3(sigma), vec3(bandAt(mediumRow(r, 9).xyz)), b.p, af.xyz,
+    sigma = attenuationE(vec3(sigma), vec3(regionSigmaAt(r, 1)), b.p, af.xyz,
                          regionIndex(r, 0, b.x), regionIndex(r, 1, b.x))
                 .x;
   if (sigma > 0.0) {

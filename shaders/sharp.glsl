@@ -28,6 +28,18 @@ const float kNudgeVoxels = 1e-4;
 #define EIKON_MEDIUM_ROW(i) mediaTable[i]
 #endif
 vec4 mediumRow(int r, int k) { return EIKON_MEDIUM_ROW(r * EIKON_MEDIUM_VEC4S + k); }
+
+// σ per mm for D along principal axis k of region r (0: σ_o, 1: σ_e, 2: σ_beta) at the wavelength
+// EIKON_FIELD_LAMBDA_UM: its 5 nm spectrum (the block after the records whose first row is row
+// 21's w, read from the storage buffer) where the material gives one, else bandAt of the band
+// values (media.h mediumSigmaAt).
+float regionSigmaAt(int r, int k) {
+  int block = int(mediumRow(r, 21).w);
+  if (block == 0) return bandAt(mediumRow(r, k == 0 ? 8 : (k == 1 ? 9 : 21)).xyz);
+  float u = clamp((EIKON_FIELD_LAMBDA_UM * 1000.0 - 380.0) / 5.0, 0.0, 80.0);
+  int i = min(int(u), 79);
+  return mix(mediaTable[block + i][k], mediaTable[block + i + 1][k], u - float(i));
+}
 int mediumFlags(int r) { return int(mediumRow(r, 7).w); }
 bool mediumHomogeneous(int r) { return (mediumFlags(r) & EIKON_MEDIUM_HOMOGENEOUS) != 0; }
 bool mediumUniaxial(int r) { return (mediumFlags(r) & EIKON_MEDIUM_UNIAXIAL) != 0; }
@@ -252,16 +264,21 @@ BoundaryCrossing nextCrossing(vec3 a, vec3 b, int region) {
 }
 
 #ifndef EIKON_SHARP_NO_MARCH
+// σ of a principal axis of region r (regionSigmaAt at the march's λ, or the band values).
+vec3 regionSigma(int r, int k) {
+  return gScalar ? vec3(regionSigmaAt(r, k)) : mediumRow(r, k == 0 ? 8 : (k == 1 ? 9 : 21)).xyz;
+}
+
 // Emission, attenuation (exact: e^{−σ len}) and in-scatter along a straight piece in the ray's
 // region.
 void absorbAlong(inout MarchState S, inout bool dispersive, vec3 dir, float len, int mode) {
   // Nothing to add where no medium attenuates, emits or scatters light (S.L += 0, S.T *= 1).
   if (!hasFlag(EIKON_F_ATTENUATION) && !hasFlag(EIKON_F_EMISSION) && !hasFlag(EIKON_F_LIT)) return;
   int r = S.region;
-  vec3 sig = sigmaOf(mediumRow(r, 8).xyz);
+  vec3 sig = regionSigma(r, 0);
   vec4 af = regionAxisField(r, S.x);
   if (mode == 1 && hasAxis(af.xyz))
-    sig = attenuationE(sig, sigmaOf(mediumRow(r, 9).xyz), S.w, af.xyz, regionIndex(r, 0, S.x, dispersive),
+    sig = attenuationE(sig, regionSigma(r, 1), S.w, af.xyz, regionIndex(r, 0, S.x, dispersive),
                        regionIndex(r, 1, S.x, dispersive));
   vec3 e = colourOf(mediumRow(r, 10).xyz);
   vec3 alb = mediumRow(r, 11).xyz;

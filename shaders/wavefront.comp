@@ -184,9 +184,9 @@ vec3 mediumShell(int r, vec3 s) {
 // Attenuation per unit ray length in region r for wave vector w: σ_o at the wavelength, or in a
 // crystal of the e-mode the pleochroic σ(θ)·cos ρ (attenuationE).
 float mediumSigma(int r, vec3 w) {
-  float so = bandAt(mediumRow(r, 8).xyz);
+  float so = regionSigmaAt(r, 0);
   if (!eMode() || !mediumUniaxial(r)) return so;
-  float se = bandAt(mediumRow(r, 9).xyz);
+  float se = regionSigmaAt(r, 1);
   if (so == 0.0 && se == 0.0) return so;
   return attenuationE(vec3(so), vec3(se), w, mediumRow(r, 7).xyz, mediumIndex(r, 0), mediumIndex(r, 1)).x;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "anisotropic/pleochroism.h"
+#include "core/volume/media.h"
 
 namespace eikon {
 
@@ -25,12 +26,7 @@ glm::dvec4 sampleMedium(const Field& f, const glm::dvec3& x, int mode) {
   return mode == 0 ? f.medium(x) : f.mediumE(x);
 }
 
-double bandAt(const glm::dvec3& rgb, double l) {
-  if (l <= 465.0) return rgb.b;
-  if (l >= 612.0) return rgb.r;
-  if (l <= 549.0) return rgb.b + (rgb.g - rgb.b) * (l - 465.0) / (549.0 - 465.0);
-  return rgb.g + (rgb.r - rgb.g) * (l - 549.0) / (612.0 - 549.0);
-}
+double bandAt(const glm::dvec3& rgb, double l) { return bandValueAt(rgb, l); }
 
 glm::dvec4 axisField(const Field& f, const glm::dvec3& x) { return f.axisField(x); }
 

@@ -145,12 +145,12 @@ void Tracer::segment(Branch& b, double len) const {
   applySheets(b, b.x, b.ray, len);
   b.opl += glm::dot(b.p, b.ray) * len;
   const MediumRecord& m = rec(b.region);
-  double sigma = field::bandAt(m.sigma_o, lambda_);
+  double sigma = mediumSigmaAt(m, 0, lambda_);
   if (m.uniaxial && b.mode == Mode::Extraordinary) {
     const glm::dvec3 a = glm::dvec3(mediumAxisField(m, b.x));
     sigma =
-        field::attenuationE(glm::dvec3(sigma), glm::dvec3(field::bandAt(m.sigma_e, lambda_)), b.p,
-                            a, mediumIndexAt(m, 0, lambda_, b.x), mediumIndexAt(m, 1, lambda_, b.x))
+        field::attenuationE(glm::dvec3(sigma), glm::dvec3(mediumSigmaAt(m, 1, lambda_)), b.p, a,
+                            mediumIndexAt(m, 0, lambda_, b.x), mediumIndexAt(m, 1, lambda_, b.x))
             .x;
   }
   if (sigma > 0.0) {

@@ -208,6 +208,12 @@ class RayMarch {
   glm::dvec3 sigmaOf(const glm::dvec3& b) const {
     return scalar_ ? glm::dvec3(field::bandAt(b, lambda_nm_)) : b;
   }
+  /// σ of a sharp region's principal axis (mediumSigmaAt: its measured spectrum at λ where it has
+  /// one) or its band values (march.glsl regionSigma).
+  glm::dvec3 regionSigma(const MediumRecord& m, int axis) const {
+    if (scalar_) return glm::dvec3(mediumSigmaAt(m, axis, lambda_nm_));
+    return axis == 0 ? m.sigma_o : axis == 1 ? m.sigma_e : m.sigma_beta;
+  }
   glm::dvec3 environment(const glm::dvec3& dir) const { return colourOf(env_.lookup(dir)); }
   /// weight × environment(dir), or, while a hero march has met nothing dispersive, recorded for
   /// all wavelengths and left out of the radiance (march.glsl environmentWeighted).
@@ -737,10 +743,10 @@ long long RayMarch::cellsOn(const glm::dvec3& a, const glm::dvec3& b) const {
 // region (march.glsl absorbAlong).
 void RayMarch::absorbAlong(MarchState& S, const glm::dvec3& dir, double len) const {
   const MediumRecord& m = rec(S.region);
-  glm::dvec3 sig = sigmaOf(m.sigma_o);
+  glm::dvec3 sig = regionSigma(m, 0);
   const glm::dvec4 af = mediumAxisField(m, S.x);
   if (mode_ == 1 && field::hasAxis(glm::dvec3(af)))
-    sig = field::attenuationE(sig, sigmaOf(m.sigma_e), S.w, glm::dvec3(af),
+    sig = field::attenuationE(sig, regionSigma(m, 1), S.w, glm::dvec3(af),
                               regionIndex(S.region, 0, S.x), regionIndex(S.region, 1, S.x));
   glm::dvec3 e = colourOf(m.emission);
   if (lit_ && m.albedo.x + m.albedo.y + m.albedo.z > 0.0)

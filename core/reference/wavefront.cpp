@@ -1234,8 +1234,8 @@ SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm
       m.n_e = mediumIndex(r.n_e, wavelength_nm);
       m.axis = r.axis;
     }
-    m.sigma = field::bandAt(r.sigma_o, wavelength_nm);
-    m.sigma_e = field::bandAt(r.sigma_e, wavelength_nm);
+    m.sigma = mediumSigmaAt(r, 0, wavelength_nm);
+    m.sigma_e = mediumSigmaAt(r, 1, wavelength_nm);
     m.homogeneous = r.homogeneous;
     m.opaque = r.opaque();
     si.media.push_back(m);

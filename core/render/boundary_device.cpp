@@ -143,7 +143,7 @@ void checkBoundaryFits(const vk::Context& ctx, const BoundaryField& field, const
                              std::to_string(lim.max_storage_buffer_range) +
                              " (or set \"interfaces\": \"smoothed\")");
   const double media_bytes =
-      16.0 * kMediumVec4s * std::max<double>(double(media.regions.size()), 1);
+      std::max<double>(16.0 * kMediumVec4s, 4.0 * double(packMediaTable(media).size()));
   if (media_bytes > double(lim.max_storage_buffer_range))
     throw std::runtime_error(
         where + "the medium table needs " + std::to_string(int64_t(media_bytes)) +

@@ -1,5 +1,6 @@
 #include "core/volume/media.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "anisotropic/units.h"
@@ -22,6 +23,18 @@ MediumDispersion dispersionRecord(const Dispersion& d) {
 
 glm::dvec3 bands(const Attenuation& a) { return glm::dvec3(a.at(612.0), a.at(549.0), a.at(465.0)); }
 
+// The 5 nm table of (σ_o, σ_e, σ_beta) where any of the three is a spectrum; else empty.
+std::vector<glm::dvec3> sigmaSpectrum(const Attenuation& o, const Attenuation& e,
+                                      const Attenuation& beta) {
+  std::vector<glm::dvec3> t;
+  if (o.wavelengths_nm.empty() && e.wavelengths_nm.empty() && beta.wavelengths_nm.empty()) return t;
+  for (int i = 0; i < kSigmaSamples; ++i) {
+    const double l = kSigmaFirstNm + i * kSigmaStepNm;
+    t.emplace_back(o.at(l), e.at(l), beta.at(l));
+  }
+  return t;
+}
+
 // A biaxial crystal: the principal indices and axes of the material (homogeneous; the scene
 // refuses GRIN profiles and axis fields on one).
 MediumRecord biaxialRecord(const SceneObject& obj, const Material& mat) {
@@ -36,6 +49,8 @@ MediumRecord biaxialRecord(const SceneObject& obj, const Material& mat) {
   m.sigma_o = bands(mat.attenuation_alpha);
   m.sigma_beta = bands(mat.attenuation_beta);
   m.sigma_e = bands(mat.attenuation_gamma);
+  m.sigma_spectrum =
+      sigmaSpectrum(mat.attenuation_alpha, mat.attenuation_gamma, mat.attenuation_beta);
   m.opacity = mat.opacity;
   m.emission = mat.emission;
   m.albedo = mat.albedo;
@@ -59,6 +74,8 @@ MediumRecord objectRecord(const SceneObject& obj, const Material& mat) {
   m.sigma_o = bands(mat.attenuation_o);
   m.sigma_e = mat.uniaxial ? bands(mat.attenuation_e) : m.sigma_o;
   m.sigma_beta = m.sigma_o;
+  const Attenuation& ae = mat.uniaxial ? mat.attenuation_e : mat.attenuation_o;
+  m.sigma_spectrum = sigmaSpectrum(mat.attenuation_o, ae, mat.attenuation_o);
   m.opacity = mat.opacity;
   m.emission = mat.emission;
   m.albedo = mat.albedo;
@@ -119,6 +136,23 @@ MediaTable buildMediaTable(const Scene& scene) {
   return t;
 }
 
+double bandValueAt(const glm::dvec3& rgb, double l) {
+  if (l <= 465.0) return rgb.b;
+  if (l >= 612.0) return rgb.r;
+  if (l <= 549.0) return rgb.b + (rgb.g - rgb.b) * (l - 465.0) / (549.0 - 465.0);
+  return rgb.g + (rgb.r - rgb.g) * (l - 549.0) / (612.0 - 549.0);
+}
+
+double mediumSigmaAt(const MediumRecord& m, int axis, double lambda_nm) {
+  if (m.sigma_spectrum.empty())
+    return bandValueAt(axis == 0 ? m.sigma_o : axis == 1 ? m.sigma_e : m.sigma_beta, lambda_nm);
+  const double u =
+      std::clamp((lambda_nm - kSigmaFirstNm) / kSigmaStepNm, 0.0, double(kSigmaSamples - 1));
+  const int i = std::min(int(u), kSigmaSamples - 2);
+  const double a = m.sigma_spectrum[size_t(i)][axis], b = m.sigma_spectrum[size_t(i) + 1][axis];
+  return a + (b - a) * (u - i);
+}
+
 double mediumIndex(const MediumDispersion& d, double lambda_nm) {
   const double l = micrometresFromNanometres(lambda_nm), l2 = l * l;
   switch (d.kind) {
@@ -177,6 +211,16 @@ glm::dvec4 mediumAxisField(const MediumRecord& m, const glm::dvec3& x) {
 
 std::vector<float> packMediaTable(const MediaTable& table) {
   std::vector<float> out(table.regions.size() * size_t(kMediumVec4s) * 4, 0.0f);
+  // The σ spectra after the records; each region's row 21.w is the first row of its block.
+  std::vector<float> spectra;
+  std::vector<size_t> block(table.regions.size(), 0);
+  for (size_t r = 0; r < table.regions.size(); ++r) {
+    const std::vector<glm::dvec3>& t = table.regions[r].sigma_spectrum;
+    if (t.empty()) continue;
+    block[r] = table.regions.size() * size_t(kMediumVec4s) + spectra.size() / 4;
+    for (const glm::dvec3& v : t)
+      spectra.insert(spectra.end(), {float(v.x), float(v.y), float(v.z), 0.0f});
+  }
   for (size_t r = 0; r < table.regions.size(); ++r) {
     const MediumRecord& m = table.regions[r];
     float* v = out.data() + r * size_t(kMediumVec4s) * 4;
@@ -199,7 +243,9 @@ std::vector<float> packMediaTable(const MediaTable& table) {
     };
     for (size_t i = 0; i < 8; ++i)
       for (int c = 0; c < 4; ++c) v[(7 + i) * 4 + size_t(c)] = float(rows[i][c]);
+    v[21 * 4 + 3] = float(block[r]);
   }
+  out.insert(out.end(), spectra.begin(), spectra.end());
   return out;
 }
 

@@ -30,7 +30,9 @@
 //   v16         : (kind_beta, terms_beta, 0, 0)
 //   v17 .. v19  : n_beta coefficients (a copy of n_o for isotropic and uniaxial media)
 //   v20         : (alpha_axis.xyz, 0)   (zero unless biaxial)
-//   v21         : (σ_beta at 612, 549, 465 nm, 0)
+//   v21         : (σ_beta at 612, 549, 465 nm, first row of the σ spectrum or 0)
+// After every region's record, one block of kSigmaSamples vec4s per region whose material gives
+// its attenuation as a spectrum: row i = (σ_o, σ_e, σ_beta) at kSigmaFirstNm + i·kSigmaStepNm.
 //
 //   eikon::MediaTable media = eikon::buildMediaTable(scene);
 //   double n = eikon::mediumIndex(media.regions[r].n_o, 587.5618);
@@ -78,6 +80,10 @@ struct MediumRecord {
   glm::dvec3 axis_centre{0.0};  ///< centre of a radial axis field
   glm::dvec3 sigma_o{0.0}, sigma_e{0.0};  ///< attenuation per mm at the bands 612, 549, 465 nm
   glm::dvec3 sigma_beta{0.0};             ///< the same for light with D along β̂
+  /// Where the material gives any attenuation as a spectrum (per nm, not RGB): (σ_o, σ_e,
+  /// σ_beta) per mm at the kSigmaSamples wavelengths, so that spectral marches see the measured
+  /// σ(λ) and not only its three band values; empty otherwise.
+  std::vector<glm::dvec3> sigma_spectrum;
   double opacity = 0.0;
   glm::dvec3 emission{0.0};
   glm::dvec3 albedo{0.0};
@@ -96,6 +102,10 @@ struct MediaTable {
   bool empty() const { return regions.empty(); }
 };
 
+/// The wavelengths of MediumRecord::sigma_spectrum: 380, 385, …, 780 nm.
+inline constexpr int kSigmaSamples = 81;
+inline constexpr double kSigmaFirstNm = 380.0, kSigmaStepNm = 5.0;
+
 /// vec4s per region in packMediaTable's layout.
 inline constexpr int kMediumVec4s = 22;
 /// Flag bits of v7.w.
@@ -104,6 +114,15 @@ inline constexpr int kMediumHomogeneous = 1, kMediumUniaxial = 2, kMediumRadialA
 
 /// One record per region of the scene's boundary field (region 0: the ambient index, clear).
 MediaTable buildMediaTable(const Scene& scene);
+
+/// The band values (σ at 612, 549, 465 nm: rgb.r, .g, .b) at lambda_nm: linear between them,
+/// constant beyond (shaders/field.glsl bandAt).
+double bandValueAt(const glm::dvec3& rgb, double lambda_nm);
+
+/// σ per mm at lambda_nm of a region for D along principal axis `axis` (0: sigma_o, 1: sigma_e,
+/// 2: sigma_beta): its spectrum, linear between the 5 nm samples and constant beyond, where it has
+/// one, else bandValueAt of the band values (shaders/sharp.glsl regionSigmaAt).
+double mediumSigmaAt(const MediumRecord& m, int axis, double lambda_nm);
 
 /// n(λ) of a dispersion record at lambda_nm (NaN at a Sellmeier pole, as Dispersion::index).
 double mediumIndex(const MediumDispersion& d, double lambda_nm);
@@ -118,7 +137,8 @@ double mediumIndexAt(const MediumRecord& m, int mode, double lambda_nm, const gl
 /// isotropic media (core/reference/field.h axisField's convention).
 glm::dvec4 mediumAxisField(const MediumRecord& m, const glm::dvec3& x);
 
-/// The table as floats for the GPU (layout above), regions · kMediumVec4s · 4 of them.
+/// The table as floats for the GPU (layout above): regions · kMediumVec4s · 4 of them, then the
+/// σ spectra blocks.
 std::vector<float> packMediaTable(const MediaTable& table);
 
 }  // namespace eikon

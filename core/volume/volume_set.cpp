@@ -71,7 +71,7 @@ size_t VolumeSet::deviceBytes() const {
     if (const auto* c = std::get_if<ConvexShape>(&s.geometry())) shape_entries += c->planes.size();
   return texels * sizeof(glm::vec4) + boundary.region.size() * sizeof(uint32_t) +
          boundary.distance.size() * sizeof(float) + shape_entries * sizeof(glm::vec4) +
-         media.regions.size() * size_t(kMediumVec4s) * sizeof(glm::vec4);
+         packMediaTable(media).size() * sizeof(float);
 }
 
 void gaussianSmooth(std::vector<float>& f, const std::array<int, 3>& dims, double sigma,
