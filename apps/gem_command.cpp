@@ -13,6 +13,7 @@
 #include "apps/commands.h"
 #include "apps/progress.h"
 #include "core/io/exr.h"
+#include "core/scene/messages.h"
 #include "core/session/gem.h"
 #include "core/session/session.h"
 
@@ -20,9 +21,8 @@ namespace eikon::cli {
 namespace {
 
 struct GemArgs {
-  std::string scene, output, tilts = "-20:20:5", progress = "auto";
+  std::string scene, output, tilts = "-20:20:5", progress = "auto", seed = "0";
   int width = 128, height = 128, spp = 4, wavelengths = 8, object = -1, threads = 0;
-  long long seed = 0;
   bool json = false, quiet = false;
 };
 
@@ -60,6 +60,15 @@ void writeReport(const std::filesystem::path& dir, const GemReport& r, const nlo
        {dir / "lightbox.png", pngPreviewContent(im.width, im.height, im.lightbox, -1.0)}});
 }
 
+/// --seed: an integer in [0, 2³² − 1] as typed (digits only), else one line quoting it.
+std::uint32_t parseSeed(const std::string& text) {
+  const bool digits = !text.empty() && text.size() <= 10 &&
+                      text.find_first_not_of("0123456789") == std::string::npos;
+  if (!digits || std::stoull(text) > 4294967295ULL)
+    throw CliError("--seed must be in [0, 4294967295], got " + excerpt(text));
+  return std::uint32_t(std::stoull(text));
+}
+
 void runGem(const GemArgs& a) {
   GemRequest req;
   req.tilts_deg = parseGemTilts(a.tilts);
@@ -68,9 +77,7 @@ void runGem(const GemArgs& a) {
   req.spp = a.spp;
   req.wavelengths = a.wavelengths;
   req.threads = a.threads;
-  if (a.seed < 0 || a.seed > 4294967295LL)
-    throw CliError("--seed must be in [0, 4294967295], got " + std::to_string(a.seed));
-  req.seed = std::uint32_t(a.seed);
+  req.seed = parseSeed(a.seed);
   if (a.object >= 0) req.object = a.object;
   req.keep_images = !a.output.empty();
   checkGemRequest(req);  // every bad option before the scene is read

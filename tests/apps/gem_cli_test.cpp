@@ -62,6 +62,7 @@ TEST(GemCli, BadInputIsOneLineAndWritesNothing) {
       {"gem " + kCut + kSmall + " --seed -1" + o, "--seed"},
       {"gem " + kCut + kSmall + " --seed 4294967296" + o, "--seed"},
       {"gem " + kCut + kSmall + " --seed x" + o, "--seed"},
+      {"gem " + kCut + kSmall + " --seed 99999999999999999999" + o, "got 99999999999999999999"},
       {"gem " + kCut + kSmall + " --progress sometimes" + o, "--progress"},
   };
   for (const auto& [args, phrase] : cases) {
