@@ -10,9 +10,9 @@ for the comparison with GIA's published trends (docs/gem-studio.md "Proportion m
 Each grid point is scenes/diamond_brilliant.json (table 57%, girdle 2%, 16 facets around) with
 its crown_deg and pavilion_deg replaced, analysed by eikon.gem at the given tilts (face-up by
 default: the nailhead and the fisheye are face-up effects). The defaults, 7 x 17 stones at
-64 x 64, take about 7 minutes on 2 cores (3.5 s a stone; at one tilt the five presets' images are made
-once, at the first stone, and kept). Progress by tqdm on stderr; --replot draws the map again
-from the CSV --csv wrote (docs/figures/gem_proportions.csv holds the shipped map's).
+64 x 64, take about 7 minutes on 2 cores (3.5 s a stone; at one tilt the five presets' images
+are made once, at the first stone, and kept). Progress by tqdm on stderr; --replot draws the map
+again from the CSV --csv wrote (docs/figures/gem_proportions.csv holds the shipped map's).
 
 The table region is the pixels within 0.9 of the table's inradius (0.57 x 5 mm) of the stone's
 centre, the pixel size following eikon gem's framing (docs/gem-studio.md "Viewing": 5% over the
