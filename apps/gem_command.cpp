@@ -3,6 +3,7 @@
 // through a series and rendered under the standard lighting presets; brightness, fire,
 // scintillation, windowing and extinction are printed per tilt and overall, and -o writes the
 // report's pictures and its JSON into DIR as one set (core/io/atomic_write.h).
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -10,7 +11,9 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "apps/progress.h"
 #include "core/io/exr.h"
+#include "core/scene/messages.h"
 #include "core/session/gem.h"
 #include "core/session/session.h"
 
@@ -18,9 +21,9 @@ namespace eikon::cli {
 namespace {
 
 struct GemArgs {
-  std::string scene, output, tilts = "-20:20:5";
+  std::string scene, output, tilts = "-20:20:5", progress = "auto", seed = "0";
   int width = 128, height = 128, spp = 4, wavelengths = 8, object = -1, threads = 0;
-  bool json = false;
+  bool json = false, quiet = false;
 };
 
 /// The tilts' face-up images side by side, five to a row (black where a row is short).
@@ -57,6 +60,15 @@ void writeReport(const std::filesystem::path& dir, const GemReport& r, const nlo
        {dir / "lightbox.png", pngPreviewContent(im.width, im.height, im.lightbox, -1.0)}});
 }
 
+/// --seed: an integer in [0, 2³² − 1] as typed (digits only), else one line quoting it.
+std::uint32_t parseSeed(const std::string& text) {
+  const bool digits = !text.empty() && text.size() <= 10 &&
+                      text.find_first_not_of("0123456789") == std::string::npos;
+  if (!digits || std::stoull(text) > 4294967295ULL)
+    throw CliError("--seed must be in [0, 4294967295], got " + excerpt(text));
+  return std::uint32_t(std::stoull(text));
+}
+
 void runGem(const GemArgs& a) {
   GemRequest req;
   req.tilts_deg = parseGemTilts(a.tilts);
@@ -65,9 +77,11 @@ void runGem(const GemArgs& a) {
   req.spp = a.spp;
   req.wavelengths = a.wavelengths;
   req.threads = a.threads;
+  req.seed = parseSeed(a.seed);
   if (a.object >= 0) req.object = a.object;
   req.keep_images = !a.output.empty();
   checkGemRequest(req);  // every bad option before the scene is read
+  const ProgressMode mode = progressMode(a.progress, a.quiet);
   const std::filesystem::path dir(a.output);
   if (!a.output.empty()) {
     if (std::filesystem::exists(dir) && !std::filesystem::is_directory(dir))
@@ -82,7 +96,10 @@ void runGem(const GemArgs& a) {
   } catch (const std::invalid_argument& e) {
     throw CliError(a.scene + ": " + e.what());
   }
-  const GemReport r = analyseGem(scene, req);
+  Progress progress(mode);
+  progress.update("tilts", 0.0);
+  const GemReport r = analyseGem(scene, req, [&](double f) { progress.update("tilts", f); });
+  progress.finish();
   const nlohmann::json j = gemReportJson(r, a.scene);
   if (!a.output.empty()) writeReport(dir, r, j);
   if (a.json) {
@@ -119,6 +136,14 @@ void addGemCommand(CLI::App& app) {
   sub->add_option("--wavelengths", a->wavelengths,
                   "Spectral samples of the fire render (default 8)");
   sub->add_option("--threads", a->threads, "CPU threads (default 0: all)");
+  sub->add_option("--seed", a->seed,
+                  "0 (default): the pixel grid centred on the stone; N > 0: shifted by a "
+                  "sub-pixel offset drawn from N (another draw of the same estimate)");
+  sub->add_flag("-q,--quiet", a->quiet, "No progress lines (same as --progress never)");
+  sub->add_option(
+      "--progress", a->progress,
+      "auto (default: progress over the tilts with ETA on stderr when it is a terminal), always "
+      "or never");
   sub->add_flag("--json", a->json, "Print the metrics as JSON");
   sub->add_option("-o,--output", a->output,
                   "Folder for the report: report.json, dome_tilts.png/.exr (contact sheet), "

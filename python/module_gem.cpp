@@ -6,6 +6,8 @@
 //   eikon.gem(scene, keep_images=True)["images"]["dome_0"]   # (H, W, 3) float32
 #include <pybind11/stl.h>
 
+#include <cstdint>
+
 #include "core/session/gem.h"
 #include "python/module.h"
 
@@ -58,7 +60,10 @@ py::dict gemDict(const GemReport& r, bool keep_images) {
 }
 
 py::dict gem(const std::shared_ptr<Scene>& scene, const py::object& tilts, int width, int height,
-             int spp, int wavelengths, std::optional<int> object, int threads, bool keep_images) {
+             int spp, int wavelengths, std::optional<int> object, int threads, bool keep_images,
+             long long seed) {
+  if (seed < 0 || seed > 4294967295LL)
+    throw py::value_error("seed must be in [0, 4294967295], got " + std::to_string(seed));
   GemRequest req;
   req.tilts_deg = gemTilts(tilts);
   req.width = width;
@@ -68,6 +73,7 @@ py::dict gem(const std::shared_ptr<Scene>& scene, const py::object& tilts, int w
   req.object = object;
   req.threads = threads;
   req.keep_images = keep_images;
+  req.seed = std::uint32_t(seed);
   checkSetting([&] { checkGemRequest(req); });  // every bad argument before any work
   (void)gemStone(*scene, req.object);           // std::invalid_argument: ValueError
   // analyseGem replaces the scene's camera and environment: the caller's Scene stays as it is.
@@ -88,6 +94,7 @@ void bindGem(py::module_& m) {
         py::arg("height") = d.height, py::arg("spp") = d.spp,
         py::arg("wavelengths") = d.wavelengths, py::arg("object") = py::none(),
         py::arg("threads") = d.threads, py::arg("keep_images") = d.keep_images,
+        py::arg("seed") = d.seed,
         "the gem studio (`eikon gem`, docs/gem-studio.md) on the CPU twin: the stone (object, "
         "else the first transparent one) viewed face-up from 250 mm, tilted through `tilts` "
         "(degrees in [-60, 60], or --tilts' text 'FROM:TO:STEP'), rendered under the standard "
@@ -97,7 +104,9 @@ void bindGem(py::module_& m) {
         "'flashes', 'outline_px'}]}, and with keep_images=True 'images': {'dome_K', 'spot_K' "
         "(per_tilt[K]), 'aset', 'idealscope', 'lightbox' (face-up)}: (H, W, 3) float32 linear "
         "sRGB. width and height in [16, 2048], spp in [1, 256], wavelengths (the fire render's) "
-        "in [1, 64]; ValueError naming the argument otherwise. The scene is not changed.");
+        "in [1, 64]; ValueError naming the argument otherwise. seed (eikon gem --seed): 0 centres "
+        "the pixel grid on the stone, another value shifts it by a sub-pixel offset drawn from "
+        "it (another draw of the same estimate). The scene is not changed.");
 }
 
 }  // namespace eikon::python

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <list>
+#include <memory>
+#include <mutex>
 #include <numbers>
 #include <vector>
 
@@ -132,15 +135,12 @@ glm::dvec3 gemRadiance(const GemLighting& g, const GemFrame& f, const glm::dvec3
       g, f, g.preset == GemPreset::Spot ? spotDirections(f) : std::vector<glm::dvec3>{}, d);
 }
 
-void makeGemEnvironment(const GemLighting& g, const Camera& camera, Environment& env) {
-  const GemFrame f = gemFrame(camera);
+namespace {
+
+/// The preset's image for a frame, texel by texel (makeGemEnvironment's work).
+std::vector<float> gemImage(const GemLighting& g, const GemFrame& f, int w, int h) {
   const std::vector<glm::dvec3> spots = spotDirections(f);
-  const int w = std::max(8, g.width), h = std::max(4, g.width / 2);
-  env = Environment{};
-  env.type = Environment::Type::LatLong;
-  env.image_width = w;
-  env.image_height = h;
-  env.image_rgba.assign(size_t(4) * size_t(w) * size_t(h), 0.0f);
+  std::vector<float> rgba(size_t(4) * size_t(w) * size_t(h), 0.0f);
   // Each texel is the mean of 2×2 directions in it (Environment::lookup's parameterisation:
   // u = atan2(x, −z)/2π + 0.5, v = acos(y)/π), so band edges are anti-aliased.
   for (int j = 0; j < h; ++j)
@@ -153,10 +153,66 @@ void makeGemEnvironment(const GemLighting& g, const Camera& camera, Environment&
                            -std::sin(theta) * std::cos(phi));
         sum += presetRadiance(g, f, spots, d);
       }
-      float* p = &env.image_rgba[size_t(4) * (size_t(j) * size_t(w) + size_t(i))];
+      float* p = &rgba[size_t(4) * (size_t(j) * size_t(w) + size_t(i))];
       for (int k = 0; k < 3; ++k) p[k] = float(0.25 * sum[k]);
       p[3] = 1.0f;
     }
+  return rgba;
+}
+
+/// The images made last, by everything they depend on (the preset's parameters and the frame,
+/// bit for bit): a scene loaded again, a sweep's next item or a gem analysis' next stone at the
+/// same tilts reuses them. Bounded to kCacheBytes (six images of the default 1024 × 512, 8 MiB
+/// each; an image over kCachedImageBytes is made every time), least recently used out first;
+/// safe from any thread.
+struct GemImageKey {
+  GemPreset preset;
+  double head_shadow_deg, spot_radius_deg, spot_radiance;
+  int width;
+  glm::dvec3 v, up;
+  bool operator==(const GemImageKey&) const = default;
+};
+constexpr size_t kCacheBytes = size_t(48) << 20, kCachedImageBytes = size_t(16) << 20;
+std::mutex gem_image_mutex;
+std::list<std::pair<GemImageKey, std::shared_ptr<const std::vector<float>>>> gem_images;
+
+std::shared_ptr<const std::vector<float>> cachedGemImage(const GemLighting& g, const GemFrame& f,
+                                                         int w, int h) {
+  const GemImageKey key{g.preset, g.head_shadow_deg, g.spot_radius_deg, g.spot_radiance, w, f.v,
+                        f.up};
+  {
+    const std::lock_guard<std::mutex> lock(gem_image_mutex);
+    for (auto it = gem_images.begin(); it != gem_images.end(); ++it)
+      if (it->first == key) {
+        gem_images.splice(gem_images.begin(), gem_images, it);
+        return it->second;
+      }
+  }
+  auto image = std::make_shared<const std::vector<float>>(gemImage(g, f, w, h));
+  const auto bytes = [](const auto& entry) { return entry.second->size() * sizeof(float); };
+  if (image->size() * sizeof(float) > kCachedImageBytes) return image;
+  const std::lock_guard<std::mutex> lock(gem_image_mutex);
+  gem_images.emplace_front(key, image);
+  size_t total = 0;
+  for (const auto& entry : gem_images) total += bytes(entry);
+  while (total > kCacheBytes) {
+    total -= bytes(gem_images.back());
+    gem_images.pop_back();
+  }
+  return image;
+}
+
+}  // namespace
+
+void makeGemEnvironment(const GemLighting& g, const Camera& camera, Environment& env) {
+  const GemFrame f = gemFrame(camera);
+  const int w = std::max(8, g.width), h = std::max(4, g.width / 2);
+  const std::shared_ptr<const std::vector<float>> image = cachedGemImage(g, f, w, h);
+  env = Environment{};
+  env.type = Environment::Type::LatLong;
+  env.image_width = w;
+  env.image_height = h;
+  env.image_rgba = *image;
 }
 
 glm::dvec3 whiteDiffuserRadiance(const Environment& env, const glm::dvec3& n) {

@@ -9,6 +9,7 @@
 #include "core/scene/gem_lighting.h"
 #include "core/scene/messages.h"
 #include "core/session/session.h"
+#include "core/spectrum/wavelength_sampling.h"
 
 namespace eikon {
 namespace {
@@ -49,6 +50,14 @@ GemView gemView(const SceneObject& stone, const GemRequest& r, double tilt_deg) 
   g.camera.fov_deg = 2.0 * std::atan(1.05 * radius / kGemViewDistanceMm) / kDeg;
   g.camera.width = r.width;
   g.camera.height = r.height;
+  if (r.seed != 0) {  // the pixel grid moved by a sub-pixel offset (the camera translated)
+    const std::uint32_t h = spectrum::pcgHash(r.seed * 0x9E3779B1u + 0x7F4A7C15u);
+    const double du = double(h & 0xffffu) / 65536.0 - 0.5, dv = double(h >> 16u) / 65536.0 - 0.5;
+    const double pixel_mm = 2.0 * 1.05 * radius / r.height;  // at the stone's centre
+    const glm::dvec3 shift = pixel_mm * (du * glm::cross(turn(up), turn(fwd)) + dv * turn(fwd));
+    g.camera.look_at += shift;
+    g.camera.position += shift;
+  }
   g.stone_up = up;
   return g;
 }
@@ -143,6 +152,12 @@ std::string formatDegrees(double v) {
 }
 
 }  // namespace
+
+Camera gemCamera(const Scene& scene, size_t object, const GemRequest& request, double tilt_deg) {
+  if (object >= scene.objects.size())
+    throw std::invalid_argument("object " + std::to_string(object) + " is not in the scene");
+  return gemView(scene.objects[object], request, tilt_deg).camera;
+}
 
 std::vector<double> parseGemTilts(const std::string& text) {
   const auto refuse = [&](const std::string& why) {

@@ -13,6 +13,7 @@
 // volume. The scene's camera and environment are replaced by the analysis' own.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -37,6 +38,10 @@ struct GemRequest {
   std::optional<int> object;  ///< the stone's index in "objects"; unset: the first transparent
   bool keep_images = false;   ///< GemReport::images (the report's pictures)
   int threads = 0;            ///< CPU threads (0: all)
+  /// 0: the pixel grid centred on the stone. Otherwise the grid is shifted by a sub-pixel offset
+  /// drawn from the seed (each axis uniform in [-0.5, 0.5) pixel): every ray the renders march
+  /// moves, so the metrics are another draw of the same estimate (docs/gem-studio.md "Viewing").
+  std::uint32_t seed = 0;
 };
 
 /// Every range of a request; SettingError naming the setting ("tilts", "width", ...).
@@ -70,6 +75,10 @@ struct GemReport {
   double seconds = 0.0;
   GemImages images;
 };
+
+/// The observer's camera of the stone `object` of `scene` tilted by `tilt_deg` (the renders'
+/// camera; its width and height are the request's).
+Camera gemCamera(const Scene& scene, size_t object, const GemRequest& request, double tilt_deg);
 
 /// Run the analysis on `scene` (whose camera and environment it replaces). `progress` (may be
 /// empty) gets the fraction done.

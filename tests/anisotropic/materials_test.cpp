@@ -179,3 +179,23 @@ TEST(Materials, RutileRewriteIsExact) {
     EXPECT_NEAR(d.index(nm), std::sqrt(5.913 + 0.2441 / (l2 - 0.0803)), 1e-14) << nm;
   }
 }
+
+TEST(Materials, MoissaniteRewriteMatchesWangWithinItsStatedError) {
+  // Wang et al.'s 6H-SiC n² = A + b/(λ² − c) − dλ² as Sellmeier terms, −dλ² by a pole at
+  // C = 10⁴ µm²: the difference dλ⁴/(C − λ²) in n² over 2n, below 1.3e-5 at 2325 nm.
+  const json m = readJson(fs::path(EIKON_SOURCE_DIR) / "materials" / "moissanite.json");
+  struct Wang {
+    const char* key;
+    double a, b, c, d;
+  };
+  for (const Wang& w : {Wang{"n_o", 6.57232, 0.1401, 0.03178, 0.02153},
+                        Wang{"n_e", 6.7452, 0.15352, 0.03597, 0.02249}}) {
+    const auto spec = parseSpec(m.at(w.key), std::string("moissanite.") + w.key);
+    for (double nm = 440; nm <= 2320; nm += 40) {
+      const double l2 = (nm * 1e-3) * (nm * 1e-3);
+      const double n = std::sqrt(w.a + w.b / (l2 - w.c) - w.d * l2);
+      EXPECT_NEAR(spec.index(nm), n, w.d * l2 * l2 / (1e4 - l2) / (2 * n) * 1.001 + 1e-14)
+          << w.key << " " << nm;
+    }
+  }
+}

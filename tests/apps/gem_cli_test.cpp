@@ -59,6 +59,11 @@ TEST(GemCli, BadInputIsOneLineAndWritesNothing) {
       {"gem " + quote(opaque.string()) + o, "no transparent object"},
       {"gem " + quote((tmp.path() / "missing.json").string()) + o, "missing.json"},
       {"gem " + kCut + kSmall + " -o " + quote(file.string()), "a file"},
+      {"gem " + kCut + kSmall + " --seed -1" + o, "--seed"},
+      {"gem " + kCut + kSmall + " --seed 4294967296" + o, "--seed"},
+      {"gem " + kCut + kSmall + " --seed x" + o, "--seed"},
+      {"gem " + kCut + kSmall + " --seed 99999999999999999999" + o, "got 99999999999999999999"},
+      {"gem " + kCut + kSmall + " --progress sometimes" + o, "--progress"},
   };
   for (const auto& [args, phrase] : cases) {
     const Outcome r = eikon::test::runEikon(args, tmp.path() / "io");
@@ -67,6 +72,40 @@ TEST(GemCli, BadInputIsOneLineAndWritesNothing) {
     EXPECT_NE(r.err.find(phrase), std::string::npos) << args << "\n" << r.err;
     EXPECT_FALSE(fs::exists(out)) << args;
   }
+}
+
+// stderr is not a terminal here: --progress always prints the tilt series' progress, with its
+// 100%; -q silences it even when forced; the default prints nothing for a short run.
+TEST(GemCli, ProgressOverTheTiltsAndQuiet) {
+  const eikon::test::TempDir tmp("eikon_gem_cli_progress");
+  const Outcome shown = eikon::test::runEikon("gem " + kCut + kSmall + " --json --progress always",
+                                              tmp.path() / "io");
+  ASSERT_EQ(shown.code, 0) << shown.err;
+  EXPECT_NE(shown.err.find("eikon: tilts"), std::string::npos) << shown.err;
+  EXPECT_NE(shown.err.find("100"), std::string::npos) << shown.err;
+  EXPECT_TRUE(nlohmann::json::accept(shown.out));  // stdout holds the JSON alone
+  const Outcome quiet = eikon::test::runEikon(
+      "gem " + kCut + kSmall + " --json --progress always -q", tmp.path() / "io");
+  ASSERT_EQ(quiet.code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+  const Outcome plain =
+      eikon::test::runEikon("gem " + kCut + kSmall + " --json", tmp.path() / "io");
+  EXPECT_EQ(plain.err, "");
+}
+
+// --seed N shifts the pixel grid: the same seed gives the same figures, another seed others.
+TEST(GemCli, SeedIsDeterministicAndChangesTheDraw) {
+  const eikon::test::TempDir tmp("eikon_gem_cli_seed");
+  const auto run = [&](const std::string& seed) {
+    const Outcome r =
+        eikon::test::runEikon("gem " + kCut + kSmall + " --json" + seed, tmp.path() / "io");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return nlohmann::json::parse(r.out);
+  };
+  const nlohmann::json a = run(" --seed 7"), b = run(" --seed 7"), c = run(" --seed 8");
+  EXPECT_EQ(a["brightness"], b["brightness"]);
+  EXPECT_EQ(a["per_tilt"], b["per_tilt"]);
+  EXPECT_NE(a["brightness"], c["brightness"]);
 }
 
 }  // namespace

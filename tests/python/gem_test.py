@@ -71,11 +71,25 @@ class Gem(unittest.TestCase):
         np.testing.assert_array_equal(scene.camera.position, camera)  # the caller's scene
         self.assertNotIn("images", eikon.gem(scene, **ARGS))
 
+    def test_seed_is_the_clis(self):
+        # seed shifts the pixel grid as --seed does: the same figures as the command's, others
+        # than seed 0's.
+        scene = eikon.Scene.load(self.path)
+        g = eikon.gem(scene, seed=5, **ARGS)
+        r = self.cli("--tilts", "-10,0", "--width", "32", "--height", "32", "--spp", "1",
+                     "--json", "--seed", "5")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        want = json.loads(r.stdout)
+        for name in FIGURES:
+            self.assertLessEqual(abs(g[name] - want[name]), 1e-12 * abs(want[name]), name)
+        self.assertNotEqual(g["brightness"], eikon.gem(scene, **ARGS)["brightness"])
+
     def test_bad_arguments_are_the_clis_refusals(self):
         scene = eikon.Scene.load(self.path)
         cases = [({"width": 8}, ("--width", "8"), "width must be in [16, 2048], got 8"),
                  ({"spp": 0}, ("--spp", "0"), "spp must be in [1, 256], got 0"),
-                 ({"tilts": "-90:0:10"}, ("--tilts", "-90:0:10"), "tilts must be FROM:TO:STEP")]
+                 ({"tilts": "-90:0:10"}, ("--tilts", "-90:0:10"), "tilts must be FROM:TO:STEP"),
+                 ({"seed": -1}, ("--seed", "-1"), "seed must be in [0, 4294967295], got -1")]
         for kw, args, words in cases:
             with self.assertRaises(ValueError) as cm:
                 eikon.gem(scene, **kw)

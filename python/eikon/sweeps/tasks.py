@@ -109,13 +109,14 @@ RESERVED = ("index", "seconds", "task_seconds", "worker", "warm", "error")
 
 class GemTask(Task):
     """eikon.gem(scene, **options) (`eikon gem`'s figures; its keywords: tilts, width, height,
-    spp, wavelengths, object, threads, keep_images). Figures: its top-level numbers (brightness,
+    spp, wavelengths, object, threads, keep_images, seed). Figures: its top-level numbers (brightness,
     fire, scintillation, windowing, extinction, contrast_change, object); with keep_images its
     pictures are the images (dome_K and spot_K per tilt, aset, idealscope, lightbox)."""
 
     kind = "gem"
     OPTIONS = {"tilts": (list, str), "width": int, "height": int, "spp": int, "wavelengths": int,
-               "object": int, "threads": int, "keep_images": bool, "exposure": numbers.Real}
+               "object": int, "threads": int, "keep_images": bool, "seed": int,
+               "exposure": numbers.Real}
 
     def __init__(self, options):
         super().__init__(options)

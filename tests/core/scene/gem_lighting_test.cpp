@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "tests/core/scene_support.h"
 
@@ -77,6 +78,46 @@ TEST(GemLighting, SceneSyntax) {
   EXPECT_TRUE(test::isOneLineSceneError(
       test::sceneErrorOf(head + R"({"preset": "dome", "head_shadow_deg": 95}})", "gem.json"),
       "gem.json", "/environment/head_shadow_deg", "must be in [0, 89]"));
+}
+
+// The preset images are kept per process (gem_lighting.cpp): the same preset, parameters and
+// frame give the same image, and a change to any of them a new one, never a kept image of another
+// key (each image below differs from the others where the change moves a band edge or a spot).
+TEST(GemLighting, KeptImagesServeOnlyTheirOwnKey) {
+  const Camera cam = cameraAt({0, 250, 0}), moved = cameraAt({150, 150, -100});
+  const auto image = [](const GemLighting& g, const Camera& c) {
+    Environment env;
+    makeGemEnvironment(g, c, env);
+    return env.image_rgba;
+  };
+  GemLighting dome, wider, spot, bigger;
+  wider.head_shadow_deg = 30.0;
+  spot.preset = GemPreset::Spot;
+  bigger = spot;
+  bigger.spot_radius_deg = 3.0;
+  const std::vector<float> a = image(dome, cam);
+  EXPECT_EQ(image(dome, cam), a);
+  EXPECT_NE(image(wider, cam), a);
+  EXPECT_NE(image(dome, moved), a);
+  EXPECT_NE(image(spot, cam), image(bigger, cam));
+  GemLighting narrow = dome;
+  narrow.width = 512;
+  EXPECT_EQ(image(narrow, cam).size(), size_t(4 * 512 * 256));
+  // The kept image is the one made afresh: a dome of 23° after six other images.
+  for (double h : {10.0, 12.0, 14.0, 16.0, 18.0, 20.0}) {
+    GemLighting other;
+    other.head_shadow_deg = h;
+    (void)image(other, cam);
+  }
+  EXPECT_EQ(image(dome, cam), a);
+  const glm::dvec3 w = whiteDiffuserRadiance(
+      [&] {
+        Environment env;
+        makeGemEnvironment(dome, cam, env);
+        return env;
+      }(),
+      {0, 1, 0});
+  EXPECT_NEAR(w.y, std::pow(std::cos(23.0 * kDeg), 2), 0.01);
 }
 
 }  // namespace
