@@ -3,8 +3,8 @@
 // (128 on the long side), simulated with WavefrontSettings defaults by the GPU twin
 // (GpuWavefront, shaders/wavefront.comp) and by the double-precision CPU reference
 // (WavefrontSimulator), each once, in one run. Prints per twin: seconds, patches processed
-// (seeded + 4·splits), patches/s, the flux balance (emitted vs left + caustic + energy + absorbed +
-// live at max_steps), the GPU/CPU speed ratio; then the same with straight steps off
+// (seeded + 4·splits + 2·halvings), patches/s, the flux balance (emitted vs left + caustic + energy
+// + absorbed + live at max_steps), the GPU/CPU speed ratio; then the same with straight steps off
 // (skip_empty = false) at a lower resolution (default 64: without skipping the 128 run takes
 // minutes per twin on a 2-core lavapipe machine), and the speed-up of skipping at that resolution.
 // Timings are not asserted anywhere (they vary ±20% on a shared machine).
@@ -27,10 +27,14 @@
 // made pencils). --reflections G1,G2,…: run the full resolution once per listed reflected-
 // generation limit (WavefrontSettings::max_reflection_generations; default 0), each printing the
 // reflected copies made and the flux dropped past the limit, and the time against the first.
+// --split halves,quarters: run the full resolution once per listed split rule
+// (WavefrontSettings::split_halves: a patch stretched along one pair of edges only is halved, or
+// every split makes quarters, the default) and print each one's time and patches against the first.
 //
 //   light_bench [--resolution N] [--no-skip-resolution M] [--steps-per-dispatch K] [--no-cpu]
 //               [--no-gpu] [--threads T1,T2,…] [--sharp] [--interfaces smoothed,sharp] [--no-low]
 //               [--caustics kill|pass] [--no-straight-to-boundary] [--reflections G1,G2,…]
+//               [--split halves,quarters]
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -58,7 +62,9 @@ double seconds(std::chrono::steady_clock::time_point t0) {
 struct Run {
   double s = 0;
   WavefrontStats st;
-  double patches() const { return double(st.seeded) + 4.0 * double(st.splits); }
+  double patches() const {
+    return double(st.seeded) + 4.0 * double(st.splits) + 2.0 * double(st.halvings);
+  }
 };
 
 void print(const char* name, const Run& r) {
@@ -66,9 +72,10 @@ void print(const char* name, const Run& r) {
   const double ended = s.flux_left + s.flux_caustic + s.flux_energy + s.flux_absorbed +
                        s.flux_reflected + s.flux_live_at_end;
   std::printf(
-      "  %-6s %8.2f s  %10.0f patches  %9.3g patches/s  steps %5d  splits %zu (refused %zu, "
-      "tears %zu)\n",
-      name, r.s, r.patches(), r.patches() / r.s, s.steps, s.splits, s.splits_refused, s.tears);
+      "  %-6s %8.2f s  %10.0f patches  %9.3g patches/s  steps %5d  splits %zu, halvings %zu "
+      "(refused %zu, tears %zu)\n",
+      name, r.s, r.patches(), r.patches() / r.s, s.steps, s.splits, s.halvings, s.splits_refused,
+      s.tears);
   std::printf(
       "       flux emitted %.9g = left %.9g + caustic %.9g + energy %.9g + absorbed %.9g + "
       "reflected %.9g + live %.9g  (balance %+.2e relative)\n",
@@ -91,10 +98,11 @@ struct Pair {
 };
 
 int gStepsPerDispatch = 16;
-bool gSharp = false;              ///< --sharp
-bool gPassCaustics = false;       ///< --caustics pass
-bool gToBoundary = true;          ///< !--no-straight-to-boundary
-int gReflections = 0;             ///< the run's --reflections entry
+bool gSharp = false;                                   ///< --sharp
+bool gPassCaustics = false;                            ///< --caustics pass
+bool gToBoundary = true;                               ///< !--no-straight-to-boundary
+int gReflections = 0;                                  ///< the run's --reflections entry
+bool gSplitHalves = WavefrontSettings{}.split_halves;  ///< the run's --split entry
 std::vector<int> gThreads = {0};  ///< CPU reference thread counts (0: hardware concurrency)
 
 Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu) {
@@ -106,6 +114,7 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
   s.pass_caustics = gPassCaustics;
   s.straight_to_boundary = gToBoundary;
   s.max_reflection_generations = gReflections;
+  s.split_halves = gSplitHalves;
   // The CPU twin's set-up (its skip distances and media; the field), timed as the GPU's is.
   const auto tc = std::chrono::steady_clock::now();
   const SharpInterfaces sharp =
@@ -113,9 +122,10 @@ Pair simulate(vk::Context* ctx, Scene scene, int resolution, bool skip, bool cpu
   const VolumeField field(vol);
   const double cpuSetup = seconds(tc);
   std::printf(
-      "\nvolume %dx%dx%d (h = %.4g mm), reflected generations %d, straight steps %s, "
+      "\nvolume %dx%dx%d (h = %.4g mm), reflected generations %d, split %s, straight steps %s, "
       "interfaces %s\n",
       vol.grid.dims[0], vol.grid.dims[1], vol.grid.dims[2], vol.grid.h, gReflections,
+      gSplitHalves ? "halves (and quarters)" : "quarters only",
       skip ? "on (skip_empty = true)" : "off (skip_empty = false)",
       !sharp.active()             ? "smoothed"
       : vol.boundary.convex_apart ? "sharp (crossings on the planes: faces known)"
@@ -209,8 +219,16 @@ int main(int argc, char** argv) {
                  "WavefrontSettings::max_reflection_generations, default 0)")
       ->delimiter(',')
       ->check(CLI::Range(0, 64));
+  const char* defaultRule = WavefrontSettings{}.split_halves ? "halves" : "quarters";
+  std::vector<std::string> splitRules = {defaultRule};
+  app.add_option("--split", splitRules,
+                 "Split rules to compare, comma separated: halves (a patch stretched one way only "
+                 "is halved), quarters (every split makes quarters; WavefrontSettings' default)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"halves", "quarters"}));
   CLI11_PARSE(app, argc, argv);
   if (gThreads.empty()) gThreads = {0};
+  if (splitRules.empty()) splitRules = {defaultRule};
   if (reflections.empty()) reflections = {0};
   gPassCaustics = caustics == "pass";
   const Scene scene = loadScene(scene_path);
@@ -227,27 +245,40 @@ int main(int argc, char** argv) {
 
   if (interfaces.empty()) interfaces = {gSharp ? "sharp" : "smoothed"};
   std::vector<std::string> rows;
+  const Pair* first = nullptr;
+  std::vector<Pair> fulls;
+  fulls.reserve(interfaces.size() * reflections.size() * splitRules.size());
   for (const std::string& kind : interfaces)
-    for (int g : reflections) {
-      gSharp = kind == "sharp";
-      gReflections = g;
-      const Pair full = simulate(ctx.get(), scene, resolution, true, cpu);
-      char row[320];
-      const double c = full.cpu.empty() ? 0.0 : full.cpu.back().s,
-                   gs = full.haveGpu ? full.gpu.s : 0.0;
-      const WavefrontStats& st = full.cpu.empty() ? full.gpu.st : full.cpu.back().st;
-      std::snprintf(
-          row, sizeof row,
-          "| %s | %d | %s | %d | %.3e | %.2f (+%.2f set-up) | %.2f (+%.2f set-up) | %.2f |",
-          scene_path.c_str(), resolution, kind.c_str(), g,
-          st.flux_emitted > 0 ? st.flux_reflected / st.flux_emitted : 0.0, c, full.cpuSetup, gs,
-          full.gpuSetup, c > 0 && gs > 0 ? c / gs : 0.0);
-      rows.push_back(row);
-    }
+    for (int g : reflections)
+      for (const std::string& rule : splitRules) {
+        gSharp = kind == "sharp";
+        gReflections = g;
+        gSplitHalves = rule == "halves";
+        const Pair& full = fulls.emplace_back(simulate(ctx.get(), scene, resolution, true, cpu));
+        if (!first) first = &full;
+        char row[400];
+        const double c = full.cpu.empty() ? 0.0 : full.cpu.back().s,
+                     gs = full.haveGpu ? full.gpu.s : 0.0;
+        const Run& r = full.cpu.empty() ? full.gpu : full.cpu.back();
+        const Run& r0 = first->cpu.empty() ? first->gpu : first->cpu.back();
+        const WavefrontStats& st = r.st;
+        std::snprintf(
+            row, sizeof row,
+            "| %s | %d | %s | %d | %s | %.0f (%.2fx) | %.3e | %.2f (+%.2f set-up; %.2fx) | %.2f "
+            "(+%.2f set-up) | %.2f |",
+            scene_path.c_str(), resolution, kind.c_str(), g, rule.c_str(), r.patches(),
+            r.patches() / r0.patches(),
+            st.flux_emitted > 0 ? st.flux_reflected / st.flux_emitted : 0.0, c, full.cpuSetup,
+            c > 0 && !first->cpu.empty() ? c / first->cpu.back().s : 0.0, gs, full.gpuSetup,
+            c > 0 && gs > 0 ? c / gs : 0.0);
+        rows.push_back(row);
+      }
   gReflections = reflections.front();
+  gSplitHalves = splitRules.front() == "halves";
   std::printf(
-      "\n| scene | resolution | interfaces | reflected generations | reflected flux dropped (of "
-      "emitted) | CPU s (last thread count) | GPU s | CPU/GPU |\n");
+      "\n| scene | resolution | interfaces | reflected generations | split | patches (against "
+      "the first row) | reflected flux dropped (of emitted) | CPU s (last thread count; against "
+      "the first row) | GPU s | CPU/GPU |\n");
   for (const std::string& r : rows) std::printf("%s\n", r.c_str());
   if (!lowRuns) return 0;
   std::printf(

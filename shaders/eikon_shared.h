@@ -282,13 +282,15 @@ struct PolarisedResult {
 #define EIKON_SCAN_BLOCK 512
 // WavePatch.state.x: what the kernel decided for the patch.
 #define EIKON_PATCH_ALIVE 0     // still propagating (or out of steps: state.w == max_steps)
-#define EIKON_PATCH_SPLIT 1     // alive, stopped because an edge exceeds the split span
+#define EIKON_PATCH_SPLIT 1     // alive, stopped because edges of both pairs exceed the split span: quarters
 #define EIKON_PATCH_LEFT 2      // killed: centre left the bounds (or its ray misses them)
 #define EIKON_PATCH_CAUSTIC 3   // killed: orientation flip (fold caustic)
 #define EIKON_PATCH_ENERGY 4    // killed: flux below min_energy_fraction of its seed's
 #define EIKON_PATCH_OPAQUE 5    // killed: centre in an opaque voxel (flux counted as absorbed)
 #define EIKON_PATCH_TORN 6      // alive, torn by a boundary (sharp): becomes four pencils, as a split
 #define EIKON_PATCH_REFLECT 7   // alive, its step undone (sharp): becomes itself and its reflected copy
+#define EIKON_PATCH_HALVE_U 8   // alive, stopped because a u edge (0→1, 3→2) alone exceeds the split span: halves
+#define EIKON_PATCH_HALVE_V 9   // alive, stopped because a v edge (1→2, 0→3) alone exceeds the split span: halves
 // Splat buffer: per voxel 4 signed 64-bit fixed-point sums as (lo, hi) uint pairs, in the order
 // weight, and the biased weight·(1 + dir.x), ·(1 + dir.y), ·(1 + dir.z) (every term ≥ 0; the host
 // subtracts the weight) (EIKON_SPLAT_ACC_WORDS words per voxel), then one uint per voxel
@@ -302,7 +304,8 @@ struct WaveParams {
   vec4 step;         // x: dt (mm); y: split edge (mm); z: min energy fraction; w: 1/h³
   vec4 wavelength;   // x: λ (µm); y: 1/λ²; z: 1/λ⁴; w: splat scale (fixed-point units per W/mm²)
   ivec4 control;     // x: probe axis (−1: none); y: steps per dispatch; z: max_steps; w: mode (0 o, 1 e)
-  vec4 probe;        // x: probe plane position (mm); yzw: unused
+  vec4 probe;        // x: probe plane position (mm); y: 1 = halves for a patch stretched one way
+                     // (split_halves), 0 = quarters always; zw: unused
   ivec4 options;     // x: 1 = straight steps across homogeneous regions (skip_empty); y: 1 = pass_caustics;
                      // z: 1 = straight steps up to the next boundary (straight_to_boundary);
                      // w: reflected generations followed (max_reflection_generations)
@@ -332,7 +335,8 @@ struct WaveTally {
   vec4 probe_dir;  // xyz: Σ ±flux·unit direction of the centre's motion at the crossing;
                    // w: sharp interfaces: Σ flux lost to Fresnel reflection in the last dispatch,
                    // less the flux reflected copies took up
-  uvec4 count_c;   // x: reflected copies asked for (EIKON_PATCH_REFLECT); yzw: unused
+  uvec4 count_c;   // x: reflected copies asked for (EIKON_PATCH_REFLECT); y: splits into halves
+                   // asked for (EIKON_PATCH_HALVE_U, _V); zw: unused
 };
 
 // One patch: four corners in bilinear order (0,0), (1,0), (1,1), (0,1).

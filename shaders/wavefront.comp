@@ -22,14 +22,16 @@
 // dispatches — each carries its own step count in state.w).
 //
 // The list rebuild between propagations (see docs/light-simulator.md, "List rebuild"):
-//   COUNT (wavefront_count.comp): scan[i] = 0 (killed, or out of steps), 1 (keep) or 4 (split one
-//     level), and the workgroup's kill statistics into tally[group]; COUNT_SPLITS / COUNT_BUDGET
-//     only when the total exceeds max_patches (rank the split requests, grant the first ones);
+//   COUNT (wavefront_count.comp): scan[i] = 0 (killed, or out of steps), 1 (keep), 2 (split into
+//     halves, or a reflected copy) or 4 (split into quarters, or torn into pencils), and the
+//     workgroup's kill statistics into tally[group]; COUNT_SPLITS / COUNT_BUDGET only when the
+//     total exceeds max_patches (rank the split requests, grant the first ones);
 //   scan.comp turns scan[] into exclusive offsets and writes the total;
-//   SCATTER (this shader, push constant control.y): survivors and the four children (bilinear 3×3
-//     lattice, new w rescaled to the float n(x), ¼ flux and area0 each) go to the other list at
-//     their offset; a child whose edge still exceeds the split span is written as SPLIT and is
-//     split again by the next rebuild without propagating (the reference's recursive split).
+//   SCATTER (this shader, push constant control.y): survivors and the four or two children
+//     (bilinear 3×3 lattice, new w rescaled to the float n(x), ¼ or ½ of the flux and area0 each)
+//     go to the other list at their offset; a child whose edge still exceeds the split span is
+//     written as due its split (SPLIT, HALVE_U, HALVE_V) and is split again by the next rebuild
+//     without propagating (the reference's recursive split).
 //
 // Sharp interfaces (specialisation constant kSharpLight, set by the host only when the
 // scene's boundary field applies, as the view renderer's kSharpMarch): every corner crosses its
@@ -308,13 +310,31 @@ void splatAt(vec3 m, float value, float irr, vec3 dir) {
 
 vec3 centreOf(vec3 x[4]) { return 0.25 * (x[0] + x[1] + x[2] + x[3]); }
 
-// Whether a patch of flux `flux`, descended from a seed of `seedFlux`, may be split: only while
-// its quarters keep at least the energy threshold (min_energy_fraction of the seed's flux). A
-// patch due a split it may not make ends as a kill by energy (endOfStep), as its quarters would
-// have after one step each; a child of a split that would need another is stepped once first
-// (scatter). Near grazing incidence on a smoothed interface a stretched patch split 2×2 until
-// then made thousands of such quarters per seed (PatchStepper::mayBeSplit).
-bool mayBeSplit(float flux, float seedFlux) { return 0.25 * flux >= P.step.z * seedFlux; }
+// How a patch splits (PatchStepper::splitWays): 0 when no edge exceeds the split span; 1 (two
+// halves across the u edges 0→1 and 3→2) or 2 (across 1→2 and 0→3) when only one pair of opposite
+// edges does; 3 (quarters) when both do, or always when WaveParams.probe.y (split_halves) is 0.
+const int kSplitNone = 0, kSplitU = 1, kSplitV = 2, kSplitQuarters = 3;
+int splitWays(vec3 x[4]) {
+  const float maxEdge = P.step.y;
+  const bool u = max(length(x[1] - x[0]), length(x[2] - x[3])) > maxEdge;
+  const bool v = max(length(x[2] - x[1]), length(x[3] - x[0])) > maxEdge;
+  if (P.probe.y < 0.5) return u || v ? kSplitQuarters : kSplitNone;
+  return (u ? kSplitU : kSplitNone) | (v ? kSplitV : kSplitNone);
+}
+// The state of a patch due a split `ways` (≠ kSplitNone).
+int splitState(int ways) {
+  return ways == kSplitQuarters ? EIKON_PATCH_SPLIT : ways == kSplitU ? EIKON_PATCH_HALVE_U : EIKON_PATCH_HALVE_V;
+}
+
+// Whether a patch of flux `flux`, descended from a seed of `seedFlux`, may be split `ways`: only
+// while its children (halves or quarters) keep at least the energy threshold (min_energy_fraction
+// of the seed's flux). A patch due a split it may not make ends as a kill by energy (endOfStep),
+// as its children would have after one step each; a child of a split that would need another is
+// stepped once first (scatter). Near grazing incidence on a smoothed interface a stretched patch
+// split until then made thousands of such children per seed (PatchStepper::mayBeSplit).
+bool mayBeSplit(float flux, float seedFlux, int ways) {
+  return (ways == kSplitQuarters ? 0.25 : 0.5) * flux >= P.step.z * seedFlux;
+}
 
 float maxEdgeOf(vec3 x[4]) {
   float e = 0.0;
@@ -849,10 +869,11 @@ bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) 
     }
     p.state.y = -p.state.y;  // pass_caustics: through the focal line, orientation reversed
   }
-  // Energy: below the threshold, or due a split whose quarters would be (mayBeSplit).
-  const bool stretched = maxEdgeOf(x) > P.step.y && !straddling;
+  // Energy: below the threshold, or due a split whose children would be (mayBeSplit).
+  const int ways = straddling ? kSplitNone : splitWays(x);
+  const bool stretched = ways != kSplitNone;
   const float ahead = p.flux.x + p.refl.x;  // a reflected copy's flux and its shadow
-  if (ahead < P.step.z * p.flux.z || (stretched && !mayBeSplit(ahead, p.flux.z))) {
+  if (ahead < P.step.z * p.flux.z || (stretched && !mayBeSplit(ahead, p.flux.z, ways))) {
     p.state.x = EIKON_PATCH_ENERGY;
     return true;
   }
@@ -861,7 +882,7 @@ bool endOfStep(inout WavePatch p, PatchStep st, vec4 med, vec3 x[4], vec3 w[4]) 
     return true;
   }
   if (stretched) {
-    p.state.x = EIKON_PATCH_SPLIT;
+    p.state.x = splitState(ways);
     return true;
   }
   return false;
@@ -977,10 +998,15 @@ void scatter(uint id) {
     }
     return;
   }
-  // Four children on the bilinear 3×3 lattice; the parent's corners are kept exactly.
+  // Quarters (EIKON_PATCH_SPLIT) or halves across the u or v edges (EIKON_PATCH_HALVE_U, _V) on
+  // the bilinear 3×3 lattice, only its points the children use; the parent's corners are kept
+  // exactly (PatchStepper::splitInto).
+  const int ways = p.state.x == EIKON_PATCH_SPLIT ? kSplitQuarters
+                   : p.state.x == EIKON_PATCH_HALVE_U ? kSplitU : kSplitV;
   vec3 X[9], W[9];
   for (int b = 0; b < 3; ++b)
     for (int a = 0; a < 3; ++a) {
+      if ((ways == kSplitU && b == 1) || (ways == kSplitV && a == 1)) continue;  // not used
       const float fa = 0.5 * float(a), fb = 0.5 * float(b);
       const float w0 = (1.0 - fa) * (1.0 - fb), w1 = fa * (1.0 - fb), w2 = fa * fb, w3 = (1.0 - fa) * fb;
       X[b * 3 + a] = w0 * p.x[0].xyz + w1 * p.x[1].xyz + w2 * p.x[2].xyz + w3 * p.x[3].xyz;
@@ -996,24 +1022,30 @@ void scatter(uint id) {
     }
   X[0] = p.x[0].xyz, X[2] = p.x[1].xyz, X[8] = p.x[2].xyz, X[6] = p.x[3].xyz;
   W[0] = p.w[0].xyz, W[2] = p.w[1].xyz, W[8] = p.w[2].xyz, W[6] = p.w[3].xyz;
-  const float maxEdge = P.step.y;
-  for (int cb = 0; cb < 2; ++cb)
-    for (int ca = 0; ca < 2; ++ca) {
-      WavePatch c = p;
-      const int pa[4] = int[4](ca, ca + 1, ca + 1, ca), pb[4] = int[4](cb, cb, cb + 1, cb + 1);
-      vec3 cx[4];
-      for (int k = 0; k < 4; ++k) {
-        cx[k] = X[pb[k] * 3 + pa[k]];
-        c.x[k] = vec4(cx[k], 0.0);
-        c.w[k] = vec4(W[pb[k] * 3 + pa[k]], 0.0);
-      }
-      c.flux.x = 0.25 * p.flux.x;
-      c.flux.y = 0.25 * p.flux.y;
-      c.refl.x = 0.25 * p.refl.x;
-      c.state.x = maxEdgeOf(cx) > maxEdge && mayBeSplit(c.flux.x + c.refl.x, c.flux.z) ? EIKON_PATCH_SPLIT
-                                                                            : EIKON_PATCH_ALIVE;
-      storeOther(o + uint(cb * 2 + ca), c);
+  const int children = ways == kSplitQuarters ? 4 : 2;
+  const float share = ways == kSplitQuarters ? 0.25 : 0.5;  // equal parameter areas
+  for (int i = 0; i < children; ++i) {
+    // The child's parameter ranges [a0, a1] × [b0, b1] on the lattice.
+    const int a0 = ways == kSplitV ? 0 : (ways == kSplitU ? i : (i & 1));
+    const int a1 = ways == kSplitV ? 2 : a0 + 1;
+    const int b0 = ways == kSplitU ? 0 : (ways == kSplitV ? i : (i >> 1));
+    const int b1 = ways == kSplitU ? 2 : b0 + 1;
+    WavePatch c = p;
+    const int pa[4] = int[4](a0, a1, a1, a0), pb[4] = int[4](b0, b0, b1, b1);
+    vec3 cx[4];
+    for (int k = 0; k < 4; ++k) {
+      cx[k] = X[pb[k] * 3 + pa[k]];
+      c.x[k] = vec4(cx[k], 0.0);
+      c.w[k] = vec4(W[pb[k] * 3 + pa[k]], 0.0);
     }
+    c.flux.x = share * p.flux.x;
+    c.flux.y = share * p.flux.y;
+    c.refl.x = share * p.refl.x;
+    const int cw = splitWays(cx);
+    c.state.x = cw != kSplitNone && mayBeSplit(c.flux.x + c.refl.x, c.flux.z, cw) ? splitState(cw)
+                                                                                  : EIKON_PATCH_ALIVE;
+    storeOther(o + uint(i), c);
+  }
 }
 
 void main() {

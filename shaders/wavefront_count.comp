@@ -1,7 +1,8 @@
 #version 450
 // Count passes of the light simulator's list rebuild (see wavefront.comp and
 // docs/light-simulator.md): per patch of the source list, its number of outputs (0 dead or out of
-// steps, 1 kept, 2 itself and its reflected copy, 4 split one level or torn into pencils) into
+// steps, 1 kept, 2 split into halves or itself and its reflected copy, 4 split into quarters or
+// torn into pencils; one level) into
 // scan[i], and in the COUNT and BUDGET
 // passes the workgroup's kill statistics and probe-plane sums reduced in shared memory (a tree of
 // EIKON_WAVE_WG lanes, float sums) into tally[workgroup], which the host adds in double. A separate
@@ -49,6 +50,12 @@ void countPass(uint id, uint lid, uint mode) {
         keep = 1u;
         wantSplit = true;
         break;
+      case EIKON_PATCH_HALVE_U:  // two halves: ranked as a split request
+      case EIKON_PATCH_HALVE_V:
+        keep = 1u;
+        wantSplit = true;
+        cc.y = 1u;
+        break;
       case EIKON_PATCH_TORN:  // four pencils: counted as a split
         keep = 1u;
         wantSplit = true;
@@ -82,13 +89,13 @@ void countPass(uint id, uint lid, uint mode) {
     cb.y = wantSplit ? 1u : 0u;
     cb.z = keep;
     cb.w = uint(max(p.state.w, 0));
-    const uint grown = cc.x != 0u ? 2u : 4u;
+    const uint grown = cc.x != 0u || cc.y != 0u ? 2u : 4u;
     uint c = wantSplit ? grown : keep;
     if (mode == EIKON_WM_COUNT_SPLITS) c = wantSplit ? 1u : 0u;
     if (mode == EIKON_WM_COUNT_BUDGET && wantSplit) {
       const bool granted = scan[id] < pc.control.z;
       c = granted ? grown : 1u;
-      if (!granted) cen.w = 0.0, cc.x = 0u;  // a refused tear or copy: the patch goes on whole
+      if (!granted) cen.w = 0.0, cc.xy = uvec2(0u);  // refused: the patch goes on whole
     }
     scan[id] = c;
   }

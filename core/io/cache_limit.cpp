@@ -67,15 +67,14 @@ uint64_t trimCacheDir(const fs::path& dir, const fs::path& keep, uint64_t max_by
   return removed;
 }
 
-uint64_t removeLeastRecentlyUsed(const fs::path& dir, const fs::path& keep, uint64_t max_bytes,
-                                 const std::string& prefix) {
+uint64_t removeLeastRecentlyUsed(const fs::path& dir, const fs::path& keep, uint64_t max_bytes) {
   std::error_code ec;
   std::vector<std::pair<fs::file_time_type, std::pair<fs::path, uint64_t>>> entries;
   uint64_t total = 0;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     std::error_code e;
     const std::string name = it->path().filename().string();
-    if (!isCacheEntryName(name) || name.rfind(prefix, 0) != 0 || !it->is_regular_file(e)) continue;
+    if (!isCacheEntryName(name) || !it->is_regular_file(e)) continue;
     const uint64_t size = it->file_size(e);
     const fs::file_time_type time = it->last_write_time(e);
     if (e) continue;  // removed meanwhile

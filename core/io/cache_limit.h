@@ -46,11 +46,9 @@ void touchCacheEntry(const std::filesystem::path& entry);
 uint64_t trimCacheDir(const std::filesystem::path& dir, const std::filesystem::path& keep = {},
                       uint64_t max_bytes = cacheMaxBytes());
 
-/// What trimCacheDir does under its lock, for the entries whose names start with `prefix` only
-/// (the volume cache's own cap on its "volume-" entries): remove the least recently used of them
-/// but `keep` until they take at most `max_bytes`. Takes no lock. Returns the bytes removed.
+/// What trimCacheDir does under its lock: remove the least recently used entries of `dir` but
+/// `keep` until all take at most `max_bytes`. Takes no lock. Returns the bytes removed.
 uint64_t removeLeastRecentlyUsed(const std::filesystem::path& dir,
-                                 const std::filesystem::path& keep, uint64_t max_bytes,
-                                 const std::string& prefix = "");
+                                 const std::filesystem::path& keep, uint64_t max_bytes);
 
 }  // namespace eikon

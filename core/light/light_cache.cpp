@@ -114,6 +114,7 @@ uint64_t lightCacheKey(const Scene& scene, const VolumeSet& v, const LightingOpt
   h.value(s.max_steps);
   h.value(s.min_energy_fraction);
   h.value(s.split_span_voxels);
+  h.value(s.split_halves);
   h.value(s.seed_span_voxels);
   h.value(s.splat);
   h.value(s.max_patches);

@@ -17,7 +17,7 @@ double LightingSummary::conservationError() const {
 
 void LightingSummary::add(const WavefrontStats& s, double weight) {
   ++runs;
-  patches += s.seeded + 4 * s.splits;
+  patches += s.seeded + 4 * s.splits + 2 * s.halvings;
   flux_emitted += weight * s.flux_emitted;
   flux_left += weight * s.flux_left;
   flux_caustic += weight * s.flux_caustic;

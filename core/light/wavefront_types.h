@@ -28,12 +28,21 @@ struct WavefrontSettings {
   double dt = 0.0;  ///< time step (mm of light travel in vacuum); ≤ 0: 0.5·h of the splat grid
   int max_steps = 20000;  ///< hard cap on the number of steps
   /// Kill a patch whose flux falls below this fraction of its seed's flux, by attenuation or by
-  /// splitting (each split quarters it): 1e-4 allows ~6 generations of splits without absorption.
+  /// splitting (a split halves or quarters it): 1e-4 allows ~6 generations of quarters (~13 of
+  /// halves) without absorption.
   /// This also ends patches trapped in whispering-gallery orbits, which stretch and split forever.
   double min_energy_fraction = 1e-4;
   double split_span_voxels =
       1.0;                        ///< split a patch when an edge is longer than this (splat voxels)
   double seed_span_voxels = 0.5;  ///< edge of the seed patches (directional: in the launch plane)
+  /// true: a patch stretched past the split span along one pair of opposite edges only is split
+  /// into two halves across them (with both pairs too long, into four quarters). false (the
+  /// default): every split makes quarters. Halves make fewer patches where a fan ends before the
+  /// energy threshold (sharp caustic_sphere 128³: 0.78× the patches, 0.9× the time) but carry the
+  /// long fans of light grazing a smoothed interface on to 10⁴ children per seed where quarters
+  /// reach the threshold at ~100 across (smoothed caustic_sphere 32³: 1.2× the patches, 2.3× the
+  /// time; docs/light-simulator.md "Split"). light_bench --split halves,quarters compares them.
+  bool split_halves = false;
   Splat splat = Splat::Accumulate;
   double wavelength_nm = 587.56;  ///< index and attenuation band are evaluated here
   int max_patches = 1 << 20;      ///< live patches never exceed this: splits beyond it are refused
@@ -170,8 +179,11 @@ struct WavefrontStats {
   size_t straight_time_steps = 0;  ///< time steps covered by them (Σ k)
   size_t seeded = 0;               ///< patches launched toward the volume
   size_t max_live = 0;             ///< most live patches at once
-  size_t splits = 0;               ///< parents split into four
-  size_t splits_refused = 0;       ///< splits not done because max_patches would be exceeded
+  size_t splits = 0;               ///< parents split into four (quarters)
+  /// parents split into two halves (stretched along one pair of opposite edges only;
+  /// WavefrontSettings::split_halves). Patches made: seeded + 4·splits + 2·halvings.
+  size_t halvings = 0;
+  size_t splits_refused = 0;  ///< splits not done because max_patches would be exceeded
   /// Sharp interfaces: torn patches (corners that met different boundaries, or one boundary with
   /// different outcomes) replaced by four pencils, one along each corner's ray (counted in
   /// `splits` too: each adds three patches)

@@ -52,10 +52,14 @@ struct alignas(64) Chunk {
   std::vector<Patch> surv;
   std::vector<size_t> survKills;
   /// Live count while the step runs: absolute when emitting against the budget (one chunk, or the
-  /// serial redo), else relative to the chunk's start (−1 per kill, +3 per split).
+  /// serial redo), else relative to the chunk's start (−1 per kill, +3 per split into quarters,
+  /// +1 per split into halves or reflected copy).
   long long live = 0;
   long long maxAfterSplit = LLONG_MIN;  ///< highest `live` right after a split in this step
-  size_t kills = 0, splits = 0, refused = 0, tears = 0, reflections = 0;  ///< this step's
+  size_t kills = 0, splits = 0, halvings = 0, refused = 0, tears = 0, reflections = 0;  ///< step's
+  /// Patches this step added to the live count by splits and reflected copies.
+  long long grown() const { return 3 * (long long)splits + (long long)(halvings + reflections); }
+  bool anyGrowth() const { return splits + halvings + reflections > 0; }
 };
 
 /// Worker threads for one WavefrontSimulator::run, created once: go(f) calls f(c) for chunk c on
@@ -194,6 +198,8 @@ class PatchStepper {
   /// Split p (repeatedly) until no edge exceeds the split span or the patch budget is spent: a
   /// split is refused when it would take ch.live above `budget` (LLONG_MAX: never).
   void emit(Chunk& ch, const Patch& p0, long long budget) const;
+  /// The ways a patch splits (splitWays): bits, kSplitU | kSplitV = quarters.
+  static constexpr int kSplitNone = 0, kSplitU = 1, kSplitV = 2, kSplitQuarters = 3;
 
  private:
   glm::dvec4 sampleIndex(const glm::dvec3& x, int mode) const {
@@ -237,21 +243,30 @@ class PatchStepper {
   static double fluxAhead(const Patch& p) { return p.energy + p.shadow; }
   bool straddles(const Patch& p) const;
   bool torn(const Patch& p) const;
-  /// Whether p may be split: only while its quarters keep at least the energy threshold
-  /// (min_energy_fraction of its seed's flux). A patch due a split it may not make ends as a kill
-  /// by energy (endOfStep), as its quarters would have after one step each; a child of a split
-  /// that would need another is stepped once first (emit). Near grazing incidence on a smoothed
-  /// interface a stretched patch split 2×2 until then made thousands of such quarters per seed
-  /// (wavefront.comp mayBeSplit).
-  static double maxEdgeOf(const Patch& p) {
-    double e = 0;
-    for (size_t k = 0; k < 4; ++k) e = std::max(e, glm::length(p.x[(k + 1) % 4] - p.x[k]));
-    return e;
+  /// How p splits (wavefront.comp splitWays): kSplitNone when no edge exceeds the split span;
+  /// kSplitU (two halves across the u edges 0→1 and 3→2) or kSplitV (across 1→2 and 0→3) when only
+  /// one pair of opposite edges does; kSplitQuarters when both do (or always, with
+  /// WavefrontSettings::split_halves off). A patch fanned along one direction (light grazing a
+  /// smoothed interface) thus doubles its patches per generation rather than quadrupling them.
+  int splitWays(const Patch& p) const {
+    auto len = [&](size_t a, size_t b) { return glm::length(p.x[b] - p.x[a]); };
+    const bool u = std::max(len(0, 1), len(3, 2)) > maxEdge_;
+    const bool v = std::max(len(1, 2), len(0, 3)) > maxEdge_;
+    if (!s_.split_halves) return u || v ? kSplitQuarters : kSplitNone;
+    return (u ? kSplitU : kSplitNone) | (v ? kSplitV : kSplitNone);
   }
-  bool mayBeSplit(const Patch& p) const {
-    return 0.25 * fluxAhead(p) >= s_.min_energy_fraction * p.seed_energy;
+  /// Whether p may be split `ways`: only while its children (halves or quarters) keep at least the
+  /// energy threshold (min_energy_fraction of its seed's flux). A patch due a split it may not make
+  /// ends as a kill by energy (endOfStep), as its children would have after one step each; a child
+  /// of a split that would need another is stepped once first (emit). Near grazing incidence on a
+  /// smoothed interface a stretched patch split until then made thousands of such children per
+  /// seed (wavefront.comp mayBeSplit).
+  bool mayBeSplit(const Patch& p, int ways) const {
+    const double share = ways == kSplitQuarters ? 0.25 : 0.5;
+    return share * fluxAhead(p) >= s_.min_energy_fraction * p.seed_energy;
   }
   double straightClear(const glm::dvec3& x, const glm::dvec3& v, int r) const;
+  void splitInto(const Patch& p, int ways, std::vector<Patch>& out) const;
 
   const Field& f_;
   const Grid& grid_;
@@ -766,20 +781,17 @@ int PatchStepper::straightSteps(const Patch& p, glm::dvec3 v[4], double& sigma1)
 // Split p (repeatedly) until no edge exceeds maxEdge_ or the patch budget is spent: a split is
 // refused when it would take ch.live above `budget` (LLONG_MAX: never; see the step loop).
 void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
-  // Most patches need no split: emitted as they are, without the work stack's copies.
-  double e0 = 0;
-  for (int k = 0; k < 4; ++k)
-    e0 = std::max(e0, glm::length(p0.x[size_t((k + 1) % 4)] - p0.x[size_t(k)]));
-  // One patch becomes four (a split or a tear's pencils) unless that takes ch.live over budget:
-  // then p goes on whole (refused).
-  auto grant = [&](const Patch& p) {
-    if (ch.live + 3 > budget) {
+  // One patch becomes four (quarters or a tear's pencils) or two (halves) unless that takes
+  // ch.live over budget: then p goes on whole (refused).
+  auto grant = [&](const Patch& p, int ways) {
+    const long long more = ways == kSplitQuarters ? 3 : 1;
+    if (ch.live + more > budget) {
       ++ch.refused;
       ch.next->push_back(p);
       return false;
     }
-    ch.live += 3;
-    ++ch.splits;
+    ch.live += more;
+    ++(ways == kSplitQuarters ? ch.splits : ch.halvings);
     ch.maxAfterSplit = std::max(ch.maxAfterSplit, ch.live);
     return true;
   };
@@ -809,7 +821,7 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
     return;
   }
   if (sharp_ && torn(p0)) {
-    if (!grant(p0)) return;
+    if (!grant(p0, kSplitQuarters)) return;
     ++ch.tears;
     // Four pencils, one per corner: all four corners on the corner's ray (zero width: a pencil
     // never splits, deposits its flux along its ray and has no irradiance of its own).
@@ -829,7 +841,8 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
     }
     return;
   }
-  if (e0 <= maxEdge_ || (sharp_ && straddles(p0))) {
+  // Most patches need no split: emitted as they are, without the work stack's copies.
+  if (splitWays(p0) == kSplitNone || (sharp_ && straddles(p0))) {
     ch.next->push_back(p0);
     return;
   }
@@ -837,46 +850,58 @@ void PatchStepper::emit(Chunk& ch, const Patch& p0, long long budget) const {
   work.clear();
   work.push_back(p0);
   while (!work.empty()) {
-    Patch p = work.back();
+    const Patch p = work.back();
     work.pop_back();
-    double e = 0;
-    for (int k = 0; k < 4; ++k)
-      e = std::max(e, glm::length(p.x[size_t((k + 1) % 4)] - p.x[size_t(k)]));
-    if (e <= maxEdge_ || (sharp_ && straddles(p)) || !mayBeSplit(p)) {
+    const int ways = splitWays(p);
+    if (ways == kSplitNone || (sharp_ && straddles(p)) || !mayBeSplit(p, ways)) {
       ch.next->push_back(p);
       continue;
     }
-    if (!grant(p)) continue;
-    // 3×3 lattice of bilinear points; the parent's own corners are kept exactly.
-    glm::dvec3 X[3][3], W[3][3];
-    for (int b = 0; b < 3; ++b)
-      for (int a = 0; a < 3; ++a) {
-        const double fa = 0.5 * a, fb = 0.5 * b;
-        X[b][a] = (1 - fa) * (1 - fb) * p.x[0] + fa * (1 - fb) * p.x[1] + fa * fb * p.x[2] +
-                  (1 - fa) * fb * p.x[3];
-        glm::dvec3 w = (1 - fa) * (1 - fb) * p.w[0] + fa * (1 - fb) * p.w[1] + fa * fb * p.w[2] +
-                       (1 - fa) * fb * p.w[3];
-        if ((a == 1 || b == 1) && sharp_)
-          w = mediumShell(p.region[0], glm::normalize(w));  // the region's medium's shell
-        else if (a == 1 || b == 1)
-          w = onShell(X[b][a], glm::normalize(w));  // back onto the mode's shell
-        W[b][a] = w;
-      }
-    X[0][0] = p.x[0], X[0][2] = p.x[1], X[2][2] = p.x[2], X[2][0] = p.x[3];
-    W[0][0] = p.w[0], W[0][2] = p.w[1], W[2][2] = p.w[2], W[2][0] = p.w[3];
-    for (int cb = 0; cb < 2; ++cb)
-      for (int ca = 0; ca < 2; ++ca) {
-        Patch c = p;
-        const int pa[4] = {ca, ca + 1, ca + 1, ca}, pb[4] = {cb, cb, cb + 1, cb + 1};
-        for (int k = 0; k < 4; ++k) {
-          c.x[size_t(k)] = X[pb[k]][pa[k]];
-          c.w[size_t(k)] = W[pb[k]][pa[k]];
-        }
-        c.energy = 0.25 * p.energy;  // equal parameter area: a quarter of the parent's ray tubes
-        c.shadow = 0.25 * p.shadow;
-        c.area0 = 0.25 * p.area0;
-        work.push_back(c);
-      }
+    if (!grant(p, ways)) continue;
+    splitInto(p, ways, work);
+  }
+}
+
+// The children of p split `ways` (wavefront.comp scatter), pushed onto `out`: on the bilinear 3×3
+// lattice of p's parameters (only its points the children use), the parent's own corners kept
+// exactly and each new point's w put back onto the shell; quarters of the lattice, or halves
+// across the u (or v) edges, each with an equal share of the parameter area and so of the flux.
+void PatchStepper::splitInto(const Patch& p, int ways, std::vector<Patch>& out) const {
+  glm::dvec3 X[3][3], W[3][3];
+  for (int b = 0; b < 3; ++b)
+    for (int a = 0; a < 3; ++a) {
+      if ((ways == kSplitU && b == 1) || (ways == kSplitV && a == 1)) continue;  // not used
+      const double fa = 0.5 * a, fb = 0.5 * b;
+      X[b][a] = (1 - fa) * (1 - fb) * p.x[0] + fa * (1 - fb) * p.x[1] + fa * fb * p.x[2] +
+                (1 - fa) * fb * p.x[3];
+      glm::dvec3 w = (1 - fa) * (1 - fb) * p.w[0] + fa * (1 - fb) * p.w[1] + fa * fb * p.w[2] +
+                     (1 - fa) * fb * p.w[3];
+      if ((a == 1 || b == 1) && sharp_)
+        w = mediumShell(p.region[0], glm::normalize(w));  // the region's medium's shell
+      else if (a == 1 || b == 1)
+        w = onShell(X[b][a], glm::normalize(w));  // back onto the mode's shell
+      W[b][a] = w;
+    }
+  X[0][0] = p.x[0], X[0][2] = p.x[1], X[2][2] = p.x[2], X[2][0] = p.x[3];
+  W[0][0] = p.w[0], W[0][2] = p.w[1], W[2][2] = p.w[2], W[2][0] = p.w[3];
+  const int n = ways == kSplitQuarters ? 4 : 2;
+  const double share = 1.0 / n;  // equal parameter areas: that share of the parent's ray tubes
+  for (int i = 0; i < n; ++i) {
+    // The child's parameter ranges [a0, a1] × [b0, b1] on the lattice.
+    const int a0 = ways == kSplitV ? 0 : (ways == kSplitU ? i : i & 1);
+    const int a1 = ways == kSplitV ? 2 : a0 + 1;
+    const int b0 = ways == kSplitU ? 0 : (ways == kSplitV ? i : i >> 1);
+    const int b1 = ways == kSplitU ? 2 : b0 + 1;
+    Patch c = p;
+    const int pa[4] = {a0, a1, a1, a0}, pb[4] = {b0, b0, b1, b1};
+    for (int k = 0; k < 4; ++k) {
+      c.x[size_t(k)] = X[pb[k]][pa[k]];
+      c.w[size_t(k)] = W[pb[k]][pa[k]];
+    }
+    c.energy = share * p.energy;
+    c.shadow = share * p.shadow;
+    c.area0 = share * p.area0;
+    out.push_back(c);
   }
 }
 
@@ -1029,9 +1054,10 @@ bool PatchStepper::endOfStep(Chunk& ch, Patch& p, const PatchStep& st,
     ended(ch, p);
     return true;
   }
-  // Energy: below the threshold, or due a split whose quarters would be (mayBeSplit).
+  // Energy: below the threshold, or due a split whose children would be (mayBeSplit).
+  const int ways = sharp_ && straddles(p) ? kSplitNone : splitWays(p);
   if (fluxAhead(p) < s_.min_energy_fraction * p.seed_energy ||
-      (!(sharp_ && straddles(p)) && maxEdgeOf(p) > maxEdge_ && !mayBeSplit(p))) {
+      (ways != kSplitNone && !mayBeSplit(p, ways))) {
     ++ch.st.kills_energy;
     ch.st.flux_energy += p.energy;
     ended(ch, p);
@@ -1100,20 +1126,19 @@ std::vector<Chunk> makeChunks(int nChunks, size_t voxels, std::vector<double>& a
 long long settleStep(std::vector<Chunk>& chunks, const PatchStepper& stepper, long long L0,
                      long long maxPatches, int ping, WavefrontStats& st) {
   if (chunks.size() == 1) {
-    if (chunks[0].splits + chunks[0].reflections > 0)
-      st.max_live = std::max(st.max_live, size_t(chunks[0].maxAfterSplit));
+    if (chunks[0].anyGrowth()) st.max_live = std::max(st.max_live, size_t(chunks[0].maxAfterSplit));
     return chunks[0].live;
   }
   bool fits = true;
   long long Lc = L0;
   size_t peak = 0;
   for (const Chunk& ch : chunks) {
-    if (ch.splits + ch.reflections > 0) {
+    if (ch.anyGrowth()) {
       const long long top = Lc + ch.maxAfterSplit;
       fits = fits && top <= maxPatches;
       peak = std::max(peak, size_t(top));
     }
-    Lc += 3 * (long long)ch.splits + (long long)ch.reflections - (long long)ch.kills;
+    Lc += ch.grown() - (long long)ch.kills;
   }
   if (fits) {
     st.max_live = std::max(st.max_live, peak);
@@ -1123,7 +1148,7 @@ long long settleStep(std::vector<Chunk>& chunks, const PatchStepper& stepper, lo
   long long live = L0;
   for (Chunk& ch : chunks) {
     ch.out[ping].clear();
-    ch.splits = ch.refused = ch.tears = ch.reflections = 0;
+    ch.splits = ch.halvings = ch.refused = ch.tears = ch.reflections = 0;
     ch.maxAfterSplit = LLONG_MIN;
     size_t seen = 0;
     for (size_t i = 0; i < ch.surv.size(); ++i) {
@@ -1134,8 +1159,7 @@ long long settleStep(std::vector<Chunk>& chunks, const PatchStepper& stepper, lo
       live = ch.live;
     }
     live -= (long long)(ch.kills - seen);
-    if (ch.splits + ch.reflections > 0)
-      st.max_live = std::max(st.max_live, size_t(ch.maxAfterSplit));
+    if (ch.anyGrowth()) st.max_live = std::max(st.max_live, size_t(ch.maxAfterSplit));
   }
   return live;
 }
@@ -1150,6 +1174,7 @@ void reduceChunks(std::vector<Chunk>& chunks, WavefrontStats& st, std::vector<do
     st.straight_steps += a.straight_steps;
     st.straight_time_steps += a.straight_time_steps;
     st.splits += a.splits;
+    st.halvings += a.halvings;
     st.splits_refused += a.splits_refused;
     st.tears += a.tears;
     st.reflections += a.reflections;
@@ -1297,7 +1322,7 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
   // Each step cuts its list into T = nChunks contiguous chunks (Chunk). With one chunk the budget
   // is checked against the running live count, as always. With T > 1 the chunks emit without a
   // budget, each tracking its live count relative to its start; single-threaded emission would
-  // have refused a split iff some chunk c, starting at L_c = L0 + Σ_{c' < c} (3·splits − kills),
+  // have refused a split iff some chunk c, starting at L_c = L0 + Σ_{c' < c} (grown − kills),
   // reaches L_c + maxAfterSplit > max_patches. Then the step's emission is redone serially from
   // the recorded survivors, in list order against the running count (settleStep). Either way the
   // counts, `next` and `done` are those of the single-threaded loop.
@@ -1325,7 +1350,7 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
       ch.done.clear();
       ch.surv.clear();
       ch.survKills.clear();
-      ch.kills = ch.splits = ch.refused = ch.tears = ch.reflections = 0;
+      ch.kills = ch.splits = ch.halvings = ch.refused = ch.tears = ch.reflections = 0;
       ch.live = nChunks == 1 ? L0 : 0;
       ch.maxAfterSplit = LLONG_MIN;
       const long long budget = nChunks == 1 ? maxPatches : LLONG_MAX;
@@ -1346,6 +1371,7 @@ WavefrontResult WavefrontSimulator::run(const Light& light) const {
     live = settleStep(chunks, stepper, L0, maxPatches, ping, st);
     for (Chunk& ch : chunks) {
       ch.st.splits += ch.splits;
+      ch.st.halvings += ch.halvings;
       ch.st.splits_refused += ch.refused;
       ch.st.tears += ch.tears;
       ch.st.reflections += ch.reflections;

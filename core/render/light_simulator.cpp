@@ -177,6 +177,7 @@ struct GpuWavefront::Impl {
   std::vector<gpu::WaveTally> tallies;  // the last pass's, read back
   size_t asked_tears = 0;               // tears asked for in the pass addTallies read last
   size_t asked_reflections = 0;         // reflected copies asked for in that pass
+  size_t asked_halvings = 0;            // splits into halves asked for in that pass
   double il2 = 0, il4 = 0, n_min = 1.0;
 
   Impl(vk::Context& c, const VolumeSet& v, WavefrontSettings settings, int k,
@@ -532,7 +533,7 @@ struct GpuWavefront::Impl {
     P.control = glm::ivec4(s.probe_axis >= 0 && s.probe_axis < 3 ? s.probe_axis : -1,
                            steps_per_dispatch, s.max_steps, eMode ? 1 : 0);
     control = P.control;
-    P.probe = glm::vec4(float(s.probe_position), 0.0f, 0.0f, 0.0f);
+    P.probe = glm::vec4(float(s.probe_position), s.split_halves ? 1.0f : 0.0f, 0.0f, 0.0f);
     P.options = glm::ivec4(s.skip_empty ? 1 : 0, s.pass_caustics ? 1 : 0,
                            s.straight_to_boundary ? 1 : 0, s.max_reflection_generations);
     params.write(&P, sizeof P);
@@ -547,7 +548,7 @@ struct GpuWavefront::Impl {
     tallies.resize(groups(n));
     tally.read(tallies.data(), tallies.size() * sizeof(gpu::WaveTally));
     survivors = 0, want_split = 0;
-    size_t pass_tears = 0, pass_reflections = 0;
+    size_t pass_tears = 0, pass_reflections = 0, pass_halvings = 0;
     for (const gpu::WaveTally& t : tallies) {
       st.flux_left += t.flux_a.x, st.flux_caustic += t.flux_a.y, st.flux_energy += t.flux_a.z;
       st.flux_absorbed += double(t.flux_a.w) + double(t.flux_b.x);
@@ -565,6 +566,7 @@ struct GpuWavefront::Impl {
       st.probe_direction += glm::dvec3(glm::vec3(t.probe_dir));
       st.flux_reflected += t.probe_dir.w;
       pass_reflections += t.count_c.x;
+      pass_halvings += t.count_c.y;
     }
     st.tears += pass_tears;
     asked_tears = pass_tears;
@@ -572,12 +574,16 @@ struct GpuWavefront::Impl {
     // one patch and is no split.
     st.reflections += pass_reflections;
     asked_reflections = pass_reflections;
+    // A split into halves is asked for and ranked as any split; it adds one patch.
+    st.halvings += pass_halvings;
+    asked_halvings = pass_halvings;
   }
 
   /// The next list's length when the pass over list `src` (n patches) asks for more than the
-  /// budget. The reference refuses a split when live + 3 > max_patches, in list order. Here: grant
-  /// the first `granted` requests of the list (rank by a scan of 0/1 flags), counting the survivors
-  /// of this pass as live.
+  /// budget. The reference refuses a split when live + 3 (quarters, pencils) or live + 1 (halves, a
+  /// reflected copy) > max_patches, in list order. Here: grant the first `granted` requests of the
+  /// list (rank by a scan of 0/1 flags), each counted as adding 3, and the survivors of this pass
+  /// as live, so the list never exceeds the budget.
   uint32_t grantSplits(uint32_t n, int src, size_t survivors, size_t want_split,
                        WavefrontStats& st) {
     const size_t budget = size_t(s.max_patches);
@@ -592,14 +598,16 @@ struct GpuWavefront::Impl {
     // The BUDGET pass tallied again, counting only the tears and reflected copies granted (a
     // refused one goes on whole).
     tally.read(tallies.data(), tallies.size() * sizeof(gpu::WaveTally));
-    size_t granted_tears = 0, granted_reflections = 0;
+    size_t granted_tears = 0, granted_reflections = 0, granted_halvings = 0;
     for (const gpu::WaveTally& t : tallies) {
       granted_tears += size_t(t.caustic_sum.w);
       granted_reflections += t.count_c.x;
+      granted_halvings += t.count_c.y;
     }
     st.tears = st.tears - asked_tears + granted_tears;
     st.reflections = st.reflections - asked_reflections + granted_reflections;
-    st.splits += granted - granted_reflections;
+    st.halvings = st.halvings - asked_halvings + granted_halvings;
+    st.splits += granted - granted_reflections - granted_halvings;
     return readTotal();
   }
 
@@ -649,7 +657,7 @@ struct GpuWavefront::Impl {
       if (total > budget) {
         total = grantSplits(n, src, survivors, wantSplit, st);
       } else {
-        st.splits += wantSplit - asked_reflections;
+        st.splits += wantSplit - asked_reflections - asked_halvings;
       }
       st.max_live = std::max<size_t>(st.max_live, total);
       if (s.progress)

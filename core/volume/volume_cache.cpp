@@ -397,8 +397,7 @@ std::string saveVolumeCache(const fs::path& dir, uint64_t key, const VolumeSet& 
   } catch (const std::exception& e) {
     return e.what();
   }
-  removeLeastRecentlyUsed(dir, path, max_cache_bytes, "volume-");  // its own cap
-  trimCacheDir(dir, path);  // and the whole cache folder's cap (core/io/cache_limit.h)
+  trimCacheDir(dir, path, max_cache_bytes);  // the cache folder's cap (core/io/cache_limit.h)
   return {};
 }
 

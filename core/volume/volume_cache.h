@@ -19,9 +19,9 @@
 // truncated, too long, corrupted (checksum), foreign (magic) or does not match its name is ignored
 // with one notice and replaced by the next save; an entry of another format version is replaced
 // quietly. Entries over kMaxVolumeEntryBytes are neither written nor read; after a save the
-// oldest volume entries (by modification time; a hit refreshes it) are removed until those left
-// take at most kMaxVolumeCacheBytes, and then the least recently used entries of every cache in
-// the folder until all take at most its cap (core/io/cache_limit.h, 1 GiB by default).
+// least recently used entries of every cache in the folder (by modification time; a hit refreshes
+// it) are removed until all take at most the folder's cap (core/io/cache_limit.h, 1 GiB by default,
+// EIKON_CACHE_MAX_MB): the one cap, with no second one of the volume cache's own.
 //
 //   const uint64_t key = eikon::volumeCacheKey(scene);      // 0: no build id, cache nothing
 //   std::string notice;
@@ -36,13 +36,13 @@
 #include <filesystem>
 #include <string>
 
+#include "core/io/cache_limit.h"
 #include "core/scene/scene.h"
 #include "core/volume/volume_set.h"
 
 namespace eikon {
 
 inline constexpr uint64_t kMaxVolumeEntryBytes = uint64_t(1) << 30;  ///< one entry: 1 GiB
-inline constexpr uint64_t kMaxVolumeCacheBytes = uint64_t(2) << 30;  ///< all entries: 2 GiB
 
 /// The entry key of a scene's volume; 0 when this binary has no build id (nothing is cached).
 uint64_t volumeCacheKey(const Scene& scene);
@@ -57,10 +57,11 @@ std::filesystem::path volumeCachePath(const std::filesystem::path& dir, uint64_t
 bool loadVolumeCache(const std::filesystem::path& dir, uint64_t key, const Scene& scene,
                      VolumeSet& volume, std::string* notice = nullptr);
 
-/// Store the volume (its voxelised part: not the light volumes) atomically, then remove the
-/// oldest other volume entries until all take at most `max_cache_bytes`. Failures are returned as
-/// a message (empty on success), not thrown: a cache that cannot be written only costs time.
+/// Store the volume (its voxelised part: not the light volumes) atomically, then trim the folder
+/// to `max_cache_bytes` (trimCacheDir: the least recently used entries of every cache but this
+/// one go first; by default the folder's cap, cacheMaxBytes()). Failures are returned as a message
+/// (empty on success), not thrown: a cache that cannot be written only costs time.
 std::string saveVolumeCache(const std::filesystem::path& dir, uint64_t key, const VolumeSet& volume,
-                            uint64_t max_cache_bytes = kMaxVolumeCacheBytes);
+                            uint64_t max_cache_bytes = cacheMaxBytes());
 
 }  // namespace eikon

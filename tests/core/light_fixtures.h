@@ -118,13 +118,14 @@ inline void unitLuneburg(const glm::dvec3& x, double& n, glm::dvec3& g) {
 
 inline void printWavefrontStats(const char* name, const WavefrontStats& s) {
   std::printf(
-      "[ measured ] %s: steps %d, seeded %zu, max live %zu, splits %zu (refused %zu, tears %zu), "
+      "[ measured ] %s: steps %d, seeded %zu, max live %zu, splits %zu, halvings %zu (refused %zu, "
+      "tears %zu), "
       "kills left/caustic/energy/opaque %zu/%zu/%zu/%zu\n             flux emitted %.12g, left "
       "%.12g, caustic %.12g, "
       "energy %.12g, absorbed %.12g, probe %.12g, ended before probe %.12g\n",
-      name, s.steps, s.seeded, s.max_live, s.splits, s.splits_refused, s.tears, s.kills_left,
-      s.kills_caustic, s.kills_energy, s.kills_opaque, s.flux_emitted, s.flux_left, s.flux_caustic,
-      s.flux_energy, s.flux_absorbed, s.flux_probe, s.flux_ended_before_probe);
+      name, s.steps, s.seeded, s.max_live, s.splits, s.halvings, s.splits_refused, s.tears,
+      s.kills_left, s.kills_caustic, s.kills_energy, s.kills_opaque, s.flux_emitted, s.flux_left,
+      s.flux_caustic, s.flux_energy, s.flux_absorbed, s.flux_probe, s.flux_ended_before_probe);
 }
 
 }  // namespace eikon::test

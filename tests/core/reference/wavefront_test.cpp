@@ -258,11 +258,11 @@ TEST(Wavefront, PatchBudgetHoldsAndTheLoopEnds) {
               1e-9 * st.flux_emitted);
 }
 
-// 4'. A patch is split only while its quarters keep the energy threshold (mayBeSplit): with
+// 4'. A patch is split only while its children keep the energy threshold (mayBeSplit): with
 // min_energy_fraction = 0.3 a seed's quarters (0.25 of its flux) would be killed after one step
-// each, so no patch splits at all; a patch stretched past the split span ends as a kill by energy
-// where it would have split, and the flux is still all accounted for. With the default threshold
-// the same run splits.
+// each, so no patch splits into quarters (halves, 0.5, still may be made); a patch stretched past
+// the split span along both pairs of edges ends as a kill by energy where it would have split,
+// and the flux is still all accounted for. With a threshold of 0.2 the same run makes quarters.
 TEST(Wavefront, NoSplitMakesQuartersBelowTheEnergyThreshold) {
   const Scene scene = sceneFromJson(kGlassSphereLightScene);
   const VolumeSet vol = voxelize(scene);
@@ -292,11 +292,11 @@ TEST(Wavefront, NoSplitMakesQuartersBelowTheEnergyThreshold) {
 // double flux sums differ only by summation order. A sum of m terms in any order is within
 // (m − 1)·u·Σ|terms| of the exact sum (u = 2^-53), so two orders differ by at most 2m·u·Σ|terms|:
 // with m ≈ 8e4 kills that is 1.8e-11 relative (measured up to 4.4e-12, so a flat 1e-12 would not
-// do); the kill sums have positive terms, the probe sums (signed, over at most seeded + 4·splits
-// crossings) are bounded with Σ|terms| ≤ that count × the largest patch flux, and the centroids
-// (Σ flux·x, |x| ≤ 4 mm) with the box size. The volumes are float32 roundings of double sums that
-// differ by ~1e-15 relative: equal, or one float ulp apart (or 1e-12 absolute for the direction,
-// whose components cancel on the axis; measured: all equal). The same thread count gives
+// do); the kill sums have positive terms, the probe sums (signed, over at most seeded + 4·splits +
+// 2·halvings crossings) are bounded with Σ|terms| ≤ that count × the largest patch flux, and the
+// centroids (Σ flux·x, |x| ≤ 4 mm) with the box size. The volumes are float32 roundings of double
+// sums that differ by ~1e-15 relative: equal, or one float ulp apart (or 1e-12 absolute for the
+// direction, whose components cancel on the axis; measured: all equal). The same thread count gives
 // bit-identical results run to run.
 TEST(Wavefront, ThreadsGiveTheSingleThreadedCounts) {
   const Scene scene = sceneFromJson(kGlassSphereLightScene);
@@ -331,6 +331,7 @@ TEST(Wavefront, ThreadsGiveTheSingleThreadedCounts) {
       EXPECT_EQ(b.seeded, a.seeded);
       EXPECT_EQ(b.max_live, a.max_live);
       EXPECT_EQ(b.splits, a.splits);
+      EXPECT_EQ(b.halvings, a.halvings);
       EXPECT_EQ(b.splits_refused, a.splits_refused);
       EXPECT_EQ(b.kills_left, a.kills_left);
       EXPECT_EQ(b.kills_caustic, a.kills_caustic);
@@ -346,7 +347,7 @@ TEST(Wavefront, ThreadsGiveTheSingleThreadedCounts) {
       EXPECT_NEAR(b.flux_energy, a.flux_energy, orders(a.kills_energy, a.flux_energy));
       EXPECT_EQ(a.flux_absorbed, 0.0);
       EXPECT_EQ(b.flux_absorbed, 0.0);
-      const size_t crossings = a.seeded + 4 * a.splits;
+      const size_t crossings = a.seeded + 4 * a.splits + 2 * a.halvings;
       const double seedFlux =
           a.flux_emitted / double(a.seeded);  // every seed carries the same flux
       EXPECT_NEAR(b.flux_probe, a.flux_probe, orders(crossings, double(crossings) * seedFlux));

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "core/io/build_id.h"
+#include "core/io/cache_limit.h"
 #include "tests/core/file_support.h"
 #include "tests/core/scene_support.h"
 
@@ -291,16 +293,24 @@ TEST_F(VolumeCache, AnotherFormatVersionIsReplacedQuietly) {
   EXPECT_EQ(notice, "");
 }
 
-// The folder is kept under its cap by removing the least recently used volume entries (never the
-// one just written, never other files).
-TEST_F(VolumeCache, TheOldestEntriesGoWhenTheCacheIsFull) {
+// One cap: after a save the folder's entries of every kind together are kept under the folder's
+// cap (core/io/cache_limit.h), least recently used first whatever their kind: an old light entry
+// goes before an older volume's neighbour, and a volume goes while a more recently used light entry
+// stays. Never the entry just written, never other files. (With a cap of the volume entries' own,
+// the old light entry outlived the volumes and the folder held more than the cap.)
+TEST_F(VolumeCache, TheFoldersCapIsTheOnlyCap) {
   std::vector<Scene> scenes;  // three entries of one size: spheres of other radii
   for (double radius : {1.0, 0.9, 0.8}) {
     Scene s = scene(kSmoothed);
     s.objects[0].shape = Shape("sphere", SphereShape{radius}, glm::dvec3(0.0), glm::dvec3(0.0));
     scenes.push_back(s);
   }
-  put(dir_.path() / "light-0000000000000001.bin", "not a volume entry");
+  const fs::path oldLight = dir_.path() / "light-0000000000000001.bin";
+  const fs::path newLight = dir_.path() / "light-0000000000000002.bin";
+  const fs::path other = dir_.path() / "notes.txt";
+  put(oldLight, "an old light entry");
+  put(newLight, "a recent light entry");
+  put(other, "not a cache entry");
   std::vector<fs::path> files;
   uint64_t sizes = 0;
   for (size_t i = 0; i < 2; ++i) {
@@ -308,15 +318,48 @@ TEST_F(VolumeCache, TheOldestEntriesGoWhenTheCacheIsFull) {
     files.push_back(volumeCachePath(dir_.path(), volumeCacheKey(scenes[i])));
     sizes += fs::file_size(files.back());
   }
-  // The first entry is the older, however fast the two saves were.
-  fs::last_write_time(files[0], fs::last_write_time(files[1]) - std::chrono::hours(1));
+  // Use order, oldest first: the old light entry, volume 0, volume 1, the recent light entry.
+  const auto now = fs::last_write_time(files[1]);
+  fs::last_write_time(oldLight, now - std::chrono::hours(3));
+  fs::last_write_time(files[0], now - std::chrono::hours(2));
+  fs::last_write_time(files[1], now - std::chrono::hours(1));
+  fs::last_write_time(newLight, now);
+  // Room for two volumes and the recent light entry: the old light entry and volume 0 go.
+  const uint64_t cap = sizes + fs::file_size(newLight);
   const VolumeSet third = voxelize(scenes[2]);
-  ASSERT_EQ(saveVolumeCache(dir_.path(), volumeCacheKey(scenes[2]), third, sizes), "");
+  ASSERT_EQ(saveVolumeCache(dir_.path(), volumeCacheKey(scenes[2]), third, cap), "");
   EXPECT_EQ(fs::file_size(volumeCachePath(dir_.path(), volumeCacheKey(scenes[2]))), sizes / 2);
+  EXPECT_FALSE(fs::exists(oldLight));
   EXPECT_FALSE(fs::exists(files[0]));
   EXPECT_TRUE(fs::exists(files[1]));
+  EXPECT_TRUE(fs::exists(newLight));
   EXPECT_TRUE(fs::exists(volumeCachePath(dir_.path(), volumeCacheKey(scenes[2]))));
-  EXPECT_TRUE(fs::exists(dir_.path() / "light-0000000000000001.bin"));
+  EXPECT_TRUE(fs::exists(other));
+}
+
+// The default cap of a save is the folder's, EIKON_CACHE_MAX_MB (0: only the entry just written
+// stays), not one of the volume cache's own.
+TEST_F(VolumeCache, ASaveKeepsToEikonCacheMaxMb) {
+  Scene s = scene(kSmoothed);
+  const fs::path light = dir_.path() / "light-0000000000000001.bin";
+  put(light, "a light entry");
+  ASSERT_EQ(saveVolumeCache(dir_.path(), volumeCacheKey(s), voxelize(s)), "");
+  EXPECT_TRUE(fs::exists(light));  // the default 1 GiB holds both
+  const char* before = std::getenv("EIKON_CACHE_MAX_MB");
+  const std::string saved = before ? before : "";
+  ::setenv("EIKON_CACHE_MAX_MB", "0", 1);
+  s.objects[0].shape = Shape("sphere", SphereShape{0.7}, glm::dvec3(0.0), glm::dvec3(0.0));
+  const std::string err = saveVolumeCache(dir_.path(), volumeCacheKey(s), voxelize(s));
+  if (before)
+    ::setenv("EIKON_CACHE_MAX_MB", saved.c_str(), 1);
+  else
+    ::unsetenv("EIKON_CACHE_MAX_MB");
+  ASSERT_EQ(err, "");
+  size_t entries = 0;
+  for (const auto& e : fs::directory_iterator(dir_.path()))
+    entries += isCacheEntryName(e.path().filename().string()) ? 1 : 0;
+  EXPECT_EQ(entries, 1u);
+  EXPECT_TRUE(fs::exists(volumeCachePath(dir_.path(), volumeCacheKey(s))));
 }
 
 }  // namespace
