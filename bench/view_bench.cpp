@@ -6,7 +6,7 @@
 //
 //   build/bench/view_bench [scene.json] [--width W --height H] [--no-cpu] [--interfaces]
 //                          [--march sharp|smoothed] [--only SUBSTRING] [--no-accuracy] [--repeat N]
-//                          [--transport]
+//                          [--transport] [--first-choice [--spp N]]
 //
 // --march: voxelise with that kind of interface whatever the scene says (the variants' integrator
 // and step only matter where the march integrates: every layer when smoothed, varying regions when
@@ -24,6 +24,14 @@
 // --transport: only full transport against the single transmitted path (docs/view-renderer.md
 // "Light transport"), at equal samples: time and steps per ray, their ratio, and the image mean
 // lost to the reflection limit (32 against 1024).
+//
+// --first-choice: only full transport's split first choice (MarchSettings::split_first_choice,
+// the default) against pure Russian roulette (every choice drawn, FirstChoice::Drawn), GPU, at
+// equal noise: each variant renders N samples per pixel (--spp, default 16); every sample's image
+// is recovered from the running means RenderSettings::on_pass reports, so the per-pixel variance
+// of ONE sample is the unbiased variance over the N independent samples (each its own seeds),
+// averaged over pixels and channels. Efficiency is 1/(variance × seconds per sample); the ratio
+// split / drawn is the factor by which the split reaches equal noise sooner (docs/performance.md).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -32,6 +40,7 @@
 #include <random>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "core/reference/reference_marcher.h"
 #include "core/render/view_renderer.h"
@@ -125,6 +134,68 @@ int compareTransport(vk::Context& ctx, const Scene& scene, int width, int height
   return 0;
 }
 
+// One variant of --first-choice: per-sample variance (mean over pixels and channels), seconds per
+// sample and the image mean.
+struct SampleNoise {
+  double variance = 0.0, seconds = 0.0, mean = 0.0;
+  long long cut = 0;
+};
+
+SampleNoise sampleNoise(ViewRenderer& gpu, RenderSettings rs) {
+  const size_t n = size_t(rs.width) * size_t(rs.height) * 3;
+  std::vector<double> before(n, 0.0), sum(n, 0.0), sum2(n, 0.0);
+  auto take = [&](const RenderImage& img, int done) {  // sample `done`'s image, from the means
+    for (size_t i = 0; i < n; ++i) {
+      const double total = double(img.rgb[i]) * done, x = total - before[i];
+      before[i] = total;
+      sum[i] += x;
+      sum2[i] += x * x;
+    }
+  };
+  rs.on_pass = [&](const RenderImage& img, int done, int) { take(img, done); };
+  const RenderImage img = gpu.render(rs);
+  take(img, rs.spp);
+  SampleNoise r;
+  const double k = rs.spp;
+  for (size_t i = 0; i < n; ++i) {
+    r.variance += std::max(0.0, sum2[i] - sum[i] * sum[i] / k) / (k - 1.0) / double(n);
+    r.mean += sum[i] / k / double(n);
+  }
+  r.seconds = img.seconds / k;
+  r.cut = img.cut_samples;
+  return r;
+}
+
+// The split first choice against every choice drawn, at equal noise (--first-choice).
+int compareFirstChoice(vk::Context& ctx, const Scene& scene, int width, int height, int spp) {
+  const VolumeSet vol = voxelize(scene);
+  ViewRenderer gpu(ctx, scene, vol);
+  RenderSettings rs;
+  rs.width = width;
+  rs.height = height;
+  rs.spp = 1;
+  rs.march.step_voxels = 0.5;  // the renders' default (`eikon render --step`)
+  gpu.render(rs);              // warm-up
+  rs.spp = spp;
+  SampleNoise v[2];
+  for (int k = 0; k < 2; ++k) {
+    rs.march.split_first_choice = k == 0;
+    v[k] = sampleNoise(gpu, rs);
+    std::printf(
+        "%-6s GPU, %d samples: per-sample variance %.4e, %.4f s per sample, efficiency "
+        "1/(variance x time) %.4g, image mean %.5f, cut samples %lld\n",
+        k ? "drawn" : "split", spp, v[k].variance, v[k].seconds,
+        1.0 / (v[k].variance * v[k].seconds), v[k].mean, v[k].cut);
+  }
+  std::printf(
+      "ratio split / drawn: variance %.3f, time %.3f, efficiency %.2f (the split reaches equal "
+      "noise %.2fx sooner)\n",
+      v[0].variance / v[1].variance, v[0].seconds / v[1].seconds,
+      (v[1].variance * v[1].seconds) / (v[0].variance * v[0].seconds),
+      (v[1].variance * v[1].seconds) / (v[0].variance * v[0].seconds));
+  return 0;
+}
+
 int main(int argc, char** argv) {
   std::string scene_path = std::string(EIKON_SOURCE_DIR) + "/scenes/glass_sphere.json";
   int width = 800, height = 600;
@@ -140,6 +211,12 @@ int main(int argc, char** argv) {
   app.add_flag("--interfaces", interfaces, "Only compare sharp and smoothed interfaces");
   bool transport = false;
   app.add_flag("--transport", transport, "Only compare full transport with the single path");
+  bool first_choice = false;
+  app.add_flag("--first-choice", first_choice,
+               "Only compare the split first choice with every choice drawn, at equal noise");
+  int spp = 16;
+  app.add_option("--spp", spp, "Samples per pixel of --first-choice (default 16)")
+      ->check(CLI::Range(2, 4096));
   std::string march_kind, only;
   app.add_option("--march", march_kind, "Voxelise with sharp or smoothed interfaces")
       ->check(CLI::IsMember({"sharp", "smoothed"}));
@@ -156,6 +233,7 @@ int main(int argc, char** argv) {
   auto ctx = vk::Context::create();
   if (interfaces) return compareInterfaces(*ctx, scene, width, height, cpu);
   if (transport) return compareTransport(*ctx, scene, width, height, cpu);
+  if (first_choice) return compareFirstChoice(*ctx, scene, width, height, spp);
   auto t0 = std::chrono::steady_clock::now();
   VolumeSet vol = voxelize(scene);
   double vox_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

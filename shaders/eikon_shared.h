@@ -178,7 +178,8 @@ struct ViewParams {
   ivec4 image;       // x: width; y: height; z: first row of this dispatch; w: rows in this dispatch
   vec4 wavelength;   // x: λ (µm) of the non-spectral mode; y: 1/λ²; z: 1/λ⁴
   ivec4 pass;        // x: the pixel sample of this dispatch; y: its first wavelength; z: wavelengths
-  ivec4 transport;   // x: 1 full transport (MarchSettings::transport); y: max reflections; z, w: unused
+  ivec4 transport;   // x: 1 full transport (MarchSettings::transport); y: max reflections; z:
+                     // 1 split the first choice (split_first_choice; both kernels); w: unused
 };
 
 // One ray for the trace kernel: origin and unit direction in world space, λ in µm.
@@ -220,7 +221,8 @@ struct BoundaryAnswer {
 #define EIKON_POL_MAX_STACK 8     // branches waiting to be followed
 #define EIKON_POL_MAX_EVENTS 48   // interface events per branch
 #define EIKON_POL_MAX_PIECES 96   // straight pieces per ray, all branches together (loop budget)
-#define EIKON_POL_MAX_BEAMS 4     // output beams per ray (exit directions)
+#define EIKON_POL_MAX_BEAMS 6     // output beams per ray (exit directions: the first choice
+                                  // reflected, and four o/e pairs converted inside a crystal)
 #define EIKON_POL_MAX_GROUPED 4   // branch mode codes reported per beam
 #define EIKON_POL_GROUP 8         // rays per workgroup of polarised_trace.comp (a SIMD group)
 // Sheets buffer: [0] = (sheet count, bandwidth_nm, source_angle_rad, reflect_at bit mask), then

@@ -82,6 +82,7 @@ struct Branch {
   int nmodes;
   int events;
   int choices;  // reflect-or-transmit choices made (P.pass.w > 0): the uniform's index k
+  int side;     // of the split first choice: 0 none, 1 transmitted, 2 reflected (recombine)
 };
 
 // The ray tree of the invocation's one ray (the CPU's Tracer): the branches waiting, the leaves,
@@ -243,7 +244,8 @@ float wavesPower(Branch b, ModeWave w[2], bool reflect, Incidence I) {
 // reflection, where asked (reflect_at), or, with Transport::Full (P.pass.w: the choices a branch
 // may make), where its random choice takes them: the reflection with probability p = the
 // reflected share of the branch's power (both basis states), the chosen fields scaled by 1/√p or
-// 1/√(1 − p).
+// 1/√(1 − p). The path's first choice, where split (P.transport.z), is no draw: the reflected and
+// the transmitted waves both go on, with their exact fields, each marked with its side.
 void cross(Branch b, BoundaryCrossing c) {
   int A = b.region, B = c.to;
   if (mediumOpaque(B)) return;  // absorbed: nothing of this branch leaves
@@ -294,24 +296,30 @@ void cross(Branch b, BoundaryCrossing c) {
   I.ep1 = cvDot(b.G1, pIn);
   I.ci = min(1.0, abs(dot(s, m)));
   float scale = 1.0;
+  bool split = false;
   if (choose) {
     float pr = wavesPower(b, wr, true, I), pw = pr + wavesPower(b, wt, false, I);
     if (pw > 0.0) {
       float p = pr / pw;
-      reflect = transportUniform(gSeed, uint(b.choices)) < p;  // march.glsl
-      scale = inversesqrt(reflect ? p : 1.0 - p);
+      split = b.choices == 0 && P.transport.z != 0;
+      reflect = !split && transportUniform(gSeed, uint(b.choices)) < p;  // march.glsl
+      if (!split) scale = inversesqrt(reflect ? p : 1.0 - p);
       b.choices++;
     }
   }
-  for (int k = 0; k < 2; ++k) {
-    ModeWave w = reflect ? wr[k] : wt[k];
+  // Split: the reflected waves, then the transmitted; else the chosen pair.
+  for (int j = reflect || split ? 0 : 2; j < (reflect ? 2 : 4); ++j) {
+    bool refl = j < 2;
+    int k = j & 1;
+    ModeWave w = refl ? wr[k] : wt[k];
     if (!w.exists) continue;
-    Branch nb = wave(b, w, k, reflect, I, scale);
+    Branch nb = wave(b, w, k, refl, I, scale);
     if (cvNorm2(nb.G0) + cvNorm2(nb.G1) < 1e-12) continue;
-    nb.region = reflect ? A : B;
+    nb.region = refl ? A : B;
     nb.x = x;
     nb.events = b.events + 1;
-    if ((reflect ? I.uA : I.uB) && nb.nmodes < 15) {
+    if (split) nb.side = refl ? 2 : 1;
+    if ((refl ? I.uA : I.uB) && nb.nmodes < 15) {
       nb.modes |= k << nb.nmodes;
       nb.nmodes++;
     }
@@ -402,7 +410,8 @@ PolarisedBeamOut recombine(int first, inout int taken, vec4 S, float lambdaMm, f
       float lateral = length(sep - dot(sep, dir) * dir);
       // Δ(S − p·x) with S = opl + p_in·(x − x_start): the path difference on a common wavefront.
       float opd = (b.opl - ref.opl) + dot(gPin - b.p, sep);
-      if (lateral > width || abs(opd) > length_) continue;
+      // The two sides of a split first choice are two estimates, added as such (incoherently).
+      if (b.side != ref.side || lateral > width || abs(opd) > length_) continue;
       inDir &= ~(1 << j);
       float waves = opd / lambdaMm;
       float ph = 2.0 * kPi * (waves - round(waves));
@@ -451,6 +460,7 @@ void main() {
   b.nmodes = 0;
   b.events = 0;
   b.choices = 0;
+  b.side = 0;
   gSeed = floatBitsToUint(ray.direction.w);
   PolarisedResult res;
   res.head = ivec4(0);

@@ -166,8 +166,9 @@ vec3 marchModes(vec3 d, ModeSpan m, float stepDivisor, bool hero, inout PathReco
   heroCount0 = 0;
   // Per mode, full transport splits the path's first Fresnel choice (march.glsl kChoice*): the
   // transmitted branch, then, where it met a choice, the reflected one; one march call site.
-  const bool full = P.transport.x != 0;
-  int mode = m.m0, branch = full ? kChoiceTransmit : kChoiceDrawn;
+  // P.transport.z = 0 (MarchSettings::split_first_choice false) draws it instead.
+  const bool split = P.transport.x != 0 && P.transport.z != 0;
+  int mode = m.m0, branch = split ? kChoiceTransmit : kChoiceDrawn;
   while (mode < m.m1) {
     if (hero) rec.dispersive = hasFlag(weightDependent);
     rec.firstChoice = branch;
@@ -176,7 +177,7 @@ vec3 marchModes(vec3 d, ModeSpan m, float stepDivisor, bool hero, inout PathReco
     rad += part;
     radMode[mode] += part;
     bool nextMode = branch != kChoiceTransmit || !r.split;
-    branch = nextMode ? (full ? kChoiceTransmit : kChoiceDrawn) : kChoiceReflect;
+    branch = nextMode ? (split ? kChoiceTransmit : kChoiceDrawn) : kChoiceReflect;
     if (hero && mode == 0 && nextMode) heroCount0 = rec.count;
     acc.steps += float(r.steps) / stepDivisor;
     acc.cut = acc.cut || r.cut;

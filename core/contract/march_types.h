@@ -65,6 +65,10 @@ struct MarchSettings {
   /// Transport::Full: the Fresnel choices a path makes before it goes on as Transport::Single
   /// (docs/view-renderer.md "Light transport" measures what the limit loses).
   int max_reflections = 32;
+  /// Transport::Full: split each sample's first Fresnel choice (FirstChoice::Transmit, then
+  /// ::Reflect), the default; false draws it as every later one (FirstChoice::Drawn: pure Russian
+  /// roulette, bench/view_bench --first-choice compares the two at equal noise).
+  bool split_first_choice = true;
 };
 
 /// The settings both twins refuse alike (std::invalid_argument), before any work: the step in

@@ -34,6 +34,10 @@ struct PolarisedTraceSettings {
   /// (eikon trace --polarised) is Single and deterministic; renders take MarchSettings::transport.
   Transport transport = Transport::Single;
   int max_reflections = 32;  ///< Full: choices per branch, in [0, 1024] (MarchSettings's)
+  /// Full: the path's first choice is split (both the reflected and the transmitted beams, their
+  /// exact fields, the two sides added incoherently; FirstChoice) rather than drawn, as the scalar
+  /// march's (MarchSettings::split_first_choice; renders take that one).
+  bool split_first_choice = true;
 };
 
 /// One beam leaving the scene.

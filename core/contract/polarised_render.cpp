@@ -145,6 +145,7 @@ RenderImage renderPolarisedWith(const Scene& scene, const RenderSettings& s,
   ts.mueller_row = true;
   ts.transport = s.march.transport;
   ts.max_reflections = s.march.max_reflections;
+  ts.split_first_choice = s.march.split_first_choice;
   const CameraRays cam(scene.camera, img.width, img.height, s.spp);
   const bool spectral = s.wavelengths > 0;
   const int N = std::max(1, s.wavelengths);

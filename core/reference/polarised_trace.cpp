@@ -55,6 +55,9 @@ struct Branch {
   std::string modes;
   int events = 0;
   int choices = 0;  ///< reflect-or-transmit choices made (Transport::Full): the uniform's index k
+  /// The side of the path's split first choice it descends from: 0 none (not met, or drawn), 1
+  /// the transmitted, 2 the reflected (FirstChoice). Only branches of one side add coherently.
+  int side = 0;
 };
 
 double power(const Branch& b) {
@@ -168,6 +171,9 @@ void Tracer::segment(Branch& b, double len) const {
 // or 1/√(1 − p) so that every |G|² and every product of fields is unbiased. The uniform is the
 // branch's choices-th of the trace's seed: o and e branches of one path draw the same numbers and
 // so make the same choice wherever their p are alike, which keeps their coherent sums together.
+// The path's first choice (choices = 0), where split_first_choice, is no draw: the branch goes on
+// as both, the reflected and the transmitted beams with their exact fields (FirstChoice), and
+// uniform 0 is left unused, as the scalar march leaves it.
 void Tracer::cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branch>& stack) const {
   const MediumRecord &A = rec(b.region), &B = rec(c.to);
   if (B.opaque()) return;  // absorbed: nothing of this branch leaves
@@ -193,33 +199,36 @@ void Tracer::cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branc
   };
   const bool asked =
       std::find(s_.reflect_at.begin(), s_.reflect_at.end(), b.events) != s_.reflect_at.end();
-  bool reflect = asked || !(map.beams[2].exists || map.beams[3].exists);
+  bool reflect = asked || !(map.beams[2].exists || map.beams[3].exists), split = false;
   double scale = 1.0;
   int choices = b.choices;
   if (!reflect && s_.transport == Transport::Full && b.choices < s_.max_reflections) {
     const double pr = slotPower(0) + slotPower(1), pt = slotPower(2) + slotPower(3);
     if (pr + pt > 0.0) {
       const double p = pr / (pr + pt);
-      reflect = transportUniform(seed_, std::uint32_t(b.choices)) < p;
-      scale = 1.0 / std::sqrt(reflect ? p : 1.0 - p);
+      split = b.choices == 0 && s_.split_first_choice;
+      reflect = !split && transportUniform(seed_, std::uint32_t(b.choices)) < p;
+      if (!split) scale = 1.0 / std::sqrt(reflect ? p : 1.0 - p);
       ++choices;
     }
   }
-  const OpticalMedium& side = reflect ? from : to;
-  for (size_t slot = reflect ? 0 : 2; slot < (reflect ? 2u : 4u); ++slot) {
+  // Split: the reflected slots (0, 1), then the transmitted (2, 3); else the chosen pair.
+  for (size_t slot = reflect || split ? 0 : 2; slot < (reflect ? 2u : 4u); ++slot) {
     const OutgoingBeam& beam = map.beams[slot];
     if (!beam.exists) continue;
+    const bool reflected = slot < 2;
     Branch nb = b;
     nb.G = {Complex(scale) * out0[slot], Complex(scale) * out1[slot]};
     if (power(nb) < 1e-14) continue;
     nb.p = beam.p;
     nb.ray = beam.ray;
     nb.mode = beam.mode;
-    nb.region = reflect ? b.region : c.to;
+    nb.region = reflected ? b.region : c.to;
     nb.x = c.point;
     nb.events = b.events + 1;
     nb.choices = choices;
-    if (side.crystal) nb.modes += beam.mode == Mode::Ordinary ? 'o' : 'e';
+    if (split) nb.side = reflected ? 2 : 1;
+    if ((reflected ? from : to).crystal) nb.modes += beam.mode == Mode::Ordinary ? 'o' : 'e';
     stack.push_back(nb);
   }
 }
@@ -284,7 +293,8 @@ PolarisedBeam recombine(const std::vector<const Branch*>& group, const Stokes& i
       const glm::dvec3 sep = b.x - ref.x;
       const double lateral = glm::length(sep - glm::dot(sep, beam.direction) * beam.direction);
       const double opd = pathDifference(b, ref);  // the o−e (or path) difference
-      if (used[j] || lateral > width || std::abs(opd) > length) continue;
+      // The two sides of a split first choice are two estimates, added as such (incoherently).
+      if (used[j] || b.side != ref.side || lateral > width || std::abs(opd) > length) continue;
       used[j] = true;
       const Complex ph = std::exp(Complex(0.0, k0 * opd));
       for (size_t c = 0; c < 2; ++c) {

@@ -1243,10 +1243,10 @@ ReferenceMarcher::Result ReferenceMarcher::marchSample(const glm::dvec3& o, cons
                                                        const MarchSettings& m, int mode,
                                                        HeroRecord* hero, uint32_t seed,
                                                        SampleTally& tally, double share) const {
-  const bool full = m.transport == Transport::Full;
+  const bool split = m.transport == Transport::Full && m.split_first_choice;
   if (hero) hero->diverged = field_.weightsDependOnLambda();
   Result r = march(o, d, lambda_nm, scalar, m, mode, hero, seed,
-                   full ? FirstChoice::Transmit : FirstChoice::Drawn);
+                   split ? FirstChoice::Transmit : FirstChoice::Drawn);
   tally.add(r, share);
   if (!r.split) return r;
   if (hero) hero->diverged = field_.weightsDependOnLambda();

@@ -874,8 +874,8 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   p.limits.y = s.spp;
   p.limits.z = std::max(1, s.wavelengths);
   // The view march's transport (the trace kernel's parameters keep 0: the transmitted path).
-  p.transport =
-      glm::ivec4(s.march.transport == Transport::Full ? 1 : 0, s.march.max_reflections, 0, 0);
+  p.transport = glm::ivec4(s.march.transport == Transport::Full ? 1 : 0, s.march.max_reflections,
+                           s.march.split_first_choice ? 1 : 0, 0);
   double l = micrometresFromNanometres(s.wavelength_nm);
   p.wavelength = glm::vec4(float(l), float(1.0 / (l * l)), float(1.0 / (l * l * l * l)), 0.0f);
   I.boundary.setRenderWavelength(s.wavelength_nm);  // the RGB march's indices (sharp.glsl)
@@ -1073,6 +1073,7 @@ std::vector<PolarisedTrace> ViewRenderer::tracePolarised(const std::vector<Polar
                       std::min(settings.max_branches, EIKON_POL_MAX_LEAVES),
                       settings.mueller_row ? 1 : 0,
                       settings.transport == Transport::Full ? settings.max_reflections : 0);
+  p.transport.z = settings.split_first_choice ? 1 : 0;  // polarised_trace.comp cross
   I.params.write(&p, sizeof p);
   vk::Buffer sb(I.ctx, sheetData.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                 "polariser sheets");
