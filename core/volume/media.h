@@ -96,6 +96,9 @@ struct MediaTable {
   bool empty() const { return regions.empty(); }
 };
 
+/// The table's crystals are all biaxial (modes named fast and slow; Scene::fastSlowModes).
+bool fastSlowModes(const MediaTable* table);
+
 /// vec4s per region in packMediaTable's layout.
 inline constexpr int kMediumVec4s = 22;
 /// Flag bits of v7.w.
