@@ -107,7 +107,7 @@ std::array<Inside, 2> principalPlaneWaves(double px, double n_perp, double n_dx,
   return te.n < tm.n ? std::array<Inside, 2>{te, tm} : std::array<Inside, 2>{tm, te};
 }
 
-TEST(BiaxialMarch, PrincipalPlanePlatesSplitBySnellAndTheIndexEllipse) {
+TEST(BiaxialGpu, PrincipalPlanePlatesSplitBySnellAndTheIndexEllipse) {
   const glm::dvec3 n(1.530, 1.680, 1.685);  // aragonite (MINTS), α̂ = x, γ̂ = z: β̂ = y
   // The three principal planes met in the x–z plane of the rays: rotate the crystal instead.
   struct Case {
@@ -162,7 +162,7 @@ glm::dvec3 unitFrom(std::mt19937_64& rng) {
   return glm::normalize(v);
 }
 
-TEST(BiaxialMarch, RandomPlatesMatchTheLibrarysInterfaceRoots) {
+TEST(BiaxialGpu, RandomPlatesMatchTheLibrarysInterfaceRoots) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   const TensorMedium air = TensorMedium::isotropic(1.0);
@@ -209,7 +209,7 @@ TEST(BiaxialMarch, RandomPlatesMatchTheLibrarysInterfaceRoots) {
   EXPECT_LE(worst_phase, 1e-4);
 }
 
-TEST(BiaxialMarch, NoRetardationAtTheMelatopeAndNothingNaNOnTheOpticAxis) {
+TEST(BiaxialGpu, NoRetardationAtTheMelatopeAndNothingNaNOnTheOpticAxis) {
   // Aragonite is negative: α̂ bisects the acute angle; the plate ⊥ α̂ (α̂ = z), γ̂ = x.
   const glm::dvec3 n(1.530, 1.680, 1.685);
   const TensorMedium xtal(n.x, n.y, n.z, {0, 0, 1}, {1, 0, 0});
@@ -248,7 +248,7 @@ TEST(BiaxialMarch, NoRetardationAtTheMelatopeAndNothingNaNOnTheOpticAxis) {
   EXPECT_GT(off, 1e-3);
 }
 
-TEST(BiaxialMarch, TrichroicPlateTransmitsTheAttenuationOfItsModesAxis) {
+TEST(BiaxialGpu, TrichroicPlateTransmitsTheAttenuationOfItsModesAxis) {
   const glm::dvec3 n(1.530, 1.680, 1.685);
   const glm::dvec3 sa(0.05, 0.10, 0.20), sb(0.30, 0.02, 0.07), sg(0.12, 0.40, 0.01);
   // Along z: α̂ = x, γ̂ = z gives D ∥ α̂ (fast) and β̂ (slow); α̂ = z, γ̂ = y gives D ∥ β̂ = y × z = x
@@ -275,7 +275,7 @@ TEST(BiaxialMarch, TrichroicPlateTransmitsTheAttenuationOfItsModesAxis) {
   EXPECT_LE(worst, 1e-5);
 }
 
-TEST(BiaxialMarch, EqualAlphaAndBetaTracesAsTheUniaxialCrystal) {
+TEST(BiaxialGpu, EqualAlphaAndBetaTracesAsTheUniaxialCrystal) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   const glm::dvec3 g = unitFrom(rng), a = glm::normalize(glm::cross(g, unitFrom(rng)));
