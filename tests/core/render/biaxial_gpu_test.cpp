@@ -36,8 +36,7 @@ constexpr double kNm = 589.2938;
 constexpr double kThick = 4.0;  // the plate: faces z = ±2
 
 /// A crystal plate (z in [−2, 2], wide in x and y) of one biaxial material, the GPU twin over it.
-/// loadScene refuses biaxial objects until the CPU twin takes them, so the material is made
-/// biaxial after parsing, as buildMediaTable reads it.
+/// The material is made biaxial in code, its indices and axes exactly as given (no JSON printing).
 struct BiaxialPlate {
   Scene scene;
   VolumeSet volume;
