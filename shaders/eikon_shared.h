@@ -101,6 +101,11 @@ using uvec4 = glm::uvec4;
 // sharp: the shape table has at most EIKON_EXACT_MAX_ROWS rows (no mesh): the view kernels read it
 // from its uniform block (EIKON_B_EXACT_ROWS) everywhere, the convex planes' loops included
 #define EIKON_F_SMALL_SHAPES 524288
+// sharp: some region is a biaxial crystal (EIKON_MEDIUM_BIAXIAL): two modes, fast (0) and slow (1),
+// solved in sharp.glsl from the region's dielectric tensor
+#define EIKON_F_BIAXIAL 1048576
+// The scene's marches have two modes (o/e in uniaxial crystals, fast/slow in biaxial ones).
+#define EIKON_F_TWO_MODES (EIKON_F_UNIAXIAL | EIKON_F_BIAXIAL)
 
 // ViewParams.pass.w bits: how one pass of the view kernel samples and what it writes (shaders/
 // view.comp; set by ViewRenderer::render).

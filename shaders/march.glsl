@@ -778,7 +778,7 @@ bool enterVolume(vec3 o, vec3 d, inout PathRecord rec, out MarchResult R, out fl
 // kSharpMarch (with EIKON_F_SHARP): the pipeline holds one of the two marches, which halves what
 // lavapipe compiles. rec: the caller's record of the path (PathRecord), carried on.
 MarchResult march(vec3 o, vec3 d, int mode, inout PathRecord rec) {
-  if (!hasFlag(EIKON_F_UNIAXIAL)) mode = 0;  // always so; as a constant it folds the e-mode away
+  if (!hasFlag(EIKON_F_TWO_MODES)) mode = 0;  // always so; as a constant it folds the e-mode away
   if (kSharpMarch) return marchSharp(o, d, mode, rec);
   MarchResult R;
   float t0;

@@ -44,8 +44,11 @@ int mediumFlags(int r) { return int(mediumRow(r, 7).w); }
 bool mediumHomogeneous(int r) { return (mediumFlags(r) & EIKON_MEDIUM_HOMOGENEOUS) != 0; }
 bool mediumUniaxial(int r) { return (mediumFlags(r) & EIKON_MEDIUM_UNIAXIAL) != 0; }
 bool mediumOpaque(int r) { return (mediumFlags(r) & EIKON_MEDIUM_OPAQUE) != 0; }
+bool mediumBiaxial(int r) {
+  return hasFlag(EIKON_F_BIAXIAL) && (mediumFlags(r) & EIKON_MEDIUM_BIAXIAL) != 0;
+}
 
-// n of a region's dispersion record (mode 0: n_o, 1: n_e) at the march's wavelength: the
+// n of a region's dispersion record (mode 0: n_o or n_α, 1: n_e or n_γ, 2: n_β) at the march's wavelength: the
 // material's own formula (mediumIndex). Sets `dispersive` where the formula depends on λ
 // (march.glsl PathRecord: wavelength sharing and hero sampling, view.comp).
 //
@@ -57,12 +60,15 @@ float mediumIndex(int r, int mode, inout bool dispersive) {
 #ifdef EIKON_INDEX_AT_RENDER_WAVELENGTH
   if (EIKON_INDEX_AT_RENDER_WAVELENGTH) {
     vec4 atRender = mediumRow(r, 15);
+    if (hasFlag(EIKON_F_BIAXIAL) && mode == 2) return atRender.z;
     return mode == 1 ? atRender.y : atRender.x;
   }
 #endif
-  vec4 head = mediumRow(r, 0);
+  // mode 2 (biaxial scenes only, folded away elsewhere): n_beta, rows 16–19.
+  bool beta = hasFlag(EIKON_F_BIAXIAL) && mode == 2;
+  vec4 head = beta ? mediumRow(r, 16) : mediumRow(r, 0);
   int kind = int(mode == 1 ? head.z : head.x), terms = min(int(mode == 1 ? head.w : head.y), 6);
-  int b = mode == 1 ? 4 : 1;
+  int b = beta ? 17 : mode == 1 ? 4 : 1;
   vec4 c0 = mediumRow(r, b), c1 = mediumRow(r, b + 1), c2 = mediumRow(r, b + 2);
   float coeff[6] = float[6](c0.x, c0.y, c0.z, c0.w, c1.x, c1.y);
   float sc[6] = float[6](c1.z, c1.w, c2.x, c2.y, c2.z, c2.w);
@@ -209,10 +215,148 @@ ModeWave solveInterfaceMode(vec3 pt, vec3 m, bool eMat, vec3 a, float no, float 
 
 vec3 orientNormal(vec3 N, vec3 flow) { return dot(N, flow) < 0.0 ? -N : N; }
 
+// ---- Biaxial media (anisotropic/tensor_medium.h, the product form) ----
+
+// A biaxial region's dielectric tensor at the march's wavelength: the principal axes α̂, β̂ = γ̂ × α̂,
+// γ̂ (rows 20, 7), the indices n_α ≤ n_β ≤ n_γ and the wave-normal optic axes c₁,₂ = ±sinV α̂ +
+// cosV γ̂ with cos²V ∝ a_β − a_γ, sin²V ∝ a_α − a_β (a_i = 1/n_i², the gaps formed as
+// (x − y)(x + y)/(x²y²): no cancellation). n_α = n_β (or n_β = n_γ) gives the uniaxial limit.
+struct Biaxial {
+  vec3 a, b, g;  // α̂, β̂, γ̂
+  vec3 n;        // n_α, n_β, n_γ
+  vec3 c1, c2;   // the optic axes
+};
+
+float inverseSquareGap(float x, float y) { return (x - y) * (x + y) / (x * x * y * y); }
+
+Biaxial biaxialOf(int r, inout bool dispersive) {
+  Biaxial B;
+  B.g = mediumRow(r, 7).xyz;
+  B.a = mediumRow(r, 20).xyz;
+  B.b = cross(B.g, B.a);
+  // A dispersion formula that lets n_β leave [n_α, n_γ] between the wavelengths the scene checks
+  // is clamped back (the CPU twin's tensorOf).
+  float na = mediumIndex(r, 0, dispersive), ng = max(mediumIndex(r, 1, dispersive), na);
+  B.n = vec3(na, clamp(mediumIndex(r, 2, dispersive), na, ng), ng);
+  float c2 = inverseSquareGap(B.n.z, B.n.y), s2 = inverseSquareGap(B.n.y, B.n.x), sum = s2 + c2;
+  float sv = sum > 0.0 ? sqrt(s2 / sum) : 0.0, cv = sum > 0.0 ? sqrt(c2 / sum) : 1.0;
+  B.c1 = sv * B.a + cv * B.g;
+  B.c2 = -sv * B.a + cv * B.g;
+  return B;
+}
+
+// ε⁻¹v = Σ ê_i (ê_i·v)/n_i².
+vec3 biaxialInverseEpsilon(Biaxial B, vec3 v) {
+  return B.a * (dot(B.a, v) / (B.n.x * B.n.x)) + B.b * (dot(B.b, v) / (B.n.y * B.n.y)) +
+         B.g * (dot(B.g, v) / (B.n.z * B.n.z));
+}
+
+// sin θ_k = |ŝ × c_k| below this (float: a few ulp of a unit cross product): on an optic axis.
+const float kOpticAxisSin = 1e-6;
+
+// 1/n² of mode 0 (fast) or 1 (slow) along the unit wave normal u, by the product form
+// u_fast, u_slow = ½(a_α + a_γ) + ½(a_α − a_γ)(cos θ₁ cos θ₂ ± sin θ₁ sin θ₂) (TensorMedium::
+// indices): the splitting is the product sin θ₁ sin θ₂, exact near the optic axes.
+float biaxialInverseSquare(Biaxial B, vec3 u, int mode) {
+  float s12 = length(cross(u, B.c1)) * length(cross(u, B.c2));
+  float mean = 0.5 * (1.0 / (B.n.x * B.n.x) + 1.0 / (B.n.z * B.n.z));
+  return mean + 0.5 * inverseSquareGap(B.n.z, B.n.x) * (dot(u, B.c1) * dot(u, B.c2) + (mode == 0 ? s12 : -s12));
+}
+
+struct BiaxialWave {
+  float n;  // the mode's index along s
+  vec3 D;   // unit D
+  vec3 t;   // unit ray direction ∝ ŝ − Ê(Ê·ŝ), E ∝ ε⁻¹D
+};
+
+// The wave of mode 0 (fast) or 1 (slow) along wave normal s (any length; TensorMedium::modes): D
+// bisects the planes (ŝ, c₁) and (ŝ, c₂) (Biot–Fresnel; the longer bisector, completed by ŝ × it),
+// the fast one the larger D̂ᵀε⁻¹D̂; on an optic axis the deterministic pair D_fast = unit(β̂ −
+// (β̂·ŝ)ŝ), D_slow = ŝ × D_fast, both at n_β (the product form's).
+BiaxialWave biaxialWave(Biaxial B, vec3 s, int mode) {
+  vec3 u = normalize(s), p1 = cross(u, B.c1), p2 = cross(u, B.c2);
+  float l1 = length(p1), l2 = length(p2);
+  vec3 da, db;
+  if (min(l1, l2) <= kOpticAxisSin) {
+    da = normalize(B.b - dot(B.b, u) * u);
+    db = cross(u, da);
+  } else {
+    vec3 plus = p1 / l1 + p2 / l2, minus = p1 / l1 - p2 / l2;
+    da = normalize(dot(plus, plus) >= dot(minus, minus) ? plus : minus);
+    db = normalize(cross(u, da));
+    if (dot(da, biaxialInverseEpsilon(B, da)) < dot(db, biaxialInverseEpsilon(B, db))) {
+      vec3 keep = da;
+      da = db;
+      db = keep;
+    }
+  }
+  BiaxialWave W;
+  W.n = inversesqrt(biaxialInverseSquare(B, u, mode));
+  W.D = mode == 0 ? da : db;
+  vec3 E = normalize(biaxialInverseEpsilon(B, W.D));
+  W.t = normalize(u - E * dot(E, u));
+  return W;
+}
+
+// Trichroic attenuation of a mode per unit RAY length: σ = n³ Σ σ_i (D̂·ê_i)²/n_i³ per unit
+// wave-normal length (TensorMedium::attenuation, FirstOrder) times cos ρ = ŝ·t̂. For a uniaxial
+// medium in biaxial keys it is attenuationE (e) and σ_o (o).
+vec3 biaxialAttenuation(Biaxial B, vec3 sa, vec3 sb, vec3 sg, vec3 s, BiaxialWave W) {
+  float wa = dot(W.D, B.a), wb = dot(W.D, B.b), wg = dot(W.D, B.g);
+  vec3 k = wa * wa * sa / (B.n.x * B.n.x * B.n.x) + wb * wb * sb / (B.n.y * B.n.y * B.n.y) +
+           wg * wg * sg / (B.n.z * B.n.z * B.n.z);
+  return W.n * W.n * W.n * k * dot(normalize(s), W.t);
+}
+
+// The outgoing wave of a biaxial mode with tangential wave vector pt (⊥ m): the root q of the mode's
+// dispersion relation G(p) = |p|²/n_m(p̂)² = 1 at p = pt + q m whose ray points along m
+// (transmitted) or against it (reflected) — the largest or the smallest root, as the mode's shell
+// is closed around p = 0 and t ∝ ∇G is its outward normal (anisotropic/tensor_interface finds the
+// same root among the Booker quartic's four). G is homogeneous of degree 2, so ∇G = 2G t/(t·p) and
+// dG/dq = 2G (t·m)/(t·p); G'' ≈ 2/n_m(m̂)² (exact for a sphere or the uniaxial e-ellipsoid). Each
+// pass solves that quadratic model for the step (the stable root form), from q₀ = ±√(n_γ² − |pt|²)
+// outside every shell: Newton's rate where the model is exact, and no halving near grazing where a
+// tangent's steps would (in double on random geometries three passes reach 3e-7 of the quartic's
+// root, four 1e-12: docs/view-renderer.md). A root exists where the last pass's G is 1 to kBiaxialSolveTolerance with
+// its ray on the right side; else the mode is evanescent. D: the wave's unit D.
+const int kBiaxialSolvePasses = 4;
+const float kBiaxialSolveTolerance = 1e-5;
+ModeWave solveBiaxialMode(vec3 pt, vec3 m, Biaxial B, int mode, bool transmitted, out vec3 D) {
+  ModeWave w;
+  w.exists = false;
+  w.s = vec3(0.0);
+  w.n = 0.0;
+  w.t = vec3(0.0);
+  D = vec3(0.0);
+  float xi2 = dot(pt, pt), sgn = transmitted ? 1.0 : -1.0;
+  if (!(xi2 < B.n.z * B.n.z)) return w;  // beyond the largest index: both modes evanescent
+  float c = biaxialInverseSquare(B, m, mode), q = sgn * sqrt(B.n.z * B.n.z - xi2), G = 0.0;
+  vec3 p = pt + q * m;
+  BiaxialWave W;
+  for (int pass = 0;; ++pass) {  // the last pass evaluates the final q
+    p = pt + q * m;
+    W = biaxialWave(B, p, mode);
+    G = dot(p, p) / (W.n * W.n);
+    if (pass == kBiaxialSolvePasses) break;
+    // c δ² + G' δ + (G − 1) = 0 in the mirrored coordinate sgn·q (its largest root).
+    float h = sgn * 2.0 * G * dot(W.t, m) / dot(W.t, p), c0 = G - 1.0;
+    float disc = h * h - 4.0 * c * c0, root = sqrt(max(disc, 0.0));
+    float dq = disc < 0.0 ? -h / (2.0 * c) : (h > 0.0 ? -2.0 * c0 / (h + root) : (root - h) / (2.0 * c));
+    q += sgn * dq;
+  }
+  if (!(abs(G - 1.0) <= kBiaxialSolveTolerance) || !(sgn * dot(W.t, m) > 0.0)) return w;
+  w.n = length(p);
+  w.s = p / w.n;
+  w.t = W.t;
+  w.exists = true;
+  D = W.D;
+  return w;
+}
+
 // ---- The stages (RayMarch::sharp*) ----
 #ifndef EIKON_SHARP_NO_MARCH
 
-// Box entry: the region there, and the wave vector of the mode in its medium along d.
+// Box entry: the region there, and the wave vector of the mode in its medium along d (p = n_m(d) d).
 void sharpEnter(inout MarchState S, inout bool dispersive, vec3 x, vec3 d, int mode) {
   S.x = x;
   S.region = regionAt(x);  // on the shapes on the exact path, else the field's
@@ -220,11 +364,14 @@ void sharpEnter(inout MarchState S, inout bool dispersive, vec3 x, vec3 d, int m
   vec4 af = regionAxisField(S.region, x);
   if (mode == 1 && hasAxis(af.xyz))
     n = inversesqrt(dot(d, applyM(d, af.xyz, n, regionIndex(S.region, 1, x, dispersive))));
+  if (mediumBiaxial(S.region)) n = inversesqrt(biaxialInverseSquare(biaxialOf(S.region, dispersive), d, mode));
   S.w = n * d;
 }
 
-// The ray (energy) direction in the ray's region: w/|w|, or M_e w for the e-mode in a crystal.
+// The ray (energy) direction in the ray's region: w/|w|, or M_e w for the e-mode in a crystal, or
+// the biaxial mode's t.
 vec3 sharpDirection(MarchState S, int mode, inout bool dispersive) {
+  if (mediumBiaxial(S.region)) return biaxialWave(biaxialOf(S.region, dispersive), S.w, mode).t;
   vec4 af = regionAxisField(S.region, S.x);
   if (mode == 0 || !hasAxis(af.xyz)) return normalize(S.w);
   return normalize(applyM(S.w, af.xyz, regionIndex(S.region, 0, S.x, dispersive),
@@ -280,6 +427,11 @@ void absorbAlong(inout MarchState S, inout bool dispersive, vec3 dir, float len,
   if (mode == 1 && hasAxis(af.xyz))
     sig = attenuationE(sig, regionSigma(r, 1), S.w, af.xyz, regionIndex(r, 0, S.x, dispersive),
                        regionIndex(r, 1, S.x, dispersive));
+  if (mediumBiaxial(r)) {  // trichroic: σ_α, σ_β, σ_γ (regionSigma 0, 2, 1)
+    Biaxial B = biaxialOf(r, dispersive);
+    sig = biaxialAttenuation(B, sig, regionSigma(r, 2), regionSigma(r, 1), S.w,
+                             biaxialWave(B, S.w, mode));
+  }
   vec3 e = colourOf(mediumRow(r, 10).xyz);
   vec3 alb = mediumRow(r, 11).xyz;
   if (hasFlag(EIKON_F_LIT) && alb.x + alb.y + alb.z > 0.0) e += inScatter(S.x + 0.5 * len * dir, dir, sig);
@@ -451,8 +603,12 @@ void crossInterface(inout MarchState S, inout MarchResult R, inout PathRecord re
   vec4 afA = regionAxisField(A, x), afB = regionAxisField(B, x);
   bool uA = hasFlag(EIKON_F_UNIAXIAL) && mediumUniaxial(A);
   bool uB = hasFlag(EIKON_F_UNIAXIAL) && mediumUniaxial(B);
+  bool bA = mediumBiaxial(A), bB = mediumBiaxial(B);  // false unless EIKON_F_BIAXIAL
+  // Equal biaxial media also share their principal axes (an object's own axes make its own tensor).
+  bool sameTensor = !hasFlag(EIKON_F_BIAXIAL) ||
+                    (mediumRow(A, 7).xyz == mediumRow(B, 7).xyz && mediumRow(A, 20).xyz == mediumRow(B, 20).xyz);
   if ((hasFlag(EIKON_F_OPACITY) && mediumOpaque(B)) || (mediumRow(A, 10).w == mediumRow(B, 10).w && int(mediumRow(A, 11).w) == 0 &&
-                          afA.xyz == afB.xyz)) {
+                          afA.xyz == afB.xyz && sameTensor)) {
     S.region = B;  // equal media: nothing changes (an opaque one stops the ray next)
     return;
   }
@@ -460,17 +616,31 @@ void crossInterface(inout MarchState S, inout MarchResult R, inout PathRecord re
   float noB = regionIndex(B, 0, x, rec.dispersive), neB = regionIndex(B, 1, x, rec.dispersive);
   float n1 = length(S.w);
   // Leaving a crystal the normal is oriented along the incident ray (energy) direction and the
-  // incident wave's index is the mode's n(θ); otherwise along s with |w|.
-  bool outOfCrystal = uA && !uB;
+  // incident wave's index is the mode's n(θ); otherwise along s with |w|. A biaxial A: its mode's
+  // wave along s (WA), once for the flow, the index, the reflection and the Fresnel weight.
+  Biaxial BA, BB;
+  BiaxialWave WA;
+  if (bA) {
+    BA = biaxialOf(A, rec.dispersive);
+    WA = biaxialWave(BA, s, mode);
+  }
+  if (bB) BB = biaxialOf(B, rec.dispersive);
+  bool outOfCrystal = (uA || bA) && !(uB || bB);
   bool eIn = uA && mode == 1;
-  vec3 flowA = eIn ? normalize(applyM(s, afA.xyz, noA, neA)) : s;
-  float nIn = outOfCrystal ? (eIn ? inversesqrt(dot(s, applyM(s, afA.xyz, noA, neA))) : noA) : n1;
-  vec3 m = orientNormal(N, outOfCrystal ? flowA : s);
+  vec3 flowA = eIn ? normalize(applyM(s, afA.xyz, noA, neA)) : bA ? WA.t : s;
+  float nInA = bA ? WA.n : eIn ? inversesqrt(dot(s, applyM(s, afA.xyz, noA, neA))) : noA;
+  float nIn = outOfCrystal ? nInA : n1;
+  // Next to a biaxial crystal the normal follows the incident ray (energy) direction always (the
+  // CPU twin's outgoingMode), which differs from s only in a crystal.
+  vec3 m = orientNormal(N, outOfCrystal || bA || bB ? flowA : s);
   vec3 pt = nIn * s - dot(nIn * s, m) * m;
   bool eOut = uB && mode == 1;  // into a crystal: the mode's shell there
-  ModeWave o = solveInterfaceMode(pt, m, eOut, afB.xyz, noB, neB, true);
+  vec3 DB = vec3(0.0);
+  ModeWave o = bB ? solveBiaxialMode(pt, m, BB, mode, true, DB)
+                  : solveInterfaceMode(pt, m, eOut, afB.xyz, noB, neB, true);
   // The mirror wave in A (total internal reflection, or a partial reflection followed): in a
-  // crystal the reflected wave of the same mode (reflectInsideUniaxial), else w mirrored.
+  // crystal the reflected wave of the same mode (reflectInsideUniaxial, or the biaxial mode's),
+  // else w mirrored.
   bool reflects = !o.exists;
   R.interfaces += reflects ? 0 : 1;
   if (o.exists && !hasFlag(EIKON_F_NO_FRESNEL)) {
@@ -480,6 +650,13 @@ void crossInterface(inout MarchState S, inout MarchResult R, inout PathRecord re
       float wsw = sWeight(uB ? o.s : s, uB ? afB.xyz : afA.xyz, N, s, mode);
       Rf = wsw * rsp.x + (1.0 - wsw) * rsp.y;
     }
+    // A biaxial crystal's share: its mode's D along the s direction (the crystal side's wave, B's
+    // where B is a crystal), as sWeight's for the uniaxial modes.
+    if ((bB || (bA && !uB))) {
+      vec3 es = cross(N, s), Dc = bB ? DB : WA.D;
+      float wsw = dot(es, es) < 1e-12 ? 0.5 : dot(Dc, normalize(es)) * dot(Dc, normalize(es));
+      Rf = wsw * rsp.x + (1.0 - wsw) * rsp.y;
+    }
     reflects = followReflection(S, Rf);  // the partial reflection, internal or external
     if (!reflects && singlePathWeights(S)) {
       if (o.n > n1) S.L += environmentWeighted(rec, S.T * Rf, reflect(s, N));
@@ -487,11 +664,12 @@ void crossInterface(inout MarchState S, inout MarchResult R, inout PathRecord re
     }
   }
   if (reflects) {  // the ray stays in A
-    if (uA) {
+    if (uA || bA) {
       m = orientNormal(N, flowA);
-      float nr = eIn ? inversesqrt(dot(s, applyM(s, afA.xyz, noA, neA))) : noA;
-      vec3 ptr = nr * s - dot(nr * s, m) * m;
-      ModeWave r = solveInterfaceMode(ptr, m, eIn, afA.xyz, noA, neA, false);
+      vec3 ptr = nInA * s - dot(nInA * s, m) * m;
+      vec3 DA;
+      ModeWave r = bA ? solveBiaxialMode(ptr, m, BA, mode, false, DA)
+                      : solveInterfaceMode(ptr, m, eIn, afA.xyz, noA, neA, false);
       S.w = r.exists ? r.n * r.s : reflect(S.w, N);
     } else {
       S.w = reflect(S.w, N);

@@ -29,7 +29,7 @@ void main() {
   setWavelength(ray.origin.w, true);
   vec3 d = normalize(ray.direction.xyz);
   // One call site of march() (lavapipe compiles every inlined copy): the modes are a loop.
-  int modes = hasFlag(EIKON_F_UNIAXIAL) ? 2 : 1;
+  int modes = hasFlag(EIKON_F_TWO_MODES) ? 2 : 1;
   for (int mode = 0; mode < modes; ++mode) {
     PathRecord rec = noRecord();  // nothing is evaluated at other wavelengths
     TraceResult o = pack(march(ray.origin.xyz, d, mode, rec));

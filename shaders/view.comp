@@ -143,7 +143,7 @@ struct ModeSpan {
 };
 
 ModeSpan passModes() {
-  const int modes = hasFlag(EIKON_F_UNIAXIAL) ? 2 : 1;
+  const int modes = hasFlag(EIKON_F_TWO_MODES) ? 2 : 1;
   const int selected = (P.pass.w >> EIKON_PASS_MODES_SHIFT) & EIKON_PASS_MODES_MASK;
   ModeSpan m;
   m.m0 = modes == 2 && selected == 2 ? 1 : 0;
@@ -272,7 +272,7 @@ float recordedRadiance(PathRecord rec, int i0, int i1) {
 
 // The record for marching bin k: on for the pass's first wavelength where it may be shared.
 PathRecord stratifiedRecord(int k, SpectralSpan w, bool crossShare) {
-  const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_UNIAXIAL;
+  const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY | EIKON_F_TWO_MODES;
   PathRecord rec = sampleRecord(w.pixel, w.sampleIndex);
   rec.record = (!hasFlag(lambdaDependent) || crossShare) && k == w.k0;
   return rec;

@@ -68,6 +68,7 @@ struct LightTreeNode {
 struct LightTree {
   int mode = 0;                      ///< 0: the o-mode (or the isotropic ray), 1: the e-mode
   bool uniaxial = false;             ///< the scene has crystals: every node is in `mode`
+  bool fast_slow = false;            ///< its crystals are all biaxial: modes named fast, slow
   bool sharp = false;                ///< sharp interfaces (LightTreeNode::object is known)
   std::vector<LightTreeNode> nodes;  ///< the root first, parents before children
   double exit = 0.0, stopped = 0.0, absorbed = 0.0, cut = 0.0;  ///< the weights' balance

@@ -15,6 +15,8 @@
 
 #include "anisotropic/fresnel.h"
 #include "anisotropic/interface.h"
+#include "anisotropic/tensor_interface.h"
+#include "anisotropic/tensor_medium.h"
 #include "anisotropic/units.h"
 #include "core/contract/render_layers.h"
 #include "core/reference/field.h"
@@ -254,17 +256,26 @@ class RayMarch {
   const MediumRecord& rec(int region) const { return media_->regions[size_t(region)]; }
   double regionIndex(int region, int mode, const glm::dvec3& x, glm::dvec3* grad = nullptr) const {
     const MediumRecord& m = rec(region);
-    if (hero_ && m.grin_type == 0) {  // shaders/sharp.glsl mediumIndex: anything but a constant
-      const MediumDispersion& d = mode == 1 ? m.n_e : m.n_o;
-      bool dispersive =
-          d.kind != MediumDispersion::Kind::Constant && d.kind != MediumDispersion::Kind::Cauchy;
-      for (int k = 1; k < std::min(d.terms, 6); ++k)  // Cauchy: any λ term
-        dispersive =
-            dispersive || (d.kind == MediumDispersion::Kind::Cauchy && d.coeff[size_t(k)] != 0.0);
-      if (dispersive) hero_->diverged = true;
-    }
+    if (hero_ && m.grin_type == 0) noteDispersion(mode == 1 ? m.n_e : m.n_o);
     return mediumIndexAt(m, mode, lambda_nm_, x, grad);
   }
+  /// A hero march has met dispersion (shaders/sharp.glsl mediumIndex: anything but a constant).
+  void noteDispersion(const MediumDispersion& d) const {
+    bool dispersive =
+        d.kind != MediumDispersion::Kind::Constant && d.kind != MediumDispersion::Kind::Cauchy;
+    for (int k = 1; k < std::min(d.terms, 6); ++k)  // Cauchy: any λ term
+      dispersive =
+          dispersive || (d.kind == MediumDispersion::Kind::Cauchy && d.coeff[size_t(k)] != 0.0);
+    if (dispersive) hero_->diverged = true;
+  }
+  // Biaxial regions (docs/biaxial-optics.md "In the renderer"): the region's dielectric tensor
+  // at the march's wavelength, and the stages' biaxial cases.
+  TensorMedium tensorOf(int region) const;
+  TensorMode modeOf(int region, const glm::dvec3& w) const;
+  ModeWave outgoingMode(int region, const glm::dvec3& x, const glm::dvec3& p_t, const glm::dvec3& m,
+                        bool transmitted) const;
+  double biaxialSWeight(int from, int to, const glm::dvec3& x, const glm::dvec3& s,
+                        const ModeWave& out, const glm::dvec3& N) const;
   void sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& d) const;
   glm::dvec3 sharpDirection(const MarchState& S) const;
   BoundaryCrossing nextCrossing(const glm::dvec3& a, const glm::dvec3& b, int region) const;
@@ -697,6 +708,10 @@ void RayMarch::sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& 
   S.region = regionAt(*bf_, x);
   if (!bf_->exact) ++f_.fetches;  // the cell around x (exact: on the shapes, no cell)
   const MediumRecord& m = rec(S.region);
+  if (m.biaxial) {  // the mode's index along d (box entry: p = n_m(d̂) d̂)
+    S.w = tensorOf(S.region).indices(d)[size_t(mode_)] * d;
+    return;
+  }
   double n = regionIndex(S.region, 0, x);
   const glm::dvec4 af = mediumAxisField(m, x);
   if (mode_ == 1 && field::hasAxis(glm::dvec3(af)))
@@ -706,6 +721,7 @@ void RayMarch::sharpEnter(MarchState& S, const glm::dvec3& x, const glm::dvec3& 
 
 // The ray (energy) direction in the ray's region: w/|w|, or M_e w for the e-mode in a crystal.
 glm::dvec3 RayMarch::sharpDirection(const MarchState& S) const {
+  if (rec(S.region).biaxial) return modeOf(S.region, S.w).t;
   const glm::dvec4 af = mediumAxisField(rec(S.region), S.x);
   if (mode_ == 0 || !field::hasAxis(glm::dvec3(af))) return glm::normalize(S.w);
   return glm::normalize(field::applyM(S.w, glm::dvec3(af), regionIndex(S.region, 0, S.x),
@@ -745,7 +761,16 @@ void RayMarch::absorbAlong(MarchState& S, const glm::dvec3& dir, double len) con
   const MediumRecord& m = rec(S.region);
   glm::dvec3 sig = regionSigma(m, 0);
   const glm::dvec4 af = mediumAxisField(m, S.x);
-  if (mode_ == 1 && field::hasAxis(glm::dvec3(af)))
+  if (m.biaxial) {  // trichroism: first order in the principal σ's, per unit ray length
+    TensorMedium t = tensorOf(S.region);
+    const glm::dvec3 s = glm::normalize(S.w);
+    const TensorMode md = t.modes(s)[mode_ == 1 ? WaveMode::Slow : WaveMode::Fast];
+    const glm::dvec3 sa = regionSigma(m, 0), sb = regionSigma(m, 2), sg = regionSigma(m, 1);
+    for (int k = 0; k < 3; ++k) {
+      t.sigma = glm::dvec3(sa[k], sb[k], sg[k]);
+      sig[k] = t.attenuation(md.D, md.n) * glm::dot(s, md.t);
+    }
+  } else if (mode_ == 1 && field::hasAxis(glm::dvec3(af)))
     sig = field::attenuationE(sig, regionSigma(m, 1), S.w, glm::dvec3(af),
                               regionIndex(S.region, 0, S.x), regionIndex(S.region, 1, S.x));
   glm::dvec3 e = colourOf(m.emission);
@@ -884,14 +909,19 @@ void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCross
   const glm::dvec3 x = S.x, N = c.normal, s = glm::normalize(S.w);
   const glm::dvec4 afA = mediumAxisField(A, x), afB = mediumAxisField(B, x);
   if (B.opaque() ||
-      (A.medium == B.medium && A.grin_type == 0 && glm::dvec3(afA) == glm::dvec3(afB))) {
+      (A.medium == B.medium && A.grin_type == 0 && glm::dvec3(afA) == glm::dvec3(afB) &&
+       A.axis == B.axis && A.alpha_axis == B.alpha_axis)) {
     S.region = c.to;  // equal media: nothing changes (an opaque one stops the ray next)
     return;
   }
   const Mode mode = mode_ == 1 ? Mode::Extraordinary : Mode::Ordinary;
   const double n1 = glm::length(S.w);
   ModeWave out;
-  if (!A.uniaxial && !B.uniaxial) {
+  const bool biaxial = A.biaxial || B.biaxial;
+  if (biaxial) {  // the mode's outgoing root beyond the face, m̂ along the incident ray
+    const glm::dvec3 m = glm::dot(sharpDirection(S), N) >= 0.0 ? N : -N;
+    out = outgoingMode(c.to, x, S.w - glm::dot(S.w, m) * m, m, true);
+  } else if (!A.uniaxial && !B.uniaxial) {
     out = refractIsotropic(s, N, n1, regionIndex(c.to, 0, x));
   } else if (!A.uniaxial || B.uniaxial) {  // crystal → crystal: as if from an isotropic n1
     const Uniaxial cr(regionIndex(c.to, 0, x), regionIndex(c.to, 1, x), glm::dvec3(afB));
@@ -911,7 +941,10 @@ void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCross
   if (m_.fresnel) {
     const FresnelReflectance rsp = fresnelReflectance(std::abs(glm::dot(s, N)), n1, out.n);
     double Rf = 0.5 * (rsp.Rs + rsp.Rp);
-    if (A.uniaxial || B.uniaxial) {
+    if (biaxial) {
+      const double wsw = biaxialSWeight(S.region, c.to, x, s, out, N);
+      Rf = wsw * rsp.Rs + (1.0 - wsw) * rsp.Rp;
+    } else if (A.uniaxial || B.uniaxial) {
       const bool intoCrystal = B.uniaxial;
       const double wsw =
           sWeight(intoCrystal ? out.s : s, glm::dvec3(intoCrystal ? afB : afA), N, s, mode_);
@@ -935,7 +968,11 @@ void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCross
 // mirrored in the face.
 void RayMarch::reflectInRegion(MarchState& S, const glm::dvec3& N) const {
   const MediumRecord& A = rec(S.region);
-  if (A.uniaxial) {
+  if (A.biaxial) {  // the same mode's reflected root, m̂ along the incident ray
+    const glm::dvec3 m = glm::dot(sharpDirection(S), N) >= 0.0 ? N : -N;
+    const ModeWave r = outgoingMode(S.region, S.x, S.w - glm::dot(S.w, m) * m, m, false);
+    S.w = r.exists ? r.p() : glm::reflect(S.w, N);
+  } else if (A.uniaxial) {
     const glm::dvec3 s = glm::normalize(S.w);
     const glm::dvec4 afA = mediumAxisField(A, S.x);
     const Uniaxial cr(regionIndex(S.region, 0, S.x), regionIndex(S.region, 1, S.x),
@@ -946,6 +983,88 @@ void RayMarch::reflectInRegion(MarchState& S, const glm::dvec3& N) const {
   } else {
     S.w = glm::reflect(S.w, N);
   }
+}
+
+// The dielectric tensor of a biaxial region at the march's wavelength. A dispersion formula that
+// lets n_beta leave [n_alpha, n_gamma] between the three wavelengths the scene checks is clamped
+// back (the principal axes keep their names).
+TensorMedium RayMarch::tensorOf(int region) const {
+  const MediumRecord& m = rec(region);
+  if (hero_) {
+    noteDispersion(m.n_o);
+    noteDispersion(m.n_beta);
+    noteDispersion(m.n_e);
+  }
+  const double a = mediumIndex(m.n_o, lambda_nm_);
+  const double g = std::max(mediumIndex(m.n_e, lambda_nm_), a);
+  const double b = std::clamp(mediumIndex(m.n_beta, lambda_nm_), a, g);
+  return TensorMedium(a, b, g, m.alpha_axis, m.axis);
+}
+
+// The march's mode (0 fast, 1 slow) of a biaxial region for wave vector w (its wave normal).
+TensorMode RayMarch::modeOf(int region, const glm::dvec3& w) const {
+  return tensorOf(region).modes(w)[mode_ == 1 ? WaveMode::Slow : WaveMode::Fast];
+}
+
+// The outgoing wave of the march's mode in `region` with tangential wave vector p_t, on the side
+// +m (transmitted) or −m (reflected), m unit along the incident ray: a biaxial region's root of
+// the mode's dispersion relation (anisotropic/tensor_interface.h, the propagating waves in order
+// of increasing index: fast, slow), a uniaxial one's o or e root (solveUniaxialMode), an
+// isotropic one's Snell root. No root: exists = false (evanescent).
+ModeWave RayMarch::outgoingMode(int region, const glm::dvec3& x, const glm::dvec3& p_t,
+                                const glm::dvec3& m, bool transmitted) const {
+  const MediumRecord& M = rec(region);
+  ModeWave out;
+  if (M.biaxial) {
+    const TensorMedium t = tensorOf(region);
+    const std::array<OutgoingWave, 2> w = outgoingWaves(t, p_t, m, transmitted);
+    const OutgoingWave* pick = nullptr;
+    if (w[0].propagating && w[1].propagating) {
+      pick = &w[size_t(mode_)];
+    } else if (w[0].propagating) {  // one mode propagates: the one whose index it has
+      const std::array<double, 2> n = t.indices(w[0].s);
+      const int its = std::abs(w[0].n - n[0]) <= std::abs(w[0].n - n[1]) ? 0 : 1;
+      if (its == mode_) pick = &w[0];
+    }
+    if (!pick) return out;
+    out.exists = true;
+    out.s = pick->s;
+    out.n = pick->n;
+    out.t = pick->t;
+    out.q = pick->q.real();
+    return out;
+  }
+  if (M.uniaxial) {
+    const Uniaxial cr(regionIndex(region, 0, x), regionIndex(region, 1, x),
+                      glm::dvec3(mediumAxisField(M, x)));
+    return solveUniaxialMode(p_t, m, cr, mode_ == 1 ? Mode::Extraordinary : Mode::Ordinary,
+                             transmitted);
+  }
+  const double n = regionIndex(region, 0, x), rem = n * n - glm::dot(p_t, p_t);
+  if (!(rem > 0.0)) return out;
+  out.exists = true;
+  out.q = (transmitted ? 1.0 : -1.0) * std::sqrt(rem);
+  out.n = n;
+  out.s = glm::normalize(p_t + out.q * m);
+  out.t = out.s;
+  return out;
+}
+
+// The Fresnel weight at a face with a biaxial side (the scalar rule of sWeight): the share of the
+// mode's unit D along the s direction N × ŝ_in, taken on the crystal side (B when B is
+// anisotropic, else A) at that side's wave normal; a uniaxial crystal side keeps sWeight.
+double RayMarch::biaxialSWeight(int from, int to, const glm::dvec3& x, const glm::dvec3& s,
+                                const ModeWave& out, const glm::dvec3& N) const {
+  const bool intoCrystal = rec(to).biaxial || rec(to).uniaxial;
+  const int side = intoCrystal ? to : from;
+  const MediumRecord& C = rec(side);
+  const glm::dvec3 sc = intoCrystal ? out.s : s;
+  if (!C.biaxial) return sWeight(sc, glm::dvec3(mediumAxisField(C, x)), N, s, mode_);
+  glm::dvec3 es = glm::cross(N, s);
+  if (glm::dot(es, es) < 1e-12) return 0.5;
+  es = glm::normalize(es);
+  const double ds = glm::dot(modeOf(side, sc).D, es);
+  return ds * ds;
 }
 
 MarchResult RayMarch::marchSharp(const glm::dvec3& o, const glm::dvec3& d) const {
@@ -1196,6 +1315,7 @@ LightTree ReferenceMarcher::lightTree(const TraceRequest& ray, const MarchSettin
   const glm::dvec3 d = ray.direction / len;
   LightTree out;
   out.uniaxial = field_.uniaxial();
+  out.fast_slow = fastSlowModes(field_.media());
   out.mode = out.uniaxial ? mode : 0;
   out.sharp = field_.boundary() && field_.media();
   // Every split followed both ways: Full transport, its roulette replaced by the script, with no

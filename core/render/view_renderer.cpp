@@ -338,8 +338,15 @@ vk::ComputePipeline takeEarly(const vk::Context* ctx, const PipelineKey& key) {
 
 int volumeFeatureFlags(const VolumeSet& v) {
   const bool sharp = !v.boundary.empty() && !v.media.empty();
-  bool varying = false, convex = false, mesh = false;
-  for (const MediumRecord& r : v.media.regions) varying = varying || !r.homogeneous;
+  bool varying = false, convex = false, mesh = false, biaxial = false, attenuating = false;
+  for (const MediumRecord& r : v.media.regions) {
+    varying = varying || !r.homogeneous;
+    biaxial = biaxial || r.biaxial;
+    // A biaxial crystal's σ_α, σ_β, σ_γ live in the medium table only (the voxel fields hold
+    // the isotropic and uniaxial materials' attenuation).
+    attenuating = attenuating || r.sigma_o != glm::dvec3(0.0) || r.sigma_e != glm::dvec3(0.0) ||
+                  r.sigma_beta != glm::dvec3(0.0);
+  }
   for (const Shape& shape : v.boundary.shapes) {
     convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());
     mesh = mesh || std::holds_alternative<MeshShape>(shape.geometry());
@@ -356,6 +363,8 @@ int volumeFeatureFlags(const VolumeSet& v) {
   if (sharp && varying) flags |= EIKON_F_VARYING;
   if (sharp && convex) flags |= EIKON_F_CONVEX;
   if (sharp && mesh) flags |= EIKON_F_MESH;
+  if (sharp && biaxial) flags |= EIKON_F_BIAXIAL;  // fast and slow modes (sharp.glsl)
+  if (sharp && attenuating) flags |= EIKON_F_ATTENUATION;
   if (sharp) flags |= crossingPathFlags(v.boundary);
   if (sharp) flags |= uniformTableFlags(v.boundary, v.media);
   return flags;
@@ -808,7 +817,7 @@ PassPlan planPasses(const RenderSettings& s, int flags, const LayerSums& layers,
     plan.N = s.wavelengths;
   }
   const int lambdaDependent = EIKON_F_ATTENUATION | EIKON_F_EMISSION | EIKON_F_OPACITY |
-                              EIKON_F_UNIAXIAL | EIKON_F_DISPERSIVE;
+                              EIKON_F_TWO_MODES | EIKON_F_DISPERSIVE;
   // Hero: one pass per pixel sample, all N wavelengths; stratified: all N in one pass where no
   // march depends on λ (the others are table lookups), else one each.
   const bool share = plan.strategy == Strategy::Hero ||
@@ -887,7 +896,8 @@ RenderImage ViewRenderer::render(const RenderSettings& s) {
   // next one is sized from the last one's time to take ~0.25 s.
   // Layers (core/contract/render_layers.h): per pixel, after the band's RGB, `stride` vec4s of
   // channel values per mode (view.comp layerWrite); the pass's bins are added on the host.
-  LayerSums layers(s, size_t(img.width) * size_t(img.height), I.uniaxial);
+  const bool twoModes = (p.grid_dims.w & EIKON_F_TWO_MODES) != 0;  // uniaxial or biaxial
+  LayerSums layers(s, size_t(img.width) * size_t(img.height), twoModes);
   const size_t pixels = size_t(img.width) * size_t(img.height);
   const PassPlan plan = planPasses(s, p.grid_dims.w, layers, pixels, I.ctx.limits());
   const int passes = plan.passes, passesPerSample = plan.passesPerSample;

@@ -713,6 +713,20 @@ ShapeGeometry parseMesh(const Node& o) {
   return scaledConvex(planes, scale);
 }
 
+// A biaxial crystal's orientation on the object: alpha_axis and gamma_axis together, unit after
+// normalising, orthogonal within 1e-6 (as on a material).
+void parseObjectAxes(const Node& o, SceneObject& obj) {
+  const auto a = o.get("alpha_axis"), g = o.get("gamma_axis");
+  if (!a && !g) return;
+  if (!a || !g) o.fail("give both alpha_axis and gamma_axis (a biaxial crystal's orientation)");
+  obj.alpha_axis = a->unitVector();
+  obj.gamma_axis = g->unitVector();
+  const double c = glm::dot(*obj.alpha_axis, *obj.gamma_axis);
+  if (std::abs(c) > 1e-6)
+    g->fail("must be orthogonal to alpha_axis (|cos| <= 1e-6 after normalising both), got cos = " +
+            fmt(c));
+}
+
 SceneObject parseObject(const Node& o) {
   o.requireObject();
   std::string shape = o.at("shape").string();
@@ -720,7 +734,8 @@ SceneObject parseObject(const Node& o) {
   glm::dvec3 rot = o.get("rotation_deg") ? o.at("rotation_deg").vec3() : glm::dvec3(0.0);
   SceneObject obj;
   ShapeGeometry g;
-  auto common = {"shape", "center", "rotation_deg", "material", "optic_axis", "optic_axis_field"};
+  auto common = {"shape",      "center",           "rotation_deg", "material",
+                 "optic_axis", "optic_axis_field", "alpha_axis",   "gamma_axis"};
   auto allow = [&](std::initializer_list<const char*> extra) {
     std::vector<const char*> keys(common);
     keys.insert(keys.end(), extra.begin(), extra.end());
@@ -819,6 +834,7 @@ SceneObject parseObject(const Node& o) {
     if (obj.radial_axis && obj.optic_axis)
       f->fail("give either optic_axis or optic_axis_field \"radial\", not both");
   }
+  parseObjectAxes(o, obj);
   return obj;
 }
 
@@ -1000,6 +1016,11 @@ glm::dvec3 Environment::lookup(const glm::dvec3& d) const {
 bool Scene::anyUniaxial() const {
   return std::any_of(materials.begin(), materials.end(),
                      [](const auto& m) { return m.second.uniaxial; });
+}
+
+bool Scene::anyBiaxial() const {
+  return std::any_of(materials.begin(), materials.end(),
+                     [](const auto& m) { return m.second.biaxial; });
 }
 
 bool Scene::anyScattering() const {
@@ -1414,6 +1435,29 @@ static void checkGrinIndex(const Node& o, const SceneObject& obj, const Material
       }
 }
 
+/// A biaxial crystal renders with sharp interfaces and its own principal axes only; an object of
+/// another material takes no alpha_axis/gamma_axis.
+static void checkBiaxialObject(const Node& o, const SceneObject& obj, const Material& mat,
+                               const Scene& scene) {
+  if (!mat.biaxial) {
+    if (obj.alpha_axis)
+      o.at("alpha_axis").fail("alpha_axis given for a material that is not biaxial");
+    return;
+  }
+  const std::string what = "biaxial material '" + excerpt(obj.material) + "'";
+  if (scene.interfaces != Scene::Interfaces::Sharp)
+    o.at("material")
+        .fail(what +
+              ": \"interfaces\": \"smoothed\" is not yet for biaxial crystals "
+              "(use the default, \"sharp\")");
+  if (obj.optic_axis)
+    o.at("optic_axis")
+        .fail("optic_axis given for a " + what + " (orient it with alpha_axis and gamma_axis)");
+  if (obj.radial_axis)
+    o.at("optic_axis_field")
+        .fail("optic-axis fields are not yet for biaxial crystals (" + what + ")");
+}
+
 /// /objects: each object, its material (from the library if not defined in the scene) and its
 /// checks against the volume; polariser sheets go to scene.polarizers. Returns the objects (index
 /// in scene.objects) that cover the whole volume; json_index[k] is object k's index in /objects.
@@ -1443,11 +1487,7 @@ static std::set<size_t> parseObjects(const Node& objs, Scene& scene, const std::
     SceneObject obj = parseObject(o);
     if (!scene.materials.count(obj.material)) loadLibraryMaterial(o, obj, scene);
     const Material& mat = scene.materials[obj.material];
-    if (mat.biaxial)
-      o.at("material")
-          .fail("'" + excerpt(obj.material) +
-                "' is a biaxial material: biaxial materials are not rendered yet (the "
-                "library and `eikon info` list them)");
+    checkBiaxialObject(o, obj, mat, scene);
     if (obj.radial_axis && !mat.uniaxial)
       o.at("optic_axis_field").fail("optic_axis_field given for an isotropic material");
     if (mat.uniaxial && !obj.optic_axis && !mat.optic_axis && !obj.radial_axis)
@@ -1476,7 +1516,7 @@ static void warnObjectsNearFaces(Scene& scene, const std::set<size_t>& covering,
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     // An object with the ambient index everywhere (a haze, an opaque floor) refracts nothing.
     const Material& mat = scene.materials[scene.objects[i].material];
-    bool refracts = mat.uniaxial || mat.grin.type != GrinProfile::Type::None;
+    bool refracts = mat.uniaxial || mat.biaxial || mat.grin.type != GrinProfile::Type::None;
     for (double l = 380.0; l <= 780.0 && !refracts; l += 40.0)
       refracts = std::abs(mat.n_o.index(l) - scene.ambient_index) > 1e-12;
     if (!refracts || covering.count(i)) continue;
@@ -1593,6 +1633,8 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto ls = root.get("lights")) {
     if (!ls->isArray()) ls->fail("expected an array of lights");
     for (size_t i = 0; i < ls->size(); ++i) scene.lights.push_back(parseLight(ls->index(i)));
+    if (!scene.lights.empty() && scene.anyBiaxial())
+      ls->fail("lights (the light simulator) are not yet for biaxial crystals");
   }
   warnInsideOpaque(scene, json_index, file);
   warnUnseenScene(scene, json_index, file);

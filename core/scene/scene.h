@@ -63,9 +63,9 @@ struct Material {
   Attenuation attenuation_o, attenuation_e;
   /// A biaxial crystal (docs/scene-format.md "Biaxial materials"): the principal indices
   /// n_α ≤ n_β ≤ n_γ of light polarised along alpha_axis, betaAxis() and gamma_axis (unit,
-  /// orthogonal, world space) and the attenuation of each. The library and listings carry it;
-  /// loadScene refuses an object made of one (the renderer does not march biaxial media), and
-  /// n_o, n_e and the o/e attenuation keep their defaults.
+  /// orthogonal, world space) and the attenuation of each. Scenes render objects of it with sharp
+  /// interfaces (docs/biaxial-optics.md "In the renderer"); n_o, n_e and the o/e attenuation keep
+  /// their defaults.
   bool biaxial = false;
   Dispersion n_alpha, n_beta, n_gamma;
   glm::dvec3 alpha_axis{1, 0, 0}, gamma_axis{0, 0, 1};
@@ -152,6 +152,9 @@ struct SceneObject {
   /// "optic_axis_field": "radial" — the axis points away from the object's centre everywhere
   /// (a spherulite); the e-ray equation then includes the axis' derivative.
   bool radial_axis = false;
+  /// Per-object principal axes of a biaxial material (both or neither; unit, orthogonal, world
+  /// space), overriding the material's alpha_axis and gamma_axis: the crystal's orientation.
+  std::optional<glm::dvec3> alpha_axis, gamma_axis;
 };
 
 /// A light of the light simulator (docs/light-simulator.md). Its power is `irradiance`
@@ -198,6 +201,10 @@ struct Scene {
   std::vector<std::string> warnings;
 
   bool anyUniaxial() const;
+  /// True if some material of the scene is biaxial (renders then march its fast and slow modes).
+  bool anyBiaxial() const;
+  /// Its crystals are all biaxial: modes 0 and 1 are named fast and slow (modeName).
+  bool fastSlowModes() const { return anyBiaxial() && !anyUniaxial(); }
   bool anyDispersive() const;
   /// Some material has an albedo (a translucent medium's in-scatter or a diffuse surface): the
   /// only places a render shows the light volumes of the scene's lights (VolumeSet::scattering).

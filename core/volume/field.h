@@ -44,7 +44,7 @@ class Field {
   /// Length scale of the steps (the voxel edge, mm).
   virtual double cellSize() const = 0;
   virtual double ambientIndex() const { return 1.0; }
-  /// True if some region is uniaxial (renders then average the o- and e-modes).
+  /// True if some region is uniaxial or biaxial (renders then average its two modes).
   virtual bool uniaxial() const { return false; }
   /// (albedo_r, albedo_g, albedo_b, Henyey–Greenstein g); zero where nothing scatters.
   virtual glm::dvec4 scatter(const glm::dvec3&) const { return glm::dvec4(0.0); }

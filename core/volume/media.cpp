@@ -35,17 +35,16 @@ std::vector<glm::dvec3> sigmaSpectrum(const Attenuation& o, const Attenuation& e
   return t;
 }
 
-// A biaxial crystal: the principal indices and axes of the material (homogeneous; the scene
-// refuses GRIN profiles and axis fields on one).
+// A biaxial crystal: the principal indices of the material, its axes or the object's (homogeneous;
+// the scene refuses GRIN profiles and axis fields on one).
 MediumRecord biaxialRecord(const SceneObject& obj, const Material& mat) {
-  (void)obj;
   MediumRecord m;
   m.biaxial = true;
   m.n_o = dispersionRecord(mat.n_alpha);
   m.n_beta = dispersionRecord(mat.n_beta);
   m.n_e = dispersionRecord(mat.n_gamma);
-  m.axis = glm::normalize(mat.gamma_axis);
-  m.alpha_axis = glm::normalize(mat.alpha_axis);
+  m.axis = glm::normalize(obj.gamma_axis.value_or(mat.gamma_axis));  // the object's own, if given
+  m.alpha_axis = glm::normalize(obj.alpha_axis.value_or(mat.alpha_axis));
   m.sigma_o = bands(mat.attenuation_alpha);
   m.sigma_beta = bands(mat.attenuation_beta);
   m.sigma_e = bands(mat.attenuation_gamma);
@@ -151,6 +150,16 @@ double mediumSigmaAt(const MediumRecord& m, int axis, double lambda_nm) {
   const int i = std::min(int(u), kSigmaSamples - 2);
   const double a = m.sigma_spectrum[size_t(i)][axis], b = m.sigma_spectrum[size_t(i) + 1][axis];
   return a + (b - a) * (u - i);
+}
+
+bool fastSlowModes(const MediaTable* table) {
+  if (!table) return false;
+  bool biaxial = false;
+  for (const MediumRecord& m : table->regions) {
+    if (m.uniaxial) return false;
+    biaxial = biaxial || m.biaxial;
+  }
+  return biaxial;
 }
 
 double mediumIndex(const MediumDispersion& d, double lambda_nm) {

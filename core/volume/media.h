@@ -106,6 +106,9 @@ struct MediaTable {
 inline constexpr int kSigmaSamples = 81;
 inline constexpr double kSigmaFirstNm = 380.0, kSigmaStepNm = 5.0;
 
+/// The table's crystals are all biaxial (modes named fast and slow; Scene::fastSlowModes).
+bool fastSlowModes(const MediaTable* table);
+
 /// vec4s per region in packMediaTable's layout.
 inline constexpr int kMediumVec4s = 22;
 /// Flag bits of v7.w.

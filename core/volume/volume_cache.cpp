@@ -121,6 +121,17 @@ void hashMaterial(KeyBytes& k, const std::string& name, const Material& m) {
     k.doubles(a->wavelengths_nm);
     k.doubles(a->values);
   }
+  k.value(m.biaxial);  // a biaxial crystal's tensor (the media table is cached)
+  if (m.biaxial) {
+    for (const Dispersion* d : {&m.n_alpha, &m.n_beta, &m.n_gamma}) hashDispersion(k, *d);
+    k.vec3(m.alpha_axis);
+    k.vec3(m.gamma_axis);
+    for (const Attenuation* a : {&m.attenuation_alpha, &m.attenuation_beta, &m.attenuation_gamma}) {
+      k.vec3(a->rgb);
+      k.doubles(a->wavelengths_nm);
+      k.doubles(a->values);
+    }
+  }
   k.vec3(m.emission);
   k.value(m.opacity);
   k.vec3(m.albedo);
@@ -257,6 +268,8 @@ uint64_t volumeCacheKey(const Scene& scene) {
     k.text(o.material);
     k.optionalVec3(o.optic_axis);
     k.value(o.radial_axis);
+    k.optionalVec3(o.alpha_axis);
+    k.optionalVec3(o.gamma_axis);
   }
   const uint64_t key = hashBytes(k.bytes().data(), k.bytes().size());
   return key == 0 ? 1 : key;  // 0 means "no key"

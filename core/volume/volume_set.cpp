@@ -183,12 +183,15 @@ std::map<std::string, MaterialValues> materialValues(const Scene& scene, VolumeS
   };
   for (const auto& [name, m] : scene.materials) {
     MaterialValues mv{};
-    auto co = m.n_o.cauchyApproximation(380.0, 780.0), ce = m.n_e.cauchyApproximation(380.0, 780.0);
+    // A biaxial crystal's fields (which its sharp march does not read) carry n_α and n_γ.
+    const Dispersion &no = m.biaxial ? m.n_alpha : m.n_o, &ne = m.biaxial ? m.n_gamma : m.n_e;
+    auto co = no.cauchyApproximation(380.0, 780.0), ce = ne.cauchyApproximation(380.0, 780.0);
     for (int c = 0; c < 3; ++c) {
       mv.v[kAo + c] = float(co.coeffs[size_t(c)]);
       mv.v[kAe + c] = float(ce.coeffs[size_t(c)]);
     }
-    glm::dvec3 so = bands(m.attenuation_o), se = bands(m.attenuation_e);
+    glm::dvec3 so = bands(m.biaxial ? m.attenuation_alpha : m.attenuation_o),
+               se = bands(m.biaxial ? m.attenuation_gamma : m.attenuation_e);
     for (int c = 0; c < 3; ++c) {
       mv.v[kSor + c] = float(so[c]);
       mv.v[kSer + c] = float(se[c]);
@@ -539,7 +542,7 @@ VolumeSet voxelize(const Scene& scene, const VoxelizeOptions& opt) {
   vs.grid = checkedGrid(scene);
   const Grid& g = vs.grid;
   const size_t N = g.count();
-  vs.uniaxial = scene.anyUniaxial();
+  vs.uniaxial = scene.anyUniaxial() || scene.anyBiaxial();  // two modes
   vs.ambient_index = scene.ambient_index;
   const std::map<std::string, MaterialValues> values = materialValues(scene, vs);
 
@@ -588,7 +591,7 @@ VolumeSet voxelizeInterfaces(const Scene& scene, const VoxelizeOptions& opt) {
     throw std::invalid_argument("voxelizeInterfaces: the scene's interfaces are smoothed");
   VolumeSet vs;
   vs.grid = checkedGrid(scene);
-  vs.uniaxial = scene.anyUniaxial();
+  vs.uniaxial = scene.anyUniaxial() || scene.anyBiaxial();  // two modes
   vs.ambient_index = scene.ambient_index;
   (void)materialValues(scene, vs);  // the flags
   // Where every crossing and region comes from the shapes (the exact path; convex planes apart)

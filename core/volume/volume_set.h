@@ -47,7 +47,7 @@ namespace eikon {
 
 struct VolumeSet {
   Grid grid;
-  bool uniaxial = false;     ///< e-mode fields differ from o-mode fields
+  bool uniaxial = false;     ///< two modes (a uniaxial or biaxial crystal): e/slow fields differ
   bool dispersive = false;   ///< some B or C coefficient is non-zero
   bool attenuating = false;  ///< some attenuation is non-zero
   bool emissive = false;     ///< some emission is non-zero

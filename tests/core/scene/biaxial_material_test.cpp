@@ -1,7 +1,8 @@
 // Biaxial materials (docs/scene-format.md "Biaxial materials", docs/materials.md): the shipped
 // files parse, their indices give the published optic angle 2V and sign, the refitted and
 // rewritten dispersions reproduce their sources, every bad input is one line naming the file and
-// the JSON path, and an object made of a biaxial material is refused. Attenuation spectra give
+// the JSON path, and an object made of a biaxial material loads with its own axes unless the
+// renderer cannot march it (smoothed interfaces, axis fields, lights). Attenuation spectra give
 // the band values the renderer stores (σ at 612, 549, 465 nm, linear in between).
 #include <gtest/gtest.h>
 
@@ -344,17 +345,48 @@ TEST(BiaxialMaterial, LibrarySpectraMustCoverTheVisible) {
   EXPECT_NO_THROW(parseScene(scene, kOrigin));
 }
 
-// Nothing renders a biaxial crystal yet: an object made of one is refused at load, whether the
-// material is the scene's own or the library's.
-TEST(BiaxialMaterial, AnObjectOfABiaxialMaterialIsRefused) {
-  EXPECT_TRUE(test::isOneLineSceneError(
-      test::sceneErrorOf(withMaterial(biaxial(""), true), kOrigin), kOrigin, "/objects/0/material",
-      "biaxial materials are not rendered yet"));
-  const std::string lib =
-      R"({"objects": [{"shape": "sphere", "radius": 3, "material": "tanzanite"}]})";
-  EXPECT_TRUE(test::isOneLineSceneError(test::sceneErrorOf(lib, kOrigin), kOrigin,
-                                        "/objects/0/material",
-                                        "'tanzanite' is a biaxial material"));
+// An object of a biaxial material loads with sharp interfaces (the default), with the material's
+// axes or its own (alpha_axis and gamma_axis together, orthogonal); the media table carries them.
+TEST(BiaxialMaterial, AnObjectOfABiaxialMaterialLoadsWithItsOwnAxes) {
+  const Scene own = parseScene(withMaterial(biaxial(""), true), kOrigin);
+  ASSERT_EQ(own.objects.size(), 1u);
+  EXPECT_TRUE(own.anyBiaxial() && own.fastSlowModes());
+  const std::string lib = R"({"objects": [{"shape": "sphere", "radius": 3,
+      "material": "tanzanite", "alpha_axis": [0, 1, 0], "gamma_axis": [1, 0, 0]}]})";
+  const Scene s = parseScene(lib, kOrigin);
+  const MediaTable media = buildMediaTable(s);
+  ASSERT_EQ(media.regions.size(), 2u);
+  EXPECT_TRUE(media.regions[1].biaxial);
+  EXPECT_EQ(media.regions[1].alpha_axis, glm::dvec3(0, 1, 0));
+  EXPECT_EQ(media.regions[1].axis, glm::dvec3(1, 0, 0));
+  EXPECT_TRUE(fastSlowModes(&media));
+}
+
+std::string biaxialObject(const std::string& extra, const std::string& top = "") {
+  return R"({)" + top + R"("materials": {"m": )" + biaxial("") +
+         R"(}, "objects": [{"shape": "sphere", "radius": 3, "material": "m")" + extra + "}]}";
+}
+#define EXPECT_OBJECT_ERROR(text, json_path, phrase) \
+  EXPECT_TRUE(                                       \
+      test::isOneLineSceneError(test::sceneErrorOf(text, kOrigin), kOrigin, json_path, phrase))
+
+// What the renderer does not do for a biaxial crystal is one line naming the JSON path.
+TEST(BiaxialMaterial, WhatTheRendererDoesNotDoIsOneLine) {
+  EXPECT_OBJECT_ERROR(biaxialObject("", R"("interfaces": "smoothed", )"), "/objects/0/material",
+                      "\"smoothed\" is not yet for biaxial crystals");
+  EXPECT_OBJECT_ERROR(biaxialObject(R"(, "optic_axis": [0, 0, 1])"), "/objects/0/optic_axis",
+                      "optic_axis given for a biaxial material");
+  EXPECT_OBJECT_ERROR(biaxialObject(R"(, "optic_axis_field": "radial")"),
+                      "/objects/0/optic_axis_field", "not yet for biaxial crystals");
+  EXPECT_OBJECT_ERROR(biaxialObject(R"(, "alpha_axis": [1, 0, 0])"), "/objects/0",
+                      "give both alpha_axis and gamma_axis");
+  EXPECT_OBJECT_ERROR(biaxialObject(R"(, "alpha_axis": [1, 0, 0], "gamma_axis": [0.01, 0, 1])"),
+                      "/objects/0/gamma_axis", "orthogonal to alpha_axis");
+  EXPECT_OBJECT_ERROR(biaxialObject("", R"("lights": [{"type": "directional"}], )"), "/lights",
+                      "not yet for biaxial crystals");
+  EXPECT_OBJECT_ERROR(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "N-BK7",
+                         "alpha_axis": [1, 0, 0], "gamma_axis": [0, 0, 1]}]})",
+                      "/objects/0/alpha_axis", "not biaxial");
 }
 
 }  // namespace
