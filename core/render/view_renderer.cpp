@@ -345,7 +345,7 @@ int volumeFeatureFlags(const VolumeSet& v) {
     // A biaxial crystal's σ_α, σ_β, σ_γ live in the medium table only (the voxel fields hold
     // the isotropic and uniaxial materials' attenuation).
     attenuating = attenuating || r.sigma_o != glm::dvec3(0.0) || r.sigma_e != glm::dvec3(0.0) ||
-                  r.sigma_beta != glm::dvec3(0.0);
+                  r.sigma_beta != glm::dvec3(0.0) || !r.sigma_spectrum.empty();
   }
   for (const Shape& shape : v.boundary.shapes) {
     convex = convex || std::holds_alternative<ConvexShape>(shape.geometry());

@@ -202,8 +202,11 @@ std::map<std::string, MaterialValues> materialValues(const Scene& scene, VolumeS
     mv.v[kOpacity] = float(m.opacity);
     values[name] = mv;
     if (mv.v[kBo] != 0 || mv.v[kCo] != 0 || mv.v[kBe] != 0 || mv.v[kCe] != 0) vs.dispersive = true;
-    for (int f : {kSor, kSog, kSob, kSer, kSeg, kSeb})
-      if (mv.v[f] != 0) vs.attenuating = true;
+    // Any attenuation, at the band points or anywhere in a spectrum (σ_β of a biaxial crystal,
+    // a narrow band between the band points), makes the scene attenuating.
+    for (const Attenuation* a : {&m.attenuation_o, &m.attenuation_e, &m.attenuation_alpha,
+                                 &m.attenuation_beta, &m.attenuation_gamma})
+      if (!a->isZero()) vs.attenuating = true;
     for (int f : {kEr, kEg, kEb})
       if (mv.v[f] != 0) vs.emissive = true;
     if (mv.v[kOpacity] != 0) vs.opaque = true;
