@@ -290,7 +290,8 @@ void runRender(const RenderArgs& a, const CLI::App& sub) {
                                                                    img.stokes, kStokesFrame)
                             : rs.spectral_layer || rs.mode_layers || rs.aov_layer
                                 ? exrLayersContent(img.width, img.height, img.rgb, img.bins,
-                                                   img.spectral, img.modes, aovNames(img), img.aov)
+                                                   img.spectral, img.modes, aovNames(img), img.aov,
+                                                   session.scene()->fastSlowModes())
                                 : exrRgbContent(img.width, img.height, img.rgb)}});
   timings::mark("written");
   printSummary(a, session, twin, light, rs, img, out, png);

@@ -107,7 +107,7 @@ void printTrace(const TraceArgs& a, const Scene& scene, const std::array<TraceOu
     j["modes"] = nlohmann::json::array();
     for (int mi = 0; mi < 2; ++mi) {
       const TraceOutcome& t = modes[size_t(mi)];
-      j["modes"].push_back({{"mode", mi == 0 ? "o" : "e"},
+      j["modes"].push_back({{"mode", modeName(mi, scene.fastSlowModes())},
                             {"exit_point", vec(t.exit_point)},
                             {"exit_direction", vec(t.exit_direction)},
                             {"wave_normal", vec(t.wave_normal)},
@@ -134,7 +134,7 @@ void printTrace(const TraceArgs& a, const Scene& scene, const std::array<TraceOu
   }
   // The text carries what --json carries. An isotropic scene has one mode: the o and e traces
   // coincide, so it is printed once and said so.
-  const bool isotropic = !scene.anyUniaxial();
+  const bool isotropic = !scene.anyUniaxial() && !scene.anyBiaxial();
   std::printf("wavelength %.4f nm on %s%s\n", a.wavelength, device.c_str(),
               isotropic ? " (isotropic scene: the o and e modes coincide)" : "");
   for (int mi = 0; mi < (isotropic ? 1 : 2); ++mi) {
@@ -142,12 +142,10 @@ void printTrace(const TraceArgs& a, const Scene& scene, const std::array<TraceOu
     std::printf(
         "  %s: exit (%.6f, %.6f, %.6f) dir (%.6f, %.6f, %.6f) wave normal (%.6f, %.6f, %.6f) OPL "
         "%.6f mm T %.6f%s\n",
-        isotropic ? "o=e"
-        : mi == 0 ? "o"
-                  : "e",
-        t.exit_point.x, t.exit_point.y, t.exit_point.z, t.exit_direction.x, t.exit_direction.y,
-        t.exit_direction.z, t.wave_normal.x, t.wave_normal.y, t.wave_normal.z, t.optical_path_mm,
-        t.transmittance, t.left_volume ? "" : " (stopped inside)");
+        isotropic ? "o=e" : modeName(mi, scene.fastSlowModes()), t.exit_point.x, t.exit_point.y,
+        t.exit_point.z, t.exit_direction.x, t.exit_direction.y, t.exit_direction.z, t.wave_normal.x,
+        t.wave_normal.y, t.wave_normal.z, t.optical_path_mm, t.transmittance,
+        t.left_volume ? "" : " (stopped inside)");
     std::printf("  %*s  %d interfaces crossed, %d total internal reflections, %d steps\n",
                 isotropic ? 3 : 1, "", t.interfaces, t.total_internal_reflections, t.steps);
   }

@@ -568,7 +568,7 @@ class Viewer {
                   shown_wavelengths_ > 0
                       ? (std::to_string(shown_wavelengths_) + " wavelengths").c_str()
                       : "RGB",
-                  integratorName(integrator_), modesName(modes_),
+                  integratorName(integrator_), modesName(modes_, session_.scene()->fastSlowModes()),
                   compiling_ ? " | compiling..."
                   : refined_ ? " | refined"
                              : "",
@@ -966,7 +966,7 @@ void runView(const ViewArgs& given, const CLI::App& sub) {
                 viewer.shownWavelengths() > 0
                     ? (std::to_string(viewer.shownWavelengths()) + " wavelengths").c_str()
                     : "RGB",
-                modesName(viewer.shownModes()),
+                modesName(viewer.shownModes(), scene->fastSlowModes()),
                 cameraJson(scene->camera, img.width, img.height).c_str());
   }
 }

@@ -24,8 +24,9 @@
 // and trace_rays() gives the same keys with arrays of shape (N, 3) / (N,). Both modes appear for
 // every scene: uniaxial scenes march each ray twice (GPU: ViewRenderer::traceModes, CPU:
 // ReferenceMarcher::trace(..., mode 0 = o, 1 = e)); isotropic scenes march once and report the
-// same outcome as "o" and "e" (as the CLI prints it). Look modes up by name, never by position;
-// `modes_traced(scene)` returns ['o', 'e'].
+// same outcome as "o" and "e" (as the CLI prints it). A scene whose crystals are all biaxial
+// names its modes "fast" and "slow" instead (docs/biaxial-optics.md "In the renderer"). Look modes
+// up by name, never by position; `modes_traced(scene)` returns the two names.
 //
 // Vulkan: one vk::Context is created lazily, on the first GPU call, and shared by every Renderer.
 // EIKON_VALIDATION=1 enables the Khronos validation layer (the context reads it); the messages it

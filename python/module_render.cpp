@@ -130,7 +130,7 @@ py::dict grid(Prepared& p) {
 // reference for CPU renders, as --reference), through the CLI's light cache when `light_cache`
 // names one.
 // The render with its layers (`layers` as `eikon render --layers`): a dict of numpy arrays.
-py::dict layerArrays(const RenderImage& img) {
+py::dict layerArrays(const RenderImage& img, bool fastSlow) {
   py::dict d;
   d["rgb"] = imageArray(img);
   if (img.bins > 0) {
@@ -147,7 +147,7 @@ py::dict layerArrays(const RenderImage& img) {
       py::array_t<float> a({py::ssize_t(img.height), py::ssize_t(img.width), py::ssize_t(3)});
       for (size_t i = 0; i < size_t(img.width) * size_t(img.height); ++i)
         for (size_t c = 0; c < 3; ++c) a.mutable_data()[3 * i + c] = img.modes[6 * i + 3 * m + c];
-      d[m == 0 ? "o" : "e"] = a;
+      d[modeName(m, fastSlow)] = a;
     }
   }
   if (!img.stokes.empty()) {  // a polarised render (docs/polarisation.md "Polarised renders")
@@ -226,7 +226,7 @@ py::object render(Prepared& p, int width, int height, std::optional<int> spp,
   printer.close();
   if (settings.spectral_layer || settings.mode_layers || settings.aov_layer ||
       settings.stokes_layers)
-    return layerArrays(img);
+    return layerArrays(img, p.scene->fastSlowModes());
   return imageArray(img);
 }
 
@@ -313,7 +313,8 @@ py::dict traceRays(Prepared& p, const py::handle& origins, const py::handle& dir
   auto req = makeRequests(origins, directions, wavelength_nm);
   auto both = traceBoth(p, req, march, device);
   py::dict modes;
-  const char* names[2] = {"o", "e"};
+  const bool fs = p.scene->fastSlowModes();
+  const char* names[2] = {modeName(0, fs), modeName(1, fs)};
   for (int k = 0; k < 2; ++k) {
     std::vector<TraceOutcome> col;
     col.reserve(both.size());
@@ -335,8 +336,9 @@ py::dict traceOne(Prepared& p, const py::handle& origin, const py::handle& direc
   TraceRequest q{toVec3(origin), toVec3(direction), wavelength_nm};
   auto both = traceBoth(p, {q}, march, device).at(0);
   py::list modes;
-  modes.append(outcomeDict(both[0], "o"));
-  modes.append(outcomeDict(both[1], "e"));
+  const bool fs = p.scene->fastSlowModes();
+  modes.append(outcomeDict(both[0], modeName(0, fs)));
+  modes.append(outcomeDict(both[1], modeName(1, fs)));
   py::dict d;
   d["wavelength_nm"] = wavelength_nm;
   d["device"] = device;

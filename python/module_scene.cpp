@@ -15,9 +15,10 @@ Transport parseTransportName(const std::string& name) {
   throw py::value_error("transport must be full or single, not '" + name + "'");
 }
 
-std::vector<std::string> modesTraced(const Scene&) {
-  // Both twins march the e-mode of uniaxial crystals; an isotropic scene's e-mode is its o-mode.
-  return {"o", "e"};
+std::vector<std::string> modesTraced(const Scene& s) {
+  // Both twins march the e-mode of uniaxial crystals (the slow mode of biaxial ones); an isotropic
+  // scene's e-mode is its o-mode.
+  return {modeName(0, s.fastSlowModes()), modeName(1, s.fastSlowModes())};
 }
 }  // namespace
 
@@ -131,7 +132,8 @@ void bindScene(py::module_& m) {
       py::arg("path"));
   m.def(
       "modes_traced", [](const Scene& s) { return modesTraced(s); }, py::arg("scene"),
-      "modes trace() reports for this scene: always ['o', 'e'] (isotropic: e identical to o)");
+      "modes trace() reports for this scene: ['o', 'e'] (isotropic: e identical to o), or "
+      "['fast', 'slow'] where its crystals are all biaxial");
 }
 
 }  // namespace eikon::python

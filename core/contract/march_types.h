@@ -130,7 +130,18 @@ inline ModeRange modeRange(Modes m, bool uniaxial) {
   if (m == Modes::E) return {1, 2, 1.0};
   return {0, 2, 0.5};
 }
-inline const char* modesName(Modes m) { return m == Modes::O ? "o" : m == Modes::E ? "e" : "both"; }
+/// The name of a Modes value; `fastSlow` (a scene whose crystals are all biaxial): fast, slow.
+inline const char* modesName(Modes m, bool fastSlow = false) {
+  if (m == Modes::Both) return "both";
+  return m == Modes::O ? (fastSlow ? "fast" : "o") : (fastSlow ? "slow" : "e");
+}
+/// The names of mode 0 and mode 1 in output (traces, light trees, render layers): "fast" and
+/// "slow" where a scene's crystals are all biaxial (fastSlow), else "o" and "e". A scene with
+/// both kinds keeps "o" and "e": its mode 0 is the o-wave in a uniaxial crystal and the fast wave
+/// in a biaxial one, as a path keeps its mode index across interfaces.
+inline const char* modeName(int mode, bool fastSlow) {
+  return fastSlow ? (mode == 0 ? "fast" : "slow") : (mode == 0 ? "o" : "e");
+}
 
 struct RenderSettings {
   int width = 0, height = 0;        ///< 0 = the scene camera's

@@ -171,7 +171,7 @@ std::string spectralChannelName(double centreNm) {
 FileContent exrLayersContent(int width, int height, const std::vector<float>& rgb, int bins,
                              const std::vector<float>& spectral, const std::vector<float>& modes,
                              const std::vector<std::string>& extra_names,
-                             const std::vector<float>& extra) {
+                             const std::vector<float>& extra, bool fast_slow) {
   const size_t n = size_t(width) * size_t(height);
   if (rgb.size() != 3 * n || spectral.size() != size_t(std::max(bins, 0)) * n ||
       (!modes.empty() && modes.size() != 6 * n) || extra.size() != extra_names.size() * n)
@@ -181,7 +181,7 @@ FileContent exrLayersContent(int width, int height, const std::vector<float>& rg
   const double width_nm = bins > 0 ? 400.0 / bins : 0.0;
   for (int k = 0; k < bins; ++k) names.push_back(spectralChannelName(380.0 + (k + 0.5) * width_nm));
   if (!modes.empty())
-    for (const char* m : {"o.", "e."})
+    for (const char* m : {fast_slow ? "fast." : "o.", fast_slow ? "slow." : "e."})
       for (const char* c : {"R", "G", "B"}) names.push_back(std::string(m) + c);
   const size_t extraAt = names.size(), E = extra_names.size();
   names.insert(names.end(), extra_names.begin(), extra_names.end());

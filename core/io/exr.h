@@ -50,13 +50,14 @@ std::string spectralChannelName(double centreNm);
 /// A render's EXR with its layers (ZIP, float): R, G, B (linear sRGB); `bins` channels
 /// spectralChannelName(bin centre) of [380, 780] nm cut in `bins` equal bins (spectral: bins per
 /// pixel, pixel-major) with the string attribute emissiveUnits = "W.m^-2.sr^-1.nm^-1"; if
-/// `modes` is not empty (6 floats per pixel), o.R, o.G, o.B, e.R, e.G, e.B; then the channels
-/// `extra_names` (e.g. the AOV layer's Z, Px, …), from `extra`: extra_names.size() floats per
-/// pixel, pixel-major. For writeFilesTogether.
+/// `modes` is not empty (6 floats per pixel), o.R, o.G, o.B, e.R, e.G, e.B (fast.R … slow.B with
+/// `fast_slow`: a scene whose crystals are all biaxial); then the channels `extra_names` (e.g. the
+/// AOV layer's Z, Px, …), from `extra`: extra_names.size() floats per pixel, pixel-major. For
+/// writeFilesTogether.
 FileContent exrLayersContent(int width, int height, const std::vector<float>& rgb, int bins,
                              const std::vector<float>& spectral, const std::vector<float>& modes,
                              const std::vector<std::string>& extra_names = {},
-                             const std::vector<float>& extra = {});
+                             const std::vector<float>& extra = {}, bool fast_slow = false);
 
 /// A polarised render's EXR (ZIP, float): R, G, B (= S0) and the Stokes layers named as Mitsuba
 /// 3's Stokes film writes them, S0.R, S0.G, S0.B, S1.R, …, S3.B (`stokes`: 12 floats per pixel,

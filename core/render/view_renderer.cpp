@@ -454,7 +454,7 @@ void checkVolumeFits(const vk::Context& ctx, const Grid& grid, const Scene& scen
                                std::to_string(lim.max_image_dimension_3d) + " per side");
   // Images: 3 index fields + medium + emission (+ 3 e-index, medium e, axis when uniaxial)
   // (+ scatter when a material has an albedo, + 2 light volumes when the scene has lights).
-  size_t images = scene.anyUniaxial() ? 10 : 5;
+  size_t images = scene.anyUniaxial() || scene.anyBiaxial() ? 10 : 5;  // two modes
   bool scattering = false;
   for (const auto& [name, m] : scene.materials)
     scattering = scattering || glm::length(m.albedo) > 0;

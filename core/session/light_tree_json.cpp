@@ -40,7 +40,7 @@ nlohmann::json lightTreesJson(const TraceRequest& ray, const LightTreeSettings& 
   j["trees"] = nlohmann::json::array();
   for (const LightTree& t : trees) {
     nlohmann::json tj;
-    tj["mode"] = !t.uniaxial ? "isotropic" : t.mode == 0 ? "o" : "e";
+    tj["mode"] = !t.uniaxial ? "isotropic" : modeName(t.mode, t.fast_slow);
     tj["nodes"] = nlohmann::json::array();
     tj["exits"] = nlohmann::json::array();
     for (const LightTreeNode& n : t.nodes) {

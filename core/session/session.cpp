@@ -56,8 +56,8 @@ SpectralSampling parseSpectralSampling(const std::string& s) {
 
 Modes parseModes(const std::string& s) {
   if (s == "both") return Modes::Both;
-  if (s == "o") return Modes::O;
-  if (s == "e") return Modes::E;
+  if (s == "o" || s == "fast") return Modes::O;  // mode 0: o, or a biaxial crystal's fast mode
+  if (s == "e" || s == "slow") return Modes::E;
   checkSettingChoice(setting("modes"), s);
   throw std::logic_error("parseModes: a choice of the table it does not know");
 }
@@ -167,11 +167,20 @@ RenderSettings renderSettings(const Scene& scene, const ViewRequest& v) {
   return rs;
 }
 
+namespace {
+/// A material's index formulas: n_o (and n_e if uniaxial), or a biaxial one's n_α, n_β, n_γ.
+std::vector<const Dispersion*> indexFormulas(const Material& m) {
+  if (m.biaxial) return {&m.n_alpha, &m.n_beta, &m.n_gamma};
+  if (m.uniaxial) return {&m.n_o, &m.n_e};
+  return {&m.n_o};
+}
+}  // namespace
+
 std::vector<std::string> materialRangeWarnings(const Scene& scene, const RenderSettings& rs) {
   std::vector<std::string> out;
   size_t count = 0;  // the first 10 are said, the rest counted (a scene may hold many materials)
   for (const auto& [name, m] : scene.materials)
-    for (const Dispersion* d : {&m.n_o, &m.n_e}) {
+    for (const Dispersion* d : indexFormulas(m)) {
       bool outside = rs.wavelengths > 0 ? !(d->inRange(380.0) && d->inRange(780.0))
                                         : !d->inRange(rs.wavelength_nm);
       if (outside && d->rangeNm()) {
@@ -484,8 +493,7 @@ RenderImage Session::render(const RenderSettings& settings, bool gpu) {
 void checkIndicesAt(const Scene& scene, double lambda_nm) {
   for (const auto& [name, m] : scene.materials) {
     if (m.grin.type != GrinProfile::Type::None) continue;  // checked inside its object on parsing
-    for (const Dispersion* d : {&m.n_o, &m.n_e}) {
-      if (d == &m.n_e && !m.uniaxial) break;
+    for (const Dispersion* d : indexFormulas(m)) {
       const double n = d->index(lambda_nm);
       if (n >= kMinIndex && n <= kMaxIndex) continue;
       char value[64];
@@ -504,7 +512,7 @@ std::vector<std::array<TraceOutcome, 2>> Session::trace(const std::vector<TraceR
     trace_rays_fitted_ = rays.size();
   }
   for (const TraceRequest& q : rays) checkIndicesAt(*scene_, q.wavelength_nm);
-  const bool uni = scene_->anyUniaxial();
+  const bool uni = scene_->anyUniaxial() || scene_->anyBiaxial();  // two modes
   std::vector<std::array<TraceOutcome, 2>> out;
   if (gpu) {
     ViewRenderer& r = gpuRenderer();
@@ -536,7 +544,8 @@ std::vector<LightTree> Session::lightTrees(const TraceRequest& ray, const MarchS
   checkIndicesAt(*scene_, ray.wavelength_nm);
   ReferenceMarcher& r = cpuMarcher();
   std::vector<LightTree> trees;
-  for (int mode = 0; mode < (scene_->anyUniaxial() ? 2 : 1); ++mode)
+  const bool twoModes = scene_->anyUniaxial() || scene_->anyBiaxial();
+  for (int mode = 0; mode < (twoModes ? 2 : 1); ++mode)
     trees.push_back(r.lightTree(ray, march, mode, tree));
   return trees;
 }
@@ -544,6 +553,9 @@ std::vector<LightTree> Session::lightTrees(const TraceRequest& ray, const MarchS
 PolarisedTrace Session::tracePolarised(const TraceRequest& ray, const Stokes& input,
                                        const PolarisedTraceSettings& settings, bool gpu) {
   checkPolarisedTrace(ray, input, settings);
+  if (scene_->anyBiaxial())
+    throw std::runtime_error(scene_->file.string() +
+                             ": the polarised trace is not yet for biaxial crystals");
   checkIndicesAt(*scene_, ray.wavelength_nm);
   if (gpu) checkGpuPolariserSheets(*scene_);  // before the volume is made
   if (gpu)

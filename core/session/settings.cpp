@@ -76,7 +76,8 @@ const std::vector<Setting> kSettings = {
      .means = "none",
      .choices = {{"spectral", "one S0.<nm> channel per wavelength bin; needs a spectral render, "
                               "wavelengths > 0"},
-                 {"modes", "o.R..B, e.R..B: the o- and e-mode radiance"},
+                 {"modes", "o.R..B, e.R..B: the o- and e-mode radiance (fast.R..slow.B when "
+                            "the scene's crystals are all biaxial)"},
                  {"aov", "Z, Px Py Pz, Nx Ny Nz, objectId: the first interface of each pixel's "
                          "first ray; steps: march steps per pixel"},
                  {"stokes", "S0.R..S3.B of a polarised render; makes the render polarised"}}},
@@ -92,6 +93,8 @@ const std::vector<Setting> kSettings = {
      .value = "both", .says_value = true,
      .choices = {{"o", "the o-mode alone, at the whole of the light"},
                  {"e", "the e-mode alone, at the whole of the light: o + e = 2 x both"},
+                 {"fast", "a biaxial crystal's fast mode alone (mode 0, as o)"},
+                 {"slow", "a biaxial crystal's slow mode alone (mode 1, as e)"},
                  {"both", "unpolarised light, each mode carrying half"}},
      .defaults = {{F::ViewCli, "both", "the M key cycles"}}},
     {.name = "step", .kind = K::Number,

@@ -117,7 +117,7 @@ void gaussianSmooth(std::vector<float>& f, const std::array<int, 3>& dims, doubl
 double voxelizeHostBytes(const Scene& scene, const Grid& g) {
   // Per voxel, everything voxelize() holds at once near its end (the smoothing's and the axis
   // dilation's temporaries included).
-  const bool uniaxial = scene.anyUniaxial();
+  const bool uniaxial = scene.anyUniaxial() || scene.anyBiaxial();  // two modes
   bool scattering = false;
   for (const auto& [name, m] : scene.materials)
     scattering = scattering || m.albedo != glm::dvec3(0.0);

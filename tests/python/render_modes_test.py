@@ -51,7 +51,7 @@ class RenderModes(unittest.TestCase):
         for bad in ("oe", "", "O"):
             with self.assertRaises(ValueError) as cm:
                 eikon.render(scene, modes=bad)
-            self.assertEqual(str(cm.exception), f"modes must be o, e or both, got '{bad}'")
+            self.assertEqual(str(cm.exception), f"modes must be o, e, fast, slow or both, got '{bad}'")
         with self.assertRaises(TypeError):
             eikon.render(scene, modes=1)
         self.assertEqual(eikon.voxelize_count(), n0)  # refused before anything is voxelised
@@ -60,7 +60,7 @@ class RenderModes(unittest.TestCase):
                                 "--modes", "oe"], capture_output=True, text=True, timeout=120)
         self.assertNotEqual(r.returncode, 0)
         self.assertEqual(r.stderr.strip().splitlines(),
-                         ["eikon: error: --modes must be o, e or both, got 'oe'"])
+                         ["eikon: error: --modes must be o, e, fast, slow or both, got 'oe'"])
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """A scene's "render" is the default of Python's render as of `eikon render`, the material
 library forgives case, spaces and underscores and answers a misspelt name with the closest ones,
-and its biaxial materials load but cannot make an object.
+and its biaxial materials load and make objects (sharp interfaces only).
 
 Run by CTest (python.scene_usability) with EIKON_BINARY (the CLI) and EIKON_PYTHON_DIR (the
 built module). The CLI and Python run the same GPU march, so their images agree to float rounding
@@ -81,9 +81,9 @@ class SceneUsability(unittest.TestCase):
         self.assertIn("did you mean 'N-BK7'?", message)
         self.assertIn("ruby", message)
 
-    def test_biaxial_materials_load_but_no_object_is_made_of_one(self):
+    def test_biaxial_materials_load_and_make_objects_with_sharp_interfaces(self):
         # docs/scene-format.md "Biaxial materials": listed with their principal indices and axes;
-        # the renderer does not march them yet, so a scene placing one in an object is refused.
+        # an object of one renders its fast and slow modes, with sharp interfaces only.
         topaz = eikon.load_material("topaz")
         self.assertTrue(topaz.biaxial)
         self.assertFalse(topaz.uniaxial)
@@ -93,10 +93,14 @@ class SceneUsability(unittest.TestCase):
         self.assertLess(a, b)
         self.assertLess(b, g)
         self.assertAlmostEqual(float(np.dot(topaz.alpha_axis, topaz.gamma_axis)), 0.0, delta=1e-12)
-        bad = copy.deepcopy(SCENE)
-        bad["objects"][0]["material"] = "topaz"
-        with self.assertRaisesRegex(Exception, r"/objects/0/material: 'topaz' is a biaxial "
-                                               r"material: biaxial materials are not rendered yet"):
+        good = copy.deepcopy(SCENE)
+        good["objects"][0]["material"] = "topaz"
+        self.assertEqual(eikon.modes_traced(eikon.Scene.parse(good, "good.json")),
+                         ["fast", "slow"])
+        bad = copy.deepcopy(good)
+        bad["interfaces"] = "smoothed"
+        with self.assertRaisesRegex(Exception, r"/objects/0/material: biaxial material 'topaz': "
+                                               r"\"interfaces\": \"smoothed\" is not yet"):
             eikon.Scene.parse(bad, "bad.json")
 
 

@@ -248,5 +248,59 @@ TEST(BiaxialMarch, TrichroicPlateTransmitsEachAxisAttenuation) {
   }
 }
 
+/// CIELAB (D65 white = linear sRGB (1, 1, 1)) of a linear-sRGB colour (IEC 61966-2-1 matrix).
+glm::dvec3 lab(const glm::dvec3& rgb) {
+  auto xyz = [](const glm::dvec3& c) {
+    return glm::dvec3(0.4124 * c.r + 0.3576 * c.g + 0.1805 * c.b,
+                      0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b,
+                      0.0193 * c.r + 0.1192 * c.g + 0.9505 * c.b);
+  };
+  const glm::dvec3 v = xyz(rgb) / xyz(glm::dvec3(1.0));
+  auto f = [](double t) {
+    return t > 216.0 / 24389.0 ? std::cbrt(t) : (24389.0 / 27.0 * t + 16.0) / 116.0;
+  };
+  return {116.0 * f(v.y) - 16.0, 500.0 * (f(v.x) - f(v.y)), 200.0 * (f(v.y) - f(v.z))};
+}
+
+// The plate's colours seen along γ̂ against a white environment (RGB render, the centre pixel of
+// a 1° view, Transport::Single): each mode shows R + (1 − R)² e^{−σ t} per band (R of its index at
+// normal incidence, the front face's reflection of the environment added), so the fast (D ∥ α̂)
+// and slow (D ∥ β̂) images differ by the CIELAB ΔE those closed forms give.
+TEST(BiaxialMarch, TrichroicColoursDifferByTheClosedFormDeltaE) {
+  const glm::dvec3 sa(0.30, 0.05, 0.10), sb(0.02, 0.25, 0.15), sg(0.12, 0.08, 0.40);
+  const double na = 1.53, nb = 1.60;
+  const Cpu cpu(biaxialMaterial(na, nb, 1.685, {1, 0, 0}, {0, 0, 1},
+                                R"(, "attenuation_alpha_per_mm": )" + vec(sa) +
+                                    R"(, "attenuation_beta_per_mm": )" + vec(sb) +
+                                    R"(, "attenuation_gamma_per_mm": )" + vec(sg)),
+                kPlate);
+  Camera cam;
+  cam.position = {0, 0, -30};
+  cam.look_at = {0, 0, 0};
+  cam.fov_deg = 1.0;
+  RenderSettings rs;
+  rs.width = rs.height = 5;
+  rs.march.transport = Transport::Single;
+  auto pixel = [&](Modes m) {
+    rs.modes = m;
+    const RenderImage img = cpu.ref.render(cam, rs, 1);
+    const size_t k = 3 * (2 * 5 + 2);
+    return glm::dvec3(img.rgb[k], img.rgb[k + 1], img.rgb[k + 2]);
+  };
+  auto closed = [](double n, const glm::dvec3& sigma) {
+    const double R = (n - 1) * (n - 1) / ((n + 1) * (n + 1));
+    return R + (1 - R) * (1 - R) * glm::exp(-sigma * kT);
+  };
+  const glm::dvec3 fast = pixel(Modes::O), slow = pixel(Modes::E);
+  const glm::dvec3 cf = closed(na, sa), cs = closed(nb, sb);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(fast[c], cf[c], 1e-6);  // float pixels
+    EXPECT_NEAR(slow[c], cs[c], 1e-6);
+  }
+  const double dE = glm::length(lab(cf) - lab(cs));
+  EXPECT_GT(dE, 5.0);  // a visible trichroism
+  EXPECT_NEAR(glm::length(lab(fast) - lab(slow)), dE, 1e-3);
+}
+
 }  // namespace
 }  // namespace eikon
