@@ -7,36 +7,11 @@
 #include <cstring>
 #include <string_view>
 
-#if defined(__SANITIZE_ADDRESS__)
-#define EIKON_UNDER_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define EIKON_UNDER_ASAN 1
-#endif
-#endif
-#ifdef EIKON_UNDER_ASAN
-#include <dlfcn.h>
-#endif
-
 #include "core/vk/check.h"
 #include "core/vk/pipeline_cache.h"
 
 namespace eikon::vk {
 namespace {
-
-// Under AddressSanitizer only (scripts/sanitize.sh): keep Mesa's lavapipe loaded for the life of
-// the process. Lavapipe allocates 128 bytes once (a realloc under pthread_once) and keeps them to
-// its end, but the Vulkan loader unloads the driver when the last instance goes, so LeakSanitizer,
-// which looks at exit, finds an unreachable block from an unknown module that no suppression can
-// name, and every test that made a device would fail on it. Opened with RTLD_NODELETE the driver
-// stays, and the block stays reachable from its globals. Where lavapipe is not installed nothing
-// is loaded.
-void keepLavapipeLoadedUnderAsan() {
-#ifdef EIKON_UNDER_ASAN
-  static const bool kept = dlopen("libvulkan_lvp.so", RTLD_NOW | RTLD_NODELETE) != nullptr;
-  (void)kept;
-#endif
-}
 
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
@@ -194,7 +169,6 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
   dci.pfnUserCallback = debugCallback;
   dci.pUserData = ctx.get();
   if (validation) ici.pNext = &dci;
-  keepLavapipeLoadedUnderAsan();
   VkResult r = vkCreateInstance(&ici, nullptr, &ctx->instance_);
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
     throw VulkanError(
