@@ -444,12 +444,12 @@ IndexData parseRefractiveIndexYaml(const std::string& text, const std::string& n
       int r = 0;
       while (std::getline(rows, row)) {
         if (trim(row).empty()) continue;
-        const std::string at = path + ".data row " + std::to_string(++r);
-        auto v = numbers(row, at);
+        const std::string where = path + ".data row " + std::to_string(++r);
+        auto v = numbers(row, where);
         if (v.size() != cols)
-          throw std::invalid_argument(at + ": expected " + std::to_string(cols) + " numbers (" +
+          throw std::invalid_argument(where + ": expected " + std::to_string(cols) + " numbers (" +
                                       type + "), got " + std::to_string(v.size()));
-        p.add(v[0] * 1000.0, v[1], std::nullopt, at);  // database λ is in µm
+        p.add(v[0] * 1000.0, v[1], std::nullopt, where);  // database λ is in µm
       }
       if (r == 0) throw std::invalid_argument(path + ".data: no rows");
     } else if (type == "tabulated k") {

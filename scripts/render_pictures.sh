@@ -39,6 +39,8 @@ pictures=(
   # A coloured stone: attenuation makes the spectral passes stratified (every wavelength marched per
   # sample), so 16 samples of 8 wavelengths converge its colour.
   "faceted_oval_ruby|800x600|"
+  # A biaxial stone: both modes marched, spectral.
+  "biaxial_chrysoberyl|800x600|"
   # The oval's fire on a table: the light through its sharp facets in 12 bands (~50 s), then the
   # view; 32 samples take the grain off the table and the spots in the shadow.
   "faceted_oval_fire|800x600|"

@@ -171,10 +171,14 @@ TEST_F(InputCli, CorruptedLightCacheIsSimulatedAgain) {
   ASSERT_EQ(first.code, 0) << first.err;
   ASSERT_NE(first.out.find("simulated 1 light runs"), std::string::npos) << first.out;
   const std::vector<float> a = eikon::readExrRgba(exr, 64, 64).rgba;
+  // The light cache's entry: the folder's largest file (beside it may lie the folder's lock).
   fs::path entry;
-  for (const auto& e : fs::directory_iterator(cache)) entry = e.path();
+  for (const auto& e : fs::directory_iterator(cache))
+    if (e.is_regular_file() && (entry.empty() || e.file_size() > fs::file_size(entry)))
+      entry = e.path();
   ASSERT_FALSE(entry.empty());
   const auto size = fs::file_size(entry);
+  ASSERT_GT(size, 1024u);
   {
     std::fstream f(entry, std::ios::in | std::ios::out | std::ios::binary);
     const float bad[4] = {std::nanf(""), 3e38f, -1e30f, 1e-40f};
