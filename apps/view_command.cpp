@@ -36,6 +36,7 @@
 #include "core/session/front_end.h"
 #include "core/session/session.h"
 #include "core/session/viewer.h"
+#include "core/session/viewer_lighting.h"
 
 namespace eikon::cli {
 
@@ -255,6 +256,7 @@ class Viewer {
         chain_(chain),
         base_(std::move(base)),
         mover_(mover),
+        lighting_(session),
         integrator_(base_.march.integrator),
         modes_(base_.modes) {
     if (mover_) wanted_light_ = session_.scene()->lights.front();
@@ -289,6 +291,7 @@ class Viewer {
       few_frames_ = 0;
       change_time_ = Clock::now();
       try {
+        lighting_.update();  // a lighting preset follows the camera
         refine();
       } catch (const Interrupted&) {
         continue;  // a change: start again with a coarse frame
@@ -338,6 +341,8 @@ class Viewer {
   void awaitFirstLight() { first_light_ = light_moved_ = true; }
 
   const RenderImage& shown() const { return shown_; }
+  /// The shown view's lighting and its live figures ("" under the scene's own lighting).
+  const std::string& figures() const { return figures_; }
   int shownSamples() const { return shown_spp_; }
   int shownWavelengths() const { return shown_wavelengths_; }
   Modes shownModes() const { return shown_modes_; }
@@ -385,6 +390,7 @@ class Viewer {
     rs.wavelengths = st.wavelengths;
     rs.march.integrator = integrator_;
     rs.modes = modes_;
+    rs.aov_layer = rs.aov_layer || lighting_.wantsAov();  // the live figures need the stone
     return rs;
   }
 
@@ -513,6 +519,7 @@ class Viewer {
       coarse_seconds_.push_back(seconds);
     }
     shown_ = img;
+    figures_ = lighting_.figures(coarse ? RenderImage{} : img);  // a coarse frame: the name
     shown_spp_ = samples;
     shown_wavelengths_ = wavelengths;
     shown_modes_ = stage_modes_;
@@ -560,19 +567,20 @@ class Viewer {
     if (frame_times_.size() > 1)
       fps = double(frame_times_.size() - 1) /
             std::max(1e-6, std::chrono::duration<double>(now - frame_times_.front()).count());
-    char buf[560];
-    std::snprintf(buf, sizeof buf,
-                  "eikon view: %s | %.1f frames/s | %dx%d, %d/%d samples, %s | %s | modes %s%s%s",
-                  session_.scene()->file.filename().c_str(), fps, shown_.width, shown_.height,
-                  shown_spp_, args_.spp,
-                  shown_wavelengths_ > 0
-                      ? (std::to_string(shown_wavelengths_) + " wavelengths").c_str()
-                      : "RGB",
-                  integratorName(integrator_), modesName(modes_, session_.scene()->fastSlowModes()),
-                  compiling_ ? " | compiling..."
-                  : refined_ ? " | refined"
-                             : "",
-                  *light ? light : light_note_.c_str());
+    char buf[720];
+    std::snprintf(
+        buf, sizeof buf,
+        "eikon view: %s | %.1f frames/s | %dx%d, %d/%d samples, %s | %s | modes %s%s%s%s%s",
+        session_.scene()->file.filename().c_str(), fps, shown_.width, shown_.height, shown_spp_,
+        args_.spp,
+        shown_wavelengths_ > 0 ? (std::to_string(shown_wavelengths_) + " wavelengths").c_str()
+                               : "RGB",
+        integratorName(integrator_), modesName(modes_, session_.scene()->fastSlowModes()),
+        compiling_ ? " | compiling..."
+        : refined_ ? " | refined"
+                   : "",
+        *light ? light : light_note_.c_str(), figures_.empty() ? "" : " | light ",
+        figures_.c_str());
     glfwSetWindowTitle(window_, buf);
   }
 
@@ -748,6 +756,10 @@ class Viewer {
         modes_ = Modes((int(modes_) + 1) % 3);
         changed_ = true;
         break;
+      case GLFW_KEY_L:  // the scene's lighting → dome → spot → aset → idealscope → lightbox
+        lighting_.next();
+        changed_ = true;
+        break;
       case GLFW_KEY_S:
         save_requested_ = true;
         break;
@@ -795,6 +807,8 @@ class Viewer {
   ViewPresenter& chain_;
   RenderSettings base_;
   LightMover* mover_;
+  ViewerLighting lighting_;
+  std::string figures_;  ///< the title's lighting and its live figures (ViewerLighting::figures)
   Light wanted_light_;
   MovedLight moved_;  ///< the last light the mover finished, until applyLight swaps it in
   bool light_moved_ = false, light_ready_ = false;
@@ -957,6 +971,7 @@ void runView(const ViewArgs& given, const CLI::App& sub) {
           stage == LightMover::Stage::Voxelising ? "voxelised" : "simulated", percent);
   }
   std::printf("%s\n", viewer.summary().c_str());
+  if (!viewer.figures().empty()) std::printf("eikon view: lighting %s\n", viewer.figures().c_str());
   const RenderImage& img = viewer.shown();
   if (!a.screenshot.empty() && !img.rgb.empty()) {
     writeFilesTogether(

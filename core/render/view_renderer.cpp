@@ -567,16 +567,7 @@ struct ViewRenderer::Impl {
     boundary = BoundaryDevice(ctx, v.boundary, v.media, scene.file.string());
     params =
         vk::Buffer(ctx, sizeof(gpu::ViewParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "view params");
-    const auto& e = scene.environment;
-    if (e.type == Environment::Type::LatLong) {
-      env = vk::Buffer(ctx, e.image_rgba.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                       "environment");
-      env.write(e.image_rgba.data(), e.image_rgba.size() * sizeof(float));
-    } else {
-      env = vk::Buffer(ctx, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "environment (unused)");
-      float zero[4] = {0, 0, 0, 0};
-      env.write(zero, 16);
-    }
+    uploadEnvironment();
     std::vector<glm::vec4> tab(EIKON_TABLE_COUNT, glm::vec4(0.0f));
     for (int i = 0; i < EIKON_CMF_COUNT; ++i)
       tab[size_t(EIKON_CMF_OFFSET + i)] = glm::vec4(glm::vec3(spectrum::cmfTableRow(i)), 0.0f);
@@ -592,6 +583,19 @@ struct ViewRenderer::Impl {
                         "spectral tables");
     tables.write(tab.data(), tab.size() * sizeof(glm::vec4));
     timings::mark("volume uploaded");
+  }
+
+  /// The scene's latitude-longitude image into `env` (in place where its size is the same; a
+  /// buffer of 16 zero bytes for the other kinds, which march.glsl computes).
+  void uploadEnvironment() {
+    const auto& e = scene.environment;
+    const bool image = e.type == Environment::Type::LatLong;
+    const size_t bytes = image ? e.image_rgba.size() * sizeof(float) : 16;
+    if (env.handle() == VK_NULL_HANDLE || env.size() != bytes)
+      env = vk::Buffer(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                       image ? "environment" : "environment (unused)");
+    const float zero[4] = {0, 0, 0, 0};
+    env.write(image ? static_cast<const void*>(e.image_rgba.data()) : zero, bytes);
   }
 
   // The AOV layer is view.comp's pass.w bit EIKON_PASS_AOV (render()), its kAov constant.
@@ -722,6 +726,12 @@ ViewRenderer::ViewRenderer(vk::Context& ctx, const Scene& scene, const VolumeSet
 ViewRenderer::~ViewRenderer() = default;
 
 void ViewRenderer::prefetch(const RenderSettings& settings) { impl_->prefetch(settings); }
+
+void ViewRenderer::environmentChanged() {
+  Impl& I = *impl_;
+  I.uploadEnvironment();
+  for (auto& [key, pipeline] : I.pipelines) pipeline.bindBuffer(EIKON_B_ENV_IMAGE, I.env);
+}
 
 bool ViewRenderer::ready(const RenderSettings& settings) {
   Impl& I = *impl_;

@@ -58,6 +58,10 @@ class ViewRenderer {
   /// the background). On lavapipe the first dispatch of a new pipeline may still compile machine
   /// code that Mesa's shader cache does not hold yet.
   bool ready(const RenderSettings& settings);
+  /// The scene's environment changed (the viewer's lighting key): its image is uploaded again and
+  /// bound to every pipeline built. Renders after it see the new environment; a change of kind
+  /// (checker, constant, image) takes another view pipeline, compiled at the next render.
+  void environmentChanged();
   /// Write `volume`'s light volumes (the same grid; a light moved and simulated again: the
   /// viewer) into the images this renderer reads, in place: no pipeline is built again. False,
   /// changing nothing, when this renderer was made without light volumes or `volume` has none

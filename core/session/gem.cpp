@@ -31,9 +31,9 @@ struct GemView {
 };
 
 GemView gemView(const SceneObject& stone, const GemRequest& r, double tilt_deg) {
-  const glm::dmat3& rot = stone.shape.rotation();
-  const glm::dvec3 up = glm::normalize(rot * glm::dvec3(0, 1, 0));
-  const glm::dvec3 fwd = glm::normalize(rot * glm::dvec3(0, 0, 1));  // the picture's up
+  const glm::dvec3 up = gemStoneUp(stone);
+  const glm::dvec3 fwd =
+      glm::normalize(stone.shape.rotation() * glm::dvec3(0, 0, 1));  // picture up
   const glm::dvec3 axis = glm::cross(up, fwd);                       // the tilt axis
   const auto [lo, hi] = stone.shape.bounds();
   const glm::dvec3 centre = 0.5 * (lo + hi);
@@ -65,11 +65,8 @@ GemView gemView(const SceneObject& stone, const GemRequest& r, double tilt_deg) 
 /// One render of the scene's stone under `preset` from `view`.
 RenderImage renderUnder(Session& session, Scene& scene, const GemRequest& r, GemPreset preset,
                         const GemView& view, int wavelengths, bool aov) {
-  GemLighting g;
-  g.preset = preset;
-  if (preset == GemPreset::IdealScope) g.head_shadow_deg = 15.0;
   scene.camera = view.camera;
-  makeGemEnvironment(g, view.camera, scene.environment);
+  makeGemEnvironment(gemAnalysisLighting(preset), view.camera, scene.environment);
   ViewRequest req;
   req.width = r.width;
   req.height = r.height;
@@ -83,38 +80,59 @@ RenderImage renderUnder(Session& session, Scene& scene, const GemRequest& r, Gem
   return session.render(renderSettings(scene, req), false);
 }
 
-/// The metrics of one tilt from its three renders; `mask` gets the outline (1 = the stone).
-GemTilt measureTilt(double tilt, const RenderImage& dome, const RenderImage& spot,
-                    const RenderImage& scope, double white_y, size_t stone,
-                    std::vector<unsigned char>& mask, std::vector<unsigned char>& flash) {
-  GemTilt t;
-  t.tilt_deg = tilt;
-  const size_t n = size_t(dome.width) * size_t(dome.height);
-  mask.assign(n, 0);
-  flash.assign(n, 0);
-  double sum_y = 0, fire = 0, dark = 0, leak = 0, count = 0;
-  for (size_t i = 0; i < n; ++i) {
-    if (dome.aov.empty() || std::lround(dome.aov[i * kAovChannels + 7]) != long(stone)) continue;
-    mask[i] = 1;
+/// The stone's pixels of a render with the AOV layer: those whose first interface is `stone`'s.
+std::vector<unsigned char> stoneMask(const RenderImage& img, size_t stone) {
+  const size_t n = size_t(img.width) * size_t(img.height);
+  std::vector<unsigned char> mask(n, 0);
+  if (img.aov.size() < n * kAovChannels) return mask;
+  for (size_t i = 0; i < n; ++i)
+    mask[i] = std::lround(img.aov[i * kAovChannels + 7]) == long(stone);
+  return mask;
+}
+
+/// Under `dome`: brightness (mean luminance over the white diffuser's) and extinction.
+void measureDome(const RenderImage& dome, const std::vector<unsigned char>& mask, double white_y,
+                 GemTilt& t) {
+  double sum_y = 0, dark = 0, count = 0;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    if (!mask[i]) continue;
     count += 1;
     const double y = luminance(&dome.rgb[3 * i]);
     sum_y += y;
     if (y < kExtinctionShare * white_y) dark += 1;
-    if (scope.rgb[3 * i + 1] > kLeakShare) leak += 1;
+  }
+  t.outline_px = count;
+  if (count == 0) return;
+  t.brightness = white_y > 0 ? sum_y / count / white_y : 0.0;
+  t.extinction = dark / count;
+}
+
+/// Under `spot`: fire (the saturated part of the light), and the flash pixels.
+void measureSpot(const RenderImage& spot, const std::vector<unsigned char>& mask, GemTilt& t,
+                 std::vector<unsigned char>& flash) {
+  flash.assign(mask.size(), 0);
+  double fire = 0, count = 0;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    if (!mask[i]) continue;
+    count += 1;
     const float* s = &spot.rgb[3 * i];
     const double hi = std::max({s[0], s[1], s[2], 0.0f}),
                  lo = std::max(0.0f, std::min({s[0], s[1], s[2]}));
     if (hi > 0 && 1.0 - lo / hi > kFireSaturation) fire += hi - lo;
     if (luminance(s) > kFlashShare) flash[i] = 1;
   }
-  t.outline_px = count;
-  if (count > 0) {
-    t.brightness = white_y > 0 ? sum_y / count / white_y : 0.0;
-    t.fire = fire / count;
-    t.extinction = dark / count;
-    t.windowing = leak / count;
+  if (count > 0) t.fire = fire / count;
+}
+
+/// Under `idealscope`: windowing (pixels lit mostly from behind the stone).
+void measureScope(const RenderImage& scope, const std::vector<unsigned char>& mask, GemTilt& t) {
+  double leak = 0, count = 0;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    if (!mask[i]) continue;
+    count += 1;
+    if (scope.rgb[3 * i + 1] > kLeakShare) leak += 1;
   }
-  return t;
+  if (count > 0) t.windowing = leak / count;
 }
 
 /// 4-connected groups of flash pixels.
@@ -152,6 +170,31 @@ std::string formatDegrees(double v) {
 }
 
 }  // namespace
+
+glm::dvec3 gemStoneUp(const SceneObject& stone) {
+  return glm::normalize(stone.shape.rotation() * glm::dvec3(0, 1, 0));
+}
+
+GemLighting gemAnalysisLighting(GemPreset preset) {
+  GemLighting g;
+  g.preset = preset;
+  if (preset == GemPreset::IdealScope) g.head_shadow_deg = 15.0;
+  return g;
+}
+
+GemTilt measureGemView(GemPreset preset, const RenderImage& img, double white_y, size_t stone) {
+  GemTilt t;
+  const std::vector<unsigned char> mask = stoneMask(img, stone);
+  t.outline_px = double(std::count(mask.begin(), mask.end(), 1));
+  std::vector<unsigned char> flash;
+  if (preset == GemPreset::Dome) measureDome(img, mask, white_y, t);
+  if (preset == GemPreset::Spot) {
+    measureSpot(img, mask, t, flash);
+    t.flashes = countFlashes(flash, img.width, img.height);
+  }
+  if (preset == GemPreset::IdealScope) measureScope(img, mask, t);
+  return t;
+}
 
 Camera gemCamera(const Scene& scene, size_t object, const GemRequest& request, double tilt_deg) {
   if (object >= scene.objects.size())
@@ -262,8 +305,12 @@ GemReport analyseGem(const std::shared_ptr<Scene>& scene, const GemRequest& r,
         renderUnder(session, *scene, r, GemPreset::Spot, view, r.wavelengths, false);
     const RenderImage scope =
         renderUnder(session, *scene, r, GemPreset::IdealScope, view, 0, false);
-    GemTilt t =
-        measureTilt(r.tilts_deg[size_t(k)], dome, spot, scope, white_y, report.object, mask, flash);
+    GemTilt t;
+    t.tilt_deg = r.tilts_deg[size_t(k)];
+    mask = stoneMask(dome, report.object);
+    measureDome(dome, mask, white_y, t);
+    measureSpot(spot, mask, t, flash);
+    measureScope(scope, mask, t);
     t.flashes = countFlashes(flash, r.width, r.height);
     std::vector<float> y(mask.size());
     for (size_t i = 0; i < y.size(); ++i) y[i] = float(luminance(&dome.rgb[3 * i]) / white_y);

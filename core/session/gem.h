@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "core/contract/march_types.h"
+#include "core/scene/gem_lighting.h"
 #include "core/scene/scene.h"
 #include "core/session/settings.h"
 
@@ -75,6 +77,22 @@ struct GemReport {
   double seconds = 0.0;
   GemImages images;
 };
+
+/// The stone's up: the normal of its girdle plane towards the table (world), the direction the
+/// analysis views it face-up from, and the white diffuser's normal of the brightness metric.
+glm::dvec3 gemStoneUp(const SceneObject& stone);
+
+/// The lighting the analysis renders `preset` with: the preset's defaults, with the Ideal-scope's
+/// viewing hole at 15° (docs/gem-studio.md "Lighting presets").
+GemLighting gemAnalysisLighting(GemPreset preset);
+
+/// The figures one render (with the AOV layer: RenderSettings::aov_layer) gives of the stone
+/// `object` under `preset`, as the analysis measures each tilt (docs/gem-studio.md "Metrics"):
+/// under dome brightness and extinction (`white_y`: the luminance of a white diffuser under the
+/// same lighting, whiteDiffuserRadiance), under spot fire and flashes, under idealscope
+/// windowing; outline_px is the stone's pixel count (0: the stone is not in view). The other
+/// figures stay 0. The viewer's live figures.
+GemTilt measureGemView(GemPreset preset, const RenderImage& img, double white_y, size_t object);
 
 /// The observer's camera of the stone `object` of `scene` tilted by `tilt_deg` (the renders'
 /// camera; its width and height are the request's).

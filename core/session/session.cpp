@@ -406,6 +406,10 @@ void Session::adoptRenderer(std::unique_ptr<ViewRenderer> renderer, std::vector<
   gpu_ = std::move(renderer);
 }
 
+void Session::environmentChanged() {
+  if (gpu_) gpu_->environmentChanged();  // the CPU twin reads scene_->environment at each render
+}
+
 void Session::setLightVolumes(std::vector<glm::vec4> fluence, std::vector<glm::vec4> flux) {
   // A volume of interfaces only that holds light volumes (adoptRenderer) takes the new ones as it
   // is: its renderer was made lit, and takes them in place.

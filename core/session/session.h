@@ -248,6 +248,9 @@ class Session {
   /// simulation of a moved light, on a session of its own), swapped in as simulateLight's are.
   /// Throws std::invalid_argument when their size is not the volume's.
   void setLightVolumes(std::vector<glm::vec4> fluence, std::vector<glm::vec4> flux);
+  /// The scene's environment was changed in place (scene()->environment; the viewer's lighting
+  /// key): the GPU renderer, if made, takes the new one (ViewRenderer::environmentChanged).
+  void environmentChanged();
   RenderImage render(const RenderSettings& settings, bool gpu);
   /// Start compiling the GPU render's view pipeline now, on a thread of its own, before the
   /// volume exists (core/render/view_pipeline_start.h): `eikon render` calls it once the device is

@@ -671,4 +671,56 @@ TEST_F(ViewerTest, SaveGoesToThePicturesFolderAndNeverOverwrites) {
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
 }
 
+/// The lighting key (L) cycles the scene's own lighting, then the gem studio's presets (dome,
+/// spot, aset, idealscope, lightbox). Under dome the title gives the stone's brightness measured
+/// as `eikon gem` measures a tilt. Here the scene's camera is the analysis' own face-up camera of
+/// the stone (a sphere of diamond's index, radius 3: its bounds' half-diagonal is 3√3, so the
+/// camera stands 250 mm above its centre with a field of 2·atan(1.05·3√3/250)), so the viewer's
+/// figure is the one `eikon gem --tilts 0` reports at the same size and samples, up to the twins'
+/// float precision (the viewer renders on the GPU twin, the analysis on the CPU twin, with the
+/// same samples). The bound is the sample noise: three times the spread of two analyses whose
+/// pixel grids are shifted by sub-pixel offsets (--seed 1 and 2), at least 0.005.
+TEST_F(ViewerTest, LightingKeyShowsTheDomeAndTheStonesBrightnessAsTheGemAnalysis) {
+  const std::string xvfb = findProgram("Xvfb"), xdotool = findProgram("xdotool");
+  if (xvfb.empty()) GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb)";
+  ASSERT_FALSE(xdotool.empty()) << "xdotool is not installed (Debian package xdotool)";
+  const double fov =
+      2.0 * std::atan(1.05 * 3.0 * std::sqrt(3.0) / 250.0) * 180.0 / std::numbers::pi;
+  nlohmann::json scene = nlohmann::json::parse(R"({
+    "camera": {"position": [0, 250, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "width": 48,
+               "height": 48},
+    "volume": {"bounds_min": [-4, -4, -4], "bounds_max": [4, 4, 4], "resolution": 32},
+    "materials": {"stone": {"n": 2.4175}},
+    "objects": [{"shape": "sphere", "center": [0, 0, 0], "radius": 3, "material": "stone"}]})");
+  scene["camera"]["fov_deg"] = fov;
+  const fs::path file = dir_ / "stone.json";
+  std::ofstream(file) << scene.dump();
+  const auto analysed = [&](const std::string& seed) {
+    const Outcome o = eikon::test::runEikon(
+        "gem " + quote(file.string()) +
+            " --tilts 0 --width 48 --height 48 --spp 4 -q --json --seed " + seed,
+        dir_ / "render_io", "EIKON_VALIDATION=1");
+    EXPECT_EQ(o.code, 0) << o.err;
+    return o.code == 0 ? nlohmann::json::parse(o.out).at("brightness").get<double>() : -1.0;
+  };
+  const double gem = analysed("0");
+  const double bound = std::max(0.005, 3.0 * std::abs(analysed("1") - analysed("2")));
+  Xvfb server(xvfb);
+  ASSERT_FALSE(server.display().empty()) << "Xvfb did not start";
+  const ViewerRun run =
+      viewWhile(server, xdotool, file.string(), "--width 48 --height 48 --spp 4",
+                " search --sync --onlyvisible --name 'samples' windowfocus %1 sleep 0.2 key l"
+                " search --sync --onlyvisible --name 'refined . light dome: brightness' key q");
+  ASSERT_TRUE(WIFEXITED(run.status) && WEXITSTATUS(run.status) == 0) << run.err;
+  EXPECT_EQ(run.err.find("validation"), std::string::npos) << run.err;
+  const std::string said = "eikon view: lighting dome: brightness ";
+  const size_t at = run.out.find(said);
+  ASSERT_NE(at, std::string::npos) << run.out;
+  const double shown = std::stod(run.out.substr(at + said.size()));
+  std::printf("[ measured ] brightness: viewer %.4f, eikon gem %.4f (bound %.4f)\n", shown, gem,
+              bound);
+  EXPECT_NEAR(shown, gem, bound);
+  EXPECT_GT(gem, 0.05);  // the stone is lit and in view
+}
+
 }  // namespace
