@@ -237,14 +237,18 @@ TEST(Gem, NailheadADeepPavilionShowsTheObserverInItsTable) {
 // x = −R at y ∈ [−g, g]. The light tree of such rays (eikon trace --tree) leaves through the
 // girdle: its strongest exit's last crossing lies on the girdle band. At the shipped 40.75° the
 // band (3.53–3.72 mm) lies outside the 2.85 mm table: no table ray reaches the girdle first.
+/// The table radii whose face-up ray meets the far girdle after its first pavilion reflection
+/// (the fisheye's ring), at pavilion angle p_deg: y(r) = −g − (R − r) tan p + (R + r) tan(90° −
+/// 2p) is linear in r, and the ring is where it lies within the girdle's ±g.
+std::pair<double, double> fisheyeBand(double p_deg) {
+  const double p = p_deg * kDeg, slope = std::tan(std::numbers::pi / 2 - 2 * p);
+  const double y0 = -kGirdleHalf - kGirdleR * std::tan(p) + kGirdleR * slope;
+  const double dy = std::tan(p) + slope;
+  return {(-kGirdleHalf - y0) / dy, (kGirdleHalf - y0) / dy};
+}
+
 TEST(Gem, FisheyeAShallowPavilionShowsTheGirdleInTheTable) {
-  const auto band = [](double p_deg) {  // the table radii whose first reflection meets the girdle
-    const double p = p_deg * kDeg, slope = std::tan(std::numbers::pi / 2 - 2 * p);
-    // y(r) = −g − (R − r) tan p + (R + r) slope, linear in r
-    const double y0 = -kGirdleHalf - kGirdleR * std::tan(p) + kGirdleR * slope;
-    const double dy = std::tan(p) + slope;
-    return std::pair{(-kGirdleHalf - y0) / dy, (kGirdleHalf - y0) / dy};
-  };
+  const auto band = fisheyeBand;
   const auto [lo37, hi37] = band(37.0);
   const auto [lo40, hi40] = band(40.75);
   EXPECT_LT(hi37, kTableR);
@@ -273,6 +277,51 @@ TEST(Gem, FisheyeAShallowPavilionShowsTheGirdleInTheTable) {
     EXPECT_TRUE(strongestExitOnGirdle(lo37 + f * (hi37 - lo37)))
         << "r " << lo37 + f * (hi37 - lo37);
   for (double r : {0.5, 1.5, 2.0, 2.7}) EXPECT_FALSE(strongestExitOnGirdle(r)) << "r " << r;
+}
+
+// The fisheye in the images, region by region. The ring's rays (fisheyeBand) cross the stone at
+// 90° − 2p = 16° above the girdle plane (p = 37°) and leave through the vertical girdle facet
+// refracted to asin(n sin 16°) = 41.8° above that plane (n = 2.4175): light from that elevation.
+// Under `aset` that is the green band (0–45°), so the 37° stone's table shows a green ring at the
+// closed-form radii, around a table that is mostly red (the 45–75° band) inside it; the shipped
+// 40.75° stone's same annulus is not green (its rays return to the observer: blue). Under `dome`
+// 41.8° is far outside the 23° head shadow, so the ring is lit (a grey ring, duller than the table
+// inside it), while the 40.75° stone's annulus is extinct (its rays see the head).
+// Each channel mean is over the ring's pixels (table-plane radius in the band; face-up rays
+// cross the table at normal incidence, unbent), 16 samples.
+TEST(Gem, FisheyeShowsAsARingOfLightFromTheGirdlePlane) {
+  const auto [lo, hi] = fisheyeBand(37.0);
+  EXPECT_NEAR(std::asin(kDiamondN * std::sin((90.0 - 2 * 37.0) * kDeg)) / kDeg, 41.8, 0.05);
+  const double white = std::pow(std::cos(23.0 * kDeg), 2);  // the white diffuser's Y face-up
+  const auto means = [&](double pavilion, GemPreset preset, glm::dvec3& ring, glm::dvec3& inside) {
+    const FaceUp f = renderFaceUp(brilliantWithPavilion(pavilion), preset, 64, 16);
+    const int n = f.image.width;
+    int rings = 0, insides = 0;
+    ring = inside = glm::dvec3(0);
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const double r = tableRadius(f.camera, n, x, y);
+        const float* p = &f.image.rgb[3 * size_t(y * n + x)];
+        if (r >= lo && r <= hi) ring += glm::dvec3(p[0], p[1], p[2]), ++rings;
+        if (r < lo - 0.2) inside += glm::dvec3(p[0], p[1], p[2]), ++insides;
+      }
+    EXPECT_GT(rings, 12);  // the ring holds enough pixels to measure
+    ring /= double(std::max(rings, 1));
+    inside /= double(std::max(insides, 1));
+    std::printf("[ measured ] pavilion %.2f, %s: ring (%.3f %.3f %.3f), inside (%.3f %.3f %.3f)\n",
+                pavilion, gemPresetName(preset), ring.r, ring.g, ring.b, inside.r, inside.g,
+                inside.b);
+  };
+  glm::dvec3 ring, inside;
+  means(37.0, GemPreset::Aset, ring, inside);
+  EXPECT_GT(ring.g, std::max(ring.r, ring.b));        // green: light from 0–45°
+  EXPECT_GT(inside.r, std::max(inside.g, inside.b));  // around a red table: a ring
+  means(37.0, GemPreset::Dome, ring, inside);
+  EXPECT_GT(0.2126 * ring.r + 0.7152 * ring.g + 0.0722 * ring.b, 0.25 * white);  // lit
+  means(40.75, GemPreset::Aset, ring, inside);
+  EXPECT_LT(ring.g, 0.1);  // no girdle light in the same annulus
+  means(40.75, GemPreset::Dome, ring, inside);
+  EXPECT_LT(0.2126 * ring.r + 0.7152 * ring.g + 0.0722 * ring.b, 0.25 * white);  // extinct
 }
 
 /// The ASET band (0 red, 1 green, 2 blue; −1 black) of a direction d leaving the stone, for the
@@ -460,4 +509,5 @@ TEST(Gem, RequestChecks) {
 }
 
 }  // namespace
+
 }  // namespace eikon
