@@ -291,7 +291,6 @@ class Viewer {
       few_frames_ = 0;
       change_time_ = Clock::now();
       try {
-        lighting_.update();  // a lighting preset follows the camera
         refine();
       } catch (const Interrupted&) {
         continue;  // a change: start again with a coarse frame
@@ -401,6 +400,7 @@ class Viewer {
       // continuous drag still shows a frame per coarse render (a restart at every motion event
       // would show none).
       finish_stage_ = st.width < full_width;
+      lighting_.update(!finish_stage_);  // a preset follows the camera once the view refines
       RenderSettings rs = settingsOf(st);
       stage_modes_ = modes_;
       if (st.width <= 0 || st.height <= 0) return;

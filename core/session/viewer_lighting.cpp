@@ -39,9 +39,9 @@ void ViewerLighting::next() {
   stale_ = true;
 }
 
-void ViewerLighting::update() {
+void ViewerLighting::update(bool follow_camera) {
   Scene& scene = *session_.scene();
-  if (!stale_ && (!preset_ || sameCamera(built_for_, scene.camera))) return;
+  if (!stale_ && (!preset_ || !follow_camera || sameCamera(built_for_, scene.camera))) return;
   if (preset_)
     makeGemEnvironment(gemAnalysisLighting(*preset_), scene.camera, scene.environment);
   else

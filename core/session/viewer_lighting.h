@@ -8,7 +8,7 @@
 //
 //   eikon::ViewerLighting lighting(session);
 //   lighting.next();                        // the scene's own → dome
-//   lighting.update();                      // before each render: the preset for the camera now
+//   lighting.update(true);                  // before a render: the preset for the camera now
 //   rs.aov_layer = lighting.wantsAov();     // the figures need the stone's pixels
 //   std::string f = lighting.figures(img);  // "dome: brightness 0.62, extinction 0.18"
 #pragma once
@@ -30,10 +30,12 @@ class ViewerLighting {
   explicit ViewerLighting(Session& session);
   /// The scene's own → dome → spot → aset → idealscope → lightbox → the scene's own.
   void next();
-  /// Before a render: where a preset is shown and the camera moved or the preset changed, the
-  /// preset is built again for the scene's camera now; the scene's own comes back after the last.
-  /// The session's renderers take the new environment (Session::environmentChanged).
-  void update();
+  /// Before a render: a preset just chosen is built for the scene's camera now (the scene's own
+  /// comes back after the last); with `follow_camera`, a preset shown is built again where the
+  /// camera moved since. The session's renderers take the new environment
+  /// (Session::environmentChanged). A build takes ~0.2 s (1024 × 512 texels), so the viewer's
+  /// coarse frames, shown while the view is dragged, keep the frame the preset was built for.
+  void update(bool follow_camera);
   /// "scene" or the preset's name.
   std::string name() const;
   /// The current preset gives figures (dome, spot, idealscope) and the scene has a stone: renders
