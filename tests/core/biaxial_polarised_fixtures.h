@@ -143,8 +143,9 @@ struct Conoscope {
       un[m] = u;
     }
     const glm::dvec3 u = glm::normalize(un[0] + un[1]);
-    glm::dvec3 e1;
-    {
+    glm::dvec3 e1 = glm::normalize(glm::cross(k, glm::dvec3(0.6, 0.8, 0)));
+    if (glm::length(glm::cross(u, c1)) > 1e-12 && glm::length(glm::cross(u, c2)) > 1e-12) {
+      // (on an optic axis Δ = 0: any pair of directions gives the same T)
       const glm::dvec3 p1 = glm::normalize(glm::cross(u, c1)),
                        p2 = glm::normalize(glm::cross(u, c2));
       const glm::dvec3 plus = p1 + p2, minus = p1 - p2;
