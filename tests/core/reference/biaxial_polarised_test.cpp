@@ -17,6 +17,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <numbers>
 #include <string>
 
@@ -201,6 +203,38 @@ TEST(BiaxialPolarisedTrace, AragoniteConoscope) {
       }
   }
   std::printf("  max |T − textbook conoscope| = %.2e\n", worst);
+}
+
+// scenes/conoscope_aragonite.json along its camera's rays: the light box's light (+z) through the
+// plate towards the camera at angle θ maps to the image radius r = f tan θ, f =
+// (height/2)/tan(fov/2); the melatopes (the darkest directions along the axial plane's diagonal)
+// lie 2 f tan E apart within 1%.
+TEST(BiaxialPolarisedTrace, ShippedAragoniteConoscopeShowsTheMelatopes) {
+  std::ifstream in(std::string(EIKON_SOURCE_DIR) + "/scenes/conoscope_aragonite.json");
+  const Scenery s(std::string(std::istreambuf_iterator<char>(in), {}));
+  const Scene& sc = s.scene;
+  ASSERT_EQ(sc.polarizers.size(), 2u);
+  const Material& ara = sc.materials.at("aragonite");
+  const double nm = test::Conoscope::kNm, pi = std::numbers::pi;
+  const test::Conoscope c{ara.n_alpha.index(nm), ara.n_beta.index(nm), ara.n_gamma.index(nm)};
+  const double E = c.apparentHalfAngle();
+  const double f = 0.5 * sc.camera.height / std::tan(0.5 * sc.camera.fov_deg * pi / 180);
+  double r[2];
+  for (int side = 0; side < 2; ++side) {
+    const double psi = pi / 4 + side * pi;
+    double best = 1e9;
+    for (int k = -200; k <= 200; ++k) {
+      const double theta = E * (1 + 0.05 * k / 200.0);
+      const glm::dvec3 u = test::Conoscope::direction(theta, psi);
+      const double T = s.trace(sc.camera.position + 40.0 * u, -u, nm).totalPower();
+      if (T < best) best = T, r[side] = f * std::tan(theta);
+    }
+    EXPECT_LT(best, 2e-3) << side;
+  }
+  const double want = 2 * f * std::tan(E);
+  std::printf("shipped aragonite conoscope: melatopes %.2f px apart (closed form %.2f px)\n",
+              r[0] + r[1], want);
+  EXPECT_NEAR(r[0] + r[1], want, 0.01 * want);
 }
 
 }  // namespace
