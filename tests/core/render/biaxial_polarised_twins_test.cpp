@@ -171,6 +171,11 @@ TEST(BiaxialPolarisedGpu, TwinsAgreeOnARandomBiaxialPlate) {
       const std::vector<PolarisedTrace> gs = s.gpuBatch(rays, in);
       for (size_t i = 0; i < rays.size(); ++i) {
         const PolarisedTrace c = s.cpu(rays[i], in);
+        // The plate splits every ray into its fast (o) and slow (e) modes on both twins.
+        for (const PolarisedTrace* t : {&c, &gs[i]})
+          EXPECT_TRUE(t->beams.at(0).modes.find('o') != std::string::npos &&
+                      t->beams.at(0).modes.find('e') != std::string::npos)
+              << t->beams.at(0).modes;
         const double dT = std::abs(gs[i].totalPower() - c.totalPower());
         worst_oblique = std::max(worst_oblique, dT);
         EXPECT_LT(dT, 3e-2) << plate_k << " ray " << i;
