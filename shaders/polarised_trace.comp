@@ -11,7 +11,12 @@
 //     outgoing mode takes the Born & Wolf s and p amplitudes of an isotropic interface of its own
 //     index n(θ), projected on the mode's field direction; the CPU solves Maxwell's 4×4 boundary
 //     problem. The two agree at normal incidence and where the modes are pure s and p (a c-cut
-//     plate), and differ by a few 1e-3 in power at oblique incidence otherwise;
+//     plate), and differ by a few 1e-3 in power at oblique incidence otherwise. A biaxial
+//     crystal's fast (mode 0) and slow (mode 1) waves come from sharp.glsl's solveBiaxialMode and
+//     take the same split with their own index and unit D (the eigenvector of ε⁻¹ ⊥ the wave
+//     normal); the CPU solves the Booker quartic and the 4×4 problem (tensor_interface.h).
+//     Reflection off a crystal face splits the incident field over the far side's two modes and
+//     reflects each part with its own index (crystalReflection: exact at normal incidence);
 //   * float32 phases: each branch carries its optical path RELATIVE to the input ray's wavefront,
 //     Σ (p − p_in)·Δx over its straight pieces, so the numbers summed are (n − n_ambient) × the
 //     thickness crossed, not the whole path; two branches' difference (the o−e retardation) is
