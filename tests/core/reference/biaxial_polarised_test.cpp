@@ -12,7 +12,10 @@
 //  - the aragonite conoscope (tests/core/biaxial_polarised_fixtures.h): the melatopes at the
 //    apparent half-angle E (sin E = n_β sin V_x) within 1%, dark there; the centre's closed form;
 //    the axial plane along the polariser: both polariser lines exactly dark (the planes of
-//    incidence are principal planes: pure s and p modes, which crossed sheets stop).
+//    incidence are principal planes: pure s and p modes, which crossed sheets stop); turned 45°:
+//    those lines bright, the dark brush through each melatope across the axial plane (T < ¼ of
+//    the isochromes' rise along it); everywhere else the textbook conoscope (the fixture's
+//    model) to 0.01 in T; the shipped scene's melatopes 2 f tan E apart in its image within 1%.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -190,6 +193,18 @@ TEST(BiaxialPolarisedTrace, AragoniteConoscope) {
   for (double psi : {0.0, pi / 2, pi, 3 * pi / 2})
     for (double f : {0.2, 0.5, 1.0, 1.3})
       EXPECT_LT(conoscopeT(cross, f * E, psi), 1e-12) << psi << " " << f;
+  // Turned 45°, the cross opens: the sheets' lines through the centre are bright, and the dark
+  // brush through each melatope runs ⊥ the axial plane there (a hyperbola's vertex) while the
+  // isochromes climb along it.
+  for (double psi : {0.0, pi / 2, pi, 3 * pi / 2})
+    EXPECT_GT(conoscopeT(diag, 0.3 * E, psi), 0.3) << psi;
+  for (double d : {0.06, 0.12}) {
+    const double along = conoscopeT(diag, E * (1 + d), pi / 4);
+    const double perp = conoscopeT(diag, E * std::hypot(1.0, d), pi / 4 + std::atan(d));
+    std::printf("  %.2f E from the melatope: T = %.4f along the axial plane, %.4f across it\n", d,
+                along, perp);
+    EXPECT_LT(perp, 0.25 * along) << d;
+  }
   // Region by region against the textbook conoscope (the fixture's model: ~0.01 in T).
   double worst = 0;
   for (double axial : {0.0, 45.0}) {

@@ -128,6 +128,15 @@ TEST(BiaxialPolarisedGpu, AragoniteConoscope) {
   for (double psi : {0.0, pi / 2, pi, 3 * pi / 2})
     for (double f : {0.2, 0.5, 1.0, 1.3}) lines.push_back({f * E, psi});
   for (double T : run(cross, lines)) EXPECT_LT(T, 1e-6);
+  std::vector<std::pair<double, double>> opened;  // as the CPU's test
+  for (double psi : {0.0, pi / 2, pi, 3 * pi / 2}) opened.push_back({0.3 * E, psi});
+  for (double d : {0.06, 0.12}) {
+    opened.push_back({E * (1 + d), pi / 4});
+    opened.push_back({E * std::hypot(1.0, d), pi / 4 + std::atan(d)});
+  }
+  const std::vector<double> To = run(diag, opened);
+  for (size_t i = 0; i < 4; ++i) EXPECT_GT(To[i], 0.3) << i;
+  for (size_t i = 4; i < 8; i += 2) EXPECT_LT(To[i + 1], 0.25 * To[i]) << i;
   double worst = 0;
   for (double axial : {0.0, 45.0}) {
     std::vector<std::pair<double, double>> dirs;
