@@ -11,7 +11,12 @@
 //     outgoing mode takes the Born & Wolf s and p amplitudes of an isotropic interface of its own
 //     index n(θ), projected on the mode's field direction; the CPU solves Maxwell's 4×4 boundary
 //     problem. The two agree at normal incidence and where the modes are pure s and p (a c-cut
-//     plate), and differ by a few 1e-3 in power at oblique incidence otherwise;
+//     plate), and differ by a few 1e-3 in power at oblique incidence otherwise. A biaxial
+//     crystal's fast (mode 0) and slow (mode 1) waves come from sharp.glsl's solveBiaxialMode and
+//     take the same split with their own index and unit D (the eigenvector of ε⁻¹ ⊥ the wave
+//     normal); the CPU solves the Booker quartic and the 4×4 problem (tensor_interface.h).
+//     Reflection off a crystal face splits the incident field over the far side's two modes and
+//     reflects each part with its own index (crystalReflection: exact at normal incidence);
 //   * float32 phases: each branch carries its optical path RELATIVE to the input ray's wavefront,
 //     Σ (p − p_in)·Δx over its straight pieces, so the numbers summed are (n − n_ambient) × the
 //     thickness crossed, not the whole path; two branches' difference (the o−e retardation) is
@@ -153,6 +158,13 @@ void segment(inout Branch b, float len) {
     sigma = attenuationE(vec3(sigma), vec3(regionSigmaAt(r, 1)), b.p, af.xyz,
                          regionIndex(r, 0, b.x), regionIndex(r, 1, b.x))
                 .x;
+  if (mediumBiaxial(r)) {  // trichroic: σ_α, σ_β, σ_γ (regionSigmaAt 0, 2, 1) of the mode's D
+    bool dispersive = false;
+    Biaxial B = biaxialOf(r, dispersive);
+    sigma = biaxialAttenuation(B, vec3(sigma), vec3(regionSigmaAt(r, 2)), vec3(regionSigmaAt(r, 1)),
+                               b.p, biaxialWave(B, b.p, b.mode))
+                .x;
+  }
   if (sigma > 0.0) {
     float f = exp(-0.5 * sigma * len);
     b.G0 = cvMul(vec2(f, 0.0), b.G0);
@@ -188,15 +200,16 @@ vec3 modeField(int mode, vec3 s, vec3 a, vec3 sHat) {
 }
 
 // One outgoing wave w of an interface: its field from the incident (E_s, E_p) with the amplitudes
-// (cs, cp), in the (ŝ, p̂ = k̂ × ŝ) frame of the wave or projected on its crystal mode.
-Branch outgoing(Branch b, ModeWave w, int mode, bool crystal, vec3 a, vec3 sHat, vec2 cs, vec2 cp,
-                vec2 es0, vec2 ep0, vec2 es1, vec2 ep1) {
+// (cs, cp), in the (ŝ, p̂ = k̂ × ŝ) frame of the wave or projected on its crystal mode (a biaxial
+// mode's unit D where D ≠ 0, else the uniaxial modeField).
+Branch outgoing(Branch b, ModeWave w, int mode, bool crystal, vec3 a, vec3 D, vec3 sHat, vec2 cs,
+                vec2 cp, vec2 es0, vec2 ep0, vec2 es1, vec2 ep1) {
   Branch nb = b;
   vec3 pw = cross(w.s, sHat);
   CV f0 = cvAdd(cvScale(cmul(cs, es0), sHat), cvScale(cmul(cp, ep0), pw));
   CV f1 = cvAdd(cvScale(cmul(cs, es1), sHat), cvScale(cmul(cp, ep1), pw));
   if (crystal) {
-    vec3 e = modeField(mode, w.s, a, sHat);
+    vec3 e = dot(D, D) > 0.25 ? D : modeField(mode, w.s, a, sHat);
     f0 = cvScale(cvDot(f0, e), e);
     f1 = cvScale(cvDot(f1, e), e);
   }
@@ -209,20 +222,60 @@ Branch outgoing(Branch b, ModeWave w, int mode, bool crystal, vec3 a, vec3 sHat,
 }
 
 // What one crossing's outgoing waves share: the incident (ŝ, p̂) frame and field components, cos i,
-// the incident and the far side's ordinary index, and each side's crystal axis (zero: isotropic).
+// the incident and the far side's ordinary index, each side's crystal axis (zero: isotropic or
+// biaxial), whether each side is a crystal (uniaxial or biaxial), the biaxial modes' unit D
+// (zero elsewhere: the uniaxial modeField applies) and the far side's transmitted waves.
 struct Incidence {
   vec3 sHat;
   vec2 es0, ep0, es1, ep1;
   float ci, nIn, noB;
   vec3 aA, aB;
   bool uA, uB;
+  vec3 dA0, dA1, dB0, dB1;
+  ModeWave wt0, wt1;
 };
+
+// The reflected amplitudes off a crystal's face (B a crystal), in the D-projection: the incident
+// field splits over B's two transmitted modes k (their unit fields e_k, as components (a_k, b_k)
+// along ŝ and the mode's p̂), and each part reflects with the s and p amplitudes of an isotropic
+// interface of that mode's own index n_k (uniaxial: n_o and the e-wave's n(θ); biaxial: n_fast,
+// n_slow): E_r = Σ_k (a_k E_s + b_k E_p)(r_s,k a_k ŝ + r_p,k b_k p̂_r). Exact at normal incidence
+// and where the modes are pure s and p; with one index for both modes a quartz face reflected
+// 6e-4 of the power wrongly. Where a mode of B is evanescent: one isotropic interface of B's n_o.
+bool crystalReflection(Incidence I, vec3 pw, float scale, out CV f0, out CV f1) {
+  f0 = CV(vec3(0.0), vec3(0.0));
+  f1 = f0;
+  if (!I.uB || !I.wt0.exists || !I.wt1.exists) return false;
+  for (int k = 0; k < 2; ++k) {
+    ModeWave t = k == 0 ? I.wt0 : I.wt1;
+    vec3 d = k == 0 ? I.dB0 : I.dB1;
+    vec3 e = dot(d, d) > 0.25 ? d : modeField(k, t.s, I.aB, I.sHat);
+    vec2 ab = vec2(dot(e, I.sHat), dot(e, cross(t.s, I.sHat)));
+    if (dot(ab, ab) < 1e-12) continue;
+    ab = normalize(ab);
+    vec2 rs, rp, ts, tp;
+    fresnelAmplitudes(I.ci, I.nIn, t.n, rs, rp, ts, tp);
+    vec2 c0 = ab.x * I.es0 + ab.y * I.ep0, c1 = ab.x * I.es1 + ab.y * I.ep1;
+    vec2 s = scale * ab.x * rs, p = scale * ab.y * rp;
+    f0 = cvAdd(f0, cvAdd(cvScale(cmul(c0, s), I.sHat), cvScale(cmul(c0, p), pw)));
+    f1 = cvAdd(f1, cvAdd(cvScale(cmul(c1, s), I.sHat), cvScale(cmul(c1, p), pw)));
+  }
+  return true;
+}
 
 // The outgoing wave w (mode k) of a crossing, reflected or transmitted, its fields scaled.
 Branch wave(Branch b, ModeWave w, int k, bool reflect, Incidence I, float scale) {
+  vec3 D = reflect ? (k == 0 ? I.dA0 : I.dA1) : (k == 0 ? I.dB0 : I.dB1);
+  CV f0, f1;
+  if (reflect && crystalReflection(I, cross(w.s, I.sHat), scale, f0, f1)) {
+    // Its fields in A's frame: the isotropic outgoing() with unit amplitudes on (E_s, E_p) of f.
+    vec3 pw = cross(w.s, I.sHat);
+    return outgoing(b, w, k, I.uA, I.aA, D, I.sHat, vec2(1, 0), vec2(1, 0), cvDot(f0, I.sHat),
+                    cvDot(f0, pw), cvDot(f1, I.sHat), cvDot(f1, pw));
+  }
   vec2 rs, rp, ts, tp;
   fresnelAmplitudes(I.ci, I.nIn, reflect ? I.noB : w.n, rs, rp, ts, tp);
-  Branch nb = outgoing(b, w, k, reflect ? I.uA : I.uB, reflect ? I.aA : I.aB, I.sHat,
+  Branch nb = outgoing(b, w, k, reflect ? I.uA : I.uB, reflect ? I.aA : I.aB, D, I.sHat,
                        scale * (reflect ? rs : ts), scale * (reflect ? rp : tp), I.es0, I.ep0,
                        I.es1, I.ep1);
   return nb;
@@ -251,14 +304,23 @@ void cross(Branch b, BoundaryCrossing c) {
   if (mediumOpaque(B)) return;  // absorbed: nothing of this branch leaves
   vec3 x = c.point;
   vec4 afA = regionAxisField(A, x), afB = regionAxisField(B, x);
-  if (mediumRow(A, 10).w == mediumRow(B, 10).w && afA.xyz == afB.xyz) {
+  bool bA = mediumBiaxial(A), bB = mediumBiaxial(B);  // false unless EIKON_F_BIAXIAL
+  // Equal biaxial media also share their principal axes (sharp.glsl crossInterface's sameTensor).
+  bool sameTensor = !(bA || bB) || (mediumRow(A, 7).xyz == mediumRow(B, 7).xyz &&
+                                    mediumRow(A, 20).xyz == mediumRow(B, 20).xyz);
+  if (mediumRow(A, 10).w == mediumRow(B, 10).w && afA.xyz == afB.xyz && sameTensor) {
     b.region = B;
     push(b);
     return;
   }
   Incidence I;
-  I.uA = hasAxis(afA.xyz);
-  I.uB = hasAxis(afB.xyz);
+  I.uA = hasAxis(afA.xyz) || bA;
+  I.uB = hasAxis(afB.xyz) || bB;
+  I.dA0 = I.dA1 = I.dB0 = I.dB1 = vec3(0.0);
+  bool dispersive = false;
+  Biaxial BA, BB;
+  if (bA) BA = biaxialOf(A, dispersive);
+  if (bB) BB = biaxialOf(B, dispersive);
   I.aA = afA.xyz;
   I.aB = afB.xyz;
   float noA = regionIndex(A, 0, x), neA = regionIndex(A, 1, x);
@@ -276,14 +338,26 @@ void cross(Branch b, BoundaryCrossing c) {
   }
   vec3 pt = b.p - dot(b.p, m) * m;
   ModeWave wt[2], wr[2];
-  for (int k = 0; k < 2; ++k) wt[k] = solveInterfaceMode(pt, m, k == 1, I.aB, I.noB, neB, true);
+  if (bB) {
+    wt[0] = solveBiaxialMode(pt, m, BB, 0, true, I.dB0);
+    wt[1] = solveBiaxialMode(pt, m, BB, 1, true, I.dB1);
+  } else {
+    for (int k = 0; k < 2; ++k) wt[k] = solveInterfaceMode(pt, m, k == 1, I.aB, I.noB, neB, true);
+  }
   if (!I.uB) wt[1].exists = false;
+  I.wt0 = wt[0];
+  I.wt1 = wt[1];
   int mask = int(sheets[0].w);
   bool asked = b.events < 24 && ((mask >> b.events) & 1) != 0;
   bool reflect = asked || !(wt[0].exists || wt[1].exists);
   bool choose = !reflect && b.choices < P.pass.w;
   if (reflect || choose) {
-    for (int k = 0; k < 2; ++k) wr[k] = solveInterfaceMode(pt, m, k == 1, I.aA, noA, neA, false);
+    if (bA) {
+      wr[0] = solveBiaxialMode(pt, m, BA, 0, false, I.dA0);
+      wr[1] = solveBiaxialMode(pt, m, BA, 1, false, I.dA1);
+    } else {
+      for (int k = 0; k < 2; ++k) wr[k] = solveInterfaceMode(pt, m, k == 1, I.aA, noA, neA, false);
+    }
     if (!I.uA) wr[1].exists = false;
   }
   I.sHat = cross(s, m);

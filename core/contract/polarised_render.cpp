@@ -102,8 +102,6 @@ std::string polarisedBecause(const Scene& scene, const RenderSettings& s) {
 
 void checkPolarisedScene(const Scene& scene, const RenderSettings& s) {
   const std::string why = "a polarised render (" + polarisedBecause(scene, s) + ")";
-  if (scene.anyBiaxial())
-    throw std::runtime_error(scene.file.string() + ": " + why + " is not yet for biaxial crystals");
   if (scene.interfaces != Scene::Interfaces::Sharp)
     throw std::runtime_error(scene.file.string() + ": /interfaces: " + why +
                              " needs \"sharp\" interfaces, got \"smoothed\"");

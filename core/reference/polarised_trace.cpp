@@ -4,9 +4,13 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "anisotropic/tensor_interface.h"
+#include "anisotropic/tensor_medium.h"
 #include "core/reference/field.h"
 #include "core/volume/boundary.h"
 #include "core/volume/media.h"
@@ -49,7 +53,7 @@ bool grazes(const glm::dvec3& p, const glm::dvec3& ray, const glm::dvec3& normal
 struct Branch {
   glm::dvec3 x{0.0}, p{0.0}, ray{0.0};
   int region = 0;
-  Mode mode = Mode::Ordinary;
+  Mode mode = Mode::Ordinary;  ///< in a biaxial region: Ordinary the fast mode, Extraordinary slow
   std::array<CV, 2> G{};
   double opl = 0.0;  ///< ∫p·dx from the origin (mm)
   std::string modes;
@@ -85,6 +89,9 @@ class Tracer {
  private:
   const MediumRecord& rec(int region) const { return media_->regions[size_t(region)]; }
   OpticalMedium mediumOf(int region, const glm::dvec3& x) const;
+  TensorMedium tensorOf(int region, const glm::dvec3& x) const;
+  InterfaceMap tensorMap(const Branch& b, const BoundaryCrossing& c) const;
+  bool sameMedium(int a, int b) const;
   BoundaryCrossing nextCrossing(const glm::dvec3& a, const glm::dvec3& b, int region) const;
   void segment(Branch& b, double len) const;
   void cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branch>& stack) const;
@@ -108,6 +115,91 @@ OpticalMedium Tracer::mediumOf(int region, const glm::dvec3& x) const {
   if (!m.uniaxial) return OpticalMedium::isotropic(n_o);
   return OpticalMedium::uniaxial(
       Uniaxial(n_o, mediumIndexAt(m, 1, lambda_, x), glm::dvec3(mediumAxisField(m, x))));
+}
+
+// A region's dielectric tensor at the trace's wavelength (biaxial: n_α, n_β, n_γ with n_β clamped
+// into [n_α, n_γ] as the scalar march's tensorOf; uniaxial and isotropic: their special cases).
+TensorMedium Tracer::tensorOf(int region, const glm::dvec3& x) const {
+  const MediumRecord& m = rec(region);
+  const double a = mediumIndexAt(m, 0, lambda_, x);
+  if (!m.biaxial) {
+    if (!m.uniaxial) return TensorMedium::isotropic(a);
+    return TensorMedium::uniaxial(a, mediumIndexAt(m, 1, lambda_, x),
+                                  glm::dvec3(mediumAxisField(m, x)));
+  }
+  const double g = std::max(mediumIndexAt(m, 1, lambda_, x), a);
+  const double b = std::clamp(mediumIndex(m.n_beta, lambda_), a, g);
+  return TensorMedium(a, b, g, m.alpha_axis, m.axis);
+}
+
+bool Tracer::sameMedium(int a, int b) const {
+  const MediumRecord &A = rec(a), &B = rec(b);
+  return A.medium == B.medium && A.axis == B.axis && A.alpha_axis == B.alpha_axis &&
+         !A.radial_axis && !B.radial_axis;
+}
+
+/// Which outgoing slot (0 the fast or ordinary mode, 1 the slow or extraordinary one) a
+/// propagating wave of `t` with index n and wave normal s takes: the mode whose index it has.
+/// A uniaxial medium names its modes o and e (the o-wave has n_o), a biaxial one fast and slow.
+size_t modeSlot(const TensorMedium& t, const Uniaxial* uni, double n, const glm::dvec3& s) {
+  if (uni)
+    return std::abs(n - uni->n_o) <= std::abs(n - uni->index(Mode::Extraordinary, s)) ? 0 : 1;
+  const std::array<double, 2> idx = t.indices(s);
+  return std::abs(n - idx[0]) <= std::abs(n - idx[1]) ? 0 : 1;
+}
+
+// The exact interface map where either side is biaxial (anisotropic/tensor_interface.h: the
+// Booker quartic of each side and Maxwell's boundary conditions, valid for any pair of media),
+// in the form of interfaceMap's: the incident basis fields (an isotropic side's s and p waves,
+// or the branch's crystal mode), and for each outgoing slot the power-normalised field per basis
+// state, amplitude·√(flux_out/flux_in) times the wave's unit E. An isotropic side's two waves
+// share one beam (slot 0 or 2); a crystal side's propagating waves take slot 0 (o or fast) and
+// 1 (e or slow) by their index.
+InterfaceMap Tracer::tensorMap(const Branch& b, const BoundaryCrossing& c) const {
+  const TensorMedium from = tensorOf(b.region, c.point), to = tensorOf(c.to, c.point);
+  const MediumRecord &A = rec(b.region), &B = rec(c.to);
+  const bool isoA = from.symmetry() == Symmetry::Isotropic;
+  const std::optional<Uniaxial> uA =
+      A.uniaxial ? std::optional<Uniaxial>(from.asUniaxial()) : std::nullopt;
+  const std::optional<Uniaxial> uB =
+      B.uniaxial ? std::optional<Uniaxial>(to.asUniaxial()) : std::nullopt;
+  const glm::dvec3 s = glm::normalize(b.p);
+  std::vector<maxwell::Wave> basis;
+  if (isoA) {  // the s and p waves of the branch's wave vector, unit E
+    const glm::dvec3 m = glm::dot(c.normal, s) < 0.0 ? -c.normal : c.normal;
+    const glm::dvec3 pt = b.p - glm::dot(b.p, m) * m;
+    for (const maxwell::Wave& w : maxwell::isotropicWaves(pt, m, from.n_alpha, true))
+      basis.push_back(maxwell::makeWave(w.p, (1.0 / maxwell::norm(w.E)) * w.E));
+  } else {
+    // The branch's crystal mode: a uniaxial o-wave is the fast mode of a positive crystal.
+    WaveMode wm = b.mode == Mode::Ordinary ? WaveMode::Fast : WaveMode::Slow;
+    if (uA && uA->n_e < uA->n_o) wm = b.mode == Mode::Ordinary ? WaveMode::Slow : WaveMode::Fast;
+    basis.push_back(modeWave(from, wm, s));
+  }
+  InterfaceMap map;
+  map.basis_count = int(basis.size());
+  for (size_t k = 0; k < basis.size(); ++k) {
+    const TensorInterfaceSolution sol = solveTensorInterface(from, basis[k], c.normal, to);
+    map.basis[k] = maxwell::real(basis[k].E);
+    const double f_in = std::abs(maxwell::flux(sol.incident, sol.normal));
+    for (size_t w = 0; w < 4; ++w) {
+      const bool refl = w < 2;
+      const OutgoingWave& o = refl ? sol.reflected[w] : sol.transmitted[w - 2];
+      if (!o.propagating) continue;
+      const TensorMedium& md = refl ? from : to;
+      const bool iso = md.symmetry() == Symmetry::Isotropic;
+      const std::optional<Uniaxial>& u = refl ? uA : uB;
+      const size_t slot = (refl ? 0 : 2) + (iso ? 0 : modeSlot(md, u ? &*u : nullptr, o.n, o.s));
+      OutgoingBeam& beam = map.beams[slot];
+      beam.exists = true;
+      beam.p = maxwell::real(o.wave.p);
+      beam.ray = iso ? o.s : o.t;
+      beam.mode = slot % 2 ? Mode::Extraordinary : Mode::Ordinary;
+      const double scale = std::sqrt(std::abs(maxwell::flux(o.wave, sol.normal)) / f_in);
+      map.out[slot][k] = map.out[slot][k] + (o.amplitude * scale) * o.wave.E;
+    }
+  }
+  return map;
 }
 
 // The sharp marches' search (core/volume/boundary.h crossingOutOf: the planes, the shapes or the
@@ -149,7 +241,13 @@ void Tracer::segment(Branch& b, double len) const {
   b.opl += glm::dot(b.p, b.ray) * len;
   const MediumRecord& m = rec(b.region);
   double sigma = mediumSigmaAt(m, 0, lambda_);
-  if (m.uniaxial && b.mode == Mode::Extraordinary) {
+  if (m.biaxial) {  // trichroic, per unit ray length (the scalar march's absorbAlong)
+    TensorMedium t = tensorOf(b.region, b.x);
+    t.sigma = {sigma, mediumSigmaAt(m, 2, lambda_), mediumSigmaAt(m, 1, lambda_)};
+    const glm::dvec3 s = glm::normalize(b.p);
+    const TensorMode md = t.modes(s)[b.mode == Mode::Ordinary ? WaveMode::Fast : WaveMode::Slow];
+    sigma = t.attenuation(md.D, md.n) * glm::dot(s, md.t);
+  } else if (m.uniaxial && b.mode == Mode::Extraordinary) {
     const glm::dvec3 a = glm::dvec3(mediumAxisField(m, b.x));
     sigma =
         field::attenuationE(glm::dvec3(sigma), glm::dvec3(mediumSigmaAt(m, 1, lambda_)), b.p, a,
@@ -176,9 +274,11 @@ void Tracer::segment(Branch& b, double len) const {
 // uniform 0 is left unused, as the scalar march leaves it.
 void Tracer::cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branch>& stack) const {
   const MediumRecord &A = rec(b.region), &B = rec(c.to);
-  if (B.opaque()) return;  // absorbed: nothing of this branch leaves
+  if (B.opaque()) return;                      // absorbed: nothing of this branch leaves
+  const bool tensor = A.biaxial || B.biaxial;  // the tensor solve; else interfaceMap
   const OpticalMedium from = mediumOf(b.region, c.point), to = mediumOf(c.to, c.point);
-  if (A.medium == B.medium && (!from.crystal || from.crystal->axis == to.crystal->axis)) {
+  if (tensor ? sameMedium(b.region, c.to)
+             : A.medium == B.medium && (!from.crystal || from.crystal->axis == to.crystal->axis)) {
     Branch same = b;
     same.region = c.to;
     stack.push_back(same);
@@ -190,7 +290,8 @@ void Tracer::cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branc
     stack.push_back(along);
     return;
   }
-  const InterfaceMap map = interfaceMap(from, b.mode, glm::normalize(b.p), c.normal, to);
+  const InterfaceMap map =
+      tensor ? tensorMap(b, c) : interfaceMap(from, b.mode, glm::normalize(b.p), c.normal, to);
   const std::array<CV, 4> out0 = map.apply(b.G[0]), out1 = map.apply(b.G[1]);
   auto slotPower = [&](size_t slot) {
     if (!map.beams[slot].exists) return 0.0;
@@ -228,7 +329,8 @@ void Tracer::cross(const Branch& b, const BoundaryCrossing& c, std::vector<Branc
     nb.events = b.events + 1;
     nb.choices = choices;
     if (split) nb.side = reflected ? 2 : 1;
-    if ((reflected ? from : to).crystal) nb.modes += beam.mode == Mode::Ordinary ? 'o' : 'e';
+    const MediumRecord& side = reflected ? A : B;
+    if (side.uniaxial || side.biaxial) nb.modes += beam.mode == Mode::Ordinary ? 'o' : 'e';
     stack.push_back(nb);
   }
 }

@@ -12,8 +12,13 @@
 //     1/√(1 − p); `seed` gives the uniforms, as march_types.h transportUniform); a wave entering
 //     a crystal splits into an o and an e branch, and one reflected inside a crystal into two,
 //     which are traced separately (a ray tree, at most max_branches leaves);
+//   * a face with a biaxial region on either side: the same exact amplitudes from
+//     anisotropic/tensor_interface.h's solveTensorInterface (each side's Booker quartic; any pair
+//     of isotropic, uniaxial and biaxial media); a biaxial crystal's branches are its fast mode
+//     (Mode::Ordinary, 'o' in the mode strings) and its slow mode (Mode::Extraordinary, 'e');
 //   * in a crystal each branch gains k₀∫p·dx (p the wave vector: walk-off is accounted for) and
-//     loses exp(−½σL) of its amplitude (pleochroic σ(θ)cos ρ per ray length, field::attenuationE);
+//     loses exp(−½σL) of its amplitude (pleochroic σ(θ)cos ρ per ray length, field::attenuationE;
+//     biaxial: the trichroic σ of the mode's D, TensorMedium::attenuation, times cos ρ);
 //   * a straight piece that crosses a polariser sheet's rectangle (scene "polarizer", outside or
 //     inside the volume) keeps only the field across the sheet's absorbing direction;
 //   * branches leaving in the same direction (within source_angle_rad) are recombined: coherently

@@ -557,9 +557,6 @@ std::vector<LightTree> Session::lightTrees(const TraceRequest& ray, const MarchS
 PolarisedTrace Session::tracePolarised(const TraceRequest& ray, const Stokes& input,
                                        const PolarisedTraceSettings& settings, bool gpu) {
   checkPolarisedTrace(ray, input, settings);
-  if (scene_->anyBiaxial())
-    throw std::runtime_error(scene_->file.string() +
-                             ": the polarised trace is not yet for biaxial crystals");
   checkIndicesAt(*scene_, ray.wavelength_nm);
   if (gpu) checkGpuPolariserSheets(*scene_);  // before the volume is made
   if (gpu)
