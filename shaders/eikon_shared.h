@@ -222,8 +222,8 @@ struct BoundaryAnswer {
 // Its own bindings on top of the trace kernel's: the polariser sheets and the trace settings.
 #define EIKON_B_SHEETS 23
 #define EIKON_POL_MAX_SHEETS 8    // polariser sheets a scene may hold for the GPU twin
-#define EIKON_POL_MAX_LEAVES 8    // o/e ray-tree leaves (exit branches) per ray
-#define EIKON_POL_MAX_STACK 8     // branches waiting to be followed
+#define EIKON_POL_MAX_LEAVES 12   // o/e ray-tree leaves (exit branches) per ray
+#define EIKON_POL_MAX_STACK 12    // branches waiting to be followed
 #define EIKON_POL_MAX_EVENTS 48   // interface events per branch
 #define EIKON_POL_MAX_PIECES 96   // straight pieces per ray, all branches together (loop budget)
 #define EIKON_POL_MAX_BEAMS 6     // output beams per ray (exit directions: the first choice

@@ -19,7 +19,7 @@ namespace eikon {
 struct PolarisedTraceSettings {
   double bandwidth_nm = 10.0;      ///< spectral width of one sample: coherence length λ²/Δλ
   double source_angle_rad = 1e-3;  ///< angular size of one light/environment sample
-  int max_branches = 64;           ///< o/e ray-tree leaves (the GPU twin: at most 8)
+  int max_branches = 64;           ///< o/e ray-tree leaves (the GPU twin: at most 12)
   int max_events = 256;            ///< interface events per branch (the GPU twin: at most 48)
   std::vector<int> reflect_at;     ///< interface events (0-based per branch) that take the
                                    ///< reflected beam instead of the transmitted one (GPU: < 24)
