@@ -633,7 +633,8 @@ float biaxialTransmission(int A, int B, vec3 w, vec3 N, ModeWave o, vec3 D) {
 // (1 − w_s) Rp), the D-projection share of fresnel.glsl (the CPU twin takes the exact Maxwell
 // share, uniaxialEntryExact: equal at normal incidence, a few 1e-3 apart at oblique incidence on
 // calcite, docs/uniaxial-optics.md); out of a crystal: the same with the incident mode's index;
-// crystal → crystal: the phase-matched wave of the same mode, no loss. Where the outgoing wave does
+// crystal → crystal: the phase-matched wave of the same mode, no loss; a biaxial side: the mode's
+// roots (modeRoot) and the D-projection share (biaxialTransmission). Where the outgoing wave does
 // not exist: total internal reflection, the mirror wave of the same mode, no loss; the corner's
 // mirror bit flips and it stays in A. Equal media, or an opaque one entered: only the region
 // changes. Multiplies `transmission` by T; true if the corner was turned. A pending corner of a

@@ -501,13 +501,14 @@ double PatchStepper::biaxialTransmission(int from, int to, const glm::dvec3& w, 
 // the run's mode (o by Snell with n_o, e by the closed form of the e-wave normal) with the exact
 // Maxwell share of the unpolarised power, doubled because a mode's run carries half the light; out
 // of a crystal: the exact exit transmission of the mode; crystal → crystal: the phase-matched wave
-// of the same mode, no loss. Where the outgoing wave does not exist, total internal reflection: the
-// mirror (same mode), no loss, the corner's mirror bit flips and it stays in its region. Equal
-// media, or an opaque one entered: only the region changes. Multiplies `transmission` by T; true if
-// the corner was turned. A pending corner of a reflected copy (Patch::pending) takes the reflected
-// wave where its twin's corner goes through (the mirror: reflectIsotropic, reflectInsideUniaxial
-// of the same mode, as total internal reflection), stays in its region and multiplies `gain` by
-// the T its twin's corner took instead.
+// of the same mode, no loss. A biaxial side (docs/light-simulator.md, "Biaxial crystals"): the
+// mode's roots (modeRoot) and Maxwell shares (biaxialTransmission) by the same rules. Where the
+// outgoing wave does not exist, total internal reflection: the mirror (same mode), no loss, the
+// corner's mirror bit flips and it stays in its region. Equal media, or an opaque one entered: only
+// the region changes. Multiplies `transmission` by T; true if the corner was turned. A pending
+// corner of a reflected copy (Patch::pending) takes the reflected wave where its twin's corner goes
+// through (the mirror: reflectIsotropic, reflectInsideUniaxial of the same mode, as total internal
+// reflection), stays in its region and multiplies `gain` by the T its twin's corner took instead.
 bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k, double& transmission,
                                   double& gain) const {
   const WavefrontMedium &a = mediumOf(c.from), &b = mediumOf(c.to);
