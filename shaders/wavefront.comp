@@ -168,9 +168,22 @@ layout(std140, binding = EIKON_B_SMALL_MEDIA) uniform SmallMediaBuf {
 
 int regionOf(int corner) { return corner & EIKON_CORNER_REGION; }
 
+// The run's mode index: 1 (the e-wave, or a biaxial crystal's slow wave) or 0 (o, or fast).
+int runMode() { return eMode() ? 1 : 0; }
+
+// A biaxial region's tensor at the run's wavelength (sharp.glsl biaxialOf).
+Biaxial biaxialAt(int r) {
+  bool dispersive = false;
+  return biaxialOf(r, dispersive);
+}
+
 // The constant-time velocity dx/dt in region r's medium (deriv in a constant field): w/n², or in a
-// crystal of the e-mode M_e w.
+// crystal of the e-mode M_e w; in a biaxial crystal the mode's energy velocity t̂/(p·t̂).
 vec3 mediumVelocity(int r, vec3 w) {
+  if (mediumBiaxial(r)) {
+    const vec3 t = biaxialWave(biaxialAt(r), w, runMode()).t;
+    return t / dot(w, t);
+  }
   float no = mediumIndex(r, 0);
   if (eMode() && mediumUniaxial(r)) return applyM(w, mediumRow(r, 7).xyz, no, mediumIndex(r, 1));
   return w / (no * no);
@@ -179,6 +192,7 @@ vec3 mediumVelocity(int r, vec3 w) {
 // The wave vector along the unit direction s on region r's shell: n·s, or in a crystal of the
 // e-mode s/√(sᵀM_e s).
 vec3 mediumShell(int r, vec3 s) {
+  if (mediumBiaxial(r)) return s * inversesqrt(biaxialInverseSquare(biaxialAt(r), s, runMode()));
   if (eMode() && mediumUniaxial(r)) return s * inversesqrt(dot(s, mediumVelocity(r, s)));
   return mediumIndex(r, 0) * s;
 }
@@ -187,6 +201,12 @@ vec3 mediumShell(int r, vec3 s) {
 // crystal of the e-mode the pleochroic σ(θ)·cos ρ (attenuationE).
 float mediumSigma(int r, vec3 w) {
   float so = regionSigmaAt(r, 0);
+  if (mediumBiaxial(r)) {  // trichroism per unit ray length (sharp.glsl biaxialAttenuation)
+    const float sb = regionSigmaAt(r, 2), sg = regionSigmaAt(r, 1);
+    if (so == 0.0 && sb == 0.0 && sg == 0.0) return 0.0;
+    const Biaxial B = biaxialAt(r);
+    return biaxialAttenuation(B, vec3(so), vec3(sb), vec3(sg), w, biaxialWave(B, w, runMode())).x;
+  }
   if (!eMode() || !mediumUniaxial(r)) return so;
   float se = regionSigmaAt(r, 1);
   if (so == 0.0 && se == 0.0) return so;
@@ -572,13 +592,49 @@ struct PatchStep {
 
 // ---- Sharp interfaces: the stages of PatchStepper (core/reference/wavefront.cpp) ----
 
+// Biaxial regions A and B with the same tensor (indices and axes): a crossing changes the region only.
+bool sameBiaxial(int A, int B) {
+  return mediumIndex(A, 0) == mediumIndex(B, 0) && mediumIndex(A, 2) == mediumIndex(B, 2) &&
+         mediumIndex(A, 1) == mediumIndex(B, 1) && mediumRow(A, 7).xyz == mediumRow(B, 7).xyz &&
+         mediumRow(A, 20).xyz == mediumRow(B, 20).xyz;
+}
+
+// The outgoing wave of the run's mode in region r with tangential wave vector pt, on the side +m
+// (transmitted) or −m (reflected), m along the incident ray (PatchStepper::modeRoot): a biaxial
+// region's root (solveBiaxialMode; D its unit D), a uniaxial one's o or e root, an isotropic one's
+// Snell root (solveInterfaceMode; D zero).
+ModeWave modeRoot(int r, vec3 pt, vec3 m, bool transmitted, out vec3 D) {
+  D = vec3(0.0);
+  if (mediumBiaxial(r)) return solveBiaxialMode(pt, m, biaxialAt(r), runMode(), transmitted, D);
+  const bool u = mediumUniaxial(r);
+  const float no = mediumIndex(r, 0);
+  return solveInterfaceMode(pt, m, u && eMode(), mediumRow(r, 7).xyz, no, u ? mediumIndex(r, 1) : no, transmitted);
+}
+
+// The transmission of the run's mode through a face with a biaxial side, o the outgoing wave (D its
+// unit D when B is biaxial): crystal → crystal none lost; otherwise T = 1 − (w_s R_s + (1 − w_s) R_p)
+// with the isotropic R_s, R_p from |w| to o.n at the wave normal's incidence and w_s = (D̂·ŝ_⊥)², the
+// mode's D on the crystal side along N × ŝ (the view march's biaxial weight; the CPU twin takes the
+// exact Maxwell powers, equal at normal incidence).
+float biaxialTransmission(int A, int B, vec3 w, vec3 N, ModeWave o, vec3 D) {
+  const bool cA = mediumBiaxial(A) || mediumUniaxial(A), cB = mediumBiaxial(B) || mediumUniaxial(B);
+  if (cA && cB) return 1.0;
+  const vec3 s = normalize(w);
+  const vec2 rsp = fresnelRsRp(min(1.0, abs(dot(s, N))), length(w), o.n);
+  if (cA) D = biaxialWave(biaxialAt(A), w, runMode()).D;
+  const vec3 c = cross(N, s);
+  const float ds = dot(c, c) < 1e-12 ? sqrt(0.5) : dot(D, normalize(c)), ws = ds * ds;
+  return 1.0 - (ws * rsp.x + (1.0 - ws) * rsp.y);
+}
+
 // Corner at the crossing c (x the crossing point, w the incident wave vector, its region A = from):
 // the exact laws between the media of A and c.to. Isotropic ↔ isotropic: Snell and T = 1 − ½(Rs +
 // Rp); into a crystal: the run's mode (solveInterfaceMode on its shell) with T = 1 − (w_s Rs +
 // (1 − w_s) Rp), the D-projection share of fresnel.glsl (the CPU twin takes the exact Maxwell
 // share, uniaxialEntryExact: equal at normal incidence, a few 1e-3 apart at oblique incidence on
 // calcite, docs/uniaxial-optics.md); out of a crystal: the same with the incident mode's index;
-// crystal → crystal: the phase-matched wave of the same mode, no loss. Where the outgoing wave does
+// crystal → crystal: the phase-matched wave of the same mode, no loss; a biaxial side: the mode's
+// roots (modeRoot) and the D-projection share (biaxialTransmission). Where the outgoing wave does
 // not exist: total internal reflection, the mirror wave of the same mode, no loss; the corner's
 // mirror bit flips and it stays in A. Equal media, or an opaque one entered: only the region
 // changes. Multiplies `transmission` by T; true if the corner was turned. A pending corner of a
@@ -592,7 +648,9 @@ bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, i
   const float noA = mediumIndex(A, 0), noB = mediumIndex(B, 0);
   const float neA = uA ? mediumIndex(A, 1) : 0.0, neB = uB ? mediumIndex(B, 1) : 0.0;
   const vec3 aA = mediumRow(A, 7).xyz, aB = mediumRow(B, 7).xyz;
-  const bool same = noA == noB && neA == neB && (!uA || aA == aB);
+  const bool bA = mediumBiaxial(A), bB = mediumBiaxial(B);
+  const bool same = bA || bB ? bA && bB && sameBiaxial(A, B)
+                             : noA == noB && neA == neB && (!uA || aA == aB);
   const bool reflects = (corner & EIKON_CORNER_PENDING) != 0;
   corner &= ~EIKON_CORNER_PENDING;
   corner = addEvent(corner);  // every region change or mirror is an event (torn)
@@ -614,7 +672,19 @@ bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, i
   ModeWave o;
   float T = 1.0;
   bool mirror = false;
-  if (!uB || !uA) {  // isotropic → isotropic, into a crystal, out of a crystal
+  // A biaxial side: m̂ along the incident ray, the mode's roots (modeRoot).
+  vec3 mb = N, ptb = w;
+  if (bA || bB) {
+    mb = orientNormal(N, mediumVelocity(A, w));
+    ptb = w - dot(w, mb) * mb;
+    vec3 D;
+    o = modeRoot(B, ptb, mb, true, D);
+    if (o.exists) T = biaxialTransmission(A, B, w, N, o, D);
+    if (!o.exists) {
+      o = modeRoot(A, ptb, mb, false, D);
+      mirror = true;
+    }
+  } else if (!uB || !uA) {  // isotropic → isotropic, into a crystal, out of a crystal
     o = solveInterfaceMode(pt, m, uB && e, aB, noB, uB ? neB : noB, true);
     if (o.exists) {
       const vec2 rsp = fresnelRsRp(min(1.0, abs(dot(s, N))), nIn, o.n);
@@ -635,7 +705,8 @@ bool crossInterface(BoundaryCrossing c, int A, inout vec3 w, inout int corner, i
     o.exists = false;
   }
   if (!o.exists && !mirror) {  // total internal reflection (or a crystal mode that cannot enter)
-    o = solveInterfaceMode(pt, m, uA && e, aA, noA, uA ? neA : noA, false);
+    vec3 D;
+    o = bA ? modeRoot(A, ptb, mb, false, D) : solveInterfaceMode(pt, m, uA && e, aA, noA, uA ? neA : noA, false);
     mirror = true;
   }
   if (!o.exists) {  // degenerate (grazing): go on unturned
@@ -815,7 +886,7 @@ vec3 splatStep(PatchStep st, vec3 x[4], vec3 w[4]) {
   const float area = length(0.5 * cross(x[2] - x[0], x[3] - x[1]));
   const vec3 wm = meanOf(w);
   const float wl = length(wm);
-  const vec3 dir = eMode() ? (st.ds > 0.0 ? (st.c1 - st.c0) / st.ds : vec3(0.0)) : (wl > 0.0 ? wm / wl : vec3(0.0));
+  const vec3 dir = eMode() || hasFlag(EIKON_F_BIAXIAL) ? (st.ds > 0.0 ? (st.c1 - st.c0) / st.ds : vec3(0.0)) : (wl > 0.0 ? wm / wl : vec3(0.0));
   if (st.kStraight > 0) {
     if (st.ds > 0.0)
       splatSegment(st.c0, (st.c1 - st.c0) / st.ds, st.ds, st.E0, st.sigma, dir, st.ds / float(st.kStraight), st.dA,

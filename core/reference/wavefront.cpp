@@ -9,11 +9,14 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
 #include "anisotropic/fresnel.h"
 #include "anisotropic/interface.h"
+#include "anisotropic/tensor_interface.h"
+#include "anisotropic/tensor_medium.h"
 #include "anisotropic/units.h"
 #include "core/light/seeding.h"
 #include "core/light/sharp_skip.h"
@@ -185,7 +188,13 @@ class PatchStepper {
         maxEdge_(s.split_span_voxels * grid.h),
         eMode_(s.mode == 1),
         sharp_(sharp && sharp->active() ? sharp : nullptr),
-        onShapes_(sharp_ && sharp_->boundary->regionsOnShapes()) {}
+        onShapes_(sharp_ && sharp_->boundary->regionsOnShapes()) {
+    if (!sharp_) return;
+    for (const WavefrontMedium& m : sharp_->media) {
+      tensors_.push_back(m.biaxial ? std::optional<TensorMedium>(tensorOfMedium(m)) : std::nullopt);
+      walk_ = walk_ || m.biaxial;
+    }
+  }
 
   /// Sharp interfaces: the region a seed corner starts in and its wave vector along s on that
   /// region's shell (the run's seeds are moved onto the media's shells with it).
@@ -230,6 +239,15 @@ class PatchStepper {
   void ended(Chunk& ch, const Patch& p) const;
   // Sharp interfaces.
   const WavefrontMedium& mediumOf(int region) const { return sharp_->media[size_t(region)]; }
+  // Biaxial regions: the medium's tensor, the run's mode (fast or slow) for wave vector w, the
+  // run's outgoing root in a region, the same mode's mirror wave, the Maxwell share at a face.
+  static TensorMedium tensorOfMedium(const WavefrontMedium& m);
+  const TensorMedium& tensorOf(int region) const { return *tensors_[size_t(region)]; }
+  TensorMode biaxialMode(int region, const glm::dvec3& w) const;
+  ModeWave modeRoot(int region, const glm::dvec3& p_t, const glm::dvec3& m, bool transmitted) const;
+  ModeWave mirrorWave(int region, const glm::dvec3& w, const glm::dvec3& N) const;
+  double biaxialTransmission(int from, int to, const glm::dvec3& w, const glm::dvec3& N,
+                             const ModeWave& out) const;
   glm::dvec3 mediumVelocity(int region, const glm::dvec3& w) const;
   double mediumSigma(int region, const glm::dvec3& w) const;
   void sharpCorner(Chunk& ch, Patch& p, int k, double T, PatchStep& st) const;
@@ -279,6 +297,11 @@ class PatchStepper {
   /// The boundary field's regions are on the shapes (BoundaryField::regionsOnShapes): crossings
   /// by crossingOutOf (sharpCorner), once per run rather than per corner step.
   bool onShapes_ = false;
+  /// Sharp interfaces: tensors_[r], region r's tensor where its medium is biaxial.
+  std::vector<std::optional<TensorMedium>> tensors_;
+  /// The energy leaves a corner along its ray, not w (the e-mode, or a biaxial region): the splat
+  /// direction is the centre's motion.
+  bool walk_ = eMode_;
 };
 
 // The skip distance at x (voxels): the sharp path's own (SharpInterfaces::skip, on the boundary
@@ -347,12 +370,17 @@ void PatchStepper::rk4(glm::dvec3& x, glm::dvec3& w) const {
 // (w/n², or M_e w), as deriv() has them in a constant field.
 glm::dvec3 PatchStepper::mediumShell(int region, const glm::dvec3& s) const {
   const WavefrontMedium& m = mediumOf(region);
+  if (m.biaxial) return tensorOf(region).indices(s)[size_t(eMode_ ? 1 : 0)] * s;
   if (eMode_ && m.n_e > 0.0) return s / std::sqrt(glm::dot(s, mediumVelocity(region, s)));
   return m.n * s;
 }
 
 glm::dvec3 PatchStepper::mediumVelocity(int region, const glm::dvec3& w) const {
   const WavefrontMedium& m = mediumOf(region);
+  if (m.biaxial) {  // the energy velocity t̂/(p·t̂): the mode's ray, p·v = 1 as on every shell
+    const glm::dvec3 t = biaxialMode(region, w).t;
+    return t / glm::dot(w, t);
+  }
   if (eMode_ && m.n_e > 0.0) {
     const double pa = glm::dot(w, m.axis);
     return pa / (m.n * m.n) * m.axis + (w - pa * m.axis) / (m.n_e * m.n_e);
@@ -364,8 +392,107 @@ glm::dvec3 PatchStepper::mediumVelocity(int region, const glm::dvec3& w) const {
 // e-mode the pleochroic σ(θ)·cos ρ of field::attenuationE (as sigmaE on the smoothed path).
 double PatchStepper::mediumSigma(int region, const glm::dvec3& w) const {
   const WavefrontMedium& m = mediumOf(region);
+  if (m.biaxial) {  // trichroism, first order in the principal σ's, per unit ray length
+    if (m.sigma == 0.0 && m.sigma_beta == 0.0 && m.sigma_e == 0.0) return 0.0;
+    const TensorMode md = biaxialMode(region, w);
+    return tensorOf(region).attenuation(md.D, md.n) * glm::dot(glm::normalize(w), md.t);
+  }
   if (!eMode_ || !(m.n_e > 0.0) || (m.sigma == 0.0 && m.sigma_e == 0.0)) return m.sigma;
   return field::attenuationE(glm::dvec3(m.sigma), glm::dvec3(m.sigma_e), w, m.axis, m.n, m.n_e).x;
+}
+
+// A biaxial medium's dielectric tensor with its principal attenuations (σ_α, σ_β, σ_γ).
+TensorMedium PatchStepper::tensorOfMedium(const WavefrontMedium& m) {
+  return TensorMedium(m.n, m.n_beta, m.n_e, m.alpha_axis, m.axis,
+                      glm::dvec3(m.sigma, m.sigma_beta, m.sigma_e));
+}
+
+// The run's mode of a biaxial region for wave vector w (its wave normal): fast (mode 0), slow (1).
+TensorMode PatchStepper::biaxialMode(int region, const glm::dvec3& w) const {
+  return tensorOf(region).modes(glm::normalize(w))[eMode_ ? WaveMode::Slow : WaveMode::Fast];
+}
+
+// The outgoing wave of the run's mode in `region` with tangential wave vector p_t, on the side +m
+// (transmitted) or −m (reflected), m unit along the incident ray (the view march's outgoingMode):
+// a biaxial region's root of the mode's dispersion relation (outgoingWaves: the propagating waves
+// in order fast, slow; where only one propagates, it is the mode whose index it has), a uniaxial
+// one's o or e root (solveUniaxialMode), an isotropic one's Snell root. None: exists = false.
+ModeWave PatchStepper::modeRoot(int region, const glm::dvec3& p_t, const glm::dvec3& m,
+                                bool transmitted) const {
+  const WavefrontMedium& M = mediumOf(region);
+  const int mode = eMode_ ? 1 : 0;
+  ModeWave out;
+  if (M.biaxial) {
+    const TensorMedium& t = tensorOf(region);
+    const std::array<OutgoingWave, 2> w = outgoingWaves(t, p_t, m, transmitted);
+    const OutgoingWave* pick = nullptr;
+    if (w[0].propagating && w[1].propagating) {
+      pick = &w[size_t(mode)];
+    } else if (w[0].propagating) {
+      const std::array<double, 2> n = t.indices(w[0].s);
+      if ((std::abs(w[0].n - n[0]) <= std::abs(w[0].n - n[1]) ? 0 : 1) == mode) pick = &w[0];
+    }
+    if (!pick) return out;
+    out.exists = true;
+    out.s = pick->s;
+    out.n = pick->n;
+    out.t = pick->t;
+    out.q = pick->q.real();
+    return out;
+  }
+  if (M.n_e > 0.0)
+    return solveUniaxialMode(p_t, m, Uniaxial(M.n, M.n_e, M.axis),
+                             eMode_ ? Mode::Extraordinary : Mode::Ordinary, transmitted);
+  const double rem = M.n * M.n - glm::dot(p_t, p_t);
+  if (!(rem > 0.0)) return out;
+  out.exists = true;
+  out.q = (transmitted ? 1.0 : -1.0) * std::sqrt(rem);
+  out.n = M.n;
+  out.s = glm::normalize(p_t + out.q * m);
+  out.t = out.s;
+  return out;
+}
+
+// The mirror wave of the run's mode in a biaxial region at a face of normal N (total internal
+// reflection, or a reflected copy's corner): the same mode's reflected root.
+ModeWave PatchStepper::mirrorWave(int region, const glm::dvec3& w, const glm::dvec3& N) const {
+  const glm::dvec3 m = glm::dot(mediumVelocity(region, w), N) >= 0 ? N : -N;
+  return modeRoot(region, w - glm::dot(w, m) * m, m, false);
+}
+
+// The transmission of the run's mode through a face with a biaxial side, `out` the outgoing wave
+// (anisotropic/tensor_interface.h, the exact Maxwell powers). Isotropic → crystal: the mode's
+// share of unpolarised light, the mean over the s and p incident waves, doubled because a mode's
+// run carries half the light (the sum of the two); crystal → isotropic: the incident mode's
+// transmitted power; crystal → crystal: the phase-matched wave of the same mode, no loss. An
+// interface the solver refuses (energy along the face: grazing) transmits nothing.
+double PatchStepper::biaxialTransmission(int from, int to, const glm::dvec3& w, const glm::dvec3& N,
+                                         const ModeWave& out) const {
+  const WavefrontMedium &a = mediumOf(from), &b = mediumOf(to);
+  const bool crystalA = a.biaxial || a.n_e > 0.0, crystalB = b.biaxial || b.n_e > 0.0;
+  if (crystalA && crystalB) return 1.0;
+  try {
+    if (crystalA)
+      return solveTensorInterface(tensorOf(from), eMode_ ? WaveMode::Slow : WaveMode::Fast,
+                                  glm::normalize(w), N, TensorMedium::isotropic(b.n))
+          .transmittedPower();
+    const glm::dvec3 m = glm::dot(w, N) >= 0 ? N : -N, pt = w - glm::dot(w, m) * m;
+    const TensorMedium near = TensorMedium::isotropic(a.n);
+    double T = 0.0;
+    for (const maxwell::Wave& in : maxwell::isotropicWaves(pt, m, a.n, true)) {
+      const TensorInterfaceSolution sol = solveTensorInterface(near, in, N, tensorOf(to));
+      const OutgoingWave* mine = nullptr;  // the transmitted wave that is `out`
+      double gap = 0.0;
+      for (const OutgoingWave& o : sol.transmitted) {
+        const double d = glm::length(o.n * o.s - out.p());
+        if (o.propagating && (!mine || d < gap)) mine = &o, gap = d;
+      }
+      if (mine) T += mine->power;
+    }
+    return T;
+  } catch (const std::exception&) {
+    return 0.0;
+  }
 }
 
 // Corner k at the crossing c (p.x[k] its point, p.w[k] the incident wave vector): the exact laws
@@ -374,18 +501,22 @@ double PatchStepper::mediumSigma(int region, const glm::dvec3& w) const {
 // the run's mode (o by Snell with n_o, e by the closed form of the e-wave normal) with the exact
 // Maxwell share of the unpolarised power, doubled because a mode's run carries half the light; out
 // of a crystal: the exact exit transmission of the mode; crystal → crystal: the phase-matched wave
-// of the same mode, no loss. Where the outgoing wave does not exist, total internal reflection: the
-// mirror (same mode), no loss, the corner's mirror bit flips and it stays in its region. Equal
-// media, or an opaque one entered: only the region changes. Multiplies `transmission` by T; true if
-// the corner was turned. A pending corner of a reflected copy (Patch::pending) takes the reflected
-// wave where its twin's corner goes through (the mirror: reflectIsotropic, reflectInsideUniaxial
-// of the same mode, as total internal reflection), stays in its region and multiplies `gain` by
-// the T its twin's corner took instead.
+// of the same mode, no loss. A biaxial side (docs/light-simulator.md, "Biaxial crystals"): the
+// mode's roots (modeRoot) and Maxwell shares (biaxialTransmission) by the same rules. Where the
+// outgoing wave does not exist, total internal reflection: the mirror (same mode), no loss, the
+// corner's mirror bit flips and it stays in its region. Equal media, or an opaque one entered: only
+// the region changes. Multiplies `transmission` by T; true if the corner was turned. A pending
+// corner of a reflected copy (Patch::pending) takes the reflected wave where its twin's corner goes
+// through (the mirror: reflectIsotropic, reflectInsideUniaxial of the same mode, as total internal
+// reflection), stays in its region and multiplies `gain` by the T its twin's corner took instead.
 bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k, double& transmission,
                                   double& gain) const {
   const WavefrontMedium &a = mediumOf(c.from), &b = mediumOf(c.to);
   glm::dvec3 N = glm::length(c.normal) > 0 ? c.normal : c.field_normal;
-  const bool same = a.n == b.n && a.n_e == b.n_e && (a.n_e == 0.0 || a.axis == b.axis);
+  const bool same = a.biaxial || b.biaxial
+                        ? a.biaxial && b.biaxial && a.n == b.n && a.n_beta == b.n_beta &&
+                              a.n_e == b.n_e && a.axis == b.axis && a.alpha_axis == b.alpha_axis
+                        : a.n == b.n && a.n_e == b.n_e && (a.n_e == 0.0 || a.axis == b.axis);
   const bool reflects = (p.pending >> k) & 1u;
   p.pending &= ~(1u << k);
   ++p.events[size_t(k)];  // every region change or mirror is an event (torn)
@@ -398,11 +529,17 @@ bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k, do
   glm::dvec3& w = p.w[size_t(k)];
   const glm::dvec3 s = glm::normalize(w);
   const Mode mode = eMode_ ? Mode::Extraordinary : Mode::Ordinary;
-  const bool inA = a.n_e > 0.0, inB = b.n_e > 0.0;
+  const bool inA = a.n_e > 0.0 && !a.biaxial, inB = b.n_e > 0.0 && !b.biaxial;
   ModeWave out;
   double T = 1.0;
   bool mirror = false;
-  if (!inA && !inB) {
+  if (a.biaxial || b.biaxial) {  // the mode's root beyond the face, m̂ along the incident ray
+    const glm::dvec3 m = glm::dot(mediumVelocity(c.from, w), N) >= 0 ? N : -N;
+    const glm::dvec3 pt = w - glm::dot(w, m) * m;
+    out = modeRoot(c.to, pt, m, true);
+    if (out.exists) T = biaxialTransmission(c.from, c.to, w, N, out);
+    if (!out.exists) out = modeRoot(c.from, pt, m, false), mirror = true;
+  } else if (!inA && !inB) {
     out = refractIsotropic(s, N, a.n, b.n);
     if (out.exists) T = 1.0 - fresnelReflectance(std::abs(glm::dot(s, N)), a.n, b.n).R;
   } else if (!inA) {
@@ -433,8 +570,9 @@ bool PatchStepper::crossInterface(const BoundaryCrossing& c, Patch& p, int k, do
   }
   if (!out.exists && !mirror) {
     // Total internal reflection into an isotropic medium, or a crystal mode that cannot enter.
-    out = inA ? reflectInsideUniaxial(Uniaxial(a.n, a.n_e, a.axis), mode, s, N)
-              : reflectIsotropic(s, N, a.n);
+    out = a.biaxial ? mirrorWave(c.from, w, N)
+          : inA     ? reflectInsideUniaxial(Uniaxial(a.n, a.n_e, a.axis), mode, s, N)
+                    : reflectIsotropic(s, N, a.n);
     mirror = true;
   }
   if (!out.exists) {  // degenerate (grazing): go on unturned
@@ -659,6 +797,10 @@ PatchStepper::Along PatchStepper::regionsAlong(const glm::dvec3& a, const glm::d
 // corner's region id.
 bool PatchStepper::sameMotion(int r, int q) const {
   const WavefrontMedium &a = mediumOf(r), &b = mediumOf(q);
+  if (a.biaxial || b.biaxial)
+    return a.biaxial == b.biaxial && a.n == b.n && a.n_beta == b.n_beta && a.n_e == b.n_e &&
+           a.axis == b.axis && a.alpha_axis == b.alpha_axis && a.sigma == b.sigma &&
+           a.sigma_beta == b.sigma_beta && a.sigma_e == b.sigma_e;
   return a.n == b.n && a.n_e == b.n_e && (a.n_e == 0.0 || a.axis == b.axis) && a.sigma == b.sigma &&
          a.sigma_e == b.sigma_e;
 }
@@ -980,8 +1122,8 @@ glm::dvec3 PatchStepper::splatStep(Chunk& ch, const PatchStep& st, const Patch& 
   const double area = glm::length(vectorArea(p));
   const glm::dvec3 wm = meanW(p);
   const double wl = glm::length(wm);
-  const glm::dvec3 dir = eMode_ ? (st.ds > 0 ? (st.c1 - st.c0) / st.ds : glm::dvec3(0.0))
-                                : (wl > 0 ? wm / wl : glm::dvec3(0.0));
+  const glm::dvec3 dir = walk_ ? (st.ds > 0 ? (st.c1 - st.c0) / st.ds : glm::dvec3(0.0))
+                               : (wl > 0 ? wm / wl : glm::dvec3(0.0));
   if (st.kStraight > 0) {
     if (st.ds > 0)
       splatSegment(ch, st.c0, (st.c1 - st.c0) / st.ds, st.ds, st.E0, st.sigma, dir,
@@ -1255,7 +1397,14 @@ SharpInterfaces sharpInterfacesFor(const VolumeSet& volume, double wavelength_nm
   for (const MediumRecord& r : volume.media.regions) {
     WavefrontMedium m;
     m.n = mediumIndex(r.n_o, wavelength_nm);
-    if (r.uniaxial && !r.radial_axis) {
+    if (r.biaxial) {  // n_α ≤ n_β ≤ n_γ kept at every wavelength (as the view march's tensorOf)
+      m.biaxial = true;
+      m.n_e = std::max(mediumIndex(r.n_e, wavelength_nm), m.n);
+      m.n_beta = std::clamp(mediumIndex(r.n_beta, wavelength_nm), m.n, m.n_e);
+      m.axis = r.axis;
+      m.alpha_axis = r.alpha_axis;
+      m.sigma_beta = mediumSigmaAt(r, 2, wavelength_nm);
+    } else if (r.uniaxial && !r.radial_axis) {
       m.n_e = mediumIndex(r.n_e, wavelength_nm);
       m.axis = r.axis;
     }
@@ -1283,6 +1432,12 @@ WavefrontSimulator::WavefrontSimulator(const Field& field, const Grid& splat_gri
                                        const SharpInterfaces& sharp)
     : WavefrontSimulator(field, splat_grid, settings) {
   if (sharp.active()) sharp_ = &sharp;
+  const bool biaxial = std::any_of(sharp.media.begin(), sharp.media.end(),
+                                   [](const WavefrontMedium& m) { return m.biaxial; });
+  if (biaxial && !sharp_)
+    throw std::invalid_argument(
+        "wavefront: a biaxial crystal needs the sharp path (the boundary field and a homogeneous "
+        "medium in every region); the smoothed field has no biaxial law");
 }
 
 std::vector<Patch> WavefrontSimulator::seed(const Light& light) const {

@@ -30,7 +30,11 @@
 // (locateCrossing), refracted or totally reflected there with the exact laws of anisotropic/
 // (Snell, Beyerle–McDermid for the e-wave) and goes on for the rest of the step; the patch's flux
 // is multiplied by the corners' Fresnel transmissions, (1 − R)^¼ per corner crossing (exact for a
-// plane wave on a plane face, where all four see the same R).
+// plane wave on a plane face, where all four see the same R). A biaxial crystal's region
+// (WavefrontMedium::biaxial, anisotropic/tensor_*.h) carries the run's mode, fast (0) or slow
+// (1): its corners move along the mode's ray t̂ at the energy velocity t̂/(p·t̂), attenuated
+// trichroically, and its faces take the mode's roots of the Booker quartic and the exact Maxwell
+// power shares (solveTensorInterface).
 //
 // Units: positions in mm; a light's `irradiance` is E (directional, per mm²) or I (point, per
 // sr) in the light's own radiometric unit (W in the text). A patch's flux is then in W (E·mm² or
@@ -65,6 +69,14 @@ struct WavefrontMedium {
   /// false: the medium varies in space (GRIN, an optic-axis field); the sharp path then does not
   /// apply and the run uses the smoothed field throughout.
   bool homogeneous = true;
+  /// A biaxial crystal (docs/biaxial-optics.md): n = n_α, n_beta = n_β, n_e = n_γ, axis = γ̂,
+  /// alpha_axis = α̂; sigma, sigma_beta, sigma_e the attenuation for D along α̂, β̂, γ̂. The run's
+  /// mode 0 is its fast wave, mode 1 its slow one (the uniaxial fields above are then unused as
+  /// such: every function tests `biaxial` first).
+  bool biaxial = false;
+  double n_beta = 0.0;
+  glm::dvec3 alpha_axis{1.0, 0.0, 0.0};
+  double sigma_beta = 0.0;
 };
 
 /// The sharp boundaries of a scene for the light simulator: the boundary field and media[r], the
@@ -101,6 +113,8 @@ class WavefrontSimulator {
   /// With sharp interfaces (referenced, must outlive the simulator): when sharp.active(), corners
   /// refract at the boundaries instead of bending through the field's smoothed layers; the field
   /// still gives the bounds and the opacity.
+  /// A biaxial medium among sharp.media needs the sharp path (sharp.active()): otherwise throws
+  /// std::invalid_argument with one line (the smoothed field has no biaxial law).
   WavefrontSimulator(const Field& field, const Grid& splat_grid, const WavefrontSettings& settings,
                      const SharpInterfaces& sharp);
   WavefrontResult run(const Light& light) const;

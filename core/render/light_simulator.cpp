@@ -395,6 +395,9 @@ struct GpuWavefront::Impl {
         if (std::holds_alternative<ConvexShape>(shape.geometry())) flags |= EIKON_F_CONVEX;
         if (std::holds_alternative<MeshShape>(shape.geometry())) flags |= EIKON_F_MESH;
       }
+      // A biaxial crystal's laws (sharp.glsl mediumBiaxial reads the media's flag only then).
+      for (const MediumRecord& r : vol.media.regions)
+        if (r.biaxial) flags |= EIKON_F_BIAXIAL;
       flags |= uniformTableFlags(vol.boundary, vol.media);  // the tables as uniform blocks
       flags |= crossingPathFlags(vol.boundary);             // with kExact: the crossing dispatch
     }

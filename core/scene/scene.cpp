@@ -1633,8 +1633,18 @@ Scene parseScene(const std::string& text, const std::filesystem::path& origin) {
   if (auto ls = root.get("lights")) {
     if (!ls->isArray()) ls->fail("expected an array of lights");
     for (size_t i = 0; i < ls->size(); ++i) scene.lights.push_back(parseLight(ls->index(i)));
-    if (!scene.lights.empty() && scene.anyBiaxial())
-      ls->fail("lights (the light simulator) are not yet for biaxial crystals");
+    // The light simulator's biaxial law is the sharp path's, which needs every region
+    // homogeneous (docs/light-simulator.md "Biaxial crystals").
+    const bool varying =
+        std::any_of(scene.objects.begin(), scene.objects.end(), [&](const auto& o) {
+          const auto m = scene.materials.find(o.material);
+          return o.radial_axis ||
+                 (m != scene.materials.end() && m->second.grin.type != GrinProfile::Type::None);
+        });
+    if (!scene.lights.empty() && scene.anyBiaxial() && varying)
+      ls->fail(
+          "lights (the light simulator) are not yet for a biaxial crystal beside a GRIN profile or "
+          "an optic-axis field");
   }
   warnInsideOpaque(scene, json_index, file);
   warnUnseenScene(scene, json_index, file);

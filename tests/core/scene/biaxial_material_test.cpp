@@ -382,9 +382,16 @@ TEST(BiaxialMaterial, WhatTheRendererDoesNotDoIsOneLine) {
                       "give both alpha_axis and gamma_axis");
   EXPECT_OBJECT_ERROR(biaxialObject(R"(, "alpha_axis": [1, 0, 0], "gamma_axis": [0.01, 0, 1])"),
                       "/objects/0/gamma_axis", "orthogonal to alpha_axis");
-  EXPECT_OBJECT_ERROR(
-      biaxialObject("", R"("lights": [{"type": "directional", "direction": [0, -1, 0]}], )"),
-      "/lights", "not yet for biaxial crystals");
+  // Lights: the light simulator's biaxial law is its sharp path, which needs every region
+  // homogeneous, so a GRIN object beside the crystal is refused; the crystal alone is lit.
+  const std::string lights = R"("lights": [{"type": "directional", "direction": [0, -1, 0]}], )";
+  EXPECT_NO_THROW(parseScene(biaxialObject("", lights), kOrigin));
+  const std::string grin =
+      R"({)" + lights + R"("materials": {"m": )" + biaxial("") +
+      R"(, "g": {"n": {"linear": {"n0": 1.5, "gradient_per_mm": [0, 0.01, 0]}}}},
+         "objects": [{"shape": "sphere", "radius": 3, "material": "m"},
+                     {"shape": "sphere", "radius": 2, "center": [8, 0, 0], "material": "g"}]})";
+  EXPECT_OBJECT_ERROR(grin, "/lights", "not yet for a biaxial crystal beside a GRIN profile");
   EXPECT_OBJECT_ERROR(R"({"objects": [{"shape": "sphere", "radius": 3, "material": "N-BK7",
                          "alpha_axis": [1, 0, 0], "gamma_axis": [0, 0, 1]}]})",
                       "/objects/0/alpha_axis", "not biaxial");
