@@ -610,8 +610,9 @@ float projectedShare(vec3 mix, float as, float ap, vec3 es, vec3 pOut, vec3 D) {
 
 // The outgoing waves of a face met inside crystal A: both reflected modes in A (r, unit D's Dr) and
 // the transmitted ones in B (t, Dt; an isotropic B: t[0] alone), with the incident tangential
-// wave vector pt on the normal m oriented along the incident ray.
-void faceWaves(int A, int B, vec3 x, vec3 pt, vec3 m, vec3 es, inout bool dispersive,
+// wave vector pt on the normal m oriented along the incident ray. True: B is a crystal (a uniaxial
+// medium with n_o = n_e is not, as TensorMedium's snapping on the CPU).
+bool faceWaves(int A, int B, vec3 x, vec3 pt, vec3 m, vec3 es, inout bool dispersive,
                out ModeWave r[2], out vec3 Dr[2], out ModeWave t[2], out vec3 Dt[2]) {
   bool bA = mediumBiaxial(A), bB = mediumBiaxial(B);
   bool uB = !bB && hasFlag(EIKON_F_UNIAXIAL) && mediumUniaxial(B);
@@ -621,6 +622,7 @@ void faceWaves(int A, int B, vec3 x, vec3 pt, vec3 m, vec3 es, inout bool disper
   vec3 aA = regionAxisField(A, x).xyz, aB = regionAxisField(B, x).xyz;
   float noA = regionIndex(A, 0, x, dispersive), neA = regionIndex(A, 1, x, dispersive);
   float noB = regionIndex(B, 0, x, dispersive), neB = regionIndex(B, 1, x, dispersive);
+  uB = uB && noB != neB;
   for (int k = 0; k < 2; ++k) {
     r[k] = bA ? solveBiaxialMode(pt, m, BA, k, false, Dr[k])
               : solveInterfaceMode(pt, m, k == 1, aA, noA, neA, false);
@@ -630,6 +632,7 @@ void faceWaves(int A, int B, vec3 x, vec3 pt, vec3 m, vec3 es, inout bool disper
     if (!bB) Dt[k] = uniaxialModeD(t[k].s, aB, k, es);
   }
   if (!(bB || uB)) t[1].exists = false;
+  return bB || uB;
 }
 
 // Mode conversion (Transport::Full, Fresnel on) at a face met inside crystal A: the path chooses
@@ -669,10 +672,9 @@ bool convertAtFace(inout MarchState S, inout MarchResult R, inout PathRecord rec
   if (!bA) Din = uniaxialModeD(s, afA.xyz, mode, es);
   ModeWave r[2], t[2];
   vec3 Dr[2], Dt[2];
-  faceWaves(A, B, x, pt, m, es, rec.dispersive, r, Dr, t, Dt);
+  bool crystalB = faceWaves(A, B, x, pt, m, es, rec.dispersive, r, Dr, t, Dt);
   bool transmits = t[0].exists || t[1].exists;
-  int kt = t[mode].exists ? mode : 1 - mode;
-  if (!(uB || bB)) kt = 0;
+  int kt = !crystalB ? 0 : t[mode].exists ? mode : 1 - mode;
   float n1 = length(S.w), n2 = transmits ? t[kt].n : regionIndex(B, 0, x, rec.dispersive);
   float ci = min(1.0, abs(dot(s, N))), as = dot(Din, es), ap = dot(Din, cross(es, s));
   vec3 rmix = fresnelReflectedMix(ci, n1, n2);
@@ -688,7 +690,7 @@ bool convertAtFace(inout MarchState S, inout MarchResult R, inout PathRecord rec
   } else {
     R.tir += 1;
   }
-  bool crystal = reflects || uB || bB;
+  bool crystal = reflects || crystalB;
   bool both = reflects ? r[0].exists && r[1].exists : crystal && t[0].exists && t[1].exists;
   int k = reflects ? (r[0].exists ? 0 : 1) : crystal ? (t[0].exists ? 0 : 1) : 0;
   if (both) {
@@ -699,7 +701,7 @@ bool convertAtFace(inout MarchState S, inout MarchResult R, inout PathRecord rec
     k = drawMode(S, P0 / max(P0 + P1, 1e-30));
   }
   ModeWave o = reflects ? r[k] : t[k];
-  if (crystal) mode = k;
+  if (crystal && o.exists) mode = k;
   S.w = o.exists ? o.n * o.s : reflect(S.w, N);
   if (!reflects) S.region = B;
   return true;
