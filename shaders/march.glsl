@@ -479,6 +479,14 @@ bool followReflection(inout MarchState S, float Rf) {
   return reflects;
 }
 
+// Mode conversion's second draw (sharp.glsl convertAtFace; the CPU twin's RayMarch::
+// convertAtFace): path mode 0 with probability p0, else 1, the next uniform of the path's stream.
+int drawMode(inout MarchState S, float p0) {
+  bool zero = transportUniform(S.seed, S.draws) < p0;
+  S.draws++;
+  return zero ? 0 : 1;
+}
+
 // Whether a crossing weighs the path by 1 − R and looks its external reflection up in the
 // environment (the single transmitted path): transport single, or past the reflection limit.
 bool singlePathWeights(MarchState S) { return P.transport.x == 0 || S.reflections >= P.transport.y; }

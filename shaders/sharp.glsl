@@ -590,6 +590,123 @@ int sharpAdvance(inout MarchState S, inout MarchResult R, inout bool dispersive,
   return c.found ? kSharpCross : leaving ? kSharpLeave : kSharpGo;
 }
 
+// ---- Mode conversion at a face met inside a crystal (the CPU twin's RayMarch::convertAtFace) ----
+
+// The unit D of a uniaxial crystal's mode along wave normal s: o along s × a, e in the principal
+// plane ⊥ s; where s ∥ a (degenerate) es for the o-mode.
+vec3 uniaxialModeD(vec3 s, vec3 a, int mode, vec3 es) {
+  vec3 o = cross(s, a);
+  o = dot(o, o) < 1e-12 ? es : normalize(o);
+  return mode == 0 ? o : normalize(cross(s, o));
+}
+
+// The D-projection share of an outgoing wave with unit D (fresnel.glsl fresnelReflectedMix):
+// |F·D|² of the field F = c_s a_s ês + c_p a_p p̂ (p̂ = ês × ŝ_out) with mix = (|c_s|², |c_p|²,
+// Re c_s c_p*).
+float projectedShare(vec3 mix, float as, float ap, vec3 es, vec3 pOut, vec3 D) {
+  float X = as * dot(es, D), Y = ap * dot(pOut, D);
+  return max(mix.x * X * X + mix.y * Y * Y + 2.0 * mix.z * X * Y, 0.0);
+}
+
+// The outgoing waves of a face met inside crystal A: both reflected modes in A (r, unit D's Dr) and
+// the transmitted ones in B (t, Dt; an isotropic B: t[0] alone), with the incident tangential
+// wave vector pt on the normal m oriented along the incident ray. True: B is a crystal (a uniaxial
+// medium with n_o = n_e is not, as TensorMedium's snapping on the CPU).
+bool faceWaves(int A, int B, vec3 x, vec3 pt, vec3 m, vec3 es, inout bool dispersive,
+               out ModeWave r[2], out vec3 Dr[2], out ModeWave t[2], out vec3 Dt[2]) {
+  bool bA = mediumBiaxial(A), bB = mediumBiaxial(B);
+  bool uB = !bB && hasFlag(EIKON_F_UNIAXIAL) && mediumUniaxial(B);
+  Biaxial BA, BB;
+  if (bA) BA = biaxialOf(A, dispersive);
+  if (bB) BB = biaxialOf(B, dispersive);
+  vec3 aA = regionAxisField(A, x).xyz, aB = regionAxisField(B, x).xyz;
+  float noA = regionIndex(A, 0, x, dispersive), neA = regionIndex(A, 1, x, dispersive);
+  float noB = regionIndex(B, 0, x, dispersive), neB = regionIndex(B, 1, x, dispersive);
+  uB = uB && noB != neB;
+  for (int k = 0; k < 2; ++k) {
+    r[k] = bA ? solveBiaxialMode(pt, m, BA, k, false, Dr[k])
+              : solveInterfaceMode(pt, m, k == 1, aA, noA, neA, false);
+    if (!bA) Dr[k] = uniaxialModeD(r[k].s, aA, k, es);
+    t[k] = bB ? solveBiaxialMode(pt, m, BB, k, true, Dt[k])
+              : solveInterfaceMode(pt, m, uB && k == 1, aB, noB, neB, true);
+    if (!bB) Dt[k] = uniaxialModeD(t[k].s, aB, k, es);
+  }
+  if (!(bB || uB)) t[1].exists = false;
+  return bB || uB;
+}
+
+// Mode conversion (Transport::Full, Fresnel on) at a face met inside crystal A: the path chooses
+// one outgoing propagating wave with the probability of its power share, keeping its weight. The
+// shares are the D-projection's: the reflected power R = a_s²R_s + a_p²R_p (a_s, a_p: the
+// incident mode's unit D on ês = N × ŝ and p̂ = ês × ŝ; R_s, R_p those of an isotropic face from
+// |w| into the transmitted wave's index), shared between the two outgoing modes of the chosen
+// side in proportion to |F·D_mode|² of that side's field F (projectedShare). The draws are the
+// CPU twin's: reflection or transmission (followReflection, none when nothing is transmitted),
+// then, where the chosen side has both modes propagating in a crystal, the mode (drawMode). The
+// path continues in that wave's mode (`mode`), wave vector and region. false: not such a face
+// (crossInterface applies the same-mode laws).
+bool convertAtFace(inout MarchState S, inout MarchResult R, inout PathRecord rec, BoundaryCrossing c,
+                   inout int mode) {
+  int A = S.region, B = c.to;
+  vec3 x = S.x, N = c.normal, s = normalize(S.w);
+  vec4 afA = regionAxisField(A, x), afB = regionAxisField(B, x);
+  bool uA = hasFlag(EIKON_F_UNIAXIAL) && mediumUniaxial(A), bA = mediumBiaxial(A);
+  bool uB = hasFlag(EIKON_F_UNIAXIAL) && mediumUniaxial(B), bB = mediumBiaxial(B);
+  if (P.transport.x == 0 || hasFlag(EIKON_F_NO_FRESNEL) || !(bA || (uA && hasAxis(afA.xyz))) ||
+      (uB && !hasAxis(afB.xyz)))
+    return false;
+  float noA = regionIndex(A, 0, x, rec.dispersive), neA = regionIndex(A, 1, x, rec.dispersive);
+  if (!bA && noA == neA) return false;  // no birefringence: nothing to convert
+  // The incident mode's ray (the normal oriented along it) and unit D.
+  vec3 flow = s, Din;
+  if (bA) {
+    BiaxialWave W = biaxialWave(biaxialOf(A, rec.dispersive), s, mode);
+    flow = W.t;
+    Din = W.D;
+  } else if (mode == 1) {
+    flow = normalize(applyM(s, afA.xyz, noA, neA));
+  }
+  vec3 m = orientNormal(N, flow), pt = S.w - dot(S.w, m) * m, es = cross(m, s);
+  es = dot(es, es) < 1e-12 ? normalize(cross(abs(m.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0), m))
+                           : normalize(es);
+  if (!bA) Din = uniaxialModeD(s, afA.xyz, mode, es);
+  ModeWave r[2], t[2];
+  vec3 Dr[2], Dt[2];
+  bool crystalB = faceWaves(A, B, x, pt, m, es, rec.dispersive, r, Dr, t, Dt);
+  bool transmits = t[0].exists || t[1].exists;
+  int kt = !crystalB ? 0 : t[mode].exists ? mode : 1 - mode;
+  float n1 = length(S.w), n2 = transmits ? t[kt].n : regionIndex(B, 0, x, rec.dispersive);
+  float ci = min(1.0, abs(dot(s, N))), as = dot(Din, es), ap = dot(Din, cross(es, s));
+  vec3 rmix = fresnelReflectedMix(ci, n1, n2);
+  bool reflects = true;
+  if (transmits) {
+    float Rf = as * as * rmix.x + ap * ap * rmix.y;
+    R.interfaces += 1;
+    reflects = followReflection(S, Rf);
+    if (!reflects && singlePathWeights(S)) {
+      if (n2 > n1) S.L += environmentWeighted(rec, S.T * Rf, reflect(s, N));
+      S.T *= 1.0 - Rf;
+    }
+  } else {
+    R.tir += 1;
+  }
+  bool crystal = reflects || crystalB;
+  bool both = reflects ? r[0].exists && r[1].exists : crystal && t[0].exists && t[1].exists;
+  int k = reflects ? (r[0].exists ? 0 : 1) : crystal ? (t[0].exists ? 0 : 1) : 0;
+  if (both) {
+    vec3 sOut = reflects ? reflect(s, N) : t[kt].s, pOut = cross(es, sOut);
+    vec3 mix = reflects ? rmix : fresnelTransmittedMix(ci, n1, n2);
+    float P0 = projectedShare(mix, as, ap, es, pOut, reflects ? Dr[0] : Dt[0]);
+    float P1 = projectedShare(mix, as, ap, es, pOut, reflects ? Dr[1] : Dt[1]);
+    k = drawMode(S, P0 / max(P0 + P1, 1e-30));
+  }
+  ModeWave o = reflects ? r[k] : t[k];
+  if (crystal && o.exists) mode = k;
+  S.w = o.exists ? o.n * o.s : reflect(S.w, N);
+  if (!reflects) S.region = B;
+  return true;
+}
+
 // The exact laws at a crossing: Snell, or the o/e waves into / out of a crystal; TIR is a lossless
 // mirror; otherwise the path reflects with probability R or refracts (full transport,
 // followReflection), or carries (1 − R) on while an external reflection adds R × environment
@@ -597,7 +714,7 @@ int sharpAdvance(inout MarchState S, inout MarchResult R, inout bool dispersive,
 // (refractIsotropic, refractIntoUniaxial, refractOutOfUniaxial and reflectInsideUniaxial are one
 // solveInterfaceMode each: the incident wave's tangential part on the outgoing mode's shell.)
 void crossInterface(inout MarchState S, inout MarchResult R, inout PathRecord rec, BoundaryCrossing c,
-                    int mode) {
+                    inout int mode) {
   int A = S.region, B = c.to;
   vec3 x = S.x, N = c.normal, s = normalize(S.w);
   vec4 afA = regionAxisField(A, x), afB = regionAxisField(B, x);
@@ -612,6 +729,7 @@ void crossInterface(inout MarchState S, inout MarchResult R, inout PathRecord re
     S.region = B;  // equal media: nothing changes (an opaque one stops the ray next)
     return;
   }
+  if (convertAtFace(S, R, rec, c, mode)) return;
   float noA = regionIndex(A, 0, x, rec.dispersive), neA = regionIndex(A, 1, x, rec.dispersive);
   float noB = regionIndex(B, 0, x, rec.dispersive), neB = regionIndex(B, 1, x, rec.dispersive);
   float n1 = length(S.w);

@@ -182,6 +182,7 @@ class RayMarch {
         scalar_(scalar),
         m_(m),
         mode_(mode),
+        mode0_(mode),
         lit_(f.lit()),
         h_(f.cellSize()),
         ds_(m.step_voxels * f.cellSize()),
@@ -199,6 +200,8 @@ class RayMarch {
   /// The light tree's march: followReflection takes the script's choices, and the events are
   /// recorded in it (ReferenceMarcher::lightTree).
   void setScript(ChoiceScript* script) { script_ = script; }
+  /// Record the path's face events in a crystal (ReferenceMarcher::samplePath).
+  void setEvents(std::vector<PathEvent>* events) { events_ = events; }
   /// Both marches start here: false (R = the environment along d) if the ray misses the volume,
   /// else true with the entry at o + t0·d, t0 ≥ 0.
   bool enterVolume(const glm::dvec3& o, const glm::dvec3& d, MarchResult& R, double& t0) const;
@@ -297,7 +300,15 @@ class RayMarch {
                  double Rf) const;
   void noteAfter(const MarchState& S) const;
 
+  // Mode conversion at the faces met inside a crystal (docs/view-renderer.md "Light transport").
+  TensorMedium tensorAt(int region, const glm::dvec3& x) const;
+  WaveMode waveModeOf(int region) const;
+  int marchModeOf(int region, const TensorMedium& t, const std::array<OutgoingWave, 2>& w,
+                  int k) const;
+  bool convertAtFace(MarchState& S, MarchResult& R, const BoundaryCrossing& c) const;
+
   ChoiceScript* script_ = nullptr;
+  std::vector<PathEvent>* events_ = nullptr;
 
   HeroRecord* hero_;
   std::uint32_t seed_;  ///< Transport::Full: transportSeed of the pixel sample and mode
@@ -307,7 +318,10 @@ class RayMarch {
   double lambda_nm_, il2_ = 0.0, il4_ = 0.0;
   bool scalar_;
   const MarchSettings& m_;
-  int mode_;
+  /// The mode the path is in now (0: o or fast, 1: e or slow): the march's mode until a face
+  /// inside a crystal converts it (convertAtFace); mode0_ the march's own.
+  mutable int mode_;
+  int mode0_;
   bool lit_;
   double h_, ds_;
   glm::dvec3 bmin_, bmax_;
@@ -914,6 +928,7 @@ void RayMarch::crossInterface(MarchState& S, MarchResult& R, const BoundaryCross
     S.region = c.to;  // equal media: nothing changes (an opaque one stops the ray next)
     return;
   }
+  if (convertAtFace(S, R, c)) return;
   const Mode mode = mode_ == 1 ? Mode::Extraordinary : Mode::Ordinary;
   const double n1 = glm::length(S.w);
   ModeWave out;
@@ -1067,11 +1082,113 @@ double RayMarch::biaxialSWeight(int from, int to, const glm::dvec3& x, const glm
   return ds * ds;
 }
 
+// The region's dielectric tensor at x and the march's wavelength (solveTensorInterface's medium):
+// a biaxial region's tensorOf, a uniaxial one's (n_o, n_e, axis there), else isotropic n_o.
+TensorMedium RayMarch::tensorAt(int region, const glm::dvec3& x) const {
+  const MediumRecord& m = rec(region);
+  if (m.biaxial) return tensorOf(region);
+  const double no = regionIndex(region, 0, x);
+  if (!m.uniaxial) return TensorMedium::isotropic(no);
+  return TensorMedium::uniaxial(no, regionIndex(region, 1, x), glm::dvec3(mediumAxisField(m, x)));
+}
+
+// Whether a crystal's path mode (0: o or fast, 1: e or slow) and its wave index k (0 fast, 1
+// slow; tensor_medium.h) are swapped: in a uniaxial crystal with n_e < n_o the o-wave is the slow
+// one (TensorMedium::uniaxial: α = n_e along the axis, β = γ = n_o).
+int modeSwap(const MediumRecord& m, const TensorMedium& t) {
+  return m.uniaxial && !m.biaxial && t.n_beta != t.n_alpha ? 1 : 0;
+}
+
+// The path mode of outgoing wave k of a crystal region's pair `w` (solveTensorInterface's order:
+// the propagating waves first, fast then slow): with both propagating, k itself; with one, the
+// mode whose index along its wave normal is the wave's (as outgoingMode decides).
+int RayMarch::marchModeOf(int region, const TensorMedium& t, const std::array<OutgoingWave, 2>& w,
+                          int k) const {
+  int fs = k;
+  if (!(w[0].propagating && w[1].propagating)) {
+    const std::array<double, 2> n = t.indices(w[size_t(k)].s);
+    fs = std::abs(w[size_t(k)].n - n[0]) <= std::abs(w[size_t(k)].n - n[1]) ? 0 : 1;
+  }
+  return fs ^ modeSwap(rec(region), t);
+}
+
+// Mode conversion at a face met inside a crystal (Transport::Full; docs/view-renderer.md "Light
+// transport"): the incident wave of the path's mode meets the face, and Maxwell's boundary
+// conditions (solveTensorInterface, exact for any pair of media) give the power fraction of each
+// outgoing propagating wave: reflected fast and slow (or o and e) in this crystal, transmitted
+// ones beyond (one ray when the far side is isotropic: its s and p waves share the direction).
+// The path chooses one wave with probability equal to its fraction, keeping its weight, in two
+// draws of transportUniform: first reflection (probability R = Σ reflected) or transmission as
+// followReflection (no draw when nothing is transmitted: total reflection), then, where the
+// chosen side has two propagating waves into a crystal, the wave of mode 0 with probability
+// P₀ / (P₀ + P₁) (one more draw, made whenever both propagate). The path continues in the chosen
+// wave's mode, wave vector and ray. false: not a face inside a crystal, or no solution (grazing
+// flow), and crossInterface applies the same-mode laws.
+bool RayMarch::convertAtFace(MarchState& S, MarchResult& R, const BoundaryCrossing& c) const {
+  const MediumRecord &A = rec(S.region), &B = rec(c.to);
+  if (!(A.uniaxial || A.biaxial) || !m_.fresnel || m_.transport != Transport::Full || script_)
+    return false;
+  const glm::dvec3 x = S.x, N = c.normal, s = glm::normalize(S.w);
+  TensorInterfaceSolution sol;
+  TensorMedium near = TensorMedium::isotropic(1.0), far = near;
+  try {
+    near = tensorAt(S.region, x);
+    far = tensorAt(c.to, x);
+    if (near.symmetry() == Symmetry::Isotropic) return false;
+    const WaveMode wm = (mode_ ^ modeSwap(A, near)) == 1 ? WaveMode::Slow : WaveMode::Fast;
+    sol = solveTensorInterface(near, wm, s, N, far);
+  } catch (const std::exception&) {
+    return false;
+  }
+  const bool farCrystal = far.symmetry() != Symmetry::Isotropic;
+  double Rt = 0.0, Tt = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    if (sol.reflected[size_t(k)].propagating) Rt += sol.reflected[size_t(k)].power;
+    if (sol.transmitted[size_t(k)].propagating) Tt += sol.transmitted[size_t(k)].power;
+  }
+  const bool transmits = sol.transmitted[0].propagating;
+  const double Rf = transmits ? std::clamp(Rt / (Rt + Tt), 0.0, 1.0) : 1.0;
+  bool reflects = true;
+  if (!transmits) {
+    R.tir++;
+  } else {
+    R.interfaces++;
+    reflects = followReflection(S, R, Rf);
+    if (!reflects && R.reflections >= m_.max_reflections) {
+      if (sol.transmitted[0].n > glm::length(S.w))
+        S.L += environmentWeighted(S.T * Rf, glm::reflect(s, N));
+      S.T *= 1.0 - Rf;
+    }
+  }
+  const std::array<OutgoingWave, 2>& w = reflects ? sol.reflected : sol.transmitted;
+  const bool crystal = reflects || farCrystal;
+  int k = 0;
+  if (crystal && w[0].propagating && w[1].propagating) {
+    const double p0 = w[0].power / std::max(w[0].power + w[1].power, 1e-300);
+    // The draw picks path mode 0 with its share: wave k = 0 is mode 0 unless swapped.
+    const int swap = modeSwap(reflects ? A : B, reflects ? near : far);
+    const double pMode0 = swap ? 1.0 - p0 : p0;
+    const int mode = transportUniform(seed_, S.draws++) < pMode0 ? 0 : 1;
+    k = mode ^ swap;
+  }
+  const OutgoingWave& out = w[size_t(k)];
+  if (!out.propagating) {  // no reflected wave (rounding at a graze): the mirror, as
+                           // reflectInRegion
+    S.w = glm::reflect(S.w, N);
+    return true;
+  }
+  if (crystal) mode_ = marchModeOf(reflects ? S.region : c.to, reflects ? near : far, w, k);
+  S.w = out.n * out.s;
+  if (!reflects) S.region = c.to;
+  return true;
+}
+
 MarchResult RayMarch::marchSharp(const glm::dvec3& o, const glm::dvec3& d) const {
   MarchResult R;
   double t0;
   if (!enterVolume(o, d, R, t0)) return R;
   MarchState S;
+  mode_ = mode0_;
   sharpEnter(S, o + d * t0, d);
   R.opl = f_.ambientIndex() * t0;
   int steps = 0;
@@ -1088,7 +1205,12 @@ MarchResult RayMarch::marchSharp(const glm::dvec3& o, const glm::dvec3& d) const
       R.first = {true, c.point, glm::dot(c.normal, S.w) > 0.0 ? -c.normal : c.normal,
                  std::max(c.from, c.to) - 1};
     if (ev == SharpEvent::Leave) break;
-    if (ev == SharpEvent::Cross) crossInterface(S, R, c);
+    if (ev == SharpEvent::Cross) {
+      const int from = S.region, tir = R.tir;
+      crossInterface(S, R, c);
+      if (events_ && (rec(from).uniaxial || rec(from).biaxial))
+        events_->push_back({c.point, S.region == from, R.tir > tir, mode_, S.region});
+    }
     noteAfter(S);
   }
   R.steps = steps;
@@ -1143,6 +1265,19 @@ TraceOutcome ReferenceMarcher::trace(const TraceRequest& ray, const MarchSetting
   t.interfaces = r.interfaces;
   t.total_internal_reflections = r.tir;
   return t;
+}
+
+std::vector<PathEvent> ReferenceMarcher::samplePath(const TraceRequest& ray, const MarchSettings& m,
+                                                    int mode, uint32_t seed) const {
+  validate(m);
+  if (mode != 0 && mode != 1) throw std::invalid_argument("mode must be 0 (o) or 1 (e)");
+  MarchSettings full = m;
+  full.transport = Transport::Full;
+  std::vector<PathEvent> events;
+  RayMarch rm(field_, env_, ray.wavelength_nm, true, full, mode, nullptr, seed);
+  rm.setEvents(&events);
+  rm.march(ray.origin, glm::normalize(ray.direction));
+  return events;
 }
 
 namespace {

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "core/contract/light_tree.h"
 #include "core/contract/march_types.h"
@@ -46,6 +47,15 @@ class AnalyticField : public Field {
   double cell_;
 };
 
+/// A face a view sample's path met inside a crystal, where its mode may convert
+/// (ReferenceMarcher::samplePath): where, whether it reflected (total: nothing was transmitted),
+/// and the path's mode (0: o or fast, 1: e or slow) and region after it.
+struct PathEvent {
+  glm::dvec3 point{0.0};
+  bool reflected = false, total = false;
+  int mode = 0, region = 0;
+};
+
 struct HeroRecord;  // hero wavelength sampling's record of one pixel sample (the .cpp)
 class LayerSums;    // core/contract/render_layers.h
 
@@ -60,6 +70,11 @@ class ReferenceMarcher {
   /// ray with the reflect/refract choices of each branch forced (O(depth) marches per leaf).
   LightTree lightTree(const TraceRequest& ray, const MarchSettings& settings, int mode,
                       const LightTreeSettings& tree) const;
+  /// The faces met inside a crystal by the full-transport path of one view sample (the sharp
+  /// march; Transport::Full, every choice drawn from transportUniform(seed, k)), in order: the
+  /// mode conversion's record, for tests. Empty for the smoothed march.
+  std::vector<PathEvent> samplePath(const TraceRequest& ray, const MarchSettings& settings,
+                                    int mode, uint32_t seed) const;
   /// Render the camera view, multi-threaded (threads = 0: hardware concurrency).
   RenderImage render(const Camera& camera, const RenderSettings& settings, int threads = 0) const;
 
