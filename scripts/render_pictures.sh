@@ -63,6 +63,7 @@ pictures=(
   # wavelengths per pixel, at one sample the 32 bins' centres for every pixel (no colour grain;
   # fewer bins miss the third order's period). The CPU twin (--reference) renders them.
   "conoscope_calcite|800x600|"
+  "conoscope_aragonite|800x600|--transport single"
   "polariscope_gems_0|800x600|--reference"
   "polariscope_gems_45|800x600|--reference"
   "polariscope_quartz_wedge|800x600|--reference"
