@@ -559,10 +559,19 @@ PolarisedTrace Session::tracePolarised(const TraceRequest& ray, const Stokes& in
   checkPolarisedTrace(ray, input, settings);
   checkIndicesAt(*scene_, ray.wavelength_nm);
   if (gpu) checkGpuPolariserSheets(*scene_);  // before the volume is made
-  if (gpu)
-    return gpuRenderer().tracePolarised(scene_->polarizers, {ray}, {input}, settings).front();
-  cpuMarcher();  // the volume and its field
-  return eikon::tracePolarised(*field_, scene_->polarizers, ray, input, settings);
+  PolarisedTrace t;
+  if (gpu) {
+    t = gpuRenderer().tracePolarised(scene_->polarizers, {ray}, {input}, settings).front();
+  } else {
+    cpuMarcher();  // the volume and its field
+    t = eikon::tracePolarised(*field_, scene_->polarizers, ray, input, settings);
+  }
+  // Both twins spell a branch's modes o and e (mode 0, mode 1); a scene whose crystals are all
+  // biaxial names them fast and slow: f and s.
+  if (scene_->fastSlowModes())
+    for (PolarisedBeam& b : t.beams)
+      for (char& c : b.modes) c = c == 'o' ? 'f' : c == 'e' ? 's' : c;
+  return t;
 }
 
 }  // namespace eikon

@@ -1,6 +1,7 @@
 // A scene with a biaxial crystal at the door (core/session): its modes are named fast and slow when
-// its crystals are all biaxial (light trees, --modes), o and e beside a uniaxial crystal; the
-// polarised render is accepted and the polarised trace runs on both twins alike.
+// its crystals are all biaxial (light trees, --modes, the polarised beams' f and s), o and e beside
+// a uniaxial crystal; the polarised render is accepted and the polarised trace runs on both twins
+// alike.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -56,6 +57,23 @@ TEST(BiaxialSession, PolarisedRenderAndTraceRunOnBothTwins) {
   EXPECT_GT(cpu.totalPower(), 0.85);
   EXPECT_LT(cpu.totalPower(), 0.93);
   EXPECT_NEAR(gpu.totalPower(), cpu.totalPower(), 3e-2);  // the GPU's D-projection at its faces
+  // The beams' mode letters are fast and slow (f, s), as the scene's modes are named; beside a
+  // uniaxial crystal they stay o and e.
+  for (const PolarisedTrace* t : {&cpu, &gpu}) {
+    std::string letters;
+    for (const PolarisedBeam& b : t->beams) letters += b.modes;
+    EXPECT_NE(letters.find('f'), std::string::npos) << letters;
+    EXPECT_NE(letters.find('s'), std::string::npos) << letters;
+    EXPECT_EQ(letters.find_first_of("oe"), std::string::npos) << letters;
+  }
+  auto mixed = std::make_shared<Scene>(
+      parseScene(sceneWith(std::string(kBiaxial) + ", " + kUniaxial), "b.json"));
+  std::string letters;
+  for (const PolarisedBeam& b :
+       Session(mixed).tracePolarised(ray, Stokes(1, 0, 0, 0), {}, false).beams)
+    letters += b.modes;
+  EXPECT_NE(letters.find_first_of("oe"), std::string::npos) << letters;
+  EXPECT_EQ(letters.find_first_of("fs"), std::string::npos) << letters;
 }
 
 }  // namespace
