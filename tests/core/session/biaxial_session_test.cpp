@@ -1,7 +1,7 @@
 // A scene with a biaxial crystal at the door (core/session): its modes are named fast and slow when
-// its crystals are all biaxial (light trees, --modes, the polarised beams' f and s), o and e beside
-// a uniaxial crystal; the polarised render is accepted and the polarised trace runs on both twins
-// alike.
+// its crystals are all biaxial (light trees, --modes, the polarised beams' f and s), o and e
+// beside a uniaxial crystal; the polarised render is accepted and the polarised trace runs on
+// both twins alike.
 #include <gtest/gtest.h>
 
 #include <memory>
