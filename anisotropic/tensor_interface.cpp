@@ -335,4 +335,24 @@ TensorInterfaceSolution solveTensorInterface(const TensorMedium& near,
   return sol;
 }
 
+ModeWave outgoingModeWave(const TensorMedium& medium, const std::array<OutgoingWave, 2>& waves,
+                          int mode) {
+  const OutgoingWave* pick = nullptr;
+  if (waves[0].propagating && waves[1].propagating) {
+    pick = &waves[size_t(mode)];
+  } else if (waves[0].propagating) {  // one mode propagates: the one whose index it has
+    const std::array<double, 2> n = medium.indices(waves[0].s);
+    if ((std::abs(waves[0].n - n[0]) <= std::abs(waves[0].n - n[1]) ? 0 : 1) == mode)
+      pick = &waves[0];
+  }
+  ModeWave out;
+  if (!pick) return out;
+  out.exists = true;
+  out.s = pick->s;
+  out.n = pick->n;
+  out.t = pick->t;
+  out.q = pick->q.real();
+  return out;
+}
+
 }  // namespace eikon

@@ -74,6 +74,7 @@
 #include <array>
 #include <glm/glm.hpp>
 
+#include "anisotropic/interface.h"
 #include "anisotropic/maxwell_boundary.h"
 #include "anisotropic/tensor_medium.h"
 
@@ -120,6 +121,13 @@ std::array<maxwell::cd, 4> quarticRoots(const std::array<double, 5>& c);
 /// +m̂ (transmitted = true) or −m̂ (false). m̂ unit.
 std::array<OutgoingWave, 2> outgoingWaves(const TensorMedium& medium, glm::dvec3 p_t, glm::dvec3 m,
                                           bool transmitted, Solver solver = Solver::Auto);
+
+/// The wave of mode 0 (fast) or 1 (slow) among `waves` (outgoingWaves' two, for `medium`), as the
+/// marches follow one mode: where both propagate the mode's own; where one propagates, it is the
+/// mode's when its index along its wave normal is the nearer of the two (`medium.indices`);
+/// exists = false where the mode has no propagating wave (its total internal reflection).
+ModeWave outgoingModeWave(const TensorMedium& medium, const std::array<OutgoingWave, 2>& waves,
+                          int mode);
 
 /// The incident plane wave of `mode` with wave normal s_in (p = n ŝ, E ∥ ε⁻¹D, H = p × E).
 maxwell::Wave modeWave(const TensorMedium& medium, WaveMode mode, glm::dvec3 s_in);

@@ -1032,22 +1032,7 @@ ModeWave RayMarch::outgoingMode(int region, const glm::dvec3& x, const glm::dvec
   ModeWave out;
   if (M.biaxial) {
     const TensorMedium t = tensorOf(region);
-    const std::array<OutgoingWave, 2> w = outgoingWaves(t, p_t, m, transmitted);
-    const OutgoingWave* pick = nullptr;
-    if (w[0].propagating && w[1].propagating) {
-      pick = &w[size_t(mode_)];
-    } else if (w[0].propagating) {  // one mode propagates: the one whose index it has
-      const std::array<double, 2> n = t.indices(w[0].s);
-      const int its = std::abs(w[0].n - n[0]) <= std::abs(w[0].n - n[1]) ? 0 : 1;
-      if (its == mode_) pick = &w[0];
-    }
-    if (!pick) return out;
-    out.exists = true;
-    out.s = pick->s;
-    out.n = pick->n;
-    out.t = pick->t;
-    out.q = pick->q.real();
-    return out;
+    return outgoingModeWave(t, outgoingWaves(t, p_t, m, transmitted), mode_);
   }
   if (M.uniaxial) {
     const Uniaxial cr(regionIndex(region, 0, x), regionIndex(region, 1, x),

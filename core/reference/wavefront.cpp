@@ -424,21 +424,7 @@ ModeWave PatchStepper::modeRoot(int region, const glm::dvec3& p_t, const glm::dv
   ModeWave out;
   if (M.biaxial) {
     const TensorMedium& t = tensorOf(region);
-    const std::array<OutgoingWave, 2> w = outgoingWaves(t, p_t, m, transmitted);
-    const OutgoingWave* pick = nullptr;
-    if (w[0].propagating && w[1].propagating) {
-      pick = &w[size_t(mode)];
-    } else if (w[0].propagating) {
-      const std::array<double, 2> n = t.indices(w[0].s);
-      if ((std::abs(w[0].n - n[0]) <= std::abs(w[0].n - n[1]) ? 0 : 1) == mode) pick = &w[0];
-    }
-    if (!pick) return out;
-    out.exists = true;
-    out.s = pick->s;
-    out.n = pick->n;
-    out.t = pick->t;
-    out.q = pick->q.real();
-    return out;
+    return outgoingModeWave(t, outgoingWaves(t, p_t, m, transmitted), mode);
   }
   if (M.n_e > 0.0)
     return solveUniaxialMode(p_t, m, Uniaxial(M.n, M.n_e, M.axis),
