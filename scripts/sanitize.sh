@@ -62,13 +62,17 @@ if selects "$@" -LE '^python$'; then
     | tee "$build/sanitize/ctest.log" || status=1
 fi
 
-# The runtime the build linked: the compiler's libasan.
+# The runtime the build linked: the compiler's libasan, preloaded with the C++ runtime after it:
+# ASan finds the functions it intercepts (__cxa_throw) in the libraries loaded at its start, and
+# the interpreter does not link libstdc++, so without it the module's first C++ throw stops the
+# process ("CHECK failed: ... real___cxa_throw").
 cxx="$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")"
 libasan="$("$cxx" -print-file-name=libasan.so)"
+libstdcxx="$("$cxx" -print-file-name=libstdc++.so)"
 python_ran=0
 if selects "$@" -L '^python$' && [ -f "$libasan" ]; then
   python_ran=1
-  LD_PRELOAD="$libasan" ASAN_OPTIONS="detect_leaks=0:$asan_common" \
+  LD_PRELOAD="$libasan $libstdcxx" ASAN_OPTIONS="detect_leaks=0:$asan_common" \
     ctest --test-dir "$build" -j"$jobs" --output-on-failure "$@" -L '^python$' \
     | tee "$build/sanitize/ctest-python.log" || status=1
 elif selects "$@" -L '^python$'; then
