@@ -77,17 +77,25 @@ RenderSettings oModeSettings() {
   return rs;
 }
 
+/// Both twins' o-mode image means of `t`, and the binomial σ of the mean for a share X of the
+/// entered paths (weight T0 each) over every pixel sample.
+struct TwinMeans {
+  double cpu = 0, gpu = 0, sigma = 0;
+};
+TwinMeans renderBoth(const Twins& t, double T0, double X) {
+  const RenderSettings rs = oModeSettings();
+  const double M = double(rs.spp) * t.scene.camera.width * t.scene.camera.height;
+  return {imageMean(t.cpu->render(t.scene.camera, rs, 2)), imageMean(t.gpu->render(rs)),
+          T0 * std::sqrt(X * (1.0 - X) / M)};
+}
+
 TEST(ModeConversionTwins, TotalReflectionInCalciteKeepsTheOModeFractionOnBothTwins) {
   const double f1 = oToO({0, 0, 1}), f2 = oToO({1, 0, 0});
   const double R0 = std::pow((kNo - 1.0) / (kNo + 1.0), 2.0), T0 = 1.0 - R0;
   const double X = T0 * f1 * (1.0 + R0 * f2) / (1.0 - R0 * R0 * f1 * f2);  // an entered path's
   const double V = R0 + T0 * X;
   const Twins t(prismScene(60.0));
-  const RenderSettings rs = oModeSettings();
-  const double M = double(rs.spp) * t.scene.camera.width * t.scene.camera.height;
-  const double sigma = T0 * std::sqrt(X * (1.0 - X) / M);
-  const double cpu = imageMean(t.cpu->render(t.scene.camera, rs, 2));
-  const double gpu = imageMean(t.gpu->render(rs));
+  const auto [cpu, gpu, sigma] = renderBoth(t, T0, X);
   std::printf(
       "[ measured ] f1 %.5f, f2 %.5f, V %.5f (sigma %.5f); CPU %.5f (%.1f sigma), GPU %.5f "
       "(%+.5f)\n",
@@ -168,11 +176,7 @@ TEST(ModeConversionTwins, CalciteOnQuartzPassesItsQuartzOShareOnBothTwins) {
                                       "attenuation_e_per_mm": 60}},
              "objects": [{"shape": "box", "center": [0, 0, -1], "size": [14, 14, 2], "material": "calcite"},
                          {"shape": "box", "center": [0, 0, 1], "size": [14, 14, 2], "material": "quartz"}]})");
-  const RenderSettings rs = oModeSettings();
-  const double M = double(rs.spp) * t.scene.camera.width * t.scene.camera.height;
-  const double sigma = T0 * std::sqrt(X * (1.0 - X) / M);
-  const double cpu = imageMean(t.cpu->render(t.scene.camera, rs, 2));
-  const double gpu = imageMean(t.gpu->render(rs));
+  const auto [cpu, gpu, sigma] = renderBoth(t, T0, X);
   std::printf(
       "[ measured ] calcite on quartz: V %.5f (sigma %.5f); CPU %.5f (%.1f sigma), GPU %.5f "
       "(%+.5f)\n",
